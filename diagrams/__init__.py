@@ -1,0 +1,1 @@
+"""Diagram builders: open loop, closed loop, Monte-Carlo campaigns."""

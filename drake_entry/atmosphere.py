@@ -1,0 +1,324 @@
+"""Atmosphere models: exponential (paper 000 eq. 29) and U.S. Standard Atmosphere 1976.
+
+Every model gives density, temperature and speed of sound, and the first and second
+altitude derivatives of density and temperature that the drag dynamics need (paper 000
+eqs. 42-46, 59). Inputs are geometric altitude h [m]; outputs SI. Methods accept a
+float, an ndarray (vectorised) or a pydrake AutoDiffXd (derivatives by the chain rule);
+``ExponentialAtmosphere.density`` also takes a symbolic Expression.
+
+US76 below 86 km is evaluated from the standard's own layer formulas (hydrostatic
+equation with piecewise-linear molecular-scale temperature in geopotential altitude), so
+it reproduces the standard's tables to their printed precision. Derivatives are exact
+within a layer and jump at layer boundaries where the standard's temperature has kinks.
+From 86 to 1000 km the standard integrates species diffusion; we ship its tabulation
+(``data/us76_upper.csv``, made with the PyPI package ``ussa1976``; regenerate with
+``python -m drake_entry.atmosphere --write-upper-table``) and interpolate ln(rho) and T
+with C2 cubic splines.
+"""
+from __future__ import annotations
+
+import argparse
+import bisect
+import math
+from dataclasses import dataclass
+from importlib import resources
+from typing import NamedTuple
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from .scalar import is_autodiff, is_symbolic, lift, value_of
+
+# U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
+G0_US76 = 9.80665  # m/s^2
+R_STAR = 8314.32  # J/(kmol K)
+M0_AIR = 28.9644  # kg/kmol
+R_AIR = R_STAR / M0_AIR  # 287.0531 J/(kg K)
+R0_GEOPOTENTIAL = 6356766.0  # m
+GAMMA_AIR = 1.4
+P0_SEA_LEVEL = 101325.0  # Pa
+
+US76_H_MIN = -5000.0  # m, lower end of the standard
+US76_H_MAX = 1000000.0  # m
+US76_LOWER_TOP = 86000.0  # m geometric
+
+
+class AtmosphereProperties(NamedTuple):
+    """Density [kg/m^3], temperature [K] and speed of sound [m/s]."""
+
+    rho: object
+    T: object
+    a: object
+
+
+class Derivatives(NamedTuple):
+    """A quantity and its first and second altitude derivatives (per m, per m^2)."""
+
+    value: object
+    d_h: object
+    d_hh: object
+
+
+def _check_range(name: str, h, lo: float, hi: float):
+    hv = np.asarray(value_of(h), dtype=float)
+    if hv.size and (np.nanmin(hv) < lo or np.nanmax(hv) > hi or np.isnan(hv).any()):
+        bad = hv[(hv < lo) | (hv > hi) | np.isnan(hv)].flat[0]
+        raise ValueError(f"altitude h = {bad:.6g} m is outside the {name} range [{lo:.6g}, {hi:.6g}] m")
+
+
+class Atmosphere:
+    """Common interface. Subclasses implement ``density_derivatives`` and
+    ``temperature_derivatives`` for float / ndarray input."""
+
+    name = "atmosphere"
+    h_min = -np.inf
+    h_max = np.inf
+    gas_constant = R_AIR
+    gamma = GAMMA_AIR
+
+    # -- to implement ----------------------------------------------------------------
+    def density_derivatives(self, h) -> Derivatives:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def temperature_derivatives(self, h) -> Derivatives:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    # -- generic ---------------------------------------------------------------------
+    def check(self, h):
+        _check_range(type(self).__name__, h, self.h_min, self.h_max)
+
+    def density(self, h):
+        """Density rho(h) [kg/m^3]."""
+        if is_autodiff(h):
+            d = self.density_derivatives(h.value())
+            return lift([h], d.value, [d.d_h])
+        return self.density_derivatives(value_of(h)).value
+
+    def temperature(self, h):
+        """Temperature T(h) [K]."""
+        if is_autodiff(h):
+            d = self.temperature_derivatives(h.value())
+            return lift([h], d.value, [d.d_h])
+        return self.temperature_derivatives(value_of(h)).value
+
+    def speed_of_sound(self, h):
+        """Speed of sound a = sqrt(gamma R T) [m/s] (paper 000 eq. 31, corrected)."""
+        return np.sqrt(self.gamma * self.gas_constant * self.temperature(h))
+
+    def properties(self, h) -> AtmosphereProperties:
+        """(rho, T, a) at altitude h [m]."""
+        T = self.temperature(h)
+        return AtmosphereProperties(self.density(h), T, np.sqrt(self.gamma * self.gas_constant * T))
+
+
+# ---------------------------------------------------------------------------------------
+# U.S. Standard Atmosphere 1976
+# ---------------------------------------------------------------------------------------
+# Base geopotential altitudes [m'] and lapse rates [K/m'] of the seven layers below 86 km.
+_H_BASE = np.array([0.0, 11000.0, 20000.0, 32000.0, 47000.0, 51000.0, 71000.0])
+_LAPSE = np.array([-6.5, 0.0, 1.0, 2.8, 0.0, -2.8, -2.0]) * 1e-3
+_GMR = G0_US76 * M0_AIR / R_STAR  # K/m'
+
+
+def _layer_bases():
+    """Base temperature and pressure of each layer, propagated from sea level."""
+    T = [288.15]
+    P = [P0_SEA_LEVEL]
+    for i in range(len(_H_BASE) - 1):
+        dH = _H_BASE[i + 1] - _H_BASE[i]
+        L = _LAPSE[i]
+        Tn = T[i] + L * dH
+        if L == 0.0:
+            Pn = P[i] * np.exp(-_GMR * dH / T[i])
+        else:
+            Pn = P[i] * (T[i] / Tn) ** (_GMR / L)
+        T.append(Tn)
+        P.append(Pn)
+    return np.array(T), np.array(P)
+
+
+_T_BASE, _P_BASE = _layer_bases()
+
+
+def _lower_layers(z: float):
+    """ln rho, d/dz, d2/dz2, T, dT/dz, d2T/dz2 at geometric altitude z <= 86 km [m]."""
+    r0 = R0_GEOPOTENTIAL
+    H = r0 * z / (r0 + z)
+    Hz = (r0 / (r0 + z)) ** 2
+    Hzz = -2.0 * r0 * r0 / (r0 + z) ** 3
+    i = max(bisect.bisect_right(_H_BASE_LIST, H) - 1, 0)
+    L = _LAPSE_LIST[i]
+    Tb = _T_BASE_LIST[i]
+    dH = H - _H_BASE_LIST[i]
+    T = Tb + L * dH
+    if L == 0.0:
+        lnP = _LN_P_BASE_LIST[i] - _GMR * dH / Tb
+    else:
+        lnP = _LN_P_BASE_LIST[i] + (_GMR / L) * math.log(Tb / T)
+    ln_rho = lnP - math.log(R_AIR * T)
+    # hydrostatic equilibrium + ideal gas with T linear in H:
+    f_H = -(_GMR + L) / T  # d ln rho / dH
+    f_HH = (_GMR + L) * L / (T * T)
+    return ln_rho, f_H * Hz, f_HH * Hz * Hz + f_H * Hzz, T, L * Hz, L * Hzz
+
+
+_H_BASE_LIST = _H_BASE.tolist()
+_LAPSE_LIST = _LAPSE.tolist()
+_T_BASE_LIST = _T_BASE.tolist()
+_LN_P_BASE_LIST = np.log(_P_BASE).tolist()
+
+
+class _ScalarCubic:
+    """Fast scalar evaluation of a scipy CubicSpline with its first two derivatives."""
+
+    def __init__(self, spline: CubicSpline):
+        self.x = spline.x.tolist()
+        self.c = spline.c.T.tolist()  # per interval: [c3, c2, c1, c0]
+
+    def __call__(self, x: float):
+        i = min(max(bisect.bisect_right(self.x, x) - 1, 0), len(self.c) - 1)
+        c3, c2, c1, c0 = self.c[i]
+        t = x - self.x[i]
+        return ((c3 * t + c2) * t + c1) * t + c0, (3.0 * c3 * t + 2.0 * c2) * t + c1, 6.0 * c3 * t + 2.0 * c2
+
+
+class _UpperTable:
+    """Splines of ln rho(z) and T(z) from 86 to 1000 km (shipped US76 tabulation)."""
+
+    def __init__(self):
+        with resources.files("drake_entry").joinpath("data/us76_upper.csv").open() as f:
+            data = np.loadtxt(f, delimiter=",", comments="#")
+        z, rho, T = data[:, 0], data[:, 1], data[:, 2]
+        self.ln_rho = _ScalarCubic(CubicSpline(z, np.log(rho)))
+        self.T = _ScalarCubic(CubicSpline(z, T))
+
+    def __call__(self, z: float):
+        return self.ln_rho(z) + self.T(z)
+
+
+_UPPER = None
+
+
+def _upper_table() -> _UpperTable:
+    global _UPPER
+    if _UPPER is None:
+        _UPPER = _UpperTable()
+    return _UPPER
+
+
+def _us76_scalar(z: float):
+    return _lower_layers(z) if z <= US76_LOWER_TOP else _upper_table()(z)
+
+
+class US76Atmosphere(Atmosphere):
+    """U.S. Standard Atmosphere 1976, -5 to 1000 km geometric altitude.
+
+    Example:
+      >>> rho, T, a = US76Atmosphere().properties(11019.0)
+    """
+
+    name = "us76"
+    h_min = US76_H_MIN
+    h_max = US76_H_MAX
+
+    def _evaluate(self, h):
+        """The six US76 quantities for a float or an ndarray of altitudes."""
+        if isinstance(h, (float, int)) or np.ndim(h) == 0:
+            z = float(h)
+            if not US76_H_MIN <= z <= US76_H_MAX:
+                self.check(z)
+            return _us76_scalar(z)
+        self.check(h)
+        z = np.asarray(h, dtype=float)
+        vals = np.array([_us76_scalar(v) for v in z.ravel().tolist()]).reshape(z.shape + (6,))
+        return [vals[..., k] for k in range(6)]
+
+    def density_derivatives(self, h) -> Derivatives:
+        ln_rho, l1, l2, *_ = self._evaluate(h)
+        rho = np.exp(ln_rho) if isinstance(ln_rho, np.ndarray) else math.exp(ln_rho)
+        return Derivatives(rho, rho * l1, rho * (l2 + l1 * l1))
+
+    def temperature_derivatives(self, h) -> Derivatives:
+        *_, T, T1, T2 = self._evaluate(h)
+        return Derivatives(T, T1, T2)
+
+    def pressure(self, h):
+        """Pressure p = rho R T [Pa] (float / ndarray; M0 air above 86 km as an approximation)."""
+        rho = self.density(h)
+        return rho * R_AIR * self.temperature(h)
+
+
+@dataclass(frozen=True)
+class ExponentialAtmosphere(Atmosphere):
+    """rho = rho0 exp(-h / h_s) (paper 000 eq. 29).
+
+    Temperature (for the Mach number, paper 000 eqs. 30-31) comes from US76's
+    piecewise-linear profile unless a constant ``temperature_K`` is given.
+
+    Attributes:
+      rho0: sea-level density [kg/m^3] (paper 000: 1.2256).
+      scale_height: h_s [m] (paper 000: 7200).
+      temperature_K: constant temperature [K], or None for the US76 profile.
+    """
+
+    rho0: float = 1.2256
+    scale_height: float = 7200.0
+    temperature_K: float | None = None
+    name = "exponential"
+
+    def __post_init__(self):
+        if not self.rho0 > 0:
+            raise ValueError(f"ExponentialAtmosphere.rho0 must be > 0 kg/m^3, got {self.rho0}")
+        if not self.scale_height > 0:
+            raise ValueError(f"ExponentialAtmosphere.scale_height must be > 0 m, got {self.scale_height}")
+        if self.temperature_K is not None and not self.temperature_K > 0:
+            raise ValueError(f"ExponentialAtmosphere.temperature_K must be > 0 K, got {self.temperature_K}")
+
+    def density(self, h):
+        return self.rho0 * np.exp(-h / self.scale_height)
+
+    def density_derivatives(self, h) -> Derivatives:
+        rho = self.rho0 * np.exp(-np.asarray(h, dtype=float) / self.scale_height)
+        return Derivatives(rho, -rho / self.scale_height, rho / self.scale_height**2)
+
+    def temperature(self, h):
+        if self.temperature_K is None:
+            return US76Atmosphere().temperature(h)
+        return self.temperature_K + 0.0 * h  # keeps the scalar type of h
+
+    def temperature_derivatives(self, h) -> Derivatives:
+        if self.temperature_K is not None:
+            z = np.zeros(np.shape(h))
+            return Derivatives(z + self.temperature_K, z, z)
+        return US76Atmosphere().temperature_derivatives(h)
+
+
+def make_atmosphere(name: str, **kwargs) -> Atmosphere:
+    """Atmosphere by name: 'us76' or 'exponential' (keyword arguments go to the model)."""
+    if name == "us76":
+        return US76Atmosphere()
+    if name == "exponential":
+        return ExponentialAtmosphere(**kwargs)
+    raise ValueError(f"atmosphere model '{name}' is unknown; allowed: 'us76', 'exponential'")
+
+
+def write_upper_table(path: str) -> None:
+    """Tabulate US76 from 86 to 1000 km with the ``ussa1976`` package."""
+    import ussa1976  # optional, test/dev extra
+
+    z = np.unique(np.concatenate([np.arange(86e3, 200e3, 1e3), np.arange(200e3, 1000e3 + 1, 5e3)]))
+    ds = ussa1976.compute(z=z, variables=["rho", "t"])
+    header = (
+        "U.S. Standard Atmosphere 1976 above 86 km, tabulated with ussa1976 "
+        f"{getattr(ussa1976, '__version__', '')} (NASA-TM-X-74335).\n"
+        "Regenerate: python -m drake_entry.atmosphere --write-upper-table PATH\n"
+        "z_m, rho_kg_m3, T_K"
+    )
+    np.savetxt(path, np.column_stack([z, ds["rho"].values, ds["t"].values]), delimiter=",",
+               header=header, fmt=["%.1f", "%.10e", "%.6f"])
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--write-upper-table", metavar="PATH", required=True)
+    write_upper_table(parser.parse_args().write_upper_table)

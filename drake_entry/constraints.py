@@ -1,0 +1,129 @@
+"""Path constraints: heat flux (every form the papers use), dynamic pressure, load factors,
+and the equilibrium-glide condition. Functions are generic over the scalar type.
+
+All heat-flux forms reduce to q_dot = K rho^n V^m [W/m^2]; the named constructors keep
+each paper's constants and never mix the V^3 and V^3.15 families (data/README.md).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class HeatFlux:
+    """Stagnation-point heat flux q_dot = coefficient * rho^density_exponent * V^velocity_exponent.
+
+    Attributes:
+      coefficient: K in SI units such that q_dot is in W/m^2.
+      density_exponent: n (0.5 for every form in the papers).
+      velocity_exponent: m (3 or 3.15).
+      form: a label saying which published form produced the constants.
+    """
+
+    coefficient: float
+    density_exponent: float = 0.5
+    velocity_exponent: float = 3.15
+    form: str = "custom"
+
+    def __post_init__(self):
+        if not self.coefficient > 0:
+            raise ValueError(f"HeatFlux.coefficient must be > 0, got {self.coefficient}")
+
+    def __call__(self, rho, V):
+        return self.coefficient * rho**self.density_exponent * V**self.velocity_exponent
+
+    @staticmethod
+    def chapman(nose_radius: float, C1: float = 5.28137e-5, m: float = 3.15) -> "HeatFlux":
+        """q = C1/sqrt(R_N) sqrt(rho) V^m (paper 000 eq. 34)."""
+        _check_nose(nose_radius)
+        return HeatFlux(C1 / np.sqrt(nose_radius), 0.5, m, "chapman")
+
+    @staticmethod
+    def sutton_graves(nose_radius: float, k: float = 1.7415e-4) -> "HeatFlux":
+        """q = k sqrt(rho / R_N) V^3 (Sutton & Graves 1971, Earth)."""
+        _check_nose(nose_radius)
+        return HeatFlux(k / np.sqrt(nose_radius), 0.5, 3.0, "sutton_graves")
+
+    @staticmethod
+    def normalised(nose_radius: float, c_star: float = 1.1097e8, n: float = 0.5, m: float = 3.15,
+                   rho0: float = 1.225, v_circular: float = 7905.0) -> "HeatFlux":
+        """q = c*/R_N^n (rho/rho0)^(1-n) (V/V_c)^m (paper 001 eq. 9)."""
+        _check_nose(nose_radius)
+        return HeatFlux(c_star / nose_radius**n / rho0 ** (1 - n) / v_circular**m, 1 - n, m, "normalised")
+
+    @staticmethod
+    def lumped(k: float, m: float) -> "HeatFlux":
+        """q = k sqrt(rho) V^m with the nose radius folded into k
+        (paper 003 eq. 3: k = 1.2444e-3, m = 3; paper 004 eq. 13: k = 9.4369e-5, m = 3.15)."""
+        return HeatFlux(k, 0.5, m, "lumped")
+
+
+def _check_nose(r):
+    if not r > 0:
+        raise ValueError(f"nose_radius must be > 0 m, got {r}")
+
+
+def make_heat_flux(form: str, *, nose_radius: float, coefficient: float | None = None,
+                   velocity_exponent: float | None = None) -> HeatFlux:
+    """Heat-flux model by form name: 'chapman', 'sutton_graves', 'normalised' or 'lumped'."""
+    if form == "chapman":
+        kw = {} if coefficient is None else {"C1": coefficient}
+        if velocity_exponent is not None:
+            kw["m"] = velocity_exponent
+        return HeatFlux.chapman(nose_radius, **kw)
+    if form == "sutton_graves":
+        return HeatFlux.sutton_graves(nose_radius, **({} if coefficient is None else {"k": coefficient}))
+    if form == "normalised":
+        return HeatFlux.normalised(nose_radius, **({} if coefficient is None else {"c_star": coefficient}))
+    if form == "lumped":
+        if coefficient is None or velocity_exponent is None:
+            raise ValueError("heat_flux form 'lumped' needs coefficient and velocity_exponent")
+        return HeatFlux.lumped(coefficient, velocity_exponent)
+    raise ValueError(f"heat_flux.form '{form}' is unknown; allowed: chapman, sutton_graves, normalised, lumped")
+
+
+def dynamic_pressure(rho, V):
+    """q = rho V^2 / 2 [Pa] (paper 000 eq. 36)."""
+    return 0.5 * rho * V * V
+
+
+def normal_load_factor(lift_acc, drag_acc, alpha, g0: float):
+    """n_z = |L cos(alpha) + D sin(alpha)| / g0 (paper 000 eq. 35), L, D in m/s^2."""
+    return abs(lift_acc * np.cos(alpha) + drag_acc * np.sin(alpha)) / g0
+
+
+def total_load_factor(lift_acc, drag_acc, g0: float):
+    """n = sqrt(L^2 + D^2) / g0 (paper 001 eq. 10, paper 002 eq. 7 in g)."""
+    return np.sqrt(lift_acc * lift_acc + drag_acc * drag_acc) / g0
+
+
+def equilibrium_glide_lift(V, r, g):
+    """Vertical lift acceleration L cos(sigma) [m/s^2] that holds gamma' = 0 on a
+    non-rotating planet: g - V^2 / r (paper 004 eq. 16, dimensional)."""
+    return g - V * V / r
+
+
+@dataclass(frozen=True)
+class PathLimits:
+    """Upper limits on heat flux [W/m^2], dynamic pressure [Pa], normal and total load factor [g]."""
+
+    heat_flux_max: float = np.inf
+    dynamic_pressure_max: float = np.inf
+    normal_load_max: float = np.inf
+    total_load_max: float = np.inf
+
+    def __post_init__(self):
+        for name in ("heat_flux_max", "dynamic_pressure_max", "normal_load_max", "total_load_max"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"PathLimits.{name} must be > 0, got {getattr(self, name)}")
+
+    def margins(self, *, heat_flux, dynamic_pressure, normal_load, total_load) -> dict:
+        """Relative margins 1 - value/limit (negative means violated)."""
+        return {
+            "heat_flux": 1.0 - heat_flux / self.heat_flux_max,
+            "dynamic_pressure": 1.0 - dynamic_pressure / self.dynamic_pressure_max,
+            "normal_load": 1.0 - normal_load / self.normal_load_max,
+            "total_load": 1.0 - total_load / self.total_load_max,
+        }

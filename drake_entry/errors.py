@@ -1,0 +1,30 @@
+"""User-facing errors and the typed YAML loader that turns schema errors into one line."""
+from __future__ import annotations
+
+import os
+
+from pydrake.common.yaml import yaml_load_typed
+
+
+class ScenarioError(ValueError):
+    """Bad user input (scenario, vehicle or problem file): one line naming the field and
+    the allowed range."""
+
+
+def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None, where: str | None = None):
+    """``yaml_load_typed`` with errors reported as a ScenarioError naming the file."""
+    where = where or path or "YAML"
+    if path is not None:
+        if not os.path.exists(path):
+            raise ScenarioError(f"file not found: {path}")
+        with open(path) as f:
+            text = f.read()
+    try:
+        return yaml_load_typed(schema=schema, data=text)
+    except RuntimeError as e:  # unknown fields, wrong structure
+        msg = str(e).replace("were unknown to the schema", f"are not fields of {schema.__name__}")
+        raise ScenarioError(f"{where}: {msg}") from None
+    except (ValueError, TypeError) as e:  # wrong scalar types
+        raise ScenarioError(f"{where}: {e}") from None
+    except Exception as e:  # the YAML parser itself
+        raise ScenarioError(f"{where}: not valid YAML: {str(e).splitlines()[0]}") from None

@@ -1,0 +1,1 @@
+"""Reference-trajectory planners, one module per method."""

@@ -1,0 +1,1 @@
+"""Drake LeafSystems of the entry plant, sensors, actuators and monitors."""

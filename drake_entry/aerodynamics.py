@@ -17,6 +17,7 @@ Models:
 from __future__ import annotations
 
 import bisect
+import math
 import csv
 from dataclasses import dataclass, field
 from importlib import resources
@@ -175,7 +176,7 @@ class TableAero(AeroModel):
         m_in = self._m_range[0] <= mach <= self._m_range[1]
         a = min(max(alpha, self._a_range[0]), self._a_range[1])
         m = min(max(mach, self._m_range[0]), self._m_range[1])
-        f, fa, fl, faa, fal, fll = self._splines[k](a, np.log(m))
+        f, fa, fl, faa, fal, fll = self._splines[k](a, math.log(m))
         # chain rule from ln M to M
         fm = fl / m
         fam = fal / m

@@ -105,10 +105,19 @@ class Atmosphere:
         """Speed of sound a = sqrt(gamma R T) [m/s] (paper 000 eq. 31, corrected)."""
         return np.sqrt(self.gamma * self.gas_constant * self.temperature(h))
 
+    def derivatives(self, h) -> tuple[Derivatives, Derivatives]:
+        """Density and temperature with their altitude derivatives (float / ndarray)."""
+        return self.density_derivatives(h), self.temperature_derivatives(h)
+
     def properties(self, h) -> AtmosphereProperties:
-        """(rho, T, a) at altitude h [m]."""
-        T = self.temperature(h)
-        return AtmosphereProperties(self.density(h), T, np.sqrt(self.gamma * self.gas_constant * T))
+        """(rho, T, a) at altitude h [m]; one model evaluation for float / AutoDiff input."""
+        if is_symbolic(h):
+            T = self.temperature(h)
+            return AtmosphereProperties(self.density(h), T, np.sqrt(self.gamma * self.gas_constant * T))
+        d, t = self.derivatives(value_of(h))
+        rho = lift([h], d.value, [d.d_h]) if is_autodiff(h) else d.value
+        T = lift([h], t.value, [t.d_h]) if is_autodiff(h) else t.value
+        return AtmosphereProperties(rho, T, np.sqrt(self.gamma * self.gas_constant * T))
 
 
 # ---------------------------------------------------------------------------------------
@@ -234,13 +243,16 @@ class US76Atmosphere(Atmosphere):
         return [vals[..., k] for k in range(6)]
 
     def density_derivatives(self, h) -> Derivatives:
-        ln_rho, l1, l2, *_ = self._evaluate(h)
-        rho = np.exp(ln_rho) if isinstance(ln_rho, np.ndarray) else math.exp(ln_rho)
-        return Derivatives(rho, rho * l1, rho * (l2 + l1 * l1))
+        return self.derivatives(h)[0]
 
     def temperature_derivatives(self, h) -> Derivatives:
         *_, T, T1, T2 = self._evaluate(h)
         return Derivatives(T, T1, T2)
+
+    def derivatives(self, h):
+        ln_rho, l1, l2, T, T1, T2 = self._evaluate(h)
+        rho = np.exp(ln_rho) if isinstance(ln_rho, np.ndarray) else math.exp(ln_rho)
+        return Derivatives(rho, rho * l1, rho * (l2 + l1 * l1)), Derivatives(T, T1, T2)
 
     def pressure(self, h):
         """Pressure p = rho R T [Pa] (float / ndarray; M0 air above 86 km as an approximation)."""

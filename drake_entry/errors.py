@@ -22,7 +22,10 @@ def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None,
     try:
         return yaml_load_typed(schema=schema, data=text)
     except RuntimeError as e:  # unknown fields, wrong structure
-        msg = str(e).replace("were unknown to the schema", f"are not fields of {schema.__name__}")
+        msg = str(e)
+        if "were unknown to the schema" in msg:
+            names = msg[msg.index("["):msg.index("]") + 1]
+            msg = f"unknown field(s) {names}; check the spelling against the {schema.__name__} schema"
         raise ScenarioError(f"{where}: {msg}") from None
     except (ValueError, TypeError) as e:  # wrong scalar types
         raise ScenarioError(f"{where}: {e}") from None

@@ -1,0 +1,63 @@
+"""Piecewise-linear command schedules (angle of attack, bank) over time, energy or Mach.
+
+The HORUS-2B angle-of-attack law (paper 000 Sec. IV.A: 40 deg, then linear down to 15 deg
+between about 960 s and 1250 s, then held) is ``Schedule.ramp``; ``smooth=True`` replaces
+the corners by a quintic blend, which keeps gamma smooth under a smooth drag profile
+(shared/notes/paper000-horus.md).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+VARIABLES = ("time", "energy", "mach", "velocity")
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """value(s) by linear interpolation in ``breakpoints`` (held constant outside).
+
+    Attributes:
+      breakpoints: increasing values of the scheduling variable (s, J/kg, -, or m/s).
+      values: command values at the breakpoints, SI (rad for angles).
+      variable: 'time', 'energy', 'mach' or 'velocity'.
+      smooth: quintic smoothstep between breakpoints instead of straight lines (C2).
+    """
+
+    breakpoints: tuple
+    values: tuple
+    variable: str = "time"
+    smooth: bool = False
+
+    def __post_init__(self):
+        bp = np.asarray(self.breakpoints, float)
+        if self.variable not in VARIABLES:
+            raise ValueError(f"Schedule.variable must be one of {VARIABLES}, got '{self.variable}'")
+        if bp.size == 0 or bp.size != len(self.values):
+            raise ValueError(f"Schedule needs as many values as breakpoints (got {bp.size} and {len(self.values)})")
+        if np.any(np.diff(bp) <= 0):
+            raise ValueError("Schedule.breakpoints must be strictly increasing")
+
+    @staticmethod
+    def constant(value: float) -> "Schedule":
+        return Schedule((0.0,), (float(value),))
+
+    @staticmethod
+    def ramp(start: float, end: float, value_start: float, value_end: float, *, variable: str = "time",
+             smooth: bool = False) -> "Schedule":
+        """value_start until ``start``, linear to value_end at ``end``, then held."""
+        return Schedule((float(start), float(end)), (float(value_start), float(value_end)), variable, smooth)
+
+    def __call__(self, s):
+        """Value at s (float or ndarray)."""
+        bp = np.asarray(self.breakpoints, float)
+        v = np.asarray(self.values, float)
+        if not self.smooth or bp.size == 1:
+            return np.interp(s, bp, v) if np.ndim(s) else float(np.interp(s, bp, v))
+        s_arr = np.asarray(s, float)
+        i = np.clip(np.searchsorted(bp, s_arr, side="right") - 1, 0, bp.size - 2)
+        t = np.clip((s_arr - bp[i]) / (bp[i + 1] - bp[i]), 0.0, 1.0)
+        blend = t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
+        out = v[i] + (v[i + 1] - v[i]) * blend
+        return out if np.ndim(s) else float(out)

@@ -1,0 +1,57 @@
+"""ScheduleSource: an open-loop command (bank or angle of attack) from a ``Schedule``.
+
+Ports:
+  input  "state"              [6]  (energy-, Mach- or velocity-scheduled only) vehicle state
+  input  "flight_conditions"  [9]  (Mach-scheduled only) EntryVehicle flight conditions
+  output "command"            [1]  the scheduled value (rad for angles)
+"""
+from __future__ import annotations
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+from pydrake.systems.primitives import TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
+
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, specific_energy
+from drake_entry.planet import Earth
+from drake_entry.schedules import Schedule
+
+
+def make_schedule_source(schedule: Schedule, planet: Earth | None = None):
+    """The cheapest source for a schedule: a native TrajectorySource (first-order hold,
+    held constant outside the breakpoints) for piecewise-linear time schedules, else a
+    ScheduleSource. Both have the output port "command" at index 0."""
+    if schedule.variable == "time" and not schedule.smooth:
+        bp = np.asarray(schedule.breakpoints, float)
+        v = np.asarray(schedule.values, float)
+        far = 1e9
+        times = np.concatenate([[min(bp[0], 0.0) - far], bp, [bp[-1] + far]])
+        values = np.concatenate([[v[0]], v, [v[-1]]])
+        return TrajectorySource(PiecewisePolynomial.FirstOrderHold(times, values.reshape(1, -1)))
+    return ScheduleSource(schedule, planet)
+
+
+class ScheduleSource(LeafSystem):
+    def __init__(self, schedule: Schedule, planet: Earth | None = None):
+        super().__init__()
+        self.schedule = schedule
+        self.planet = planet or Earth()
+        var = schedule.variable
+        self.state_port = self.DeclareVectorInputPort("state", 6) if var in ("energy", "velocity") else None
+        self.conditions_port = (
+            self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES)) if var == "mach" else None
+        )
+        prereq = {self.time_ticket()} if var == "time" else {self.all_input_ports_ticket()}
+        self.DeclareVectorOutputPort("command", 1, self._calc, prerequisites_of_calc=prereq)
+
+    def _calc(self, context, output):
+        var = self.schedule.variable
+        if var == "time":
+            s = context.get_time()
+        elif var == "energy":
+            s = specific_energy(self.state_port.Eval(context), self.planet)
+        elif var == "velocity":
+            s = self.state_port.Eval(context)[3]
+        else:
+            s = self.conditions_port.Eval(context)[FLIGHT_CONDITION_NAMES.index("mach")]
+        output.SetAtIndex(0, self.schedule(s))

@@ -1,0 +1,78 @@
+import numpy as np
+import pytest
+
+from drake_entry.aerodynamics import (CallableAero, CavHAero, DragPolarAero, fit_horus_forms, horus2b_table,
+                                      horus_cd_form, horus_cl_form, packaged_data, _read_csv)
+from drake_entry.vehicles import load_vehicle
+
+
+@pytest.fixture(scope="module")
+def table():
+    return horus2b_table()
+
+
+def test_table_reproduces_every_cell_of_m692_and_the_2024_fill(table):
+    for i, a in enumerate(table.alpha_deg):
+        for j, m in enumerate(table.mach):
+            cl, cd = table.coefficients(np.radians(a), m)
+            assert cl == pytest.approx(table.CL[i, j], abs=1e-12)
+            assert cd == pytest.approx(table.CD[i, j], abs=1e-12)
+
+
+@pytest.mark.parametrize("alpha_deg, mach", [(17.0, 2.6), (33.0, 7.5), (41.0, 14.0)])
+def test_table_partials_equal_finite_differences(table, alpha_deg, mach):
+    a = np.radians(alpha_deg)
+    d = table.derivatives(a, mach)
+    e = 1e-6
+    for k, c in enumerate((d.CL, d.CD)):
+        fa = (table.coefficients(a + e, mach)[k] - table.coefficients(a - e, mach)[k]) / (2 * e)
+        fm = (table.coefficients(a, mach + e)[k] - table.coefficients(a, mach - e)[k]) / (2 * e)
+        assert c.d_alpha == pytest.approx(fa, rel=1e-6, abs=1e-9)
+        assert c.d_mach == pytest.approx(fm, rel=1e-5, abs=1e-9)
+
+
+def test_table_is_held_constant_above_mach_20(table):
+    assert table.coefficients(0.7, 25.0) == pytest.approx(table.coefficients(0.7, 20.0))
+    assert table.derivatives(0.7, 25.0).CD.d_mach == 0.0
+
+
+def test_packaged_horus_fit_residuals_as_documented():
+    """horus2b.yaml states C_D RMS 0.0145 and C_L RMS 0.0087 over the published M-692 cells."""
+    fit = load_vehicle("horus2b").aero
+    with packaged_data("horus2b_clean_aero_m692.csv") as f:
+        rows = _read_csv(f)
+    mach = [float(h[1:]) for h in rows[0][2:]]
+    cells = {"CD": [], "CL": []}
+    for r in rows[1:]:
+        cells[r[0]] += [(float(r[1]), m, float(v)) for m, v in zip(mach, r[2:]) if v.strip()]
+    for name, form, coefs, rms_doc in (("CD", horus_cd_form, fit.aD, 0.0145), ("CL", horus_cl_form, fit.aL, 0.0087)):
+        a, m, data = np.array(cells[name]).T
+        res = form(coefs, a, m) - data
+        assert np.sqrt(np.mean(res**2)) == pytest.approx(rms_doc, abs=1e-4)
+
+
+def test_fit_of_paper000_forms_from_a_generic_start():
+    rep = fit_horus_forms()
+    assert rep.cells_CD == 66 and rep.cells_CL == 63
+    assert rep.rms_CD == pytest.approx(0.014509, abs=1e-5)  # linear least squares: unique
+    assert rep.rms_CL < 0.010
+
+
+def test_drag_polar_alpha_bar_is_paper002_eq19():
+    assert DragPolarAero().alpha_max_lift_to_drag == pytest.approx(0.207, abs=5e-4)
+
+
+def test_cav_h_max_lift_to_drag_is_about_3p4_at_mach_10_to_15():
+    m = CavHAero()
+    a = np.radians(np.linspace(5, 20, 301))
+    ld = m.lift_to_drag(a, 12.0)
+    assert ld.max() == pytest.approx(3.4, abs=0.15)
+    assert 9.0 <= np.degrees(a[ld.argmax()]) <= 14.0
+
+
+def test_user_callables_give_exact_autodiff_derivatives():
+    m = CallableAero(cl=lambda a, M: 1.5 * np.sin(a) ** 2 / M, cd=lambda a, M: 0.1 + a * a)
+    d = m.derivatives(0.3, 5.0)
+    assert d.CD.d_alpha == pytest.approx(0.6)
+    assert d.CD.d_alpha_alpha == pytest.approx(2.0, rel=1e-6)
+    assert d.CL.d_mach == pytest.approx(-1.5 * np.sin(0.3) ** 2 / 25.0)

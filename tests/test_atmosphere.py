@@ -1,0 +1,72 @@
+import numpy as np
+import pytest
+from pydrake.autodiffutils import AutoDiffXd
+
+from drake_entry.atmosphere import ExponentialAtmosphere, US76Atmosphere
+
+# U.S. Standard Atmosphere 1976 reference densities (shared/data/README.md)
+US76_TABLE = [(0.0, 1.2250), (11019.0, 0.36392), (20063.0, 0.088035), (32162.0, 0.013225),
+              (47350.0, 1.4275e-3), (51413.0, 8.6161e-4), (71802.0, 6.4211e-5), (86000.0, 6.958e-6)]
+
+
+@pytest.mark.parametrize("h, rho", US76_TABLE)
+def test_us76_density_within_0p1_percent_of_the_standard_below_86km(us76, h, rho):
+    assert us76.density(h) == pytest.approx(rho, rel=1e-3)
+
+
+@pytest.mark.parametrize("h, rho", [(100e3, 5.604e-7), (120e3, 2.222e-8)])
+def test_us76_density_within_1_percent_of_the_standard_86_to_150km(us76, h, rho):
+    assert us76.density(h) == pytest.approx(rho, rel=1e-2)
+
+
+def test_us76_sea_level_temperature_and_speed_of_sound(us76):
+    rho, T, a = us76.properties(0.0)
+    assert T == pytest.approx(288.15, abs=1e-9)
+    assert a == pytest.approx(340.294, abs=1e-3)
+
+
+def test_us76_matches_ussa1976_everywhere_to_1000km(us76):
+    ussa1976 = pytest.importorskip("ussa1976")
+    z = np.linspace(0.0, 1e6, 997)
+    ds = ussa1976.compute(z=z, variables=["rho", "t"])
+    err = us76.density(z) / ds["rho"].values - 1.0
+    assert np.abs(err[z <= 86e3]).max() < 1e-3
+    assert np.abs(err[(z > 86e3) & (z <= 150e3)]).max() < 1e-2
+    assert np.abs(err).max() < 1e-2
+
+
+@pytest.mark.parametrize("h", [5e3, 15e3, 40e3, 60e3, 80e3, 95e3, 130e3, 400e3])
+def test_us76_density_derivatives_equal_finite_differences(us76, h):
+    d = us76.density_derivatives(h)
+    e = 0.5
+    fd1 = (us76.density(h + e) - us76.density(h - e)) / (2 * e)
+    fd2 = (us76.density(h + e) - 2 * us76.density(h) + us76.density(h - e)) / e**2
+    assert d.d_h == pytest.approx(fd1, rel=1e-6)
+    assert d.d_hh == pytest.approx(fd2, rel=1e-4)
+
+
+def test_autodiff_density_gradient_is_the_analytic_derivative(us76):
+    h = AutoDiffXd(42e3, np.array([1.0]))
+    assert us76.density(h).derivatives()[0] == pytest.approx(us76.density_derivatives(42e3).d_h, rel=1e-12)
+
+
+def test_vectorised_equals_scalar(us76):
+    h = np.array([1e3, 50e3, 90e3])
+    assert np.allclose(us76.density(h), [us76.density(float(v)) for v in h], rtol=1e-14)
+
+
+def test_exponential_is_paper000_eq29():
+    atm = ExponentialAtmosphere()
+    assert atm.density(7200.0) == pytest.approx(1.2256 / np.e)
+    d = atm.density_derivatives(10e3)
+    assert d.d_h == pytest.approx(-d.value / 7200.0)
+
+
+def test_altitude_outside_the_model_names_the_range(us76):
+    with pytest.raises(ValueError, match=r"outside the US76Atmosphere range \[-5000, 1e\+06\] m"):
+        us76.density(1.2e6)
+
+
+def test_bad_exponential_parameters_are_rejected():
+    with pytest.raises(ValueError, match="scale_height must be > 0"):
+        ExponentialAtmosphere(scale_height=-1.0)

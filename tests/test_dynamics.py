@@ -1,0 +1,99 @@
+import numpy as np
+import pytest
+from pydrake.autodiffutils import ExtractGradient, InitializeAutoDiff
+from pydrake.symbolic import Expression, Variable
+from scipy.integrate import solve_ivp
+
+from drake_entry.aerodynamics import CallableAero
+from drake_entry.atmosphere import ExponentialAtmosphere
+from drake_entry.dynamics import energy_rate, flight_conditions, specific_energy, state_derivatives
+from drake_entry.planet import Earth
+from drake_entry.vehicles import Vehicle
+
+
+def test_autodiff_jacobian_equals_finite_differences(horus, us76, entry_state):
+    p = Earth.oblate()
+    z = np.append(entry_state, [0.6, np.radians(40.0)])
+    J = ExtractGradient(_f_ad(z, horus, p, us76))
+    for i in range(8):
+        e = 1e-6 * max(1.0, abs(z[i]))
+        zp, zm = z.copy(), z.copy()
+        zp[i] += e
+        zm[i] -= e
+        fd = (_f(zp, horus, p, us76) - _f(zm, horus, p, us76)) / (2 * e)
+        assert np.allclose(J[:, i], fd, rtol=1e-5, atol=1e-12), i
+
+
+def _f(z, v, p, a):
+    return state_derivatives(z[:6], z[6], z[7], v, p, a)
+
+
+def _f_ad(z, v, p, a):
+    zad = InitializeAutoDiff(z).ravel()
+    return state_derivatives(zad[:6], zad[6], zad[7], v, p, a)
+
+
+def _liftonly_vehicle():
+    return Vehicle("glider", 1000.0, 1.0, 0.5, CallableAero(cl=lambda a, M: 0.5 + 0.0 * M, cd=lambda a, M: 0.0 * M))
+
+
+@pytest.mark.parametrize("planet", [Earth.spherical(rotating=False), Earth(omega=0.0)])
+def test_energy_is_conserved_without_drag_on_a_non_rotating_planet(planet):
+    v = _liftonly_vehicle()
+    atm = ExponentialAtmosphere()
+    x0 = np.array([60e3, 0.1, 0.5, 6500.0, np.radians(-1.0), 0.7])
+    sol = solve_ivp(lambda t, x: state_derivatives(x, 0.4, 0.2, v, planet, atm), (0, 600), x0,
+                    method="DOP853", rtol=1e-11, atol=1e-9)
+    E = [specific_energy(x, planet) for x in sol.y.T]
+    assert np.ptp(E) / abs(E[0]) < 1e-9
+
+
+def test_jacobi_integral_is_conserved_on_a_rotating_planet_without_drag():
+    p = Earth.oblate()
+    v = _liftonly_vehicle()
+    atm = ExponentialAtmosphere()
+    x0 = np.array([60e3, 0.1, 0.5, 6500.0, np.radians(-1.0), 0.7])
+    sol = solve_ivp(lambda t, x: state_derivatives(x, -0.3, 0.2, v, p, atm), (0, 600), x0,
+                    method="DOP853", rtol=1e-11, atol=1e-9)
+
+    def jacobi(x):
+        r = p.radius(x[0])
+        return specific_energy(x, p) - 0.5 * (p.omega * r * np.cos(x[2])) ** 2
+
+    J = [jacobi(x) for x in sol.y.T]
+    assert np.ptp(J) / abs(J[0]) < 1e-9
+
+
+def test_energy_rate_is_minus_drag_times_speed_paper000_eq39(horus, us76, entry_state):
+    p = Earth.spherical(rotating=False)
+    xdot = state_derivatives(entry_state, 0.5, 0.7, horus, p, us76)
+    fc = flight_conditions(entry_state, 0.5, 0.7, horus, p, us76)
+    assert energy_rate(entry_state, xdot, p) == pytest.approx(-fc.drag * entry_state[3], rel=1e-12)
+
+
+def test_paper000_eq102_terms_by_hand(horus, us76, entry_state):
+    p = Earth.spherical()
+    h, lon, lat, V, g, psi = entry_state
+    fc = flight_conditions(entry_state, 0.0, 0.7, horus, p, us76)
+    xdot = state_derivatives(entry_state, 0.0, 0.7, horus, p, us76)
+    r = p.radius(h)
+    gr = p.mu / r**2
+    w = p.omega
+    vdot = -fc.drag - gr * np.sin(g) + w**2 * r * np.cos(lat) * (np.sin(g) * np.cos(lat) - np.cos(g) * np.sin(lat) * np.cos(psi))
+    assert xdot[3] == pytest.approx(vdot, rel=1e-12)
+    assert xdot[0] == pytest.approx(V * np.sin(g))
+
+
+def test_symbolic_dynamics_evaluate_to_the_float_dynamics():
+    from drake_entry.vehicles import load_vehicle
+
+    x = [Variable(n) for n in ("h", "lon", "lat", "V", "gamma", "psi")]
+    sigma, alpha = Variable("sigma"), Variable("alpha")
+    vehicle, planet = load_vehicle("cav_h"), Earth.oblate()
+    atm = ExponentialAtmosphere(temperature_K=250.0)
+    f = state_derivatives(x, sigma, alpha, vehicle, planet, atm)
+    assert all(isinstance(e, Expression) for e in f)
+    point = [50e3, 0.1, 0.3, 5000.0, -0.01, 1.0]
+    env = {**dict(zip(x, point)), sigma: 0.4, alpha: 0.2}
+    expected = state_derivatives(np.array(point), 0.4, 0.2, vehicle, planet, atm)
+    assert np.allclose([e.Evaluate(env) for e in f], expected, rtol=1e-12)

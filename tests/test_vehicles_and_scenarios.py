@@ -1,0 +1,77 @@
+import numpy as np
+import pytest
+
+from drake_entry.errors import ScenarioError
+from drake_entry.scenario import PACKAGED_SCENARIOS, load_scenario
+from drake_entry.vehicles import PACKAGED_VEHICLES, load_vehicle
+
+
+@pytest.mark.parametrize("name", PACKAGED_VEHICLES)
+def test_packaged_vehicles_load_with_positive_properties(name):
+    v = load_vehicle(name)
+    assert v.mass > 0 and v.reference_area > 0 and v.nose_radius > 0
+    cl, cd = v.aero.coefficients(np.radians(20.0), 8.0)
+    assert cd > 0
+
+
+def test_horus2b_is_paper000_table1():
+    v = load_vehicle("horus2b")
+    assert (v.mass, v.reference_area, v.nose_radius) == (26029.0, 110.0, 0.8)
+    assert v.limits.heat_flux_max == 530e3 and v.limits.normal_load_max == 2.5
+    assert v.limits.dynamic_pressure_max == 1e4
+    assert not v.representative
+    assert load_vehicle("shefex3").representative and load_vehicle("sphynx").representative
+
+
+def test_user_vehicle_yaml_with_polynomial_aero(tmp_path):
+    f = tmp_path / "v.yaml"
+    f.write_text("name: my\nmass_kg: 500\nreference_area_m2: 2\nnose_radius_m: 0.3\n"
+                 "aero:\n  poly: {model: polynomial, alpha_unit: deg, CL: [[0.0, 0.0], [0.03, 0.1]], "
+                 "CD: [[0.05, 0.2], [0.0, 0.0], [0.0005, 0.0]]}\n")
+    v = load_vehicle(str(f))
+    cl, cd = v.aero.coefficients(np.radians(10.0), 5.0)
+    assert cl == pytest.approx(0.3 + 0.1 * 10 / 5)
+    assert cd == pytest.approx(0.05 + 0.2 / 5 + 0.05)
+
+
+def test_negative_mass_names_the_field_and_range(tmp_path):
+    f = tmp_path / "v.yaml"
+    f.write_text("name: bad\nmass_kg: -5\nreference_area_m2: 1\nnose_radius_m: 1\naero: {a: {model: cav_h}}\n")
+    with pytest.raises(ScenarioError, match=r"mass_kg = -5.0 is out of range: must be > 0 kg"):
+        load_vehicle(str(f))
+
+
+@pytest.mark.parametrize("name", PACKAGED_SCENARIOS)
+def test_packaged_scenarios_validate(name):
+    s = load_scenario(name)
+    assert s.initial_state().shape == (6,)
+
+
+def test_horus_scenario_is_paper000_table1():
+    x0 = load_scenario("horus2b").initial_state()
+    assert np.allclose(x0, [122e3, np.radians(-106.7), np.radians(-22.3), 7435.5, np.radians(-1.43),
+                            np.radians(70.75)])
+
+
+def _write(tmp_path, text):
+    f = tmp_path / "s.yaml"
+    f.write_text(text)
+    return str(f)
+
+
+def test_misspelled_field_is_one_clear_line(tmp_path):
+    p = _write(tmp_path, "name: x\nvehicle: horus2b\nentry: {altitude_km: 120, velocty_m_s: 7000}\n")
+    with pytest.raises(ScenarioError, match=r"unknown field\(s\) \['velocty_m_s'\]; check the spelling"):
+        load_scenario(p)
+
+
+def test_altitude_outside_model_range(tmp_path):
+    p = _write(tmp_path, "name: x\nvehicle: horus2b\nentry: {altitude_km: 1500, velocity_m_s: 7000}\n"
+                         "terminal: {altitude_km: 25}\n")
+    with pytest.raises(ScenarioError, match=r"entry.altitude_km = 1500.0 is out of range; allowed \[-5, 1000\]"):
+        load_scenario(p)
+
+
+def test_missing_file():
+    with pytest.raises(ScenarioError, match="neither a packaged scenario"):
+        load_scenario("/nope/missing.yaml")

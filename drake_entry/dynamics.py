@@ -21,6 +21,7 @@ import numpy as np
 from .atmosphere import Atmosphere
 from .constraints import dynamic_pressure, normal_load_factor, total_load_factor
 from .planet import Earth
+from .scalar import promote
 from .vehicles import Vehicle
 
 STATE_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
@@ -68,6 +69,8 @@ def state_derivatives(x, bank, alpha, vehicle: Vehicle, planet: Earth, atmospher
     Returns:
       numpy array (dtype float or object) of the six time derivatives, SI.
     """
+    x = [promote(v) for v in x]
+    bank, alpha = promote(bank), promote(alpha)
     rho, a = air_data(x, planet, atmosphere)
     _, L, D = aero_accelerations(x, alpha, rho, a, vehicle)
     return equations_of_motion(x, bank, L, D, planet)

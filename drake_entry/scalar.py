@@ -70,3 +70,8 @@ def clamp(x, lo: float, hi: float):
     if v > hi:
         return hi if not is_autodiff(x) else AutoDiffXd(hi, 0.0 * x.derivatives())
     return x
+
+
+def promote(x):
+    """A bare symbolic Variable becomes an Expression (numpy ufuncs warn on Variables)."""
+    return Expression(x) if isinstance(x, Variable) else x

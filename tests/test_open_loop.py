@@ -1,0 +1,56 @@
+"""The Drake open-loop diagram against an independent scipy integration of the same equations."""
+import numpy as np
+import pytest
+
+from diagrams.open_loop import simulate
+from drake_entry.crosscheck import solve_ivp_open_loop
+from drake_entry.scenario import load_scenario
+
+
+@pytest.fixture(scope="module")
+def horus_1500s():
+    s = load_scenario("horus2b")
+    s.simulation.max_time_s = 1500.0
+    return s
+
+
+def test_drake_matches_solve_ivp_within_1m_altitude_after_1500s(horus_1500s):
+    tr = simulate(horus_1500s)
+    sol, _ = solve_ivp_open_loop(horus_1500s, 1500.0, method="DOP853", rtol=1e-11)
+    assert tr.time[-1] == pytest.approx(1500.0)
+    assert abs(tr.state[-1, 0] - sol.y[0, -1]) < 1.0
+    assert abs(tr.state[-1, 3] - sol.y[3, -1]) < 0.1
+    r = 6378137.0
+    assert r * abs(tr.state[-1, 1] - sol.y[1, -1]) < 5.0 and r * abs(tr.state[-1, 2] - sol.y[2, -1]) < 5.0
+
+
+def test_run_stops_exactly_on_the_terminal_interface():
+    s = load_scenario("horus2b")
+    tr = simulate(s)
+    assert "altitude" in tr.reason or "mach" in tr.reason
+    if "altitude" in tr.reason:
+        assert tr.state[-1, 0] == pytest.approx(25000.0, abs=1.0)
+    else:
+        assert tr.column("mach")[-1] == pytest.approx(2.5, abs=1e-3)
+    assert np.all(np.diff(tr.time) > 0)
+
+
+def test_cli_simulate_writes_table_summary_and_plots(tmp_path):
+    from drake_entry.cli import main
+    from drake_entry.results import read_table
+
+    assert main(["simulate", "horus2b", "--out", str(tmp_path), "--format", "csv"]) == 0
+    t = read_table(str(tmp_path / "trajectory.csv"))
+    assert t["altitude_m"][0] == pytest.approx(122e3)
+    for png in ("altitude_velocity", "groundtrack", "heat_flux", "dynamic_pressure", "load_factor", "controls"):
+        assert (tmp_path / f"{png}.png").stat().st_size > 10_000
+
+
+def test_cli_reports_bad_scenario_in_one_line(tmp_path, capsys):
+    from drake_entry.cli import main
+
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: x\nvehicle: horus2b\nentry: {altitude_km: 120, velocity_m_s: -5}\nterminal: {mach: 2}\n")
+    assert main(["simulate", str(bad)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "entry.velocity_m_s = -5.0 is out of range" in err

@@ -1,0 +1,138 @@
+"""Each LeafSystem: ports, units, and behaviour against the model functions."""
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource
+
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, flight_conditions, state_derivatives
+from drake_entry.planet import Earth
+from drake_entry.schedules import Schedule
+from systems.actuators import BankActuator
+from systems.atmosphere import AtmosphereSystem
+from systems.monitors import TerminationMonitor
+from systems.navigation import Navigation
+from systems.schedule import ScheduleSource, make_schedule_source
+from systems.vehicle import EntryVehicle, EntryVehicle_
+
+
+def _fixed_inputs(system, context, **values):
+    for name, v in values.items():
+        system.GetInputPort(name).FixValue(context, np.atleast_1d(v))
+
+
+def test_entry_vehicle_ports():
+    from drake_entry.vehicles import load_vehicle
+
+    s = EntryVehicle(load_vehicle("horus2b"), Earth.spherical(), None, air_data_input=True)
+    assert [s.get_input_port(i).get_name() for i in range(s.num_input_ports())] == ["bank", "alpha", "air_data"]
+    assert s.GetOutputPort("state").size() == 6
+    assert s.GetOutputPort("flight_conditions").size() == len(FLIGHT_CONDITION_NAMES) == 9
+
+
+def test_entry_vehicle_derivatives_and_conditions_equal_the_model(horus, us76, entry_state, earth):
+    s = EntryVehicle(horus, earth, us76, initial_state=entry_state)
+    ctx = s.CreateDefaultContext()
+    _fixed_inputs(s, ctx, bank=0.6, alpha=0.7)
+    xdot = s.EvalTimeDerivatives(ctx).CopyToVector()
+    assert np.allclose(xdot, state_derivatives(entry_state, 0.6, 0.7, horus, earth, us76), rtol=1e-14)
+    fc = s.GetOutputPort("flight_conditions").Eval(ctx)
+    assert np.allclose(fc, flight_conditions(entry_state, 0.6, 0.7, horus, earth, us76), rtol=1e-14)
+
+
+def test_entry_vehicle_converts_to_autodiff_for_trajectory_optimisation(horus, us76, entry_state, earth):
+    s = EntryVehicle(horus, earth, us76, initial_state=entry_state)
+    from pydrake.autodiffutils import AutoDiffXd, ExtractGradient, InitializeAutoDiff
+
+    ad = s.ToAutoDiffXd()
+    assert isinstance(ad, EntryVehicle_[AutoDiffXd])
+    ctx = ad.CreateDefaultContext()
+    ad.get_input_port(0).FixValue(ctx, InitializeAutoDiff(np.array([0.6]), 2, 0).ravel())
+    ad.get_input_port(1).FixValue(ctx, InitializeAutoDiff(np.array([0.7]), 2, 1).ravel())
+    ctx.SetContinuousState(entry_state.astype(object) + 0 * InitializeAutoDiff(np.zeros(1), 2, 0)[0, 0])
+    xdot = ad.EvalTimeDerivatives(ctx).CopyToVector()
+    grad = ExtractGradient(xdot)  # d xdot / d(bank, alpha)
+    e = 1e-6
+    fd_bank = (state_derivatives(entry_state, 0.6 + e, 0.7, horus, earth, us76)
+               - state_derivatives(entry_state, 0.6 - e, 0.7, horus, earth, us76)) / (2 * e)
+    assert np.allclose(grad[:, 0], fd_bank, rtol=1e-6, atol=1e-12)
+
+
+def test_atmosphere_system_applies_density_scale(us76, entry_state, earth):
+    s = AtmosphereSystem(us76, earth, density_scale=1.1)
+    ctx = s.CreateDefaultContext()
+    s.get_input_port().FixValue(ctx, entry_state)
+    rho, a = s.get_output_port().Eval(ctx)
+    assert rho == pytest.approx(1.1 * us76.density(entry_state[0]))
+    assert a == pytest.approx(us76.speed_of_sound(entry_state[0]))
+    with pytest.raises(ValueError, match="density_scale must be > 0"):
+        AtmosphereSystem(us76, earth, density_scale=0.0)
+
+
+def _simulate_actuator(command, t_end, **kw):
+    b = DiagramBuilder()
+    src = b.AddSystem(ConstantVectorSource([command]))
+    act = b.AddSystem(BankActuator(**kw))
+    b.Connect(src.get_output_port(), act.get_input_port())
+    rate_log = []
+    d = b.Build()
+    sim = Simulator(d)
+    ctx = act.GetMyContextFromRoot(sim.get_mutable_context())
+    ts = np.linspace(0, t_end, 201)
+    out = []
+    for t in ts:
+        sim.AdvanceTo(t)
+        out.append(act.get_output_port(0).Eval(ctx)[0])
+        rate_log.append(act.GetOutputPort("bank_rate").Eval(ctx)[0])
+    return ts, np.array(out), np.array(rate_log)
+
+
+def test_bank_reversal_respects_rate_and_acceleration_limits():
+    rate, accel = np.radians(10.0), np.radians(5.0)
+    t, bank, bank_rate = _simulate_actuator(np.radians(-60.0), 40.0, bank_limit=np.radians(80.0), rate_limit=rate,
+                                            accel_limit=accel, initial_bank=np.radians(60.0))
+    assert np.abs(bank_rate).max() <= rate * (1 + 1e-6)
+    assert np.abs(np.diff(bank_rate) / np.diff(t)).max() <= accel * 1.05
+    assert bank[-1] == pytest.approx(np.radians(-60.0), abs=np.radians(0.5))
+    # a 120 deg reversal at 10 deg/s takes at least 12 s
+    assert bank[np.searchsorted(t, 11.0)] > np.radians(-60.0) + np.radians(5.0)
+
+
+def test_bank_command_is_clipped_to_the_bank_limit():
+    _, bank, _ = _simulate_actuator(np.radians(120.0), 60.0, bank_limit=np.radians(89.0), rate_limit=1.0,
+                                    accel_limit=1.0)
+    assert bank.max() <= np.radians(89.0) + np.radians(0.01)
+    assert bank[-1] == pytest.approx(np.radians(89.0), abs=np.radians(0.01))
+
+
+def test_navigation_noise_is_reproducible_from_the_seed():
+    def run(seed):
+        b = DiagramBuilder()
+        src = b.AddSystem(ConstantVectorSource(np.arange(6.0)))
+        nav = b.AddSystem(Navigation(bias=np.full(6, 0.5), noise_sigma=np.ones(6), period=0.5, seed=seed))
+        b.Connect(src.get_output_port(), nav.get_input_port())
+        sim = Simulator(b.Build())
+        sim.AdvanceTo(3.2)
+        return nav.get_output_port().Eval(nav.GetMyContextFromRoot(sim.get_context()))
+
+    a, b_, c = run(7), run(7), run(8)
+    assert np.array_equal(a, b_)
+    assert not np.allclose(a, c)
+    assert np.abs(a - np.arange(6.0) - 0.5).max() < 6.0  # bias plus unit-sigma noise
+
+
+def test_schedule_sources_native_and_python_agree():
+    sch = Schedule.ramp(960.0, 1250.0, np.radians(40), np.radians(15))
+    native = make_schedule_source(sch)
+    python = ScheduleSource(sch)
+    for t in (0.0, 1000.0, 1250.0, 5000.0):
+        cn, cp = native.CreateDefaultContext(), python.CreateDefaultContext()
+        cn.SetTime(t)
+        cp.SetTime(t)
+        assert native.get_output_port().Eval(cn)[0] == pytest.approx(python.get_output_port().Eval(cp)[0])
+    assert Schedule.ramp(0, 1, 0.0, 1.0, smooth=True)(0.5) == pytest.approx(0.5)
+
+
+def test_termination_monitor_needs_a_condition():
+    with pytest.raises(ValueError, match="at least one"):
+        TerminationMonitor()

@@ -83,7 +83,7 @@ def build_open_loop(scenario: Scenario):
     t = scenario.terminal
     monitor = builder.AddNamedSystem("termination", TerminationMonitor(
         altitude=None if t.altitude_km is None else t.altitude_km * 1e3, mach=t.mach,
-        velocity=t.velocity_m_s, energy=None if t.energy_MJ_kg is None else t.energy_MJ_kg * 1e6))
+        velocity=t.velocity_m_s, energy=None if t.energy_MJ_kg is None else t.energy_MJ_kg * 1e6, planet=planet))
     state = plant.GetOutputPort("state")
     conditions = plant.GetOutputPort("flight_conditions")
     builder.Connect(state, air.get_input_port())
@@ -96,7 +96,7 @@ def build_open_loop(scenario: Scenario):
     builder.Connect(bank.get_output_port(), actuator.get_input_port())
     builder.Connect(actuator.GetOutputPort("bank"), plant.GetInputPort("bank"))
     builder.Connect(state, monitor.GetInputPort("state"))
-    builder.Connect(conditions, monitor.GetInputPort("flight_conditions"))
+    builder.Connect(air.GetOutputPort("air_data"), monitor.GetInputPort("air_data"))
     period = scenario.simulation.log_period_s
     loggers = {
         "state": LogVectorOutput(state, builder, period),
@@ -133,7 +133,7 @@ def simulate(scenario: Scenario, *, initial_state=None) -> Trajectory:
     t0 = _time.perf_counter()
     status = simulator.AdvanceTo(scenario.simulation.max_time_s)
     wall = _time.perf_counter() - t0
-    reason = status.FormatMessage() if status.reason() != status.ReturnReason.kReachedBoundaryTime else "max_time"
+    reason = status.message() if status.reason() != status.ReturnReason.kReachedBoundaryTime else "max_time"
     logs = {k: v.FindLog(context) for k, v in loggers.items()}
     # append the exact final instant (the witness-located terminal point)
     plant_ctx = plant.GetMyContextFromRoot(context)

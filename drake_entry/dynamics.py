@@ -14,6 +14,7 @@ evaluated at the geodetic altitude (paper 001 Sec. II.A).
 """
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -82,10 +83,11 @@ def equations_of_motion(x, bank, L, D, planet: Earth):
     r = planet.radius(h)
     g_r, g_n = planet.gravity(r, lat)
     w = planet.omega
-    sg, cg = np.sin(gamma), np.cos(gamma)
-    sp, cp = np.sin(psi), np.cos(psi)
-    sl, cl = np.sin(lat), np.cos(lat)
-    sb, cb = np.sin(bank), np.cos(bank)
+    fn = math if isinstance(gamma, float) and isinstance(bank, float) else np  # float fast path
+    sg, cg = fn.sin(gamma), fn.cos(gamma)
+    sp, cp = fn.sin(psi), fn.cos(psi)
+    sl, cl = fn.sin(lat), fn.cos(lat)
+    sb, cb = fn.sin(bank), fn.cos(bank)
     tan_g = sg / cg
     h_dot = V * sg
     lon_dot = V * cg * sp / (r * cl)

@@ -92,6 +92,8 @@ class Earth:
         paper 001 eq. 7 with g_R = -g_r), g_n = -3 mu/r^2 J2 (R/r)^2 sin lat cos lat
         (paper 001 eq. 7).
         """
+        if self.j2 == 0.0:
+            return self.mu / (r * r), 0.0 * lat
         s = np.sin(lat)
         c = np.cos(lat)
         k = self.j2 * (self.equatorial_radius / r) ** 2

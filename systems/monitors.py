@@ -6,25 +6,26 @@ specific energy below ``energy`` [J/kg], speed below ``velocity`` [m/s]. Whichev
 triggers first ends the run; ``reason`` names it.
 
 Ports:
-  input "state"              [6]
-  input "flight_conditions"  [9]  (EntryVehicle output)
+  input "state"     [6]  vehicle state
+  input "air_data"  [2]  density, speed of sound (AtmosphereSystem output): Mach = V / a
+                         reuses the air data the vehicle already evaluated at that state
 """
 from __future__ import annotations
 
 from pydrake.systems.framework import EventStatus, LeafSystem, PublishEvent, WitnessFunctionDirection
 
-from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
-
-_MACH = FLIGHT_CONDITION_NAMES.index("mach")
-_ENERGY = FLIGHT_CONDITION_NAMES.index("energy")
+from drake_entry.dynamics import specific_energy
+from drake_entry.planet import Earth
 
 
 class TerminationMonitor(LeafSystem):
     def __init__(self, *, altitude: float | None = None, mach: float | None = None,
-                 energy: float | None = None, velocity: float | None = None):
+                 energy: float | None = None, velocity: float | None = None, planet: Earth | None = None):
+        """Targets in SI: altitude [m], Mach, energy [J/kg] (with ``planet``), velocity [m/s]."""
         super().__init__()
+        self.planet = planet or Earth()
         self.state_port = self.DeclareVectorInputPort("state", 6)
-        self.conditions_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
+        self.air_port = self.DeclareVectorInputPort("air_data", 2)
         self.reason = None
         self.targets = {k: v for k, v in (("altitude", altitude), ("mach", mach), ("energy", energy),
                                           ("velocity", velocity)) if v is not None}
@@ -42,8 +43,9 @@ class TerminationMonitor(LeafSystem):
             return lambda c: self.state_port.Eval(c)[0] - target
         if name == "velocity":
             return lambda c: self.state_port.Eval(c)[3] - target
-        index = _MACH if name == "mach" else _ENERGY
-        return lambda c: self.conditions_port.Eval(c)[index] - target
+        if name == "mach":
+            return lambda c: self.state_port.Eval(c)[3] / self.air_port.Eval(c)[1] - target
+        return lambda c: specific_energy(self.state_port.Eval(c), self.planet) - target
 
     def _make_handler(self, name):
         def handler(context, event):

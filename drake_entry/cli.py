@@ -2,6 +2,7 @@
 
 Commands:
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
+  fit-horus           refit the HORUS-2B aero forms (paper 000 eqs. 32-33); print residuals
   bench               time the Drake open-loop HORUS flight against scipy solve_ivp
 """
 from __future__ import annotations
@@ -52,6 +53,19 @@ def _cmd_simulate(args) -> int:
     return 0
 
 
+def _cmd_fit_horus(args) -> int:
+    from .aerodynamics import fit_horus_forms
+    from .vehicles import load_vehicle
+
+    rep = fit_horus_forms(initial_aL=load_vehicle("horus2b").aero.aL)
+    print("least-squares fit of paper 000 eqs. 32-33 to the clean, untrimmed M-692 cells")
+    print(f"C_D: {rep.cells_CD} cells, RMS {rep.rms_CD:.4f}, max |residual| {rep.max_CD:.4f}")
+    print(f"C_L: {rep.cells_CL} cells, RMS {rep.rms_CL:.4f}, max |residual| {rep.max_CL:.4f}")
+    print("aD =", [float(f"{v:.10g}") for v in rep.aD])
+    print("aL =", [float(f"{v:.10g}") for v in rep.aL])
+    return 0
+
+
 def _cmd_bench(args) -> int:
     from .benchmark import open_loop_benchmark
 
@@ -68,6 +82,8 @@ def main(argv=None) -> int:
     p.add_argument("--out", default="out/simulate", help="output directory")
     p.add_argument("--format", choices=("parquet", "csv"), default="parquet")
     p.set_defaults(func=_cmd_simulate)
+    f = sub.add_parser("fit-horus", help="refit paper 000 eqs. 32-33 to the M-692 table; print residuals")
+    f.set_defaults(func=_cmd_fit_horus)
     b = sub.add_parser("bench", help="Drake open loop vs scipy solve_ivp, side by side")
     b.add_argument("--repeats", type=int, default=3)
     b.set_defaults(func=_cmd_bench)

@@ -97,3 +97,15 @@ def test_symbolic_dynamics_evaluate_to_the_float_dynamics():
     env = {**dict(zip(x, point)), sigma: 0.4, alpha: 0.2}
     expected = state_derivatives(np.array(point), 0.4, 0.2, vehicle, planet, atm)
     assert np.allclose([e.Evaluate(env) for e in f], expected, rtol=1e-12)
+
+
+def test_energy_domain_form_is_time_form_divided_by_energy_rate(horus, us76, entry_state):
+    from drake_entry.dynamics import energy_domain_derivatives
+
+    p = Earth.oblate()
+    dx_dE = energy_domain_derivatives(entry_state, 0.3, 0.7, horus, p, us76)
+    xdot = state_derivatives(entry_state, 0.3, 0.7, horus, p, us76)
+    edot = energy_rate(entry_state, xdot, p)
+    assert np.allclose(dx_dE[:6] * edot, xdot, rtol=1e-12)
+    assert dx_dE[6] == pytest.approx(1.0 / edot)
+    assert edot < 0  # drag dissipates energy

@@ -75,3 +75,16 @@ def test_altitude_outside_model_range(tmp_path):
 def test_missing_file():
     with pytest.raises(ScenarioError, match="neither a packaged scenario"):
         load_scenario("/nope/missing.yaml")
+
+
+def test_entry_dispersion_is_reproducible_and_bounded_paper000_table2():
+    from drake_entry.dispersions import EntryDispersion
+
+    d = EntryDispersion.paper000_table2()
+    draws = np.array([d.sample(seed=42, index=i) for i in range(2000)])
+    assert np.array_equal(draws[17], d.sample(seed=42, index=17))
+    assert np.all(np.abs(draws) <= np.array(d.scale))
+    # uniform on [-a, a]: standard deviation a / sqrt(3)
+    assert np.allclose(draws.std(axis=0) / (np.array(d.scale) / np.sqrt(3)), 1.0, atol=0.05)
+    with pytest.raises(ValueError, match="6 non-negative"):
+        EntryDispersion((1.0, 2.0))

@@ -49,6 +49,23 @@ class Schedule:
         """value_start until ``start``, linear to value_end at ``end``, then held."""
         return Schedule((float(start), float(end)), (float(value_start), float(value_end)), variable, smooth)
 
+    def derivatives(self, s: float) -> tuple[float, float, float]:
+        """(value, d/ds, d2/ds2) at a scalar s (zero slope outside the breakpoints; the
+        second derivative of a non-smooth schedule is zero between its corners)."""
+        bp = np.asarray(self.breakpoints, float)
+        v = np.asarray(self.values, float)
+        if bp.size == 1 or s <= bp[0] or s >= bp[-1]:
+            return self(s), 0.0, 0.0
+        i = int(np.clip(np.searchsorted(bp, s, side="right") - 1, 0, bp.size - 2))
+        width = bp[i + 1] - bp[i]
+        dv = v[i + 1] - v[i]
+        if not self.smooth:
+            return self(s), dv / width, 0.0
+        t = (s - bp[i]) / width
+        d1 = 30.0 * t * t * (1.0 - t) ** 2
+        d2 = 60.0 * t * (1.0 - t) * (1.0 - 2.0 * t)
+        return self(s), dv * d1 / width, dv * d2 / width**2
+
     def __call__(self, s):
         """Value at s (float or ndarray)."""
         bp = np.asarray(self.breakpoints, float)

@@ -136,3 +136,13 @@ def test_schedule_sources_native_and_python_agree():
 def test_termination_monitor_needs_a_condition():
     with pytest.raises(ValueError, match="at least one"):
         TerminationMonitor()
+
+
+@pytest.mark.parametrize("smooth", [False, True])
+def test_schedule_derivatives_equal_finite_differences(smooth):
+    sch = Schedule((-5.0e7, -4.0e7), (0.26, 0.70), "energy", smooth)
+    for s in (-4.7e7, -4.3e7):
+        v, d1, d2 = sch.derivatives(s)
+        e = 1e3
+        assert d1 == pytest.approx((sch(s + e) - sch(s - e)) / (2 * e), rel=1e-6)
+        assert d2 == pytest.approx((sch(s + e) - 2 * v + sch(s - e)) / e**2, rel=1e-4, abs=1e-20)

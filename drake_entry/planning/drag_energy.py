@@ -1,0 +1,328 @@
+"""Drag-energy entry guidance by pseudospectral convex optimisation (paper 000, Sec. VI).
+
+The reference drag profile D(E) is planned in the inverse variable I = 1/D on LGL nodes in
+energy (eq. 82). Then the range constraint is linear (eq. 83, with the ground-range
+correction below), the corridor is a box (eq. 86), the initial drag and slope are linear
+(eq. 84, corrected to I0' = -D0'/D0^2), and smoothness is two second-order cones:
+||D1 I|| <= s', ||D2 I|| <= s'', minimise s' + s'' (eqs. 90-92). One SOCP, no initial
+guess, solved with Clarabel (default) or SCS through Drake's MathematicalProgram.
+
+Derivatives in the cones are taken in the normalised LGL variable tau (so s' and s''
+are commensurate: in J/kg the I'' term would be about 1e7 times smaller than I'), and I
+is scaled by a reference drag for conditioning.
+
+Range: eq. 71 (R = -int dE / D) neglects cos(gamma) and R/r. We weight each node with
+kappa = R_E cos(gamma) / r from the extracted states and re-solve (``range_iterations``),
+so the ground range of the extracted trajectory equals the range to go.
+
+After the solve, states and bank are extracted node by node (eqs. 93-96): altitude and
+speed from (E, D), gamma from D' (eq. 94), u_FF (eq. 95) and sigma (eq. 96), with the
+bank saturated explicitly at [0, sigma_max] (flags returned).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.solvers import ClarabelSolver, MathematicalProgram, ScsSolver
+from scipy.optimize import brentq
+
+from ..atmosphere import Atmosphere
+from ..corridor import Corridor
+from ..drag_dynamics import AlphaProfile, drag_acceleration, drag_dynamics
+from ..planet import Earth
+from ..pseudospectral import LGL
+from ..schedules import Schedule
+from ..vehicles import Vehicle
+
+SOLVERS = {"clarabel": ClarabelSolver, "scs": ScsSolver}
+
+
+@dataclass
+class DragEnergyProblem:
+    """One planning request.
+
+    Attributes:
+      vehicle, planet, atmosphere: models (the planner uses central gravity, eq. 37).
+      alpha: angle-of-attack schedule in energy [rad vs J/kg].
+      corridor: drag corridor covering [E_f, E_0] (drake_entry.corridor).
+      E0, Ef: initial and final energy [J/kg], E0 > Ef.
+      D0, D0_prime: drag [m/s^2] and dD/dE [1/m] at E0 (eqs. 72-74).
+      range_to_go: ground distance to fly [m].
+      Df, Df_prime: optional terminal drag and slope (eq. 85).
+      lat0, latf, heading0, headingf: [rad] linear profiles for the Earth-rate term (eq. 50).
+      n_nodes: LGL nodes. solver: 'clarabel' or 'scs'. range_iterations: see module doc.
+      sigma_max: bank limit for extraction [rad].
+    """
+
+    vehicle: Vehicle
+    planet: Earth
+    atmosphere: Atmosphere
+    alpha: Schedule
+    corridor: Corridor
+    E0: float
+    Ef: float
+    D0: float
+    D0_prime: float
+    range_to_go: float
+    Df: float | None = None
+    Df_prime: float | None = None
+    lat0: float = 0.0
+    latf: float = 0.0
+    heading0: float = 0.0
+    headingf: float = 0.0
+    n_nodes: int = 40
+    solver: str = "clarabel"
+    range_iterations: int = 2
+    sigma_max: float = math.radians(89.0)
+
+    def validate(self):
+        if not self.E0 > self.Ef:
+            raise ValueError(f"DragEnergyProblem needs E0 > Ef, got E0={self.E0:.6g}, Ef={self.Ef:.6g} J/kg")
+        if not (self.corridor.energy[0] <= self.Ef and self.E0 <= self.corridor.energy[-1] + 1.0):
+            raise ValueError(f"corridor covers [{self.corridor.energy[0]:.6g}, {self.corridor.energy[-1]:.6g}] "
+                             f"J/kg, not [{self.Ef:.6g}, {self.E0:.6g}]")
+        if self.solver not in SOLVERS:
+            raise ValueError(f"solver '{self.solver}' is unknown; allowed: {', '.join(SOLVERS)}")
+        if not 5 <= self.n_nodes <= 400:
+            raise ValueError(f"n_nodes must be in [5, 400], got {self.n_nodes}")
+        if not self.D0 > 0 or not self.range_to_go > 0:
+            raise ValueError(f"D0 and range_to_go must be > 0 (got {self.D0}, {self.range_to_go})")
+
+
+@dataclass
+class Extraction:
+    """States and bank at the nodes (eqs. 93-96). Arrays over nodes, SI / rad."""
+
+    h: np.ndarray
+    V: np.ndarray
+    gamma: np.ndarray
+    u_ff: np.ndarray
+    sigma: np.ndarray
+    saturated: np.ndarray  # True where |u_FF| exceeded what the bank can give
+    lift_to_drag: np.ndarray
+
+
+@dataclass
+class DragEnergyReference:
+    """Result of ``plan``: the reference D(E) and everything needed to fly it."""
+
+    success: bool
+    message: str
+    problem: DragEnergyProblem
+    lgl: LGL | None = None
+    I: np.ndarray | None = None  # 1/D at the nodes [s^2/m]
+    kappa: np.ndarray | None = None
+    extraction: Extraction | None = None
+    solver: str = ""
+    solve_time: float = 0.0
+    build_time: float = 0.0
+    iterations: int = 0
+    binding: list = field(default_factory=list)  # which bounds bind, where (diagnosis)
+
+    # -- the profile and its energy derivatives -----------------------------------------
+    @property
+    def energy(self) -> np.ndarray:
+        return self.lgl.x
+
+    @property
+    def D(self) -> np.ndarray:
+        return 1.0 / self.I
+
+    def profile(self, E):
+        """(D, D', D'') at energies E (eq. 87-88 from the interpolated I(E); held at the ends)."""
+        E = np.clip(np.atleast_1d(np.asarray(E, float)), self.problem.Ef, self.problem.E0)
+        P = self.lgl.interpolation(E)
+        I = P @ self.I
+        I1 = P @ (self.lgl.D1 @ self.I)
+        I2 = P @ (self.lgl.D2 @ self.I)
+        D = 1.0 / I
+        return D, -I1 / I**2, 2.0 * I1**2 / I**3 - I2 / I**2
+
+    def range_flown(self) -> float:
+        """Ground range of the profile [m] (eq. 83 with kappa)."""
+        return float(-self.lgl.weights @ (self.kappa * self.I))
+
+    def corridor_violation(self, n_dense: int = 2000) -> dict:
+        """Largest relative excursion outside the corridor on a dense energy grid (between
+        nodes too), and where (normalised energy e = (E0 - E)/(E0 - Ef))."""
+        p = self.problem
+        E = np.linspace(p.E0, p.Ef, n_dense)
+        D = self.profile(E)[0]
+        lo, hi = p.corridor.bounds(E)
+        over = D / hi - 1.0
+        under = 1.0 - D / lo
+        e = (p.E0 - E) / (p.E0 - p.Ef)
+        return {"above_max": float(max(over.max(), 0.0)), "above_max_at_e": float(e[over.argmax()]),
+                "below_min": float(max(under.max(), 0.0)), "below_min_at_e": float(e[under.argmax()])}
+
+
+def _alpha_profile(alpha: Schedule, E: float) -> AlphaProfile:
+    return AlphaProfile(*alpha.derivatives(E))
+
+
+def plan(problem: DragEnergyProblem) -> DragEnergyReference:
+    """Solve the drag-energy SOCP (eqs. 82-92) and extract states and bank (eqs. 93-96).
+
+    Never raises for an infeasible request: the result says which bound binds and where.
+    """
+    problem.validate()
+    p = problem
+    op = LGL(p.n_nodes, p.E0, p.Ef)
+    D_lo, D_hi = p.corridor.bounds(op.x)
+    diag = _diagnose(p, op, D_lo, D_hi)
+    if diag:
+        return DragEnergyReference(False, "; ".join(d["message"] for d in diag), p, lgl=op, binding=diag)
+    kappa = np.full(p.n_nodes, p.planet.reference_radius / p.planet.radius(0.0))
+    ref = None
+    total_build = total_solve = 0.0
+    for it in range(max(1, p.range_iterations)):
+        ref = _solve_socp(p, op, D_lo, D_hi, kappa)
+        total_build += ref.build_time
+        total_solve += ref.solve_time
+        if not ref.success:
+            break
+        ref.extraction = extract(p, op, ref.I)
+        x = ref.extraction
+        kappa = p.planet.reference_radius * np.cos(x.gamma) / p.planet.radius(x.h)
+        if it + 1 < p.range_iterations:
+            continue
+    ref.build_time, ref.solve_time = total_build, total_solve
+    if ref.success:
+        ref.kappa = kappa
+        ref.binding = _binding(ref, D_lo, D_hi)
+    return ref
+
+
+def _solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyReference:
+    t0 = time.perf_counter()
+    n = p.n_nodes
+    scale = p.D0  # I_hat = I * scale is O(1)
+    prog = MathematicalProgram()
+    I = prog.NewContinuousVariables(n, "I")
+    s = prog.NewContinuousVariables(2, "s")
+    prog.AddBoundingBoxConstraint(scale / D_hi, scale / D_lo, I)  # eq. 86
+    # eq. 83 with the ground-range weights kappa: R = -sum w_i kappa_i I_i
+    prog.AddLinearEqualityConstraint((-op.weights * kappa / scale)[None, :], [p.range_to_go], I)
+    # eq. 84 (corrected): I0 = 1/D0, dI/dtau(-1) = (dE/dtau) * (-D0'/D0^2)
+    half = (op.b - op.a) / 2.0
+    A0 = np.vstack([np.eye(n)[0], op.D1_tau[0]])
+    b0 = np.array([1.0, half * (-p.D0_prime / p.D0**2) * scale])
+    if p.Df is not None:  # eq. 85
+        A0 = np.vstack([A0, np.eye(n)[-1]])
+        b0 = np.append(b0, scale / p.Df)
+        if p.Df_prime is not None:
+            A0 = np.vstack([A0, op.D1_tau[-1]])
+            b0 = np.append(b0, half * (-p.Df_prime / p.Df**2) * scale)
+    prog.AddLinearEqualityConstraint(A0, b0, I)
+    # eq. 91: ||D1 I|| <= s', ||D2 I|| <= s'' as Lorentz cones on [s_k, I]
+    for k, Dk in enumerate((op.D1_tau, op.D2_tau)):
+        A = np.zeros((n + 1, n + 1))
+        A[0, 0] = 1.0
+        A[1:, 1:] = Dk
+        prog.AddLorentzConeConstraint(A, np.zeros(n + 1), np.concatenate([[s[k]], I]))
+    prog.AddLinearCost(np.ones(2), 0.0, s)  # eq. 92
+    t1 = time.perf_counter()
+    solver = SOLVERS[p.solver]()
+    result = solver.Solve(prog)
+    t2 = time.perf_counter()
+    ok = result.is_success()
+    details = result.get_solver_details()
+    iters = int(getattr(details, "iterations", getattr(details, "iter", 0)) or 0)
+    msg = "optimal" if ok else f"{p.solver} returned {result.get_solution_result().name}"
+    return DragEnergyReference(ok, msg, p, lgl=op, I=result.GetSolution(I) / scale if ok else None,
+                               solver=p.solver, build_time=t1 - t0, solve_time=t2 - t1, iterations=iters)
+
+
+def _reachable_range(op: LGL, D, kappa=None) -> float:
+    kappa = np.ones(op.n_nodes) if kappa is None else kappa
+    return float(-op.weights @ (kappa / D))
+
+
+def _diagnose(p: DragEnergyProblem, op: LGL, D_lo, D_hi) -> list:
+    """Name the bound that makes the request infeasible before calling the solver."""
+    out = []
+    e = (p.E0 - op.x) / (p.E0 - p.Ef)
+    empty = D_lo > D_hi
+    if empty.any():
+        out.append({"bound": "corridor", "where_e": float(e[empty][0]),
+                    "message": f"corridor empty (D_min > D_max) from e = {e[empty][0]:.3f} "
+                               f"to {e[empty][-1]:.3f}: reduce the margin or change alpha(E)"})
+        return out
+    if not D_lo[0] <= p.D0 <= D_hi[0]:
+        side = "above D_max" if p.D0 > D_hi[0] else "below D_min"
+        out.append({"bound": "initial_drag", "where_e": 0.0,
+                    "message": f"initial drag {p.D0:.4g} m/s^2 is {side} "
+                               f"[{D_lo[0]:.4g}, {D_hi[0]:.4g}] at E0"})
+    if p.Df is not None and not D_lo[-1] <= p.Df <= D_hi[-1]:
+        side = "above D_max" if p.Df > D_hi[-1] else "below D_min"
+        out.append({"bound": "terminal_drag", "where_e": 1.0,
+                    "message": f"terminal drag {p.Df:.4g} m/s^2 is {side} [{D_lo[-1]:.4g}, {D_hi[-1]:.4g}] "
+                               f"at Ef (e.g. the q limit at the nominal terminal point)"})
+    r_e = p.planet.reference_radius / p.planet.radius(0.0)
+    R_min = _reachable_range(op, D_hi) * r_e
+    R_max = _reachable_range(op, D_lo) * r_e
+    if p.range_to_go < R_min:
+        out.append({"bound": "D_max", "where_e": None,
+                    "message": f"range to go {p.range_to_go / 1e3:.1f} km is shorter than the corridor allows "
+                               f"({R_min / 1e3:.1f} km flying on D_max everywhere): the upper bound binds"})
+    elif p.range_to_go > R_max:
+        out.append({"bound": "D_min", "where_e": None,
+                    "message": f"range to go {p.range_to_go / 1e3:.1f} km is longer than the corridor allows "
+                               f"({R_max / 1e3:.1f} km flying on D_min everywhere): the lower bound binds"})
+    return out
+
+
+def _binding(ref: DragEnergyReference, D_lo, D_hi, tol: float = 1e-4) -> list:
+    """Where the solution rides a corridor bound (at nodes)."""
+    D = ref.D
+    e = (ref.problem.E0 - ref.energy) / (ref.problem.E0 - ref.problem.Ef)
+    out = []
+    for name, mask in (("D_max", D >= D_hi * (1 - tol)), ("D_min", D <= D_lo * (1 + tol))):
+        if mask.any():
+            out.append({"bound": name, "nodes": int(mask.sum()), "e": e[mask].round(4).tolist()})
+    return out
+
+
+def extract(p: DragEnergyProblem, op: LGL, I: np.ndarray) -> Extraction:
+    """States and bank at the nodes (eqs. 93-96)."""
+    n = op.n_nodes
+    D = 1.0 / I
+    I1 = op.D1 @ I
+    I2 = op.D2 @ I
+    Dp = -I1 / I**2
+    Dpp = 2.0 * I1**2 / I**3 - I2 / I**2
+    out = {k: np.zeros(n) for k in ("h", "V", "gamma", "u_ff", "sigma", "ld")}
+    sat = np.zeros(n, bool)
+    frac = (p.E0 - op.x) / (p.E0 - p.Ef)
+    for i, E in enumerate(op.x):
+        alpha = _alpha_profile(p.alpha, E)
+        h, V = altitude_speed_from_drag(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere)
+        lat = p.lat0 + frac[i] * (p.latf - p.lat0)
+        heading = p.heading0 + frac[i] * (p.headingf - p.heading0)
+        d0 = drag_dynamics(h, V, 0.0, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat, heading=heading)
+        gamma = math.asin(float(np.clip((Dp[i] - d0.a_Dgamma) / d0.b_Dgamma, -1.0, 1.0)))  # eq. 94
+        dd = drag_dynamics(h, V, gamma, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat, heading=heading)
+        u = dd.feedforward(Dpp[i])  # eq. 95
+        ratio = u / dd.lift_to_drag
+        lo = math.cos(p.sigma_max)
+        sat[i] = ratio > 1.0 or ratio < lo
+        sigma = math.acos(float(np.clip(ratio, lo, 1.0)))  # eq. 96, saturated
+        for k, v in (("h", h), ("V", V), ("gamma", gamma), ("u_ff", u), ("sigma", sigma), ("ld", dd.lift_to_drag)):
+            out[k][i] = v
+    return Extraction(out["h"], out["V"], out["gamma"], out["u_ff"], out["sigma"], sat, out["ld"])
+
+
+def altitude_speed_from_drag(E: float, D: float, alpha: float, vehicle: Vehicle, planet: Earth,
+                             atmosphere: Atmosphere, h_floor: float = 0.0):
+    """(h, V) on energy level E where the drag equals D (eq. 93)."""
+    h_top = planet.mu / (-E) - planet.reference_radius - 1.0
+
+    def f(h):
+        V = math.sqrt(max(2.0 * (E + planet.mu / planet.radius(h)), 0.0))
+        return drag_acceleration(h, V, alpha, vehicle, atmosphere) - D
+
+    h = brentq(f, h_floor, min(h_top, atmosphere.h_max), xtol=1e-4)
+    return h, math.sqrt(2.0 * (E + planet.mu / planet.radius(h)))

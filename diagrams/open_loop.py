@@ -8,61 +8,16 @@ with a termination monitor and loggers; ``simulate`` flies it and returns a Traj
 """
 from __future__ import annotations
 
-import dataclasses as dc
-import time as _time
-
-import numpy as np
-from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, STATE_NAMES
+from diagrams.common import Trajectory, run  # noqa: F401  (Trajectory re-exported)
 from drake_entry.scenario import Scenario
 from systems.actuators import BankActuator
 from systems.atmosphere import AtmosphereSystem
 from systems.monitors import TerminationMonitor
 from systems.schedule import make_schedule_source
 from systems.vehicle import EntryVehicle
-
-
-@dc.dataclass
-class Trajectory:
-    """A simulated trajectory sampled at the log period (plus the final instant).
-
-    Attributes:
-      time: [s], shape (n,). state: (n, 6) [h, lon, lat, V, gamma, psi] SI.
-      conditions: (n, 9) FlightConditions columns. bank, alpha: (n,) [rad].
-      reason: why the run stopped. wall_time: [s].
-    """
-
-    time: np.ndarray
-    state: np.ndarray
-    conditions: np.ndarray
-    bank: np.ndarray
-    alpha: np.ndarray
-    reason: str
-    wall_time: float
-
-    def column(self, name: str) -> np.ndarray:
-        if name in STATE_NAMES:
-            return self.state[:, STATE_NAMES.index(name)]
-        if name in FLIGHT_CONDITION_NAMES:
-            return self.conditions[:, FLIGHT_CONDITION_NAMES.index(name)]
-        return {"time": self.time, "bank": self.bank, "alpha": self.alpha}[name]
-
-    def table(self) -> dict:
-        """Columns with units in the names (for Parquet / CSV)."""
-        out = {"time_s": self.time,
-               "altitude_m": self.state[:, 0], "longitude_deg": np.degrees(self.state[:, 1]),
-               "latitude_deg": np.degrees(self.state[:, 2]), "velocity_m_s": self.state[:, 3],
-               "flight_path_deg": np.degrees(self.state[:, 4]), "heading_deg": np.degrees(self.state[:, 5]),
-               "bank_deg": np.degrees(self.bank), "alpha_deg": np.degrees(self.alpha)}
-        units = {"rho": "density_kg_m3", "mach": "mach", "dynamic_pressure": "dynamic_pressure_Pa",
-                 "heat_flux": "heat_flux_W_m2", "normal_load": "normal_load_g", "total_load": "total_load_g",
-                 "lift": "lift_m_s2", "drag": "drag_m_s2", "energy": "energy_J_kg"}
-        for i, name in enumerate(FLIGHT_CONDITION_NAMES):
-            out[units[name]] = self.conditions[:, i]
-        return out
 
 
 def build_open_loop(scenario: Scenario):
@@ -109,52 +64,9 @@ def build_open_loop(scenario: Scenario):
     return diagram, loggers
 
 
-def configure_integrator(simulator: Simulator, scenario: Scenario):
-    """Integrator, accuracy and maximum step from the scenario (RK5 by default; see DESIGN.md)."""
-    sim = scenario.simulation
-    integrator = ResetIntegratorFromFlags(simulator, sim.integrator, sim.max_step_s)
-    integrator.set_target_accuracy(sim.accuracy)
-    integrator.set_maximum_step_size(sim.max_step_s)
-    # witness functions need the context accuracy set explicitly (DESIGN.md)
-    simulator.get_mutable_context().SetAccuracy(sim.accuracy)
-    return integrator
-
-
 def simulate(scenario: Scenario, *, initial_state=None) -> Trajectory:
     """Fly the open-loop diagram until a terminal condition or max_time_s."""
     diagram, loggers = build_open_loop(scenario)
-    simulator = Simulator(diagram)
-    context = simulator.get_mutable_context()
-    plant = diagram.GetSubsystemByName("vehicle")
-    if initial_state is not None:
-        plant.set_initial_state(plant.GetMyMutableContextFromRoot(context), initial_state)
-    configure_integrator(simulator, scenario)
-    simulator.Initialize()
-    t0 = _time.perf_counter()
-    status = simulator.AdvanceTo(scenario.simulation.max_time_s)
-    wall = _time.perf_counter() - t0
-    reason = status.message() if status.reason() != status.ReturnReason.kReachedBoundaryTime else "max_time"
-    logs = {k: v.FindLog(context) for k, v in loggers.items()}
-    # append the exact final instant (the witness-located terminal point)
-    plant_ctx = plant.GetMyContextFromRoot(context)
-    t_end = context.get_time()
-    final = {
-        "state": plant.GetOutputPort("state").Eval(plant_ctx),
-        "conditions": plant.GetOutputPort("flight_conditions").Eval(plant_ctx),
-        "bank": diagram.GetSubsystemByName("bank_actuator").GetOutputPort("bank").Eval(
-            diagram.GetSubsystemByName("bank_actuator").GetMyContextFromRoot(context)),
-        "alpha": diagram.GetSubsystemByName("alpha_schedule").get_output_port().Eval(
-            diagram.GetSubsystemByName("alpha_schedule").GetMyContextFromRoot(context)),
-    }
-    times = logs["state"].sample_times()
-    keep = times < t_end - 1e-9
-    data = {k: np.column_stack([logs[k].data()[:, keep], final[k]]) for k in logs}
-    return Trajectory(
-        time=np.append(times[keep], t_end),
-        state=data["state"].T,
-        conditions=data["conditions"].T,
-        bank=data["bank"][0],
-        alpha=data["alpha"][0],
-        reason=reason,
-        wall_time=wall,
-    )
+    sources = {"state": ("vehicle", "state"), "conditions": ("vehicle", "flight_conditions"),
+               "bank": ("bank_actuator", "bank"), "alpha": ("alpha_schedule", 0)}
+    return run(diagram, loggers, scenario, sources=sources, initial_state=initial_state)[0]

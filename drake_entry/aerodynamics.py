@@ -85,6 +85,13 @@ class AeroModel:
         return AeroDerivatives(*out)
 
 
+    def drag_derivatives(self, alpha: float, mach: float) -> tuple[CoefficientDerivatives, float]:
+        """C_D with its partials and the C_L value: what the drag dynamics need
+        (paper 000 eqs. 44, 61). Subclasses with analytic C_D partials override this."""
+        d = self.derivatives(alpha, mach)
+        return d.CD, d.CL.value
+
+
 # ---------------------------------------------------------------------------------------
 # Tables
 # ---------------------------------------------------------------------------------------
@@ -202,6 +209,9 @@ class TableAero(AeroModel):
     def derivatives(self, alpha: float, mach: float, **_) -> AeroDerivatives:
         return AeroDerivatives(self._eval(0, float(alpha), float(mach)), self._eval(1, float(alpha), float(mach)))
 
+    def drag_derivatives(self, alpha: float, mach: float):
+        return self._eval(1, float(alpha), float(mach)), self._eval(0, float(alpha), float(mach)).value
+
 
 def read_wide_table(path_or_file, *, fill=None) -> TableAero:
     """Read a table CSV in the M-692 layout (coefficient, alpha_deg, M1.2, M1.5, ...),
@@ -273,9 +283,33 @@ class HorusFitAero(AeroModel):
         self.aL = [float(v) for v in self.aL]
 
     def coefficients(self, alpha, mach):
+        if isinstance(alpha, float) and isinstance(mach, float):  # plain floats are faster than numpy scalars
+            alpha, mach = float(alpha), float(mach)
+            a = alpha / DEG
+            M = min(max(mach, self.mach_min), self.mach_max)
+            arg = self.aL[7] * a + self.aL[8] * a / (M + self.aL[9])
+            return _horus_cl(self.aL, a, M, math.sin(arg), math.cos(arg)), horus_cd_form(self.aD, a, M)
         a = alpha / DEG
         M = clamp(mach, self.mach_min, self.mach_max)
         return horus_cl_form(self.aL, a, M), horus_cd_form(self.aD, a, M)
+
+    def drag_derivatives(self, alpha: float, mach: float):
+        """Analytic partials of the eq. 32 polynomial (alpha in rad outside, deg inside)."""
+        d = self.aD
+        a = float(alpha) / DEG
+        inside = self.mach_min <= mach <= self.mach_max
+        M = min(max(float(mach), self.mach_min), self.mach_max)
+        cd = horus_cd_form(d, a, M)
+        c_a = d[1] + 2 * d[2] * a + 3 * d[3] * a * a + d[6] * M + d[7] / M + 2 * d[8] * a / M + d[9] / M**2
+        c_aa = 2 * d[2] + 6 * d[3] * a + 2 * d[8] / M
+        c_M = d[4] + 2 * d[5] * M + d[6] * a - d[7] * a / M**2 - d[8] * a * a / M**2 - 2 * d[9] * a / M**3
+        c_MM = 2 * d[5] + 2 * d[7] * a / M**3 + 2 * d[8] * a * a / M**3 + 6 * d[9] * a / M**4
+        c_aM = d[6] - d[7] / M**2 - 2 * d[8] * a / M**2 - 2 * d[9] / M**3
+        k = 1.0 / DEG  # d/d(alpha rad) = (1/DEG) d/d(alpha deg)
+        if not inside:
+            c_M = c_MM = c_aM = 0.0
+        cl, _ = self.coefficients(float(alpha), float(mach))
+        return CoefficientDerivatives(cd, c_a * k, c_M, c_aa * k * k, c_aM * k, c_MM), float(cl)
 
 
 def horus_cd_form(d, a, M):
@@ -287,8 +321,12 @@ def horus_cd_form(d, a, M):
 def horus_cl_form(p, a, M):
     """Paper 000 eq. 33 (alpha a in degrees)."""
     arg = p[7] * a + p[8] * a / (M + p[9])
-    return (p[0] + p[1] * M + p[2] / (M + p[3]) + (p[4] + p[5] / (M + p[6])) * np.sin(arg)
-            + (p[10] + p[11] * M + p[12] / (M + p[13])) * np.cos(arg))
+    return _horus_cl(p, a, M, np.sin(arg), np.cos(arg))
+
+
+def _horus_cl(p, a, M, s, c):
+    return (p[0] + p[1] * M + p[2] / (M + p[3]) + (p[4] + p[5] / (M + p[6])) * s
+            + (p[10] + p[11] * M + p[12] / (M + p[13])) * c)
 
 
 class FitReport(NamedTuple):

@@ -11,7 +11,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .actuator import bank_actuator_rates
-from .dynamics import state_derivatives
+from .dynamics import specific_energy, state_derivatives
 from .scenario import Scenario
 
 
@@ -19,23 +19,27 @@ def solve_ivp_open_loop(scenario: Scenario, t_final: float, *, method: str = "DO
                         atol: float | None = None, bandwidth: float = 2.0):
     """Integrate [x(6), sigma, sigma_dot] from the entry interface to t_final [s].
 
-    Only time-scheduled commands are supported here. Returns (solution, wall time [s]).
+    Time- and energy-scheduled commands. Returns (solution, wall time [s]).
     """
-    for which in ("alpha", "bank"):
-        if getattr(scenario, which).variable != "time":
-            raise ValueError(f"solve_ivp_open_loop supports time schedules only ({which} is "
-                             f"'{getattr(scenario, which).variable}')")
     vehicle, planet, atm = scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere()
     alpha_s, bank_s = scenario.schedule("alpha"), scenario.schedule("bank")
+    for which, sch in (("alpha", alpha_s), ("bank", bank_s)):
+        if sch.variable not in ("time", "energy"):
+            raise ValueError(f"solve_ivp_open_loop supports time and energy schedules only ({which} is "
+                             f"'{sch.variable}')")
+
+    def command(sch, t, y):
+        return sch(t) if sch.variable == "time" else sch(specific_energy(y, planet))
     lim = dict(bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit,
                accel_limit=vehicle.bank_accel_limit, bandwidth=bandwidth)
 
     def rhs(t, y):
-        xdot = state_derivatives(y[:6], y[6], alpha_s(t), vehicle, planet, atm)
-        s_dot, s_ddot = bank_actuator_rates(y[6], y[7], bank_s(t), **lim)
+        xdot = state_derivatives(y[:6], y[6], command(alpha_s, t, y), vehicle, planet, atm)
+        s_dot, s_ddot = bank_actuator_rates(y[6], y[7], command(bank_s, t, y), **lim)
         return np.append(xdot, (s_dot, s_ddot))
 
-    y0 = np.append(scenario.initial_state(), (bank_s(0.0), 0.0))
+    x0 = scenario.initial_state()
+    y0 = np.append(x0, (command(bank_s, 0.0, x0), 0.0))
     # absolute tolerances scaled to each state's size (m, rad, m/s, rad)
     scale = np.array([1e5, 1.0, 1.0, 1e4, 1.0, 1.0, 1.0, 1.0])
     atol = rtol * scale if atol is None else atol

@@ -95,8 +95,7 @@ def drag_dynamics(h: float, V: float, gamma: float, alpha: AlphaProfile, vehicle
     M_V = 1.0 / a
     M_hh = 0.75 * M * (T_h / T) ** 2 - 0.5 * M * T_hh / T  # eq. 59
     M_hV = -0.5 * T_h / (T * a)  # eq. 59, corrected
-    aero = vehicle.aero.derivatives(alpha.alpha, M)
-    cd = aero.CD
+    cd, CL = vehicle.aero.drag_derivatives(alpha.alpha, M)
     CD = cd.value
     D = 0.5 * rho * V * V * vehicle.area_over_mass * CD
     sg, cg = math.sin(gamma), math.cos(gamma)
@@ -134,4 +133,4 @@ def drag_dynamics(h: float, V: float, gamma: float, alpha: AlphaProfile, vehicle
 
     a_D = second(0.0)
     b_D = second(1.0) - a_D
-    return DragDynamics(D, Dp, a_D, b_D, a_Dg, b_Dg, aero.CL.value / CD, M, rho)
+    return DragDynamics(D, Dp, a_D, b_D, a_Dg, b_Dg, CL / CD, M, rho)

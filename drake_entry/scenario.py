@@ -83,6 +83,46 @@ class ScheduleSpec:
 
 
 @dc.dataclass
+class GuidanceSpec:
+    """Closed-loop guidance settings (paper 000 Secs. IV.A, VI.D)."""
+
+    # drag_energy (paper 000); more methods arrive with their issues
+    method: str = "drag_energy"
+    # guidance terminal interface: the reference ends at the energy of this altitude and Mach
+    terminal_altitude_km: float = 25.0
+    terminal_mach: float = 2.5
+    n_nodes: int = 40
+    # constrain the terminal drag to the terminal interface's (eq. 85) instead of leaving it free
+    terminal_drag: bool = True
+    # clarabel | scs
+    solver: str = "clarabel"
+    # relative safety margin on both corridor bounds
+    corridor_margin: float = 0.03
+    corridor_points: int = 300
+    # pre-guidance: this bank until the drag stops rising (D' >= 0) after pre_guidance_min_s
+    pre_guidance_bank_deg: float = 0.0
+    pre_guidance_min_s: float = 100.0
+    # guidance and control update period [s]; re-planning period [s] (0 = plan once)
+    period_s: float = 1.0
+    replan_period_s: float = 0.0
+    # no re-planning past this normalised energy (little range is left to correct)
+    replan_until_e: float = 0.9
+    # drag tracking (eq. 101), energy domain: zeta < 0 because E decreases (paper 000 Sec. VI.D)
+    zeta: float = -0.7
+    # pseudo-frequency omega_D [1/(J/kg)] = 2 pi / (energy per oscillation) (paper 000: constant)
+    omega_per_J: float = 2.0e-6
+    # if > 0: schedule omega_D = bandwidth / (D V) so the loop has this time-domain bandwidth
+    # [rad/s] all along (a constant omega_D is 25x faster at peak drag than at the end)
+    bandwidth_rad_s: float = 0.0
+    # integral gain as a fraction of its stability limit: k_D^i = -ratio * 2 |zeta| omega^3
+    # (Routh-Hurwitz on lambda^3 + 2 zeta omega lambda^2 + omega^2 lambda + k = 0, E decreasing)
+    integral_ratio: float = 0.0
+    # bank reversals: heading-error corridor [deg] linear in speed between the two velocities
+    reversal_heading_deg: list[float] = dc.field(default_factory=lambda: [5.0, 15.0])
+    reversal_velocity_m_s: list[float] = dc.field(default_factory=lambda: [1000.0, 6000.0])
+
+
+@dc.dataclass
 class SimulationSpec:
     # hard stop [s] if no terminal condition triggers
     max_time_s: float = 3000.0
@@ -113,6 +153,7 @@ class Scenario:
     alpha: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
     bank: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
     simulation: SimulationSpec = dc.field(default_factory=SimulationSpec)
+    guidance: GuidanceSpec = dc.field(default_factory=GuidanceSpec)
 
     # -- models ----------------------------------------------------------------------
     def make_vehicle(self) -> Vehicle:
@@ -143,10 +184,32 @@ class Scenario:
         return np.array([e.altitude_km * 1e3, np.radians(e.longitude_deg), np.radians(e.latitude_deg),
                          e.velocity_m_s, np.radians(e.flight_path_deg), np.radians(e.heading_deg)])
 
+    def entry_energy(self) -> float:
+        """Specific energy at the entry interface [J/kg] (central gravity, eq. 37 convention)."""
+        x0 = self.initial_state()
+        return float(self.make_planet().with_(j2=0.0).specific_energy(x0[0], x0[3]))
+
+    def guidance_terminal_state(self) -> tuple[float, float, float]:
+        """(h_f [m], V_f [m/s], E_f [J/kg]) of the guidance terminal interface."""
+        g = self.guidance
+        h = g.terminal_altitude_km * 1e3
+        V = g.terminal_mach * float(self.make_atmosphere().speed_of_sound(h))
+        return h, V, float(self.make_planet().with_(j2=0.0).specific_energy(h, V))
+
     def schedule(self, which: str) -> Schedule:
+        """The alpha or bank schedule in SI; 'normalized_energy' breakpoints
+        e = (E0 - E)/(E0 - Ef) are converted to energy [J/kg]."""
         s = getattr(self, which)
+        bp, values = list(s.breakpoints), list(np.radians(s.values_deg))
+        variable = s.variable
+        if variable == "normalized_energy":
+            E0, Ef = self.entry_energy(), self.guidance_terminal_state()[2]
+            energies = [E0 - e * (E0 - Ef) for e in bp]
+            order = np.argsort(energies)
+            bp, values = [energies[i] for i in order], [values[i] for i in order]
+            variable = "energy"
         try:
-            return Schedule(tuple(s.breakpoints), tuple(np.radians(s.values_deg)), s.variable, s.smooth)
+            return Schedule(tuple(bp), tuple(values), variable, s.smooth)
         except ValueError as e:
             raise ScenarioError(f"{which}: {e}") from None
 
@@ -174,8 +237,26 @@ class Scenario:
         _range("simulation.log_period_s", sim.log_period_s, 1e-3, 1e3)
         if sim.integrator not in INTEGRATORS:
             raise ScenarioError(f"simulation.integrator '{sim.integrator}' is unknown; allowed: {', '.join(INTEGRATORS)}")
+        g = self.guidance
+        if g.method not in ("drag_energy",):
+            raise ScenarioError(f"guidance.method '{g.method}' is unknown; allowed: drag_energy")
+        _range("guidance.n_nodes", g.n_nodes, 5, 400)
+        _range("guidance.zeta", g.zeta, -10.0, -1e-3)
+        _range("guidance.omega_per_J", g.omega_per_J, 1e-9, 1e-3)
+        _range("guidance.integral_ratio", g.integral_ratio, 0.0, 0.99)
+        _range("guidance.bandwidth_rad_s", g.bandwidth_rad_s, 0.0, 10.0)
+        _range("guidance.replan_until_e", g.replan_until_e, 0.0, 1.0)
+        _range("guidance.corridor_margin", g.corridor_margin, 0.0, 0.49)
+        _range("guidance.period_s", g.period_s, 0.01, 60.0)
+        _range("guidance.replan_period_s", g.replan_period_s, 0.0, 1e4)
+        _range("guidance.terminal_altitude_km", g.terminal_altitude_km, 0.0, self.entry.altitude_km)
+        _range("guidance.terminal_mach", g.terminal_mach, 0.1, 30.0)
+        if g.solver not in ("clarabel", "scs"):
+            raise ScenarioError(f"guidance.solver '{g.solver}' is unknown; allowed: clarabel, scs")
+        if len(g.reversal_heading_deg) != 2 or len(g.reversal_velocity_m_s) != 2:
+            raise ScenarioError("guidance.reversal_heading_deg and reversal_velocity_m_s need two values each")
         for which in ("alpha", "bank"):
-            if getattr(self, which).variable not in VARIABLES:
+            if getattr(self, which).variable not in VARIABLES + ("normalized_energy",):
                 raise ScenarioError(f"{which}.variable '{getattr(self, which).variable}' is unknown; "
                                     f"allowed: {', '.join(VARIABLES)}")
             self.schedule(which)

@@ -7,6 +7,7 @@ the corners by a quintic blend, which keeps gamma smooth under a smooth drag pro
 """
 from __future__ import annotations
 
+import bisect
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,6 +40,18 @@ class Schedule:
         if np.any(np.diff(bp) <= 0):
             raise ValueError("Schedule.breakpoints must be strictly increasing")
 
+    def _scalar(self, s: float) -> float:
+        bp, v = self.breakpoints, self.values
+        if s <= bp[0]:
+            return float(v[0])
+        if s >= bp[-1]:
+            return float(v[-1])
+        i = bisect.bisect_right(bp, s) - 1
+        t = (s - bp[i]) / (bp[i + 1] - bp[i])
+        if self.smooth:
+            t = t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
+        return float(v[i] + (v[i + 1] - v[i]) * t)
+
     @staticmethod
     def constant(value: float) -> "Schedule":
         return Schedule((0.0,), (float(value),))
@@ -68,6 +81,8 @@ class Schedule:
 
     def __call__(self, s):
         """Value at s (float or ndarray)."""
+        if isinstance(s, float):
+            return self._scalar(s)
         bp = np.asarray(self.breakpoints, float)
         v = np.asarray(self.values, float)
         if not self.smooth or bp.size == 1:

@@ -32,7 +32,12 @@ def make_schedule_source(schedule: Schedule, planet: Earth | None = None):
 
 
 class ScheduleSource(LeafSystem):
-    def __init__(self, schedule: Schedule, planet: Earth | None = None):
+    """Args: schedule; planet (for energy schedules); period [s]: if given, the command is
+    sampled every period and held (a guidance command, cheap for the integrator),
+    starting from ``initial_value``; otherwise it is evaluated continuously."""
+
+    def __init__(self, schedule: Schedule, planet: Earth | None = None, period: float | None = None,
+                 initial_value: float = 0.0):
         super().__init__()
         self.schedule = schedule
         self.planet = planet or Earth()
@@ -41,10 +46,24 @@ class ScheduleSource(LeafSystem):
         self.conditions_port = (
             self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES)) if var == "mach" else None
         )
+        if period is not None:
+            if not period > 0:
+                raise ValueError(f"ScheduleSource.period must be > 0 s, got {period}")
+            self._held = self.DeclareDiscreteState([initial_value])
+            self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._sample)
+            self.DeclareForcedDiscreteUpdateEvent(self._sample)
+            self.DeclareStateOutputPort("command", self._held)
+            return
         prereq = {self.time_ticket()} if var == "time" else {self.all_input_ports_ticket()}
         self.DeclareVectorOutputPort("command", 1, self._calc, prerequisites_of_calc=prereq)
 
+    def _sample(self, context, discrete_state):
+        discrete_state.get_mutable_vector(self._held).SetAtIndex(0, self.value(context))
+
     def _calc(self, context, output):
+        output.SetAtIndex(0, self.value(context))
+
+    def value(self, context) -> float:
         var = self.schedule.variable
         if var == "time":
             s = context.get_time()
@@ -54,4 +73,4 @@ class ScheduleSource(LeafSystem):
             s = self.state_port.Eval(context)[3]
         else:
             s = self.conditions_port.Eval(context)[FLIGHT_CONDITION_NAMES.index("mach")]
-        output.SetAtIndex(0, self.schedule(s))
+        return self.schedule(float(s))

@@ -76,3 +76,15 @@ def test_user_callables_give_exact_autodiff_derivatives():
     assert d.CD.d_alpha == pytest.approx(0.6)
     assert d.CD.d_alpha_alpha == pytest.approx(2.0, rel=1e-6)
     assert d.CL.d_mach == pytest.approx(-1.5 * np.sin(0.3) ** 2 / 25.0)
+
+
+def test_analytic_horus_drag_partials_equal_autodiff_and_differences():
+    from drake_entry.aerodynamics import AeroModel
+
+    fit = load_vehicle("horus2b").aero
+    for alpha, mach in ((0.6, 7.0), (0.3, 2.4), (0.7, 15.0)):
+        analytic, cl = fit.drag_derivatives(alpha, mach)
+        generic = AeroModel.derivatives(fit, alpha, mach)
+        assert cl == pytest.approx(generic.CL.value, rel=1e-12)
+        for field in ("value", "d_alpha", "d_mach", "d_alpha_alpha", "d_alpha_mach", "d_mach_mach"):
+            assert getattr(analytic, field) == pytest.approx(getattr(generic.CD, field), rel=1e-5, abs=1e-9), field

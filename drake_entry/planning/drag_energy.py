@@ -21,6 +21,7 @@ bank saturated explicitly at [0, sigma_max] (flags returned).
 """
 from __future__ import annotations
 
+import dataclasses as dc
 import math
 import time
 from dataclasses import dataclass, field
@@ -30,7 +31,7 @@ from pydrake.solvers import ClarabelSolver, MathematicalProgram, ScsSolver
 from scipy.optimize import brentq
 
 from ..atmosphere import Atmosphere
-from ..corridor import Corridor
+from ..corridor import Corridor, compute_corridor
 from ..drag_dynamics import AlphaProfile, drag_acceleration, drag_dynamics
 from ..planet import Earth
 from ..pseudospectral import LGL
@@ -77,6 +78,8 @@ class DragEnergyProblem:
     solver: str = "clarabel"
     range_iterations: int = 2
     sigma_max: float = math.radians(89.0)
+    # a D0 outside the (margin-reduced) corridor by less than this fraction is projected onto it
+    initial_tolerance: float = 0.03
 
     def validate(self):
         if not self.E0 > self.Ef:
@@ -121,6 +124,7 @@ class DragEnergyReference:
     build_time: float = 0.0
     iterations: int = 0
     binding: list = field(default_factory=list)  # which bounds bind, where (diagnosis)
+    _nodal: np.ndarray | None = field(default=None, repr=False)
 
     # -- the profile and its energy derivatives -----------------------------------------
     @property
@@ -132,12 +136,11 @@ class DragEnergyReference:
         return 1.0 / self.I
 
     def profile(self, E):
-        """(D, D', D'') at energies E (eq. 87-88 from the interpolated I(E); held at the ends)."""
+        """(D, D', D'') at energies E (eqs. 87-88 from the interpolated I(E); held at the ends)."""
         E = np.clip(np.atleast_1d(np.asarray(E, float)), self.problem.Ef, self.problem.E0)
-        P = self.lgl.interpolation(E)
-        I = P @ self.I
-        I1 = P @ (self.lgl.D1 @ self.I)
-        I2 = P @ (self.lgl.D2 @ self.I)
+        if self._nodal is None:  # I, I', I'' at the nodes, once
+            self._nodal = np.vstack([self.I, self.lgl.D1 @ self.I, self.lgl.D2 @ self.I]).T
+        I, I1, I2 = (self.lgl.interpolation(E) @ self._nodal).T
         D = 1.0 / I
         return D, -I1 / I**2, 2.0 * I1**2 / I**3 - I2 / I**2
 
@@ -172,6 +175,11 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
     p = problem
     op = LGL(p.n_nodes, p.E0, p.Ef)
     D_lo, D_hi = p.corridor.bounds(op.x)
+    note = ""
+    D0_in = min(max(p.D0, D_lo[0]), D_hi[0])
+    if D0_in != p.D0 and abs(D0_in / p.D0 - 1.0) <= p.initial_tolerance:
+        note = f" (initial drag {p.D0:.4g} projected onto the corridor bound {D0_in:.4g} m/s^2)"
+        p = dc.replace(p, D0=D0_in)
     diag = _diagnose(p, op, D_lo, D_hi)
     if diag:
         return DragEnergyReference(False, "; ".join(d["message"] for d in diag), p, lgl=op, binding=diag)
@@ -190,6 +198,7 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
         if it + 1 < p.range_iterations:
             continue
     ref.build_time, ref.solve_time = total_build, total_solve
+    ref.message += note
     if ref.success:
         ref.kappa = kappa
         ref.binding = _binding(ref, D_lo, D_hi)
@@ -326,3 +335,74 @@ def altitude_speed_from_drag(E: float, D: float, alpha: float, vehicle: Vehicle,
 
     h = brentq(f, h_floor, min(h_top, atmosphere.h_max), xtol=1e-4)
     return h, math.sqrt(2.0 * (E + planet.mu / planet.radius(h)))
+
+
+def bearing(lon1, lat1, lon2, lat2) -> float:
+    """Initial great-circle bearing [rad] from point 1 to point 2, from north, clockwise."""
+    dlon = lon2 - lon1
+    return math.atan2(math.sin(dlon) * math.cos(lat2),
+                      math.cos(lat1) * math.sin(lat2) - math.sin(lat1) * math.cos(lat2) * math.cos(dlon))
+
+
+class DragEnergyPlanner:
+    """Plans drag-energy references from navigation states for one mission.
+
+    The corridor depends only on energy (alpha is scheduled in energy), so it is computed
+    once here and shared by every plan, every re-plan and every Monte-Carlo sample.
+    """
+
+    def __init__(self, *, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, alpha: Schedule,
+                 target_lon: float, target_lat: float, E_entry: float, E_final: float, n_nodes: int = 40,
+                 solver: str = "clarabel", margin: float = 0.03, corridor_points: int = 300,
+                 sigma_max: float | None = None, terminal_drag: float | None = None):
+        if alpha.variable != "energy":
+            raise ValueError(f"the drag-energy planner needs alpha scheduled in energy, got '{alpha.variable}'")
+        self.vehicle, self.atmosphere, self.alpha = vehicle, atmosphere, alpha
+        self.planet = planet.with_(j2=0.0)  # paper 000 eq. 37: central gravity in the planner
+        self.target = (target_lon, target_lat)
+        self.E_entry, self.E_final = E_entry, E_final
+        self.terminal_drag = terminal_drag  # D_f of eq. 85, or None (free)
+        self.n_nodes, self.solver = n_nodes, solver
+        self.sigma_max = vehicle.bank_limit if sigma_max is None else sigma_max
+        E = np.linspace(E_final, E_entry + 0.02 * (E_entry - E_final), corridor_points)
+        self.corridor = compute_corridor(E, alpha, vehicle, self.planet, atmosphere, margin=margin)
+
+    @staticmethod
+    def from_scenario(scenario) -> "DragEnergyPlanner":
+        g = scenario.guidance
+        vehicle = scenario.make_vehicle()
+        h_f, V_f, Ef = scenario.guidance_terminal_state()
+        alpha = scenario.schedule("alpha")
+        D_f = drag_acceleration(h_f, V_f, alpha(Ef), vehicle, scenario.make_atmosphere()) if g.terminal_drag else None
+        return DragEnergyPlanner(
+            vehicle=vehicle, planet=scenario.make_planet(), atmosphere=scenario.make_atmosphere(),
+            alpha=scenario.schedule("alpha"), target_lon=math.radians(scenario.target.longitude_deg),
+            target_lat=math.radians(scenario.target.latitude_deg), E_entry=scenario.entry_energy(), E_final=Ef,
+            n_nodes=g.n_nodes, solver=g.solver, margin=g.corridor_margin, corridor_points=g.corridor_points,
+            terminal_drag=D_f)
+
+    def energy(self, x) -> float:
+        return float(self.planet.specific_energy(x[0], x[3]))
+
+    def drag_state(self, x) -> DragDynamics:
+        """D, D', a_D, b_D at state x for the scheduled alpha(E) (eqs. 40-63)."""
+        E = self.energy(x)
+        return drag_dynamics(x[0], x[3], x[4], _alpha_profile(self.alpha, E), self.vehicle, self.planet,
+                             self.atmosphere, lat=x[2], heading=x[5])
+
+    def range_to_go(self, x) -> float:
+        return float(self.planet.great_circle_distance(x[1], x[2], *self.target))
+
+    def problem(self, x, **overrides) -> DragEnergyProblem:
+        """The planning request from state x [h, lon, lat, V, gamma, psi]."""
+        d = self.drag_state(x)
+        kw = dict(vehicle=self.vehicle, planet=self.planet, atmosphere=self.atmosphere, alpha=self.alpha,
+                  corridor=self.corridor, E0=self.energy(x), Ef=self.E_final, D0=d.D, D0_prime=d.D_prime,
+                  range_to_go=self.range_to_go(x), lat0=float(x[2]), latf=self.target[1],
+                  heading0=float(x[5]), headingf=bearing(x[1], x[2], *self.target), Df=self.terminal_drag,
+                  n_nodes=self.n_nodes, solver=self.solver, sigma_max=self.sigma_max)
+        kw.update(overrides)
+        return DragEnergyProblem(**kw)
+
+    def plan_from_state(self, x, **overrides) -> DragEnergyReference:
+        return plan(self.problem(x, **overrides))

@@ -1,0 +1,174 @@
+"""Closed-loop drag-energy entry (paper 000 Secs. IV.A and VI.D) as a Drake diagram.
+
+  EntryVehicle --state--> Navigation --estimate--> DragEnergyGuidance --reference-->
+  DragTrackingController --|sigma|--> BankReversalLogic --sigma_cmd--> BankActuator --> EntryVehicle
+  AtmosphereSystem(state) --air_data--> EntryVehicle, TerminationMonitor
+  alpha(E) ScheduleSource(estimate) --alpha--> EntryVehicle
+
+The run stops exactly at the guidance terminal energy E_f (witness function), or on an
+altitude floor (a crash guard) or max_time_s. ``fly`` returns the trajectory, the
+reference, and the terminal errors in the form of paper 000 Table 3.
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+
+import numpy as np
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import LogVectorOutput
+
+from diagrams.common import Trajectory, run
+from drake_entry.dispersions import EntryDispersion
+from drake_entry.planning.drag_energy import DragEnergyPlanner, DragEnergyReference
+from drake_entry.scenario import Scenario
+from systems.actuators import BankActuator
+from systems.atmosphere import AtmosphereSystem
+from systems.bank_reversal import BankReversalLogic
+from systems.drag_tracking import DragTrackingController
+from systems.guidance import DragEnergyGuidance
+from systems.monitors import TerminationMonitor
+from systems.navigation import Navigation
+from systems.schedule import ScheduleSource
+from systems.vehicle import EntryVehicle
+
+ALTITUDE_FLOOR_M = 5000.0
+
+
+@dc.dataclass
+class ClosedLoopResult:
+    """One closed-loop flight.
+
+    Attributes:
+      trajectory: the flown Trajectory (extra['reference'] = [D_ref, D'_ref, D''_ref, engaged]).
+      reference: the last successful plan (None if guidance never engaged).
+      errors: terminal errors (Table 3 form): altitude_m, longitude_deg, latitude_deg,
+        velocity_m_s, range_to_go_m (signed: + short of the target), distance_m.
+      engaged_at: guidance engagement time [s]; plans: successful plans; reversals: count.
+      planning_failures: list of (time, message).
+      success: reached the terminal energy with guidance engaged.
+      message: human summary.
+    """
+
+    trajectory: Trajectory
+    reference: DragEnergyReference | None
+    errors: dict
+    engaged_at: float | None
+    plans: int
+    reversals: int
+    planning_failures: list
+    success: bool
+    message: str
+
+
+def build_closed_loop(scenario: Scenario, planner: DragEnergyPlanner | None = None, *, nav_seed: int = 0,
+                      nav_bias=None, nav_noise=None, density_scale: float = 1.0):
+    """Diagram, loggers and the planner (built from the scenario unless given)."""
+    planner = planner or DragEnergyPlanner.from_scenario(scenario)
+    g = scenario.guidance
+    vehicle, planet, atmosphere = planner.vehicle, scenario.make_planet(), planner.atmosphere
+    builder = DiagramBuilder()
+    plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, planet, atmosphere,
+                                                           initial_state=scenario.initial_state(),
+                                                           air_data_input=True))
+    air = builder.AddNamedSystem("atmosphere", AtmosphereSystem(atmosphere, planet, density_scale=density_scale))
+    nav = builder.AddNamedSystem("navigation", Navigation(bias=nav_bias, noise_sigma=nav_noise,
+                                                          period=g.period_s, seed=nav_seed))
+    guidance = builder.AddNamedSystem("guidance", DragEnergyGuidance(
+        planner, period=g.period_s, pre_guidance_min_s=g.pre_guidance_min_s, replan_period_s=g.replan_period_s,
+        replan_until_e=g.replan_until_e))
+    pre_bank = math.radians(g.pre_guidance_bank_deg)
+    controller = builder.AddNamedSystem("drag_tracking", DragTrackingController(
+        planner, zeta=g.zeta, omega=g.omega_per_J, integral_ratio=g.integral_ratio, period=g.period_s,
+        pre_guidance_bank=abs(pre_bank), bandwidth=g.bandwidth_rad_s))
+    reversal = builder.AddNamedSystem("bank_reversal", BankReversalLogic(
+        target_lon=planner.target[0], target_lat=planner.target[1], corridor_deg=tuple(g.reversal_heading_deg),
+        corridor_velocity=tuple(g.reversal_velocity_m_s), period=g.period_s,
+        initial_sign=1.0 if pre_bank >= 0 else -1.0))
+    actuator = builder.AddNamedSystem("bank_actuator", BankActuator(
+        bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit, accel_limit=vehicle.bank_accel_limit,
+        initial_bank=pre_bank))
+    alpha = builder.AddNamedSystem("alpha_schedule", ScheduleSource(
+        planner.alpha, planner.planet, period=g.period_s, initial_value=planner.alpha(scenario.entry_energy())))
+    monitor = builder.AddNamedSystem("termination", TerminationMonitor(
+        energy=planner.E_final, altitude=ALTITUDE_FLOOR_M, planet=planner.planet))
+
+    state = plant.GetOutputPort("state")
+    estimate = nav.GetOutputPort("estimated_state")
+    builder.Connect(state, air.get_input_port())
+    builder.Connect(air.GetOutputPort("air_data"), plant.GetInputPort("air_data"))
+    builder.Connect(state, nav.GetInputPort("true_state"))
+    builder.Connect(estimate, guidance.GetInputPort("estimated_state"))
+    builder.Connect(estimate, controller.GetInputPort("estimated_state"))
+    builder.Connect(guidance.GetOutputPort("reference"), controller.GetInputPort("reference"))
+    builder.Connect(estimate, reversal.GetInputPort("estimated_state"))
+    builder.Connect(controller.GetOutputPort("bank_magnitude"), reversal.GetInputPort("bank_magnitude"))
+    builder.Connect(reversal.GetOutputPort("bank_command"), actuator.get_input_port())
+    builder.Connect(actuator.GetOutputPort("bank"), plant.GetInputPort("bank"))
+    builder.Connect(estimate, alpha.GetInputPort("state"))
+    builder.Connect(alpha.get_output_port(), plant.GetInputPort("alpha"))
+    builder.Connect(state, monitor.GetInputPort("state"))
+    builder.Connect(air.GetOutputPort("air_data"), monitor.GetInputPort("air_data"))
+    period = scenario.simulation.log_period_s
+    loggers = {
+        "state": LogVectorOutput(state, builder, period),
+        "conditions": LogVectorOutput(plant.GetOutputPort("flight_conditions"), builder, period),
+        "bank": LogVectorOutput(actuator.GetOutputPort("bank"), builder, period),
+        "alpha": LogVectorOutput(alpha.get_output_port(), builder, period),
+        "reference": LogVectorOutput(guidance.GetOutputPort("reference"), builder, period),
+        "bank_command": LogVectorOutput(reversal.GetOutputPort("bank_command"), builder, period),
+    }
+    diagram = builder.Build()
+    diagram.set_name(f"closed_loop_{scenario.name}")
+    return diagram, loggers, planner
+
+
+SOURCES = {"state": ("vehicle", "state"), "conditions": ("vehicle", "flight_conditions"),
+           "bank": ("bank_actuator", "bank"), "alpha": ("alpha_schedule", "command"),
+           "reference": ("guidance", "reference"), "bank_command": ("bank_reversal", "bank_command")}
+
+
+def terminal_errors(x, scenario: Scenario, planner: DragEnergyPlanner) -> dict:
+    """Final errors against the guidance terminal interface and the target (Table 3 form)."""
+    h_f, V_f, _ = scenario.guidance_terminal_state()
+    tlon, tlat = planner.target
+    dist = float(planner.planet.great_circle_distance(x[1], x[2], tlon, tlat))
+    # signed range to go: positive if the target is still ahead along the velocity heading
+    from drake_entry.planning.drag_energy import bearing
+
+    ahead = math.cos(bearing(x[1], x[2], tlon, tlat) - x[5]) >= 0.0
+    return {"altitude_m": float(x[0] - h_f), "longitude_deg": math.degrees(x[1] - tlon),
+            "latitude_deg": math.degrees(x[2] - tlat), "velocity_m_s": float(x[3] - V_f),
+            "range_to_go_m": dist if ahead else -dist, "distance_m": dist}
+
+
+def fly(scenario: Scenario, planner: DragEnergyPlanner | None = None, *, initial_state=None,
+        nav_seed: int = 0, nav_bias=None, nav_noise=None, density_scale: float = 1.0) -> ClosedLoopResult:
+    """Fly the closed loop once (the nominal entry state unless ``initial_state`` is given)."""
+    diagram, loggers, planner = build_closed_loop(scenario, planner, nav_seed=nav_seed, nav_bias=nav_bias,
+                                                  nav_noise=nav_noise, density_scale=density_scale)
+    tr, simulator = run(diagram, loggers, scenario, sources=SOURCES, initial_state=initial_state)
+    ctx = simulator.get_context()
+    guidance = diagram.GetSubsystemByName("guidance")
+    mem = guidance.memory(guidance.GetMyContextFromRoot(ctx))
+    reversal = diagram.GetSubsystemByName("bank_reversal")
+    n_rev = int(reversal.GetOutputPort("reversals").Eval(reversal.GetMyContextFromRoot(ctx))[0])
+    x = tr.state[-1]
+    errors = terminal_errors(x, scenario, planner)
+    reached = "energy" in tr.reason
+    ok = reached and mem.engaged_at is not None
+    if ok:
+        msg = f"reached E_f at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
+    elif mem.engaged_at is None:
+        last = mem.failures[-1][1] if mem.failures else "engagement condition never met"
+        msg = f"guidance never engaged: {last}"
+    else:
+        msg = f"stopped before E_f: {tr.reason}"
+    return ClosedLoopResult(tr, mem.reference, errors, mem.engaged_at, mem.plans, n_rev, mem.failures, ok, msg)
+
+
+def dispersed_entry(scenario: Scenario, seed: int, index: int,
+                    dispersion: EntryDispersion | None = None) -> np.ndarray:
+    """Entry state of Monte-Carlo sample ``index`` (paper 000 Table 2 by default)."""
+    dispersion = dispersion or EntryDispersion.paper000_table2()
+    return dispersion.apply(scenario.initial_state(), seed, index)

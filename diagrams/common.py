@@ -1,0 +1,105 @@
+"""Pieces every diagram runner shares: the Trajectory record, integrator set-up, and a
+run loop that stops on the termination monitor and appends the exact final instant."""
+from __future__ import annotations
+
+import dataclasses as dc
+import time as _time
+
+import numpy as np
+from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
+
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, STATE_NAMES
+from drake_entry.scenario import Scenario
+
+
+@dc.dataclass
+class Trajectory:
+    """A simulated trajectory sampled at the log period (plus the final instant).
+
+    Attributes:
+      time: [s], shape (n,). state: (n, 6) [h, lon, lat, V, gamma, psi] SI.
+      conditions: (n, 9) FlightConditions columns. bank, alpha: (n,) [rad].
+      reason: why the run stopped. wall_time: [s].
+      extra: other logged signals by name, (n, k) arrays.
+    """
+
+    time: np.ndarray
+    state: np.ndarray
+    conditions: np.ndarray
+    bank: np.ndarray
+    alpha: np.ndarray
+    reason: str
+    wall_time: float
+    extra: dict = dc.field(default_factory=dict)
+
+    def column(self, name: str) -> np.ndarray:
+        if name in STATE_NAMES:
+            return self.state[:, STATE_NAMES.index(name)]
+        if name in FLIGHT_CONDITION_NAMES:
+            return self.conditions[:, FLIGHT_CONDITION_NAMES.index(name)]
+        return {"time": self.time, "bank": self.bank, "alpha": self.alpha}[name]
+
+    def table(self) -> dict:
+        """Columns with units in the names (for Parquet / CSV)."""
+        out = {"time_s": self.time,
+               "altitude_m": self.state[:, 0], "longitude_deg": np.degrees(self.state[:, 1]),
+               "latitude_deg": np.degrees(self.state[:, 2]), "velocity_m_s": self.state[:, 3],
+               "flight_path_deg": np.degrees(self.state[:, 4]), "heading_deg": np.degrees(self.state[:, 5]),
+               "bank_deg": np.degrees(self.bank), "alpha_deg": np.degrees(self.alpha)}
+        units = {"rho": "density_kg_m3", "mach": "mach", "dynamic_pressure": "dynamic_pressure_Pa",
+                 "heat_flux": "heat_flux_W_m2", "normal_load": "normal_load_g", "total_load": "total_load_g",
+                 "lift": "lift_m_s2", "drag": "drag_m_s2", "energy": "energy_J_kg"}
+        for i, name in enumerate(FLIGHT_CONDITION_NAMES):
+            out[units[name]] = self.conditions[:, i]
+        return out
+
+
+def configure_integrator(simulator: Simulator, scenario: Scenario):
+    """Integrator, accuracy and maximum step from the scenario (RK5 by default; see DESIGN.md)."""
+    sim = scenario.simulation
+    integrator = ResetIntegratorFromFlags(simulator, sim.integrator, sim.max_step_s)
+    integrator.set_target_accuracy(sim.accuracy)
+    integrator.set_maximum_step_size(sim.max_step_s)
+    # witness functions need the context accuracy set explicitly (DESIGN.md)
+    simulator.get_mutable_context().SetAccuracy(sim.accuracy)
+    return integrator
+
+
+def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_state=None,
+        prepare=None) -> tuple[Trajectory, Simulator]:
+    """Simulate ``diagram`` to a terminal condition or max_time_s.
+
+    Args:
+      loggers: name -> VectorLogSink; must include 'state', 'conditions', 'bank', 'alpha'.
+      sources: name -> (system name, output port name or index) giving each logged signal's value
+        at the final instant (appended after the witness-located stop).
+      initial_state: entry state to use instead of the scenario's.
+      prepare: optional callable(simulator) run after the integrator is configured.
+    """
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    plant = diagram.GetSubsystemByName("vehicle")
+    if initial_state is not None:
+        plant.set_initial_state(plant.GetMyMutableContextFromRoot(context), initial_state)
+    configure_integrator(simulator, scenario)
+    if prepare is not None:
+        prepare(simulator)
+    simulator.Initialize()
+    t0 = _time.perf_counter()
+    status = simulator.AdvanceTo(scenario.simulation.max_time_s)
+    wall = _time.perf_counter() - t0
+    reason = status.message() if status.reason() != status.ReturnReason.kReachedBoundaryTime else "max_time"
+    t_end = context.get_time()
+    data = {}
+    times = loggers["state"].FindLog(context).sample_times()
+    keep = times < t_end - 1e-9
+    for name, logger in loggers.items():
+        system_name, port = sources[name]
+        system = diagram.GetSubsystemByName(system_name)
+        port = system.GetOutputPort(port) if isinstance(port, str) else system.get_output_port(port)
+        final = port.Eval(system.GetMyContextFromRoot(context))
+        data[name] = np.column_stack([logger.FindLog(context).data()[:, keep], final]).T
+    extra = {k: v for k, v in data.items() if k not in ("state", "conditions", "bank", "alpha")}
+    tr = Trajectory(time=np.append(times[keep], t_end), state=data["state"], conditions=data["conditions"],
+                    bank=data["bank"][:, 0], alpha=data["alpha"][:, 0], reason=reason, wall_time=wall, extra=extra)
+    return tr, simulator

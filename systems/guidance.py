@@ -1,0 +1,93 @@
+"""DragEnergyGuidance: plans the drag-energy reference on board and serves it (paper 000).
+
+Pre-guidance (Sec. IV.A): until the drag stops rising (D' >= 0, the flight-path angle
+levels out) after ``pre_guidance_min_s``, no reference is served. Then the SOCP is solved
+from the navigation estimate (one plan, about 10 ms of solver time at 40 nodes); with
+``replan_period_s`` > 0 it is re-solved from the current estimate at that period until the
+normalised energy reaches ``replan_until_e``. A failed plan keeps the previous reference
+(or stays in pre-guidance), is recorded, and is retried a period later.
+
+Ports:
+  input  "estimated_state"  [6]
+  output "reference"        [4]  D_ref [m/s^2], D'_ref [1/m], D''_ref [s^2/m^3] at the
+                                 estimate's energy, engaged flag (1 after the first plan)
+"""
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import LeafSystem
+
+from drake_entry.planning.drag_energy import DragEnergyPlanner, DragEnergyReference
+
+
+@dataclass
+class GuidanceMemory:
+    reference: DragEnergyReference | None = None
+    engaged_at: float | None = None
+    last_plan_at: float = -np.inf
+    plans: int = 0
+    failures: list = field(default_factory=list)  # (time, message)
+
+    def __deepcopy__(self, memo):
+        # Drake copies abstract state at every update; the reference is never mutated after
+        # planning, so copies share it (a deep copy of the corridor each second cost ~1 ms).
+        return GuidanceMemory(self.reference, self.engaged_at, self.last_plan_at, self.plans, list(self.failures))
+
+
+class DragEnergyGuidance(LeafSystem):
+    def __init__(self, planner: DragEnergyPlanner, *, period: float = 1.0, pre_guidance_min_s: float = 100.0,
+                 replan_period_s: float = 0.0, replan_until_e: float = 0.9):
+        super().__init__()
+        self.planner = planner
+        self.pre_min = pre_guidance_min_s
+        self.replan = replan_period_s
+        self.replan_until_e = replan_until_e
+        self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
+        self._memory = self.DeclareAbstractState(AbstractValue.Make(GuidanceMemory()))
+        self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._update)
+        self.DeclareVectorOutputPort("reference", 4, self._calc,
+                                     prerequisites_of_calc={self.est_port.ticket(), self.all_state_ticket()})
+
+    def memory(self, context) -> GuidanceMemory:
+        return context.get_abstract_state(int(self._memory)).get_value()
+
+    def _update(self, context, state):
+        mem = self.memory(context)
+        t = context.get_time()
+        x = self.est_port.Eval(context)
+        if mem.reference is None:
+            due = t >= self.pre_min and self.planner.drag_state(x).D_prime >= 0.0
+        else:
+            E0, Ef = self.planner.E_entry, self.planner.E_final
+            e = (E0 - self.planner.energy(x)) / (E0 - Ef)
+            due = self.replan > 0 and t - mem.last_plan_at >= self.replan - 1e-9 and e < self.replan_until_e
+        if not due:
+            return
+        new = copy.deepcopy(mem)
+        new.last_plan_at = t  # a failed re-plan is retried one re-plan period later
+        try:
+            ref = self.planner.plan_from_state(x)
+        except Exception as e:  # a numerical failure in planning must not stop the flight
+            ref = None
+            new.failures.append((t, f"{type(e).__name__}: {e}"))
+        if ref is not None and ref.success:
+            new.reference = ref
+            new.plans += 1
+            if new.engaged_at is None:
+                new.engaged_at = t
+        elif ref is not None:
+            new.failures.append((t, ref.message))
+        state.get_mutable_abstract_state(int(self._memory)).set_value(new)
+
+    def _calc(self, context, output):
+        mem = self.memory(context)
+        if mem.reference is None:
+            output.SetFromVector([0.0, 0.0, 0.0, 0.0])
+            return
+        E = self.planner.energy(self.est_port.Eval(context))
+        D, Dp, Dpp = mem.reference.profile(E)
+        output.SetFromVector([D[0], Dp[0], Dpp[0], 1.0])

@@ -11,6 +11,7 @@ from drake_entry.scenario import load_scenario
 def horus_1500s():
     s = load_scenario("horus2b")
     s.simulation.max_time_s = 1500.0
+    s.terminal.altitude_km, s.terminal.mach = 5.0, None  # fly the full 1500 s
     return s
 
 

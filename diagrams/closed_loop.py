@@ -20,7 +20,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from diagrams.common import Trajectory, run
 from drake_entry.dispersions import EntryDispersion
-from drake_entry.planning.drag_energy import DragEnergyPlanner, DragEnergyReference
+from drake_entry.planning.drag_energy import DragEnergyPlanner, DragEnergyReference, bearing
 from drake_entry.scenario import Scenario
 from systems.actuators import BankActuator
 from systems.atmosphere import AtmosphereSystem
@@ -43,7 +43,8 @@ class ClosedLoopResult:
       trajectory: the flown Trajectory (extra['reference'] = [D_ref, D'_ref, D''_ref, engaged]).
       reference: the last successful plan (None if guidance never engaged).
       errors: terminal errors (Table 3 form): altitude_m, longitude_deg, latitude_deg,
-        velocity_m_s, range_to_go_m (signed: + short of the target), distance_m.
+        velocity_m_s, range_to_go_m (along the heading, + short of the target),
+        crossrange_m (+ target to the right), distance_m.
       engaged_at: guidance engagement time [s]; plans: successful plans; reversals: count.
       planning_failures: list of (time, message).
       success: reached the terminal energy with guidance engaged.
@@ -62,14 +63,15 @@ class ClosedLoopResult:
 
 
 def build_closed_loop(scenario: Scenario, planner: DragEnergyPlanner | None = None, *, nav_seed: int = 0,
-                      nav_bias=None, nav_noise=None, density_scale: float = 1.0):
-    """Diagram, loggers and the planner (built from the scenario unless given)."""
+                      nav_bias=None, nav_noise=None, density_scale: float = 1.0, initial_state=None):
+    """Diagram, loggers and the planner (built from the scenario unless given).
+    ``initial_state`` becomes the vehicle's default state (what SetRandomContext keeps)."""
     planner = planner or DragEnergyPlanner.from_scenario(scenario)
     g = scenario.guidance
     vehicle, planet, atmosphere = planner.vehicle, scenario.make_planet(), planner.atmosphere
     builder = DiagramBuilder()
-    plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, planet, atmosphere,
-                                                           initial_state=scenario.initial_state(),
+    x0 = scenario.initial_state() if initial_state is None else np.asarray(initial_state, float)
+    plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, planet, atmosphere, initial_state=x0,
                                                            air_data_input=True))
     air = builder.AddNamedSystem("atmosphere", AtmosphereSystem(atmosphere, planet, density_scale=density_scale))
     nav = builder.AddNamedSystem("navigation", Navigation(bias=nav_bias, noise_sigma=nav_noise,
@@ -87,7 +89,7 @@ def build_closed_loop(scenario: Scenario, planner: DragEnergyPlanner | None = No
         initial_sign=1.0 if pre_bank >= 0 else -1.0))
     actuator = builder.AddNamedSystem("bank_actuator", BankActuator(
         bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit, accel_limit=vehicle.bank_accel_limit,
-        initial_bank=pre_bank))
+        initial_bank=pre_bank, period=g.period_s))
     alpha = builder.AddNamedSystem("alpha_schedule", ScheduleSource(
         planner.alpha, planner.planet, period=g.period_s, initial_value=planner.alpha(scenario.entry_energy())))
     monitor = builder.AddNamedSystem("termination", TerminationMonitor(
@@ -133,22 +135,25 @@ def terminal_errors(x, scenario: Scenario, planner: DragEnergyPlanner) -> dict:
     h_f, V_f, _ = scenario.guidance_terminal_state()
     tlon, tlat = planner.target
     dist = float(planner.planet.great_circle_distance(x[1], x[2], tlon, tlat))
-    # signed range to go: positive if the target is still ahead along the velocity heading
-    from drake_entry.planning.drag_energy import bearing
-
-    ahead = math.cos(bearing(x[1], x[2], tlon, tlat) - x[5]) >= 0.0
+    # range to go along the velocity heading (+ short of the target), and cross-range
+    rel = bearing(x[1], x[2], tlon, tlat) - x[5]
     return {"altitude_m": float(x[0] - h_f), "longitude_deg": math.degrees(x[1] - tlon),
             "latitude_deg": math.degrees(x[2] - tlat), "velocity_m_s": float(x[3] - V_f),
-            "range_to_go_m": dist if ahead else -dist, "distance_m": dist}
+            "range_to_go_m": dist * math.cos(rel), "crossrange_m": dist * math.sin(rel), "distance_m": dist}
 
 
 def fly(scenario: Scenario, planner: DragEnergyPlanner | None = None, *, initial_state=None,
         nav_seed: int = 0, nav_bias=None, nav_noise=None, density_scale: float = 1.0) -> ClosedLoopResult:
     """Fly the closed loop once (the nominal entry state unless ``initial_state`` is given)."""
     diagram, loggers, planner = build_closed_loop(scenario, planner, nav_seed=nav_seed, nav_bias=nav_bias,
-                                                  nav_noise=nav_noise, density_scale=density_scale)
-    tr, simulator = run(diagram, loggers, scenario, sources=SOURCES, initial_state=initial_state)
-    ctx = simulator.get_context()
+                                                  nav_noise=nav_noise, density_scale=density_scale,
+                                                  initial_state=initial_state)
+    tr, simulator = run(diagram, loggers, scenario, sources=SOURCES)
+    return summarise(diagram, simulator.get_context(), tr, scenario, planner)
+
+
+def summarise(diagram, ctx, tr: Trajectory, scenario: Scenario, planner: DragEnergyPlanner) -> ClosedLoopResult:
+    """ClosedLoopResult of a finished closed-loop simulation."""
     guidance = diagram.GetSubsystemByName("guidance")
     mem = guidance.memory(guidance.GetMyContextFromRoot(ctx))
     reversal = diagram.GetSubsystemByName("bank_reversal")

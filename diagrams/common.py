@@ -65,30 +65,14 @@ def configure_integrator(simulator: Simulator, scenario: Scenario):
     return integrator
 
 
-def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_state=None,
-        prepare=None) -> tuple[Trajectory, Simulator]:
-    """Simulate ``diagram`` to a terminal condition or max_time_s.
+def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason: str, wall_time: float) -> Trajectory:
+    """Trajectory from the loggers, with every logged signal's value at the final instant
+    appended (the witness-located stop).
 
     Args:
       loggers: name -> VectorLogSink; must include 'state', 'conditions', 'bank', 'alpha'.
-      sources: name -> (system name, output port name or index) giving each logged signal's value
-        at the final instant (appended after the witness-located stop).
-      initial_state: entry state to use instead of the scenario's.
-      prepare: optional callable(simulator) run after the integrator is configured.
+      sources: name -> (system name, output port name or index) giving each logged signal.
     """
-    simulator = Simulator(diagram)
-    context = simulator.get_mutable_context()
-    plant = diagram.GetSubsystemByName("vehicle")
-    if initial_state is not None:
-        plant.set_initial_state(plant.GetMyMutableContextFromRoot(context), initial_state)
-    configure_integrator(simulator, scenario)
-    if prepare is not None:
-        prepare(simulator)
-    simulator.Initialize()
-    t0 = _time.perf_counter()
-    status = simulator.AdvanceTo(scenario.simulation.max_time_s)
-    wall = _time.perf_counter() - t0
-    reason = status.message() if status.reason() != status.ReturnReason.kReachedBoundaryTime else "max_time"
     t_end = context.get_time()
     data = {}
     times = loggers["state"].FindLog(context).sample_times()
@@ -100,6 +84,32 @@ def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_st
         final = port.Eval(system.GetMyContextFromRoot(context))
         data[name] = np.column_stack([logger.FindLog(context).data()[:, keep], final]).T
     extra = {k: v for k, v in data.items() if k not in ("state", "conditions", "bank", "alpha")}
-    tr = Trajectory(time=np.append(times[keep], t_end), state=data["state"], conditions=data["conditions"],
-                    bank=data["bank"][:, 0], alpha=data["alpha"][:, 0], reason=reason, wall_time=wall, extra=extra)
+    return Trajectory(time=np.append(times[keep], t_end), state=data["state"], conditions=data["conditions"],
+                      bank=data["bank"][:, 0], alpha=data["alpha"][:, 0], reason=reason, wall_time=wall_time,
+                      extra=extra)
+
+
+def make_simulator(diagram, scenario: Scenario, *, initial_state=None) -> Simulator:
+    """Simulator with the scenario's integrator; optional entry state override."""
+    simulator = Simulator(diagram)
+    if initial_state is not None:
+        plant = diagram.GetSubsystemByName("vehicle")
+        plant.set_initial_state(plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()), initial_state)
+    configure_integrator(simulator, scenario)
+    return simulator
+
+
+def stop_reason(status) -> str:
+    return status.message() if status.reason() != status.ReturnReason.kReachedBoundaryTime else "max_time"
+
+
+def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_state=None) -> tuple[Trajectory, Simulator]:
+    """Simulate ``diagram`` to a terminal condition or max_time_s (see collect_trajectory)."""
+    simulator = make_simulator(diagram, scenario, initial_state=initial_state)
+    simulator.Initialize()
+    t0 = _time.perf_counter()
+    status = simulator.AdvanceTo(scenario.simulation.max_time_s)
+    wall = _time.perf_counter() - t0
+    tr = collect_trajectory(diagram, loggers, simulator.get_context(), sources=sources, reason=stop_reason(status),
+                            wall_time=wall)
     return tr, simulator

@@ -32,7 +32,10 @@ class EntryDispersion:
 
     def sample(self, seed: int, index: int = 0) -> np.ndarray:
         """Deviation of sample ``index`` of the campaign seeded with ``seed``."""
-        rng = np.random.default_rng([int(seed), int(index)])
+        return self.draw(np.random.default_rng([int(seed), int(index)]))
+
+    def draw(self, rng: np.random.Generator) -> np.ndarray:
+        """Deviation drawn from ``rng``."""
         s = np.asarray(self.scale, float)
         if self.distribution == "uniform":
             return rng.uniform(-1.0, 1.0, 6) * s

@@ -1,16 +1,27 @@
-"""BankActuator: second-order bank-angle actuator with angle, rate and acceleration limits.
+"""BankActuator: bank-angle actuator with angle, rate and acceleration limits.
 
 The law is drake_entry.actuator.bank_actuator_rates: the command is clipped to
 +-bank_limit and tracked with rate and acceleration limits, so a bank reversal (a sign
-flip of the command) rotates through wings-level at the rate limit.
+flip of the command) rotates through wings-level at the rate limit. Two realisations:
+
+  continuous  (period=None) the actuator state [sigma, sigma_dot] is continuous state.
+              Its inner loop (4 x bandwidth rad/s) bounds the step of explicit integrators.
+  sampled     (period=T) the command is sampled every T seconds; the same law is integrated
+              over the coming period in ``substep`` steps (RK2) and the output is the C1
+              Hermite interpolant of (sigma, sigma_dot) in time. No continuous state, so
+              the vehicle integrator takes steps as long as the flight allows.
 
 Ports:
   input  "bank_command"  [1]  sigma_cmd [rad]
-  output "bank"          [1]  sigma [rad] (state: no direct feedthrough)
+  output "bank"          [1]  sigma [rad] (no direct feedthrough)
   output "bank_rate"     [1]  sigma_dot [rad/s]
 """
 from __future__ import annotations
 
+import bisect
+
+import numpy as np
+from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.actuator import bank_actuator_rates
@@ -18,27 +29,92 @@ from drake_entry.actuator import bank_actuator_rates
 
 class BankActuator(LeafSystem):
     def __init__(self, *, bank_limit: float, rate_limit: float, accel_limit: float,
-                 bandwidth: float = 2.0, initial_bank: float = 0.0):
-        """Args: bank_limit [rad], rate_limit [rad/s], accel_limit [rad/s^2],
-        bandwidth omega [rad/s] of the position loop (the rate loop runs at 4 omega)."""
+                 bandwidth: float = 2.0, initial_bank: float = 0.0, period: float | None = None,
+                 substep: float = 0.01):
+        """Args: bank_limit [rad], rate_limit [rad/s], accel_limit [rad/s^2], bandwidth omega
+        [rad/s] of the position loop (the rate loop runs at 4 omega), initial_bank [rad],
+        period [s] for the sampled realisation (None = continuous), substep [s]."""
         super().__init__()
         for name, v in (("bank_limit", bank_limit), ("rate_limit", rate_limit),
                         ("accel_limit", accel_limit), ("bandwidth", bandwidth)):
             if not v > 0:
                 raise ValueError(f"BankActuator.{name} must be > 0, got {v}")
+        self.limits = dict(bank_limit=bank_limit, rate_limit=rate_limit, accel_limit=accel_limit,
+                           bandwidth=bandwidth)
         self.bank_limit, self.rate_limit, self.accel_limit = bank_limit, rate_limit, accel_limit
         self.omega = bandwidth
-        self.DeclareContinuousState(BasicVector([initial_bank, 0.0]))
         self.cmd_port = self.DeclareVectorInputPort("bank_command", 1)
-        state = {self.all_state_ticket()}
-        self.DeclareVectorOutputPort("bank", 1, lambda c, o: o.SetAtIndex(0, c.get_continuous_state_vector()[0]),
-                                     prerequisites_of_calc=state)
-        self.DeclareVectorOutputPort("bank_rate", 1,
-                                     lambda c, o: o.SetAtIndex(0, c.get_continuous_state_vector()[1]),
-                                     prerequisites_of_calc=state)
+        self.period = period
+        if period is None:
+            self.DeclareContinuousState(BasicVector([initial_bank, 0.0]))
+            state = {self.all_state_ticket()}
+            self.DeclareVectorOutputPort("bank", 1, lambda c, o: o.SetAtIndex(0, c.get_continuous_state_vector()[0]),
+                                         prerequisites_of_calc=state)
+            self.DeclareVectorOutputPort("bank_rate", 1,
+                                         lambda c, o: o.SetAtIndex(0, c.get_continuous_state_vector()[1]),
+                                         prerequisites_of_calc=state)
+            return
+        if not 0 < substep <= period:
+            raise ValueError(f"BankActuator.substep must be in (0, period], got {substep}")
+        self.n_sub = max(1, int(round(period / substep)))
+        self._segment = self.DeclareAbstractState(AbstractValue.Make(_constant_segment(initial_bank)))
+        self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._plan_segment)
+        deps = {self.abstract_state_ticket(self._segment), self.time_ticket()}
+        self.DeclareVectorOutputPort("bank", 1, lambda c, o: o.SetAtIndex(0, self._sample(c)[0]),
+                                     prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort("bank_rate", 1, lambda c, o: o.SetAtIndex(0, self._sample(c)[1]),
+                                     prerequisites_of_calc=deps)
 
     def DoCalcTimeDerivatives(self, context, derivatives):
+        if self.period is not None:  # sampled: no continuous state
+            return
         sigma, rate = context.get_continuous_state_vector().CopyToVector()
         derivatives.get_mutable_vector().SetFromVector(bank_actuator_rates(
-            sigma, rate, self.cmd_port.Eval(context)[0], bank_limit=self.bank_limit, rate_limit=self.rate_limit,
-            accel_limit=self.accel_limit, bandwidth=self.omega))
+            sigma, rate, self.cmd_port.Eval(context)[0], **self.limits))
+
+    # -- sampled realisation -------------------------------------------------------------
+    def _sample(self, context):
+        return context.get_abstract_state(int(self._segment)).get_value().at(context.get_time())
+
+    def _plan_segment(self, context, state):
+        t0 = context.get_time()
+        sigma, rate = self._sample(context)
+        cmd = float(self.cmd_port.Eval(context)[0])
+        h = self.period / self.n_sub
+        s, r = [sigma], [rate]
+        for _ in range(self.n_sub):  # RK2 (midpoint) on the actuator law
+            d1 = bank_actuator_rates(s[-1], r[-1], cmd, **self.limits)
+            d2 = bank_actuator_rates(s[-1] + 0.5 * h * d1[0], r[-1] + 0.5 * h * d1[1], cmd, **self.limits)
+            s.append(s[-1] + h * d2[0])
+            r.append(r[-1] + h * d2[1])
+        state.get_mutable_abstract_state(int(self._segment)).set_value(_Segment(t0, h, s, r))
+
+
+class _Segment:
+    """(sigma, sigma_dot) samples from t0 every h seconds; C1 cubic Hermite between them,
+    held after the last sample."""
+
+    def __init__(self, t0: float, h: float, sigma: list, rate: list):
+        self.t0, self.h, self.sigma, self.rate = t0, h, sigma, rate
+        self.times = [t0 + k * h for k in range(len(sigma))]
+
+    def at(self, t: float):
+        n = len(self.sigma) - 1
+        if n == 0 or t >= self.times[-1]:
+            return self.sigma[-1], self.rate[-1]
+        i = min(max(bisect.bisect_right(self.times, t) - 1, 0), n - 1)
+        h = self.h
+        u = (t - self.times[i]) / h
+        p0, p1 = self.sigma[i], self.sigma[i + 1]
+        m0, m1 = self.rate[i] * h, self.rate[i + 1] * h
+        u2, u3 = u * u, u * u * u
+        val = (2 * u3 - 3 * u2 + 1) * p0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * p1 + (u3 - u2) * m1
+        der = ((6 * u2 - 6 * u) * p0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * p1 + (3 * u2 - 2 * u) * m1) / h
+        return val, der
+
+    def __deepcopy__(self, memo):
+        return self  # immutable once built
+
+
+def _constant_segment(sigma: float) -> _Segment:
+    return _Segment(0.0, 1.0, [sigma], [0.0])

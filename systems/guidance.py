@@ -70,7 +70,7 @@ class DragEnergyGuidance(LeafSystem):
         new = copy.deepcopy(mem)
         new.last_plan_at = t  # a failed re-plan is retried one re-plan period later
         try:
-            ref = self.planner.plan_from_state(x)
+            ref = self.planner.plan_from_state(x, previous=mem.reference)
         except Exception as e:  # a numerical failure in planning must not stop the flight
             ref = None
             new.failures.append((t, f"{type(e).__name__}: {e}"))

@@ -146,3 +146,12 @@ def test_schedule_derivatives_equal_finite_differences(smooth):
         e = 1e3
         assert d1 == pytest.approx((sch(s + e) - sch(s - e)) / (2 * e), rel=1e-6)
         assert d2 == pytest.approx((sch(s + e) - 2 * v + sch(s - e)) / e**2, rel=1e-4, abs=1e-20)
+
+
+def test_sampled_actuator_reproduces_the_continuous_one():
+    kw = dict(bank_limit=np.radians(80.0), rate_limit=np.radians(10.0), accel_limit=np.radians(5.0),
+              initial_bank=np.radians(60.0))
+    t, cont, _ = _simulate_actuator(np.radians(-60.0), 30.0, **kw)
+    t, samp, rate = _simulate_actuator(np.radians(-60.0), 30.0, period=1.0, **kw)
+    assert np.abs(samp - cont).max() < np.radians(0.05)
+    assert np.abs(rate).max() <= np.radians(10.0) * (1 + 1e-3)

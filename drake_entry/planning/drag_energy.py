@@ -80,6 +80,8 @@ class DragEnergyProblem:
     sigma_max: float = math.radians(89.0)
     # a D0 outside the (margin-reduced) corridor by less than this fraction is projected onto it
     initial_tolerance: float = 0.03
+    # first guess of the ground-range weight kappa(E) (e.g. from the previous plan), or None
+    kappa_guess: object = None
 
     def validate(self):
         if not self.E0 > self.Ef:
@@ -144,6 +146,10 @@ class DragEnergyReference:
         D = 1.0 / I
         return D, -I1 / I**2, 2.0 * I1**2 / I**3 - I2 / I**2
 
+    def kappa_at(self, E) -> np.ndarray:
+        """Ground-range weight kappa = R cos(gamma)/r interpolated at energies E."""
+        return np.interp(E, self.energy[::-1], self.kappa[::-1])
+
     def range_flown(self) -> float:
         """Ground range of the profile [m] (eq. 83 with kappa)."""
         return float(-self.lgl.weights @ (self.kappa * self.I))
@@ -183,7 +189,10 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
     diag = _diagnose(p, op, D_lo, D_hi)
     if diag:
         return DragEnergyReference(False, "; ".join(d["message"] for d in diag), p, lgl=op, binding=diag)
-    kappa = np.full(p.n_nodes, p.planet.reference_radius / p.planet.radius(0.0))
+    if p.kappa_guess is not None:
+        kappa = np.asarray(p.kappa_guess(op.x), float)
+    else:
+        kappa = np.full(p.n_nodes, p.planet.reference_radius / p.planet.radius(0.0))
     ref = None
     total_build = total_solve = 0.0
     for it in range(max(1, p.range_iterations)):
@@ -404,5 +413,8 @@ class DragEnergyPlanner:
         kw.update(overrides)
         return DragEnergyProblem(**kw)
 
-    def plan_from_state(self, x, **overrides) -> DragEnergyReference:
+    def plan_from_state(self, x, previous: DragEnergyReference | None = None, **overrides) -> DragEnergyReference:
+        """Plan from state x; a successful ``previous`` plan seeds kappa(E), so one SOCP suffices."""
+        if previous is not None and previous.success and previous.kappa is not None:
+            overrides = {"kappa_guess": previous.kappa_at, "range_iterations": 1, **overrides}
         return plan(self.problem(x, **overrides))

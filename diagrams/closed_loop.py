@@ -46,6 +46,7 @@ class ClosedLoopResult:
         velocity_m_s, range_to_go_m (along the heading, + short of the target),
         crossrange_m (+ target to the right), distance_m.
       engaged_at: guidance engagement time [s]; plans: successful plans; reversals: count.
+      first_reference, engaged_state: the plan made at engagement and the estimate it used.
       planning_failures: list of (time, message).
       success: reached the terminal energy with guidance engaged.
       message: human summary.
@@ -60,6 +61,8 @@ class ClosedLoopResult:
     planning_failures: list
     success: bool
     message: str
+    first_reference: DragEnergyReference | None = None
+    engaged_state: np.ndarray | None = None
 
 
 def build_closed_loop(scenario: Scenario, planner: DragEnergyPlanner | None = None, *, nav_seed: int = 0,
@@ -169,7 +172,8 @@ def summarise(diagram, ctx, tr: Trajectory, scenario: Scenario, planner: DragEne
         msg = f"guidance never engaged: {last}"
     else:
         msg = f"stopped before E_f: {tr.reason}"
-    return ClosedLoopResult(tr, mem.reference, errors, mem.engaged_at, mem.plans, n_rev, mem.failures, ok, msg)
+    return ClosedLoopResult(tr, mem.reference, errors, mem.engaged_at, mem.plans, n_rev, mem.failures, ok, msg,
+                            mem.first_reference, mem.engaged_state)
 
 
 def dispersed_entry(scenario: Scenario, seed: int, index: int,
@@ -177,3 +181,22 @@ def dispersed_entry(scenario: Scenario, seed: int, index: int,
     """Entry state of Monte-Carlo sample ``index`` (paper 000 Table 2 by default)."""
     dispersion = dispersion or EntryDispersion.paper000_table2()
     return dispersion.apply(scenario.initial_state(), seed, index)
+
+
+def propagate_extracted_bank(scenario: Scenario, reference: DragEnergyReference, x0) -> Trajectory:
+    """Open-loop flight from x0 with the extracted bank magnitude sigma(E) and alpha(E)
+    (paper 000 Fig. 5: extracted states against open-loop propagation)."""
+    from diagrams.open_loop import simulate
+
+    sc = dc.replace(scenario)
+    x = reference.extraction
+    E = reference.energy[::-1]  # increasing
+    sc.bank = dc.replace(scenario.bank, variable="energy", breakpoints=list(E),
+                         values_deg=list(np.degrees(x.sigma[::-1])), smooth=False)
+    sc.alpha = dc.replace(scenario.alpha, variable="energy", breakpoints=list(reference.problem.alpha.breakpoints),
+                          values_deg=list(np.degrees(reference.problem.alpha.values)),
+                          smooth=reference.problem.alpha.smooth)
+    sc.terminal = dc.replace(scenario.terminal, altitude_km=None, mach=None, velocity_m_s=None,
+                             energy_MJ_kg=reference.problem.Ef / 1e6)
+    sc.simulation = dc.replace(scenario.simulation, integrator="runge_kutta5", accuracy=1e-8)
+    return simulate(sc, initial_state=x0)

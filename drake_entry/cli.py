@@ -1,6 +1,11 @@
 """drake-entry: plan, fly and analyse atmospheric-entry trajectories on Drake.
 
 Commands:
+  campaign SCENARIO   closed-loop Monte-Carlo campaign (Drake RandomSimulation) with a report
+  report DIR          (re)write the report of a campaign directory
+  fly SCENARIO        one closed-loop guided flight with plots
+  plan SCENARIO       the drag-energy corridor and the reference planned at engagement,
+                      extracted states against open-loop propagation (paper 000 Figs. 3-5)
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
   fit-horus           refit the HORUS-2B aero forms (paper 000 eqs. 32-33); print residuals
   bench               time the Drake open-loop HORUS flight against scipy solve_ivp
@@ -53,6 +58,94 @@ def _cmd_simulate(args) -> int:
     return 0
 
 
+def _cmd_fly(args) -> int:
+    from diagrams.closed_loop import fly
+
+    from .plots import tracking_plot, trajectory_plots
+    from .results import write_table
+    from .scenario import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    res = fly(scenario)
+    tr = res.trajectory
+    os.makedirs(args.out, exist_ok=True)
+    write_table(tr.table(), os.path.join(args.out, f"trajectory.{args.format}"))
+    limits = scenario.make_vehicle().limits
+    trajectory_plots(tr, args.out, limits=limits, target=(scenario.target.longitude_deg, scenario.target.latitude_deg),
+                     title=f"{scenario.name}: closed loop")
+    tracking_plot(tr, args.out, title=f"{scenario.name}: drag tracking")
+    summary = {"success": res.success, "message": res.message, "engaged_at_s": res.engaged_at, "plans": res.plans,
+               "reversals": res.reversals, "planning_failures": len(res.planning_failures), **res.errors,
+               "peak_heat_flux_kW_m2": float(tr.column("heat_flux").max() / 1e3),
+               "peak_dynamic_pressure_kPa": float(tr.column("dynamic_pressure").max() / 1e3),
+               "peak_normal_load_g": float(tr.column("normal_load").max()), "wall_time_s": tr.wall_time}
+    with open(os.path.join(args.out, "summary.json"), "w") as f:
+        json.dump(summary, f, indent=2, default=float)
+    for k, v in summary.items():
+        print(f"{k:28s} {v:.6g}" if isinstance(v, float) else f"{k:28s} {v}")
+    print(f"wrote trajectory, summary and plots to {args.out}")
+    return 0 if res.success else 1
+
+
+def _cmd_plan(args) -> int:
+    from diagrams.closed_loop import fly, propagate_extracted_bank
+
+    from .plots import corridor_plot, extraction_plot
+    from .scenario import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    scenario.guidance.replan_period_s = 0.0
+    res = fly(scenario)
+    ref = res.first_reference
+    if ref is None:
+        print(f"drake-entry: the guidance never engaged: {res.message}", file=sys.stderr)
+        return 1
+    p = ref.problem
+    E0, Ef = scenario.entry_energy(), p.Ef
+    paths = corridor_plot(p.corridor, E0, Ef, args.out, reference=ref, title=f"{scenario.name}: drag-energy plan")
+    prop = propagate_extracted_bank(scenario, ref, res.engaged_state)
+    paths += extraction_plot(ref, prop, p.planet, args.out, title=f"{scenario.name}: extraction")
+    viol = ref.corridor_violation()
+    x = ref.extraction
+    print(f"engaged at t = {res.engaged_at:.0f} s, e = {(E0 - p.E0) / (E0 - Ef):.3f}, D0 = {p.D0:.3f} m/s^2, "
+          f"range to go {p.range_to_go / 1e3:.1f} km")
+    print(f"SOCP ({p.solver}, {p.n_nodes} nodes): {ref.message}; build {1e3 * ref.build_time:.1f} ms, "
+          f"solve {1e3 * ref.solve_time:.1f} ms")
+    print(f"binding: {[(b['bound'], b['nodes']) for b in ref.binding]}; between nodes: "
+          f"{100 * viol['above_max']:.2f} % above D_max (at e = {viol['above_max_at_e']:.3f}), "
+          f"{100 * viol['below_min']:.2f} % below D_min")
+    print(f"extracted: final h {x.h[-1] / 1e3:.2f} km, V {x.V[-1]:.0f} m/s; bank saturated at "
+          f"{int(x.saturated.sum())} nodes; open-loop propagation ends at h {prop.state[-1, 0] / 1e3:.2f} km")
+    print(f"wrote {len(paths)} plots to {args.out}")
+    return 0
+
+
+def _cmd_campaign(args) -> int:
+    from diagrams.montecarlo import run_campaign
+
+    from .report import write_report, summary_statistics, table3_markdown  # noqa: F401
+
+    out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers)
+    return _cmd_report(argparse.Namespace(dir=out))
+
+
+def _cmd_report(args) -> int:
+    from .report import table3_markdown, write_report
+    from .scenario import load_scenario
+
+    meta_path = os.path.join(args.dir, "campaign.json")
+    limits = None
+    if os.path.exists(meta_path):
+        limits = load_scenario(json.load(open(meta_path))["scenario"]).make_vehicle().limits
+    path = write_report(args.dir, limits=limits)
+    stats = json.load(open(os.path.join(args.dir, "summary.json")))
+    print(table3_markdown(stats))
+    for k, m in stats["margins"].items():
+        print(f"worst {k}: {100 * m['worst']:.2f} % ({m['violations']} violations)")
+    print(f"{stats['successful']}/{stats['samples']} samples reached the terminal interface; report: {path}")
+    return 0
+
+
 def _cmd_fit_horus(args) -> int:
     from .aerodynamics import fit_horus_forms
     from .vehicles import load_vehicle
@@ -77,6 +170,25 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="drake-entry", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
+    c = sub.add_parser("campaign", help="closed-loop Monte-Carlo campaign with a report")
+    c.add_argument("scenario", help="packaged scenario name or YAML path")
+    c.add_argument("--runs", type=int, default=100)
+    c.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    c.add_argument("--seed", type=int, default=0, help="campaign seed; sample i is reproducible from (seed, i)")
+    c.add_argument("--out", default="out/campaign", help="campaign directory (re-running resumes it)")
+    c.set_defaults(func=_cmd_campaign)
+    r = sub.add_parser("report", help="write the report of a campaign directory")
+    r.add_argument("dir")
+    r.set_defaults(func=_cmd_report)
+    fl = sub.add_parser("fly", help="one closed-loop guided flight")
+    fl.add_argument("scenario")
+    fl.add_argument("--out", default="out/fly")
+    fl.add_argument("--format", choices=("parquet", "csv"), default="parquet")
+    fl.set_defaults(func=_cmd_fly)
+    pl = sub.add_parser("plan", help="corridor, reference and extraction plots (paper 000 Figs. 3-5)")
+    pl.add_argument("scenario")
+    pl.add_argument("--out", default="out/plan")
+    pl.set_defaults(func=_cmd_plan)
     p = sub.add_parser("simulate", help="fly the open-loop diagram of a scenario")
     p.add_argument("scenario", help="packaged scenario name (horus2b, shefex3, cav_h, marv) or a YAML path")
     p.add_argument("--out", default="out/simulate", help="output directory")

@@ -27,6 +27,8 @@ from drake_entry.planning.drag_energy import DragEnergyPlanner, DragEnergyRefere
 @dataclass
 class GuidanceMemory:
     reference: DragEnergyReference | None = None
+    first_reference: DragEnergyReference | None = None  # the plan at engagement
+    engaged_state: object = None  # navigation estimate at engagement
     engaged_at: float | None = None
     last_plan_at: float = -np.inf
     plans: int = 0
@@ -35,7 +37,8 @@ class GuidanceMemory:
     def __deepcopy__(self, memo):
         # Drake copies abstract state at every update; the reference is never mutated after
         # planning, so copies share it (a deep copy of the corridor each second cost ~1 ms).
-        return GuidanceMemory(self.reference, self.engaged_at, self.last_plan_at, self.plans, list(self.failures))
+        return GuidanceMemory(self.reference, self.first_reference, self.engaged_state, self.engaged_at,
+                              self.last_plan_at, self.plans, list(self.failures))
 
 
 class DragEnergyGuidance(LeafSystem):
@@ -79,6 +82,8 @@ class DragEnergyGuidance(LeafSystem):
             new.plans += 1
             if new.engaged_at is None:
                 new.engaged_at = t
+                new.first_reference = ref
+                new.engaged_state = np.array(x)
         elif ref is not None:
             new.failures.append((t, ref.message))
         state.get_mutable_abstract_state(int(self._memory)).set_value(new)

@@ -1,0 +1,221 @@
+"""Campaign reports: Table-3-style statistics, margins and plots, written as Markdown + PNG.
+
+``summary_statistics(rows)`` gives mean, 1-sigma and percentiles of the terminal errors
+(paper 000 Table 3; paper 003 Table 3 counts inside 25/50/75 km) and the worst
+path-constraint margins. ``write_report(out_dir)`` reads a campaign directory
+(samples.parquet, trajectories.parquet) and writes report.md with its figures.
+"""
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+
+from . import plots  # noqa: F401  (sets the Agg backend)
+import matplotlib.pyplot as plt  # noqa: E402
+
+ERROR_COLUMNS = (("err_altitude_m", "Δh", "m"), ("err_longitude_deg", "Δθ", "deg"),
+                 ("err_latitude_deg", "Δφ", "deg"), ("err_velocity_m_s", "ΔV", "m/s"),
+                 ("err_range_m", "ΔR (range to go)", "m"), ("err_crossrange_m", "cross-range", "m"),
+                 ("err_distance_m", "distance to target", "m"))
+MARGIN_COLUMNS = ("margin_heat_flux", "margin_dynamic_pressure", "margin_normal_load")
+
+# paper 000 Table 3 (mean, 1-sigma), for side-by-side comparison
+PAPER000_TABLE3 = {"err_altitude_m": (168.6, 1107.3), "err_longitude_deg": (-0.0036, 0.0055),
+                   "err_latitude_deg": (-0.0047, 0.0096), "err_velocity_m_s": (12.1, 68.95),
+                   "err_range_m": (312.3, 1529.7)}
+
+
+def summary_statistics(rows: dict) -> dict:
+    """Statistics over successful samples; rows is a column dict (e.g. from Parquet)."""
+    ok = np.asarray(rows["success"], bool)
+    n = int(ok.size)
+    out = {"samples": n, "successful": int(ok.sum()), "failed": int(n - ok.sum()), "errors": {}, "margins": {}}
+    reasons = {}
+    for flag, msg in zip(ok, rows.get("message", [""] * n)):
+        if not flag:
+            key = str(msg).split(":")[0][:80]
+            reasons[key] = reasons.get(key, 0) + 1
+    out["failure_reasons"] = reasons
+    for col, _, _ in ERROR_COLUMNS:
+        if col not in rows:
+            continue
+        v = np.asarray(rows[col], float)[ok]
+        v = v[np.isfinite(v)]
+        if v.size == 0:
+            continue
+        out["errors"][col] = {"mean": float(v.mean()), "std": float(v.std(ddof=1)) if v.size > 1 else 0.0,
+                              "p5": float(np.percentile(v, 5)), "p50": float(np.percentile(v, 50)),
+                              "p95": float(np.percentile(v, 95)), "max_abs": float(np.abs(v).max())}
+    if "err_distance_m" in rows:
+        d = np.asarray(rows["err_distance_m"], float)[ok]
+        out["inside_km"] = {str(r): int((d <= r * 1e3).sum()) for r in (2, 25, 50, 75)}
+    for col in MARGIN_COLUMNS:
+        if col in rows:
+            m = np.asarray(rows[col], float)[ok]
+            if m.size:
+                out["margins"][col] = {"worst": float(m.min()), "violations": int((m < 0).sum()),
+                                       "worst_sample": int(np.asarray(rows["index"])[ok][m.argmin()])}
+    if "wall_time_s" in rows:
+        w = np.asarray(rows["wall_time_s"], float)
+        out["wall_time_s"] = {"mean": float(w.mean()), "total": float(w.sum())}
+    return out
+
+
+def table3_markdown(stats: dict) -> str:
+    """Paper 000 Table 3 layout, ours beside the paper's."""
+    lines = ["| variable | this campaign: mean ± 1σ | paper 000 Table 3 | unit |", "|---|---|---|---|"]
+    for col, label, unit in ERROR_COLUMNS:
+        if col not in stats["errors"]:
+            continue
+        s = stats["errors"][col]
+        paper = PAPER000_TABLE3.get(col)
+        ps = f"{paper[0]:g} ± {paper[1]:g}" if paper else "—"
+        fmt = "{:.4f}" if unit == "deg" else "{:.1f}"
+        lines.append(f"| {label} | {fmt.format(s['mean'])} ± {fmt.format(s['std'])} | {ps} | {unit} |")
+    return "\n".join(lines)
+
+
+def _read(out_dir: str, name: str):
+    import pyarrow.parquet as pq
+
+    path = os.path.join(out_dir, name)
+    return pq.read_table(path).to_pydict() if os.path.exists(path) else None
+
+
+def write_report(out_dir: str, *, title: str | None = None, limits=None) -> str:
+    """Write report.md, summary.json and PNG figures for the campaign in out_dir."""
+    rows = _read(out_dir, "samples.parquet")
+    if rows is None:
+        raise FileNotFoundError(f"{out_dir}/samples.parquet not found: run the campaign first")
+    traj = _read(out_dir, "trajectories.parquet")
+    stats = summary_statistics(rows)
+    meta = json.load(open(os.path.join(out_dir, "campaign.json"))) if os.path.exists(
+        os.path.join(out_dir, "campaign.json")) else {}
+    with open(os.path.join(out_dir, "summary.json"), "w") as f:
+        json.dump(stats, f, indent=2)
+    figs = []
+    ok = np.asarray(rows["success"], bool)
+
+    # histograms of the terminal errors
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
+    for ax, (col, label, unit) in zip(axes, (ERROR_COLUMNS[0], ERROR_COLUMNS[3], ERROR_COLUMNS[4])):
+        ax.hist(np.asarray(rows[col], float)[ok], bins=40, color="C0")
+        ax.set_xlabel(f"{label} [{unit}]")
+        ax.grid(True)
+    axes[0].set_ylabel("samples")
+    figs.append(_save(fig, out_dir, "error_histograms.png"))
+
+    # terminal footprint: range-to-go vs cross-range with a 2-sigma ellipse
+    fig, ax = plt.subplots(figsize=(5.5, 5))
+    x = np.asarray(rows["err_crossrange_m"], float)[ok] / 1e3
+    y = np.asarray(rows["err_range_m"], float)[ok] / 1e3
+    ax.plot(x, y, ".", ms=3)
+    if x.size > 2:
+        cov = np.cov(np.vstack([x, y]))
+        vals, vecs = np.linalg.eigh(cov)
+        t = np.linspace(0, 2 * np.pi, 200)
+        ell = vecs @ (2 * np.sqrt(np.maximum(vals, 0))[:, None] * np.vstack([np.cos(t), np.sin(t)]))
+        ax.plot(x.mean() + ell[0], y.mean() + ell[1], "r-", label="2σ ellipse")
+        ax.legend(fontsize=8)
+    ax.set_xlabel("cross-range [km]")
+    ax.set_ylabel("range to go [km]")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True)
+    figs.append(_save(fig, out_dir, "footprint.png"))
+
+    if traj is not None:
+        figs += _trajectory_figures(traj, out_dir, limits)
+
+    md = [f"# {title or 'Monte-Carlo campaign'}", "",
+          f"Scenario `{meta.get('scenario', '?')}`, {stats['samples']} samples (seed {meta.get('seed', '?')}, "
+          f"dispersion {meta.get('dispersion', '?')}, overrides {meta.get('overrides', {})}); "
+          f"{stats['successful']} reached the terminal interface, {stats['failed']} failed.", "",
+          "## Terminal errors (paper 000 Table 3 form)", "", table3_markdown(stats), "",
+          "ΔR is the range to go along the final heading (+ short of the target); the cross-range "
+          "is reported separately, the paper does not give it.", ""]
+    if stats.get("inside_km"):
+        md += ["Samples within a distance of the target: " + ", ".join(
+            f"{k} km: {v}" for k, v in stats["inside_km"].items()), ""]
+    md += ["## Path-constraint margins (worst over all runs; negative = violated)", "",
+           "| constraint | worst margin | violations | worst sample |", "|---|---|---|---|"]
+    for col, m in stats["margins"].items():
+        md.append(f"| {col.replace('margin_', '')} | {100 * m['worst']:.2f} % | {m['violations']} | {m['worst_sample']} |")
+    if stats["failure_reasons"]:
+        md += ["", "## Failed samples", ""] + [f"- {k}: {v}" for k, v in stats["failure_reasons"].items()]
+    md += ["", "## Figures", ""] + [f"![{os.path.basename(p)}]({os.path.basename(p)})" for p in figs]
+    path = os.path.join(out_dir, "report.md")
+    with open(path, "w") as f:
+        f.write("\n".join(md) + "\n")
+    return path
+
+
+def _trajectory_figures(traj: dict, out_dir: str, limits) -> list:
+    figs = []
+    sample = np.asarray(traj["sample"])
+    E = np.asarray(traj["energy_J_kg"], float)
+    E0, Ef = E.max(), E.min()
+    e = (E0 - E) / (E0 - Ef)
+    groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+    for ax, (col, scale, label) in zip(axes.ravel(), (("altitude_m", 1e-3, "altitude [km]"),
+                                                       ("velocity_m_s", 1e-3, "speed [km/s]"),
+                                                       ("flight_path_deg", 1.0, "flight-path angle [deg]"),
+                                                       ("bank_deg", 1.0, "bank [deg]"))):
+        v = np.asarray(traj[col], float) * scale
+        for g in groups:
+            ax.plot(e[g], v[g], lw=0.4, alpha=0.5)
+        ax.set_ylabel(label)
+        ax.grid(True)
+    for ax in axes[1]:
+        ax.set_xlabel("normalised energy e")
+    figs.append(_save(fig, out_dir, "states_vs_energy.png"))  # paper 000 Fig. 6
+
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    for ax, (col, scale, label, lim) in zip(axes, (
+            ("dynamic_pressure_Pa", 1e-3, "dynamic pressure [kPa]", "dynamic_pressure_max"),
+            ("heat_flux_W_m2", 1e-3, "heat flux [kW/m^2]", "heat_flux_max"),
+            ("normal_load_g", 1.0, "normal load [g]", "normal_load_max"))):
+        v = np.asarray(traj[col], float) * scale
+        for g in groups:
+            ax.plot(e[g], v[g], lw=0.4, alpha=0.5)
+        if limits is not None and np.isfinite(getattr(limits, lim)):
+            ax.axhline(getattr(limits, lim) * scale, color="r", ls="--", lw=1)
+        ax.set_xlabel("normalised energy e")
+        ax.set_ylabel(label)
+        ax.grid(True)
+    figs.append(_save(fig, out_dir, "constraints_vs_energy.png"))  # paper 000 Fig. 7
+
+    if "reference_drag_m_s2" in traj:
+        fig, ax = plt.subplots(figsize=(6.5, 4.5))
+        ref = np.asarray(traj["reference_drag_m_s2"], float)
+        D = np.asarray(traj["drag_m_s2"], float)
+        for g in groups:
+            m = ref[g] > 0
+            ax.plot(e[g][m], ref[g][m], lw=0.4, alpha=0.5)
+        ax.plot([], [], label="references (one per sample)")
+        ax.plot(e, D, ",", color="k", alpha=0.3, label="flown")
+        ax.set_xlabel("normalised energy e")
+        ax.set_ylabel("drag [m/s^2]")
+        ax.legend(fontsize=8)
+        ax.grid(True)
+        figs.append(_save(fig, out_dir, "drag_profiles.png"))  # paper 000 Fig. 8
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    lon, lat = np.asarray(traj["longitude_deg"]), np.asarray(traj["latitude_deg"])
+    for g in groups:
+        ax.plot(lon[g], lat[g], lw=0.4, alpha=0.5)
+    ax.set_xlabel("longitude [deg]")
+    ax.set_ylabel("latitude [deg]")
+    ax.grid(True)
+    figs.append(_save(fig, out_dir, "groundtracks.png"))  # paper 000 Fig. 9
+    return figs
+
+
+def _save(fig, out_dir, name) -> str:
+    fig.tight_layout()
+    path = os.path.join(out_dir, name)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

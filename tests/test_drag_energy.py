@@ -1,0 +1,186 @@
+"""Paper 000 method: corridor, SOCP in I = 1/D, extraction, tracking and reversals."""
+import dataclasses as dc
+import math
+
+import numpy as np
+import pytest
+
+from drake_entry.drag_dynamics import drag_acceleration
+from drake_entry.planning.drag_energy import DragEnergyPlanner, plan
+from drake_entry.scenario import load_scenario
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return load_scenario("horus2b")
+
+
+@pytest.fixture(scope="module")
+def planner(scenario):
+    return DragEnergyPlanner.from_scenario(scenario)
+
+
+@pytest.fixture(scope="module")
+def engagement_state():
+    """Pre-guidance end of the nominal flight (measured: t = 300 s, e = 0.042)."""
+    return np.array([77438.3, math.radians(-90.93), math.radians(-16.93), 7332.0, math.radians(-0.0158),
+                     math.radians(73.5)])
+
+
+def _state_on_bound(planner, i, name):
+    """(h, V, alpha) where constraint ``name`` reaches its limit at corridor energy i."""
+    c = planner.corridor
+    E, alpha = c.energy[i], c.alpha[i]
+    from drake_entry.planning.drag_energy import altitude_speed_from_drag
+
+    h, V = altitude_speed_from_drag(E, c.upper[name][i], alpha, planner.vehicle, planner.planet, planner.atmosphere)
+    return h, V, alpha
+
+
+def test_corridor_upper_bound_equals_the_heat_flux_limit_where_heat_flux_binds(planner):
+    c = planner.corridor
+    act = c.active()
+    i = next(k for k in range(len(act)) if act[k] == "heat_flux" and c.energy[k] > -4.0e7)
+    h, V, _ = _state_on_bound(planner, i, "heat_flux")
+    rho = planner.atmosphere.density(h)
+    assert planner.vehicle.heat_flux(rho, V) == pytest.approx(530e3, rel=1e-4)
+
+
+def test_corridor_active_constraints_and_narrowest_point_match_the_feasibility_study(planner, scenario):
+    """shared/notes/paper000-horus.md: heat flux binds for e < 0.57, load factor to 0.85, then q;
+    narrowest D_max/D_min about 1.17 near e = 0.93 (with its own alpha ramp)."""
+    c = planner.corridor
+    E0, Ef = scenario.entry_energy(), planner.E_final
+    e = (E0 - c.energy) / (E0 - Ef)
+    act = np.array(c.active())
+    assert set(act[(e > 0.05) & (e < 0.5)]) == {"heat_flux"}
+    assert set(act[(e > 0.62) & (e < 0.84)]) == {"normal_load"}
+    assert "dynamic_pressure" in set(act[e > 0.95])
+    ratio = (c.D_max / (1 - c.margin)) / (c.D_min / (1 + c.margin))
+    k = np.argmin(np.where(e > 0.05, ratio, np.inf))
+    assert 1.05 < ratio[k] < 1.3 and 0.85 < e[k] < 1.0
+    assert c.empty_at.size == 0
+
+
+def test_equilibrium_glide_lower_bound_holds_lift_equal_to_gravity_minus_centrifugal(planner):
+    c = planner.corridor
+    i = len(c.energy) // 2
+    from drake_entry.planning.drag_energy import altitude_speed_from_drag
+
+    h, V = altitude_speed_from_drag(c.energy[i], c.D_eq_glide[i], c.alpha[i], planner.vehicle, planner.planet,
+                                    planner.atmosphere)
+    r = planner.planet.radius(h)
+    rho, _, a = planner.atmosphere.properties(h)
+    cl, _ = planner.vehicle.aero.coefficients(c.alpha[i], V / a)
+    L = 0.5 * rho * V * V * planner.vehicle.area_over_mass * cl
+    assert L == pytest.approx(planner.planet.mu / r**2 - V * V / r, rel=1e-5)
+
+
+@pytest.fixture(scope="module")
+def reference(planner, engagement_state):
+    ref = planner.plan_from_state(engagement_state)
+    assert ref.success, ref.message
+    return ref
+
+
+def test_socp_solution_satisfies_range_bounds_and_initial_conditions(reference):
+    p = reference.problem
+    assert reference.range_flown() == pytest.approx(p.range_to_go, rel=1e-6)  # eq. 83
+    lo, hi = p.corridor.bounds(reference.energy)
+    assert np.all(reference.D <= hi * (1 + 1e-6)) and np.all(reference.D >= lo * (1 - 1e-6))  # eq. 86
+    D, Dp, _ = reference.profile(p.E0)
+    assert D[0] == pytest.approx(p.D0, rel=1e-7)  # eq. 84
+    assert Dp[0] == pytest.approx(p.D0_prime, rel=1e-4, abs=1e-12)
+    assert reference.D[-1] == pytest.approx(p.Df, rel=1e-6)  # eq. 85
+
+
+def test_clarabel_is_optimal_against_an_independent_scs_solution(reference):
+    """An SCS (first-order) answer is either flagged inaccurate by the planner's own check,
+    or feasible and never cheaper than Clarabel's interior-point optimum (cost
+    s' + s'' = ||D1 I|| + ||D2 I||, eq. 92)."""
+    p = dc.replace(reference.problem, solver="scs", range_iterations=1, kappa_guess=reference.kappa_at)
+    scs = plan(p)
+    if not scs.success:
+        assert "inaccurate solution" in scs.message and "%" in scs.message or "range" in scs.message
+        return
+    op = reference.lgl
+
+    def cost(ref):
+        return np.linalg.norm(op.D1_tau @ (ref.I * p.D0)) + np.linalg.norm(op.D2_tau @ (ref.I * p.D0))
+
+    lo, hi = p.corridor.bounds(scs.energy)
+    assert np.all(scs.D <= hi * (1 + 1e-3)) and np.all(scs.D >= lo * (1 - 1e-3))  # the planner's check
+    assert scs.range_flown() == pytest.approx(p.range_to_go, rel=1e-5)
+    assert cost(reference) <= cost(scs) * (1 + 1e-6)
+
+
+def test_extraction_reproduces_energy_drag_and_drag_slope(reference, planner):
+    p = reference.problem
+    x = reference.extraction
+    for k in range(0, p.n_nodes, 7):
+        E = reference.energy[k]
+        assert planner.planet.specific_energy(x.h[k], x.V[k]) == pytest.approx(E, rel=1e-9)  # eq. 93
+        assert drag_acceleration(x.h[k], x.V[k], p.alpha(E), planner.vehicle, planner.atmosphere) == pytest.approx(
+            reference.D[k], rel=1e-6)
+    assert not x.saturated.any()
+    assert x.h[-1] == pytest.approx(26e3, abs=5.0)  # terminal drag pinned at 26 km, Mach 2.5
+
+
+def test_infeasible_range_is_diagnosed_not_raised(planner, engagement_state):
+    short = planner.plan_from_state(engagement_state, range_to_go=2000e3)
+    assert not short.success
+    assert "upper bound binds" in short.message and short.binding[0]["bound"] == "D_max"
+    long = planner.plan_from_state(engagement_state, range_to_go=9000e3)
+    assert not long.success and "lower bound binds" in long.message
+
+
+def test_nominal_terminal_point_violates_q_as_the_notes_say(planner, engagement_state, scenario):
+    """A fixed terminal drag at 25 km, Mach 2.5 is above D_max (q limit; notes)."""
+    h, V = 25e3, 2.5 * float(planner.atmosphere.speed_of_sound(25e3))
+    E = planner.planet.specific_energy(h, V)
+    Df = drag_acceleration(h, V, planner.alpha(E), planner.vehicle, planner.atmosphere)
+    ref = planner.plan_from_state(engagement_state, Df=Df)
+    assert not ref.success and "terminal drag" in ref.message and "above D_max" in ref.message
+
+
+def test_dense_grid_violation_shrinks_with_nodes(planner, engagement_state):
+    v = [planner.plan_from_state(engagement_state, n_nodes=n).corridor_violation()["above_max"] for n in (20, 60)]
+    assert v[1] < v[0]
+
+
+def test_bank_reversal_turns_back_at_the_corridor_edge():
+    from systems.bank_reversal import BankReversalLogic
+
+    logic = BankReversalLogic(target_lon=0.0, target_lat=0.0, corridor_deg=(5.0, 15.0),
+                              corridor_velocity=(1000.0, 6000.0))
+    # due east of the target, heading north: the target bears 270 deg, heading error +90 deg
+    x = np.array([50e3, math.radians(1.0), 0.0, 3500.0, 0.0, 0.0])
+    assert logic.heading_error(x) == pytest.approx(math.radians(90.0), abs=1e-6)
+    assert logic.limit(3500.0) == pytest.approx(math.radians(10.0))
+    assert logic.new_sign(x, +1.0) == -1.0  # turn left, towards the target
+    x[5] = math.radians(265.0)  # 5 deg error: inside the 10 deg corridor, keep the sign
+    assert logic.new_sign(x, +1.0) == +1.0 and logic.new_sign(x, -1.0) == -1.0
+
+
+def test_drag_tracking_recovers_from_a_perturbed_entry(scenario, planner):
+    """Controller stability: 250 m and 15 m/s off the entry interface, the loop still tracks its
+    reference within 4 % after engagement and reaches E_f within 3 km of the runway."""
+    from diagrams.closed_loop import fly
+
+    x0 = scenario.initial_state() + np.array([250.0, 0, 0, -15.0, math.radians(0.01), 0])
+    res = fly(scenario, planner, initial_state=x0)
+    assert res.success, res.message
+    tr = res.trajectory
+    ref = tr.extra["reference"]
+    on = (ref[:, 3] > 0.5) & (tr.time > res.engaged_at + 60.0)
+    assert np.max(np.abs(tr.column("drag")[on] / ref[on, 0] - 1.0)) < 0.04
+    assert res.errors["distance_m"] < 3e3
+    assert abs(res.errors["altitude_m"]) < 500.0
+    assert tr.column("heat_flux").max() <= 530e3 and tr.column("normal_load").max() <= 2.5
+
+
+def test_drag_tracking_sign_convention_requires_negative_zeta(planner):
+    from systems.drag_tracking import DragTrackingController
+
+    with pytest.raises(ValueError, match="zeta must be < 0"):
+        DragTrackingController(planner, zeta=0.7, omega=1e-6)

@@ -151,6 +151,17 @@ def apply_overrides(scenario: Scenario, overrides: dict):
     scenario.validate()
 
 
+def _trim_partial_line(path: str):
+    """Drop a last line cut by an interruption, so appended rows start on a fresh line."""
+    if not os.path.exists(path) or os.path.getsize(path) == 0:
+        return
+    with open(path, "rb+") as f:
+        data = f.read()
+        if data.endswith(b"\n"):
+            return
+        f.truncate(data.rfind(b"\n") + 1)
+
+
 def done_indices(out_dir: str) -> set:
     path = os.path.join(out_dir, "samples.jsonl")
     if not os.path.exists(path):
@@ -182,6 +193,8 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
                                                                         ("scenario", "seed", "overrides")}:
             raise ValueError(f"{out_dir} holds a campaign with other settings ({old}); use another --out")
     json.dump(meta, open(meta_path, "w"), indent=2)
+    for name in ("samples.jsonl", "trajectories.jsonl"):
+        _trim_partial_line(os.path.join(out_dir, name))
     todo = [i for i in range(runs) if i not in done_indices(out_dir)]
     workers = workers or os.cpu_count() or 1
     bar = None

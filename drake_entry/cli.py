@@ -8,7 +8,7 @@ Commands:
                       extracted states against open-loop propagation (paper 000 Figs. 3-5)
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
   fit-horus           refit the HORUS-2B aero forms (paper 000 eqs. 32-33); print residuals
-  bench               time the Drake open-loop HORUS flight against scipy solve_ivp
+  bench [open-loop|socp]  Drake open loop vs scipy solve_ivp; SOCP build/solve, Clarabel vs SCS
 """
 from __future__ import annotations
 
@@ -160,9 +160,12 @@ def _cmd_fit_horus(args) -> int:
 
 
 def _cmd_bench(args) -> int:
-    from .benchmark import open_loop_benchmark
+    from .benchmark import open_loop_benchmark, socp_benchmark
 
-    open_loop_benchmark(repeats=args.repeats)
+    if args.which in ("all", "open-loop"):
+        open_loop_benchmark(repeats=args.repeats)
+    if args.which in ("all", "socp"):
+        socp_benchmark(repeats=max(args.repeats, 5))
     return 0
 
 
@@ -196,7 +199,8 @@ def main(argv=None) -> int:
     p.set_defaults(func=_cmd_simulate)
     f = sub.add_parser("fit-horus", help="refit paper 000 eqs. 32-33 to the M-692 table; print residuals")
     f.set_defaults(func=_cmd_fit_horus)
-    b = sub.add_parser("bench", help="Drake open loop vs scipy solve_ivp, side by side")
+    b = sub.add_parser("bench", help="benchmarks: Drake open loop vs scipy; SOCP with Clarabel vs SCS")
+    b.add_argument("which", nargs="?", choices=("all", "open-loop", "socp"), default="all")
     b.add_argument("--repeats", type=int, default=3)
     b.set_defaults(func=_cmd_bench)
     args = parser.parse_args(argv)

@@ -29,12 +29,7 @@ def trajectory_plots(tr, out_dir: str, *, limits=None, target=None, title: str =
     paths = []
 
     def save(fig, name):
-        fig.suptitle(title, fontsize=10)
-        fig.tight_layout()
-        p = os.path.join(out_dir, name)
-        fig.savefig(p, dpi=110)
-        plt.close(fig)
-        paths.append(p)
+        _save(fig, out_dir, name, paths, title)
 
     fig, ax = plt.subplots(figsize=(6, 4.5))
     ax.plot(tr.column("V") / 1e3, tr.column("h") / 1e3)
@@ -96,6 +91,7 @@ def trajectory_plots(tr, out_dir: str, *, limits=None, target=None, title: str =
 
 
 def _save(fig, out_dir, name, paths, title=""):
+    """Save fig as out_dir/name (PNG), append the path to ``paths``, close it."""
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()

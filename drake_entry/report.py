@@ -12,7 +12,7 @@ import os
 
 import numpy as np
 
-from . import plots  # noqa: F401  (sets the Agg backend)
+from . import plots  # also sets the Agg backend
 import matplotlib.pyplot as plt  # noqa: E402
 
 ERROR_COLUMNS = (("err_altitude_m", "Δh", "m"), ("err_longitude_deg", "Δθ", "deg"),
@@ -214,8 +214,6 @@ def _trajectory_figures(traj: dict, out_dir: str, limits) -> list:
 
 
 def _save(fig, out_dir, name) -> str:
-    fig.tight_layout()
-    path = os.path.join(out_dir, name)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    paths = []
+    plots._save(fig, out_dir, name, paths)
+    return paths[0]

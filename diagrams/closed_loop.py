@@ -19,7 +19,9 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from diagrams.common import Trajectory, run
-from drake_entry.dispersions import EntryDispersion
+from drake_entry.aerodynamics import ScaledAero
+from drake_entry.atmosphere import DispersedAtmosphere
+from drake_entry.dispersions import Draw, EntryDispersion
 from drake_entry.planning.drag_energy import DragEnergyPlanner, DragEnergyReference, bearing
 from drake_entry.scenario import Scenario
 from systems.actuators import BankActuator
@@ -66,17 +68,28 @@ class ClosedLoopResult:
 
 
 def build_closed_loop(scenario: Scenario, planner: DragEnergyPlanner | None = None, *, nav_seed: int = 0,
-                      nav_bias=None, nav_noise=None, density_scale: float = 1.0, initial_state=None):
+                      nav_bias=None, nav_noise=None, initial_state=None, draw: Draw | None = None):
     """Diagram, loggers and the planner (built from the scenario unless given).
-    ``initial_state`` becomes the vehicle's default state (what SetRandomContext keeps)."""
+
+    ``initial_state`` becomes the vehicle's default state (what SetRandomContext keeps).
+    ``draw`` (a Monte-Carlo sample) disperses the plant: entry state, density, aerodynamic
+    scale factors, mass and navigation errors; the guidance keeps the nominal models.
+    """
     planner = planner or DragEnergyPlanner.from_scenario(scenario)
     g = scenario.guidance
     vehicle, planet, atmosphere = planner.vehicle, scenario.make_planet(), planner.atmosphere
+    if draw is not None:
+        vehicle = dc.replace(vehicle, mass=vehicle.mass * draw.mass_scale,
+                             aero=ScaledAero(vehicle.aero, draw.lift_scale, draw.drag_scale))
+        atmosphere = DispersedAtmosphere(atmosphere, scale=draw.density_scale, amplitude=draw.density_wave_amplitude,
+                                         wavelength=draw.density_wave_length, phase=draw.density_wave_phase)
+        initial_state = scenario.initial_state() + draw.entry_delta
+        nav_bias, nav_noise, nav_seed = draw.nav_bias, draw.nav_noise_sigma, draw.nav_seed
     builder = DiagramBuilder()
     x0 = scenario.initial_state() if initial_state is None else np.asarray(initial_state, float)
     plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, planet, atmosphere, initial_state=x0,
                                                            air_data_input=True))
-    air = builder.AddNamedSystem("atmosphere", AtmosphereSystem(atmosphere, planet, density_scale=density_scale))
+    air = builder.AddNamedSystem("atmosphere", AtmosphereSystem(atmosphere, planet))
     nav = builder.AddNamedSystem("navigation", Navigation(bias=nav_bias, noise_sigma=nav_noise,
                                                           period=g.period_s, seed=nav_seed))
     guidance = builder.AddNamedSystem("guidance", DragEnergyGuidance(
@@ -95,6 +108,7 @@ def build_closed_loop(scenario: Scenario, planner: DragEnergyPlanner | None = No
         initial_bank=pre_bank, period=g.period_s))
     alpha = builder.AddNamedSystem("alpha_schedule", ScheduleSource(
         planner.alpha, planner.planet, period=g.period_s, initial_value=planner.alpha(scenario.entry_energy())))
+    # vehicle limits (bank) are the true vehicle's; the plant flies the (possibly dispersed) models
     monitor = builder.AddNamedSystem("termination", TerminationMonitor(
         energy=planner.E_final, altitude=ALTITUDE_FLOOR_M, planet=planner.planet))
 
@@ -106,6 +120,9 @@ def build_closed_loop(scenario: Scenario, planner: DragEnergyPlanner | None = No
     builder.Connect(estimate, guidance.GetInputPort("estimated_state"))
     builder.Connect(estimate, controller.GetInputPort("estimated_state"))
     builder.Connect(guidance.GetOutputPort("reference"), controller.GetInputPort("reference"))
+    # the accelerometer's drag: guidance and feedback act on the drag actually felt
+    builder.Connect(plant.GetOutputPort("flight_conditions"), guidance.GetInputPort("flight_conditions"))
+    builder.Connect(plant.GetOutputPort("flight_conditions"), controller.GetInputPort("flight_conditions"))
     builder.Connect(estimate, reversal.GetInputPort("estimated_state"))
     builder.Connect(controller.GetOutputPort("bank_magnitude"), reversal.GetInputPort("bank_magnitude"))
     builder.Connect(reversal.GetOutputPort("bank_command"), actuator.get_input_port())
@@ -146,11 +163,11 @@ def terminal_errors(x, scenario: Scenario, planner: DragEnergyPlanner) -> dict:
 
 
 def fly(scenario: Scenario, planner: DragEnergyPlanner | None = None, *, initial_state=None,
-        nav_seed: int = 0, nav_bias=None, nav_noise=None, density_scale: float = 1.0) -> ClosedLoopResult:
-    """Fly the closed loop once (the nominal entry state unless ``initial_state`` is given)."""
+        nav_seed: int = 0, nav_bias=None, nav_noise=None, draw: Draw | None = None) -> ClosedLoopResult:
+    """Fly the closed loop once (the nominal entry state unless ``initial_state`` or a
+    Monte-Carlo ``draw`` is given)."""
     diagram, loggers, planner = build_closed_loop(scenario, planner, nav_seed=nav_seed, nav_bias=nav_bias,
-                                                  nav_noise=nav_noise, density_scale=density_scale,
-                                                  initial_state=initial_state)
+                                                  nav_noise=nav_noise, initial_state=initial_state, draw=draw)
     tr, simulator = run(diagram, loggers, scenario, sources=SOURCES)
     return summarise(diagram, simulator.get_context(), tr, scenario, planner)
 

@@ -25,12 +25,10 @@ from pydrake.systems.analysis import RandomSimulation
 
 from diagrams.closed_loop import SOURCES, build_closed_loop, summarise
 from diagrams.common import collect_trajectory, make_simulator
-from drake_entry.dispersions import EntryDispersion
+from drake_entry.dispersions import draw
 from drake_entry.planning.drag_energy import DragEnergyPlanner
 from drake_entry.scenario import Scenario, load_scenario
 
-STATE_UNITS_OUT = (("dh_m", 1.0), ("dlon_deg", 180 / math.pi), ("dlat_deg", 180 / math.pi), ("dV_m_s", 1.0),
-                   ("dgamma_deg", 180 / math.pi), ("dpsi_deg", 180 / math.pi))
 TRAJECTORY_STEP_S = 10.0
 
 
@@ -39,20 +37,18 @@ def sample_seed(campaign_seed: int, index: int) -> int:
     return int(np.random.SeedSequence([int(campaign_seed), int(index)]).generate_state(1)[0])
 
 
-def run_sample(scenario: Scenario, planner: DragEnergyPlanner, campaign_seed: int, index: int,
-               dispersion: EntryDispersion, *, keep_trajectory: bool = True) -> tuple[dict, dict | None]:
-    """One Monte-Carlo sample: (row, down-sampled trajectory columns or None)."""
+def run_sample(scenario: Scenario, planner: DragEnergyPlanner, campaign_seed: int, index: int, *,
+               keep_trajectory: bool = True) -> tuple[dict, dict | None]:
+    """One Monte-Carlo sample of ``scenario.dispersions``: (row, down-sampled trajectory
+    columns or None)."""
     seed = sample_seed(campaign_seed, index)
     t_wall = time.perf_counter()
     row = {"index": int(index), "seed": seed}
     box = {}
 
     def make(generator: RandomGenerator):
-        rng = np.random.default_rng([generator(), generator()])
-        delta = dispersion.draw(rng)
-        box["delta"] = delta
-        diagram, loggers, _ = build_closed_loop(scenario, planner, initial_state=scenario.initial_state() + delta,
-                                                nav_seed=int(generator()))
+        box["draw"] = d = draw(scenario.dispersions, generator)
+        diagram, loggers, _ = build_closed_loop(scenario, planner, draw=d)
         box["diagram"], box["loggers"] = diagram, loggers
         simulator = make_simulator(diagram, scenario)
         box["simulator"] = simulator
@@ -72,11 +68,11 @@ def run_sample(scenario: Scenario, planner: DragEnergyPlanner, campaign_seed: in
         tr = collect_trajectory(diagram, box["loggers"], ctx, sources=SOURCES, reason=reason,
                                 wall_time=time.perf_counter() - t_wall)
         res = summarise(diagram, ctx, tr, scenario, planner)
-        row.update(_row(res, planner, box["delta"]))
+        row.update(box["draw"].columns())
+        row.update(_row(res, planner))
         traj = _downsample(tr, index) if keep_trajectory else None
     except Exception as e:  # one failed sample never stops the campaign
-        row.update({f"disp_{n}": float(box["delta"][k] * f) for k, (n, f) in enumerate(STATE_UNITS_OUT)}
-                   if "delta" in box else {})
+        row.update(box["draw"].columns() if "draw" in box else {})
         row.update({"success": False, "message": f"{type(e).__name__}: {e}".splitlines()[0][:500],
                     "traceback": traceback.format_exc(limit=3)[-2000:]})
         traj = None
@@ -84,14 +80,14 @@ def run_sample(scenario: Scenario, planner: DragEnergyPlanner, campaign_seed: in
     return row, traj
 
 
-def _row(res, planner: DragEnergyPlanner, delta) -> dict:
+def _row(res, planner: DragEnergyPlanner) -> dict:
     tr = res.trajectory
     c = tr.conditions
     limits = planner.vehicle.limits
     peak_q = float(c[:, 2].max())
     peak_heat = float(c[:, 3].max())
     peak_nz = float(c[:, 4].max())
-    row = {f"disp_{n}": float(delta[k] * f) for k, (n, f) in enumerate(STATE_UNITS_OUT)}
+    row = {}
     row.update({
         "success": bool(res.success), "message": res.message, "stop": tr.reason,
         "flight_time_s": float(tr.time[-1]), "engaged_at_s": res.engaged_at if res.engaged_at is not None else np.nan,
@@ -135,7 +131,7 @@ def _init_worker(scenario_path: str, overrides: dict):
 
 def _work(args):
     seed, index = args
-    return run_sample(_WORKER["scenario"], _WORKER["planner"], seed, index, EntryDispersion.paper000_table2())
+    return run_sample(_WORKER["scenario"], _WORKER["planner"], seed, index)
 
 
 def apply_overrides(scenario: Scenario, overrides: dict):
@@ -186,7 +182,7 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     os.makedirs(out_dir, exist_ok=True)
     meta_path = os.path.join(out_dir, "campaign.json")
     meta = {"scenario": scenario_path, "runs": runs, "seed": seed, "overrides": overrides or {},
-            "dispersion": "paper000_table2"}
+            "dispersion": "scenario dispersions"}
     if os.path.exists(meta_path):
         old = json.load(open(meta_path))
         if {k: old.get(k) for k in ("scenario", "seed", "overrides")} != {k: meta[k] for k in

@@ -485,3 +485,24 @@ class CallableAero(AeroModel):
 
     def coefficients(self, alpha, mach):
         return self.cl(alpha, mach), self.cd(alpha, mach)
+
+
+@dataclass
+class ScaledAero(AeroModel):
+    """A dispersed vehicle's true aerodynamics: C_L and C_D of ``base`` times scale factors."""
+
+    base: AeroModel
+    lift_scale: float = 1.0
+    drag_scale: float = 1.0
+
+    def __post_init__(self):
+        if not self.lift_scale > 0 or not self.drag_scale > 0:
+            raise ValueError(f"ScaledAero scales must be > 0, got {self.lift_scale}, {self.drag_scale}")
+
+    def coefficients(self, alpha, mach):
+        cl, cd = self.base.coefficients(alpha, mach)
+        return cl * self.lift_scale, cd * self.drag_scale
+
+    def drag_derivatives(self, alpha: float, mach: float):
+        cd, cl = self.base.drag_derivatives(alpha, mach)
+        return CoefficientDerivatives(*(self.drag_scale * v for v in cd)), cl * self.lift_scale

@@ -305,6 +305,47 @@ class ExponentialAtmosphere(Atmosphere):
         return US76Atmosphere().temperature_derivatives(h)
 
 
+class DispersedAtmosphere(Atmosphere):
+    """A Monte-Carlo sample's true atmosphere: rho = rho_nominal * scale * (1 + A sin(2 pi h /
+    wavelength + phase)) (bias plus an altitude-correlated perturbation); temperature nominal.
+
+    Args: base atmosphere, scale (> 0), amplitude A in [0, 1), wavelength [m], phase [rad].
+    """
+
+    def __init__(self, base: Atmosphere, *, scale: float = 1.0, amplitude: float = 0.0,
+                 wavelength: float = 8000.0, phase: float = 0.0):
+        if not scale > 0 or not 0 <= amplitude < 1 or not wavelength > 0:
+            raise ValueError(f"DispersedAtmosphere needs scale > 0, 0 <= amplitude < 1, wavelength > 0 "
+                             f"(got {scale}, {amplitude}, {wavelength})")
+        self.base, self.scale, self.amplitude = base, scale, amplitude
+        self.k, self.phase = 2.0 * math.pi / wavelength, phase
+        self.name = f"dispersed {base.name}"
+        self.h_min, self.h_max = base.h_min, base.h_max
+        self.gas_constant, self.gamma = base.gas_constant, base.gamma
+
+    def _factor(self, h):
+        """f, f', f'' of the multiplicative perturbation."""
+        arg = self.k * np.asarray(h, float) + self.phase
+        a = self.amplitude
+        return (self.scale * (1.0 + a * np.sin(arg)), self.scale * a * self.k * np.cos(arg),
+                -self.scale * a * self.k**2 * np.sin(arg))
+
+    def density_derivatives(self, h) -> Derivatives:
+        d = self.base.density_derivatives(h)
+        f, f1, f2 = self._factor(h)
+        return Derivatives(d.value * f, d.d_h * f + d.value * f1, d.d_hh * f + 2 * d.d_h * f1 + d.value * f2)
+
+    def temperature_derivatives(self, h) -> Derivatives:
+        return self.base.temperature_derivatives(h)
+
+    def derivatives(self, h):
+        d, t = self.base.derivatives(h)
+        f, f1, f2 = self._factor(h)
+        if np.ndim(h) == 0:
+            f, f1, f2 = float(f), float(f1), float(f2)
+        return Derivatives(d.value * f, d.d_h * f + d.value * f1, d.d_hh * f + 2 * d.d_h * f1 + d.value * f2), t
+
+
 def make_atmosphere(name: str, **kwargs) -> Atmosphere:
     """Atmosphere by name: 'us76' or 'exponential' (keyword arguments go to the model)."""
     if name == "us76":

@@ -1,19 +1,138 @@
-"""Entry-interface dispersions: seeded draws of the initial-state error.
+"""Dispersions: declared in scenario YAML with Drake's schema distributions, drawn per
+Monte-Carlo sample from that sample's RandomGenerator.
 
-``EntryDispersion.paper000_table2()`` is paper 000 Table 2 (uniform). A draw depends only
-on (seed, sample index), so any Monte-Carlo sample can be re-run alone.
+    dispersions:
+      entry:                      # paper 000 Table 2 (uniform)
+        altitude_m: !Uniform {min: -250, max: 250}
+        velocity_m_s: !Uniform {min: -15, max: 15}
+        ...
+      density_scale: !Gaussian {mean: 1.0, stddev: 0.05}    # bias on the density
+      density_wave_amplitude: !Uniform {min: 0.0, max: 0.05} # altitude-correlated part
+      density_wave_length_km: 8.0
+      lift_scale: !Gaussian {mean: 1.0, stddev: 0.03}
+      drag_scale: !Gaussian {mean: 1.0, stddev: 0.03}
+      mass_scale: 1.0
+      nav_bias: !GaussianVector {mean: [0, 0, 0, 0, 0, 0], stddev: [50, 1e-6, 1e-6, 1, 1e-4, 1e-4]}
+      nav_noise_sigma: [10.0, 0.0, 0.0, 0.5, 0.0, 0.0]
+
+Every field also takes a plain number (deterministic). Fields not in SI carry their unit in
+the name. ``draw(spec, generator)`` returns a ``Draw`` with SI values, always consuming the
+generator in the same order so that a sample depends on (seed, index) only.
 """
-from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses as dc
+import math
+import typing
 
 import numpy as np
+import pydrake.common.schema as schema
+
+Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
+Vector = typing.Union[schema.DeterministicVectorX, schema.GaussianVectorX, schema.UniformVectorX]
 
 
-@dataclass(frozen=True)
+@dc.dataclass
+class EntryDispersionSpec:
+    """Deviation of the entry-interface state from the nominal."""
+
+    altitude_m: Scalar = 0.0
+    longitude_deg: Scalar = 0.0
+    latitude_deg: Scalar = 0.0
+    velocity_m_s: Scalar = 0.0
+    flight_path_deg: Scalar = 0.0
+    heading_deg: Scalar = 0.0
+
+
+@dc.dataclass
+class DispersionSpec:
+    """Everything a Monte-Carlo sample may disperse (defaults: nothing)."""
+
+    entry: EntryDispersionSpec = dc.field(default_factory=EntryDispersionSpec)
+    # true density = nominal * density_scale * (1 + amplitude sin(2 pi h / wavelength + phase))
+    density_scale: Scalar = 1.0
+    density_wave_amplitude: Scalar = 0.0
+    density_wave_length_km: float = 8.0
+    # true aerodynamic coefficients = nominal * scale; true mass = nominal * scale
+    lift_scale: Scalar = 1.0
+    drag_scale: Scalar = 1.0
+    mass_scale: Scalar = 1.0
+    # navigation: constant bias [state units, SI / rad] and white-noise sigma
+    nav_bias: Vector = dc.field(default_factory=lambda: schema.DeterministicVectorX(value=[0.0] * 6))
+    nav_noise_sigma: list[float] = dc.field(default_factory=lambda: [0.0] * 6)
+
+    @staticmethod
+    def paper000_table2() -> "DispersionSpec":
+        """Paper 000 Table 2: uniform entry-interface dispersions, nothing else."""
+        u = lambda a: schema.Uniform(min=-a, max=a)  # noqa: E731
+        return DispersionSpec(entry=EntryDispersionSpec(u(250.0), u(0.1), u(0.1), u(15.0), u(0.01), u(0.01)))
+
+
+@dc.dataclass(frozen=True)
+class Draw:
+    """One sample's dispersions in SI / rad."""
+
+    entry_delta: np.ndarray
+    density_scale: float = 1.0
+    density_wave_amplitude: float = 0.0
+    density_wave_length: float = 8000.0
+    density_wave_phase: float = 0.0
+    lift_scale: float = 1.0
+    drag_scale: float = 1.0
+    mass_scale: float = 1.0
+    nav_bias: np.ndarray = dc.field(default_factory=lambda: np.zeros(6))
+    nav_noise_sigma: np.ndarray = dc.field(default_factory=lambda: np.zeros(6))
+    nav_seed: int = 0
+
+    def columns(self) -> dict:
+        """Flat record for result tables (entry deviations in table units)."""
+        d = self.entry_delta
+        out = {"disp_dh_m": d[0], "disp_dlon_deg": math.degrees(d[1]), "disp_dlat_deg": math.degrees(d[2]),
+               "disp_dV_m_s": d[3], "disp_dgamma_deg": math.degrees(d[4]), "disp_dpsi_deg": math.degrees(d[5]),
+               "disp_density_scale": self.density_scale, "disp_density_wave": self.density_wave_amplitude,
+               "disp_lift_scale": self.lift_scale, "disp_drag_scale": self.drag_scale,
+               "disp_mass_scale": self.mass_scale}
+        for k, v in zip(("h", "lon", "lat", "V", "gamma", "psi"), self.nav_bias):
+            out[f"disp_nav_bias_{k}"] = v
+        return {k: float(v) for k, v in out.items()}
+
+
+def _sample(x, generator) -> float:
+    return float(x) if isinstance(x, (int, float)) else float(x.Sample(generator))
+
+
+def draw(spec: DispersionSpec, generator) -> Draw:
+    """Draw one sample (fixed order of draws; see module doc)."""
+    e = spec.entry
+    raw = [_sample(getattr(e, f.name), generator) for f in dc.fields(EntryDispersionSpec)]
+    delta = np.array([raw[0], math.radians(raw[1]), math.radians(raw[2]), raw[3], math.radians(raw[4]),
+                      math.radians(raw[5])])
+    scales = {k: _sample(getattr(spec, k), generator) for k in
+              ("density_scale", "density_wave_amplitude", "lift_scale", "drag_scale", "mass_scale")}
+    phase = 2.0 * math.pi * schema.Uniform(min=0.0, max=1.0).Sample(generator)
+    bias = np.asarray(spec.nav_bias.Sample(generator), float).ravel()
+    nav_seed = int(schema.UniformDiscrete(values=[float(v) for v in range(2**20)]).Sample(generator))
+    for k in ("density_scale", "lift_scale", "drag_scale", "mass_scale"):
+        if not scales[k] > 0:
+            raise ValueError(f"dispersions.{k} drew {scales[k]:g}; it must stay > 0 (narrow its distribution)")
+    return Draw(delta, scales["density_scale"], scales["density_wave_amplitude"],
+                spec.density_wave_length_km * 1e3, phase, scales["lift_scale"], scales["drag_scale"],
+                scales["mass_scale"], bias, np.asarray(spec.nav_noise_sigma, float), nav_seed)
+
+
+def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
+    """Shape and range checks that do not need a draw."""
+    if np.asarray(spec.nav_bias.Mean()).size != 6:
+        raise ValueError(f"{where}.nav_bias needs 6 entries [h, lon, lat, V, gamma, psi]")
+    if len(spec.nav_noise_sigma) != 6 or min(spec.nav_noise_sigma) < 0:
+        raise ValueError(f"{where}.nav_noise_sigma needs 6 entries >= 0")
+    if not spec.density_wave_length_km > 0:
+        raise ValueError(f"{where}.density_wave_length_km must be > 0, got {spec.density_wave_length_km}")
+
+
+@dc.dataclass(frozen=True)
 class EntryDispersion:
     """Half-widths (uniform) or standard deviations (gaussian) of [h, lon, lat, V, gamma, psi]
-    in SI / rad."""
+    in SI / rad, drawn with numpy (for scripts; campaigns use DispersionSpec)."""
 
     scale: tuple = (0.0,) * 6
     distribution: str = "uniform"

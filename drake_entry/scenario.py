@@ -12,6 +12,7 @@ from typing import Optional
 
 import numpy as np
 
+from . import dispersions as disp
 from .atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere, ExponentialAtmosphere, US76Atmosphere
 from .errors import ScenarioError, load_yaml_typed
 from .planet import Earth
@@ -154,6 +155,8 @@ class Scenario:
     bank: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
     simulation: SimulationSpec = dc.field(default_factory=SimulationSpec)
     guidance: GuidanceSpec = dc.field(default_factory=GuidanceSpec)
+    # Monte-Carlo dispersions (Drake schema distributions: !Uniform, !Gaussian, ...)
+    dispersions: disp.DispersionSpec = dc.field(default_factory=disp.DispersionSpec)
 
     # -- models ----------------------------------------------------------------------
     def make_vehicle(self) -> Vehicle:
@@ -262,6 +265,10 @@ class Scenario:
             self.schedule(which)
         self.make_planet()
         self.make_atmosphere()
+        try:
+            disp.validate(self.dispersions)
+        except ValueError as e:
+            raise ScenarioError(str(e)) from None
         if not self.vehicle:
             raise ScenarioError("vehicle: missing; give a packaged vehicle name or a vehicle YAML path")
         try:

@@ -12,6 +12,8 @@ engages, the pre-guidance bank is commanded.
 Ports:
   input  "estimated_state"  [6]
   input  "reference"        [4]  DragEnergyGuidance output
+  input  "flight_conditions" [9] (optional) the accelerometer's drag is fed back, with the
+                                 model's drag dynamics scaled to it (planner.drag_state)
   output "bank_magnitude"   [1]  |sigma_cmd| [rad] (discrete state: no feedthrough)
   output "vertical_control" [1]  u = (L/D) cos(sigma) demanded (before saturation)
 """
@@ -22,7 +24,9 @@ import math
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.planning.drag_energy import DragEnergyPlanner
+from systems.guidance import sensed_drag
 
 
 class DragTrackingController(LeafSystem):
@@ -46,6 +50,7 @@ class DragTrackingController(LeafSystem):
         self.sigma_max = planner.sigma_max if sigma_max is None else sigma_max
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.ref_port = self.DeclareVectorInputPort("reference", 4)
+        self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         # [|sigma|, u, integral of dD dE, E at last update (nan before engagement)]
         self._state = self.DeclareDiscreteState(BasicVector([pre_guidance_bank, 0.0, 0.0, np.nan]))
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
@@ -56,9 +61,9 @@ class DragTrackingController(LeafSystem):
                                      lambda c, o: o.SetAtIndex(0, c.get_discrete_state(self._state).get_value()[1]),
                                      prerequisites_of_calc={self.xd_ticket()})
 
-    def control(self, x, ref, integral: float):
+    def control(self, x, ref, integral: float, sensed: float | None = None):
         """(|sigma|, u) for estimate x and reference [D, D', D''] (eq. 101)."""
-        d = self.planner.drag_state(x)
+        d = self.planner.drag_state(x, sensed)
         dD = d.D - ref[0]
         dDp = d.D_prime - ref[1]
         w = self.bandwidth / (d.D * x[3]) if self.bandwidth > 0 else self.omega
@@ -74,10 +79,10 @@ class DragTrackingController(LeafSystem):
             s[0] = self.pre_bank
         else:
             x = self.est_port.Eval(context)
+            sensed = sensed_drag(self.fc_port, context)
             E = self.planner.energy(x)
-            dD = self.planner.drag_state(x).D - ref[0]
+            s[0], s[1], dD, _ = self.control(x, ref, s[2], sensed)
             if np.isfinite(s[3]):
                 s[2] += dD * (E - s[3])
             s[3] = E
-            s[0], s[1], _, _ = self.control(x, ref, s[2])
         discrete_state.get_mutable_vector(self._state).SetFromVector(s)

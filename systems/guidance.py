@@ -9,6 +9,8 @@ normalised energy reaches ``replan_until_e``. A failed plan keeps the previous r
 
 Ports:
   input  "estimated_state"  [6]
+  input  "flight_conditions" [9]  only its drag entry is read: the accelerometer's drag
+                                  (EntryVehicle output; the plan starts from the sensed drag)
   output "reference"        [4]  D_ref [m/s^2], D'_ref [1/m], D''_ref [s^2/m^3] at the
                                  estimate's energy, engaged flag (1 after the first plan)
 """
@@ -21,7 +23,15 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.planning.drag_energy import DragEnergyPlanner, DragEnergyReference
+
+_DRAG = FLIGHT_CONDITION_NAMES.index("drag")
+
+
+def sensed_drag(port, context) -> float | None:
+    """The accelerometer's drag [m/s^2] from a connected flight-conditions port, else None."""
+    return float(port.Eval(context)[_DRAG]) if port.HasValue(context) else None
 
 
 @dataclass
@@ -50,6 +60,7 @@ class DragEnergyGuidance(LeafSystem):
         self.replan = replan_period_s
         self.replan_until_e = replan_until_e
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
+        self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self._memory = self.DeclareAbstractState(AbstractValue.Make(GuidanceMemory()))
         self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._update)
         self.DeclareVectorOutputPort("reference", 4, self._calc,
@@ -62,8 +73,9 @@ class DragEnergyGuidance(LeafSystem):
         mem = self.memory(context)
         t = context.get_time()
         x = self.est_port.Eval(context)
+        sensed = sensed_drag(self.fc_port, context)
         if mem.reference is None:
-            due = t >= self.pre_min and self.planner.drag_state(x).D_prime >= 0.0
+            due = t >= self.pre_min and self.planner.drag_state(x, sensed).D_prime >= 0.0
         else:
             E0, Ef = self.planner.E_entry, self.planner.E_final
             e = (E0 - self.planner.energy(x)) / (E0 - Ef)
@@ -73,7 +85,7 @@ class DragEnergyGuidance(LeafSystem):
         new = copy.deepcopy(mem)
         new.last_plan_at = t  # a failed re-plan is retried one re-plan period later
         try:
-            ref = self.planner.plan_from_state(x, previous=mem.reference)
+            ref = self.planner.plan_from_state(x, previous=mem.reference, sensed_drag=sensed)
         except Exception as e:  # a numerical failure in planning must not stop the flight
             ref = None
             new.failures.append((t, f"{type(e).__name__}: {e}"))

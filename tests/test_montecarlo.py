@@ -5,7 +5,6 @@ import numpy as np
 import pytest
 
 from diagrams.montecarlo import done_indices, run_campaign, run_sample, sample_seed
-from drake_entry.dispersions import EntryDispersion
 from drake_entry.planning.drag_energy import DragEnergyPlanner
 from drake_entry.report import summary_statistics, write_report
 from drake_entry.scenario import load_scenario
@@ -19,8 +18,8 @@ def horus():
 
 def test_a_sample_rerun_alone_reproduces_its_row_bit_for_bit(horus):
     s, p = horus
-    a, _ = run_sample(s, p, 11, 5, EntryDispersion.paper000_table2(), keep_trajectory=False)
-    b, _ = run_sample(s, p, 11, 5, EntryDispersion.paper000_table2(), keep_trajectory=False)
+    a, _ = run_sample(s, p, 11, 5, keep_trajectory=False)
+    b, _ = run_sample(s, p, 11, 5, keep_trajectory=False)
     assert a["success"], a["message"]
     for k in a:
         if k != "wall_time_s":
@@ -37,7 +36,7 @@ def test_a_failing_sample_is_recorded_with_its_reason(horus):
 
     broken = BrokenPlanner.from_scenario(s)
     broken.__class__ = BrokenPlanner
-    row, _ = run_sample(s, broken, 1, 0, EntryDispersion.paper000_table2(), keep_trajectory=False)
+    row, _ = run_sample(s, broken, 1, 0, keep_trajectory=False)
     assert row["success"] is False
     assert "guidance never engaged" in row["message"] and "solver library missing" in row["message"]
     assert np.isfinite(row["disp_dh_m"])

@@ -423,18 +423,28 @@ class DragEnergyPlanner:
     def energy(self, x) -> float:
         return float(self.planet.specific_energy(x[0], x[3]))
 
-    def drag_state(self, x) -> DragDynamics:
-        """D, D', a_D, b_D at state x for the scheduled alpha(E) (eqs. 40-63)."""
+    def drag_state(self, x, sensed_drag: float | None = None) -> DragDynamics:
+        """D, D', a_D, b_D at state x for the scheduled alpha(E) (eqs. 40-63).
+
+        With ``sensed_drag`` (the accelerometer's drag acceleration [m/s^2]) the model's
+        drag dynamics are scaled by sensed/model: a density or drag-coefficient error scales
+        D, D' and D'' alike to first order, and the feedback then acts on the true drag.
+        """
         E = self.energy(x)
-        return drag_dynamics(x[0], x[3], x[4], _alpha_profile(self.alpha, E), self.vehicle, self.planet,
-                             self.atmosphere, lat=x[2], heading=x[5])
+        d = drag_dynamics(x[0], x[3], x[4], _alpha_profile(self.alpha, E), self.vehicle, self.planet,
+                          self.atmosphere, lat=x[2], heading=x[5])
+        if sensed_drag is None or not sensed_drag > 0:
+            return d
+        k = sensed_drag / d.D
+        return dc.replace(d, D=sensed_drag, D_prime=k * d.D_prime, a_D=k * d.a_D, b_D=k * d.b_D,
+                          a_Dgamma=k * d.a_Dgamma, b_Dgamma=k * d.b_Dgamma)
 
     def range_to_go(self, x) -> float:
         return float(self.planet.great_circle_distance(x[1], x[2], *self.target))
 
-    def problem(self, x, **overrides) -> DragEnergyProblem:
-        """The planning request from state x [h, lon, lat, V, gamma, psi]."""
-        d = self.drag_state(x)
+    def problem(self, x, sensed_drag: float | None = None, **overrides) -> DragEnergyProblem:
+        """The planning request from state x [h, lon, lat, V, gamma, psi] (and sensed drag)."""
+        d = self.drag_state(x, sensed_drag)
         kw = dict(vehicle=self.vehicle, planet=self.planet, atmosphere=self.atmosphere, alpha=self.alpha,
                   corridor=self.corridor, E0=self.energy(x), Ef=self.E_final, D0=d.D, D0_prime=d.D_prime,
                   range_to_go=self.range_to_go(x), lat0=float(x[2]), latf=self.target[1],
@@ -443,8 +453,9 @@ class DragEnergyPlanner:
         kw.update(overrides)
         return DragEnergyProblem(**kw)
 
-    def plan_from_state(self, x, previous: DragEnergyReference | None = None, **overrides) -> DragEnergyReference:
+    def plan_from_state(self, x, previous: DragEnergyReference | None = None, sensed_drag: float | None = None,
+                        **overrides) -> DragEnergyReference:
         """Plan from state x; a successful ``previous`` plan seeds kappa(E), so one SOCP suffices."""
         if previous is not None and previous.success and previous.kappa is not None:
             overrides = {"kappa_guess": previous.kappa_at, "range_iterations": 1, **overrides}
-        return plan(self.problem(x, **overrides))
+        return plan(self.problem(x, sensed_drag, **overrides))

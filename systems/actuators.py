@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import bisect
 
-import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 

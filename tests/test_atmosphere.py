@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from pydrake.autodiffutils import AutoDiffXd
 
-from drake_entry.atmosphere import ExponentialAtmosphere, US76Atmosphere
+from drake_entry.atmosphere import ExponentialAtmosphere
 
 # U.S. Standard Atmosphere 1976 reference densities (shared/data/README.md)
 US76_TABLE = [(0.0, 1.2250), (11019.0, 0.36392), (20063.0, 0.088035), (32162.0, 0.013225),

@@ -32,7 +32,7 @@ from scipy.optimize import brentq
 
 from ..atmosphere import Atmosphere
 from ..corridor import Corridor, compute_corridor
-from ..drag_dynamics import AlphaProfile, drag_acceleration, drag_dynamics
+from ..drag_dynamics import AlphaProfile, DragDynamics, drag_acceleration, drag_dynamics
 from ..planet import Earth
 from ..pseudospectral import LGL
 from ..schedules import Schedule

@@ -55,3 +55,25 @@ def test_cli_reports_bad_scenario_in_one_line(tmp_path, capsys):
     assert main(["simulate", str(bad)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "entry.velocity_m_s = -5.0 is out of range" in err
+
+
+def test_cli_plan_writes_figures_3_to_5_and_reports_the_socp(tmp_path, capsys):
+    from drake_entry.cli import main
+
+    assert main(["plan", "horus2b", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "SOCP (clarabel, 40 nodes): optimal" in out and "bank saturated at 0 nodes" in out
+    for png in ("corridor", "reference_profile", "extraction_vs_propagation"):
+        assert (tmp_path / f"{png}.png").stat().st_size > 20_000
+
+
+def test_cli_fly_reaches_the_terminal_interface_near_the_runway(tmp_path):
+    import json
+
+    from drake_entry.cli import main
+
+    assert main(["fly", "horus2b", "--out", str(tmp_path), "--format", "csv"]) == 0
+    s = json.load(open(tmp_path / "summary.json"))
+    assert s["success"] and s["distance_m"] < 2000.0 and abs(s["altitude_m"]) < 200.0
+    assert s["peak_heat_flux_kW_m2"] <= 530.0 and s["peak_normal_load_g"] <= 2.5
+    assert (tmp_path / "drag_tracking.png").exists()

@@ -21,7 +21,7 @@ from pydrake.systems.primitives import LogVectorOutput
 from diagrams.common import Trajectory, run
 from drake_entry.aerodynamics import ScaledAero
 from drake_entry.atmosphere import DispersedAtmosphere
-from drake_entry.dispersions import Draw, EntryDispersion
+from drake_entry.dispersions import Draw
 from drake_entry.planning.drag_energy import DragEnergyPlanner, DragEnergyReference, bearing
 from drake_entry.scenario import Scenario
 from systems.actuators import BankActuator
@@ -108,7 +108,6 @@ def build_closed_loop(scenario: Scenario, planner: DragEnergyPlanner | None = No
         initial_bank=pre_bank, period=g.period_s))
     alpha = builder.AddNamedSystem("alpha_schedule", ScheduleSource(
         planner.alpha, planner.planet, period=g.period_s, initial_value=planner.alpha(scenario.entry_energy())))
-    # vehicle limits (bank) are the true vehicle's; the plant flies the (possibly dispersed) models
     monitor = builder.AddNamedSystem("termination", TerminationMonitor(
         energy=planner.E_final, altitude=ALTITUDE_FLOOR_M, planet=planner.planet))
 
@@ -192,12 +191,6 @@ def summarise(diagram, ctx, tr: Trajectory, scenario: Scenario, planner: DragEne
     return ClosedLoopResult(tr, mem.reference, errors, mem.engaged_at, mem.plans, n_rev, mem.failures, ok, msg,
                             mem.first_reference, mem.engaged_state)
 
-
-def dispersed_entry(scenario: Scenario, seed: int, index: int,
-                    dispersion: EntryDispersion | None = None) -> np.ndarray:
-    """Entry state of Monte-Carlo sample ``index`` (paper 000 Table 2 by default)."""
-    dispersion = dispersion or EntryDispersion.paper000_table2()
-    return dispersion.apply(scenario.initial_state(), seed, index)
 
 
 def propagate_extracted_bank(scenario: Scenario, reference: DragEnergyReference, x0) -> Trajectory:

@@ -18,12 +18,30 @@ def _best(rows, target):
 
 
 def open_loop_benchmark(*, repeats: int = 3, scenario_name: str = "horus2b") -> dict:
+    """Both alpha laws: the paper's time law (Sec. IV.A: 40 deg, linear to 15 deg from 960 s
+    to 1250 s; a native Drake TrajectorySource) and the scenario's energy law (a Python
+    ScheduleSource evaluated at every derivative call)."""
+    import dataclasses as dc
+
+    from .scenario import load_scenario
+
+    out = {}
+    base = load_scenario(scenario_name)
+    time_law = dc.replace(base.alpha, variable="time", breakpoints=[960.0, 1250.0], values_deg=[40.0, 15.0],
+                          smooth=False)
+    for label, alpha in (("alpha(t), paper 000 Sec. IV.A", time_law), ("alpha(E), scenario", base.alpha)):
+        scenario = load_scenario(scenario_name)
+        scenario.alpha = alpha
+        print(f"\n== {label} ==")
+        out[label] = _open_loop_benchmark(scenario, repeats)
+    return out
+
+
+def _open_loop_benchmark(scenario, repeats: int) -> dict:
     from diagrams.open_loop import simulate
 
     from .crosscheck import solve_ivp_open_loop
-    from .scenario import load_scenario
 
-    scenario = load_scenario(scenario_name)
     scenario.simulation.max_time_s = T_FINAL
     scenario.terminal.altitude_km, scenario.terminal.mach = 5.0, None  # fly the full T_FINAL
     ref, _ = solve_ivp_open_loop(scenario, T_FINAL, method="DOP853", rtol=1e-12)
@@ -79,9 +97,9 @@ def socp_benchmark(*, repeats: int = 5, nodes=(20, 40, 80, 160), scenario_name: 
     from .pseudospectral import LGL
     from .scenario import load_scenario
 
-    from pydrake.common import set_log_level
+    import logging
 
-    set_log_level("warn")  # SCS's per-solve INFO lines
+    logging.getLogger("drake").setLevel(logging.WARNING)  # SCS's per-solve INFO lines
     scenario = load_scenario(scenario_name)
     planner = DragEnergyPlanner.from_scenario(scenario)
     # nominal engagement state (drake-entry plan horus2b: t = 300 s, e = 0.042)

@@ -110,7 +110,7 @@ def draw(spec: DispersionSpec, generator) -> Draw:
               ("density_scale", "density_wave_amplitude", "lift_scale", "drag_scale", "mass_scale")}
     phase = 2.0 * math.pi * schema.Uniform(min=0.0, max=1.0).Sample(generator)
     bias = np.asarray(spec.nav_bias.Sample(generator), float).ravel()
-    nav_seed = int(schema.UniformDiscrete(values=[float(v) for v in range(2**20)]).Sample(generator))
+    nav_seed = int(generator())  # last draw: seeds the navigation noise sequence
     for k in ("density_scale", "lift_scale", "drag_scale", "mass_scale"):
         if not scales[k] > 0:
             raise ValueError(f"dispersions.{k} drew {scales[k]:g}; it must stay > 0 (narrow its distribution)")
@@ -127,39 +127,3 @@ def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
         raise ValueError(f"{where}.nav_noise_sigma needs 6 entries >= 0")
     if not spec.density_wave_length_km > 0:
         raise ValueError(f"{where}.density_wave_length_km must be > 0, got {spec.density_wave_length_km}")
-
-
-@dc.dataclass(frozen=True)
-class EntryDispersion:
-    """Half-widths (uniform) or standard deviations (gaussian) of [h, lon, lat, V, gamma, psi]
-    in SI / rad, drawn with numpy (for scripts; campaigns use DispersionSpec)."""
-
-    scale: tuple = (0.0,) * 6
-    distribution: str = "uniform"
-
-    def __post_init__(self):
-        if len(self.scale) != 6 or any(s < 0 for s in self.scale):
-            raise ValueError("EntryDispersion.scale needs 6 non-negative entries [h, lon, lat, V, gamma, psi]")
-        if self.distribution not in ("uniform", "gaussian"):
-            raise ValueError(f"EntryDispersion.distribution must be 'uniform' or 'gaussian', got '{self.distribution}'")
-
-    @staticmethod
-    def paper000_table2() -> "EntryDispersion":
-        """+-250 m, +-0.1 deg lon/lat, +-15 m/s, +-0.01 deg gamma/psi (paper 000 Table 2)."""
-        d = np.radians
-        return EntryDispersion((250.0, d(0.1), d(0.1), 15.0, d(0.01), d(0.01)), "uniform")
-
-    def sample(self, seed: int, index: int = 0) -> np.ndarray:
-        """Deviation of sample ``index`` of the campaign seeded with ``seed``."""
-        return self.draw(np.random.default_rng([int(seed), int(index)]))
-
-    def draw(self, rng: np.random.Generator) -> np.ndarray:
-        """Deviation drawn from ``rng``."""
-        s = np.asarray(self.scale, float)
-        if self.distribution == "uniform":
-            return rng.uniform(-1.0, 1.0, 6) * s
-        return rng.standard_normal(6) * s
-
-    def apply(self, x0, seed: int, index: int = 0) -> np.ndarray:
-        """Dispersed entry state x0 + sample."""
-        return np.asarray(x0, float) + self.sample(seed, index)

@@ -77,14 +77,16 @@ def test_missing_file():
         load_scenario("/nope/missing.yaml")
 
 
-def test_entry_dispersion_is_reproducible_and_bounded_paper000_table2():
-    from drake_entry.dispersions import EntryDispersion
+def test_paper000_table2_dispersion_is_reproducible_bounded_and_uniform():
+    from pydrake.common import RandomGenerator
 
-    d = EntryDispersion.paper000_table2()
-    draws = np.array([d.sample(seed=42, index=i) for i in range(2000)])
-    assert np.array_equal(draws[17], d.sample(seed=42, index=17))
-    assert np.all(np.abs(draws) <= np.array(d.scale))
+    from drake_entry.dispersions import DispersionSpec, draw
+
+    spec = DispersionSpec.paper000_table2()
+    half = np.array([250.0, np.radians(0.1), np.radians(0.1), 15.0, np.radians(0.01), np.radians(0.01)])
+    draws = np.array([draw(spec, RandomGenerator(i)).entry_delta for i in range(2000)])
+    assert np.array_equal(draws[17], draw(spec, RandomGenerator(17)).entry_delta)
+    assert np.all(np.abs(draws) <= half)
     # uniform on [-a, a]: standard deviation a / sqrt(3)
-    assert np.allclose(draws.std(axis=0) / (np.array(d.scale) / np.sqrt(3)), 1.0, atol=0.05)
-    with pytest.raises(ValueError, match="6 non-negative"):
-        EntryDispersion((1.0, 2.0))
+    assert np.allclose(draws.std(axis=0) / (half / np.sqrt(3)), 1.0, atol=0.05)
+    assert load_scenario("horus2b").dispersions.entry.altitude_m.max == 250.0

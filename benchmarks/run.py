@@ -1,6 +1,12 @@
-"""All benchmarks in one command: python benchmarks/run.py"""
-from drake_entry.benchmark import open_loop_benchmark, socp_benchmark
+"""All benchmarks in one command: python benchmarks/run.py [--samples N]"""
+import argparse
+
+from drake_entry.benchmark import campaign_benchmark, open_loop_benchmark, socp_benchmark
 
 if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--samples", type=int, default=100, help="campaign benchmark samples per backend")
+    args = parser.parse_args()
     open_loop_benchmark()
     socp_benchmark()
+    campaign_benchmark(samples=args.samples)

@@ -1,5 +1,9 @@
 """Monte-Carlo campaigns of the closed-loop diagram through Drake's RandomSimulation.
 
+Backends behind one interface (``run_campaign(backend=...)``): 'serial', 'processes'
+(local worker processes, the default, every core) and 'dask' (Dask distributed: the
+cluster at ``scheduler`` or a LocalCluster of ``workers`` processes).
+
 Each sample is one ``pydrake.systems.analysis.RandomSimulation`` whose RandomGenerator is
 seeded from (campaign seed, sample index) only, so any sample re-runs alone and
 reproduces its row. Inside ``make_simulator`` the sample's dispersions are drawn from that
@@ -134,6 +138,18 @@ def _work(args):
     return run_sample(_WORKER["scenario"], _WORKER["planner"], seed, index)
 
 
+def _dask_task(scenario_path: str, overrides: dict, seed: int, index: int):
+    """One sample on a Dask worker; the scenario and planner are built once per worker process."""
+    key = (scenario_path, json.dumps(overrides or {}, sort_keys=True))
+    if _WORKER.get("key") != key:
+        _init_worker(scenario_path, overrides)
+        _WORKER["key"] = key
+    return _work((seed, index))
+
+
+BACKENDS = ("serial", "processes", "dask")
+
+
 def apply_overrides(scenario: Scenario, overrides: dict):
     """Set dotted fields, e.g. {'guidance.replan_period_s': 0}."""
     for key, value in (overrides or {}).items():
@@ -173,12 +189,21 @@ def done_indices(out_dir: str) -> set:
 
 
 def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, workers: int | None = None,
-                 overrides: dict | None = None, progress: bool = True) -> str:
+                 overrides: dict | None = None, progress: bool = True, backend: str = "processes",
+                 scheduler: str | None = None) -> str:
     """Run (or resume) a campaign of ``runs`` samples; returns out_dir.
+
+    backend: 'serial', 'processes' (``workers`` local processes, default all cores) or
+    'dask' (``scheduler`` address of a running Dask cluster, or a LocalCluster of
+    ``workers`` single-threaded processes when None).
 
     Rows stream to out_dir/samples.jsonl; trajectories to trajectories.jsonl; at the end
     both are converted to Parquet and campaign.json records the settings.
     """
+    if backend not in BACKENDS:
+        raise ValueError(f"backend '{backend}' is unknown; allowed: {', '.join(BACKENDS)}")
+    if not runs >= 1:
+        raise ValueError(f"runs must be >= 1, got {runs}")
     os.makedirs(out_dir, exist_ok=True)
     meta_path = os.path.join(out_dir, "campaign.json")
     meta = {"scenario": scenario_path, "runs": runs, "seed": seed, "overrides": overrides or {},
@@ -213,19 +238,46 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
                     bar.set_postfix(failed=record.failed)
 
         record.failed = 0
-        if workers == 1:
+        if backend == "serial" or (backend == "processes" and workers == 1):
             _init_worker(scenario_path, overrides)
             for i in todo:
                 record(*_work((seed, i)))
-        else:
+        elif backend == "processes":
             ctx = mp.get_context("spawn")
             with ctx.Pool(workers, initializer=_init_worker, initargs=(scenario_path, overrides)) as pool:
                 for row, traj in pool.imap_unordered(_work, [(seed, i) for i in todo], chunksize=1):
                     record(row, traj)
+        else:
+            _run_dask(todo, record, scenario_path, overrides, seed, workers, scheduler)
     if bar is not None:
         bar.close()
     finalise(out_dir)
     return out_dir
+
+
+def _run_dask(todo, record, scenario_path, overrides, seed, workers, scheduler):
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    if scheduler:
+        client = Client(scheduler)
+    else:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        client = Client(cluster)
+    try:
+        futures = {client.submit(_dask_task, scenario_path, overrides, seed, i, pure=False): i for i in todo}
+        for fut in as_completed(futures):
+            i = futures[fut]
+            try:
+                row, traj = fut.result()
+            except Exception as e:  # the worker itself died: record and go on
+                row, traj = {"index": i, "seed": sample_seed(seed, i), "success": False,
+                             "message": f"worker failure: {type(e).__name__}: {e}"[:500]}, None
+            record(row, traj)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def finalise(out_dir: str):

@@ -134,3 +134,30 @@ def socp_benchmark(*, repeats: int = 5, nodes=(20, 40, 80, 160), scenario_name: 
     if (40, "clarabel") in out:
         print(f"goal: build + solve < 10 ms at 40 nodes with Clarabel: {out[(40, 'clarabel')]:.2f} ms")
     return out
+
+
+def campaign_benchmark(*, samples: int = 100, scenario_name: str = "horus2b", seed: int = 7) -> dict:
+    """Runs per second of the closed-loop campaign on the same samples: one worker process,
+    two local worker processes, and Dask distributed (LocalCluster, two workers). Includes
+    start-up (worker spawn, planner and corridor per worker)."""
+    import tempfile
+    import time
+
+    from diagrams.montecarlo import run_campaign
+
+    cases = (("1 worker (serial)", "serial", 1), ("2 workers (processes)", "processes", 2),
+             ("Dask LocalCluster, 2 workers", "dask", 2))
+    out = {}
+    print(f"closed-loop {scenario_name} campaign, the same {samples} samples (seed {seed}) on each backend")
+    for label, backend, workers in cases:
+        with tempfile.TemporaryDirectory() as d:
+            t0 = time.perf_counter()
+            run_campaign(scenario_name, runs=samples, out_dir=d, seed=seed, workers=workers, backend=backend,
+                         progress=False)
+            wall = time.perf_counter() - t0
+        out[label] = samples / wall
+        print(f"{label:30s} {wall:7.1f} s  {samples / wall:6.2f} runs/s")
+    one, two, dask = (out[c[0]] for c in cases)
+    print(f"2 workers / 1 worker: {two / one:.2f}x (goal >= 1.8); Dask / processes: {dask / two:.2f} "
+          f"(goal within 10 %); 1000 runs on 2 workers: {1000 / two / 60:.1f} min (goal < 5)")
+    return out

@@ -8,7 +8,7 @@ Commands:
                       extracted states against open-loop propagation (paper 000 Figs. 3-5)
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
   fit-horus           refit the HORUS-2B aero forms (paper 000 eqs. 32-33); print residuals
-  bench [open-loop|socp]  Drake open loop vs scipy solve_ivp; SOCP build/solve, Clarabel vs SCS
+  bench [open-loop|socp|campaign]  Drake open loop vs scipy; SOCP Clarabel vs SCS; campaign runs/s by backend
 """
 from __future__ import annotations
 
@@ -125,7 +125,9 @@ def _cmd_campaign(args) -> int:
 
     from .report import write_report, summary_statistics, table3_markdown  # noqa: F401
 
-    out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers)
+    backend = "dask" if args.scheduler else args.backend
+    out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
+                       backend=backend, scheduler=args.scheduler)
     return _cmd_report(argparse.Namespace(dir=out))
 
 
@@ -160,8 +162,10 @@ def _cmd_fit_horus(args) -> int:
 
 
 def _cmd_bench(args) -> int:
-    from .benchmark import open_loop_benchmark, socp_benchmark
+    from .benchmark import campaign_benchmark, open_loop_benchmark, socp_benchmark
 
+    if args.which in ("all", "campaign"):
+        campaign_benchmark(samples=args.samples)
     if args.which in ("all", "open-loop"):
         open_loop_benchmark(repeats=args.repeats)
     if args.which in ("all", "socp"):
@@ -179,6 +183,10 @@ def main(argv=None) -> int:
     c.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
     c.add_argument("--seed", type=int, default=0, help="campaign seed; sample i is reproducible from (seed, i)")
     c.add_argument("--out", default="out/campaign", help="campaign directory (re-running resumes it)")
+    c.add_argument("--backend", choices=("processes", "serial", "dask"), default="processes",
+                   help="local processes (default), one process, or Dask distributed")
+    c.add_argument("--scheduler", default=None,
+                   help="Dask scheduler address (implies --backend dask); a LocalCluster when omitted")
     c.set_defaults(func=_cmd_campaign)
     r = sub.add_parser("report", help="write the report of a campaign directory")
     r.add_argument("dir")
@@ -200,7 +208,8 @@ def main(argv=None) -> int:
     f = sub.add_parser("fit-horus", help="refit paper 000 eqs. 32-33 to the M-692 table; print residuals")
     f.set_defaults(func=_cmd_fit_horus)
     b = sub.add_parser("bench", help="benchmarks: Drake open loop vs scipy; SOCP with Clarabel vs SCS")
-    b.add_argument("which", nargs="?", choices=("all", "open-loop", "socp"), default="all")
+    b.add_argument("which", nargs="?", choices=("all", "open-loop", "socp", "campaign"), default="all")
+    b.add_argument("--samples", type=int, default=100, help="campaign benchmark: samples per backend")
     b.add_argument("--repeats", type=int, default=3)
     b.set_defaults(func=_cmd_bench)
     args = parser.parse_args(argv)

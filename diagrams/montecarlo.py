@@ -86,13 +86,11 @@ def run_sample(scenario: Scenario, planner: DragEnergyPlanner, campaign_seed: in
 
 def _row(res, planner: DragEnergyPlanner) -> dict:
     tr = res.trajectory
-    c = tr.conditions
     limits = planner.vehicle.limits
-    peak_q = float(c[:, 2].max())
-    peak_heat = float(c[:, 3].max())
-    peak_nz = float(c[:, 4].max())
-    row = {}
-    row.update({
+    peak_q = float(tr.column("dynamic_pressure").max())
+    peak_heat = float(tr.column("heat_flux").max())
+    peak_nz = float(tr.column("normal_load").max())
+    row = {
         "success": bool(res.success), "message": res.message, "stop": tr.reason,
         "flight_time_s": float(tr.time[-1]), "engaged_at_s": res.engaged_at if res.engaged_at is not None else np.nan,
         "plans": int(res.plans), "planning_failures": len(res.planning_failures), "reversals": int(res.reversals),
@@ -106,7 +104,7 @@ def _row(res, planner: DragEnergyPlanner) -> dict:
         "margin_heat_flux": 1.0 - peak_heat / limits.heat_flux_max,
         "margin_dynamic_pressure": 1.0 - peak_q / limits.dynamic_pressure_max,
         "margin_normal_load": 1.0 - peak_nz / limits.normal_load_max,
-    })
+    }
     return row
 
 
@@ -225,7 +223,10 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
         bar = tqdm(total=runs, initial=runs - len(todo), unit="run", desc="campaign", smoothing=0.05)
     with open(os.path.join(out_dir, "samples.jsonl"), "a") as rows_f, \
             open(os.path.join(out_dir, "trajectories.jsonl"), "a") as traj_f:
+        failed = 0
+
         def record(row, traj):
+            nonlocal failed
             rows_f.write(json.dumps(row, default=float) + "\n")
             rows_f.flush()
             if traj is not None:
@@ -234,10 +235,9 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
             if bar is not None:
                 bar.update(1)
                 if not row.get("success"):
-                    record.failed += 1
-                    bar.set_postfix(failed=record.failed)
+                    failed += 1
+                    bar.set_postfix(failed=failed)
 
-        record.failed = 0
         if backend == "serial" or (backend == "processes" and workers == 1):
             _init_worker(scenario_path, overrides)
             for i in todo:

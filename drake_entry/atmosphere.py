@@ -331,14 +331,13 @@ class DispersedAtmosphere(Atmosphere):
                 -self.scale * a * self.k**2 * np.sin(arg))
 
     def density_derivatives(self, h) -> Derivatives:
-        d = self.base.density_derivatives(h)
-        f, f1, f2 = self._factor(h)
-        return Derivatives(d.value * f, d.d_h * f + d.value * f1, d.d_hh * f + 2 * d.d_h * f1 + d.value * f2)
+        return self.derivatives(h)[0]
 
     def temperature_derivatives(self, h) -> Derivatives:
         return self.base.temperature_derivatives(h)
 
     def derivatives(self, h):
+        """Product rule on rho_nominal * f(h)."""
         d, t = self.base.derivatives(h)
         f, f1, f2 = self._factor(h)
         if np.ndim(h) == 0:

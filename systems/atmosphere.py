@@ -1,11 +1,10 @@
-"""AtmosphereSystem: air data along the trajectory, with an optional density dispersion.
+"""AtmosphereSystem: air data along the trajectory.
 
 Ports:
   input  "state"     [6]  vehicle state [h m, lon, lat rad, V m/s, gamma, psi rad]
   output "air_data"  [2]  density rho [kg/m^3], speed of sound a [m/s]
 
-A density scale factor (1 + bias) is a parameter, so one diagram serves every
-Monte-Carlo sample.
+A Monte-Carlo sample's density dispersion is a model, drake_entry.atmosphere.DispersedAtmosphere.
 """
 from __future__ import annotations
 
@@ -20,26 +19,21 @@ from drake_entry.planet import Earth
 @TemplateSystem.define("AtmosphereSystem_")
 def AtmosphereSystem_(T):
     class Impl(LeafSystem_[T]):
-        def _construct(self, atmosphere: Atmosphere, planet: Earth, *, density_scale: float = 1.0,
-                       converter=None):
+        def _construct(self, atmosphere: Atmosphere, planet: Earth, *, converter=None):
             LeafSystem_[T].__init__(self, converter)
-            if not density_scale > 0:
-                raise ValueError(f"AtmosphereSystem density_scale must be > 0, got {density_scale}")
             self.atmosphere = atmosphere
             self.planet = planet
-            self.density_scale = float(density_scale)
             self.state_port = self.DeclareVectorInputPort("state", 6)
             self.DeclareVectorOutputPort("air_data", 2, self._calc,
                                          prerequisites_of_calc={self.state_port.ticket()})
 
         def _construct_copy(self, other, converter=None):
-            Impl._construct(self, other.atmosphere, other.planet, density_scale=other.density_scale,
-                            converter=converter)
+            Impl._construct(self, other.atmosphere, other.planet, converter=converter)
 
         def _calc(self, context, output):
             x = self.state_port.Eval(context)
             rho, _, a = self.atmosphere.properties(self.planet.atmospheric_altitude(x[0], x[2]))
-            output.SetFromVector(np.array([self.density_scale * rho, a]))
+            output.SetFromVector(np.array([rho, a]))
 
     return Impl
 

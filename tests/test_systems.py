@@ -58,15 +58,17 @@ def test_entry_vehicle_converts_to_autodiff_for_trajectory_optimisation(horus, u
     assert np.allclose(grad[:, 0], fd_bank, rtol=1e-6, atol=1e-12)
 
 
-def test_atmosphere_system_applies_density_scale(us76, entry_state, earth):
-    s = AtmosphereSystem(us76, earth, density_scale=1.1)
+def test_atmosphere_system_serves_a_dispersed_density(us76, entry_state, earth):
+    from drake_entry.atmosphere import DispersedAtmosphere
+
+    s = AtmosphereSystem(DispersedAtmosphere(us76, scale=1.1), earth)
     ctx = s.CreateDefaultContext()
     s.get_input_port().FixValue(ctx, entry_state)
     rho, a = s.get_output_port().Eval(ctx)
     assert rho == pytest.approx(1.1 * us76.density(entry_state[0]))
     assert a == pytest.approx(us76.speed_of_sound(entry_state[0]))
-    with pytest.raises(ValueError, match="density_scale must be > 0"):
-        AtmosphereSystem(us76, earth, density_scale=0.0)
+    with pytest.raises(ValueError, match="needs scale > 0"):
+        DispersedAtmosphere(us76, scale=0.0)
 
 
 def _simulate_actuator(command, t_end, **kw):

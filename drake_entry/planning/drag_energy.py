@@ -189,13 +189,11 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
     diag = _diagnose(p, op, D_lo, D_hi)
     if diag:
         return DragEnergyReference(False, "; ".join(d["message"] for d in diag), p, lgl=op, binding=diag)
-    if p.kappa_guess is not None:
-        kappa = np.asarray(p.kappa_guess(op.x), float)
-    else:
-        kappa = np.full(p.n_nodes, p.planet.reference_radius / p.planet.radius(0.0))
+    # ground-range weights: the guess, or eq. 71's kappa = 1 until the first extraction
+    kappa = np.ones(p.n_nodes) if p.kappa_guess is None else np.asarray(p.kappa_guess(op.x), float)
     ref = None
     total_build = total_solve = 0.0
-    for it in range(max(1, p.range_iterations)):
+    for _ in range(max(1, p.range_iterations)):
         ref = _solve_socp(p, op, D_lo, D_hi, kappa)
         total_build += ref.build_time
         total_solve += ref.solve_time
@@ -284,9 +282,9 @@ def _check_solution(p: DragEnergyProblem, op: LGL, I, D_lo, D_hi, kappa, tol: fl
     return ""
 
 
-def _reachable_range(op: LGL, D, kappa=None) -> float:
-    kappa = np.ones(op.n_nodes) if kappa is None else kappa
-    return float(-op.weights @ (kappa / D))
+def _reachable_range(op: LGL, D) -> float:
+    """Range [m] flown on the profile D at the nodes (eq. 83 with kappa = 1)."""
+    return float(-op.weights @ (1.0 / D))
 
 
 def _diagnose(p: DragEnergyProblem, op: LGL, D_lo, D_hi) -> list:
@@ -309,9 +307,8 @@ def _diagnose(p: DragEnergyProblem, op: LGL, D_lo, D_hi) -> list:
         out.append({"bound": "terminal_drag", "where_e": 1.0,
                     "message": f"terminal drag {p.Df:.4g} m/s^2 is {side} [{D_lo[-1]:.4g}, {D_hi[-1]:.4g}] "
                                f"at Ef (e.g. the q limit at the nominal terminal point)"})
-    r_e = p.planet.reference_radius / p.planet.radius(0.0)
-    R_min = _reachable_range(op, D_hi) * r_e
-    R_max = _reachable_range(op, D_lo) * r_e
+    R_min = _reachable_range(op, D_hi)
+    R_max = _reachable_range(op, D_lo)
     if p.range_to_go < R_min:
         out.append({"bound": "D_max", "where_e": None,
                     "message": f"range to go {p.range_to_go / 1e3:.1f} km is shorter than the corridor allows "

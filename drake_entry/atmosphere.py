@@ -325,8 +325,12 @@ class DispersedAtmosphere(Atmosphere):
 
     def _factor(self, h):
         """f, f', f'' of the multiplicative perturbation."""
-        arg = self.k * np.asarray(h, float) + self.phase
         a = self.amplitude
+        if isinstance(h, float):  # the simulation's scalar path, without numpy overhead
+            arg = self.k * h + self.phase
+            s, c = math.sin(arg), math.cos(arg)
+            return self.scale * (1.0 + a * s), self.scale * a * self.k * c, -self.scale * a * self.k**2 * s
+        arg = self.k * np.asarray(h, float) + self.phase
         return (self.scale * (1.0 + a * np.sin(arg)), self.scale * a * self.k * np.cos(arg),
                 -self.scale * a * self.k**2 * np.sin(arg))
 

@@ -46,7 +46,7 @@ def interpolation_matrix(nodes: np.ndarray, points, bary=None) -> np.ndarray:
     bary = barycentric_weights(nodes) if bary is None else bary
     pts = np.atleast_1d(np.asarray(points, float))
     diff = pts[:, None] - nodes[None, :]
-    exact = np.isclose(diff, 0.0, atol=1e-14 * max(1.0, np.max(np.abs(nodes))))
+    exact = np.abs(diff) <= 1e-14 * max(1.0, np.max(np.abs(nodes)))
     diff[exact] = 1.0
     M = bary[None, :] / diff
     M /= M.sum(axis=1, keepdims=True)

@@ -23,7 +23,7 @@ import bisect
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.actuator import bank_actuator_rates
+from drake_entry.actuator import bank_actuator_rates, integrate_bank_actuator
 
 
 class BankActuator(LeafSystem):
@@ -78,14 +78,9 @@ class BankActuator(LeafSystem):
     def _plan_segment(self, context, state):
         t0 = context.get_time()
         sigma, rate = self._sample(context)
-        cmd = float(self.cmd_port.Eval(context)[0])
         h = self.period / self.n_sub
-        s, r = [sigma], [rate]
-        for _ in range(self.n_sub):  # RK2 (midpoint) on the actuator law
-            d1 = bank_actuator_rates(s[-1], r[-1], cmd, **self.limits)
-            d2 = bank_actuator_rates(s[-1] + 0.5 * h * d1[0], r[-1] + 0.5 * h * d1[1], cmd, **self.limits)
-            s.append(s[-1] + h * d2[0])
-            r.append(r[-1] + h * d2[1])
+        s, r = integrate_bank_actuator(sigma, rate, float(self.cmd_port.Eval(context)[0]), h, self.n_sub,
+                                       **self.limits)
         state.get_mutable_abstract_state(int(self._segment)).set_value(_Segment(t0, h, s, r))
 
 

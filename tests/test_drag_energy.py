@@ -184,3 +184,18 @@ def test_drag_tracking_sign_convention_requires_negative_zeta(planner):
 
     with pytest.raises(ValueError, match="zeta must be < 0"):
         DragTrackingController(planner, zeta=0.7, omega=1e-6)
+
+
+def test_drag_inversion_from_a_neighbour_guess_equals_the_bracketed_root(planner):
+    """Eq. 93 inverted by secant steps from a guess gives Brent's root (to 1e-3 m) and the drag."""
+    from drake_entry.drag_dynamics import drag_acceleration
+    from drake_entry.planning.drag_energy import altitude_speed_from_drag
+
+    c = planner.corridor
+    for i in (10, 150, 280):
+        D = 0.5 * (c.D_min[i] + c.D_max[i])
+        args = (c.energy[i], D, c.alpha[i], planner.vehicle, planner.planet, planner.atmosphere)
+        h_b, V_b = altitude_speed_from_drag(*args)
+        h_s, V_s = altitude_speed_from_drag(*args, h_guess=h_b + 3000.0)
+        assert abs(h_s - h_b) < 1e-3 and abs(V_s - V_b) < 1e-6
+        assert drag_acceleration(h_s, V_s, c.alpha[i], planner.vehicle, planner.atmosphere) == pytest.approx(D, rel=1e-8)

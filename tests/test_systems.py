@@ -1,4 +1,6 @@
 """Each LeafSystem: ports, units, and behaviour against the model functions."""
+import math
+
 import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
@@ -157,3 +159,21 @@ def test_sampled_actuator_reproduces_the_continuous_one():
     t, samp, rate = _simulate_actuator(np.radians(-60.0), 30.0, period=1.0, **kw)
     assert np.abs(samp - cont).max() < np.radians(0.05)
     assert np.abs(rate).max() <= np.radians(10.0) * (1 + 1e-3)
+
+
+def test_segment_integrator_equals_midpoint_steps_of_the_actuator_law():
+    """The sampled actuator's tight loop is the same RK2 on bank_actuator_rates (reversal
+    through wings level, rate- and acceleration-limited)."""
+    from drake_entry.actuator import bank_actuator_rates, integrate_bank_actuator
+
+    lim = dict(bank_limit=math.radians(80), rate_limit=math.radians(10), accel_limit=math.radians(5), bandwidth=2.0)
+    s, r, cmd, h = math.radians(60), 0.0, math.radians(-70), 0.01
+    fast_s, fast_r = integrate_bank_actuator(s, r, cmd, h, 300, **lim)
+    for k in range(300):
+        d1 = bank_actuator_rates(s, r, cmd, **lim)
+        d2 = bank_actuator_rates(s + 0.5 * h * d1[0], r + 0.5 * h * d1[1], cmd, **lim)
+        s, r = s + h * d2[0], r + h * d2[1]
+        assert fast_s[k + 1] == pytest.approx(s, abs=1e-14) and fast_r[k + 1] == pytest.approx(r, abs=1e-14)
+    assert max(abs(v) for v in fast_r) <= lim["rate_limit"] * (1 + 1e-9)
+    settled = integrate_bank_actuator(0.3, 0.0, 0.3, h, 5, **lim)
+    assert settled == ([0.3] * 6, [0.0] * 6)

@@ -342,9 +342,10 @@ def extract(p: DragEnergyProblem, op: LGL, I: np.ndarray) -> Extraction:
     out = {k: np.zeros(n) for k in ("h", "V", "gamma", "u_ff", "sigma", "ld")}
     sat = np.zeros(n, bool)
     frac = (p.E0 - op.x) / (p.E0 - p.Ef)
+    h = None
     for i, E in enumerate(op.x):
         alpha = _alpha_profile(p.alpha, E)
-        h, V = altitude_speed_from_drag(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere)
+        h, V = altitude_speed_from_drag(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere, h_guess=h)
         lat = p.lat0 + frac[i] * (p.latf - p.lat0)
         heading = p.heading0 + frac[i] * (p.headingf - p.heading0)
         d0 = drag_dynamics(h, V, 0.0, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat, heading=heading)
@@ -361,16 +362,42 @@ def extract(p: DragEnergyProblem, op: LGL, I: np.ndarray) -> Extraction:
 
 
 def altitude_speed_from_drag(E: float, D: float, alpha: float, vehicle: Vehicle, planet: Earth,
-                             atmosphere: Atmosphere, h_floor: float = 0.0):
-    """(h, V) on energy level E where the drag equals D (eq. 93)."""
-    h_top = planet.mu / (-E) - planet.reference_radius - 1.0
+                             atmosphere: Atmosphere, h_floor: float = 0.0, h_guess: float | None = None):
+    """(h, V) on energy level E where the drag equals D (eq. 93), to 1e-4 m.
+
+    With ``h_guess`` (the neighbouring node's altitude) a secant iteration on ln D, nearly
+    linear in h, converges in a few model evaluations; Brent's bracketed method is the
+    fallback and the default."""
+    h_top = min(planet.mu / (-E) - planet.reference_radius - 1.0, atmosphere.h_max)
 
     def f(h):
         V = math.sqrt(max(2.0 * (E + planet.mu / planet.radius(h)), 0.0))
         return drag_acceleration(h, V, alpha, vehicle, atmosphere) - D
 
-    h = brentq(f, h_floor, min(h_top, atmosphere.h_max), xtol=1e-4)
+    h = _secant_log_drag(f, D, h_guess, h_floor, h_top) if h_guess is not None else None
+    if h is None:
+        h = brentq(f, h_floor, h_top, xtol=1e-4)
     return h, math.sqrt(2.0 * (E + planet.mu / planet.radius(h)))
+
+
+def _secant_log_drag(f, D: float, h0: float, lo: float, hi: float, tol: float = 1e-4, iterations: int = 12):
+    """Root of f(h) + D = D by secant steps on ln(f(h) + D) - ln D; None unless it converges in [lo, hi]."""
+    def g(h):
+        v = f(h) + D
+        return math.log(v / D) if v > 0.0 else None
+
+    a, b = min(max(h0, lo), hi), min(max(h0 + 200.0, lo), hi)
+    ga, gb = g(a), g(b)
+    for _ in range(iterations):
+        if ga is None or gb is None or gb == ga:
+            return None
+        c = b - gb * (b - a) / (gb - ga)
+        if not lo <= c <= hi:
+            return None
+        if abs(c - b) < tol:
+            return c
+        a, ga, b, gb = b, gb, c, g(c)
+    return None
 
 
 def bearing(lon1, lat1, lon2, lat2) -> float:

@@ -33,7 +33,7 @@ from drake_entry.dispersions import draw
 from drake_entry.planning.drag_energy import DragEnergyPlanner
 from drake_entry.scenario import Scenario, load_scenario
 
-TRAJECTORY_STEP_S = 10.0
+TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
 
 
 def sample_seed(campaign_seed: int, index: int) -> int:
@@ -42,9 +42,9 @@ def sample_seed(campaign_seed: int, index: int) -> int:
 
 
 def run_sample(scenario: Scenario, planner: DragEnergyPlanner, campaign_seed: int, index: int, *,
-               keep_trajectory: bool = True) -> tuple[dict, dict | None]:
-    """One Monte-Carlo sample of ``scenario.dispersions``: (row, down-sampled trajectory
-    columns or None)."""
+               trajectory_step_s: float = TRAJECTORY_STEP_S) -> tuple[dict, dict | None]:
+    """One Monte-Carlo sample of ``scenario.dispersions``: (row, trajectory columns every
+    ``trajectory_step_s`` seconds plus the final instant, or None when it is 0)."""
     seed = sample_seed(campaign_seed, index)
     t_wall = time.perf_counter()
     row = {"index": int(index), "seed": seed}
@@ -74,7 +74,7 @@ def run_sample(scenario: Scenario, planner: DragEnergyPlanner, campaign_seed: in
         res = summarise(diagram, ctx, tr, scenario, planner)
         row.update(box["draw"].columns())
         row.update(_row(res, planner))
-        traj = _downsample(tr, index) if keep_trajectory else None
+        traj = _downsample(tr, index, trajectory_step_s) if trajectory_step_s > 0 else None
     except Exception as e:  # one failed sample never stops the campaign
         row.update(box["draw"].columns() if "draw" in box else {})
         row.update({"success": False, "message": f"{type(e).__name__}: {e}".splitlines()[0][:500],
@@ -108,9 +108,9 @@ def _row(res, planner: DragEnergyPlanner) -> dict:
     return row
 
 
-def _downsample(tr, index: int) -> dict:
+def _downsample(tr, index: int, step_s: float) -> dict:
     t = tr.time
-    keep = np.unique(np.append(np.searchsorted(t, np.arange(0.0, t[-1], TRAJECTORY_STEP_S)), len(t) - 1))
+    keep = np.unique(np.append(np.searchsorted(t, np.arange(0.0, t[-1], step_s)), len(t) - 1))
     out = {"sample": np.full(keep.size, index), **{k: np.asarray(v)[keep] for k, v in tr.table().items()}}
     ref = tr.extra.get("reference")
     if ref is not None:
@@ -124,7 +124,8 @@ def _downsample(tr, index: int) -> dict:
 _WORKER = {}
 
 
-def _init_worker(scenario_path: str, overrides: dict):
+def _init_worker(scenario_path: str, overrides: dict, trajectory_step_s: float = TRAJECTORY_STEP_S):
+    _WORKER["trajectory_step_s"] = trajectory_step_s
     scenario = load_scenario(scenario_path)
     apply_overrides(scenario, overrides)
     _WORKER["scenario"] = scenario
@@ -133,14 +134,15 @@ def _init_worker(scenario_path: str, overrides: dict):
 
 def _work(args):
     seed, index = args
-    return run_sample(_WORKER["scenario"], _WORKER["planner"], seed, index)
+    return run_sample(_WORKER["scenario"], _WORKER["planner"], seed, index,
+                      trajectory_step_s=_WORKER["trajectory_step_s"])
 
 
-def _dask_task(scenario_path: str, overrides: dict, seed: int, index: int):
+def _dask_task(scenario_path: str, overrides: dict, seed: int, index: int, trajectory_step_s: float):
     """One sample on a Dask worker; the scenario and planner are built once per worker process."""
-    key = (scenario_path, json.dumps(overrides or {}, sort_keys=True))
+    key = (scenario_path, json.dumps(overrides or {}, sort_keys=True), trajectory_step_s)
     if _WORKER.get("key") != key:
-        _init_worker(scenario_path, overrides)
+        _init_worker(scenario_path, overrides, trajectory_step_s)
         _WORKER["key"] = key
     return _work((seed, index))
 
@@ -188,12 +190,15 @@ def done_indices(out_dir: str) -> set:
 
 def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, workers: int | None = None,
                  overrides: dict | None = None, progress: bool = True, backend: str = "processes",
-                 scheduler: str | None = None) -> str:
+                 scheduler: str | None = None, trajectory_step_s: float = TRAJECTORY_STEP_S) -> str:
     """Run (or resume) a campaign of ``runs`` samples; returns out_dir.
 
     backend: 'serial', 'processes' (``workers`` local processes, default all cores) or
     'dask' (``scheduler`` address of a running Dask cluster, or a LocalCluster of
     ``workers`` single-threaded processes when None).
+
+    trajectory_step_s: spacing [s] of the down-sampled trajectories kept per sample (0 keeps
+    none: the smallest output for large campaigns; the report then omits the envelopes).
 
     Rows stream to out_dir/samples.jsonl; trajectories to trajectories.jsonl; at the end
     both are converted to Parquet and campaign.json records the settings.
@@ -202,9 +207,12 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
         raise ValueError(f"backend '{backend}' is unknown; allowed: {', '.join(BACKENDS)}")
     if not runs >= 1:
         raise ValueError(f"runs must be >= 1, got {runs}")
+    if not trajectory_step_s >= 0:
+        raise ValueError(f"trajectory_step_s must be >= 0 s (0 = no trajectories), got {trajectory_step_s}")
     os.makedirs(out_dir, exist_ok=True)
     meta_path = os.path.join(out_dir, "campaign.json")
     meta = {"scenario": scenario_path, "runs": runs, "seed": seed, "overrides": overrides or {},
+            "trajectory_step_s": trajectory_step_s,
             "dispersion": "scenario dispersions"}
     if os.path.exists(meta_path):
         old = json.load(open(meta_path))
@@ -239,23 +247,24 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
                     bar.set_postfix(failed=failed)
 
         if backend == "serial" or (backend == "processes" and workers == 1):
-            _init_worker(scenario_path, overrides)
+            _init_worker(scenario_path, overrides, trajectory_step_s)
             for i in todo:
                 record(*_work((seed, i)))
         elif backend == "processes":
             ctx = mp.get_context("spawn")
-            with ctx.Pool(workers, initializer=_init_worker, initargs=(scenario_path, overrides)) as pool:
+            with ctx.Pool(workers, initializer=_init_worker,
+                          initargs=(scenario_path, overrides, trajectory_step_s)) as pool:
                 for row, traj in pool.imap_unordered(_work, [(seed, i) for i in todo], chunksize=1):
                     record(row, traj)
         else:
-            _run_dask(todo, record, scenario_path, overrides, seed, workers, scheduler)
+            _run_dask(todo, record, scenario_path, overrides, seed, workers, scheduler, trajectory_step_s)
     if bar is not None:
         bar.close()
     finalise(out_dir)
     return out_dir
 
 
-def _run_dask(todo, record, scenario_path, overrides, seed, workers, scheduler):
+def _run_dask(todo, record, scenario_path, overrides, seed, workers, scheduler, trajectory_step_s):
     """Submit the samples to a Dask cluster. A LocalCluster is started without the workers'
     statistical profiler: it takes the GIL every few ms and cost 18 % of throughput on these
     CPU-bound Python samples (start external workers with
@@ -271,7 +280,7 @@ def _run_dask(todo, record, scenario_path, overrides, seed, workers, scheduler):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(cluster)
     try:
-        futures = {client.submit(_dask_task, scenario_path, overrides, seed, i, pure=False): i for i in todo}
+        futures = {client.submit(_dask_task, scenario_path, overrides, seed, i, trajectory_step_s, pure=False): i for i in todo}
         for fut in as_completed(futures):
             i = futures[fut]
             try:

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 
 def _clip(v: float, lim: float) -> float:
     return -lim if v < -lim else (lim if v > lim else v)
@@ -38,19 +40,33 @@ def bank_actuator_rates(sigma: float, rate: float, command: float, *, bank_limit
 def integrate_bank_actuator(sigma: float, rate: float, command: float, step: float, steps: int, *,
                             bank_limit: float, rate_limit: float, accel_limit: float,
                             bandwidth: float) -> tuple[list, list]:
-    """(sigma, sigma_dot) after 0..steps midpoint-RK2 steps of ``step`` seconds of
-    bank_actuator_rates under a constant command: lists of steps + 1 values [rad, rad/s].
+    """(sigma, sigma_dot) at 0, step, ..., steps * step seconds of bank_actuator_rates under
+    a constant command: lists of steps + 1 values [rad, rad/s].
 
-    A settled actuator (at the command, at rest) stays put without integrating."""
+    Where no limit is active over the whole interval the law is linear,
+    x'' = -4 omega x' - 4 omega^2 x with x = sigma - command (critically damped, double root
+    -2 omega), and the exact solution x = (x0 + (v0 + 2 omega x0) t) exp(-2 omega t) is used;
+    otherwise midpoint-RK2 steps of ``step`` seconds."""
     c = _clip(command, bank_limit)
-    if sigma == c and rate == 0.0:
+    if sigma == c and rate == 0.0:  # settled
         return [sigma] * (steps + 1), [0.0] * (steps + 1)
+    w = bandwidth
+    t = np.arange(steps + 1) * step
+    x0 = sigma - c
+    B = rate + 2.0 * w * x0
+    decay = np.exp(-2.0 * w * t)
+    x = (x0 + B * t) * decay
+    v = (rate - 2.0 * w * B * t) * decay
+    linear = (np.abs(x).max() <= min(rate_limit / w, accel_limit / (w * w))
+              and np.abs(4.0 * w * (w * x + v)).max() <= accel_limit)
+    if linear:
+        return (x + c).tolist(), v.tolist()
     s_out, r_out = [sigma], [rate]
     s, r, hh = sigma, rate, 0.5 * step
     for _ in range(steps):
-        a1 = _accel(c - s, r, bandwidth, rate_limit, accel_limit)
+        a1 = _accel(c - s, r, w, rate_limit, accel_limit)
         r_mid = r + hh * a1
-        a2 = _accel(c - (s + hh * r), r_mid, bandwidth, rate_limit, accel_limit)
+        a2 = _accel(c - (s + hh * r), r_mid, w, rate_limit, accel_limit)
         s += step * r_mid
         r += step * a2
         s_out.append(s)

@@ -127,7 +127,7 @@ def _cmd_campaign(args) -> int:
 
     backend = "dask" if args.scheduler else args.backend
     out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
-                       backend=backend, scheduler=args.scheduler)
+                       backend=backend, scheduler=args.scheduler, trajectory_step_s=args.trajectory_step)
     return _cmd_report(argparse.Namespace(dir=out))
 
 
@@ -187,6 +187,8 @@ def main(argv=None) -> int:
                    help="local processes (default), one process, or Dask distributed")
     c.add_argument("--scheduler", default=None,
                    help="Dask scheduler address (implies --backend dask); a LocalCluster when omitted")
+    c.add_argument("--trajectory-step", type=float, default=10.0, metavar="SECONDS",
+                   help="keep each sample's trajectory every SECONDS (default 10; 0 = none, rows only)")
     c.set_defaults(func=_cmd_campaign)
     r = sub.add_parser("report", help="write the report of a campaign directory")
     r.add_argument("dir")

@@ -144,6 +144,9 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None) -> str:
         md.append(f"| {col.replace('margin_', '')} | {100 * m['worst']:.2f} % | {m['violations']} | {m['worst_sample']} |")
     if stats["failure_reasons"]:
         md += ["", "## Failed samples", ""] + [f"- {k}: {v}" for k, v in stats["failure_reasons"].items()]
+    if traj is None:
+        md += ["", "Trajectories were not kept (`--trajectory-step 0`): the state envelopes, constraint "
+               "histories, drag profiles and groundtracks are omitted."]
     md += ["", "## Figures", ""] + [f"![{os.path.basename(p)}]({os.path.basename(p)})" for p in figs]
     path = os.path.join(out_dir, "report.md")
     with open(path, "w") as f:

@@ -1,7 +1,9 @@
 """Monte-Carlo campaigns: reproducibility, failures recorded, resume, statistics."""
 import json
+import os
 
 import numpy as np
+import pyarrow.parquet as pq
 import pytest
 
 from diagrams.montecarlo import done_indices, run_campaign, run_sample, sample_seed
@@ -18,8 +20,8 @@ def horus():
 
 def test_a_sample_rerun_alone_reproduces_its_row_bit_for_bit(horus):
     s, p = horus
-    a, _ = run_sample(s, p, 11, 5, keep_trajectory=False)
-    b, _ = run_sample(s, p, 11, 5, keep_trajectory=False)
+    a, _ = run_sample(s, p, 11, 5, trajectory_step_s=0)
+    b, _ = run_sample(s, p, 11, 5, trajectory_step_s=0)
     assert a["success"], a["message"]
     for k in a:
         if k != "wall_time_s":
@@ -36,7 +38,7 @@ def test_a_failing_sample_is_recorded_with_its_reason(horus):
 
     broken = BrokenPlanner.from_scenario(s)
     broken.__class__ = BrokenPlanner
-    row, _ = run_sample(s, broken, 1, 0, keep_trajectory=False)
+    row, _ = run_sample(s, broken, 1, 0, trajectory_step_s=0)
     assert row["success"] is False
     assert "guidance never engaged" in row["message"] and "solver library missing" in row["message"]
     assert np.isfinite(row["disp_dh_m"])
@@ -56,6 +58,18 @@ def test_campaign_resumes_without_losing_or_repeating_samples(tmp_path):
     report = write_report(out)
     text = open(report).read()
     assert "paper 000 Table 3" in text and "Δh" in text
+    traj = pq.read_table(f"{out}/trajectories.parquet").to_pydict()
+    t0 = np.array(traj["time_s"])[np.array(traj["sample"]) == 0]
+    assert np.allclose(np.diff(t0)[:-1], 10.0) and t0[-1] > 1000.0  # every 10 s, then the final instant
+
+
+def test_campaign_without_trajectories_keeps_rows_only(tmp_path):
+    out = str(tmp_path / "rows")
+    run_campaign("horus2b", runs=1, out_dir=out, seed=4, workers=1, progress=False, trajectory_step_s=0)
+    assert os.path.exists(f"{out}/samples.parquet") and not os.path.exists(f"{out}/trajectories.parquet")
+    assert "Trajectories were not kept" in open(write_report(out)).read()
+    with pytest.raises(ValueError, match="trajectory_step_s must be >= 0"):
+        run_campaign("horus2b", runs=1, out_dir=out, seed=4, trajectory_step_s=-1.0)
 
 
 def test_statistics_against_a_hand_computed_case():

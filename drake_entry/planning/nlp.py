@@ -1,0 +1,521 @@
+"""NLP path: entry optimal control by Legendre pseudospectral (LGL) collocation or Drake's
+DirectCollocation, solved with Ipopt or SNOPT (paper 002).
+
+    result = solve(problem, transcription="lgl" | "dircol", solver="ipopt" | "snopt", nodes=N)
+
+``problem`` is an ``OptimalControlProblem`` (entry dynamics, planning/ocp.py) or a
+``CustomProblem``. The NLP runs in scaled units (problem.scales(): canonical units as in
+paper 002, altitude in 10 km, controls by their bounds); results are SI.
+
+LGL (paper 002 eqs. 12-14, Fahroo & Ross): states and controls at the N LGL nodes
+tau_k of [-1, 1], t = (tau + 1) t_f / 2. The defects are split so every nonlinear
+binding stays small (one per node): F_k = (t_f / 2) f(x_k, u_k) (nonlinear, per node) and
+D X = F (linear, per state). Costates come from the KKT multipliers of D X = F (eq. 15):
+lambda(t_k) = nu_k / w_k, converted back to SI.
+
+DirectCollocation: Drake's Hermite-Simpson transcription of systems.ocp_plant (the same
+scaled dynamics as a Drake System) with N samples; the running cost is the trapezoid rule
+over the samples; costates are estimated at the segment midpoints from the collocation
+multipliers, lambda(t_k+1/2) = 3 nu_k / (2 h_k).
+
+The result reports the Hamiltonian H = L + lambda' f along the solution (zero on an
+extremal with free final time, paper 002 Fig. 10) and ``propagate`` (diagrams.propagation)
+flies the controls with the Drake Simulator to check the terminal state.
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+import time as _time
+
+import numpy as np
+from pydrake.solvers import IpoptSolver, MathematicalProgram, SnoptSolver, SolverOptions
+
+from ..pseudospectral import LGL, interpolation_matrix
+from .ocp import OptimalControlProblem
+
+TRANSCRIPTIONS = ("lgl", "dircol")
+COSTATE_SIGN = 1.0  # Drake's multiplier sign convention, checked on analytic problems (tests)
+DIRCOL_COSTATE_FACTOR = 1.5
+SOLVERS = ("ipopt", "snopt")
+
+
+@dc.dataclass
+class NlpResult:
+    """Solution of an optimal-control problem.
+
+    Attributes:
+      success, message: solver verdict in words.
+      time: node times [s] (nodes,). states: (nodes, n_states) SI in the problem's state
+        order ([h, lon, lat, V, gamma, psi] first). controls: (nodes, n_controls) SI.
+      objective: J in the problem's cost units (Lagrange terms integrated in seconds).
+      costates: (nodes, n_states) d J / d x, SI (LGL: at the nodes; dircol: at segment
+        midpoints, see costate_time), or None if the solver returned no multipliers.
+      costate_time: times of the costate rows [s].
+      hamiltonian: H = L + lambda' f at costate_time [cost units / s].
+      solve_time: wall time of the solver [s]; build_time: transcription [s].
+      transcription, solver, nodes; iterations where the solver reports them.
+      max_defect: largest scaled dynamics/constraint violation at the solution.
+    """
+
+    success: bool
+    message: str
+    time: np.ndarray
+    states: np.ndarray
+    controls: np.ndarray
+    objective: float
+    costates: np.ndarray | None
+    costate_time: np.ndarray | None
+    hamiltonian: np.ndarray | None
+    solve_time: float
+    build_time: float
+    transcription: str
+    solver: str
+    nodes: int
+    max_defect: float
+    problem: object = dc.field(repr=False, default=None)
+
+    @property
+    def final_time(self) -> float:
+        return float(self.time[-1])
+
+    def control_function(self):
+        """u(t) [SI] between the nodes: the Lagrange interpolant of the LGL nodes (the
+        method's own representation) or first-order hold for dircol."""
+        t, U = self.time, self.controls
+        if self.transcription == "lgl":
+            tf = t[-1]
+            tau_nodes = 2.0 * t / tf - 1.0
+
+            def u(tt):
+                tau = np.clip(2.0 * np.atleast_1d(tt) / tf - 1.0, -1.0, 1.0)
+                return interpolation_matrix(tau_nodes, tau) @ U
+        else:
+            def u(tt):
+                return np.column_stack([np.interp(np.atleast_1d(tt), t, U[:, j]) for j in range(U.shape[1])])
+        return u
+
+    def state_function(self):
+        """x(t) [SI] between the nodes (Lagrange interpolant for LGL, linear for dircol)."""
+        t, X = self.time, self.states
+        if self.transcription == "lgl":
+            tau_nodes = 2.0 * t / t[-1] - 1.0
+            return lambda tt: interpolation_matrix(tau_nodes, np.clip(2.0 * np.atleast_1d(tt) / t[-1] - 1.0, -1, 1)) @ X
+        return lambda tt: np.column_stack([np.interp(np.atleast_1d(tt), t, X[:, j]) for j in range(X.shape[1])])
+
+
+class NlpError(RuntimeError):
+    """The NLP could not be built (bad options or problem)."""
+
+
+# ---------------------------------------------------------------------------------------
+# public entry point
+# ---------------------------------------------------------------------------------------
+def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: int = 40, guess=None,
+          tolerance: float = 1e-8, max_iterations: int = 3000, verbose: bool = False) -> NlpResult:
+    """Solve ``problem`` (see module docstring).
+
+    Args:
+      transcription: 'lgl' (Legendre pseudospectral, paper 002 eqs. 12-14) or 'dircol'.
+      solver: 'ipopt' (default) or 'snopt'.
+      nodes: LGL nodes or DirectCollocation samples (>= 3).
+      guess: an NlpResult, or (t [s], states (n, nx), controls (n, nu)) SI, or None for the
+        built-in propagated guess (``initial_guess``).
+      tolerance: solver optimality and feasibility tolerance (scaled units).
+      max_iterations: solver iteration limit.
+    """
+    if transcription not in TRANSCRIPTIONS:
+        raise ValueError(f"transcription '{transcription}' is unknown; allowed: {', '.join(TRANSCRIPTIONS)}")
+    if solver not in SOLVERS:
+        raise ValueError(f"solver '{solver}' is unknown; allowed: {', '.join(SOLVERS)}")
+    if not (isinstance(nodes, (int, np.integer)) and nodes >= 3):
+        raise ValueError(f"nodes must be an integer >= 3, got {nodes}")
+    if not tolerance > 0:
+        raise ValueError(f"tolerance must be > 0, got {tolerance}")
+    engine = IpoptSolver() if solver == "ipopt" else SnoptSolver()
+    if not engine.available() or not engine.enabled():
+        raise NlpError(f"solver '{solver}' is not available in this pydrake build")
+    if guess is None:
+        guess = initial_guess(problem)
+    elif isinstance(guess, NlpResult):
+        guess = (guess.time, guess.states, guess.controls)
+    t_build = _time.perf_counter()
+    tx = _LglTranscription(problem, nodes) if transcription == "lgl" else _DircolTranscription(problem, nodes)
+    tx.set_guess(*guess)
+    build_time = _time.perf_counter() - t_build
+    options = SolverOptions()
+    if solver == "ipopt":
+        options.SetOption(engine.solver_id(), "tol", tolerance)
+        options.SetOption(engine.solver_id(), "constr_viol_tol", tolerance)
+        options.SetOption(engine.solver_id(), "max_iter", int(max_iterations))
+        options.SetOption(engine.solver_id(), "print_level", 5 if verbose else 0)
+    else:
+        options.SetOption(engine.solver_id(), "Major optimality tolerance", tolerance)
+        options.SetOption(engine.solver_id(), "Major feasibility tolerance", tolerance)
+        options.SetOption(engine.solver_id(), "Major iterations limit", int(max_iterations))
+        options.SetOption(engine.solver_id(), "Iterations limit", int(max_iterations) * 100)
+        if verbose:
+            options.SetOption(engine.solver_id(), "Print file", "snopt.out")
+    t0 = _time.perf_counter()
+    res = engine.Solve(tx.prog, tx.initial_guess, options)
+    solve_time = _time.perf_counter() - t0
+    return tx.result(res, solver, solve_time, build_time)
+
+
+# ---------------------------------------------------------------------------------------
+# initial guess by propagating a simple control law
+# ---------------------------------------------------------------------------------------
+def initial_guess(problem, samples: int = 200):
+    """(t, states, controls) SI: a propagated guess.
+
+    Entry problems: fly a constant angle of attack (alpha-bar, within the bounds) and a
+    constant bank magnitude found by bisection so the flight ends at the final altitude
+    near the final position (or at the fixed/maximum final time), with controls at rest.
+    Other problems: the straight line between the boundary values over the mean final
+    time, controls at the middle of their bounds (or zero).
+    """
+    if isinstance(problem, OptimalControlProblem):
+        return _entry_guess(problem, samples)
+    return _straight_line_guess(problem, samples)
+
+
+def _mid(lo, hi, default):
+    if np.isfinite(lo) and np.isfinite(hi):
+        return 0.5 * (lo + hi)
+    if np.isfinite(lo):
+        return max(lo, default)
+    if np.isfinite(hi):
+        return min(hi, default)
+    return default
+
+
+def _straight_line_guess(problem, samples):
+    t_lo, t_hi = problem.final_time_bounds
+    tf = 0.5 * (t_lo + t_hi) if np.isfinite(t_hi) else t_lo * 2.0
+    x0l, x0h = problem.boundary_bounds("initial")
+    xfl, xfh = problem.boundary_bounds("final")
+    xl, xh, ul, uh = problem.bounds_arrays()
+    x0 = np.array([_mid(a, b, _mid(c, d, 0.0)) for a, b, c, d in zip(x0l, x0h, xl, xh)])
+    xf = np.array([_mid(a, b, x0[i]) for i, (a, b) in enumerate(zip(xfl, xfh))])
+    t = np.linspace(0.0, tf, samples)
+    X = x0[None, :] + (t / tf)[:, None] * (xf - x0)[None, :]
+    U = np.tile([_mid(a, b, 0.0) for a, b in zip(ul, uh)], (samples, 1))
+    return t, X, U
+
+
+def _entry_guess(problem: OptimalControlProblem, samples):
+    from scipy.integrate import solve_ivp
+
+    x0l, x0h = problem.boundary_bounds("initial")
+    if not np.all(np.isfinite(x0l[:6])) or not np.allclose(x0l[:6], x0h[:6]):
+        return _straight_line_guess(problem, samples)
+    x0 = x0l.copy()
+    xl, xh, ul, uh = problem.bounds_arrays()
+    xfl, xfh = problem.boundary_bounds("final")
+    h_end = xfl[0] if np.isfinite(xfl[0]) else 0.0
+    alpha = float(np.clip(problem.alpha_bar, xl[6] if problem.controls == "rates" else ul[0],
+                          xh[6] if problem.controls == "rates" else uh[0]))
+    if problem.controls == "rates" and not np.isfinite(x0[6]):
+        x0[6] = alpha
+    t_lo, t_hi = problem.final_time_bounds
+    t_max = t_hi if np.isfinite(t_hi) else 5000.0
+    target = None
+    if np.isfinite(xfl[1]) and np.isfinite(xfl[2]):
+        target = (xfl[1], xfl[2])
+
+    def fly(bank):
+        def f(t, y):
+            u = np.zeros(problem.n_controls) if problem.controls == "rates" else np.array([alpha, bank])
+            x = y.copy()
+            if problem.controls == "rates":
+                x[6], x[7] = alpha, bank
+            return problem.dynamics(x, u)
+
+        def ground(t, y):
+            return y[0] - h_end
+        ground.terminal, ground.direction = True, -1
+        y0 = x0.copy()
+        if problem.controls == "rates":
+            y0[6], y0[7] = alpha, bank
+        return solve_ivp(f, (0.0, t_max), y0, events=ground, rtol=1e-7, atol=1e-9, max_step=5.0)
+
+    def miss(sol):
+        xf = sol.y[:, -1]
+        if target is None:
+            return 0.0
+        return problem._central_angle(float(xf[1]), float(xf[2]), *target) - \
+            problem._central_angle(float(x0[1]), float(x0[2]), *target)
+
+    # bisection on the bank magnitude: more bank = shorter flight
+    lo, hi = 0.0, math.radians(89.0)
+    sol = fly(lo)
+    if target is not None and miss(sol) > 0:  # cannot even reach: keep wings level
+        best = sol
+    else:
+        best = sol
+        for _ in range(30):
+            mid = 0.5 * (lo + hi)
+            s = fly(mid)
+            if s.status == 1 and miss(s) < 0:  # landed beyond the target: bank more
+                lo, best = mid, s
+            else:
+                hi = mid
+            if hi - lo < 1e-4:
+                break
+    t = np.linspace(0.0, best.t[-1], samples)
+    from scipy.interpolate import interp1d
+
+    X = interp1d(best.t, best.y, axis=1)(t).T
+    if problem.controls == "rates":
+        U = np.zeros((samples, 2))
+    else:
+        U = np.column_stack([np.full(samples, alpha), X[:, 6] if X.shape[1] > 6 else np.full(samples, lo)])
+    if t[-1] < t_lo or t[-1] > t_hi:  # stretch to the allowed final time
+        t = t * np.clip(t[-1], t_lo, t_hi) / t[-1]
+    return t, X, U
+
+
+# ---------------------------------------------------------------------------------------
+# transcriptions
+# ---------------------------------------------------------------------------------------
+class _Transcription:
+    """Scaling, bounds, boundary conditions, path constraints shared by both transcriptions."""
+
+    def __init__(self, problem, nodes: int):
+        self.problem = problem
+        self.N = nodes
+        self.sx, self.su, self.ts = problem.scales()
+        self.nx, self.nu = problem.n_states, problem.n_controls
+        self.t_lo, self.t_hi = problem.final_time_bounds
+        self.fixed_tf = self.t_lo == self.t_hi
+
+    # scaled <-> SI
+    def f_scaled(self, xs, us):
+        return np.asarray(self.problem.dynamics(xs * self.sx, us * self.su)) * (self.ts / self.sx)
+
+    def L_scaled(self, xs, us):
+        """Lagrangian per scaled time unit (so J_scaled = J / time_scale... times ts / ts)."""
+        return self.problem.lagrangian(xs * self.sx, us * self.su)
+
+    def path_scaled(self, xs, us):
+        vals = self.problem.path_values(xs * self.sx, us * self.su)
+        return np.array([v / c.scale for v, c in zip(vals, self.problem.path)])
+
+    def add_bounds(self, prog, X, U, x_first, x_last):
+        xl, xh, ul, uh = self.problem.bounds_arrays()
+        for k in range(X.shape[0]):
+            prog.AddBoundingBoxConstraint(xl / self.sx, xh / self.sx, X[k])
+        for k in range(U.shape[0]):
+            prog.AddBoundingBoxConstraint(ul / self.su, uh / self.su, U[k])
+        for which, var in (("initial", x_first), ("final", x_last)):
+            lo, hi = self.problem.boundary_bounds(which)
+            prog.AddBoundingBoxConstraint(lo / self.sx, hi / self.sx, var)
+
+    def add_path(self, prog, X, U):
+        path = self.problem.path
+        if not path:
+            return
+        lo = np.array([c.min / c.scale for c in path])
+        hi = np.array([c.max / c.scale for c in path])
+        nx = self.nx
+        for k in range(X.shape[0]):
+            prog.AddConstraint(lambda z: self.path_scaled(z[:nx], z[nx:]), lo, hi,
+                               np.concatenate([X[k], U[k]]), description=f"path[{k}]")
+
+    def mayer_cost(self, prog, x_last, tf_vars):
+        """Mayer cost M(x_f, t_f) / time_scale; t_f (scaled) is the sum of ``tf_vars`` (the
+        LGL final time, or the DirectCollocation time steps), or fixed when None."""
+        if not self.problem.has_mayer:
+            return
+        nx = self.nx
+        if tf_vars is None:
+            tf = self.t_lo
+            prog.AddCost(lambda z: self.problem.mayer(z * self.sx, tf) / self.ts, x_last)
+        else:
+            prog.AddCost(lambda z: self.problem.mayer(z[:nx] * self.sx, z[nx:].sum() * self.ts) / self.ts,
+                         np.concatenate([x_last, np.atleast_1d(tf_vars)]))
+
+    def diagnose(self, res) -> str:
+        """Name the worst violated constraint at the returned point (infeasible problems)."""
+        worst, where = 0.0, ""
+        for b in self.prog.GetAllConstraints():
+            v = res.EvalBinding(b)
+            lo, hi = b.evaluator().lower_bound(), b.evaluator().upper_bound()
+            viol = np.maximum(lo - v, 0.0) + np.maximum(v - hi, 0.0)
+            viol = viol[np.isfinite(viol)]
+            if viol.size and viol.max() > worst:
+                worst = float(viol.max())
+                where = b.evaluator().get_description() or type(b.evaluator()).__name__
+        return f"largest violation {worst:.3g} (scaled) in '{where}'" if worst > 0 else "no violated constraint"
+
+    def _message(self, res, solver) -> tuple[bool, str]:
+        ok = res.is_success()
+        detail = res.get_solution_result().name
+        try:
+            if solver == "ipopt":
+                detail += f" (Ipopt status {res.get_solver_details().status})"
+            else:
+                detail += f" (SNOPT info {res.get_solver_details().info})"
+        except Exception:  # noqa: BLE001 - details are a courtesy
+            pass
+        return ok, ("solved: " if ok else "not solved: ") + detail
+
+
+class _LglTranscription(_Transcription):
+    """Paper 002 eqs. 12-14 on LGL nodes, with per-node dynamics bindings."""
+
+    def __init__(self, problem, nodes):
+        super().__init__(problem, nodes)
+        self.lgl = LGL(nodes)
+        prog = self.prog = MathematicalProgram()
+        N, nx, nu = nodes, self.nx, self.nu
+        self.X = prog.NewContinuousVariables(N, nx, "x")
+        self.U = prog.NewContinuousVariables(N, nu, "u")
+        self.F = prog.NewContinuousVariables(N, nx, "f")
+        self.tf = None if self.fixed_tf else prog.NewContinuousVariables(1, "tf")[0]
+        if self.tf is not None:
+            prog.AddBoundingBoxConstraint(self.t_lo / self.ts, min(self.t_hi, 1e12) / self.ts, self.tf)
+        # F_k = (tf / 2) f(x_k, u_k), one nonlinear binding per node
+        self.dyn = []
+        for k in range(N):
+            if self.tf is None:
+                half = 0.5 * self.t_lo / self.ts
+                fun = (lambda z, half=half: half * self.f_scaled(z[:nx], z[nx:nx + nu]) - z[nx + nu:])
+                vars_ = np.concatenate([self.X[k], self.U[k], self.F[k]])
+            else:
+                fun = (lambda z: 0.5 * z[nx + nu] * self.f_scaled(z[:nx], z[nx:nx + nu]) - z[nx + nu + 1:])
+                vars_ = np.concatenate([self.X[k], self.U[k], [self.tf], self.F[k]])
+            self.dyn.append(prog.AddConstraint(fun, np.zeros(nx), np.zeros(nx), vars_, description=f"dynamics node {k}"))
+        # D X = F, linear (paper 002 eq. 13): its multipliers are the costates (eq. 15)
+        A = np.hstack([self.lgl.D1_tau, -np.eye(N)])
+        self.defects = [prog.AddLinearEqualityConstraint(A, np.zeros(N), np.concatenate([self.X[:, i], self.F[:, i]]))
+                        for i in range(nx)]
+        for i, b in enumerate(self.defects):
+            b.evaluator().set_description(f"defect {problem.state_names[i]}")
+        self.add_bounds(prog, self.X, self.U, self.X[0], self.X[-1])
+        self.add_path(prog, self.X, self.U)
+        # Lagrange term (eq. 12): (tf / 2) sum w_k L_k, in canonical time
+        if problem.has_lagrange:
+            w = self.lgl.weights_tau
+            for k in range(N):
+                if self.tf is None:
+                    c = 0.5 * self.t_lo / self.ts * w[k]
+                    prog.AddCost(lambda z, c=c: c * self.L_scaled(z[:nx], z[nx:]), np.concatenate([self.X[k], self.U[k]]))
+                else:
+                    prog.AddCost(lambda z, wk=w[k]: 0.5 * z[nx + nu] * wk * self.L_scaled(z[:nx], z[nx:nx + nu]),
+                                 np.concatenate([self.X[k], self.U[k], [self.tf]]))
+        self.mayer_cost(prog, self.X[-1], None if self.tf is None else [self.tf])
+
+    def set_guess(self, t, X, U):
+        t = np.asarray(t, float)
+        tf = float(np.clip(t[-1], self.t_lo, self.t_hi))
+        tk = (self.lgl.tau + 1.0) * 0.5 * t[-1]
+        Xk = np.column_stack([np.interp(tk, t, np.asarray(X)[:, i]) for i in range(self.nx)]) / self.sx
+        Uk = np.column_stack([np.interp(tk, t, np.asarray(U)[:, j]) for j in range(self.nu)]) / self.su
+        guess = np.zeros(self.prog.num_vars())
+        self.initial_guess = guess
+        self.prog.SetDecisionVariableValueInVector(self.X, Xk, guess)
+        self.prog.SetDecisionVariableValueInVector(self.U, Uk, guess)
+        self.prog.SetDecisionVariableValueInVector(self.F, self.lgl.D1_tau @ Xk, guess)
+        if self.tf is not None:
+            self.prog.SetDecisionVariableValueInVector(self.tf, tf / self.ts, guess)
+
+    def result(self, res, solver, solve_time, build_time) -> NlpResult:
+        ok, msg = self._message(res, solver)
+        Xs = np.reshape(res.GetSolution(self.X), (self.N, self.nx))
+        Us = np.reshape(res.GetSolution(self.U), (self.N, self.nu))
+        tf = self.t_lo if self.tf is None else float(res.GetSolution(self.tf)) * self.ts
+        t = (self.lgl.tau + 1.0) * 0.5 * tf
+        X, U = Xs * self.sx, Us * self.su
+        costates = None
+        try:  # eq. 15: lambda_k = nu_k / w_k (scaled), then d J / d x in SI
+            nu = np.column_stack([res.GetDualSolution(b) for b in self.defects])
+            lam_scaled = nu / self.lgl.weights_tau[:, None]
+            costates = COSTATE_SIGN * lam_scaled * self.ts / self.sx  # lambda = d(J/ts)/d(x/sx) scaled back
+        except Exception:  # noqa: BLE001 - a solver without duals
+            costates = None
+        if not ok:
+            msg += "; " + self.diagnose(res)
+        return _finish(self, ok, msg, t, X, U, res, costates, t if costates is not None else None,
+                       solve_time, build_time, "lgl", solver)
+
+
+class _DircolTranscription(_Transcription):
+    """Drake DirectCollocation (Hermite-Simpson) of the scaled plant."""
+
+    def __init__(self, problem, nodes):
+        super().__init__(problem, nodes)
+        from pydrake.planning import DirectCollocation
+
+        from systems.ocp_plant import OptimalControlPlant  # the transcription needs a Drake System
+
+        self.plant = OptimalControlPlant(problem, self.sx, self.su, self.ts)
+        h_min = self.t_lo / self.ts / (nodes - 1) * 0.2
+        h_max = (self.t_hi if np.isfinite(self.t_hi) else 10 * self.t_lo) / self.ts / (nodes - 1) * 5.0
+        self.dc = DirectCollocation(self.plant, self.plant.CreateDefaultContext(), nodes, h_min, h_max)
+        self.dc.AddEqualTimeIntervalsConstraints()
+        self.dc.AddDurationBounds(self.t_lo / self.ts, min(self.t_hi, 1e12) / self.ts)
+        prog = self.prog = self.dc.prog()
+        N, nx, nu = nodes, self.nx, self.nu
+        self.X = np.array([self.dc.state(k) for k in range(N)])
+        self.U = np.array([self.dc.input(k) for k in range(N)])
+        self.H = np.array([self.dc.time_step(k)[0] for k in range(N - 1)])
+        self.add_bounds(prog, self.X, self.U, self.dc.initial_state(), self.dc.final_state())
+        self.add_path(prog, self.X, self.U)
+        if problem.has_lagrange:  # trapezoid rule over the samples
+            for k in range(N - 1):
+                prog.AddCost(lambda z: 0.5 * z[-1] * (self.L_scaled(z[:nx], z[nx:nx + nu])
+                                                      + self.L_scaled(z[nx + nu:2 * nx + nu], z[2 * nx + nu:-1])),
+                             np.concatenate([self.X[k], self.U[k], self.X[k + 1], self.U[k + 1], [self.H[k]]]))
+        self.collocation = [b for b in prog.GetAllConstraints()
+                            if b.evaluator().get_description().startswith("collocation constraint")]
+        self.mayer_cost(prog, self.X[-1], None if self.fixed_tf else self.H)
+
+    def set_guess(self, t, X, U):
+        from pydrake.trajectories import PiecewisePolynomial
+
+        t = np.asarray(t, float) / self.ts
+        Xs = (np.asarray(X) / self.sx).T
+        Us = (np.asarray(U) / self.su).T
+        self.dc.SetInitialTrajectory(PiecewisePolynomial.FirstOrderHold(t, Us),
+                                     PiecewisePolynomial.FirstOrderHold(t, Xs))
+        self.initial_guess = self.prog.GetInitialGuess(self.prog.decision_variables())
+
+    def result(self, res, solver, solve_time, build_time) -> NlpResult:
+        ok, msg = self._message(res, solver)
+        t = self.dc.GetSampleTimes(res) * self.ts
+        X = np.reshape(self.dc.GetStateSamples(res), (self.nx, self.N)).T * self.sx
+        U = np.reshape(self.dc.GetInputSamples(res), (self.nu, self.N)).T * self.su
+        costates, t_mid = None, 0.5 * (t[:-1] + t[1:])
+        try:  # collocation multipliers at the segment midpoints
+            h = np.diff(t) / self.ts
+            nu = np.vstack([res.GetDualSolution(b) for b in self.collocation])
+            costates = COSTATE_SIGN * DIRCOL_COSTATE_FACTOR * nu / h[:, None] * self.ts / self.sx
+        except Exception:  # noqa: BLE001
+            costates = None
+        if not ok:
+            msg += "; " + self.diagnose(res)
+        return _finish(self, ok, msg, t, X, U, res, costates, t_mid if costates is not None else None,
+                       solve_time, build_time, "dircol", solver)
+
+
+def _finish(tx, ok, msg, t, X, U, res, costates, t_costate, solve_time, build_time, transcription, solver):
+    problem = tx.problem
+    objective = float(res.get_optimal_cost()) * tx.ts
+    ham = None
+    if costates is not None:
+        Xc = X if len(t_costate) == len(t) else 0.5 * (X[:-1] + X[1:])
+        Uc = U if len(t_costate) == len(t) else 0.5 * (U[:-1] + U[1:])
+        ham = np.array([float(problem.lagrangian(x, u)) + float(lam @ np.asarray(problem.dynamics(x, u), float))
+                        for x, u, lam in zip(Xc, Uc, costates)])
+    viol = 0.0
+    for b in tx.prog.GetAllConstraints():
+        v = res.EvalBinding(b)
+        lo, hi = b.evaluator().lower_bound(), b.evaluator().upper_bound()
+        e = np.maximum(lo - v, 0.0) + np.maximum(v - hi, 0.0)
+        e = e[np.isfinite(e)]
+        viol = max(viol, float(e.max()) if e.size else 0.0)
+    return NlpResult(success=ok, message=msg, time=t, states=X, controls=U, objective=objective,
+                     costates=costates, costate_time=t_costate, hamiltonian=ham, solve_time=solve_time,
+                     build_time=build_time, transcription=transcription, solver=solver, nodes=tx.N,
+                     max_defect=viol, problem=problem)

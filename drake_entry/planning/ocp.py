@@ -1,0 +1,425 @@
+"""Entry optimal-control problems: the description the NLP path (planning/nlp.py) solves.
+
+A problem holds the models (vehicle, planet, atmosphere), the state and control layout,
+boundary conditions, bounds, path constraints and an objective of Mayer and Lagrange
+terms (paper 002 eqs. 1-11). Everything is SI and radians; users build it in Python or
+read it from YAML (``load_problem``, fields with units in their names). Model functions
+and user callables are evaluated with floats and with Drake AutoDiffXd.
+
+State order: [h, lon, lat, V, gamma, psi] (the canonical order, DESIGN.md), then, with
+``controls='rates'``, [alpha, sigma] driven by the controls [u_alpha, u_sigma]
+(paper 002 eq. 6); with ``controls='direct'`` the controls are [alpha, sigma].
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+from typing import Callable
+
+import numpy as np
+
+from ..atmosphere import Atmosphere
+from ..dynamics import STATE_NAMES, FlightConditions, conditions_from, state_derivatives
+from ..planet import Earth
+from ..vehicles import Vehicle
+
+PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
+    "dynamic_pressure": ("dynamic_pressure", "Pa"), "heat_flux": ("heat_flux", "W/m^2"),
+    "normal_load": ("normal_load", "g"), "total_load": ("total_load", "g"),
+    "sensed_acceleration": ("total_load", "g"),  # paper 002 eq. 7, a = sqrt(L^2 + D^2), in g
+}
+LAGRANGE_KINDS = ("control_margin", "heat_load", "lagrange")
+MAYER_KINDS = ("final_time", "miss_distance", "final_latitude", "final_crossrange", "final_velocity", "mayer")
+
+
+@dc.dataclass
+class PathConstraint:
+    """min <= value(x, u) <= max at every node.
+
+    quantity: a PATH_QUANTITIES name (SI units as listed) or a callable
+    ``f(x, u, env) -> scalar`` with env the node's FlightConditions; ``scale`` is the
+    value's typical size (default: the finite bound), used to scale the NLP row."""
+
+    quantity: str | Callable
+    min: float = -math.inf
+    max: float = math.inf
+    scale: float | None = None
+    name: str = ""
+
+    def __post_init__(self):
+        if not callable(self.quantity) and self.quantity not in PATH_QUANTITIES:
+            raise ValueError(f"path constraint quantity '{self.quantity}' is unknown; allowed: "
+                             f"{', '.join(PATH_QUANTITIES)} or a callable f(x, u, env)")
+        if not self.min <= self.max or (math.isinf(self.min) and math.isinf(self.max)):
+            raise ValueError(f"path constraint '{self.label}' needs min <= max with one finite, got "
+                             f"[{self.min}, {self.max}]")
+        if self.scale is None:
+            finite = [abs(v) for v in (self.min, self.max) if math.isfinite(v) and v != 0.0]
+            self.scale = max(finite) if finite else 1.0
+
+    @property
+    def label(self) -> str:
+        return self.name or (self.quantity if isinstance(self.quantity, str) else "user")
+
+    def value(self, x, u, env: FlightConditions):
+        if callable(self.quantity):
+            return self.quantity(x, u, env)
+        return getattr(env, PATH_QUANTITIES[self.quantity][0])
+
+
+@dc.dataclass
+class ObjectiveTerm:
+    """One weighted term of J = sum(weight * term).
+
+    Lagrange kinds (integrated over time):
+      control_margin  paper 002 eq. 11: k1 ((alpha - alpha_bar)/alpha_max)^2
+                      + k2 (u_alpha/u_alpha_max)^2 + k3 (u_sigma/u_sigma_max)^2 [1/s]
+      heat_load       heat flux [W/m^2] (J = heat load [J/m^2])
+      lagrange        ``function(x, u, env)``
+    Mayer kinds (at the final node): final_time [s]; miss_distance [m] to ``target``
+      (lon, lat rad), squared and divided by ``scale`` unless ``squared=False``;
+      final_latitude [rad]; final_crossrange [m] from the great circle through the initial
+      position along the initial heading; final_velocity [m/s]; mayer ``function(xf, tf)``.
+    Use a negative weight to maximise (e.g. final_latitude with weight -1).
+    """
+
+    kind: str
+    weight: float = 1.0
+    k: tuple = (1.0, 18.0, 20.0)  # paper 002 eq. 19
+    alpha_bar: float | None = None  # default: the vehicle's max-L/D alpha
+    alpha_max: float = math.radians(25.0)
+    u_alpha_max: float = math.radians(10.0)
+    u_sigma_max: float = math.radians(30.0)
+    target: tuple | None = None
+    scale: float = 1.0
+    squared: bool = True
+    function: Callable | None = None
+
+    def __post_init__(self):
+        if self.kind not in LAGRANGE_KINDS + MAYER_KINDS:
+            raise ValueError(f"objective kind '{self.kind}' is unknown; allowed: "
+                             f"{', '.join(LAGRANGE_KINDS + MAYER_KINDS)}")
+        if self.kind in ("lagrange", "mayer") and self.function is None:
+            raise ValueError(f"objective kind '{self.kind}' needs a function")
+        if self.kind == "miss_distance" and self.target is None:
+            raise ValueError("objective 'miss_distance' needs target = (lon, lat) [rad]")
+
+    @property
+    def is_lagrange(self) -> bool:
+        return self.kind in LAGRANGE_KINDS
+
+
+class _ProblemLayout:
+    """Bounds and layout shared by every problem class (needs state_names, control_names,
+    initial, final, final_time, state_bounds, control_bounds, path)."""
+
+    @property
+    def n_states(self) -> int:
+        return len(self.state_names)
+
+    @property
+    def n_controls(self) -> int:
+        return len(self.control_names)
+
+    @property
+    def final_time_bounds(self) -> tuple:
+        if isinstance(self.final_time, (int, float)):
+            return float(self.final_time), float(self.final_time)
+        return float(self.final_time[0]), float(self.final_time[1])
+
+    def _check_layout(self):
+        for where, d in (("initial", self.initial), ("final", self.final), ("state_bounds", self.state_bounds)):
+            for k in d:
+                if k not in self.state_names:
+                    raise ValueError(f"{where}: unknown state '{k}'; states are {', '.join(self.state_names)}")
+        for k in self.control_bounds:
+            if k not in self.control_names:
+                raise ValueError(f"control_bounds: unknown control '{k}'; controls are {', '.join(self.control_names)}")
+        lo, hi = self.final_time_bounds
+        if not 0.0 < lo <= hi:
+            raise ValueError(f"final_time must be > 0 with min <= max, got {self.final_time}")
+
+    def _default_state_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.full(self.n_states, -np.inf), np.full(self.n_states, np.inf)
+
+    def bounds_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(x_lo, x_hi, u_lo, u_hi) path bounds; +-inf where unbounded."""
+        xl, xh = self._default_state_bounds()
+        for i, n in enumerate(self.state_names):
+            if n in self.state_bounds:
+                xl[i], xh[i] = max(xl[i], self.state_bounds[n][0]), min(xh[i], self.state_bounds[n][1])
+        ul, uh = np.full(self.n_controls, -np.inf), np.full(self.n_controls, np.inf)
+        for i, n in enumerate(self.control_names):
+            if n in self.control_bounds:
+                ul[i], uh[i] = self.control_bounds[n]
+        return xl, xh, ul, uh
+
+    def boundary_bounds(self, which: str) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) of the 'initial' or 'final' state; +-inf where free."""
+        spec = self.initial if which == "initial" else self.final
+        lo, hi = (b.copy() for b in self.bounds_arrays()[:2])
+        for i, name in enumerate(self.state_names):
+            v = spec.get(name)
+            if v is None:
+                continue
+            if isinstance(v, (tuple, list)):
+                lo[i], hi[i] = max(lo[i], v[0]), min(hi[i], v[1])
+            else:
+                lo[i] = hi[i] = float(v)
+        return lo, hi
+
+
+@dc.dataclass
+class CustomProblem(_ProblemLayout):
+    """A general optimal-control problem given by functions (any state and control layout);
+    the same transcriptions and solvers as the entry problem.
+
+    Attributes:
+      state_names, control_names: names (their order is the vector order).
+      dynamics_function: f(x, u) -> xdot. lagrange_function: L(x, u) or None.
+      mayer_function: M(xf, tf) or None. path: PathConstraint list whose quantity is a
+        callable f(x, u, env) (env is None here).
+      initial, final, final_time, state_bounds, control_bounds: as OptimalControlProblem.
+      state_scale, control_scale, time_scale: typical sizes used to scale the NLP.
+    """
+
+    state_names: tuple
+    control_names: tuple
+    dynamics_function: Callable
+    initial: dict
+    final: dict
+    final_time: float | tuple
+    lagrange_function: Callable | None = None
+    mayer_function: Callable | None = None
+    state_bounds: dict = dc.field(default_factory=dict)
+    control_bounds: dict = dc.field(default_factory=dict)
+    path: list = dc.field(default_factory=list)
+    state_scale: tuple | None = None
+    control_scale: tuple | None = None
+    time_scale: float = 1.0
+    name: str = "custom"
+
+    def __post_init__(self):
+        self._check_layout()
+        if self.lagrange_function is None and self.mayer_function is None:
+            raise ValueError("CustomProblem needs a lagrange_function or a mayer_function")
+
+    def dynamics(self, x, u):
+        return np.asarray(self.dynamics_function(x, u))
+
+    def lagrangian(self, x, u):
+        return self.lagrange_function(x, u) if self.lagrange_function is not None else 0.0
+
+    def mayer(self, xf, tf):
+        return self.mayer_function(xf, tf) if self.mayer_function is not None else 0.0
+
+    @property
+    def has_lagrange(self) -> bool:
+        return self.lagrange_function is not None
+
+    @property
+    def has_mayer(self) -> bool:
+        return self.mayer_function is not None
+
+    def path_values(self, x, u) -> list:
+        return [c.quantity(x, u, None) for c in self.path]
+
+    def scales(self) -> tuple[np.ndarray, np.ndarray, float]:
+        sx = np.ones(self.n_states) if self.state_scale is None else np.asarray(self.state_scale, float)
+        su = np.ones(self.n_controls) if self.control_scale is None else np.asarray(self.control_scale, float)
+        return sx, su, float(self.time_scale)
+
+
+@dc.dataclass
+class OptimalControlProblem(_ProblemLayout):
+    """An entry optimal-control problem (paper 002 Sec. 'Optimal Control Problem').
+
+    Attributes:
+      vehicle, planet, atmosphere: the models.
+      initial, final: state name -> fixed value, (min, max) or None (free), SI / rad.
+        States not named are free.
+      final_time: fixed t_f [s] or (min, max) for a free final time; t_0 = 0.
+      controls: 'rates' (alpha, sigma are states, controls are their rates) or 'direct'.
+      state_bounds, control_bounds: name -> (min, max) along the whole trajectory.
+      path: path constraints. objective: terms (at least one).
+    """
+
+    vehicle: Vehicle
+    planet: Earth
+    atmosphere: Atmosphere
+    initial: dict
+    final: dict
+    final_time: float | tuple
+    objective: list
+    controls: str = "rates"
+    state_bounds: dict = dc.field(default_factory=dict)
+    control_bounds: dict = dc.field(default_factory=dict)
+    path: list = dc.field(default_factory=list)
+    name: str = "problem"
+
+    def __post_init__(self):
+        if self.controls not in ("rates", "direct"):
+            raise ValueError(f"controls must be 'rates' or 'direct', got '{self.controls}'")
+        self._check_layout()
+        if not self.objective:
+            raise ValueError("objective needs at least one term")
+        for term in self.objective:
+            if term.kind == "control_margin" and self.controls != "rates":
+                raise ValueError("objective 'control_margin' (paper 002 eq. 11) needs controls='rates'")
+
+    # -- layout -------------------------------------------------------------------------
+    @property
+    def state_names(self) -> tuple:
+        return STATE_NAMES + (("alpha", "sigma") if self.controls == "rates" else ())
+
+    @property
+    def control_names(self) -> tuple:
+        return ("u_alpha", "u_sigma") if self.controls == "rates" else ("alpha", "sigma")
+
+    def _default_state_bounds(self):
+        xl, xh = np.full(self.n_states, -np.inf), np.full(self.n_states, np.inf)
+        xl[3] = 1.0  # speed stays positive (the equations divide by V)
+        xl[4], xh[4] = -math.radians(89.99), math.radians(89.99)  # gamma = +-90 deg is singular
+        return xl, xh
+
+    def scales(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """NLP scaling (canonical units, paper 002 'Application', with altitude in 10 km):
+        state scales, control scales (the control bound where finite) and the time unit
+        T = R / V_c (the period of a circular orbit at one radius divided by 2 pi) [SI]."""
+        R = self.planet.reference_radius
+        Vc = math.sqrt(self.planet.mu / R)
+        sx = np.ones(self.n_states)
+        sx[0], sx[3] = 1.0e4, Vc
+        _, _, ul, uh = self.bounds_arrays()
+        su = np.array([max(abs(lo), abs(hi)) if np.isfinite(lo) and np.isfinite(hi) else 1.0
+                       for lo, hi in zip(ul, uh)])
+        return sx, su, R / Vc
+
+    # -- models (float and AutoDiffXd) ---------------------------------------------------
+    def alpha_sigma(self, x, u):
+        return (x[6], x[7]) if self.controls == "rates" else (u[0], u[1])
+
+    def dynamics(self, x, u) -> np.ndarray:
+        """xdot [SI] (paper 002 eqs. 1 and 6, in the canonical state order)."""
+        alpha, sigma = self.alpha_sigma(x, u)
+        xdot = state_derivatives(x[:6], sigma, alpha, self.vehicle, self.planet, self.atmosphere)
+        if self.controls == "rates":
+            return np.concatenate([xdot, [u[0], u[1]]])
+        return xdot
+
+    def conditions(self, x, u) -> FlightConditions:
+        """Flight conditions at (x, u): q, heat flux, load factors, L, D, ..."""
+        alpha, _ = self.alpha_sigma(x, u)
+        from ..dynamics import aero_accelerations, air_data
+
+        rho, a = air_data(x[:6], self.planet, self.atmosphere)
+        mach, L, D = aero_accelerations(x[:6], alpha, rho, a, self.vehicle)
+        return conditions_from(x[:6], alpha, rho, mach, L, D, self.vehicle, self.planet)
+
+    def lagrangian(self, x, u):
+        """Sum of the weighted Lagrange terms at (x, u) [cost units / s]."""
+        total, env = 0.0, None
+        for term in self.objective:
+            if not term.is_lagrange:
+                continue
+            if term.kind == "control_margin":  # paper 002 eq. 11
+                k1, k2, k3 = term.k
+                a_bar = self.alpha_bar if term.alpha_bar is None else term.alpha_bar
+                v = (k1 * ((x[6] - a_bar) / term.alpha_max) ** 2 + k2 * (u[0] / term.u_alpha_max) ** 2
+                     + k3 * (u[1] / term.u_sigma_max) ** 2)
+            else:
+                env = env if env is not None else self.conditions(x, u)
+                v = env.heat_flux if term.kind == "heat_load" else term.function(x, u, env)
+            total = total + term.weight * v
+        return total
+
+    def mayer(self, xf, tf):
+        """Sum of the weighted Mayer terms at the final state xf and time tf [s]."""
+        total = 0.0
+        for term in self.objective:
+            if term.is_lagrange:
+                continue
+            if term.kind == "final_time":
+                v = tf
+            elif term.kind == "miss_distance":
+                d = self._central_angle(xf[1], xf[2], *term.target) * self.planet.reference_radius
+                v = d * d / term.scale if term.squared else d
+            elif term.kind == "final_latitude":
+                v = xf[2]
+            elif term.kind == "final_velocity":
+                v = xf[3]
+            elif term.kind == "final_crossrange":
+                v = self.crossrange(xf)
+            else:
+                v = term.function(xf, tf)
+            total = total + term.weight * v
+        return total
+
+    @property
+    def has_lagrange(self) -> bool:
+        return any(t.is_lagrange for t in self.objective)
+
+    @property
+    def has_mayer(self) -> bool:
+        return any(not t.is_lagrange for t in self.objective)
+
+    @property
+    def alpha_bar(self) -> float:
+        """alpha at maximum L/D (paper 002: sqrt(C_D0/K) for the drag polar)."""
+        a = getattr(self.vehicle.aero, "alpha_max_lift_to_drag", None)
+        return float(a) if a is not None else math.radians(10.0)
+
+    def crossrange(self, x):
+        """Signed distance [m] of x from the great circle through the initial position along
+        the initial heading (+ right of the initial heading)."""
+        x0 = np.array([self._initial_value(i) for i in range(6)], float)
+        fn = np if not isinstance(x[1], float) else math
+        lon0, lat0, psi0 = x0[1], x0[2], x0[5]
+        # unit normal of the initial great circle (right-handed: +right of the heading)
+        e = np.array([math.cos(lat0) * math.cos(lon0), math.cos(lat0) * math.sin(lon0), math.sin(lat0)])
+        north = np.array([-math.sin(lat0) * math.cos(lon0), -math.sin(lat0) * math.sin(lon0), math.cos(lat0)])
+        east = np.array([-math.sin(lon0), math.cos(lon0), 0.0])
+        v = math.cos(psi0) * north + math.sin(psi0) * east
+        n = np.cross(e, v)  # left of the heading
+        p = [fn.cos(x[2]) * fn.cos(x[1]), fn.cos(x[2]) * fn.sin(x[1]), fn.sin(x[2])]
+        s = -(n[0] * p[0] + n[1] * p[1] + n[2] * p[2])
+        return self.planet.reference_radius * np.arcsin(s) if not isinstance(s, float) else \
+            self.planet.reference_radius * math.asin(s)
+
+    def _initial_value(self, i: int) -> float:
+        v = self.initial.get(self.state_names[i])
+        if v is None or isinstance(v, (tuple, list)):
+            raise ValueError(f"crossrange needs a fixed initial {self.state_names[i]}")
+        return float(v)
+
+    @staticmethod
+    def _central_angle(lon1, lat1, lon2, lat2):
+        """Great-circle angle by the haversine form (smooth, AutoDiff-safe away from 0)."""
+        fn = math if isinstance(lon1, float) else np
+        s = fn.sin(0.5 * (lat2 - lat1)) ** 2 + fn.cos(lat1) * fn.cos(lat2) * fn.sin(0.5 * (lon2 - lon1)) ** 2
+        return 2.0 * fn.arcsin(fn.sqrt(s + 1e-30)) if fn is np else 2.0 * math.asin(math.sqrt(s + 1e-30))
+
+    def path_values(self, x, u) -> list:
+        env = self.conditions(x, u)
+        return [c.value(x, u, env) for c in self.path]
+
+    def with_(self, **changes) -> "OptimalControlProblem":
+        return dc.replace(self, **changes)
+
+
+def downtrack_crosstrack(lon, lat, lon0: float, lat0: float, lonf: float, latf: float, radius: float):
+    """Paper 002 appendix eqs. 24-30: downtrack d and crosstrack c [m] of points (lon, lat)
+    in the frame of the initial position r0 and the final position rf (arrays)."""
+    def unit(lo, la):
+        return np.stack([np.cos(la) * np.cos(lo), np.cos(la) * np.sin(lo), np.sin(la)], axis=-1)
+
+    u1 = unit(lon0, lat0)
+    rf = unit(lonf, latf)
+    u3 = np.cross(u1, rf)
+    u3 = u3 / np.linalg.norm(u3)
+    u2 = np.cross(u3, u1)
+    r = unit(np.asarray(lon, float), np.asarray(lat, float))
+    rdc = r @ np.vstack([u1, u2, u3]).T  # eq. 28
+    a = np.arctan2(rdc[..., 1], rdc[..., 0])  # eq. 29
+    b = np.arcsin(np.clip(rdc[..., 2], -1.0, 1.0))
+    return radius * a, radius * b  # eq. 30

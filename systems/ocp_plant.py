@@ -1,0 +1,49 @@
+"""OptimalControlPlant: the dynamics of an optimal-control problem as a Drake system, for
+Drake's DirectCollocation (which needs a System converting to AutoDiffXd) and for
+propagating NLP controls with the Simulator.
+
+The plant runs in scaled units: state x_s = x / state_scale, input u_s = u / control_scale
+and time t_s = t / time_scale, so dx_s/dt_s = time_scale / state_scale * f(x, u). With all
+scales 1 it is the physical plant.
+
+Ports:
+  input  "u"  [n_controls]  scaled controls (the problem's control order)
+  output "x"  [n_states]    scaled state (the problem's state order)
+"""
+from __future__ import annotations
+
+import numpy as np
+from pydrake.systems.framework import BasicVector_, ContinuousStateIndex, LeafSystem_
+from pydrake.systems.scalar_conversion import TemplateSystem
+
+
+@TemplateSystem.define("OptimalControlPlant_")
+def OptimalControlPlant_(T):
+    class Impl(LeafSystem_[T]):
+        def _construct(self, problem, state_scale=None, control_scale=None, time_scale: float = 1.0,
+                       converter=None):
+            """Args: problem with n_states, n_controls and dynamics(x, u) (SI); scales (SI per
+            scaled unit; default 1)."""
+            LeafSystem_[T].__init__(self, converter)
+            self.problem = problem
+            nx, nu = problem.n_states, problem.n_controls
+            self.sx = np.ones(nx) if state_scale is None else np.asarray(state_scale, float)
+            self.su = np.ones(nu) if control_scale is None else np.asarray(control_scale, float)
+            self.ts = float(time_scale)
+            self.DeclareContinuousState(BasicVector_[T](np.zeros(nx)))
+            self.u_port = self.DeclareVectorInputPort("u", nu)
+            self.DeclareStateOutputPort("x", ContinuousStateIndex(0))
+
+        def _construct_copy(self, other, converter=None):
+            Impl._construct(self, other.problem, other.sx, other.su, other.ts, converter=converter)
+
+        def DoCalcTimeDerivatives(self, context, derivatives):
+            xs = context.get_continuous_state_vector().CopyToVector()
+            us = self.u_port.Eval(context)
+            f = self.problem.dynamics(xs * self.sx, us * self.su)
+            derivatives.get_mutable_vector().SetFromVector(np.asarray(f) * (self.ts / self.sx))
+
+    return Impl
+
+
+OptimalControlPlant = OptimalControlPlant_[None]

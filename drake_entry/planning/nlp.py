@@ -29,6 +29,7 @@ import math
 import time as _time
 
 import numpy as np
+from pydrake.autodiffutils import ExtractGradient, ExtractValue, InitializeAutoDiff
 from pydrake.solvers import IpoptSolver, MathematicalProgram, SnoptSolver, SolverOptions
 
 from ..pseudospectral import LGL, interpolation_matrix
@@ -239,29 +240,26 @@ def _entry_guess(problem: OptimalControlProblem, samples):
             y0[6], y0[7] = alpha, bank
         return solve_ivp(f, (0.0, t_max), y0, events=ground, rtol=1e-7, atol=1e-9, max_step=5.0)
 
-    def miss(sol):
+    def miss(sol):  # flown central angle beyond the target's [rad]
         xf = sol.y[:, -1]
-        if target is None:
-            return 0.0
-        return problem._central_angle(float(xf[1]), float(xf[2]), *target) - \
-            problem._central_angle(float(x0[1]), float(x0[2]), *target)
+        start = (float(x0[1]), float(x0[2]))
+        return problem._central_angle(*start, float(xf[1]), float(xf[2])) - problem._central_angle(*start, *target)
 
-    # bisection on the bank magnitude: more bank = shorter flight
+    def too_long(sol):  # did not land, or landed beyond the final position
+        return sol.status != 1 or (target is not None and miss(sol) > 0)
+
+    # bisection on a constant bank magnitude: more bank = shorter flight
     lo, hi = 0.0, math.radians(89.0)
-    sol = fly(lo)
-    if target is not None and miss(sol) > 0:  # cannot even reach: keep wings level
-        best = sol
-    else:
-        best = sol
-        for _ in range(30):
-            mid = 0.5 * (lo + hi)
-            s = fly(mid)
-            if s.status == 1 and miss(s) < 0:  # landed beyond the target: bank more
-                lo, best = mid, s
-            else:
-                hi = mid
-            if hi - lo < 1e-4:
-                break
+    best = fly(hi)
+    for _ in range(25):
+        mid = 0.5 * (lo + hi)
+        s = fly(mid)
+        if too_long(s):
+            lo = mid
+        else:
+            hi, best = mid, s
+        if hi - lo < 1e-4:
+            break
     t = np.linspace(0.0, best.t[-1], samples)
     from scipy.interpolate import interp1d
 
@@ -361,8 +359,90 @@ class _Transcription:
         return ok, ("solved: " if ok else "not solved: ") + detail
 
 
+class _NodeEvaluator:
+    """Dynamics, path functions and Lagrangian at all nodes with their Jacobians.
+
+    Every node's values depend only on that node's state and control, so one vectorised
+    model call on the nodes and their 2 (n_x + n_u) central perturbations gives all
+    Jacobian blocks (step (eps^(1/3)) in scaled units, truncation error ~1e-10). Models only
+    need to accept float arrays; a model that does not is evaluated node by node."""
+
+    def __init__(self, tx, step: float = 6e-6):
+        self.tx, self.step = tx, step
+        self._key, self._out = None, None
+        self.vectorised = True
+
+    def _models(self, Xs, Us):
+        """f_scaled (nx, M), path_scaled (np, M), L (M,) at M scaled points (columns)."""
+        tx = self.tx
+        x = Xs * tx.sx[:, None]
+        u = Us * tx.su[:, None]
+        if self.vectorised:
+            try:
+                return self._call(x, u)
+            except Exception:  # noqa: BLE001 - a model without array support
+                self.vectorised = False
+        cols = [self._call(x[:, m], u[:, m]) for m in range(x.shape[1])]
+        return (np.column_stack([c[0] for c in cols]), np.column_stack([c[1] for c in cols]),
+                np.array([c[2] for c in cols], float))
+
+    def _call(self, x, u):
+        tx, p = self.tx, self.tx.problem
+        xs, us = list(x), list(u)
+        m = np.shape(x)[1:] or ()
+        f = np.array([np.broadcast_to(np.asarray(v, float), m) for v in p.dynamics(xs, us)])
+        f = f * (tx.ts / tx.sx).reshape((-1,) + (1,) * len(m))
+        if p.path:
+            g = np.array([np.broadcast_to(np.asarray(v, float), m) / c.scale
+                          for v, c in zip(p.path_values(xs, us), p.path)])
+        else:
+            g = np.zeros((0,) + tuple(m))
+        L = np.broadcast_to(np.asarray(p.lagrangian(xs, us), float), m) if p.has_lagrange else np.zeros(m)
+        return f, g, L
+
+    def evaluate(self, Xs, Us):
+        """Values and node Jacobians: f (N, nx), g (N, np), L (N,), and df (N, nx, nx+nu),
+        dg (N, np, nx+nu), dL (N, nx+nu) with respect to the scaled node variables."""
+        key = np.concatenate([Xs.ravel(), Us.ravel()]).tobytes()
+        if key == self._key:
+            return self._out
+        N, nx = Xs.shape
+        nu = Us.shape[1]
+        nv = nx + nu
+        V = np.hstack([Xs, Us])  # (N, nv)
+        h = self.step * np.maximum(1.0, np.abs(V))  # (N, nv)
+        pts = [V]
+        for j in range(nv):
+            for sgn in (1.0, -1.0):
+                W = V.copy()
+                W[:, j] += sgn * h[:, j]
+                pts.append(W)
+        P = np.vstack(pts).T  # (nv, N (1 + 2 nv))
+        f, g, L = self._models(P[:nx], P[nx:])
+        M = N
+        f0, g0, L0 = f[:, :M].T, g[:, :M].T, L[:M]
+        df = np.empty((N, nx, nv))
+        dg = np.empty((N, g.shape[0], nv))
+        dL = np.empty((N, nv))
+        for j in range(nv):
+            a, b = slice((1 + 2 * j) * M, (2 + 2 * j) * M), slice((2 + 2 * j) * M, (3 + 2 * j) * M)
+            den = 2.0 * h[:, j]
+            df[:, :, j] = ((f[:, a] - f[:, b]) / den).T
+            dg[:, :, j] = ((g[:, a] - g[:, b]) / den).T
+            dL[:, j] = (L[a] - L[b]) / den
+        self._key, self._out = key, (f0, g0, L0, df, dg, dL)
+        return self._out
+
+
 class _LglTranscription(_Transcription):
-    """Paper 002 eqs. 12-14 on LGL nodes, with per-node dynamics bindings."""
+    """Paper 002 eqs. 12-14 on LGL nodes.
+
+    Decision variables z = [X (N x nx), U (N x nu), t_f] (scaled). One constraint holds
+    the defects D X - (t_f / 2) f(X, U) = 0 (eq. 13, rows node-major) and the path
+    functions (eq. 14); its Jacobian is assembled from the exact D and the node Jacobians
+    of _NodeEvaluator, with the true sparsity pattern declared to the solver. The cost is
+    (t_f / 2) sum w_k L_k (eq. 12) plus the Mayer term. Costates: the defect rows'
+    multipliers divided by the LGL weights (eq. 15)."""
 
     def __init__(self, problem, nodes):
         super().__init__(problem, nodes)
@@ -371,40 +451,102 @@ class _LglTranscription(_Transcription):
         N, nx, nu = nodes, self.nx, self.nu
         self.X = prog.NewContinuousVariables(N, nx, "x")
         self.U = prog.NewContinuousVariables(N, nu, "u")
-        self.F = prog.NewContinuousVariables(N, nx, "f")
         self.tf = None if self.fixed_tf else prog.NewContinuousVariables(1, "tf")[0]
         if self.tf is not None:
             prog.AddBoundingBoxConstraint(self.t_lo / self.ts, min(self.t_hi, 1e12) / self.ts, self.tf)
-        # F_k = (tf / 2) f(x_k, u_k), one nonlinear binding per node
-        self.dyn = []
-        for k in range(N):
-            if self.tf is None:
-                half = 0.5 * self.t_lo / self.ts
-                fun = (lambda z, half=half: half * self.f_scaled(z[:nx], z[nx:nx + nu]) - z[nx + nu:])
-                vars_ = np.concatenate([self.X[k], self.U[k], self.F[k]])
-            else:
-                fun = (lambda z: 0.5 * z[nx + nu] * self.f_scaled(z[:nx], z[nx:nx + nu]) - z[nx + nu + 1:])
-                vars_ = np.concatenate([self.X[k], self.U[k], [self.tf], self.F[k]])
-            self.dyn.append(prog.AddConstraint(fun, np.zeros(nx), np.zeros(nx), vars_, description=f"dynamics node {k}"))
-        # D X = F, linear (paper 002 eq. 13): its multipliers are the costates (eq. 15)
-        A = np.hstack([self.lgl.D1_tau, -np.eye(N)])
-        self.defects = [prog.AddLinearEqualityConstraint(A, np.zeros(N), np.concatenate([self.X[:, i], self.F[:, i]]))
-                        for i in range(nx)]
-        for i, b in enumerate(self.defects):
-            b.evaluator().set_description(f"defect {problem.state_names[i]}")
+        self.nodes_eval = _NodeEvaluator(self)
+        self.n_path = len(problem.path)
+        z = [self.X.ravel(), self.U.ravel()] + ([[self.tf]] if self.tf is not None else [])
+        self.z = np.concatenate(z)
+        lo = np.concatenate([np.zeros(N * nx)] + [np.full(N, c.min / c.scale) for c in problem.path])
+        hi = np.concatenate([np.zeros(N * nx)] + [np.full(N, c.max / c.scale) for c in problem.path])
+        # path rows are ordered path-major: row N nx + c N + k
+        self.collocation = prog.AddConstraint(self._constraint, lo, hi, self.z, description="LGL defects and path")
+        self.collocation.evaluator().SetGradientSparsityPattern(self._sparsity())
         self.add_bounds(prog, self.X, self.U, self.X[0], self.X[-1])
-        self.add_path(prog, self.X, self.U)
-        # Lagrange term (eq. 12): (tf / 2) sum w_k L_k, in canonical time
         if problem.has_lagrange:
-            w = self.lgl.weights_tau
-            for k in range(N):
-                if self.tf is None:
-                    c = 0.5 * self.t_lo / self.ts * w[k]
-                    prog.AddCost(lambda z, c=c: c * self.L_scaled(z[:nx], z[nx:]), np.concatenate([self.X[k], self.U[k]]))
-                else:
-                    prog.AddCost(lambda z, wk=w[k]: 0.5 * z[nx + nu] * wk * self.L_scaled(z[:nx], z[nx:nx + nu]),
-                                 np.concatenate([self.X[k], self.U[k], [self.tf]]))
+            prog.AddCost(self._lagrange_cost, self.z)
         self.mayer_cost(prog, self.X[-1], None if self.tf is None else [self.tf])
+
+    # -- variable layout ------------------------------------------------------------------
+    def _split(self, zv):
+        N, nx, nu = self.N, self.nx, self.nu
+        Xs = zv[:N * nx].reshape(N, nx)
+        Us = zv[N * nx:N * (nx + nu)].reshape(N, nu)
+        tf = zv[-1] if self.tf is not None else self.t_lo / self.ts
+        return Xs, Us, tf
+
+    def _x_col(self, k, i):
+        return k * self.nx + i
+
+    def _u_col(self, k, j):
+        return self.N * self.nx + k * self.nu + j
+
+    def _sparsity(self):
+        N, nx, nu, npth = self.N, self.nx, self.nu, self.n_path
+        pairs = []
+        node_cols = [[self._x_col(k, m) for m in range(nx)] + [self._u_col(k, j) for j in range(nu)] for k in range(N)]
+        tf_col = [self.z.size - 1] if self.tf is not None else []
+        for k in range(N):
+            for i in range(nx):
+                r = k * nx + i
+                cols = set(self._x_col(l, i) for l in range(N)) | set(node_cols[k]) | set(tf_col)
+                pairs += [(r, c) for c in sorted(cols)]
+        for c in range(npth):
+            for k in range(N):
+                pairs += [(N * nx + c * N + k, col) for col in node_cols[k]]
+        return pairs
+
+    # -- NLP functions --------------------------------------------------------------------
+    def _values_jacobian(self, zv):
+        N, nx, nu, npth = self.N, self.nx, self.nu, self.n_path
+        Xs, Us, tf = self._split(zv)
+        f, g, L, df, dg, dL = self.nodes_eval.evaluate(Xs, Us)
+        D = self.lgl.D1_tau
+        defect = (D @ Xs - 0.5 * tf * f).ravel()
+        values = np.concatenate([defect, g.T.ravel()])
+        J = np.zeros((N * nx + npth * N, zv.size))
+        xcols = np.arange(N)[:, None] * nx  # (N, 1)
+        for i in range(nx):
+            rows = np.arange(N) * nx + i
+            J[np.ix_(rows, xcols[:, 0] + i)] += D
+        for k in range(N):
+            rows = k * nx + np.arange(nx)
+            J[np.ix_(rows, k * nx + np.arange(nx))] -= 0.5 * tf * df[k, :, :nx]
+            J[np.ix_(rows, N * nx + k * nu + np.arange(nu))] -= 0.5 * tf * df[k, :, nx:]
+            for c in range(npth):
+                r = N * nx + c * N + k
+                J[r, k * nx:(k + 1) * nx] = dg[k, c, :nx]
+                J[r, N * nx + k * nu:N * nx + (k + 1) * nu] = dg[k, c, nx:]
+        if self.tf is not None:
+            J[:N * nx, -1] = -0.5 * f.ravel()
+        return values, J
+
+    def _constraint(self, z):
+        if z.dtype != object:
+            return self._values_jacobian(np.asarray(z, float))[0]
+        zv = ExtractValue(z).ravel()
+        values, J = self._values_jacobian(zv)
+        return InitializeAutoDiff(values, J @ ExtractGradient(z)).ravel()
+
+    def _lagrange_value_gradient(self, zv):
+        N, nx, nu = self.N, self.nx, self.nu
+        Xs, Us, tf = self._split(zv)
+        *_, L, _, _, dL = self.nodes_eval.evaluate(Xs, Us)
+        w = self.lgl.weights_tau
+        value = 0.5 * tf * float(w @ L)
+        grad = np.zeros(zv.size)
+        grad[:N * nx] = (0.5 * tf * w[:, None] * dL[:, :nx]).ravel()
+        grad[N * nx:N * (nx + nu)] = (0.5 * tf * w[:, None] * dL[:, nx:]).ravel()
+        if self.tf is not None:
+            grad[-1] = 0.5 * float(w @ L)
+        return value, grad
+
+    def _lagrange_cost(self, z):
+        if z.dtype != object:
+            return self._lagrange_value_gradient(np.asarray(z, float))[0]
+        value, grad = self._lagrange_value_gradient(ExtractValue(z).ravel())
+        return InitializeAutoDiff(np.array([value]), (grad @ ExtractGradient(z))[None, :])[0, 0]
 
     def set_guess(self, t, X, U):
         t = np.asarray(t, float)
@@ -416,7 +558,6 @@ class _LglTranscription(_Transcription):
         self.initial_guess = guess
         self.prog.SetDecisionVariableValueInVector(self.X, Xk, guess)
         self.prog.SetDecisionVariableValueInVector(self.U, Uk, guess)
-        self.prog.SetDecisionVariableValueInVector(self.F, self.lgl.D1_tau @ Xk, guess)
         if self.tf is not None:
             self.prog.SetDecisionVariableValueInVector(self.tf, tf / self.ts, guess)
 
@@ -429,9 +570,9 @@ class _LglTranscription(_Transcription):
         X, U = Xs * self.sx, Us * self.su
         costates = None
         try:  # eq. 15: lambda_k = nu_k / w_k (scaled), then d J / d x in SI
-            nu = np.column_stack([res.GetDualSolution(b) for b in self.defects])
+            nu = np.asarray(res.GetDualSolution(self.collocation))[:self.N * self.nx].reshape(self.N, self.nx)
             lam_scaled = nu / self.lgl.weights_tau[:, None]
-            costates = COSTATE_SIGN * lam_scaled * self.ts / self.sx  # lambda = d(J/ts)/d(x/sx) scaled back
+            costates = COSTATE_SIGN * lam_scaled * self.ts / self.sx
         except Exception:  # noqa: BLE001 - a solver without duals
             costates = None
         if not ok:
@@ -519,3 +660,25 @@ def _finish(tx, ok, msg, t, X, U, res, costates, t_costate, solve_time, build_ti
                      costates=costates, costate_time=t_costate, hamiltonian=ham, solve_time=solve_time,
                      build_time=build_time, transcription=transcription, solver=solver, nodes=tx.N,
                      max_defect=viol, problem=problem)
+
+
+def extremal_controls(problem, result: NlpResult) -> np.ndarray:
+    """Rates u* that minimise the Hamiltonian given the costates (paper 002 eqs. 22-23):
+    dH/du = 2 k2 u / u_max^2 + lambda_alpha = 0 gives u*_alpha = -u_max^2 lambda_alpha / (2 k2)
+    (and likewise for sigma), clipped to the rate bounds; at the costate times, SI.
+
+    The paper prints u_max / (2 k) in eq. 23; differentiating its eq. 11 gives u_max^2
+    (the square is missing in eqs. 22-23)."""
+    if not isinstance(problem, OptimalControlProblem) or problem.controls != "rates":
+        raise ValueError("extremal_controls needs an entry problem with controls='rates'")
+    terms = [t for t in problem.objective if t.kind == "control_margin"]
+    if len(terms) != 1 or any(t.kind in ("lagrange",) for t in problem.objective):
+        raise ValueError("extremal_controls needs exactly one control_margin term and no user Lagrange term")
+    if result.costates is None:
+        raise ValueError("the result has no costates (the solver returned no multipliers)")
+    t = terms[0]
+    lam = result.costates
+    u = np.column_stack([-t.u_alpha_max ** 2 * lam[:, 6] / (2.0 * t.weight * t.k[1]),
+                         -t.u_sigma_max ** 2 * lam[:, 7] / (2.0 * t.weight * t.k[2])])
+    _, _, ul, uh = problem.bounds_arrays()
+    return np.clip(u, ul, uh)

@@ -278,6 +278,9 @@ class OptimalControlProblem(_ProblemLayout):
 
     def _default_state_bounds(self):
         xl, xh = np.full(self.n_states, -np.inf), np.full(self.n_states, np.inf)
+        # altitude within the atmosphere model's range (a solver step never leaves it)
+        xl[0] = max(getattr(self.atmosphere, "h_min", -np.inf), -4000.0)
+        xh[0] = min(getattr(self.atmosphere, "h_max", np.inf), 1.0e6)
         xl[3] = 1.0  # speed stays positive (the equations divide by V)
         xl[4], xh[4] = -math.radians(89.99), math.radians(89.99)  # gamma = +-90 deg is singular
         return xl, xh

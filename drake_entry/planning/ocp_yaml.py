@@ -1,0 +1,217 @@
+"""Optimal-control problems from YAML (``drake-entry optimize PROBLEM.yaml``).
+
+Schema (units in the field names; a boundary entry is {value} fixed, {min, max}
+bounded, or absent = free):
+
+  name: marv
+  vehicle: marv                 # packaged vehicle or YAML path; aero: optional model name
+  mass_over_area_kg_m2: 1000.0  # optional override of m/S
+  planet: {model: spherical, rotating: true, j2: false, radius_m: 6378145.0}
+  atmosphere: {model: exponential, rho0_kg_m3: 1.225, scale_height_m: 7200.0}
+  controls: rates               # rates (alpha, sigma states; u_alpha, u_sigma controls) | direct
+  initial: {altitude_km: {value: 37.0}, ...}
+  final: {...}
+  final_time_s: {min: 100.0, max: 2000.0}     # or {value: ...}
+  state_bounds: {alpha_deg: {min: 0.0, max: 25.0}, ...}
+  control_bounds: {alpha_rate_deg_s: {min: -10, max: 10}, bank_rate_deg_s: {...}}
+  path: [{quantity: dynamic_pressure, min: 12000.0}, {quantity: sensed_acceleration, max: 45.0}]
+  objective: [{kind: control_margin, weight: 1.0, k: [1, 18, 20]}, ...]
+  solve: {transcription: lgl, solver: ipopt, nodes: 125, tolerance: 1.0e-8}
+"""
+import dataclasses as dc
+import math
+import os
+from importlib import resources
+from typing import Dict, List, Optional
+
+from ..atmosphere import ExponentialAtmosphere, US76Atmosphere
+from ..errors import ScenarioError, load_yaml_typed
+from ..planet import Earth
+from ..vehicles import load_vehicle
+from .ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
+
+# YAML field -> (state or control name, factor to SI)
+STATE_FIELDS = {"altitude_km": ("h", 1e3), "longitude_deg": ("lon", math.pi / 180), "latitude_deg": ("lat", math.pi / 180),
+                "velocity_m_s": ("V", 1.0), "flight_path_deg": ("gamma", math.pi / 180),
+                "heading_deg": ("psi", math.pi / 180), "alpha_deg": ("alpha", math.pi / 180),
+                "bank_deg": ("sigma", math.pi / 180)}
+CONTROL_FIELDS = {"alpha_rate_deg_s": ("u_alpha", math.pi / 180), "bank_rate_deg_s": ("u_sigma", math.pi / 180),
+                  "alpha_deg": ("alpha", math.pi / 180), "bank_deg": ("sigma", math.pi / 180)}
+PACKAGED_PROBLEMS = ("marv",)
+
+
+@dc.dataclass
+class BoundSpec:
+    value: Optional[float] = None
+    min: Optional[float] = None
+    max: Optional[float] = None
+
+
+@dc.dataclass
+class PlanetOcpSpec:
+    model: str = "spherical"
+    rotating: bool = True
+    j2: bool = False
+    radius_m: Optional[float] = None
+
+
+@dc.dataclass
+class AtmosphereOcpSpec:
+    model: str = "exponential"
+    rho0_kg_m3: float = 1.225
+    scale_height_m: float = 7200.0
+
+
+@dc.dataclass
+class PathSpec:
+    quantity: str = ""
+    min: Optional[float] = None
+    max: Optional[float] = None
+
+
+@dc.dataclass
+class ObjectiveSpec:
+    kind: str = ""
+    weight: float = 1.0
+    k: List[float] = dc.field(default_factory=lambda: [1.0, 18.0, 20.0])
+    alpha_bar_deg: Optional[float] = None
+    alpha_max_deg: float = 25.0
+    alpha_rate_max_deg_s: float = 10.0
+    bank_rate_max_deg_s: float = 30.0
+    target_longitude_deg: Optional[float] = None
+    target_latitude_deg: Optional[float] = None
+    scale: float = 1.0
+
+
+@dc.dataclass
+class SolveSpec:
+    transcription: str = "lgl"
+    solver: str = "ipopt"
+    nodes: int = 40
+    tolerance: float = 1.0e-8
+    max_iterations: int = 3000
+
+
+@dc.dataclass
+class ProblemSpec:
+    name: str = "problem"
+    description: str = ""
+    source: str = ""
+    vehicle: str = ""
+    aero: str = ""
+    mass_over_area_kg_m2: Optional[float] = None
+    planet: PlanetOcpSpec = dc.field(default_factory=PlanetOcpSpec)
+    atmosphere: AtmosphereOcpSpec = dc.field(default_factory=AtmosphereOcpSpec)
+    controls: str = "rates"
+    initial: Dict[str, BoundSpec] = dc.field(default_factory=dict)
+    final: Dict[str, BoundSpec] = dc.field(default_factory=dict)
+    final_time_s: BoundSpec = dc.field(default_factory=BoundSpec)
+    state_bounds: Dict[str, BoundSpec] = dc.field(default_factory=dict)
+    control_bounds: Dict[str, BoundSpec] = dc.field(default_factory=dict)
+    path: List[PathSpec] = dc.field(default_factory=list)
+    objective: List[ObjectiveSpec] = dc.field(default_factory=list)
+    solve: SolveSpec = dc.field(default_factory=SolveSpec)
+
+
+def _bound(where: str, b: BoundSpec, factor: float, *, allow_free: bool = True):
+    if b.value is not None:
+        if b.min is not None or b.max is not None:
+            raise ScenarioError(f"{where}: give either value or min/max, not both")
+        return b.value * factor
+    if b.min is None and b.max is None:
+        if allow_free:
+            return None
+        raise ScenarioError(f"{where}: needs value or min/max")
+    lo = -math.inf if b.min is None else b.min * factor
+    hi = math.inf if b.max is None else b.max * factor
+    if not lo <= hi:
+        raise ScenarioError(f"{where}: min {b.min} > max {b.max}")
+    return (lo, hi)
+
+
+def _named(where: str, specs: dict, fields: dict, allowed: tuple) -> dict:
+    out = {}
+    for key, b in specs.items():
+        if key not in fields or fields[key][0] not in allowed:
+            names = [k for k, (n, _) in fields.items() if n in allowed]
+            raise ScenarioError(f"{where}.{key}: unknown field; allowed: {', '.join(names)}")
+        name, factor = fields[key]
+        v = _bound(f"{where}.{key}", b, factor)
+        if v is not None:
+            out[name] = v
+    return out
+
+
+def problem_from_spec(spec: ProblemSpec) -> OptimalControlProblem:
+    """OptimalControlProblem of a ProblemSpec (SI inside); one-line ScenarioError on bad input."""
+    if spec.controls not in ("rates", "direct"):
+        raise ScenarioError(f"controls = '{spec.controls}'; allowed: rates, direct")
+    vehicle = load_vehicle(spec.vehicle, aero=spec.aero or None)
+    if spec.mass_over_area_kg_m2 is not None:
+        if not spec.mass_over_area_kg_m2 > 0:
+            raise ScenarioError(f"mass_over_area_kg_m2 = {spec.mass_over_area_kg_m2}; allowed > 0")
+        vehicle = dc.replace(vehicle, mass=spec.mass_over_area_kg_m2 * vehicle.reference_area)
+    p = spec.planet
+    if p.model not in ("spherical", "oblate"):
+        raise ScenarioError(f"planet.model = '{p.model}'; allowed: spherical, oblate")
+    kw = {}
+    if p.radius_m is not None:
+        kw = dict(reference_radius=p.radius_m, equatorial_radius=p.radius_m)
+    planet = (Earth.spherical(rotating=p.rotating, j2=p.j2, **kw) if p.model == "spherical"
+              else Earth.oblate(omega=Earth().omega if p.rotating else 0.0, j2=Earth().j2 if p.j2 else 0.0, **kw))
+    a = spec.atmosphere
+    if a.model == "us76":
+        atmosphere = US76Atmosphere()
+    elif a.model == "exponential":
+        atmosphere = ExponentialAtmosphere(a.rho0_kg_m3, a.scale_height_m)
+    else:
+        raise ScenarioError(f"atmosphere.model = '{a.model}'; allowed: us76, exponential")
+    states = ("h", "lon", "lat", "V", "gamma", "psi") + (("alpha", "sigma") if spec.controls == "rates" else ())
+    controls = ("u_alpha", "u_sigma") if spec.controls == "rates" else ("alpha", "sigma")
+    tf = _bound("final_time_s", spec.final_time_s, 1.0, allow_free=False)
+    terms = []
+    for i, o in enumerate(spec.objective):
+        target = None
+        if o.target_longitude_deg is not None and o.target_latitude_deg is not None:
+            target = (math.radians(o.target_longitude_deg), math.radians(o.target_latitude_deg))
+        try:
+            terms.append(ObjectiveTerm(kind=o.kind, weight=o.weight, k=tuple(o.k),
+                                       alpha_bar=None if o.alpha_bar_deg is None else math.radians(o.alpha_bar_deg),
+                                       alpha_max=math.radians(o.alpha_max_deg),
+                                       u_alpha_max=math.radians(o.alpha_rate_max_deg_s),
+                                       u_sigma_max=math.radians(o.bank_rate_max_deg_s), target=target, scale=o.scale))
+        except ValueError as e:
+            raise ScenarioError(f"objective[{i}]: {e}") from None
+    path = []
+    for i, c in enumerate(spec.path):
+        try:
+            path.append(PathConstraint(c.quantity, -math.inf if c.min is None else c.min,
+                                       math.inf if c.max is None else c.max))
+        except ValueError as e:
+            raise ScenarioError(f"path[{i}]: {e}") from None
+    try:
+        return OptimalControlProblem(
+            vehicle=vehicle, planet=planet, atmosphere=atmosphere, controls=spec.controls,
+            initial=_named("initial", spec.initial, STATE_FIELDS, states),
+            final=_named("final", spec.final, STATE_FIELDS, states), final_time=tf,
+            state_bounds=_named("state_bounds", spec.state_bounds, STATE_FIELDS, states),
+            control_bounds=_named("control_bounds", spec.control_bounds, CONTROL_FIELDS, controls),
+            path=path, objective=terms, name=spec.name)
+    except ValueError as e:
+        raise ScenarioError(f"problem '{spec.name}': {e}") from None
+
+
+def load_problem_spec(name_or_path: str) -> ProblemSpec:
+    if name_or_path in PACKAGED_PROBLEMS:
+        text = resources.files("drake_entry").joinpath(f"problems/{name_or_path}.yaml").read_text()
+        return load_yaml_typed(ProblemSpec, text=text, where=f"problem '{name_or_path}'")
+    if os.path.exists(name_or_path):
+        return load_yaml_typed(ProblemSpec, path=name_or_path)
+    raise ScenarioError(f"problem '{name_or_path}' is neither a packaged problem ({', '.join(PACKAGED_PROBLEMS)}) "
+                        f"nor a file")
+
+
+def load_problem(name_or_path: str) -> tuple[OptimalControlProblem, SolveSpec]:
+    """(problem, solve settings) from a packaged name ('marv') or a YAML path."""
+    spec = load_problem_spec(name_or_path)
+    return problem_from_spec(spec), spec.solve

@@ -1,0 +1,137 @@
+"""NLP path (paper 002): transcriptions against analytic optima, costates (eq. 15),
+extremal controls (eqs. 22-23), bad input and infeasibility diagnosis."""
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from drake_entry.errors import ScenarioError
+from drake_entry.planning import nlp
+from drake_entry.planning.ocp import CustomProblem, PathConstraint
+from drake_entry.planning.ocp_yaml import load_problem
+
+
+def double_integrator(**kw):
+    """min int u^2/2, x'' = u, (0, 0) -> (1, 0) in 1 s: u = 6 - 12 t, J = 6,
+    lambda_x = -12, lambda_v = 12 t - 6."""
+    args = dict(state_names=("x", "v"), control_names=("u",), dynamics_function=lambda x, u: np.array([x[1], u[0]]),
+                initial={"x": 0.0, "v": 0.0}, final={"x": 1.0, "v": 0.0}, final_time=1.0,
+                lagrange_function=lambda x, u: 0.5 * u[0] ** 2)
+    args.update(kw)
+    return CustomProblem(**args)
+
+
+G = 9.81
+
+
+def brachistochrone(xf=2.0, yf=1.0):
+    """Minimum time from (0, 0) at rest to (xf, yf), y down, theta from the vertical."""
+    return CustomProblem(
+        state_names=("x", "y", "v"), control_names=("theta",),
+        dynamics_function=lambda s, u: np.array([s[2] * np.sin(u[0]), s[2] * np.cos(u[0]), G * np.cos(u[0])]),
+        initial={"x": 0.0, "y": 0.0, "v": 0.0}, final={"x": xf, "y": yf}, final_time=(0.1, 5.0),
+        mayer_function=lambda xf_, tf: tf, control_bounds={"theta": (0.0, math.pi)})
+
+
+def cycloid_time(xf, yf):
+    """Exact minimum time: the cycloid x = R(p - sin p), y = R(1 - cos p) through (xf, yf)."""
+    p = brentq(lambda p: (p - math.sin(p)) / (1 - math.cos(p)) - xf / yf, 1e-6, 2 * math.pi - 1e-6)
+    R = yf / (1 - math.cos(p))
+    return p * math.sqrt(R / G)
+
+
+@pytest.mark.parametrize("solver", ["ipopt", "snopt"])
+def test_lgl_double_integrator_control_objective_and_costates_are_exact(solver):
+    r = nlp.solve(double_integrator(), transcription="lgl", solver=solver, nodes=12)
+    assert r.success, r.message
+    t = r.time
+    assert r.objective == pytest.approx(6.0, abs=1e-7)
+    assert np.abs(r.controls[:, 0] - (6 - 12 * t)).max() < 1e-5
+    # eq. 15: lambda = nu / w
+    assert np.abs(r.costates[:, 0] + 12.0).max() < 1e-5
+    assert np.abs(r.costates[:, 1] - (12 * t - 6)).max() < 1e-5
+    assert np.abs(r.hamiltonian - r.hamiltonian.mean()).max() < 1e-5  # constant H (autonomous)
+
+
+def test_dircol_double_integrator_converges_at_second_order():
+    errs = []
+    for n in (12, 24, 48):
+        r = nlp.solve(double_integrator(), transcription="dircol", nodes=n)
+        assert r.success, r.message
+        errs.append(abs(r.objective - 6.0))
+        tm = r.costate_time
+        assert np.abs(r.costates[:, 1] - (12 * tm - 6)).max() < 0.04 * 12 / n * 12
+    assert errs[0] / errs[2] > 12  # ~16 for second order (trapezoid cost)
+
+
+@pytest.mark.parametrize("transcription,nodes,tol", [("lgl", 20, 2e-5), ("dircol", 40, 2e-3)])
+def test_brachistochrone_minimum_time_equals_the_cycloid(transcription, nodes, tol):
+    r = nlp.solve(brachistochrone(), transcription=transcription, nodes=nodes)
+    assert r.success, r.message
+    T = cycloid_time(2.0, 1.0)
+    assert r.final_time == pytest.approx(T, rel=tol)
+    assert r.objective == pytest.approx(T, rel=tol)
+    if transcription == "lgl":  # free final time, M = t_f: H = -dM/dt_f = -1 along the extremal
+        assert np.abs(r.hamiltonian[1:-1] + 1.0).max() < 1e-3
+
+
+def test_propagated_controls_reach_the_nlp_final_state():
+    from diagrams.propagation import propagate
+
+    p = brachistochrone()
+    r = nlp.solve(p, nodes=20)
+    check = propagate(p, r)
+    assert check.terminal_error["state_max"] < 1e-4
+    assert check.states[-1, 0] == pytest.approx(2.0, abs=1e-4)
+
+
+def test_infeasible_problem_is_diagnosed_not_raised():
+    """|u| <= 1 cannot move 1 m and stop in 1 s (needs |u| = 4 at bang-bang)."""
+    r = nlp.solve(double_integrator(control_bounds={"u": (-1.0, 1.0)}), nodes=10, max_iterations=200)
+    assert not r.success
+    assert "largest violation" in r.message and "defects" in r.message
+
+
+def test_bad_options_and_problems_are_rejected_with_the_allowed_values():
+    p = double_integrator()
+    with pytest.raises(ValueError, match="allowed: lgl, dircol"):
+        nlp.solve(p, transcription="hermite")
+    with pytest.raises(ValueError, match="allowed: ipopt, snopt"):
+        nlp.solve(p, solver="knitro")
+    with pytest.raises(ValueError, match="nodes must be an integer >= 3"):
+        nlp.solve(p, nodes=2)
+    with pytest.raises(ValueError, match="unknown state 'z'"):
+        double_integrator(final={"z": 1.0})
+    with pytest.raises(ValueError, match="min <= max"):
+        PathConstraint("dynamic_pressure", min=5.0, max=1.0)
+
+
+def test_problem_yaml_errors_name_the_field(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("vehicle: marv\ninitial: {altitud_km: {value: 3.0}}\nfinal_time_s: {value: 10.0}\n"
+                   "objective: [{kind: final_time}]\n")
+    with pytest.raises(ScenarioError, match=r"initial.altitud_km: unknown field; allowed: altitude_km"):
+        load_problem(str(bad))
+    bad.write_text("vehicle: marv\nfinal_time_s: {value: 10.0}\nobjective: [{kind: min_fuel}]\n")
+    with pytest.raises(ScenarioError, match="objective kind 'min_fuel' is unknown"):
+        load_problem(str(bad))
+
+
+def test_marv_solution_satisfies_paper_002_constraints_and_extremal_controls():
+    """Paper 002 eqs. 16-18 hold at the nodes; eq. 23 (with the u_max^2 the Hamiltonian
+    gives) reproduces the NLP controls from the costates."""
+    p, _ = load_problem("marv")
+    r = nlp.solve(p, nodes=24, solver="snopt", tolerance=1e-7)
+    assert r.success, r.message
+    X, U = r.states, r.controls
+    assert X[0, 0] == pytest.approx(37000.0) and X[-1, 0] == pytest.approx(0.0, abs=1e-3)
+    assert math.degrees(X[-1, 1]) == pytest.approx(25.15, abs=1e-8)
+    assert X[-1, 3] == pytest.approx(1219.0, abs=1e-6) and math.degrees(X[-1, 4]) == pytest.approx(-89.0, abs=1e-8)
+    assert abs(X[-1, 6]) < 1e-8  # obliquity
+    q = np.array([p.conditions(x, u).dynamic_pressure for x, u in zip(X, U)])
+    a = np.array([p.conditions(x, u).total_load for x, u in zip(X, U)])
+    assert q.min() >= 12000.0 * (1 - 1e-6) and a.max() <= 45.0 * (1 + 1e-6)
+    assert np.all(np.abs(np.degrees(U[:, 0])) <= 10.0 + 1e-6) and np.all(np.abs(np.degrees(U[:, 1])) <= 30.0 + 1e-6)
+    ext = nlp.extremal_controls(p, r)
+    assert np.abs(ext - U).max() < 1e-6 * 100

@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from .scalar import is_autodiff, is_symbolic, lift, value_of
+from .scalar import clamp, is_autodiff, is_symbolic, lift, value_of
 
 # U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
 G0_US76 = 9.80665  # m/s^2
@@ -294,15 +294,20 @@ class ExponentialAtmosphere(Atmosphere):
         return Derivatives(rho, -rho / self.scale_height, rho / self.scale_height**2)
 
     def temperature(self, h):
+        """US76 temperature (held at its range ends: the exponential density model has no
+        altitude limit, and optimisers may step outside) or the constant temperature [K]."""
         if self.temperature_K is None:
-            return US76Atmosphere().temperature(h)
+            return US76Atmosphere().temperature(clamp(h, US76_H_MIN, US76_H_MAX))
         return self.temperature_K + 0.0 * h  # keeps the scalar type of h
 
     def temperature_derivatives(self, h) -> Derivatives:
         if self.temperature_K is not None:
             z = np.zeros(np.shape(h))
             return Derivatives(z + self.temperature_K, z, z)
-        return US76Atmosphere().temperature_derivatives(h)
+        inside = (np.asarray(h) >= US76_H_MIN) & (np.asarray(h) <= US76_H_MAX)
+        d = US76Atmosphere().temperature_derivatives(np.clip(h, US76_H_MIN, US76_H_MAX))
+        return Derivatives(d.value, np.where(inside, d.d_h, 0.0) if np.ndim(h) else (d.d_h if inside else 0.0),
+                           np.where(inside, d.d_hh, 0.0) if np.ndim(h) else (d.d_hh if inside else 0.0))
 
 
 class DispersedAtmosphere(Atmosphere):

@@ -161,3 +161,35 @@ def campaign_benchmark(*, samples: int = 100, scenario_name: str = "horus2b", se
     print(f"2 workers / 1 worker: {two / one:.2f}x (goal >= 1.8); Dask / processes: {dask / two:.2f} "
           f"(goal within 10 %); 1000 runs on 2 workers: {1000 / two / 60:.1f} min (goal < 5)")
     return out
+
+
+def nlp_benchmark(*, problem_name: str = "marv", nodes: int = 40, tolerance: float = 1e-6) -> dict:
+    """The same optimal-control problem by both transcriptions (LGL pseudospectral, Drake
+    DirectCollocation) and both solvers (Ipopt, SNOPT), from the same propagated guess:
+    solve time, objective, final time and the Drake-propagated terminal position error,
+    side by side in one run."""
+    from diagrams.propagation import propagate
+
+    from .planning import nlp
+    from .planning.ocp_yaml import load_problem
+
+    problem, _ = load_problem(problem_name)
+    guess = nlp.initial_guess(problem)
+    print(f"{problem_name}: {nodes} nodes / samples, tolerance {tolerance:g}, same propagated guess")
+    print(f"{'transcription':14s} {'solver':7s} {'ok':3s} {'solve [s]':>10s} {'objective':>12s} {'t_f [s]':>9s} "
+          f"{'prop. miss [m]':>15s}")
+    out = {}
+    for transcription in nlp.TRANSCRIPTIONS:
+        for solver in nlp.SOLVERS:
+            try:
+                r = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, guess=guess,
+                              tolerance=tolerance)
+            except Exception as e:  # noqa: BLE001 - one failing combination is reported, not fatal
+                print(f"{transcription:14s} {solver:7s} error: {type(e).__name__}: {str(e).splitlines()[0][:80]}")
+                continue
+            miss = propagate(problem, r).terminal_error["position_m"] if r.success else float("nan")
+            out[(transcription, solver)] = dict(success=r.success, solve_time=r.solve_time, objective=r.objective,
+                                                final_time=r.final_time, miss_m=miss)
+            print(f"{transcription:14s} {solver:7s} {'yes' if r.success else 'no':3s} {r.solve_time:10.2f} "
+                  f"{r.objective:12.6g} {r.final_time:9.2f} {miss:15.1f}")
+    return out

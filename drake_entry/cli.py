@@ -7,8 +7,11 @@ Commands:
   plan SCENARIO       the drag-energy corridor and the reference planned at engagement,
                       extracted states against open-loop propagation (paper 000 Figs. 3-5)
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
+  optimize PROBLEM    optimal reference by the NLP path (LGL pseudospectral or DirectCollocation,
+                      Ipopt or SNOPT), propagated with Drake, plots like paper 002 Figs. 1-10
   fit-horus           refit the HORUS-2B aero forms (paper 000 eqs. 32-33); print residuals
-  bench [open-loop|socp|campaign]  Drake open loop vs scipy; SOCP Clarabel vs SCS; campaign runs/s by backend
+  bench [open-loop|socp|campaign|nlp]  Drake open loop vs scipy; SOCP Clarabel vs SCS; campaign
+                      runs/s by backend; NLP transcriptions x solvers
 """
 from __future__ import annotations
 
@@ -161,8 +164,58 @@ def _cmd_fit_horus(args) -> int:
     return 0
 
 
+def _cmd_optimize(args) -> int:
+    from diagrams.propagation import propagate
+
+    from .planning import nlp
+    from .planning.ocp_yaml import load_problem
+    from .plots import nlp_solution_plots
+    from .results import write_table
+
+    problem, settings = load_problem(args.problem)
+    nodes = args.nodes or settings.nodes
+    transcription = args.transcription or settings.transcription
+    solver = args.solver or settings.solver
+    tol = args.tolerance or settings.tolerance
+    guess = None
+    if args.coarse:
+        print(f"coarse solve: {transcription}, {args.coarse} nodes, {solver} ...", flush=True)
+        coarse = nlp.solve(problem, transcription=transcription, solver=solver, nodes=args.coarse,
+                           tolerance=max(tol, 1e-6), max_iterations=settings.max_iterations)
+        print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
+        guess = coarse if coarse.success else None
+    print(f"solve: {problem.name}, {transcription}, {nodes} nodes, {solver} ...", flush=True)
+    result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
+                       max_iterations=settings.max_iterations, guess=guess)
+    check = propagate(problem, result) if result.success and not args.no_propagate else None
+    info = nlp.summary(problem, result, check)
+    os.makedirs(args.out, exist_ok=True)
+    cols = {"time_s": result.time}
+    for i, name in enumerate(problem.state_names):
+        cols[name] = result.states[:, i]
+    for j, name in enumerate(problem.control_names):
+        cols[name] = result.controls[:, j]
+    if result.costates is not None and len(result.costate_time) == len(result.time):
+        for i, name in enumerate(problem.state_names):
+            cols[f"lambda_{name}"] = result.costates[:, i]
+        cols["hamiltonian"] = result.hamiltonian
+    write_table(cols, os.path.join(args.out, f"solution.{args.format}"))
+    with open(os.path.join(args.out, "summary.json"), "w") as f:
+        json.dump(info, f, indent=2, default=float)
+    ext = None
+    try:
+        ext = nlp.extremal_controls(problem, result)
+    except ValueError:
+        pass
+    pngs = nlp_solution_plots(problem, result, args.out, propagated=check, extremal=ext,
+                              title=f"{problem.name}: {transcription.upper()} {nodes} nodes, {solver}")
+    print(json.dumps(info, indent=2, default=float))
+    print(f"wrote solution, summary.json and {len(pngs)} plots to {args.out}")
+    return 0 if result.success else 1
+
+
 def _cmd_bench(args) -> int:
-    from .benchmark import campaign_benchmark, open_loop_benchmark, socp_benchmark
+    from .benchmark import campaign_benchmark, nlp_benchmark, open_loop_benchmark, socp_benchmark
 
     if args.which in ("all", "campaign"):
         campaign_benchmark(samples=args.samples)
@@ -170,6 +223,8 @@ def _cmd_bench(args) -> int:
         open_loop_benchmark(repeats=args.repeats)
     if args.which in ("all", "socp"):
         socp_benchmark(repeats=max(args.repeats, 5))
+    if args.which in ("all", "nlp"):
+        nlp_benchmark(nodes=args.nodes)
     return 0
 
 
@@ -207,10 +262,23 @@ def main(argv=None) -> int:
     p.add_argument("--out", default="out/simulate", help="output directory")
     p.add_argument("--format", choices=("parquet", "csv"), default="parquet")
     p.set_defaults(func=_cmd_simulate)
+    o = sub.add_parser("optimize", help="optimal reference by the NLP path (paper 002)")
+    o.add_argument("problem", help="packaged problem (marv) or a problem YAML path")
+    o.add_argument("--nodes", type=int, default=None, help="LGL nodes / collocation samples (default: the YAML)")
+    o.add_argument("--transcription", choices=("lgl", "dircol"), default=None)
+    o.add_argument("--solver", choices=("ipopt", "snopt"), default=None)
+    o.add_argument("--tolerance", type=float, default=None)
+    o.add_argument("--coarse", type=int, default=0, metavar="N",
+                   help="first solve with N nodes and start the full solve from it (0 = propagated guess)")
+    o.add_argument("--no-propagate", action="store_true", help="skip the Drake propagation check")
+    o.add_argument("--out", default="out/optimize")
+    o.add_argument("--format", choices=("parquet", "csv"), default="csv")
+    o.set_defaults(func=_cmd_optimize)
     f = sub.add_parser("fit-horus", help="refit paper 000 eqs. 32-33 to the M-692 table; print residuals")
     f.set_defaults(func=_cmd_fit_horus)
     b = sub.add_parser("bench", help="benchmarks: Drake open loop vs scipy; SOCP with Clarabel vs SCS")
-    b.add_argument("which", nargs="?", choices=("all", "open-loop", "socp", "campaign"), default="all")
+    b.add_argument("which", nargs="?", choices=("all", "open-loop", "socp", "campaign", "nlp"), default="all")
+    b.add_argument("--nodes", type=int, default=40, help="NLP benchmark: nodes / samples")
     b.add_argument("--samples", type=int, default=100, help="campaign benchmark: samples per backend")
     b.add_argument("--repeats", type=int, default=3)
     b.set_defaults(func=_cmd_bench)

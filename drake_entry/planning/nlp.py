@@ -434,6 +434,14 @@ class _NodeEvaluator:
         return self._out
 
 
+def _chain(J, G):
+    """J @ G for the input gradient G that Drake passes: the identity in practice (skip the
+    dense product, which dominates at 125 nodes), any matrix in general."""
+    if G.shape[0] == G.shape[1] and np.count_nonzero(G) == G.shape[0] and np.all(np.diag(G) == 1.0):
+        return J
+    return J @ G
+
+
 class _LglTranscription(_Transcription):
     """Paper 002 eqs. 12-14 on LGL nodes.
 
@@ -527,7 +535,7 @@ class _LglTranscription(_Transcription):
             return self._values_jacobian(np.asarray(z, float))[0]
         zv = ExtractValue(z).ravel()
         values, J = self._values_jacobian(zv)
-        return InitializeAutoDiff(values, J @ ExtractGradient(z)).ravel()
+        return InitializeAutoDiff(values, _chain(J, ExtractGradient(z))).ravel()
 
     def _lagrange_value_gradient(self, zv):
         N, nx, nu = self.N, self.nx, self.nu
@@ -546,7 +554,7 @@ class _LglTranscription(_Transcription):
         if z.dtype != object:
             return self._lagrange_value_gradient(np.asarray(z, float))[0]
         value, grad = self._lagrange_value_gradient(ExtractValue(z).ravel())
-        return InitializeAutoDiff(np.array([value]), (grad @ ExtractGradient(z))[None, :])[0, 0]
+        return InitializeAutoDiff(np.array([value]), _chain(grad[None, :], ExtractGradient(z)))[0, 0]
 
     def set_guess(self, t, X, U):
         t = np.asarray(t, float)
@@ -682,3 +690,40 @@ def extremal_controls(problem, result: NlpResult) -> np.ndarray:
                          -t.u_sigma_max ** 2 * lam[:, 7] / (2.0 * t.weight * t.k[2])])
     _, _, ul, uh = problem.bounds_arrays()
     return np.clip(u, ul, uh)
+
+
+def summary(problem, result: NlpResult, check=None) -> dict:
+    """Figures of merit of a solution (paper 002 'Results' for entry problems): objective,
+    final time, solve time, the local altitude maxima and the dynamic pressure there,
+    final bank, largest |H| at interior nodes, extremal-control match and, with ``check``
+    (a diagrams.propagation.PropagationCheck), the propagated terminal errors."""
+    out = {"success": result.success, "message": result.message, "transcription": result.transcription,
+           "solver": result.solver, "nodes": result.nodes, "objective": result.objective,
+           "final_time_s": result.final_time, "solve_time_s": result.solve_time, "build_time_s": result.build_time,
+           "max_constraint_violation_scaled": result.max_defect}
+    if result.hamiltonian is not None:
+        inner = result.hamiltonian[1:-1] if result.hamiltonian.size > 2 else result.hamiltonian
+        out["hamiltonian_interior_max_abs"] = float(np.abs(inner).max())
+        out["hamiltonian_interior_rms"] = float(np.sqrt(np.mean(inner ** 2)))
+    if isinstance(problem, OptimalControlProblem):
+        t = np.linspace(0.0, result.final_time, 4001)
+        x = result.state_function()(t)
+        h = x[:, 0]
+        peaks = [i for i in range(1, len(t) - 1) if h[i] >= h[i - 1] and h[i] > h[i + 1]]
+        out["altitude_maxima"] = [{"time_s": float(t[i]), "altitude_km": float(h[i] / 1e3),
+                                   "dynamic_pressure_kPa": float(problem.conditions(x[i], np.zeros(problem.n_controls))
+                                                                  .dynamic_pressure / 1e3)} for i in peaks]
+        if problem.controls == "rates":
+            out["final_bank_deg"] = float(np.degrees(result.states[-1, 7]))
+            out["max_bank_deg"] = float(np.degrees(np.abs(result.states[:, 7]).max()))
+            out["max_alpha_deg"] = float(np.degrees(result.states[:, 6].max()))
+            try:
+                ext = extremal_controls(problem, result)
+                U = result.controls if len(result.costate_time) == len(result.time) else \
+                    0.5 * (result.controls[:-1] + result.controls[1:])
+                out["extremal_control_max_diff_deg_s"] = float(np.degrees(np.abs(ext - U).max()))
+            except ValueError:
+                pass
+    if check is not None:
+        out["propagated_terminal_error"] = check.terminal_error
+    return out

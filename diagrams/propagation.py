@@ -4,7 +4,9 @@ the optimal controls flown open loop, compared with the NLP states at t_f).
   TrajectorySource(u(t)) --u--> OptimalControlPlant (SI) --> VectorLogSink
 
 u(t) is the transcription's own control representation (the LGL Lagrange interpolant,
-sampled densely into a C2 cubic spline; first-order hold for DirectCollocation).
+sampled densely into a C2 cubic spline; first-order hold for DirectCollocation). The
+sampling matters: on the 125-node MARV solution 16 samples per node interval leave 41 m of
+terminal miss, 64 leave 1.5 m, 256 (the default) 0.04 m.
 """
 from __future__ import annotations
 
@@ -36,7 +38,7 @@ class PropagationCheck:
     terminal_error: dict
 
 
-def propagate(problem, result, *, accuracy: float = 1e-11, samples_per_interval: int = 16,
+def propagate(problem, result, *, accuracy: float = 1e-11, samples_per_interval: int = 256,
               log_points: int = 2000) -> PropagationCheck:
     """Fly ``result.controls`` from ``result.states[0]`` over [0, t_f] (RK5, ``accuracy``)."""
     t_nodes, tf = result.time, result.final_time

@@ -178,9 +178,10 @@ def _cmd_optimize(args) -> int:
     solver = args.solver or settings.solver
     tol = args.tolerance or settings.tolerance
     guess = None
-    if args.coarse:
-        print(f"coarse solve: {transcription}, {args.coarse} nodes, {solver} ...", flush=True)
-        coarse = nlp.solve(problem, transcription=transcription, solver=solver, nodes=args.coarse,
+    coarse_nodes = settings.coarse_nodes if args.coarse is None else args.coarse
+    if coarse_nodes and coarse_nodes < nodes:
+        print(f"coarse solve: {transcription}, {coarse_nodes} nodes, {solver} ...", flush=True)
+        coarse = nlp.solve(problem, transcription=transcription, solver=solver, nodes=coarse_nodes,
                            tolerance=max(tol, 1e-6), max_iterations=settings.max_iterations)
         print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
         guess = coarse if coarse.success else None
@@ -268,8 +269,9 @@ def main(argv=None) -> int:
     o.add_argument("--transcription", choices=("lgl", "dircol"), default=None)
     o.add_argument("--solver", choices=("ipopt", "snopt"), default=None)
     o.add_argument("--tolerance", type=float, default=None)
-    o.add_argument("--coarse", type=int, default=0, metavar="N",
-                   help="first solve with N nodes and start the full solve from it (0 = propagated guess)")
+    o.add_argument("--coarse", type=int, default=None, metavar="N",
+                   help="first solve with N nodes and start the full solve from it (0 = the propagated "
+                        "guess; default: the YAML's coarse_nodes)")
     o.add_argument("--no-propagate", action="store_true", help="skip the Drake propagation check")
     o.add_argument("--out", default="out/optimize")
     o.add_argument("--format", choices=("parquet", "csv"), default="csv")

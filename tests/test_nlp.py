@@ -135,3 +135,23 @@ def test_marv_solution_satisfies_paper_002_constraints_and_extremal_controls():
     assert np.all(np.abs(np.degrees(U[:, 0])) <= 10.0 + 1e-6) and np.all(np.abs(np.degrees(U[:, 1])) <= 30.0 + 1e-6)
     ext = nlp.extremal_controls(p, r)
     assert np.abs(ext - U).max() < 1e-6 * 100
+
+
+@pytest.mark.parametrize("transcription", ["lgl", "dircol"])
+def test_user_path_callable_binds_on_both_transcriptions(transcription):
+    """v <= 1.2 (the free optimum peaks at 1.5) as a user callable: active, met at the nodes,
+    and the cost rises above the free optimum (DirectCollocation evaluates it in AutoDiff)."""
+    p = double_integrator(path=[PathConstraint(lambda x, u, env: x[1], max=1.2, name="speed")])
+    r = nlp.solve(p, transcription=transcription, nodes=21)
+    assert r.success, r.message
+    assert r.states[:, 1].max() == pytest.approx(1.2, abs=1e-6)
+    assert r.objective > 6.0 * 1.05
+
+
+def test_user_dynamic_pressure_callable_equals_the_builtin_constraint():
+    p, _ = load_problem("marv")
+    builtin = nlp.solve(p, nodes=16, solver="snopt", tolerance=1e-7)
+    user = [PathConstraint(lambda x, u, env: env.dynamic_pressure, min=12000.0, name="q_user")] + p.path[1:]
+    mine = nlp.solve(p.with_(path=user), nodes=16, solver="snopt", tolerance=1e-7, guess=builtin)
+    assert builtin.success and mine.success
+    assert mine.objective == pytest.approx(builtin.objective, rel=1e-6)

@@ -16,7 +16,7 @@ bounded, or absent = free):
   control_bounds: {alpha_rate_deg_s: {min: -10, max: 10}, bank_rate_deg_s: {...}}
   path: [{quantity: dynamic_pressure, min: 12000.0}, {quantity: sensed_acceleration, max: 45.0}]
   objective: [{kind: control_margin, weight: 1.0, k: [1, 18, 20]}, ...]
-  solve: {transcription: lgl, solver: ipopt, nodes: 125, tolerance: 1.0e-8}
+  solve: {transcription: lgl, solver: snopt, nodes: 125, tolerance: 1.0e-7, coarse_nodes: 60}
 """
 import dataclasses as dc
 import math
@@ -90,6 +90,8 @@ class SolveSpec:
     nodes: int = 40
     tolerance: float = 1.0e-8
     max_iterations: int = 3000
+    # solve first on this many nodes and start from that solution (0 = propagated guess)
+    coarse_nodes: int = 0
 
 
 @dc.dataclass

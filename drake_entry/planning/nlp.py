@@ -705,6 +705,7 @@ def summary(problem, result: NlpResult, check=None) -> dict:
         inner = result.hamiltonian[1:-1] if result.hamiltonian.size > 2 else result.hamiltonian
         out["hamiltonian_interior_max_abs"] = float(np.abs(inner).max())
         out["hamiltonian_interior_rms"] = float(np.sqrt(np.mean(inner ** 2)))
+        out["hamiltonian_interior_mean"] = float(np.mean(inner))
     if isinstance(problem, OptimalControlProblem):
         t = np.linspace(0.0, result.final_time, 4001)
         x = result.state_function()(t)

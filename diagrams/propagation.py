@@ -30,7 +30,8 @@ class PropagationCheck:
       time [s], states (n, n_states) SI: the propagated trajectory.
       terminal_error: propagated minus NLP at t_f: downtrack_m, crosstrack_m, position_m
         (their root sum square, paper 002's 18.16 m), altitude_m, velocity_m_s,
-        flight_path_deg (entry problems), or state_max for other problems.
+        flight_path_deg (entry problems), or state_max for other problems; {'failed': reason}
+        when the integration could not reach t_f.
     """
 
     time: np.ndarray
@@ -60,13 +61,19 @@ def propagate(problem, result, *, accuracy: float = 1e-11, samples_per_interval:
     integrator = ResetIntegratorFromFlags(simulator, "runge_kutta5", tf / 200)
     integrator.set_target_accuracy(accuracy)
     simulator.Initialize()
-    simulator.AdvanceTo(tf)
+    failure = None
+    try:
+        simulator.AdvanceTo(tf)
+    except RuntimeError as e:  # e.g. the flight-path angle reaching the -90 deg singularity
+        failure = f"propagation stopped at t = {ctx.get_time():.2f} s of {tf:.2f} s: {str(e).splitlines()[0][:200]}"
     log = logger.FindLog(ctx)
+    t_end = ctx.get_time()
     x_end = plant.GetMyContextFromRoot(ctx).get_continuous_state_vector().CopyToVector()
-    keep = log.sample_times() < tf - 1e-9
-    t = np.append(log.sample_times()[keep], tf)
+    keep = log.sample_times() < t_end - 1e-9
+    t = np.append(log.sample_times()[keep], t_end)
     X = np.vstack([log.data()[:, keep].T, x_end])
-    return PropagationCheck(time=t, states=X, terminal_error=terminal_error(problem, result, x_end))
+    err = {"failed": failure} if failure else terminal_error(problem, result, x_end)
+    return PropagationCheck(time=t, states=X, terminal_error=err)
 
 
 def terminal_error(problem, result, x_end) -> dict:

@@ -187,7 +187,7 @@ def nlp_benchmark(*, problem_name: str = "marv", nodes: int = 40, tolerance: flo
             except Exception as e:  # noqa: BLE001 - one failing combination is reported, not fatal
                 print(f"{transcription:14s} {solver:7s} error: {type(e).__name__}: {str(e).splitlines()[0][:80]}")
                 continue
-            miss = propagate(problem, r).terminal_error["position_m"] if r.success else float("nan")
+            miss = propagate(problem, r).terminal_error.get("position_m", float("nan")) if r.success else float("nan")
             out[(transcription, solver)] = dict(success=r.success, solve_time=r.solve_time, objective=r.objective,
                                                 final_time=r.final_time, miss_m=miss)
             print(f"{transcription:14s} {solver:7s} {'yes' if r.success else 'no':3s} {r.solve_time:10.2f} "

@@ -155,3 +155,19 @@ def test_user_dynamic_pressure_callable_equals_the_builtin_constraint():
     mine = nlp.solve(p.with_(path=user), nodes=16, solver="snopt", tolerance=1e-7, guess=builtin)
     assert builtin.success and mine.success
     assert mine.objective == pytest.approx(builtin.objective, rel=1e-6)
+
+
+def test_optimize_command_writes_solution_summary_and_the_ten_figures(tmp_path):
+    import json
+
+    from drake_entry.cli import main
+
+    out = tmp_path / "opt"
+    rc = main(["optimize", "marv", "--nodes", "24", "--coarse", "0", "--solver", "snopt", "--tolerance", "1e-7",
+               "--out", str(out)])
+    assert rc == 0
+    info = json.load(open(out / "summary.json"))
+    assert info["success"] and info["nodes"] == 24 and info["final_time_s"] > 0
+    assert info["extremal_control_max_diff_deg_s"] < 1e-3
+    assert len(list(out.glob("fig*.png"))) == 10 and (out / "solution.csv").exists()
+    assert main(["optimize", "no_such_problem", "--out", str(out)]) == 2

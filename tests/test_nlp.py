@@ -171,3 +171,25 @@ def test_optimize_command_writes_solution_summary_and_the_ten_figures(tmp_path):
     assert info["extremal_control_max_diff_deg_s"] < 1e-3
     assert len(list(out.glob("fig*.png"))) == 10 and (out / "solution.csv").exists()
     assert main(["optimize", "no_such_problem", "--out", str(out)]) == 2
+
+
+def test_objective_terms_have_their_geometric_values():
+    """Mayer terms against hand values: great-circle miss, crossrange sign (+ right of the
+    initial heading), final latitude; the heat-load integrand is the vehicle's heat flux."""
+    from drake_entry.planning.ocp import ObjectiveTerm
+
+    p, _ = load_problem("marv")
+    R = p.planet.reference_radius
+    xf = np.array([0.0, math.radians(1.0), 0.0, 1219.0, math.radians(-89.0), 0.0, 0.0, 0.0])
+    miss = p.with_(objective=[ObjectiveTerm("miss_distance", target=(0.0, 0.0), squared=False)])
+    assert miss.mayer(xf, 100.0) == pytest.approx(R * math.radians(1.0), rel=1e-9)
+    north = xf.copy()
+    north[1], north[2] = math.radians(5.0), 0.01  # initial heading is east: north is to the left
+    cross = p.with_(objective=[ObjectiveTerm("final_crossrange")])
+    assert cross.mayer(north, 100.0) == pytest.approx(-R * 0.01, rel=1e-6)
+    lat = p.with_(objective=[ObjectiveTerm("final_latitude", weight=-1.0)])
+    assert lat.mayer(north, 100.0) == pytest.approx(-0.01)
+    heat = p.with_(objective=[ObjectiveTerm("heat_load")])
+    x = np.array([30000.0, 0, 0, 5000.0, 0, 1.5, 0.2, 0.0])
+    rho = p.atmosphere.density(30000.0)
+    assert heat.lagrangian(x, np.zeros(2)) == pytest.approx(p.vehicle.heat_flux(rho, 5000.0), rel=1e-12)

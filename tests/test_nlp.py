@@ -193,3 +193,18 @@ def test_objective_terms_have_their_geometric_values():
     x = np.array([30000.0, 0, 0, 5000.0, 0, 1.5, 0.2, 0.0])
     rho = p.atmosphere.density(30000.0)
     assert heat.lagrangian(x, np.zeros(2)) == pytest.approx(p.vehicle.heat_flux(rho, 5000.0), rel=1e-12)
+
+
+@pytest.mark.slow
+def test_marv_60_nodes_reproduces_the_reported_solution():
+    """Reduced size of docs/results/paper002_marv (README): J, t_f, the altitude maxima on
+    the q = 12 kPa bound, the bank near 180 deg at t_f and the extremal controls."""
+    p, _ = load_problem("marv")
+    r = nlp.solve(p, nodes=60, solver="snopt", tolerance=1e-7)
+    assert r.success, r.message
+    assert r.objective == pytest.approx(17.6556, rel=1e-4) and r.final_time == pytest.approx(808.46, abs=0.05)
+    info = nlp.summary(p, r)
+    maxima = info["altitude_maxima"]
+    assert len(maxima) == 3 and all(abs(m["dynamic_pressure_kPa"] - 12.0) < 0.4 for m in maxima)
+    assert abs(info["final_bank_deg"] - 180.0) < 5.0
+    assert info["extremal_control_max_diff_deg_s"] < 1e-4

@@ -61,6 +61,8 @@ class PlanetSpec:
     model: str = "spherical"
     rotating: bool = True
     j2: bool = False
+    # sphere / ellipsoid radius override [m] (paper 002: R_e = 6378145 m); None = WGS-84
+    radius_m: Optional[float] = None
 
 
 @dc.dataclass
@@ -163,23 +165,10 @@ class Scenario:
         return load_vehicle(self.vehicle, aero=self.aero or None)
 
     def make_planet(self) -> Earth:
-        p = self.planet
-        if p.model == "spherical":
-            return Earth.spherical(rotating=p.rotating, j2=p.j2)
-        if p.model == "oblate":
-            return Earth.oblate(omega=Earth().omega if p.rotating else 0.0, j2=Earth().j2 if p.j2 else 0.0)
-        raise ScenarioError(f"planet.model '{p.model}' is unknown; allowed: spherical, oblate")
+        return planet_from_spec(self.planet)
 
     def make_atmosphere(self) -> Atmosphere:
-        a = self.atmosphere
-        if a.model == "us76":
-            return US76Atmosphere()
-        if a.model == "exponential":
-            try:
-                return ExponentialAtmosphere(a.rho0_kg_m3, a.scale_height_m)
-            except ValueError as e:
-                raise ScenarioError(f"atmosphere: {e}") from None
-        raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential")
+        return atmosphere_from_spec(self.atmosphere)
 
     def initial_state(self) -> np.ndarray:
         """Entry state x0 = [h, lon, lat, V, gamma, psi] in SI / rad."""
@@ -279,6 +268,32 @@ class Scenario:
 
 
 INTEGRATORS = ("runge_kutta5", "runge_kutta3", "radau3")
+
+
+def planet_from_spec(p: PlanetSpec) -> Earth:
+    """Earth model of a PlanetSpec (one-line ScenarioError on a bad field)."""
+    kw = {}
+    if p.radius_m is not None:
+        if not p.radius_m > 0:
+            raise ScenarioError(f"planet.radius_m = {p.radius_m}; allowed > 0")
+        kw = dict(reference_radius=p.radius_m, equatorial_radius=p.radius_m)
+    if p.model == "spherical":
+        return Earth.spherical(rotating=p.rotating, j2=p.j2, **kw)
+    if p.model == "oblate":
+        return Earth.oblate(omega=Earth().omega if p.rotating else 0.0, j2=Earth().j2 if p.j2 else 0.0, **kw)
+    raise ScenarioError(f"planet.model '{p.model}' is unknown; allowed: spherical, oblate")
+
+
+def atmosphere_from_spec(a: AtmosphereSpec) -> Atmosphere:
+    """Atmosphere model of an AtmosphereSpec (one-line ScenarioError on a bad field)."""
+    if a.model == "us76":
+        return US76Atmosphere()
+    if a.model == "exponential":
+        try:
+            return ExponentialAtmosphere(a.rho0_kg_m3, a.scale_height_m)
+        except ValueError as e:
+            raise ScenarioError(f"atmosphere: {e}") from None
+    raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential")
 
 
 def _range(field: str, value, lo: float, hi: float):

@@ -257,7 +257,7 @@ def _entry_guess(problem: OptimalControlProblem, samples):
         if too_long(s):
             lo = mid
         else:
-            hi, best = mid, s
+            hi, best = mid, s  # best is always the flight with bank hi
         if hi - lo < 1e-4:
             break
     t = np.linspace(0.0, best.t[-1], samples)
@@ -267,7 +267,7 @@ def _entry_guess(problem: OptimalControlProblem, samples):
     if problem.controls == "rates":
         U = np.zeros((samples, 2))
     else:
-        U = np.column_stack([np.full(samples, alpha), X[:, 6] if X.shape[1] > 6 else np.full(samples, lo)])
+        U = np.column_stack([np.full(samples, alpha), np.full(samples, hi)])
     if t[-1] < t_lo or t[-1] > t_hi:  # stretch to the allowed final time
         t = t * np.clip(t[-1], t_lo, t_hi) / t[-1]
     return t, X, U
@@ -288,11 +288,8 @@ class _Transcription:
         self.fixed_tf = self.t_lo == self.t_hi
 
     # scaled <-> SI
-    def f_scaled(self, xs, us):
-        return np.asarray(self.problem.dynamics(xs * self.sx, us * self.su)) * (self.ts / self.sx)
-
     def L_scaled(self, xs, us):
-        """Lagrangian per scaled time unit (so J_scaled = J / time_scale... times ts / ts)."""
+        """Lagrangian at scaled (x, u): integrated over scaled time it gives J / time_scale."""
         return self.problem.lagrangian(xs * self.sx, us * self.su)
 
     def path_scaled(self, xs, us):

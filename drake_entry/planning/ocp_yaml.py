@@ -6,8 +6,8 @@ bounded, or absent = free):
   name: marv
   vehicle: marv                 # packaged vehicle or YAML path; aero: optional model name
   mass_over_area_kg_m2: 1000.0  # optional override of m/S
-  planet: {model: spherical, rotating: true, j2: false, radius_m: 6378145.0}
-  atmosphere: {model: exponential, rho0_kg_m3: 1.225, scale_height_m: 7200.0}
+  planet: {model: spherical, rotating: true, j2: false, radius_m: 6378145.0}   # as in scenarios
+  atmosphere: {model: exponential, rho0_kg_m3: 1.225, scale_height_m: 7200.0}  # (default us76)
   controls: rates               # rates (alpha, sigma states; u_alpha, u_sigma controls) | direct
   initial: {altitude_km: {value: 37.0}, ...}
   final: {...}
@@ -24,9 +24,8 @@ import os
 from importlib import resources
 from typing import Dict, List, Optional
 
-from ..atmosphere import ExponentialAtmosphere, US76Atmosphere
 from ..errors import ScenarioError, load_yaml_typed
-from ..planet import Earth
+from ..scenario import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
 from ..vehicles import load_vehicle
 from .ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
 
@@ -45,21 +44,6 @@ class BoundSpec:
     value: Optional[float] = None
     min: Optional[float] = None
     max: Optional[float] = None
-
-
-@dc.dataclass
-class PlanetOcpSpec:
-    model: str = "spherical"
-    rotating: bool = True
-    j2: bool = False
-    radius_m: Optional[float] = None
-
-
-@dc.dataclass
-class AtmosphereOcpSpec:
-    model: str = "exponential"
-    rho0_kg_m3: float = 1.225
-    scale_height_m: float = 7200.0
 
 
 @dc.dataclass
@@ -102,8 +86,8 @@ class ProblemSpec:
     vehicle: str = ""
     aero: str = ""
     mass_over_area_kg_m2: Optional[float] = None
-    planet: PlanetOcpSpec = dc.field(default_factory=PlanetOcpSpec)
-    atmosphere: AtmosphereOcpSpec = dc.field(default_factory=AtmosphereOcpSpec)
+    planet: PlanetSpec = dc.field(default_factory=PlanetSpec)
+    atmosphere: AtmosphereSpec = dc.field(default_factory=AtmosphereSpec)
     controls: str = "rates"
     initial: Dict[str, BoundSpec] = dc.field(default_factory=dict)
     final: Dict[str, BoundSpec] = dc.field(default_factory=dict)
@@ -153,21 +137,8 @@ def problem_from_spec(spec: ProblemSpec) -> OptimalControlProblem:
         if not spec.mass_over_area_kg_m2 > 0:
             raise ScenarioError(f"mass_over_area_kg_m2 = {spec.mass_over_area_kg_m2}; allowed > 0")
         vehicle = dc.replace(vehicle, mass=spec.mass_over_area_kg_m2 * vehicle.reference_area)
-    p = spec.planet
-    if p.model not in ("spherical", "oblate"):
-        raise ScenarioError(f"planet.model = '{p.model}'; allowed: spherical, oblate")
-    kw = {}
-    if p.radius_m is not None:
-        kw = dict(reference_radius=p.radius_m, equatorial_radius=p.radius_m)
-    planet = (Earth.spherical(rotating=p.rotating, j2=p.j2, **kw) if p.model == "spherical"
-              else Earth.oblate(omega=Earth().omega if p.rotating else 0.0, j2=Earth().j2 if p.j2 else 0.0, **kw))
-    a = spec.atmosphere
-    if a.model == "us76":
-        atmosphere = US76Atmosphere()
-    elif a.model == "exponential":
-        atmosphere = ExponentialAtmosphere(a.rho0_kg_m3, a.scale_height_m)
-    else:
-        raise ScenarioError(f"atmosphere.model = '{a.model}'; allowed: us76, exponential")
+    planet = planet_from_spec(spec.planet)
+    atmosphere = atmosphere_from_spec(spec.atmosphere)
     states = ("h", "lon", "lat", "V", "gamma", "psi") + (("alpha", "sigma") if spec.controls == "rates" else ())
     controls = ("u_alpha", "u_sigma") if spec.controls == "rates" else ("alpha", "sigma")
     tf = _bound("final_time_s", spec.final_time_s, 1.0, allow_free=False)

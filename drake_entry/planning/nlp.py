@@ -330,8 +330,8 @@ class _Transcription:
             prog.AddCost(lambda z: self.problem.mayer(z[:nx] * self.sx, z[nx:].sum() * self.ts) / self.ts,
                          np.concatenate([x_last, np.atleast_1d(tf_vars)]))
 
-    def diagnose(self, res) -> str:
-        """Name the worst violated constraint at the returned point (infeasible problems)."""
+    def worst_violation(self, res) -> tuple[float, str]:
+        """(largest scaled constraint violation, the constraint's description) at ``res``."""
         worst, where = 0.0, ""
         for b in self.prog.GetAllConstraints():
             v = res.EvalBinding(b)
@@ -341,6 +341,11 @@ class _Transcription:
             if viol.size and viol.max() > worst:
                 worst = float(viol.max())
                 where = b.evaluator().get_description() or type(b.evaluator()).__name__
+        return worst, where
+
+    def diagnose(self, res) -> str:
+        """Name the worst violated constraint at the returned point (infeasible problems)."""
+        worst, where = self.worst_violation(res)
         return f"largest violation {worst:.3g} (scaled) in '{where}'" if worst > 0 else "no violated constraint"
 
     def _message(self, res, solver) -> tuple[bool, str]:
@@ -654,13 +659,7 @@ def _finish(tx, ok, msg, t, X, U, res, costates, t_costate, solve_time, build_ti
         Uc = U if len(t_costate) == len(t) else 0.5 * (U[:-1] + U[1:])
         ham = np.array([float(problem.lagrangian(x, u)) + float(lam @ np.asarray(problem.dynamics(x, u), float))
                         for x, u, lam in zip(Xc, Uc, costates)])
-    viol = 0.0
-    for b in tx.prog.GetAllConstraints():
-        v = res.EvalBinding(b)
-        lo, hi = b.evaluator().lower_bound(), b.evaluator().upper_bound()
-        e = np.maximum(lo - v, 0.0) + np.maximum(v - hi, 0.0)
-        e = e[np.isfinite(e)]
-        viol = max(viol, float(e.max()) if e.size else 0.0)
+    viol = tx.worst_violation(res)[0]
     return NlpResult(success=ok, message=msg, time=t, states=X, controls=U, objective=objective,
                      costates=costates, costate_time=t_costate, hamiltonian=ham, solve_time=solve_time,
                      build_time=build_time, transcription=transcription, solver=solver, nodes=tx.N,

@@ -216,8 +216,6 @@ def _entry_guess(problem: OptimalControlProblem, samples):
     h_end = xfl[0] if np.isfinite(xfl[0]) else 0.0
     alpha = float(np.clip(problem.alpha_bar, xl[6] if problem.controls == "rates" else ul[0],
                           xh[6] if problem.controls == "rates" else uh[0]))
-    if problem.controls == "rates" and not np.isfinite(x0[6]):
-        x0[6] = alpha
     t_lo, t_hi = problem.final_time_bounds
     t_max = t_hi if np.isfinite(t_hi) else 5000.0
     target = None
@@ -516,10 +514,9 @@ class _LglTranscription(_Transcription):
         defect = (D @ Xs - 0.5 * tf * f).ravel()
         values = np.concatenate([defect, g.T.ravel()])
         J = np.zeros((N * nx + npth * N, zv.size))
-        xcols = np.arange(N)[:, None] * nx  # (N, 1)
-        for i in range(nx):
-            rows = np.arange(N) * nx + i
-            J[np.ix_(rows, xcols[:, 0] + i)] += D
+        for i in range(nx):  # D acts on each state's nodal values
+            idx = np.arange(N) * nx + i
+            J[np.ix_(idx, idx)] += D
         for k in range(N):
             rows = k * nx + np.arange(nx)
             J[np.ix_(rows, k * nx + np.arange(nx))] -= 0.5 * tf * df[k, :, :nx]

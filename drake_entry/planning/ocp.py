@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 
 from ..atmosphere import Atmosphere
-from ..dynamics import STATE_NAMES, FlightConditions, conditions_from, state_derivatives
+from ..dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_derivatives
 from ..planet import Earth
 from ..vehicles import Vehicle
 
@@ -312,12 +312,8 @@ class OptimalControlProblem(_ProblemLayout):
 
     def conditions(self, x, u) -> FlightConditions:
         """Flight conditions at (x, u): q, heat flux, load factors, L, D, ..."""
-        alpha, _ = self.alpha_sigma(x, u)
-        from ..dynamics import aero_accelerations, air_data
-
-        rho, a = air_data(x[:6], self.planet, self.atmosphere)
-        mach, L, D = aero_accelerations(x[:6], alpha, rho, a, self.vehicle)
-        return conditions_from(x[:6], alpha, rho, mach, L, D, self.vehicle, self.planet)
+        alpha, sigma = self.alpha_sigma(x, u)
+        return flight_conditions(x[:6], sigma, alpha, self.vehicle, self.planet, self.atmosphere)
 
     def lagrangian(self, x, u):
         """Sum of the weighted Lagrange terms at (x, u) [cost units / s]."""

@@ -167,7 +167,7 @@ def fly(scenario: Scenario, planner: DragEnergyPlanner | None = None, *, initial
     Monte-Carlo ``draw`` is given)."""
     diagram, loggers, planner = build_closed_loop(scenario, planner, nav_seed=nav_seed, nav_bias=nav_bias,
                                                   nav_noise=nav_noise, initial_state=initial_state, draw=draw)
-    tr, simulator = run(diagram, loggers, scenario, sources=SOURCES)
+    tr, simulator = run(diagram, loggers, scenario, sources=SOURCES, closed_loop=True)
     return summarise(diagram, simulator.get_context(), tr, scenario, planner)
 
 

@@ -54,12 +54,17 @@ class Trajectory:
         return out
 
 
-def configure_integrator(simulator: Simulator, scenario: Scenario):
-    """Integrator, accuracy and maximum step from the scenario (RK5 by default; see DESIGN.md)."""
+def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loop: bool = False):
+    """Integrator, accuracy and maximum step from the scenario (RK5 by default; see DESIGN.md);
+    a closed loop takes fixed steps of ``simulation.closed_loop_step_s`` when that is > 0."""
     sim = scenario.simulation
-    integrator = ResetIntegratorFromFlags(simulator, sim.integrator, sim.max_step_s)
-    integrator.set_target_accuracy(sim.accuracy)
-    integrator.set_maximum_step_size(sim.max_step_s)
+    step = sim.closed_loop_step_s if closed_loop and sim.closed_loop_step_s > 0 else 0.0
+    integrator = ResetIntegratorFromFlags(simulator, sim.integrator, step or sim.max_step_s)
+    if step:
+        integrator.set_fixed_step_mode(True)
+    else:
+        integrator.set_target_accuracy(sim.accuracy)
+        integrator.set_maximum_step_size(sim.max_step_s)
     # witness functions need the context accuracy set explicitly (DESIGN.md)
     simulator.get_mutable_context().SetAccuracy(sim.accuracy)
     return integrator
@@ -89,13 +94,14 @@ def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason
                       extra=extra)
 
 
-def make_simulator(diagram, scenario: Scenario, *, initial_state=None) -> Simulator:
-    """Simulator with the scenario's integrator; optional entry state override."""
+def make_simulator(diagram, scenario: Scenario, *, initial_state=None, closed_loop: bool = False) -> Simulator:
+    """Simulator with the scenario's integrator (``closed_loop``: see configure_integrator);
+    optional entry state override."""
     simulator = Simulator(diagram)
     if initial_state is not None:
         plant = diagram.GetSubsystemByName("vehicle")
         plant.set_initial_state(plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()), initial_state)
-    configure_integrator(simulator, scenario)
+    configure_integrator(simulator, scenario, closed_loop=closed_loop)
     return simulator
 
 
@@ -103,9 +109,10 @@ def stop_reason(status) -> str:
     return status.message() if status.reason() != status.ReturnReason.kReachedBoundaryTime else "max_time"
 
 
-def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_state=None) -> tuple[Trajectory, Simulator]:
+def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_state=None,
+        closed_loop: bool = False) -> tuple[Trajectory, Simulator]:
     """Simulate ``diagram`` to a terminal condition or max_time_s (see collect_trajectory)."""
-    simulator = make_simulator(diagram, scenario, initial_state=initial_state)
+    simulator = make_simulator(diagram, scenario, initial_state=initial_state, closed_loop=closed_loop)
     simulator.Initialize()
     t0 = _time.perf_counter()
     status = simulator.AdvanceTo(scenario.simulation.max_time_s)

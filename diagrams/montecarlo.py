@@ -54,7 +54,7 @@ def run_sample(scenario: Scenario, planner: DragEnergyPlanner, campaign_seed: in
         box["draw"] = d = draw(scenario.dispersions, generator)
         diagram, loggers, _ = build_closed_loop(scenario, planner, draw=d)
         box["diagram"], box["loggers"] = diagram, loggers
-        simulator = make_simulator(diagram, scenario)
+        simulator = make_simulator(diagram, scenario, closed_loop=True)
         box["simulator"] = simulator
         return simulator
 

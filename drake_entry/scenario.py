@@ -129,10 +129,16 @@ class GuidanceSpec:
 class SimulationSpec:
     # hard stop [s] if no terminal condition triggers
     max_time_s: float = 3000.0
-    # runge_kutta5 | runge_kutta3 | radau3
+    # runge_kutta5 | runge_kutta3 | runge_kutta2 | radau3 (any of Drake's GetIntegrationSchemes())
     integrator: str = "runge_kutta5"
+    # error-control accuracy (also the witness-function localisation accuracy)
     accuracy: float = 1e-8
     max_step_s: float = 10.0
+    # closed-loop flights only: a fixed integration step [s] (0 = the error-controlled settings
+    # above). A closed loop samples its fast dynamics (bank actuator, guidance, control) at the
+    # guidance period, so a step dividing that period is exact at every event; open-loop
+    # diagrams keep the continuous bank actuator, whose 8 rad/s loop needs error control.
+    closed_loop_step_s: float = 0.0
     # trajectory sample period for logs and plots [s]
     log_period_s: float = 1.0
 
@@ -227,6 +233,10 @@ class Scenario:
         _range("simulation.accuracy", sim.accuracy, 1e-14, 1e-1)
         _range("simulation.max_step_s", sim.max_step_s, 1e-4, 1e3)
         _range("simulation.log_period_s", sim.log_period_s, 1e-3, 1e3)
+        step, period = sim.closed_loop_step_s, self.guidance.period_s
+        if step != 0.0 and not (0.0 < step <= period and abs(period / step - round(period / step)) < 1e-9):
+            raise ScenarioError(f"simulation.closed_loop_step_s = {step:g} s must be 0 (error control) or divide "
+                                f"guidance.period_s = {period:g} s (e.g. {period:g}, {period / 2:g}, {period / 4:g})")
         if sim.integrator not in INTEGRATORS:
             raise ScenarioError(f"simulation.integrator '{sim.integrator}' is unknown; allowed: {', '.join(INTEGRATORS)}")
         g = self.guidance

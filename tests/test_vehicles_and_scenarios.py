@@ -90,3 +90,27 @@ def test_paper000_table2_dispersion_is_reproducible_bounded_and_uniform():
     # uniform on [-a, a]: standard deviation a / sqrt(3)
     assert np.allclose(draws.std(axis=0) / (half / np.sqrt(3)), 1.0, atol=0.05)
     assert load_scenario("horus2b").dispersions.entry.altitude_m.max == 250.0
+
+
+def test_closed_loop_step_must_divide_the_guidance_period(tmp_path):
+    p = _write(tmp_path, "name: x\nvehicle: horus2b\nentry: {altitude_km: 120, velocity_m_s: 7000}\n"
+                         "terminal: {altitude_km: 25}\nsimulation: {closed_loop_step_s: 0.3}\n")
+    with pytest.raises(ScenarioError, match=r"simulation.closed_loop_step_s = 0.3 s must be 0 \(error control\) "
+                                            r"or divide guidance.period_s = 1 s"):
+        load_scenario(p)
+
+
+def test_closed_loop_runs_fixed_steps_and_open_loop_keeps_error_control():
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    from diagrams.common import make_simulator
+
+    sc = load_scenario("horus2b")
+    builder = DiagramBuilder()
+    builder.AddSystem(ConstantVectorSource([1.0]))
+    diagram = builder.Build()
+    closed = make_simulator(diagram, sc, closed_loop=True).get_integrator()
+    assert closed.get_fixed_step_mode() and closed.get_maximum_step_size() == sc.simulation.closed_loop_step_s == 0.5
+    opened = make_simulator(diagram, sc).get_integrator()
+    assert not opened.get_fixed_step_mode() and opened.get_target_accuracy() == sc.simulation.accuracy

@@ -12,6 +12,7 @@ energy as the independent variable.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 from numpy.polynomial import legendre
@@ -55,6 +56,24 @@ def interpolation_matrix(nodes: np.ndarray, points, bary=None) -> np.ndarray:
     return M
 
 
+@lru_cache(maxsize=32)
+def _reference_operators(n_nodes: int):
+    """(tau, weights_tau, D1_tau, D2_tau, barycentric weights) on [-1, 1]; computed once per
+    node count (a re-plan builds new LGL objects many times a flight). Read-only arrays."""
+    N = n_nodes - 1
+    tau = lgl_nodes(n_nodes)
+    P_N = legendre.legval(tau, np.eye(N + 1)[N])
+    weights = 2.0 / (N * (N + 1) * P_N**2)
+    D = P_N[:, None] / (P_N[None, :] * (tau[:, None] - tau[None, :] + np.eye(N + 1)))
+    np.fill_diagonal(D, 0.0)
+    D[0, 0] = -N * (N + 1) / 4.0
+    D[N, N] = N * (N + 1) / 4.0
+    out = (tau, weights, D, D @ D, barycentric_weights(tau))
+    for a in out:
+        a.flags.writeable = False
+    return out
+
+
 @dataclass
 class LGL:
     """LGL operators for ``n_nodes`` nodes on the interval [a, b] (a > b allowed, e.g. energy
@@ -74,17 +93,7 @@ class LGL:
     def __post_init__(self):
         if self.a == self.b:
             raise ValueError("LGL interval must have a != b")
-        N = self.n_nodes - 1
-        self.tau = lgl_nodes(self.n_nodes)
-        P_N = legendre.legval(self.tau, np.eye(N + 1)[N])
-        self.weights_tau = 2.0 / (N * (N + 1) * P_N**2)
-        D = P_N[:, None] / (P_N[None, :] * (self.tau[:, None] - self.tau[None, :] + np.eye(N + 1)))
-        np.fill_diagonal(D, 0.0)
-        D[0, 0] = -N * (N + 1) / 4.0
-        D[N, N] = N * (N + 1) / 4.0
-        self.D1_tau = D
-        self.D2_tau = D @ D
-        self.bary = barycentric_weights(self.tau)
+        self.tau, self.weights_tau, self.D1_tau, self.D2_tau, self.bary = _reference_operators(int(self.n_nodes))
         half = (self.b - self.a) / 2.0
         self.x = half * self.tau + (self.a + self.b) / 2.0  # eq. 12
         self.weights = half * self.weights_tau  # eq. 16

@@ -199,3 +199,19 @@ def test_drag_inversion_from_a_neighbour_guess_equals_the_bracketed_root(planner
         h_s, V_s = altitude_speed_from_drag(*args, h_guess=h_b + 3000.0)
         assert abs(h_s - h_b) < 1e-3 and abs(V_s - V_b) < 1e-6
         assert drag_acceleration(h_s, V_s, c.alpha[i], planner.vehicle, planner.atmosphere) == pytest.approx(D, rel=1e-8)
+
+
+def test_replan_where_clarabel_stalls_without_refinement_still_succeeds(planner):
+    """A re-plan from a dispersed flight (tests/data) on which Clarabel with iterative
+    refinement off (the planner's fast setting) stops with InsufficientProgress: the planner
+    solves again with Clarabel's defaults and returns a verified plan."""
+    import json
+    from pathlib import Path
+
+    case = json.loads((Path(__file__).parent / "data" / "replan_clarabel_stall.json").read_text())
+    E, kappa = np.array(case["previous_energy"]), np.array(case["previous_kappa"])
+    ref = planner.plan_from_state(np.array(case["state"]), sensed_drag=case["sensed_drag"], range_iterations=1,
+                                  kappa_guess=lambda e: np.interp(e, E[::-1], kappa[::-1]))
+    assert ref.success, ref.message
+    assert ref.range_flown() == pytest.approx(planner.range_to_go(np.array(case["state"])), rel=1e-5)
+    assert 1.0 / ref.I[0] == pytest.approx(case["sensed_drag"], rel=1e-6)

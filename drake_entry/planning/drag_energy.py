@@ -32,7 +32,7 @@ from scipy.optimize import brentq
 
 from ..atmosphere import Atmosphere
 from ..corridor import Corridor, compute_corridor
-from ..drag_dynamics import AlphaProfile, DragDynamics, drag_acceleration, drag_dynamics
+from ..drag_dynamics import AlphaProfile, DragDynamics, DragTerms, drag_acceleration, drag_dynamics
 from ..planet import Earth
 from ..pseudospectral import LGL
 from ..schedules import Schedule
@@ -138,10 +138,22 @@ class DragEnergyReference:
         return 1.0 / self.I
 
     def profile(self, E):
-        """(D, D', D'') at energies E (eqs. 87-88 from the interpolated I(E); held at the ends)."""
-        E = np.clip(np.atleast_1d(np.asarray(E, float)), self.problem.Ef, self.problem.E0)
+        """(D, D', D'') at energies E (eqs. 87-88 from the interpolated I(E); held at the ends).
+        Arrays of the shape of ``np.atleast_1d(E)``."""
         if self._nodal is None:  # I, I', I'' at the nodes, once
             self._nodal = np.vstack([self.I, self.lgl.D1 @ self.I, self.lgl.D2 @ self.I]).T
+        if np.ndim(E) == 0:  # the guidance's once-a-period call: one barycentric row (eq. 9)
+            op = self.lgl
+            E = min(max(float(E), self.problem.Ef), self.problem.E0)
+            d = (2.0 * E - (op.a + op.b)) / (op.b - op.a) - op.tau
+            if d.all():
+                w = op.bary / d
+                I, I1, I2 = ((w @ self._nodal) / w.sum()).tolist()
+            else:  # on a node
+                I, I1, I2 = self._nodal[int(np.argmin(np.abs(d)))].tolist()
+            D = 1.0 / I
+            return np.array([D]), np.array([-I1 / I**2]), np.array([2.0 * I1**2 / I**3 - I2 / I**2])
+        E = np.clip(np.atleast_1d(np.asarray(E, float)), self.problem.Ef, self.problem.E0)
         I, I1, I2 = (self.lgl.interpolation(E) @ self._nodal).T
         D = 1.0 / I
         return D, -I1 / I**2, 2.0 * I1**2 / I**3 - I2 / I**2
@@ -244,7 +256,14 @@ def _solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyR
     if p.solver == "scs":  # first-order: converges slowly here (drake-entry bench-socp); cap the work
         for k, v in (("eps_abs", 1e-7), ("eps_rel", 1e-7), ("max_iters", 20000)):
             options.SetOption(solver.solver_id(), k, v)
+    else:  # Clarabel's iterative refinement of each KKT solve took about 30 % of the solve time here
+        # and moved the 40-node solution by 5e-9 (relative); _check_solution verifies the result.
+        # Without it Clarabel stalled (InsufficientProgress) in about 1 of 300 re-plans: then
+        # the problem is solved again with Clarabel's defaults.
+        options.SetOption(solver.solver_id(), "iterative_refinement_enable", False)
     result = solver.Solve(prog, None, options)
+    if not result.is_success() and p.solver == "clarabel":
+        result = solver.Solve(prog, None, SolverOptions())
     t2 = time.perf_counter()
     ok = result.is_success()
     details = result.get_solver_details()
@@ -342,20 +361,21 @@ def extract(p: DragEnergyProblem, op: LGL, I: np.ndarray) -> Extraction:
     out = {k: np.zeros(n) for k in ("h", "V", "gamma", "u_ff", "sigma", "ld")}
     sat = np.zeros(n, bool)
     frac = (p.E0 - op.x) / (p.E0 - p.Ef)
-    h = None
+    h = slope = None
     for i, E in enumerate(op.x):
         alpha = _alpha_profile(p.alpha, E)
-        h, V = altitude_speed_from_drag(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere, h_guess=h)
+        h, V, slope = _altitude_speed(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere, h_guess=h,
+                                      slope_guess=slope)
         lat = p.lat0 + frac[i] * (p.latf - p.lat0)
         heading = p.heading0 + frac[i] * (p.headingf - p.heading0)
-        d0 = drag_dynamics(h, V, 0.0, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat, heading=heading)
-        gamma = math.asin(float(np.clip((Dp[i] - d0.a_Dgamma) / d0.b_Dgamma, -1.0, 1.0)))  # eq. 94
-        dd = drag_dynamics(h, V, gamma, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat, heading=heading)
+        terms = DragTerms(h, V, alpha, p.vehicle, p.planet, p.atmosphere)
+        gamma = math.asin(min(max((Dp[i] - terms.a_Dgamma) / terms.b_Dgamma, -1.0), 1.0))  # eq. 94
+        dd = terms.at(gamma, lat=lat, heading=heading)
         u = dd.feedforward(Dpp[i])  # eq. 95
         ratio = u / dd.lift_to_drag
         lo = math.cos(p.sigma_max)
         sat[i] = ratio > 1.0 or ratio < lo
-        sigma = math.acos(float(np.clip(ratio, lo, 1.0)))  # eq. 96, saturated
+        sigma = math.acos(min(max(ratio, lo), 1.0))  # eq. 96, saturated
         for k, v in (("h", h), ("V", V), ("gamma", gamma), ("u_ff", u), ("sigma", sigma), ("ld", dd.lift_to_drag)):
             out[k][i] = v
     return Extraction(out["h"], out["V"], out["gamma"], out["u_ff"], out["sigma"], sat, out["ld"])
@@ -368,34 +388,49 @@ def altitude_speed_from_drag(E: float, D: float, alpha: float, vehicle: Vehicle,
     With ``h_guess`` (the neighbouring node's altitude) a secant iteration on ln D, nearly
     linear in h, converges in a few model evaluations; Brent's bracketed method is the
     fallback and the default."""
+    return _altitude_speed(E, D, alpha, vehicle, planet, atmosphere, h_floor, h_guess)[:2]
+
+
+def _altitude_speed(E, D, alpha, vehicle, planet, atmosphere, h_floor=0.0, h_guess=None, slope_guess=None):
+    """altitude_speed_from_drag and the last secant slope d ln D / dh [1/m] (None after
+    Brent), which starts the next node's secant one model evaluation closer."""
     h_top = min(planet.mu / (-E) - planet.reference_radius - 1.0, atmosphere.h_max)
 
     def f(h):
         V = math.sqrt(max(2.0 * (E + planet.mu / planet.radius(h)), 0.0))
         return drag_acceleration(h, V, alpha, vehicle, atmosphere) - D
 
-    h = _secant_log_drag(f, D, h_guess, h_floor, h_top) if h_guess is not None else None
-    if h is None:
-        h = brentq(f, h_floor, h_top, xtol=1e-4)
-    return h, math.sqrt(2.0 * (E + planet.mu / planet.radius(h)))
+    found = _secant_log_drag(f, D, h_guess, h_floor, h_top, slope_guess) if h_guess is not None else None
+    h, slope = found if found is not None else (brentq(f, h_floor, h_top, xtol=1e-4), None)
+    return h, math.sqrt(2.0 * (E + planet.mu / planet.radius(h))), slope
 
 
-def _secant_log_drag(f, D: float, h0: float, lo: float, hi: float, tol: float = 1e-4, iterations: int = 12):
-    """Root of f(h) + D = D by secant steps on ln(f(h) + D) - ln D; None unless it converges in [lo, hi]."""
+def _secant_log_drag(f, D: float, h0: float, lo: float, hi: float, slope: float | None = None,
+                     tol: float = 1e-4, iterations: int = 12):
+    """(root of f(h) + D = D, last slope) by secant steps on ln(f(h) + D) - ln D, the first
+    step a Newton step with ``slope`` when given; None unless it converges in [lo, hi]."""
     def g(h):
         v = f(h) + D
         return math.log(v / D) if v > 0.0 else None
 
-    a, b = min(max(h0, lo), hi), min(max(h0 + 200.0, lo), hi)
-    ga, gb = g(a), g(b)
+    a = min(max(h0, lo), hi)
+    ga = g(a)
+    if ga is None:
+        return None
+    if abs(ga) < 1e-12:
+        return a, slope
+    step = -ga / slope if slope is not None and slope < 0.0 else 200.0
+    b = min(max(a + step, lo), hi)
+    gb = g(b)
     for _ in range(iterations):
-        if ga is None or gb is None or gb == ga:
+        if gb is None or gb == ga or a == b:
             return None
-        c = b - gb * (b - a) / (gb - ga)
+        s = (gb - ga) / (b - a)
+        c = b - gb / s
         if not lo <= c <= hi:
             return None
         if abs(c - b) < tol:
-            return c
+            return c, s
         a, ga, b, gb = b, gb, c, g(c)
     return None
 

@@ -109,6 +109,13 @@ class Atmosphere:
         """Density and temperature with their altitude derivatives (float / ndarray)."""
         return self.density_derivatives(h), self.temperature_derivatives(h)
 
+    def air_data(self, h: float) -> tuple[float, float]:
+        """(density [kg/m^3], speed of sound [m/s]) at a float altitude h [m]: the
+        simulation's once-per-derivative call, without the derivatives (equal to
+        ``properties`` to the last bit)."""
+        d, t = self.derivatives(h)
+        return float(d.value), math.sqrt(self.gamma * self.gas_constant * float(t.value))
+
     def properties(self, h) -> AtmosphereProperties:
         """(rho, T, a) at altitude h [m]; one model evaluation for float / AutoDiff input."""
         if is_symbolic(h):
@@ -242,6 +249,13 @@ class US76Atmosphere(Atmosphere):
         vals = np.array([_us76_scalar(v) for v in z.ravel().tolist()]).reshape(z.shape + (6,))
         return [vals[..., k] for k in range(6)]
 
+    def air_data(self, h: float) -> tuple[float, float]:
+        z = float(h)
+        if not US76_H_MIN <= z <= US76_H_MAX:
+            self.check(z)
+        ln_rho, _, _, T, _, _ = _us76_scalar(z)
+        return math.exp(ln_rho), math.sqrt(GAMMA_AIR * R_AIR * T)
+
     def density_derivatives(self, h) -> Derivatives:
         return self.derivatives(h)[0]
 
@@ -338,6 +352,10 @@ class DispersedAtmosphere(Atmosphere):
         arg = self.k * np.asarray(h, float) + self.phase
         return (self.scale * (1.0 + a * np.sin(arg)), self.scale * a * self.k * np.cos(arg),
                 -self.scale * a * self.k**2 * np.sin(arg))
+
+    def air_data(self, h: float) -> tuple[float, float]:
+        rho, a = self.base.air_data(h)
+        return rho * (self.scale * (1.0 + self.amplitude * math.sin(self.k * float(h) + self.phase))), a
 
     def density_derivatives(self, h) -> Derivatives:
         return self.derivatives(h)[0]

@@ -48,7 +48,10 @@ FLIGHT_CONDITION_NAMES = FlightConditions._fields
 
 def air_data(x, planet: Earth, atmosphere: Atmosphere):
     """Density [kg/m^3] and speed of sound [m/s] at state x."""
-    rho, _, a = atmosphere.properties(planet.atmospheric_altitude(x[0], x[2]))
+    h = planet.atmospheric_altitude(x[0], x[2])
+    if isinstance(h, float):
+        return atmosphere.air_data(h)
+    rho, _, a = atmosphere.properties(h)
     return rho, a
 
 

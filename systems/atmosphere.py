@@ -13,6 +13,7 @@ from pydrake.systems.framework import LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drake_entry.atmosphere import Atmosphere
+from drake_entry.dynamics import air_data
 from drake_entry.planet import Earth
 
 
@@ -31,9 +32,7 @@ def AtmosphereSystem_(T):
             Impl._construct(self, other.atmosphere, other.planet, converter=converter)
 
         def _calc(self, context, output):
-            x = self.state_port.Eval(context)
-            rho, _, a = self.atmosphere.properties(self.planet.atmospheric_altitude(x[0], x[2]))
-            output.SetFromVector(np.array([rho, a]))
+            output.SetFromVector(np.array(air_data(self.state_port.Eval(context), self.planet, self.atmosphere)))
 
     return Impl
 

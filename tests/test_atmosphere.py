@@ -70,3 +70,15 @@ def test_altitude_outside_the_model_names_the_range(us76):
 def test_bad_exponential_parameters_are_rejected():
     with pytest.raises(ValueError, match="scale_height must be > 0"):
         ExponentialAtmosphere(scale_height=-1.0)
+
+
+@pytest.mark.parametrize("h", [-4000.0, 0.0, 11000.0, 30500.0, 71000.0, 85999.0, 86001.0, 121500.0])
+def test_air_data_fast_path_equals_properties_to_the_last_bit(us76, h):
+    from drake_entry.atmosphere import DispersedAtmosphere
+
+    for atm in (us76, ExponentialAtmosphere(), DispersedAtmosphere(us76, scale=1.07, amplitude=0.05,
+                                                                     wavelength=9000.0, phase=0.3)):
+        rho, _, a = atm.properties(h)
+        assert atm.air_data(h) == (rho, a)
+    with pytest.raises(ValueError, match="outside"):
+        us76.air_data(1.1e6)

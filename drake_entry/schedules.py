@@ -65,19 +65,19 @@ class Schedule:
     def derivatives(self, s: float) -> tuple[float, float, float]:
         """(value, d/ds, d2/ds2) at a scalar s (zero slope outside the breakpoints; the
         second derivative of a non-smooth schedule is zero between its corners)."""
-        bp = np.asarray(self.breakpoints, float)
-        v = np.asarray(self.values, float)
-        if bp.size == 1 or s <= bp[0] or s >= bp[-1]:
-            return self(s), 0.0, 0.0
-        i = int(np.clip(np.searchsorted(bp, s, side="right") - 1, 0, bp.size - 2))
-        width = bp[i + 1] - bp[i]
-        dv = v[i + 1] - v[i]
+        bp, v = self.breakpoints, self.values
+        s = float(s)
+        if len(bp) == 1 or s <= bp[0] or s >= bp[-1]:
+            return self._scalar(s), 0.0, 0.0
+        i = min(max(bisect.bisect_right(bp, s) - 1, 0), len(bp) - 2)
+        width = float(bp[i + 1] - bp[i])
+        dv = float(v[i + 1] - v[i])
         if not self.smooth:
-            return self(s), dv / width, 0.0
+            return self._scalar(s), dv / width, 0.0
         t = (s - bp[i]) / width
         d1 = 30.0 * t * t * (1.0 - t) ** 2
         d2 = 60.0 * t * (1.0 - t) * (1.0 - 2.0 * t)
-        return self(s), dv * d1 / width, dv * d2 / width**2
+        return self._scalar(s), dv * d1 / width, dv * d2 / width**2
 
     def __call__(self, s):
         """Value at s (float or ndarray)."""

@@ -219,7 +219,7 @@ def _cmd_bench(args) -> int:
     from .benchmark import campaign_benchmark, nlp_benchmark, open_loop_benchmark, socp_benchmark
 
     if args.which in ("all", "campaign"):
-        campaign_benchmark(samples=args.samples)
+        campaign_benchmark(samples=args.samples, rounds=args.rounds)
     if args.which in ("all", "open-loop"):
         open_loop_benchmark(repeats=args.repeats)
     if args.which in ("all", "socp"):
@@ -283,6 +283,8 @@ def main(argv=None) -> int:
     b.add_argument("--nodes", type=int, default=40, help="NLP benchmark: nodes / samples")
     b.add_argument("--samples", type=int, default=100, help="campaign benchmark: samples per backend")
     b.add_argument("--repeats", type=int, default=3)
+    b.add_argument("--rounds", type=int, default=2,
+                   help="campaign benchmark: interleaved rounds, best of each backend (timing noise ~20 %%)")
     b.set_defaults(func=_cmd_bench)
     args = parser.parse_args(argv)
     try:

@@ -49,7 +49,7 @@ class ClosedLoopResult:
         crossrange_m (+ target to the right), distance_m.
       engaged_at: guidance engagement time [s]; plans: successful plans; reversals: count.
       first_reference, engaged_state: the plan made at engagement and the estimate it used.
-      planning_failures: list of (time, message).
+      planning_failures: list of (time, message). planning_wall_s: wall time spent planning [s].
       success: reached the terminal energy with guidance engaged.
       message: human summary.
     """
@@ -65,6 +65,7 @@ class ClosedLoopResult:
     message: str
     first_reference: DragEnergyReference | None = None
     engaged_state: np.ndarray | None = None
+    planning_wall_s: float = 0.0
 
 
 def build_closed_loop(scenario: Scenario, planner: DragEnergyPlanner | None = None, *, nav_seed: int = 0,
@@ -189,7 +190,7 @@ def summarise(diagram, ctx, tr: Trajectory, scenario: Scenario, planner: DragEne
     else:
         msg = f"stopped before E_f: {tr.reason}"
     return ClosedLoopResult(tr, mem.reference, errors, mem.engaged_at, mem.plans, n_rev, mem.failures, ok, msg,
-                            mem.first_reference, mem.engaged_state)
+                            mem.first_reference, mem.engaged_state, mem.planning_wall_s)
 
 
 

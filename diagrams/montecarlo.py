@@ -34,6 +34,8 @@ from drake_entry.planning.drag_energy import DragEnergyPlanner
 from drake_entry.scenario import Scenario, load_scenario
 
 TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
+# row columns that measure this machine's wall-clock time (excluded from reproducibility)
+TIMING_COLUMNS = ("wall_time_s", "planning_wall_s")
 
 
 def sample_seed(campaign_seed: int, index: int) -> int:
@@ -74,6 +76,9 @@ def run_sample(scenario: Scenario, planner: DragEnergyPlanner, campaign_seed: in
         res = summarise(diagram, ctx, tr, scenario, planner)
         row.update(box["draw"].columns())
         row.update(_row(res, planner))
+        integrator = box["simulator"].get_integrator()
+        row.update({"planning_wall_s": res.planning_wall_s, "integration_steps": integrator.get_num_steps_taken(),
+                    "derivative_evaluations": integrator.get_num_derivative_evaluations()})
         traj = _downsample(tr, index, trajectory_step_s) if trajectory_step_s > 0 else None
     except Exception as e:  # one failed sample never stops the campaign
         row.update(box["draw"].columns() if "draw" in box else {})

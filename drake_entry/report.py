@@ -60,6 +60,13 @@ def summary_statistics(rows: dict) -> dict:
     if "wall_time_s" in rows:
         w = np.asarray(rows["wall_time_s"], float)
         out["wall_time_s"] = {"mean": float(w.mean()), "total": float(w.sum())}
+        cost = {k: np.asarray(rows[k], float)[ok] for k in ("planning_wall_s", "plans", "derivative_evaluations")
+                if k in rows}
+        if len(cost) == 3 and cost["plans"].size:
+            out["cost"] = {"wall_s_per_sample": float(w[ok].mean()),
+                           "planning_share": float(cost["planning_wall_s"].sum() / w[ok].sum()),
+                           "plans_per_sample": float(cost["plans"].mean()),
+                           "derivative_evaluations_per_sample": float(cost["derivative_evaluations"].mean())}
     return out
 
 
@@ -142,6 +149,11 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None) -> str:
            "| constraint | worst margin | violations | worst sample |", "|---|---|---|---|"]
     for col, m in stats["margins"].items():
         md.append(f"| {col.replace('margin_', '')} | {100 * m['worst']:.2f} % | {m['violations']} | {m['worst_sample']} |")
+    if stats.get("cost"):
+        c = stats["cost"]
+        md += ["", f"Cost: {c['wall_s_per_sample']:.2f} s of one core per sample, {100 * c['planning_share']:.0f} % of "
+               f"it re-planning ({c['plans_per_sample']:.1f} plans), {c['derivative_evaluations_per_sample']:.0f} "
+               "plant derivative evaluations."]
     if stats["failure_reasons"]:
         md += ["", "## Failed samples", ""] + [f"- {k}: {v}" for k, v in stats["failure_reasons"].items()]
     if traj is None:

@@ -17,6 +17,7 @@ Ports:
 from __future__ import annotations
 
 import copy
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,12 +44,13 @@ class GuidanceMemory:
     last_plan_at: float = -np.inf
     plans: int = 0
     failures: list = field(default_factory=list)  # (time, message)
+    planning_wall_s: float = 0.0  # wall-clock time spent planning [s] (cost accounting only)
 
     def __deepcopy__(self, memo):
         # Drake copies abstract state at every update; the reference is never mutated after
         # planning, so copies share it (a deep copy of the corridor each second cost ~1 ms).
         return GuidanceMemory(self.reference, self.first_reference, self.engaged_state, self.engaged_at,
-                              self.last_plan_at, self.plans, list(self.failures))
+                              self.last_plan_at, self.plans, list(self.failures), self.planning_wall_s)
 
 
 class DragEnergyGuidance(LeafSystem):
@@ -84,11 +86,13 @@ class DragEnergyGuidance(LeafSystem):
             return
         new = copy.deepcopy(mem)
         new.last_plan_at = t  # a failed re-plan is retried one re-plan period later
+        t_wall = time.perf_counter()
         try:
             ref = self.planner.plan_from_state(x, previous=mem.reference, sensed_drag=sensed)
         except Exception as e:  # a numerical failure in planning must not stop the flight
             ref = None
             new.failures.append((t, f"{type(e).__name__}: {e}"))
+        new.planning_wall_s += time.perf_counter() - t_wall
         if ref is not None and ref.success:
             new.reference = ref
             new.plans += 1

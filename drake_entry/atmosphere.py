@@ -109,10 +109,16 @@ class Atmosphere:
         """Density and temperature with their altitude derivatives (float / ndarray)."""
         return self.density_derivatives(h), self.temperature_derivatives(h)
 
-    def air_data(self, h: float) -> tuple[float, float]:
-        """(density [kg/m^3], speed of sound [m/s]) at a float altitude h [m]: the
-        simulation's once-per-derivative call, without the derivatives (equal to
-        ``properties`` to the last bit)."""
+    def air_data(self, h):
+        """(density [kg/m^3], speed of sound [m/s]) at altitude h [m], any scalar type. A float
+        (the simulation's once-per-derivative call) takes a path without the altitude
+        derivatives, equal to ``properties`` to the last bit."""
+        if isinstance(h, float):
+            return self._air_data_float(h)
+        rho, _, a = self.properties(h)
+        return rho, a
+
+    def _air_data_float(self, h: float) -> tuple[float, float]:
         d, t = self.derivatives(h)
         return float(d.value), math.sqrt(self.gamma * self.gas_constant * float(t.value))
 
@@ -249,7 +255,7 @@ class US76Atmosphere(Atmosphere):
         vals = np.array([_us76_scalar(v) for v in z.ravel().tolist()]).reshape(z.shape + (6,))
         return [vals[..., k] for k in range(6)]
 
-    def air_data(self, h: float) -> tuple[float, float]:
+    def _air_data_float(self, h: float) -> tuple[float, float]:
         z = float(h)
         if not US76_H_MIN <= z <= US76_H_MAX:
             self.check(z)
@@ -353,7 +359,7 @@ class DispersedAtmosphere(Atmosphere):
         return (self.scale * (1.0 + a * np.sin(arg)), self.scale * a * self.k * np.cos(arg),
                 -self.scale * a * self.k**2 * np.sin(arg))
 
-    def air_data(self, h: float) -> tuple[float, float]:
+    def _air_data_float(self, h: float) -> tuple[float, float]:
         rho, a = self.base.air_data(h)
         return rho * (self.scale * (1.0 + self.amplitude * math.sin(self.k * float(h) + self.phase))), a
 

@@ -72,7 +72,7 @@ def gamma_correction(D, V, r, gamma, lat, heading, omega) -> float:
 
 def drag_acceleration(h: float, V: float, alpha: float, vehicle: Vehicle, atmosphere: Atmosphere) -> float:
     """D = rho V^2 S C_D / (2 m) [m/s^2] (eqs. 40, 65)."""
-    rho, a = atmosphere.air_data(h) if isinstance(h, float) else atmosphere.properties(h)[::2]
+    rho, a = atmosphere.air_data(h)
     _, cd = vehicle.aero.coefficients(alpha, V / a)
     return 0.5 * rho * V * V * vehicle.area_over_mass * cd
 

@@ -48,11 +48,7 @@ FLIGHT_CONDITION_NAMES = FlightConditions._fields
 
 def air_data(x, planet: Earth, atmosphere: Atmosphere):
     """Density [kg/m^3] and speed of sound [m/s] at state x."""
-    h = planet.atmospheric_altitude(x[0], x[2])
-    if isinstance(h, float):
-        return atmosphere.air_data(h)
-    rho, _, a = atmosphere.properties(h)
-    return rho, a
+    return atmosphere.air_data(planet.atmospheric_altitude(x[0], x[2]))
 
 
 def aero_accelerations(x, alpha, rho, speed_of_sound, vehicle: Vehicle):

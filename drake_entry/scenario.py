@@ -129,7 +129,7 @@ class GuidanceSpec:
 class SimulationSpec:
     # hard stop [s] if no terminal condition triggers
     max_time_s: float = 3000.0
-    # runge_kutta5 | runge_kutta3 | runge_kutta2 | radau3 (any of Drake's GetIntegrationSchemes())
+    # runge_kutta5 | runge_kutta3 | radau3
     integrator: str = "runge_kutta5"
     # error-control accuracy (also the witness-function localisation accuracy)
     accuracy: float = 1e-8

@@ -80,5 +80,7 @@ def test_air_data_fast_path_equals_properties_to_the_last_bit(us76, h):
                                                                      wavelength=9000.0, phase=0.3)):
         rho, _, a = atm.properties(h)
         assert atm.air_data(h) == (rho, a)
+        rho_v, a_v = atm.air_data(np.array([h, h + 500.0]))  # other scalar types: properties
+        assert rho_v[0] == rho and a_v[0] == a
     with pytest.raises(ValueError, match="outside"):
         us76.air_data(1.1e6)

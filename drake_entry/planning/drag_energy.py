@@ -258,7 +258,7 @@ def _solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyR
             options.SetOption(solver.solver_id(), k, v)
     else:  # Clarabel's iterative refinement of each KKT solve took about 30 % of the solve time here
         # and moved the 40-node solution by 5e-9 (relative); _check_solution verifies the result.
-        # Without it Clarabel stalled (InsufficientProgress) in about 1 of 300 re-plans: then
+        # Without it Clarabel stalled (InsufficientProgress) in about 1 of 170 re-plans: then
         # the problem is solved again with Clarabel's defaults.
         options.SetOption(solver.solver_id(), "iterative_refinement_enable", False)
     result = solver.Solve(prog, None, options)

@@ -22,6 +22,7 @@ bank saturated explicitly at [0, sigma_max] (flags returned).
 from __future__ import annotations
 
 import dataclasses as dc
+import logging
 import math
 import time
 from dataclasses import dataclass, field
@@ -261,9 +262,18 @@ def _solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyR
         # Without it Clarabel stalled (InsufficientProgress) in about 1 of 170 re-plans: then
         # the problem is solved again with Clarabel's defaults.
         options.SetOption(solver.solver_id(), "iterative_refinement_enable", False)
-    result = solver.Solve(prog, None, options)
-    if not result.is_success() and p.solver == "clarabel":
-        result = solver.Solve(prog, None, SolverOptions())
+    if p.solver == "clarabel":
+        drake_log = logging.getLogger("drake")
+        level = drake_log.level
+        drake_log.setLevel(logging.WARNING)  # the fast attempt's rare stall is expected: no INFO line
+        try:
+            result = solver.Solve(prog, None, options)
+        finally:
+            drake_log.setLevel(level)
+        if not result.is_success():
+            result = solver.Solve(prog, None, SolverOptions())
+    else:
+        result = solver.Solve(prog, None, options)
     t2 = time.perf_counter()
     ok = result.is_success()
     details = result.get_solver_details()

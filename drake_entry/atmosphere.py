@@ -256,10 +256,7 @@ class US76Atmosphere(Atmosphere):
         return [vals[..., k] for k in range(6)]
 
     def _air_data_float(self, h: float) -> tuple[float, float]:
-        z = float(h)
-        if not US76_H_MIN <= z <= US76_H_MAX:
-            self.check(z)
-        ln_rho, _, _, T, _, _ = _us76_scalar(z)
+        ln_rho, _, _, T, _, _ = self._evaluate(float(h))
         return math.exp(ln_rho), math.sqrt(GAMMA_AIR * R_AIR * T)
 
     def density_derivatives(self, h) -> Derivatives:
@@ -361,7 +358,7 @@ class DispersedAtmosphere(Atmosphere):
 
     def _air_data_float(self, h: float) -> tuple[float, float]:
         rho, a = self.base.air_data(h)
-        return rho * (self.scale * (1.0 + self.amplitude * math.sin(self.k * float(h) + self.phase))), a
+        return rho * self._factor(float(h))[0], a
 
     def density_derivatives(self, h) -> Derivatives:
         return self.derivatives(h)[0]

@@ -152,12 +152,11 @@ class DragEnergyReference:
                 I, I1, I2 = ((w @ self._nodal) / w.sum()).tolist()
             else:  # on a node
                 I, I1, I2 = self._nodal[int(np.argmin(np.abs(d)))].tolist()
-            D = 1.0 / I
-            return np.array([D]), np.array([-I1 / I**2]), np.array([2.0 * I1**2 / I**3 - I2 / I**2])
-        E = np.clip(np.atleast_1d(np.asarray(E, float)), self.problem.Ef, self.problem.E0)
-        I, I1, I2 = (self.lgl.interpolation(E) @ self._nodal).T
-        D = 1.0 / I
-        return D, -I1 / I**2, 2.0 * I1**2 / I**3 - I2 / I**2
+        else:
+            E = np.clip(np.atleast_1d(np.asarray(E, float)), self.problem.Ef, self.problem.E0)
+            I, I1, I2 = (self.lgl.interpolation(E) @ self._nodal).T
+        return (np.atleast_1d(1.0 / I), np.atleast_1d(-I1 / I**2),
+                np.atleast_1d(2.0 * I1**2 / I**3 - I2 / I**2))
 
     def kappa_at(self, E) -> np.ndarray:
         """Ground-range weight kappa = R cos(gamma)/r interpolated at energies E."""

@@ -18,21 +18,21 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from diagrams.common import Trajectory, run
+from drake_entry.diagrams.common import Trajectory, run
 from drake_entry.aerodynamics import ScaledAero
 from drake_entry.atmosphere import DispersedAtmosphere
 from drake_entry.dispersions import Draw
 from drake_entry.planning.drag_energy import DragEnergyPlanner, DragEnergyReference, bearing
 from drake_entry.scenario import Scenario
-from systems.actuators import BankActuator
-from systems.atmosphere import AtmosphereSystem
-from systems.bank_reversal import BankReversalLogic
-from systems.drag_tracking import DragTrackingController
-from systems.guidance import DragEnergyGuidance
-from systems.monitors import TerminationMonitor
-from systems.navigation import Navigation
-from systems.schedule import ScheduleSource
-from systems.vehicle import EntryVehicle
+from drake_entry.systems.actuators import BankActuator
+from drake_entry.systems.atmosphere import AtmosphereSystem
+from drake_entry.systems.bank_reversal import BankReversalLogic
+from drake_entry.systems.drag_tracking import DragTrackingController
+from drake_entry.systems.guidance import DragEnergyGuidance
+from drake_entry.systems.monitors import TerminationMonitor
+from drake_entry.systems.navigation import Navigation
+from drake_entry.systems.schedule import ScheduleSource
+from drake_entry.systems.vehicle import EntryVehicle
 
 ALTITUDE_FLOOR_M = 5000.0
 
@@ -197,7 +197,7 @@ def summarise(diagram, ctx, tr: Trajectory, scenario: Scenario, planner: DragEne
 def propagate_extracted_bank(scenario: Scenario, reference: DragEnergyReference, x0) -> Trajectory:
     """Open-loop flight from x0 with the extracted bank magnitude sigma(E) and alpha(E)
     (paper 000 Fig. 5: extracted states against open-loop propagation)."""
-    from diagrams.open_loop import simulate
+    from drake_entry.diagrams.open_loop import simulate
 
     sc = dc.replace(scenario)
     x = reference.extraction

@@ -27,8 +27,8 @@ import numpy as np
 from pydrake.common import RandomGenerator
 from pydrake.systems.analysis import RandomSimulation
 
-from diagrams.closed_loop import SOURCES, build_closed_loop, summarise
-from diagrams.common import collect_trajectory, make_simulator
+from drake_entry.diagrams.closed_loop import SOURCES, build_closed_loop, summarise
+from drake_entry.diagrams.common import collect_trajectory, make_simulator
 from drake_entry.dispersions import draw
 from drake_entry.planning.drag_energy import DragEnergyPlanner
 from drake_entry.scenario import Scenario, load_scenario

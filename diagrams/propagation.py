@@ -19,7 +19,7 @@ from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.planning.ocp import OptimalControlProblem, downtrack_crosstrack
-from systems.ocp_plant import OptimalControlPlant
+from drake_entry.systems.ocp_plant import OptimalControlPlant
 
 
 @dc.dataclass

@@ -38,7 +38,7 @@ def open_loop_benchmark(*, repeats: int = 3, scenario_name: str = "horus2b") -> 
 
 
 def _open_loop_benchmark(scenario, repeats: int) -> dict:
-    from diagrams.open_loop import simulate
+    from drake_entry.diagrams.open_loop import simulate
 
     from .crosscheck import solve_ivp_open_loop
 
@@ -145,7 +145,7 @@ def campaign_benchmark(*, samples: int = 100, scenario_name: str = "horus2b", se
     import tempfile
     import time
 
-    from diagrams.montecarlo import run_campaign
+    from drake_entry.diagrams.montecarlo import run_campaign
 
     cases = (("1 worker (serial)", "serial", 1), ("2 workers (processes)", "processes", 2),
              ("Dask LocalCluster, 2 workers", "dask", 2))
@@ -174,7 +174,7 @@ def nlp_benchmark(*, problem_name: str = "marv", nodes: int = 40, tolerance: flo
     DirectCollocation) and both solvers (Ipopt, SNOPT), all from the same start (the
     propagated guess, then a 30-node LGL solution): solve time, objective, final time and
     the Drake-propagated terminal position error, side by side in one run."""
-    from diagrams.propagation import propagate
+    from drake_entry.diagrams.propagation import propagate
 
     from .planning import nlp
     from .planning.ocp_yaml import load_problem

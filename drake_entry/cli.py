@@ -26,7 +26,7 @@ from .errors import ScenarioError
 
 
 def _cmd_simulate(args) -> int:
-    from diagrams.open_loop import simulate
+    from drake_entry.diagrams.open_loop import simulate
 
     from .plots import trajectory_plots
     from .results import write_table
@@ -62,7 +62,7 @@ def _cmd_simulate(args) -> int:
 
 
 def _cmd_fly(args) -> int:
-    from diagrams.closed_loop import fly
+    from drake_entry.diagrams.closed_loop import fly
 
     from .plots import tracking_plot, trajectory_plots
     from .results import write_table
@@ -91,7 +91,7 @@ def _cmd_fly(args) -> int:
 
 
 def _cmd_plan(args) -> int:
-    from diagrams.closed_loop import fly, propagate_extracted_bank
+    from drake_entry.diagrams.closed_loop import fly, propagate_extracted_bank
 
     from .plots import corridor_plot, extraction_plot
     from .scenario import load_scenario
@@ -124,7 +124,7 @@ def _cmd_plan(args) -> int:
 
 
 def _cmd_campaign(args) -> int:
-    from diagrams.montecarlo import run_campaign
+    from drake_entry.diagrams.montecarlo import run_campaign
 
     from .report import write_report, summary_statistics, table3_markdown  # noqa: F401
 
@@ -165,7 +165,7 @@ def _cmd_fit_horus(args) -> int:
 
 
 def _cmd_optimize(args) -> int:
-    from diagrams.propagation import propagate
+    from drake_entry.diagrams.propagation import propagate
 
     from .planning import nlp
     from .planning.ocp_yaml import load_problem

@@ -59,7 +59,7 @@ def test_density_bias_is_absorbed_by_sensed_drag_feedback(scale, miss_km):
     """Guidance and tracking act on the accelerometer's drag, so a +-10 % density bias the
     nominal models do not know still reaches E_f near the target (measured: 1.8 km at -10 %,
     9.2 km at +10 %; feeding back the model's drag instead missed by 207 km at -10 %)."""
-    from diagrams.closed_loop import fly
+    from drake_entry.diagrams.closed_loop import fly
 
     s = load_scenario("horus2b")
     res = fly(s, draw=draw(DispersionSpec(density_scale=scale), RandomGenerator(0)))

@@ -149,7 +149,7 @@ def test_dense_grid_violation_shrinks_with_nodes(planner, engagement_state):
 
 
 def test_bank_reversal_turns_back_at_the_corridor_edge():
-    from systems.bank_reversal import BankReversalLogic
+    from drake_entry.systems.bank_reversal import BankReversalLogic
 
     logic = BankReversalLogic(target_lon=0.0, target_lat=0.0, corridor_deg=(5.0, 15.0),
                               corridor_velocity=(1000.0, 6000.0))
@@ -165,7 +165,7 @@ def test_bank_reversal_turns_back_at_the_corridor_edge():
 def test_drag_tracking_recovers_from_a_perturbed_entry(scenario, planner):
     """Controller stability: 250 m and 15 m/s off the entry interface, the loop still tracks its
     reference within 4 % after engagement and reaches E_f within 3 km of the runway."""
-    from diagrams.closed_loop import fly
+    from drake_entry.diagrams.closed_loop import fly
 
     x0 = scenario.initial_state() + np.array([250.0, 0, 0, -15.0, math.radians(0.01), 0])
     res = fly(scenario, planner, initial_state=x0)
@@ -180,7 +180,7 @@ def test_drag_tracking_recovers_from_a_perturbed_entry(scenario, planner):
 
 
 def test_drag_tracking_sign_convention_requires_negative_zeta(planner):
-    from systems.drag_tracking import DragTrackingController
+    from drake_entry.systems.drag_tracking import DragTrackingController
 
     with pytest.raises(ValueError, match="zeta must be < 0"):
         DragTrackingController(planner, zeta=0.7, omega=1e-6)

@@ -6,7 +6,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from diagrams.montecarlo import TIMING_COLUMNS, done_indices, run_campaign, run_sample, sample_seed
+from drake_entry.diagrams.montecarlo import TIMING_COLUMNS, done_indices, run_campaign, run_sample, sample_seed
 from drake_entry.planning.drag_energy import DragEnergyPlanner
 from drake_entry.report import summary_statistics, write_report
 from drake_entry.scenario import load_scenario

@@ -77,7 +77,7 @@ def test_brachistochrone_minimum_time_equals_the_cycloid(transcription, nodes, t
 
 
 def test_propagated_controls_reach_the_nlp_final_state():
-    from diagrams.propagation import propagate
+    from drake_entry.diagrams.propagation import propagate
 
     p = brachistochrone()
     r = nlp.solve(p, nodes=20)

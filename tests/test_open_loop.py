@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from diagrams.open_loop import simulate
+from drake_entry.diagrams.open_loop import simulate
 from drake_entry.crosscheck import solve_ivp_open_loop
 from drake_entry.scenario import load_scenario
 

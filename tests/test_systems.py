@@ -10,12 +10,12 @@ from pydrake.systems.primitives import ConstantVectorSource
 from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, flight_conditions, state_derivatives
 from drake_entry.planet import Earth
 from drake_entry.schedules import Schedule
-from systems.actuators import BankActuator
-from systems.atmosphere import AtmosphereSystem
-from systems.monitors import TerminationMonitor
-from systems.navigation import Navigation
-from systems.schedule import ScheduleSource, make_schedule_source
-from systems.vehicle import EntryVehicle, EntryVehicle_
+from drake_entry.systems.actuators import BankActuator
+from drake_entry.systems.atmosphere import AtmosphereSystem
+from drake_entry.systems.monitors import TerminationMonitor
+from drake_entry.systems.navigation import Navigation
+from drake_entry.systems.schedule import ScheduleSource, make_schedule_source
+from drake_entry.systems.vehicle import EntryVehicle, EntryVehicle_
 
 
 def _fixed_inputs(system, context, **values):

@@ -104,7 +104,7 @@ def test_closed_loop_runs_fixed_steps_and_open_loop_keeps_error_control():
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import ConstantVectorSource
 
-    from diagrams.common import make_simulator
+    from drake_entry.diagrams.common import make_simulator
 
     sc = load_scenario("horus2b")
     builder = DiagramBuilder()

@@ -595,7 +595,7 @@ class _DircolTranscription(_Transcription):
         super().__init__(problem, nodes)
         from pydrake.planning import DirectCollocation
 
-        from systems.ocp_plant import OptimalControlPlant  # the transcription needs a Drake System
+        from drake_entry.systems.ocp_plant import OptimalControlPlant  # the transcription needs a Drake System
 
         self.plant = OptimalControlPlant(problem, self.sx, self.su, self.ts)
         h_min = self.t_lo / self.ts / (nodes - 1) * 0.2

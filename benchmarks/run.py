@@ -1,14 +1,48 @@
-"""All benchmarks in one command: python benchmarks/run.py [--samples N]"""
-import argparse
+"""Benchmarks, each printing its figures and ratios measured side by side in one run.
 
-from drake_entry.benchmark import campaign_benchmark, nlp_benchmark, open_loop_benchmark, socp_benchmark
+    python benchmarks/run.py [open-loop|socp|nlp|campaign|interface-cost|all] [options]
+
+open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
+socp            drag-energy SOCP build/solve times, Clarabel vs SCS, by node count
+nlp             NLP path: LGL / DirectCollocation x Ipopt / SNOPT from the same starts
+campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios)
+interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline commit
+"""
+import argparse
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--samples", type=int, default=100, help="campaign benchmark samples per backend")
-    parser.add_argument("--nodes", type=int, default=40, help="NLP benchmark nodes / samples")
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("which", nargs="?", default="all",
+                        choices=("all", "open-loop", "socp", "nlp", "campaign", "interface-cost"))
+    parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
+    parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
+    parser.add_argument("--nodes", type=int, default=40, help="nlp: nodes / samples")
+    parser.add_argument("--repeats", type=int, default=3, help="open-loop / socp: repeats (best is kept)")
+    parser.add_argument("--baseline", default=None,
+                        help="interface-cost: git revision to compare with (default: the commit before the "
+                             "guidance-method interface)")
     args = parser.parse_args()
-    open_loop_benchmark()
-    socp_benchmark()
-    nlp_benchmark(nodes=args.nodes)
-    campaign_benchmark(samples=args.samples)
+    if args.which in ("all", "open-loop"):
+        from open_loop import open_loop_benchmark
+
+        open_loop_benchmark(repeats=args.repeats)
+    if args.which in ("all", "socp"):
+        from socp import socp_benchmark
+
+        socp_benchmark(repeats=max(args.repeats, 5))
+    if args.which in ("all", "nlp"):
+        from nlp import nlp_benchmark
+
+        nlp_benchmark(nodes=args.nodes)
+    if args.which in ("all", "campaign"):
+        from campaign import campaign_benchmark
+
+        campaign_benchmark(samples=args.samples, rounds=args.rounds)
+    if args.which in ("all", "interface-cost"):
+        from interface_cost import interface_cost_benchmark
+
+        interface_cost_benchmark(baseline=args.baseline, rounds=args.rounds)

@@ -1,57 +1,15 @@
-"""Pieces every diagram runner shares: the Trajectory record, integrator set-up, and a
-run loop that stops on the termination monitor and appends the exact final instant."""
+"""Pieces every diagram runner shares: integrator set-up, collecting the loggers into a
+``drake_entry.trajectory.Trajectory``, and a run loop that stops on the termination
+monitor and appends the exact final instant."""
 from __future__ import annotations
 
-import dataclasses as dc
 import time as _time
 
 import numpy as np
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 
-from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, STATE_NAMES
 from drake_entry.scenario import Scenario
-
-
-@dc.dataclass
-class Trajectory:
-    """A simulated trajectory sampled at the log period (plus the final instant).
-
-    Attributes:
-      time: [s], shape (n,). state: (n, 6) [h, lon, lat, V, gamma, psi] SI.
-      conditions: (n, 9) FlightConditions columns. bank, alpha: (n,) [rad].
-      reason: why the run stopped. wall_time: [s].
-      extra: other logged signals by name, (n, k) arrays.
-    """
-
-    time: np.ndarray
-    state: np.ndarray
-    conditions: np.ndarray
-    bank: np.ndarray
-    alpha: np.ndarray
-    reason: str
-    wall_time: float
-    extra: dict = dc.field(default_factory=dict)
-
-    def column(self, name: str) -> np.ndarray:
-        if name in STATE_NAMES:
-            return self.state[:, STATE_NAMES.index(name)]
-        if name in FLIGHT_CONDITION_NAMES:
-            return self.conditions[:, FLIGHT_CONDITION_NAMES.index(name)]
-        return {"time": self.time, "bank": self.bank, "alpha": self.alpha}[name]
-
-    def table(self) -> dict:
-        """Columns with units in the names (for Parquet / CSV)."""
-        out = {"time_s": self.time,
-               "altitude_m": self.state[:, 0], "longitude_deg": np.degrees(self.state[:, 1]),
-               "latitude_deg": np.degrees(self.state[:, 2]), "velocity_m_s": self.state[:, 3],
-               "flight_path_deg": np.degrees(self.state[:, 4]), "heading_deg": np.degrees(self.state[:, 5]),
-               "bank_deg": np.degrees(self.bank), "alpha_deg": np.degrees(self.alpha)}
-        units = {"rho": "density_kg_m3", "mach": "mach", "dynamic_pressure": "dynamic_pressure_Pa",
-                 "heat_flux": "heat_flux_W_m2", "normal_load": "normal_load_g", "total_load": "total_load_g",
-                 "lift": "lift_m_s2", "drag": "drag_m_s2", "energy": "energy_J_kg"}
-        for i, name in enumerate(FLIGHT_CONDITION_NAMES):
-            out[units[name]] = self.conditions[:, i]
-        return out
+from drake_entry.trajectory import Trajectory
 
 
 def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loop: bool = False):
@@ -70,13 +28,15 @@ def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loo
     return integrator
 
 
-def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason: str, wall_time: float) -> Trajectory:
+def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason: str, wall_time: float,
+                       columns: dict | None = None) -> Trajectory:
     """Trajectory from the loggers, with every logged signal's value at the final instant
     appended (the witness-located stop).
 
     Args:
       loggers: name -> VectorLogSink; must include 'state', 'conditions', 'bank', 'alpha'.
       sources: name -> (system name, output port name or index) giving each logged signal.
+      columns: name -> table column names of the extra signals (Trajectory.extra_columns).
     """
     t_end = context.get_time()
     data = {}
@@ -91,7 +51,7 @@ def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason
     extra = {k: v for k, v in data.items() if k not in ("state", "conditions", "bank", "alpha")}
     return Trajectory(time=np.append(times[keep], t_end), state=data["state"], conditions=data["conditions"],
                       bank=data["bank"][:, 0], alpha=data["alpha"][:, 0], reason=reason, wall_time=wall_time,
-                      extra=extra)
+                      extra=extra, extra_columns={k: v for k, v in (columns or {}).items() if k in extra})
 
 
 def make_simulator(diagram, scenario: Scenario, *, initial_state=None, closed_loop: bool = False) -> Simulator:
@@ -110,7 +70,7 @@ def stop_reason(status) -> str:
 
 
 def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_state=None,
-        closed_loop: bool = False) -> tuple[Trajectory, Simulator]:
+        closed_loop: bool = False, columns: dict | None = None) -> tuple[Trajectory, Simulator]:
     """Simulate ``diagram`` to a terminal condition or max_time_s (see collect_trajectory)."""
     simulator = make_simulator(diagram, scenario, initial_state=initial_state, closed_loop=closed_loop)
     simulator.Initialize()
@@ -118,5 +78,5 @@ def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_st
     status = simulator.AdvanceTo(scenario.simulation.max_time_s)
     wall = _time.perf_counter() - t0
     tr = collect_trajectory(diagram, loggers, simulator.get_context(), sources=sources, reason=stop_reason(status),
-                            wall_time=wall)
+                            wall_time=wall, columns=columns)
     return tr, simulator

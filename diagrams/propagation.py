@@ -18,7 +18,8 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from drake_entry.planning.ocp import OptimalControlProblem, downtrack_crosstrack
+from drake_entry.geodesy import downtrack_crosstrack
+from drake_entry.planning.ocp import OptimalControlProblem
 from drake_entry.systems.ocp_plant import OptimalControlPlant
 
 

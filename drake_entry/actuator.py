@@ -1,4 +1,5 @@
-"""Bank-angle actuator law shared by the Drake BankActuator and the scipy cross-check."""
+"""Second-order actuator law with position, rate and acceleration limits, shared by the Drake
+bank and angle-of-attack actuators (systems/actuators.py) and the scipy cross-check."""
 from __future__ import annotations
 
 import math
@@ -6,12 +7,12 @@ import math
 import numpy as np
 
 
-def _clip(v: float, lim: float) -> float:
-    return -lim if v < -lim else (lim if v > lim else v)
+def _clip(v: float, lower: float, upper: float) -> float:
+    return lower if v < lower else (upper if v > upper else v)
 
 
 def _accel(e: float, rate: float, omega: float, rate_limit: float, accel_limit: float) -> float:
-    """sigma_ddot for the position error e = clipped command - sigma (see bank_actuator_rates)."""
+    """x_ddot for the position error e = clipped command - x (see actuator_rates)."""
     ae = e if e >= 0.0 else -e
     mag = omega * ae
     if mag > rate_limit:
@@ -23,31 +24,31 @@ def _accel(e: float, rate: float, omega: float, rate_limit: float, accel_limit: 
     return -accel_limit if acc < -accel_limit else (accel_limit if acc > accel_limit else acc)
 
 
-def bank_actuator_rates(sigma: float, rate: float, command: float, *, bank_limit: float, rate_limit: float,
-                        accel_limit: float, bandwidth: float) -> tuple[float, float]:
-    """(sigma_dot, sigma_ddot) of the rate- and acceleration-limited bank actuator.
+def actuator_rates(x: float, rate: float, command: float, *, lower: float, upper: float, rate_limit: float,
+                   accel_limit: float, bandwidth: float) -> tuple[float, float]:
+    """(x_dot, x_ddot) of the rate- and acceleration-limited actuator (bank: x = sigma with
+    bounds +-bank_limit; angle of attack: x = alpha in [alpha_min, alpha_max]).
 
-    e = clip(cmd, +-bank_limit) - sigma;
-    sigma_dot_des = sign(e) min(omega |e|, rate_limit, sqrt(accel_limit |e|)) (the last term
+    e = clip(cmd, lower, upper) - x;
+    x_dot_des = sign(e) min(omega |e|, rate_limit, sqrt(accel_limit |e|)) (the last term
     is a braking curve planned at half the acceleration limit, so the lagging rate loop
-    can still stop at the command and does not overshoot it or the bank limit);
-    sigma_ddot = clip(4 omega (sigma_dot_des - sigma_dot),
-    +-accel_limit). SI units.
+    can still stop at the command and does not overshoot it or the position limit);
+    x_ddot = clip(4 omega (x_dot_des - x_dot), +-accel_limit). SI units.
     """
-    return rate, _accel(_clip(command, bank_limit) - sigma, rate, bandwidth, rate_limit, accel_limit)
+    return rate, _accel(_clip(command, lower, upper) - x, rate, bandwidth, rate_limit, accel_limit)
 
 
-def integrate_bank_actuator(sigma: float, rate: float, command: float, step: float, steps: int, *,
-                            bank_limit: float, rate_limit: float, accel_limit: float,
-                            bandwidth: float) -> tuple[list, list]:
-    """(sigma, sigma_dot) at 0, step, ..., steps * step seconds of bank_actuator_rates under
+def integrate_actuator(sigma: float, rate: float, command: float, step: float, steps: int, *,
+                       lower: float, upper: float, rate_limit: float, accel_limit: float,
+                       bandwidth: float) -> tuple[list, list]:
+    """(x, x_dot) at 0, step, ..., steps * step seconds of actuator_rates under
     a constant command: lists of steps + 1 values [rad, rad/s].
 
     Where no limit is active over the whole interval the law is linear,
     x'' = -4 omega x' - 4 omega^2 x with x = sigma - command (critically damped, double root
     -2 omega), and the exact solution x = (x0 + (v0 + 2 omega x0) t) exp(-2 omega t) is used;
     otherwise midpoint-RK2 steps of ``step`` seconds."""
-    c = _clip(command, bank_limit)
+    c = _clip(command, lower, upper)
     if sigma == c and rate == 0.0:  # settled
         return [sigma] * (steps + 1), [0.0] * (steps + 1)
     w = bandwidth

@@ -4,14 +4,14 @@ Commands:
   campaign SCENARIO   closed-loop Monte-Carlo campaign (Drake RandomSimulation) with a report
   report DIR          (re)write the report of a campaign directory
   fly SCENARIO        one closed-loop guided flight with plots
-  plan SCENARIO       the drag-energy corridor and the reference planned at engagement,
-                      extracted states against open-loop propagation (paper 000 Figs. 3-5)
+  plan SCENARIO       the guidance method's reference plan with its figures (drag-energy:
+                      corridor, reference at engagement, extraction vs propagation, paper 000 Figs. 3-5)
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
   optimize PROBLEM    optimal reference by the NLP path (LGL pseudospectral or DirectCollocation,
                       Ipopt or SNOPT), propagated with Drake, plots like paper 002 Figs. 1-10
   fit-horus           refit the HORUS-2B aero forms (paper 000 eqs. 32-33); print residuals
-  bench [open-loop|socp|campaign|nlp]  Drake open loop vs scipy; SOCP Clarabel vs SCS; campaign
-                      runs/s by backend; NLP transcriptions x solvers
+
+Benchmarks are scripts, not commands: python benchmarks/run.py (see README).
 """
 from __future__ import annotations
 
@@ -26,11 +26,12 @@ from .errors import ScenarioError
 
 
 def _cmd_simulate(args) -> int:
-    from drake_entry.diagrams.open_loop import simulate
+    from .diagrams.open_loop import simulate
 
     from .plots import trajectory_plots
     from .results import write_table
     from .scenario import load_scenario
+    from .trajectory import metrics
 
     scenario = load_scenario(args.scenario)
     tr = simulate(scenario)
@@ -47,11 +48,7 @@ def _cmd_simulate(args) -> int:
     summary = {
         "scenario": scenario.name, "stop": tr.reason, "flight_time_s": float(tr.time[-1]),
         "final_altitude_km": float(x[0] / 1e3), "final_mach": float(tr.column("mach")[-1]),
-        "distance_to_target_km": float(dist / 1e3),
-        "peak_heat_flux_kW_m2": float(tr.column("heat_flux").max() / 1e3),
-        "peak_dynamic_pressure_kPa": float(tr.column("dynamic_pressure").max() / 1e3),
-        "peak_normal_load_g": float(tr.column("normal_load").max()),
-        "wall_time_s": tr.wall_time,
+        "distance_to_target_km": float(dist / 1e3), **metrics(tr, vehicle.limits), "wall_time_s": tr.wall_time,
     }
     with open(os.path.join(args.out, "summary.json"), "w") as f:
         json.dump(summary, f, indent=2)
@@ -62,26 +59,26 @@ def _cmd_simulate(args) -> int:
 
 
 def _cmd_fly(args) -> int:
-    from drake_entry.diagrams.closed_loop import fly
-
-    from .plots import tracking_plot, trajectory_plots
+    from .diagrams.closed_loop import ClosedLoopSetup, fly
+    from .plots import trajectory_plots
     from .results import write_table
     from .scenario import load_scenario
+    from .trajectory import metrics
 
     scenario = load_scenario(args.scenario)
-    res = fly(scenario)
+    setup = ClosedLoopSetup.from_scenario(scenario)
+    res = fly(setup)
     tr = res.trajectory
     os.makedirs(args.out, exist_ok=True)
     write_table(tr.table(), os.path.join(args.out, f"trajectory.{args.format}"))
-    limits = scenario.make_vehicle().limits
-    trajectory_plots(tr, args.out, limits=limits, target=(scenario.target.longitude_deg, scenario.target.latitude_deg),
-                     title=f"{scenario.name}: closed loop")
-    tracking_plot(tr, args.out, title=f"{scenario.name}: drag tracking")
-    summary = {"success": res.success, "message": res.message, "engaged_at_s": res.engaged_at, "plans": res.plans,
-               "reversals": res.reversals, "planning_failures": len(res.planning_failures), **res.errors,
-               "peak_heat_flux_kW_m2": float(tr.column("heat_flux").max() / 1e3),
-               "peak_dynamic_pressure_kPa": float(tr.column("dynamic_pressure").max() / 1e3),
-               "peak_normal_load_g": float(tr.column("normal_load").max()), "wall_time_s": tr.wall_time}
+    title = f"{scenario.name}: closed loop ({res.method})"
+    trajectory_plots(tr, args.out, limits=setup.vehicle.limits,
+                     target=(scenario.target.longitude_deg, scenario.target.latitude_deg), title=title)
+    setup.method.flight_plots(res, args.out, title=scenario.name)
+    g = res.guidance
+    summary = {"success": res.success, "message": res.message, "method": res.method, "plans": g.plans,
+               "planning_wall_s": g.planning_wall_s, **g.fields, **res.errors, **metrics(tr, setup.vehicle.limits),
+               "wall_time_s": tr.wall_time}
     with open(os.path.join(args.out, "summary.json"), "w") as f:
         json.dump(summary, f, indent=2, default=float)
     for k, v in summary.items():
@@ -91,42 +88,20 @@ def _cmd_fly(args) -> int:
 
 
 def _cmd_plan(args) -> int:
-    from drake_entry.diagrams.closed_loop import fly, propagate_extracted_bank
-
-    from .plots import corridor_plot, extraction_plot
+    from .guidance import method_for
     from .scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
-    scenario.guidance.replan_period_s = 0.0
-    res = fly(scenario)
-    ref = res.first_reference
-    if ref is None:
-        print(f"drake-entry: the guidance never engaged: {res.message}", file=sys.stderr)
-        return 1
-    p = ref.problem
-    E0, Ef = scenario.entry_energy(), p.Ef
-    paths = corridor_plot(p.corridor, E0, Ef, args.out, reference=ref, title=f"{scenario.name}: drag-energy plan")
-    prop = propagate_extracted_bank(scenario, ref, res.engaged_state)
-    paths += extraction_plot(ref, prop, p.planet, args.out, title=f"{scenario.name}: extraction")
-    viol = ref.corridor_violation()
-    x = ref.extraction
-    print(f"engaged at t = {res.engaged_at:.0f} s, e = {(E0 - p.E0) / (E0 - Ef):.3f}, D0 = {p.D0:.3f} m/s^2, "
-          f"range to go {p.range_to_go / 1e3:.1f} km")
-    print(f"SOCP ({p.solver}, {p.n_nodes} nodes): {ref.message}; build {1e3 * ref.build_time:.1f} ms, "
-          f"solve {1e3 * ref.solve_time:.1f} ms")
-    print(f"binding: {[(b['bound'], b['nodes']) for b in ref.binding]}; between nodes: "
-          f"{100 * viol['above_max']:.2f} % above D_max (at e = {viol['above_max_at_e']:.3f}), "
-          f"{100 * viol['below_min']:.2f} % below D_min")
-    print(f"extracted: final h {x.h[-1] / 1e3:.2f} km, V {x.V[-1]:.0f} m/s; bank saturated at "
-          f"{int(x.saturated.sum())} nodes; open-loop propagation ends at h {prop.state[-1, 0] / 1e3:.2f} km")
-    print(f"wrote {len(paths)} plots to {args.out}")
-    return 0
+    method = method_for(scenario.guidance)
+    try:
+        return method.plan_report(scenario, args.out)
+    except NotImplementedError as e:
+        print(f"drake-entry: {e}", file=sys.stderr)
+        return 2
 
 
 def _cmd_campaign(args) -> int:
-    from drake_entry.diagrams.montecarlo import run_campaign
-
-    from .report import write_report, summary_statistics, table3_markdown  # noqa: F401
+    from .diagrams.montecarlo import run_campaign
 
     backend = "dask" if args.scheduler else args.backend
     out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
@@ -165,7 +140,7 @@ def _cmd_fit_horus(args) -> int:
 
 
 def _cmd_optimize(args) -> int:
-    from drake_entry.diagrams.propagation import propagate
+    from .diagrams.propagation import propagate
 
     from .planning import nlp
     from .planning.ocp_yaml import load_problem
@@ -213,20 +188,6 @@ def _cmd_optimize(args) -> int:
     print(json.dumps(info, indent=2, default=float))
     print(f"wrote solution, summary.json and {len(pngs)} plots to {args.out}")
     return 0 if result.success else 1
-
-
-def _cmd_bench(args) -> int:
-    from .benchmark import campaign_benchmark, nlp_benchmark, open_loop_benchmark, socp_benchmark
-
-    if args.which in ("all", "campaign"):
-        campaign_benchmark(samples=args.samples, rounds=args.rounds)
-    if args.which in ("all", "open-loop"):
-        open_loop_benchmark(repeats=args.repeats)
-    if args.which in ("all", "socp"):
-        socp_benchmark(repeats=max(args.repeats, 5))
-    if args.which in ("all", "nlp"):
-        nlp_benchmark(nodes=args.nodes)
-    return 0
 
 
 def main(argv=None) -> int:
@@ -278,14 +239,6 @@ def main(argv=None) -> int:
     o.set_defaults(func=_cmd_optimize)
     f = sub.add_parser("fit-horus", help="refit paper 000 eqs. 32-33 to the M-692 table; print residuals")
     f.set_defaults(func=_cmd_fit_horus)
-    b = sub.add_parser("bench", help="benchmarks: Drake open loop vs scipy; SOCP with Clarabel vs SCS")
-    b.add_argument("which", nargs="?", choices=("all", "open-loop", "socp", "campaign", "nlp"), default="all")
-    b.add_argument("--nodes", type=int, default=40, help="NLP benchmark: nodes / samples")
-    b.add_argument("--samples", type=int, default=100, help="campaign benchmark: samples per backend")
-    b.add_argument("--repeats", type=int, default=3)
-    b.add_argument("--rounds", type=int, default=2,
-                   help="campaign benchmark: interleaved rounds, best of each backend (timing noise ~20 %%)")
-    b.set_defaults(func=_cmd_bench)
     args = parser.parse_args(argv)
     try:
         return args.func(args)

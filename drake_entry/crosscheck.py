@@ -10,7 +10,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .actuator import bank_actuator_rates
+from .actuator import actuator_rates
 from .dynamics import specific_energy, state_derivatives
 from .scenario import Scenario
 
@@ -30,12 +30,12 @@ def solve_ivp_open_loop(scenario: Scenario, t_final: float, *, method: str = "DO
 
     def command(sch, t, y):
         return sch(t) if sch.variable == "time" else sch(specific_energy(y, planet))
-    lim = dict(bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit,
+    lim = dict(lower=-vehicle.bank_limit, upper=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit,
                accel_limit=vehicle.bank_accel_limit, bandwidth=bandwidth)
 
     def rhs(t, y):
         xdot = state_derivatives(y[:6], y[6], command(alpha_s, t, y), vehicle, planet, atm)
-        s_dot, s_ddot = bank_actuator_rates(y[6], y[7], command(bank_s, t, y), **lim)
+        s_dot, s_ddot = actuator_rates(y[6], y[7], command(bank_s, t, y), **lim)
         return np.append(xdot, (s_dot, s_ddot))
 
     x0 = scenario.initial_state()

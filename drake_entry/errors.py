@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import re
 
 from pydrake.common.yaml import yaml_load_typed
 
@@ -9,6 +10,12 @@ from pydrake.common.yaml import yaml_load_typed
 class ScenarioError(ValueError):
     """Bad user input (scenario, vehicle or problem file): one line naming the field and
     the allowed range."""
+
+
+def check_range(field: str, value, lo: float, hi: float):
+    """Raise a one-line ScenarioError unless lo <= value <= hi (None and NaN fail)."""
+    if value is None or not (lo <= value <= hi):
+        raise ScenarioError(f"{field} = {value} is out of range; allowed [{lo:g}, {hi:g}]")
 
 
 def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None, where: str | None = None):
@@ -26,6 +33,11 @@ def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None,
         if "were unknown to the schema" in msg:
             names = msg[msg.index("["):msg.index("]") + 1]
             msg = f"unknown field(s) {names}; check the spelling against the {schema.__name__} schema"
+        elif "did not match any of the allowed type options for" in msg:  # a Union field's !Tag
+            m = re.search(r"tag value '([^']*)'.*options for '([^']*)' \((.*)\)", msg)
+            if m:
+                allowed = ", ".join("!" + t for t in re.findall(r"\.(\w+)'>", m.group(3)))
+                msg = f"{m.group(2)}: unknown type tag '!{m.group(1)}'; allowed: {allowed}"
         raise ScenarioError(f"{where}: {msg}") from None
     except (ValueError, TypeError) as e:  # wrong scalar types
         raise ScenarioError(f"{where}: {e}") from None

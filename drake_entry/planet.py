@@ -10,6 +10,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from . import geodesy
+
 # WGS-84 / EGM constants.
 MU_EARTH = 3.986004418e14  # m^3/s^2 (paper 000 eq. 28, corrected units)
 R_EQUATOR = 6378137.0  # m
@@ -148,10 +150,7 @@ class Earth:
 
     def great_circle_angle(self, lon1, lat1, lon2, lat2):
         """Central angle [rad] between two points on the sphere (haversine form)."""
-        dlat = lat2 - lat1
-        dlon = lon2 - lon1
-        a = np.sin(dlat / 2) ** 2 + np.cos(lat1) * np.cos(lat2) * np.sin(dlon / 2) ** 2
-        return 2.0 * np.arcsin(np.sqrt(np.clip(a, 0.0, 1.0)))
+        return geodesy.central_angle(lon1, lat1, lon2, lat2)
 
     def great_circle_distance(self, lon1, lat1, lon2, lat2):
         """Surface distance [m] on the reference sphere between two points."""

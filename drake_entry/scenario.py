@@ -14,7 +14,9 @@ import numpy as np
 
 from . import dispersions as disp
 from .atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere, ExponentialAtmosphere, US76Atmosphere
-from .errors import ScenarioError, load_yaml_typed
+from .errors import ScenarioError, check_range, load_yaml_typed
+from .guidance import GuidanceSpec, known_tags
+from .guidance.drag_energy.spec import DragEnergy
 from .planet import Earth
 from .schedules import VARIABLES, Schedule
 from .vehicles import Vehicle, load_vehicle
@@ -86,46 +88,6 @@ class ScheduleSpec:
 
 
 @dc.dataclass
-class GuidanceSpec:
-    """Closed-loop guidance settings (paper 000 Secs. IV.A, VI.D)."""
-
-    # drag_energy (paper 000); more methods arrive with their issues
-    method: str = "drag_energy"
-    # guidance terminal interface: the reference ends at the energy of this altitude and Mach
-    terminal_altitude_km: float = 25.0
-    terminal_mach: float = 2.5
-    n_nodes: int = 40
-    # constrain the terminal drag to the terminal interface's (eq. 85) instead of leaving it free
-    terminal_drag: bool = True
-    # clarabel | scs
-    solver: str = "clarabel"
-    # relative safety margin on both corridor bounds
-    corridor_margin: float = 0.03
-    corridor_points: int = 300
-    # pre-guidance: this bank until the drag stops rising (D' >= 0) after pre_guidance_min_s
-    pre_guidance_bank_deg: float = 0.0
-    pre_guidance_min_s: float = 100.0
-    # guidance and control update period [s]; re-planning period [s] (0 = plan once)
-    period_s: float = 1.0
-    replan_period_s: float = 0.0
-    # no re-planning past this normalised energy (little range is left to correct)
-    replan_until_e: float = 0.9
-    # drag tracking (eq. 101), energy domain: zeta < 0 because E decreases (paper 000 Sec. VI.D)
-    zeta: float = -0.7
-    # pseudo-frequency omega_D [1/(J/kg)] = 2 pi / (energy per oscillation) (paper 000: constant)
-    omega_per_J: float = 2.0e-6
-    # if > 0: schedule omega_D = bandwidth / (D V) so the loop has this time-domain bandwidth
-    # [rad/s] all along (a constant omega_D is 25x faster at peak drag than at the end)
-    bandwidth_rad_s: float = 0.0
-    # integral gain as a fraction of its stability limit: k_D^i = -ratio * 2 |zeta| omega^3
-    # (Routh-Hurwitz on lambda^3 + 2 zeta omega lambda^2 + omega^2 lambda + k = 0, E decreasing)
-    integral_ratio: float = 0.0
-    # bank reversals: heading-error corridor [deg] linear in speed between the two velocities
-    reversal_heading_deg: list[float] = dc.field(default_factory=lambda: [5.0, 15.0])
-    reversal_velocity_m_s: list[float] = dc.field(default_factory=lambda: [1000.0, 6000.0])
-
-
-@dc.dataclass
 class SimulationSpec:
     # hard stop [s] if no terminal condition triggers
     max_time_s: float = 3000.0
@@ -162,7 +124,9 @@ class Scenario:
     alpha: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
     bank: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
     simulation: SimulationSpec = dc.field(default_factory=SimulationSpec)
-    guidance: GuidanceSpec = dc.field(default_factory=GuidanceSpec)
+    # the guidance method, selected by YAML tag (!DragEnergy, !BankProfile, ...; the
+    # registry in drake_entry/guidance); untagged = drag-energy
+    guidance: GuidanceSpec = dc.field(default_factory=DragEnergy)
     # Monte-Carlo dispersions (Drake schema distributions: !Uniform, !Gaussian, ...)
     dispersions: disp.DispersionSpec = dc.field(default_factory=disp.DispersionSpec)
 
@@ -213,50 +177,32 @@ class Scenario:
 
     def validate(self) -> "Scenario":
         """Check every field against its allowed range; return self."""
-        _range("entry.altitude_km", self.entry.altitude_km, US76_H_MIN / 1e3, US76_H_MAX / 1e3)
-        _range("entry.velocity_m_s", self.entry.velocity_m_s, 1.0, 12000.0)
-        _range("entry.flight_path_deg", self.entry.flight_path_deg, -89.0, 89.0)
-        _range("entry.latitude_deg", self.entry.latitude_deg, -89.0, 89.0)
-        _range("entry.longitude_deg", self.entry.longitude_deg, -360.0, 360.0)
-        _range("entry.heading_deg", self.entry.heading_deg, -360.0, 360.0)
-        _range("target.latitude_deg", self.target.latitude_deg, -90.0, 90.0)
-        _range("target.longitude_deg", self.target.longitude_deg, -360.0, 360.0)
+        check_range("entry.altitude_km", self.entry.altitude_km, US76_H_MIN / 1e3, US76_H_MAX / 1e3)
+        check_range("entry.velocity_m_s", self.entry.velocity_m_s, 1.0, 12000.0)
+        check_range("entry.flight_path_deg", self.entry.flight_path_deg, -89.0, 89.0)
+        check_range("entry.latitude_deg", self.entry.latitude_deg, -89.0, 89.0)
+        check_range("entry.longitude_deg", self.entry.longitude_deg, -360.0, 360.0)
+        check_range("entry.heading_deg", self.entry.heading_deg, -360.0, 360.0)
+        check_range("target.latitude_deg", self.target.latitude_deg, -90.0, 90.0)
+        check_range("target.longitude_deg", self.target.longitude_deg, -360.0, 360.0)
         t = self.terminal
         if all(v is None for v in (t.altitude_km, t.mach, t.velocity_m_s, t.energy_MJ_kg)):
             raise ScenarioError("terminal: give at least one of altitude_km, mach, velocity_m_s, energy_MJ_kg")
         if t.altitude_km is not None:
-            _range("terminal.altitude_km", t.altitude_km, 0.0, self.entry.altitude_km)
+            check_range("terminal.altitude_km", t.altitude_km, 0.0, self.entry.altitude_km)
         if t.mach is not None:
-            _range("terminal.mach", t.mach, 0.0, 50.0)
+            check_range("terminal.mach", t.mach, 0.0, 50.0)
         sim = self.simulation
-        _range("simulation.max_time_s", sim.max_time_s, 1.0, 1e5)
-        _range("simulation.accuracy", sim.accuracy, 1e-14, 1e-1)
-        _range("simulation.max_step_s", sim.max_step_s, 1e-4, 1e3)
-        _range("simulation.log_period_s", sim.log_period_s, 1e-3, 1e3)
+        check_range("simulation.max_time_s", sim.max_time_s, 1.0, 1e5)
+        check_range("simulation.accuracy", sim.accuracy, 1e-14, 1e-1)
+        check_range("simulation.max_step_s", sim.max_step_s, 1e-4, 1e3)
+        check_range("simulation.log_period_s", sim.log_period_s, 1e-3, 1e3)
         step, period = sim.closed_loop_step_s, self.guidance.period_s
         if step != 0.0 and not (0.0 < step <= period and abs(period / step - round(period / step)) < 1e-9):
             raise ScenarioError(f"simulation.closed_loop_step_s = {step:g} s must be 0 (error control) or divide "
                                 f"guidance.period_s = {period:g} s (e.g. {period:g}, {period / 2:g}, {period / 4:g})")
         if sim.integrator not in INTEGRATORS:
             raise ScenarioError(f"simulation.integrator '{sim.integrator}' is unknown; allowed: {', '.join(INTEGRATORS)}")
-        g = self.guidance
-        if g.method not in ("drag_energy",):
-            raise ScenarioError(f"guidance.method '{g.method}' is unknown; allowed: drag_energy")
-        _range("guidance.n_nodes", g.n_nodes, 5, 400)
-        _range("guidance.zeta", g.zeta, -10.0, -1e-3)
-        _range("guidance.omega_per_J", g.omega_per_J, 1e-9, 1e-3)
-        _range("guidance.integral_ratio", g.integral_ratio, 0.0, 0.99)
-        _range("guidance.bandwidth_rad_s", g.bandwidth_rad_s, 0.0, 10.0)
-        _range("guidance.replan_until_e", g.replan_until_e, 0.0, 1.0)
-        _range("guidance.corridor_margin", g.corridor_margin, 0.0, 0.49)
-        _range("guidance.period_s", g.period_s, 0.01, 60.0)
-        _range("guidance.replan_period_s", g.replan_period_s, 0.0, 1e4)
-        _range("guidance.terminal_altitude_km", g.terminal_altitude_km, 0.0, self.entry.altitude_km)
-        _range("guidance.terminal_mach", g.terminal_mach, 0.1, 30.0)
-        if g.solver not in ("clarabel", "scs"):
-            raise ScenarioError(f"guidance.solver '{g.solver}' is unknown; allowed: clarabel, scs")
-        if len(g.reversal_heading_deg) != 2 or len(g.reversal_velocity_m_s) != 2:
-            raise ScenarioError("guidance.reversal_heading_deg and reversal_velocity_m_s need two values each")
         for which in ("alpha", "bank"):
             if getattr(self, which).variable not in VARIABLES + ("normalized_energy",):
                 raise ScenarioError(f"{which}.variable '{getattr(self, which).variable}' is unknown; "
@@ -274,6 +220,7 @@ class Scenario:
             self.make_vehicle()
         except ValueError as e:
             raise ScenarioError(str(e)) from None
+        self.guidance.validate(self)
         return self
 
 
@@ -306,11 +253,6 @@ def atmosphere_from_spec(a: AtmosphereSpec) -> Atmosphere:
     raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential")
 
 
-def _range(field: str, value, lo: float, hi: float):
-    if value is None or not (lo <= value <= hi):
-        raise ScenarioError(f"{field} = {value} is out of range; allowed [{lo:g}, {hi:g}]")
-
-
 PACKAGED_SCENARIOS = ("horus2b", "shefex3", "cav_h", "marv")
 
 
@@ -320,8 +262,34 @@ def load_scenario(name_or_path: str) -> Scenario:
         text = resources.files("drake_entry").joinpath(f"scenarios/{name_or_path}.yaml").read_text()
         scenario = load_yaml_typed(Scenario, text=text, where=f"scenario '{name_or_path}'")
     elif os.path.exists(name_or_path):
-        scenario = load_yaml_typed(Scenario, path=name_or_path)
+        try:
+            scenario = load_yaml_typed(Scenario, path=name_or_path)
+        except ScenarioError as e:
+            if "unknown field(s) ['method']" in str(e):  # a scenario written before the method tags
+                raise ScenarioError(f"{name_or_path}: guidance 'method:' is now a YAML tag: write "
+                                    f"'guidance: !DragEnergy' (known: {known_tags()})") from None
+            raise
     else:
         raise ScenarioError(f"scenario '{name_or_path}' is neither a packaged scenario "
                             f"({', '.join(PACKAGED_SCENARIOS)}) nor a file")
     return scenario.validate()
+
+
+def apply_overrides(scenario: Scenario, overrides: dict):
+    """Set dotted fields, e.g. {'guidance.replan_period_s': 0}."""
+    for key, value in (overrides or {}).items():
+        obj = scenario
+        *path, last = key.split(".")
+        for p in path:
+            obj = getattr(obj, p)
+        if not hasattr(obj, last):
+            raise ValueError(f"override '{key}': no such field")
+        setattr(obj, last, value)
+    scenario.validate()
+
+
+def load_campaign_scenario(scenario_path: str, overrides: dict | None) -> Scenario:
+    """The scenario a campaign flies: packaged name or file, with dotted overrides."""
+    scenario = load_scenario(scenario_path)
+    apply_overrides(scenario, overrides)
+    return scenario

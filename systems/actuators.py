@@ -1,74 +1,75 @@
-"""BankActuator: bank-angle actuator with angle, rate and acceleration limits.
+"""Second-order actuators with position, rate and acceleration limits: BankActuator and
+AlphaActuator (one LeafSystem, ``LimitedActuator``, named per use).
 
-The law is drake_entry.actuator.bank_actuator_rates: the command is clipped to
-+-bank_limit and tracked with rate and acceleration limits, so a bank reversal (a sign
-flip of the command) rotates through wings-level at the rate limit. Two realisations:
+The law is drake_entry.actuator.actuator_rates: the command is clipped to [lower, upper]
+and tracked with rate and acceleration limits, so a bank reversal (a sign flip of the
+command) rotates through wings-level at the rate limit. Two realisations:
 
-  continuous  (period=None) the actuator state [sigma, sigma_dot] is continuous state.
+  continuous  (period=None) the actuator state [x, x_dot] is continuous state.
               Its inner loop (4 x bandwidth rad/s) bounds the step of explicit integrators.
   sampled     (period=T) the command is sampled every T seconds; the same law is integrated
               over the coming period in ``substep`` steps (RK2) and the output is the C1
-              Hermite interpolant of (sigma, sigma_dot) in time. No continuous state, so
-              the vehicle integrator takes steps as long as the flight allows.
+              Hermite interpolant of (x, x_dot) in time. No continuous state, so the vehicle
+              integrator takes steps as long as the flight allows, and the limits act inside
+              the guidance period (a limiter updated once per period would limit-cycle).
 
-Ports:
-  input  "bank_command"  [1]  sigma_cmd [rad]
-  output "bank"          [1]  sigma [rad] (no direct feedthrough)
-  output "bank_rate"     [1]  sigma_dot [rad/s]
+Ports (``name`` = "bank" or "alpha"):
+  input  "<name>_command"  [1]  command [rad]
+  output "<name>"          [1]  actuator position [rad] (no direct feedthrough)
+  output "<name>_rate"     [1]  its rate [rad/s]
 """
 from __future__ import annotations
 
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.actuator import bank_actuator_rates, integrate_bank_actuator
+from drake_entry.actuator import actuator_rates, integrate_actuator
 
 
-class BankActuator(LeafSystem):
-    def __init__(self, *, bank_limit: float, rate_limit: float, accel_limit: float,
-                 bandwidth: float = 2.0, initial_bank: float = 0.0, period: float | None = None,
-                 substep: float = 0.02):
-        """Args: bank_limit [rad], rate_limit [rad/s], accel_limit [rad/s^2], bandwidth omega
-        [rad/s] of the position loop (the rate loop runs at 4 omega), initial_bank [rad],
-        period [s] for the sampled realisation (None = continuous), substep [s] (RK2 at 0.02 s
-        follows a 120 deg HORUS reversal within 5e-4 deg of a 1e-3 s integration)."""
+class LimitedActuator(LeafSystem):
+    def __init__(self, *, name: str, lower: float, upper: float, rate_limit: float, accel_limit: float,
+                 bandwidth: float = 2.0, initial: float = 0.0, period: float | None = None, substep: float = 0.02):
+        """Args: name of the ports; lower, upper [rad] position limits; rate_limit [rad/s];
+        accel_limit [rad/s^2]; bandwidth omega [rad/s] of the position loop (the rate loop
+        runs at 4 omega); initial position [rad]; period [s] for the sampled realisation
+        (None = continuous); substep [s] (RK2 at 0.02 s follows a 120 deg HORUS reversal
+        within 5e-4 deg of a 1e-3 s integration)."""
         super().__init__()
-        for name, v in (("bank_limit", bank_limit), ("rate_limit", rate_limit),
-                        ("accel_limit", accel_limit), ("bandwidth", bandwidth)):
+        for field, v in (("rate_limit", rate_limit), ("accel_limit", accel_limit), ("bandwidth", bandwidth)):
             if not v > 0:
-                raise ValueError(f"BankActuator.{name} must be > 0, got {v}")
-        self.limits = dict(bank_limit=bank_limit, rate_limit=rate_limit, accel_limit=accel_limit,
+                raise ValueError(f"{type(self).__name__}.{field} must be > 0, got {v}")
+        if not lower < upper:
+            raise ValueError(f"{type(self).__name__} needs lower < upper, got [{lower}, {upper}]")
+        self.limits = dict(lower=lower, upper=upper, rate_limit=rate_limit, accel_limit=accel_limit,
                            bandwidth=bandwidth)
-        self.bank_limit, self.rate_limit, self.accel_limit = bank_limit, rate_limit, accel_limit
-        self.omega = bandwidth
-        self.cmd_port = self.DeclareVectorInputPort("bank_command", 1)
+        self.cmd_port = self.DeclareVectorInputPort(f"{name}_command", 1)
         self.period = period
         if period is None:
-            self.DeclareContinuousState(BasicVector([initial_bank, 0.0]))
+            self.DeclareContinuousState(BasicVector([initial, 0.0]))
             state = {self.all_state_ticket()}
-            self.DeclareVectorOutputPort("bank", 1, lambda c, o: o.SetAtIndex(0, c.get_continuous_state_vector()[0]),
+            self.DeclareVectorOutputPort(name, 1, lambda c, o: o.SetAtIndex(0, c.get_continuous_state_vector()[0]),
                                          prerequisites_of_calc=state)
-            self.DeclareVectorOutputPort("bank_rate", 1,
+            self.DeclareVectorOutputPort(f"{name}_rate", 1,
                                          lambda c, o: o.SetAtIndex(0, c.get_continuous_state_vector()[1]),
                                          prerequisites_of_calc=state)
             return
         if not 0 < substep <= period:
-            raise ValueError(f"BankActuator.substep must be in (0, period], got {substep}")
+            raise ValueError(f"{type(self).__name__}.substep must be in (0, period], got {substep}")
         self.n_sub = max(1, int(round(period / substep)))
-        self._segment = self.DeclareAbstractState(AbstractValue.Make(_constant_segment(initial_bank)))
+        self._segment = self.DeclareAbstractState(AbstractValue.Make(_constant_segment(initial)))
         self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._plan_segment)
         deps = {self.abstract_state_ticket(self._segment), self.time_ticket()}
-        self.DeclareVectorOutputPort("bank", 1, lambda c, o: o.SetAtIndex(0, self._sample(c)[0]),
+        self.DeclareVectorOutputPort(name, 1, lambda c, o: o.SetAtIndex(0, self._sample(c)[0]),
                                      prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort("bank_rate", 1, lambda c, o: o.SetAtIndex(0, self._sample(c)[1]),
+        self.DeclareVectorOutputPort(f"{name}_rate", 1, lambda c, o: o.SetAtIndex(0, self._sample(c)[1]),
                                      prerequisites_of_calc=deps)
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         if self.period is not None:  # sampled: no continuous state
             return
-        sigma, rate = context.get_continuous_state_vector().CopyToVector()
-        derivatives.get_mutable_vector().SetFromVector(bank_actuator_rates(
-            sigma, rate, self.cmd_port.Eval(context)[0], **self.limits))
+        x, rate = context.get_continuous_state_vector().CopyToVector()
+        derivatives.get_mutable_vector().SetFromVector(actuator_rates(
+            x, rate, self.cmd_port.Eval(context)[0], **self.limits))
 
     # -- sampled realisation -------------------------------------------------------------
     def _sample(self, context):
@@ -76,11 +77,36 @@ class BankActuator(LeafSystem):
 
     def _plan_segment(self, context, state):
         t0 = context.get_time()
-        sigma, rate = self._sample(context)
+        x, rate = self._sample(context)
         h = self.period / self.n_sub
-        s, r = integrate_bank_actuator(sigma, rate, float(self.cmd_port.Eval(context)[0]), h, self.n_sub,
-                                       **self.limits)
+        s, r = integrate_actuator(x, rate, float(self.cmd_port.Eval(context)[0]), h, self.n_sub, **self.limits)
         state.get_mutable_abstract_state(int(self._segment)).set_value(_Segment(t0, h, s, r))
+
+
+class BankActuator(LimitedActuator):
+    """Bank actuator: |sigma| <= bank_limit, ports "bank_command" -> "bank", "bank_rate"."""
+
+    def __init__(self, *, bank_limit: float, rate_limit: float, accel_limit: float, bandwidth: float = 2.0,
+                 initial_bank: float = 0.0, period: float | None = None, substep: float = 0.02):
+        """Args: bank_limit [rad] (> 0), the rest as LimitedActuator."""
+        if not bank_limit > 0:
+            raise ValueError(f"BankActuator.bank_limit must be > 0, got {bank_limit}")
+        super().__init__(name="bank", lower=-bank_limit, upper=bank_limit, rate_limit=rate_limit,
+                         accel_limit=accel_limit, bandwidth=bandwidth, initial=initial_bank, period=period,
+                         substep=substep)
+
+
+class AlphaActuator(LimitedActuator):
+    """Angle-of-attack actuator: alpha in [alpha_min, alpha_max] with rate and acceleration
+    limits (papers 001 and 004 command alpha), ports "alpha_command" -> "alpha", "alpha_rate"."""
+
+    def __init__(self, *, alpha_min: float, alpha_max: float, rate_limit: float, accel_limit: float,
+                 bandwidth: float = 2.0, initial_alpha: float = 0.0, period: float | None = None,
+                 substep: float = 0.02):
+        """Args: alpha_min < alpha_max [rad], the rest as LimitedActuator."""
+        super().__init__(name="alpha", lower=alpha_min, upper=alpha_max, rate_limit=rate_limit,
+                         accel_limit=accel_limit, bandwidth=bandwidth, initial=initial_alpha, period=period,
+                         substep=substep)
 
 
 class _Segment:

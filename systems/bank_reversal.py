@@ -19,7 +19,7 @@ import math
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.planning.drag_energy import bearing
+from drake_entry.geodesy import bearing
 
 
 class BankReversalLogic(LeafSystem):

@@ -26,7 +26,7 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.planning.drag_energy import DragEnergyPlanner
-from drake_entry.systems.guidance import sensed_drag
+from drake_entry.systems.drag_energy_guidance import sensed_drag
 
 
 class DragTrackingController(LeafSystem):

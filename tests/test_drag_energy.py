@@ -172,7 +172,7 @@ def test_drag_tracking_recovers_from_a_perturbed_entry(scenario, planner):
     assert res.success, res.message
     tr = res.trajectory
     ref = tr.extra["reference"]
-    on = (ref[:, 3] > 0.5) & (tr.time > res.engaged_at + 60.0)
+    on = (ref[:, 3] > 0.5) & (tr.time > res.guidance.details.engaged_at + 60.0)
     assert np.max(np.abs(tr.column("drag")[on] / ref[on, 0] - 1.0)) < 0.04
     assert res.errors["distance_m"] < 3e3
     assert abs(res.errors["altitude_m"]) < 500.0

@@ -6,6 +6,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 from drake_entry.diagrams.montecarlo import TIMING_COLUMNS, done_indices, run_campaign, run_sample, sample_seed
 from drake_entry.planning.drag_energy import DragEnergyPlanner
 from drake_entry.report import summary_statistics, write_report
@@ -14,14 +15,12 @@ from drake_entry.scenario import load_scenario
 
 @pytest.fixture(scope="module")
 def horus():
-    s = load_scenario("horus2b")
-    return s, DragEnergyPlanner.from_scenario(s)
+    return ClosedLoopSetup.from_scenario(load_scenario("horus2b"))
 
 
 def test_a_sample_rerun_alone_reproduces_its_row_bit_for_bit(horus):
-    s, p = horus
-    a, _ = run_sample(s, p, 11, 5, trajectory_step_s=0)
-    b, _ = run_sample(s, p, 11, 5, trajectory_step_s=0)
+    a, _ = run_sample(horus, 11, 5, trajectory_step_s=0)
+    b, _ = run_sample(horus, 11, 5, trajectory_step_s=0)
     assert a["success"], a["message"]
     for k in a:
         if k not in TIMING_COLUMNS:
@@ -30,15 +29,13 @@ def test_a_sample_rerun_alone_reproduces_its_row_bit_for_bit(horus):
 
 
 def test_a_failing_sample_is_recorded_with_its_reason(horus):
-    s, _ = horus
-
     class BrokenPlanner(DragEnergyPlanner):
         def plan_from_state(self, x, previous=None, **kw):
             raise RuntimeError("solver library missing")
 
-    broken = BrokenPlanner.from_scenario(s)
+    broken = DragEnergyPlanner.from_scenario(horus.scenario)
     broken.__class__ = BrokenPlanner
-    row, _ = run_sample(s, broken, 1, 0, trajectory_step_s=0)
+    row, _ = run_sample(ClosedLoopSetup.from_scenario(horus.scenario, broken), 1, 0, trajectory_step_s=0)
     assert row["success"] is False
     assert "guidance never engaged" in row["message"] and "solver library missing" in row["message"]
     assert np.isfinite(row["disp_dh_m"])

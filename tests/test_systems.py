@@ -164,25 +164,25 @@ def test_sampled_actuator_reproduces_the_continuous_one():
 def test_segment_integrator_equals_midpoint_steps_of_the_actuator_law():
     """The sampled actuator's segment: RK2 on bank_actuator_rates through a limited reversal,
     and the exact critically damped solution where no limit is active (RK2 agrees to O(h^2))."""
-    from drake_entry.actuator import bank_actuator_rates, integrate_bank_actuator
+    from drake_entry.actuator import actuator_rates, integrate_actuator
 
-    lim = dict(bank_limit=math.radians(80), rate_limit=math.radians(10), accel_limit=math.radians(5), bandwidth=2.0)
+    lim = dict(lower=-math.radians(80), upper=math.radians(80), rate_limit=math.radians(10), accel_limit=math.radians(5), bandwidth=2.0)
 
     def rk2(s, r, cmd, h, n):
         out = [(s, r)]
         for _ in range(n):
-            d1 = bank_actuator_rates(s, r, cmd, **lim)
-            d2 = bank_actuator_rates(s + 0.5 * h * d1[0], r + 0.5 * h * d1[1], cmd, **lim)
+            d1 = actuator_rates(s, r, cmd, **lim)
+            d2 = actuator_rates(s + 0.5 * h * d1[0], r + 0.5 * h * d1[1], cmd, **lim)
             s, r = s + h * d2[0], r + h * d2[1]
             out.append((s, r))
         return np.array(out)
 
     h = 0.01
-    fast = np.array(integrate_bank_actuator(math.radians(60), 0.0, math.radians(-70), h, 300, **lim)).T
+    fast = np.array(integrate_actuator(math.radians(60), 0.0, math.radians(-70), h, 300, **lim)).T
     assert np.abs(fast - rk2(math.radians(60), 0.0, math.radians(-70), h, 300)).max() < 1e-14
     assert np.abs(fast[:, 1]).max() <= lim["rate_limit"] * (1 + 1e-9)
-    small = np.array(integrate_bank_actuator(0.30, 0.0, 0.303, h, 100, **lim)).T  # no limit active
+    small = np.array(integrate_actuator(0.30, 0.0, 0.303, h, 100, **lim)).T  # no limit active
     assert np.abs(small - rk2(0.30, 0.0, 0.303, h, 100)).max() < 1e-5  # RK2 O(h^2)
     t = np.arange(101) * h
     assert small[:, 0] == pytest.approx(0.303 - 0.003 * (1 + 4 * t) * np.exp(-4 * t), abs=1e-15)
-    assert integrate_bank_actuator(0.3, 0.0, 0.3, h, 5, **lim) == ([0.3] * 6, [0.0] * 6)
+    assert integrate_actuator(0.3, 0.0, 0.3, h, 5, **lim) == ([0.3] * 6, [0.0] * 6)

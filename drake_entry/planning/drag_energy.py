@@ -33,9 +33,11 @@ from scipy.optimize import brentq
 
 from ..atmosphere import Atmosphere
 from ..corridor import Corridor, compute_corridor
+from ..geodesy import bearing
 from ..drag_dynamics import AlphaProfile, DragDynamics, DragTerms, drag_acceleration, drag_dynamics
 from ..planet import Earth
 from ..pseudospectral import LGL
+from .result import PlanResult
 from ..schedules import Schedule
 from ..vehicles import Vehicle
 
@@ -112,20 +114,19 @@ class Extraction:
 
 
 @dataclass
-class DragEnergyReference:
-    """Result of ``plan``: the reference D(E) and everything needed to fly it."""
+class DragEnergyReference(PlanResult):
+    """Result of ``plan``: the reference D(E) and everything needed to fly it. ``objective``
+    is s' + s'' of eq. 92 [s^2/m] (norms of the tau-derivatives of I); ``evaluate(E)``
+    gives D, D', D''."""
 
-    success: bool
-    message: str
+    variable = "energy"
+
     problem: DragEnergyProblem
     lgl: LGL | None = None
     I: np.ndarray | None = None  # 1/D at the nodes [s^2/m]
     kappa: np.ndarray | None = None
     extraction: Extraction | None = None
     solver: str = ""
-    solve_time: float = 0.0
-    build_time: float = 0.0
-    iterations: int = 0
     binding: list = field(default_factory=list)  # which bounds bind, where (diagnosis)
     _nodal: np.ndarray | None = field(default=None, repr=False)
 
@@ -157,6 +158,11 @@ class DragEnergyReference:
             I, I1, I2 = (self.lgl.interpolation(E) @ self._nodal).T
         return (np.atleast_1d(1.0 / I), np.atleast_1d(-I1 / I**2),
                 np.atleast_1d(2.0 * I1**2 / I**3 - I2 / I**2))
+
+    def evaluate(self, at) -> dict:
+        """{'drag_m_s2', 'drag_slope_1_m' (dD/dE), 'drag_curvature_s2_m3' (d2D/dE2)} at energies [J/kg]."""
+        D, Dp, Dpp = self.profile(np.atleast_1d(np.asarray(at, float)))
+        return {"drag_m_s2": D, "drag_slope_1_m": Dp, "drag_curvature_s2_m3": Dpp}
 
     def kappa_at(self, E) -> np.ndarray:
         """Ground-range weight kappa = R cos(gamma)/r interpolated at energies E."""
@@ -200,29 +206,34 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
         p = dc.replace(p, D0=D0_in)
     diag = _diagnose(p, op, D_lo, D_hi)
     if diag:
-        return DragEnergyReference(False, "; ".join(d["message"] for d in diag), p, lgl=op, binding=diag)
+        return DragEnergyReference(success=False, message="; ".join(d["message"] for d in diag), problem=p, lgl=op,
+                                   binding=diag)
     # ground-range weights: the guess, or eq. 71's kappa = 1 until the first extraction
     kappa = np.ones(p.n_nodes) if p.kappa_guess is None else np.asarray(p.kappa_guess(op.x), float)
     ref = None
     total_build = total_solve = 0.0
+    total_iterations = 0
     for _ in range(max(1, p.range_iterations)):
-        ref = _solve_socp(p, op, D_lo, D_hi, kappa)
+        ref = solve_socp(p, op, D_lo, D_hi, kappa)
         total_build += ref.build_time
         total_solve += ref.solve_time
+        total_iterations += ref.iterations
         if not ref.success:
             break
         ref.kappa = kappa  # the weights this solve satisfied exactly (eq. 83)
         ref.extraction = extract(p, op, ref.I)
         x = ref.extraction
         kappa = p.planet.reference_radius * np.cos(x.gamma) / p.planet.radius(x.h)
-    ref.build_time, ref.solve_time = total_build, total_solve
+    ref.build_time, ref.solve_time, ref.iterations = total_build, total_solve, total_iterations
     ref.message += note
     if ref.success:
         ref.binding = _binding(ref, D_lo, D_hi)
     return ref
 
 
-def _solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyReference:
+def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyReference:
+    """One SOCP of eqs. 82-92 on the LGL operator ``op`` with corridor bounds D_lo, D_hi [m/s^2]
+    at its nodes and fixed range weights kappa (``plan`` iterates it and extracts the states)."""
     t0 = time.perf_counter()
     n = p.n_nodes
     scale = p.D0  # I_hat = I * scale is O(1)
@@ -283,8 +294,9 @@ def _solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyR
         problem_msg = _check_solution(p, op, I_sol, D_lo, D_hi, kappa)
         if problem_msg:
             ok, msg = False, f"{p.solver} returned an inaccurate solution: {problem_msg}"
-    return DragEnergyReference(ok, msg, p, lgl=op, I=I_sol if ok else None, solver=p.solver,
-                               build_time=t1 - t0, solve_time=t2 - t1, iterations=iters)
+    return DragEnergyReference(success=ok, message=msg, problem=p, lgl=op, I=I_sol if ok else None, solver=p.solver,
+                               build_time=t1 - t0, solve_time=t2 - t1, iterations=iters,
+                               objective=float(result.get_optimal_cost()) / scale if ok else math.nan)
 
 
 def _check_solution(p: DragEnergyProblem, op: LGL, I, D_lo, D_hi, kappa, tol: float = 1e-3,
@@ -442,13 +454,6 @@ def _secant_log_drag(f, D: float, h0: float, lo: float, hi: float, slope: float 
             return c, s
         a, ga, b, gb = b, gb, c, g(c)
     return None
-
-
-def bearing(lon1, lat1, lon2, lat2) -> float:
-    """Initial great-circle bearing [rad] from point 1 to point 2, from north, clockwise."""
-    dlon = lon2 - lon1
-    return math.atan2(math.sin(dlon) * math.cos(lat2),
-                      math.cos(lat1) * math.sin(lat2) - math.sin(lat1) * math.cos(lat2) * math.cos(dlon))
 
 
 class DragEnergyPlanner:

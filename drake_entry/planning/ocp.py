@@ -19,6 +19,7 @@ from typing import Callable
 import numpy as np
 
 from ..atmosphere import Atmosphere
+from ..geodesy import central_angle_smooth, crossrange_from_great_circle
 from ..dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_derivatives
 from ..planet import Earth
 from ..vehicles import Vehicle
@@ -341,7 +342,7 @@ class OptimalControlProblem(_ProblemLayout):
             if term.kind == "final_time":
                 v = tf
             elif term.kind == "miss_distance":
-                d = self._central_angle(xf[1], xf[2], *term.target) * self.planet.reference_radius
+                d = central_angle_smooth(xf[1], xf[2], *term.target) * self.planet.reference_radius
                 v = d * d / term.scale if term.squared else d
             elif term.kind == "final_latitude":
                 v = xf[2]
@@ -371,19 +372,8 @@ class OptimalControlProblem(_ProblemLayout):
     def crossrange(self, x):
         """Signed distance [m] of x from the great circle through the initial position along
         the initial heading (+ right of the initial heading)."""
-        x0 = np.array([self._initial_value(i) for i in range(6)], float)
-        fn = np if not isinstance(x[1], float) else math
-        lon0, lat0, psi0 = x0[1], x0[2], x0[5]
-        # unit normal of the initial great circle (right-handed: +right of the heading)
-        e = np.array([math.cos(lat0) * math.cos(lon0), math.cos(lat0) * math.sin(lon0), math.sin(lat0)])
-        north = np.array([-math.sin(lat0) * math.cos(lon0), -math.sin(lat0) * math.sin(lon0), math.cos(lat0)])
-        east = np.array([-math.sin(lon0), math.cos(lon0), 0.0])
-        v = math.cos(psi0) * north + math.sin(psi0) * east
-        n = np.cross(e, v)  # left of the heading
-        p = [fn.cos(x[2]) * fn.cos(x[1]), fn.cos(x[2]) * fn.sin(x[1]), fn.sin(x[2])]
-        s = -(n[0] * p[0] + n[1] * p[1] + n[2] * p[2])
-        return self.planet.reference_radius * np.arcsin(s) if not isinstance(s, float) else \
-            self.planet.reference_radius * math.asin(s)
+        x0 = [self._initial_value(i) for i in range(6)]
+        return crossrange_from_great_circle(x[1], x[2], x0[1], x0[2], x0[5], self.planet.reference_radius)
 
     def _initial_value(self, i: int) -> float:
         v = self.initial.get(self.state_names[i])
@@ -391,34 +381,9 @@ class OptimalControlProblem(_ProblemLayout):
             raise ValueError(f"crossrange needs a fixed initial {self.state_names[i]}")
         return float(v)
 
-    @staticmethod
-    def _central_angle(lon1, lat1, lon2, lat2):
-        """Great-circle angle by the haversine form (smooth, AutoDiff-safe away from 0)."""
-        fn = math if isinstance(lon1, float) else np
-        s = fn.sin(0.5 * (lat2 - lat1)) ** 2 + fn.cos(lat1) * fn.cos(lat2) * fn.sin(0.5 * (lon2 - lon1)) ** 2
-        return 2.0 * fn.arcsin(fn.sqrt(s + 1e-30)) if fn is np else 2.0 * math.asin(math.sqrt(s + 1e-30))
-
     def path_values(self, x, u) -> list:
         env = self.conditions(x, u)
         return [c.value(x, u, env) for c in self.path]
 
     def with_(self, **changes) -> "OptimalControlProblem":
         return dc.replace(self, **changes)
-
-
-def downtrack_crosstrack(lon, lat, lon0: float, lat0: float, lonf: float, latf: float, radius: float):
-    """Paper 002 appendix eqs. 24-30: downtrack d and crosstrack c [m] of points (lon, lat)
-    in the frame of the initial position r0 and the final position rf (arrays)."""
-    def unit(lo, la):
-        return np.stack([np.cos(la) * np.cos(lo), np.cos(la) * np.sin(lo), np.sin(la)], axis=-1)
-
-    u1 = unit(lon0, lat0)
-    rf = unit(lonf, latf)
-    u3 = np.cross(u1, rf)
-    u3 = u3 / np.linalg.norm(u3)
-    u2 = np.cross(u3, u1)
-    r = unit(np.asarray(lon, float), np.asarray(lat, float))
-    rdc = r @ np.vstack([u1, u2, u3]).T  # eq. 28
-    a = np.arctan2(rdc[..., 1], rdc[..., 0])  # eq. 29
-    b = np.arcsin(np.clip(rdc[..., 2], -1.0, 1.0))
-    return radius * a, radius * b  # eq. 30

@@ -1,0 +1,100 @@
+"""One Monte-Carlo sample of a closed loop through Drake's RandomSimulation, and its row.
+
+Each sample is one ``pydrake.systems.analysis.RandomSimulation`` whose RandomGenerator is
+seeded from (campaign seed, sample index) only, so any sample re-runs alone and
+reproduces its row. Inside ``make_simulator`` the sample's dispersions are drawn from that
+generator and built into the diagram's defaults (Drake's SetRandomContext then keeps
+them; DESIGN.md). A sample that raises returns a row with its reason instead.
+"""
+from __future__ import annotations
+
+import math
+import time
+import traceback
+
+import numpy as np
+from pydrake.common import RandomGenerator
+from pydrake.systems.analysis import RandomSimulation
+
+from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, build_closed_loop, summarise
+from drake_entry.diagrams.common import collect_trajectory, make_simulator
+from drake_entry.dispersions import draw
+from drake_entry.trajectory import metrics
+
+TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
+# row columns that measure this machine's wall-clock time (excluded from reproducibility)
+TIMING_COLUMNS = ("wall_time_s", "planning_wall_s")
+
+
+def sample_seed(campaign_seed: int, index: int) -> int:
+    """The RandomGenerator seed of sample ``index`` (independent streams per sample)."""
+    return int(np.random.SeedSequence([int(campaign_seed), int(index)]).generate_state(1)[0])
+
+
+def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
+               trajectory_step_s: float = TRAJECTORY_STEP_S) -> tuple[dict, dict | None]:
+    """One Monte-Carlo sample of ``setup.scenario.dispersions``: (row, trajectory columns every
+    ``trajectory_step_s`` seconds plus the final instant, or None when it is 0)."""
+    scenario = setup.scenario
+    seed = sample_seed(campaign_seed, index)
+    t_wall = time.perf_counter()
+    row = {"index": int(index), "seed": seed}
+    box = {}
+
+    def make(generator: RandomGenerator):
+        box["draw"] = d = draw(scenario.dispersions, generator)
+        box["built"] = built = build_closed_loop(setup, draw=d)
+        box["simulator"] = simulator = make_simulator(built.diagram, scenario, closed_loop=True)
+        return simulator
+
+    def output(system, context):
+        box["context"] = context
+        vehicle = system.GetSubsystemByName("vehicle")
+        return float(vehicle.GetOutputPort("state").Eval(vehicle.GetMyContextFromRoot(context))[0])
+
+    try:
+        RandomSimulation(make, output, scenario.simulation.max_time_s, RandomGenerator(seed))
+        built, ctx = box["built"], box["context"]
+        reason = built.diagram.GetSubsystemByName("termination").reason
+        reason = f"reached {reason}" if reason else "max_time"
+        tr = collect_trajectory(built.diagram, built.loggers, ctx, sources=built.sources, reason=reason,
+                                wall_time=time.perf_counter() - t_wall, columns=built.columns)
+        res = summarise(setup, built.diagram, ctx, tr)
+        row.update(box["draw"].columns())
+        row.update(campaign_row(res, setup))
+        integrator = box["simulator"].get_integrator()
+        row.update({"integration_steps": integrator.get_num_steps_taken(),
+                    "derivative_evaluations": integrator.get_num_derivative_evaluations()})
+        traj = _downsample(tr, index, trajectory_step_s) if trajectory_step_s > 0 else None
+    except Exception as e:  # one failed sample never stops the campaign
+        row.update(box["draw"].columns() if "draw" in box else {})
+        row.update({"success": False, "message": f"{type(e).__name__}: {e}".splitlines()[0][:500],
+                    "traceback": traceback.format_exc(limit=3)[-2000:]})
+        traj = None
+    row["wall_time_s"] = time.perf_counter() - t_wall
+    return row, traj
+
+
+def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
+    """The row of one flight: outcome, the method's fields, final state, terminal errors,
+    peak path quantities and margins (drake_entry.trajectory.metrics)."""
+    tr, x = res.trajectory, res.trajectory.state[-1]
+    g = res.guidance
+    return {
+        "success": bool(res.success), "message": res.message, "stop": tr.reason, "method": res.method,
+        "flight_time_s": float(tr.time[-1]), "plans": int(g.plans), "planning_wall_s": g.planning_wall_s, **g.fields,
+        "final_altitude_m": float(x[0]), "final_velocity_m_s": float(x[3]),
+        "final_longitude_deg": math.degrees(x[1]), "final_latitude_deg": math.degrees(x[2]),
+        "err_altitude_m": res.errors["altitude_m"], "err_longitude_deg": res.errors["longitude_deg"],
+        "err_latitude_deg": res.errors["latitude_deg"], "err_velocity_m_s": res.errors["velocity_m_s"],
+        "err_range_m": res.errors["range_to_go_m"], "err_crossrange_m": res.errors["crossrange_m"],
+        "err_distance_m": res.errors["distance_m"],
+        **metrics(tr, setup.vehicle.limits),
+    }
+
+
+def _downsample(tr, index: int, step_s: float) -> dict:
+    t = tr.time
+    keep = np.unique(np.append(np.searchsorted(t, np.arange(0.0, t[-1], step_s)), len(t) - 1))
+    out = {"sample": np.full(keep.size, index), **{k: np.asarray(v)[keep] for k, v in tr.table().items()}}
+    return {k: np.asarray(v).tolist() for k, v in out.items()}

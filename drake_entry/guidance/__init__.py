@@ -1,0 +1,37 @@
+"""Guidance methods, registered in one place.
+
+``REGISTRY`` maps each method's scenario spec (a dataclass; YAML tag ``!ClassName``) to
+the module that holds its ``GuidanceMethod`` as ``METHOD``. The spec modules are pure data
+and imported here; method modules (which import Drake systems) are imported on first use.
+Add a method: a new package beside ``drag_energy`` and one line below
+(docs/architecture.md).
+"""
+from __future__ import annotations
+
+import importlib
+from typing import Union
+
+from ..errors import ScenarioError
+from .bank_profile.spec import BankProfile
+from .drag_energy.spec import DragEnergy
+
+REGISTRY = {
+    DragEnergy: "drake_entry.guidance.drag_energy.method",
+    BankProfile: "drake_entry.guidance.bank_profile.method",
+}
+
+#: the scenario's ``guidance:`` field type (the first is the default when untagged)
+GuidanceSpec = Union[tuple(REGISTRY)]
+
+
+def known_tags() -> str:
+    return ", ".join(f"!{spec.__name__}" for spec in REGISTRY)
+
+
+def method_for(spec):
+    """The GuidanceMethod of a scenario's guidance spec."""
+    module = REGISTRY.get(type(spec))
+    if module is None:
+        raise ScenarioError(f"guidance: {type(spec).__name__} is not a registered guidance method; "
+                            f"known: {known_tags()}")
+    return importlib.import_module(module).METHOD

@@ -1,0 +1,2 @@
+"""Bank-profile guidance: |sigma| linear in normalised energy with the shared reversal logic.
+The worked example of adding a method (docs/architecture.md)."""

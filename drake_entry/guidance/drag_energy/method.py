@@ -1,0 +1,76 @@
+"""Drag-energy guidance (paper 000 Secs. IV.A, VI.D) as a GuidanceMethod:
+
+  estimate, sensed drag --> DragEnergyGuidance --reference--> DragTrackingController
+    --|sigma|--> BankReversalLogic --sigma_cmd--> (shared bank actuator)
+
+The vehicle flies the scenario's alpha(E) schedule (paper 000 Sec. IV.A). The planner
+(``DragEnergyPlanner``: the corridor, computed once) is shared by every flight and sample.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...planning.drag_energy import DragEnergyPlanner
+from ...systems.drag_energy_guidance import DragEnergyGuidance
+from ...systems.drag_tracking import DragTrackingController
+from ..interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
+from ..reversal import add_bank_reversal, reversal_count
+
+REFERENCE_COLUMNS = ("reference_drag_m_s2", "reference_drag_slope_1_m", "reference_drag_curvature_s2_m3",
+                     "guidance_engaged")
+
+
+class DragEnergyMethod(GuidanceMethod):
+    name = "drag_energy"
+
+    def make_planner(self, scenario) -> DragEnergyPlanner:
+        return DragEnergyPlanner.from_scenario(scenario)
+
+    def add_systems(self, builder, scenario, planner, plant: PlantPorts) -> GuidanceCommands:
+        g = scenario.guidance
+        guidance = builder.AddNamedSystem("guidance", DragEnergyGuidance(
+            planner, period=g.period_s, pre_guidance_min_s=g.pre_guidance_min_s, replan_period_s=g.replan_period_s,
+            replan_until_e=g.replan_until_e))
+        pre_bank = math.radians(g.pre_guidance_bank_deg)
+        controller = builder.AddNamedSystem("drag_tracking", DragTrackingController(
+            planner, zeta=g.zeta, omega=g.omega_per_J, integral_ratio=g.integral_ratio, period=g.period_s,
+            pre_guidance_bank=abs(pre_bank), bandwidth=g.bandwidth_rad_s))
+        reversal = add_bank_reversal(builder, scenario, plant, controller.GetOutputPort("bank_magnitude"),
+                                     initial_sign=1.0 if pre_bank >= 0 else -1.0)
+        builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
+        builder.Connect(plant.estimated_state, controller.GetInputPort("estimated_state"))
+        builder.Connect(guidance.GetOutputPort("reference"), controller.GetInputPort("reference"))
+        # the accelerometer's drag: guidance and feedback act on the drag actually felt
+        builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
+        builder.Connect(plant.flight_conditions, controller.GetInputPort("flight_conditions"))
+        return GuidanceCommands(bank=reversal.GetOutputPort("bank_command"), initial_bank=pre_bank,
+                                logged={"reference": LoggedSignal(guidance.GetOutputPort("reference"),
+                                                                  REFERENCE_COLUMNS)})
+
+    def summarise(self, diagram, context, planner) -> GuidanceSummary:
+        guidance = diagram.GetSubsystemByName("guidance")
+        mem = guidance.memory(guidance.GetMyContextFromRoot(context))
+        active = mem.engaged_at is not None
+        message = ""
+        if not active:
+            message = "guidance never engaged: " + (mem.failures[-1][1] if mem.failures
+                                                    else "engagement condition never met")
+        fields = {"engaged_at_s": mem.engaged_at if active else np.nan, "planning_failures": len(mem.failures),
+                  "reversals": reversal_count(diagram, context)}
+        return GuidanceSummary(active, message, plans=mem.plans, planning_wall_s=mem.planning_wall_s, fields=fields,
+                               details=mem)
+
+    def flight_plots(self, result, out_dir: str, *, title: str = "") -> list[str]:
+        from ...plots import tracking_plot
+
+        return tracking_plot(result.trajectory, out_dir, title=f"{title}: drag tracking")
+
+    def plan_report(self, scenario, out_dir: str) -> int:
+        from .commands import plan_report  # CLI layer: flies diagrams
+
+        return plan_report(scenario, out_dir)
+
+
+METHOD = DragEnergyMethod()

@@ -1,0 +1,70 @@
+"""Drake DirectCollocation (Hermite-Simpson) transcription. It needs the problem as a Drake
+System, so it imports systems.ocp_plant: the one deliberate exception to the layer rule
+(docs/architecture.md)."""
+from __future__ import annotations
+
+import numpy as np
+
+from .result import NlpResult
+from .transcription import COSTATE_SIGN, _finish, _Transcription
+
+DIRCOL_COSTATE_FACTOR = 1.5
+
+
+class _DircolTranscription(_Transcription):
+    """Drake DirectCollocation (Hermite-Simpson) of the scaled plant."""
+
+    def __init__(self, problem, nodes):
+        super().__init__(problem, nodes)
+        from pydrake.planning import DirectCollocation
+
+        from drake_entry.systems.ocp_plant import OptimalControlPlant  # the transcription needs a Drake System
+
+        self.plant = OptimalControlPlant(problem, self.sx, self.su, self.ts)
+        h_min = self.t_lo / self.ts / (nodes - 1) * 0.2
+        h_max = (self.t_hi if np.isfinite(self.t_hi) else 10 * self.t_lo) / self.ts / (nodes - 1) * 5.0
+        self.dc = DirectCollocation(self.plant, self.plant.CreateDefaultContext(), nodes, h_min, h_max)
+        self.dc.AddEqualTimeIntervalsConstraints()
+        self.dc.AddDurationBounds(self.t_lo / self.ts, min(self.t_hi, 1e12) / self.ts)
+        prog = self.prog = self.dc.prog()
+        N, nx, nu = nodes, self.nx, self.nu
+        self.X = np.array([self.dc.state(k) for k in range(N)])
+        self.U = np.array([self.dc.input(k) for k in range(N)])
+        self.H = np.array([self.dc.time_step(k)[0] for k in range(N - 1)])
+        self.add_bounds(prog, self.X, self.U, self.dc.initial_state(), self.dc.final_state())
+        self.add_path(prog, self.X, self.U)
+        if problem.has_lagrange:  # trapezoid rule over the samples
+            for k in range(N - 1):
+                prog.AddCost(lambda z: 0.5 * z[-1] * (self.L_scaled(z[:nx], z[nx:nx + nu])
+                                                      + self.L_scaled(z[nx + nu:2 * nx + nu], z[2 * nx + nu:-1])),
+                             np.concatenate([self.X[k], self.U[k], self.X[k + 1], self.U[k + 1], [self.H[k]]]))
+        self.collocation = [b for b in prog.GetAllConstraints()
+                            if b.evaluator().get_description().startswith("collocation constraint")]
+        self.mayer_cost(prog, self.X[-1], None if self.fixed_tf else self.H)
+
+    def set_guess(self, t, X, U):
+        from pydrake.trajectories import PiecewisePolynomial
+
+        t = np.asarray(t, float) / self.ts
+        Xs = (np.asarray(X) / self.sx).T
+        Us = (np.asarray(U) / self.su).T
+        self.dc.SetInitialTrajectory(PiecewisePolynomial.FirstOrderHold(t, Us),
+                                     PiecewisePolynomial.FirstOrderHold(t, Xs))
+        self.initial_guess = self.prog.GetInitialGuess(self.prog.decision_variables())
+
+    def result(self, res, solver, solve_time, build_time) -> NlpResult:
+        ok, msg = self._message(res, solver)
+        t = self.dc.GetSampleTimes(res) * self.ts
+        X = np.reshape(self.dc.GetStateSamples(res), (self.nx, self.N)).T * self.sx
+        U = np.reshape(self.dc.GetInputSamples(res), (self.nu, self.N)).T * self.su
+        costates, t_mid = None, 0.5 * (t[:-1] + t[1:])
+        try:  # collocation multipliers at the segment midpoints
+            h = np.diff(t) / self.ts
+            nu = np.vstack([res.GetDualSolution(b) for b in self.collocation])
+            costates = COSTATE_SIGN * DIRCOL_COSTATE_FACTOR * nu / h[:, None] * self.ts / self.sx
+        except Exception:  # noqa: BLE001
+            costates = None
+        if not ok:
+            msg += "; " + self.diagnose(res)
+        return _finish(self, ok, msg, t, X, U, res, costates, t_mid if costates is not None else None,
+                       solve_time, build_time, "dircol", solver)

@@ -1,0 +1,115 @@
+"""Initial guesses for the NLP: a propagated constant-control flight (entry problems) or
+the straight line between the boundary values."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...geodesy import central_angle_smooth
+from ..ocp import OptimalControlProblem
+
+
+def initial_guess(problem, samples: int = 200):
+    """(t, states, controls) SI: a propagated guess.
+
+    Entry problems: fly a constant angle of attack (alpha-bar, within the bounds) and a
+    constant bank magnitude found by bisection so the flight ends at the final altitude
+    near the final position (or at the fixed/maximum final time), with controls at rest.
+    Other problems: the straight line between the boundary values over the mean final
+    time, controls at the middle of their bounds (or zero).
+    """
+    if isinstance(problem, OptimalControlProblem):
+        return _entry_guess(problem, samples)
+    return _straight_line_guess(problem, samples)
+
+
+def _mid(lo, hi, default):
+    if np.isfinite(lo) and np.isfinite(hi):
+        return 0.5 * (lo + hi)
+    if np.isfinite(lo):
+        return max(lo, default)
+    if np.isfinite(hi):
+        return min(hi, default)
+    return default
+
+
+def _straight_line_guess(problem, samples):
+    t_lo, t_hi = problem.final_time_bounds
+    tf = 0.5 * (t_lo + t_hi) if np.isfinite(t_hi) else t_lo * 2.0
+    x0l, x0h = problem.boundary_bounds("initial")
+    xfl, xfh = problem.boundary_bounds("final")
+    xl, xh, ul, uh = problem.bounds_arrays()
+    x0 = np.array([_mid(a, b, _mid(c, d, 0.0)) for a, b, c, d in zip(x0l, x0h, xl, xh)])
+    xf = np.array([_mid(a, b, x0[i]) for i, (a, b) in enumerate(zip(xfl, xfh))])
+    t = np.linspace(0.0, tf, samples)
+    X = x0[None, :] + (t / tf)[:, None] * (xf - x0)[None, :]
+    U = np.tile([_mid(a, b, 0.0) for a, b in zip(ul, uh)], (samples, 1))
+    return t, X, U
+
+
+def _entry_guess(problem: OptimalControlProblem, samples):
+    from scipy.integrate import solve_ivp
+
+    x0l, x0h = problem.boundary_bounds("initial")
+    if not np.all(np.isfinite(x0l[:6])) or not np.allclose(x0l[:6], x0h[:6]):
+        return _straight_line_guess(problem, samples)
+    x0 = x0l.copy()
+    xl, xh, ul, uh = problem.bounds_arrays()
+    xfl, xfh = problem.boundary_bounds("final")
+    h_end = xfl[0] if np.isfinite(xfl[0]) else 0.0
+    alpha = float(np.clip(problem.alpha_bar, xl[6] if problem.controls == "rates" else ul[0],
+                          xh[6] if problem.controls == "rates" else uh[0]))
+    t_lo, t_hi = problem.final_time_bounds
+    t_max = t_hi if np.isfinite(t_hi) else 5000.0
+    target = None
+    if np.isfinite(xfl[1]) and np.isfinite(xfl[2]):
+        target = (xfl[1], xfl[2])
+
+    def fly(bank):
+        def f(t, y):
+            u = np.zeros(problem.n_controls) if problem.controls == "rates" else np.array([alpha, bank])
+            x = y.copy()
+            if problem.controls == "rates":
+                x[6], x[7] = alpha, bank
+            return problem.dynamics(x, u)
+
+        def ground(t, y):
+            return y[0] - h_end
+        ground.terminal, ground.direction = True, -1
+        y0 = x0.copy()
+        if problem.controls == "rates":
+            y0[6], y0[7] = alpha, bank
+        return solve_ivp(f, (0.0, t_max), y0, events=ground, rtol=1e-7, atol=1e-9, max_step=5.0)
+
+    def miss(sol):  # flown central angle beyond the target's [rad]
+        xf = sol.y[:, -1]
+        start = (float(x0[1]), float(x0[2]))
+        return central_angle_smooth(*start, float(xf[1]), float(xf[2])) - central_angle_smooth(*start, *target)
+
+    def too_long(sol):  # did not land, or landed beyond the final position
+        return sol.status != 1 or (target is not None and miss(sol) > 0)
+
+    # bisection on a constant bank magnitude: more bank = shorter flight
+    lo, hi = 0.0, math.radians(89.0)
+    best = fly(hi)
+    for _ in range(25):
+        mid = 0.5 * (lo + hi)
+        s = fly(mid)
+        if too_long(s):
+            lo = mid
+        else:
+            hi, best = mid, s  # best is always the flight with bank hi
+        if hi - lo < 1e-4:
+            break
+    t = np.linspace(0.0, best.t[-1], samples)
+    from scipy.interpolate import interp1d
+
+    X = interp1d(best.t, best.y, axis=1)(t).T
+    if problem.controls == "rates":
+        U = np.zeros((samples, 2))
+    else:
+        U = np.column_stack([np.full(samples, alpha), np.full(samples, hi)])
+    if t[-1] < t_lo or t[-1] > t_hi:  # stretch to the allowed final time
+        t = t * np.clip(t[-1], t_lo, t_hi) / t[-1]
+    return t, X, U

@@ -1,0 +1,146 @@
+"""NLP results: the solution record, and what is derived from it after the solve
+(extremal controls from the costates, a summary)."""
+from __future__ import annotations
+
+import dataclasses as dc
+
+import numpy as np
+
+from ...pseudospectral import interpolation_matrix
+from ..ocp import OptimalControlProblem
+from ..result import PlanResult
+
+
+@dc.dataclass
+class NlpResult(PlanResult):
+    """Solution of an optimal-control problem (a PlanResult: ``evaluate(t)`` gives the
+    states and controls at times t [s]).
+
+    Attributes:
+      success, message: solver verdict in words.
+      time: node times [s] (nodes,). states: (nodes, n_states) SI in the problem's state
+        order ([h, lon, lat, V, gamma, psi] first). controls: (nodes, n_controls) SI.
+      objective: J in the problem's cost units (Lagrange terms integrated in seconds).
+      costates: (nodes, n_states) d J / d x, SI (LGL: at the nodes; dircol: at segment
+        midpoints, see costate_time), or None if the solver returned no multipliers.
+      costate_time: times of the costate rows [s].
+      hamiltonian: H = L + lambda' f at costate_time [cost units / s].
+      solve_time: wall time of the solver [s]; build_time: transcription [s].
+      transcription, solver, nodes; iterations: 0 (Drake's Ipopt and SNOPT bindings do not
+        report them).
+      max_defect: largest scaled dynamics/constraint violation at the solution.
+    """
+
+    time: np.ndarray
+    states: np.ndarray
+    controls: np.ndarray
+    costates: np.ndarray | None
+    costate_time: np.ndarray | None
+    hamiltonian: np.ndarray | None
+    transcription: str
+    solver: str
+    nodes: int
+    max_defect: float
+    problem: object = dc.field(repr=False, default=None)
+
+    @property
+    def final_time(self) -> float:
+        return float(self.time[-1])
+
+    def evaluate(self, at) -> dict:
+        """States and controls at times ``at`` [s] by the transcription's own interpolant,
+        named by the problem's state and control names (x0.., u0.. without a problem)."""
+        t = np.atleast_1d(np.asarray(at, float))
+        X, U = self.state_function()(t), self.control_function()(t)
+        xn = getattr(self.problem, "state_names", None) or [f"x{i}" for i in range(X.shape[1])]
+        un = getattr(self.problem, "control_names", None) or [f"u{j}" for j in range(U.shape[1])]
+        return {**{n: X[:, i] for i, n in enumerate(xn)}, **{n: U[:, j] for j, n in enumerate(un)}}
+
+    def control_function(self):
+        """u(t) [SI] between the nodes: the Lagrange interpolant of the LGL nodes (the
+        method's own representation) or first-order hold for dircol."""
+        t, U = self.time, self.controls
+        if self.transcription == "lgl":
+            tf = t[-1]
+            tau_nodes = 2.0 * t / tf - 1.0
+
+            def u(tt):
+                tau = np.clip(2.0 * np.atleast_1d(tt) / tf - 1.0, -1.0, 1.0)
+                return interpolation_matrix(tau_nodes, tau) @ U
+        else:
+            def u(tt):
+                return np.column_stack([np.interp(np.atleast_1d(tt), t, U[:, j]) for j in range(U.shape[1])])
+        return u
+
+    def state_function(self):
+        """x(t) [SI] between the nodes (Lagrange interpolant for LGL, linear for dircol)."""
+        t, X = self.time, self.states
+        if self.transcription == "lgl":
+            tau_nodes = 2.0 * t / t[-1] - 1.0
+            return lambda tt: interpolation_matrix(tau_nodes, np.clip(2.0 * np.atleast_1d(tt) / t[-1] - 1.0, -1, 1)) @ X
+        return lambda tt: np.column_stack([np.interp(np.atleast_1d(tt), t, X[:, j]) for j in range(X.shape[1])])
+
+
+class NlpError(RuntimeError):
+    """The NLP could not be built (bad options or problem)."""
+
+
+
+def extremal_controls(problem, result: NlpResult) -> np.ndarray:
+    """Rates u* that minimise the Hamiltonian given the costates (paper 002 eqs. 22-23):
+    dH/du = 2 k2 u / u_max^2 + lambda_alpha = 0 gives u*_alpha = -u_max^2 lambda_alpha / (2 k2)
+    (and likewise for sigma), clipped to the rate bounds; at the costate times, SI.
+
+    The paper prints u_max / (2 k) in eq. 23; differentiating its eq. 11 gives u_max^2
+    (the square is missing in eqs. 22-23)."""
+    if not isinstance(problem, OptimalControlProblem) or problem.controls != "rates":
+        raise ValueError("extremal_controls needs an entry problem with controls='rates'")
+    terms = [t for t in problem.objective if t.kind == "control_margin"]
+    if len(terms) != 1 or any(t.kind in ("lagrange",) for t in problem.objective):
+        raise ValueError("extremal_controls needs exactly one control_margin term and no user Lagrange term")
+    if result.costates is None:
+        raise ValueError("the result has no costates (the solver returned no multipliers)")
+    t = terms[0]
+    lam = result.costates
+    u = np.column_stack([-t.u_alpha_max ** 2 * lam[:, 6] / (2.0 * t.weight * t.k[1]),
+                         -t.u_sigma_max ** 2 * lam[:, 7] / (2.0 * t.weight * t.k[2])])
+    _, _, ul, uh = problem.bounds_arrays()
+    return np.clip(u, ul, uh)
+
+
+def summary(problem, result: NlpResult, check=None) -> dict:
+    """Figures of merit of a solution (paper 002 'Results' for entry problems): objective,
+    final time, solve time, the local altitude maxima and the dynamic pressure there,
+    final bank, largest |H| at interior nodes, extremal-control match and, with ``check``
+    (a diagrams.propagation.PropagationCheck), the propagated terminal errors."""
+    out = {"success": result.success, "message": result.message, "transcription": result.transcription,
+           "solver": result.solver, "nodes": result.nodes, "objective": result.objective,
+           "final_time_s": result.final_time, "solve_time_s": result.solve_time, "build_time_s": result.build_time,
+           "max_constraint_violation_scaled": result.max_defect}
+    if result.hamiltonian is not None:
+        inner = result.hamiltonian[1:-1] if result.hamiltonian.size > 2 else result.hamiltonian
+        out["hamiltonian_interior_max_abs"] = float(np.abs(inner).max())
+        out["hamiltonian_interior_rms"] = float(np.sqrt(np.mean(inner ** 2)))
+        out["hamiltonian_interior_mean"] = float(np.mean(inner))
+    if isinstance(problem, OptimalControlProblem):
+        t = np.linspace(0.0, result.final_time, 4001)
+        x = result.state_function()(t)
+        h = x[:, 0]
+        peaks = [i for i in range(1, len(t) - 1) if h[i] >= h[i - 1] and h[i] > h[i + 1]]
+        out["altitude_maxima"] = [{"time_s": float(t[i]), "altitude_km": float(h[i] / 1e3),
+                                   "dynamic_pressure_kPa": float(problem.conditions(x[i], np.zeros(problem.n_controls))
+                                                                  .dynamic_pressure / 1e3)} for i in peaks]
+        if problem.controls == "rates":
+            out["final_bank_deg"] = float(np.degrees(result.states[-1, 7]))
+            out["max_bank_deg"] = float(np.degrees(np.abs(result.states[:, 7]).max()))
+            out["max_alpha_deg"] = float(np.degrees(result.states[:, 6].max()))
+            try:
+                ext = extremal_controls(problem, result)
+                U = result.controls if len(result.costate_time) == len(result.time) else \
+                    0.5 * (result.controls[:-1] + result.controls[1:])
+                out["extremal_control_max_diff_deg_s"] = float(np.degrees(np.abs(ext - U).max()))
+            except ValueError:
+                pass
+    if check is not None:
+        out["propagated_terminal_error"] = check.terminal_error
+    return out

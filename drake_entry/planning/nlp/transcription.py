@@ -1,0 +1,112 @@
+"""What both transcriptions share: scaling, bounds, boundary and path constraints, the
+Mayer cost, the violation diagnosis, and assembling the NlpResult."""
+from __future__ import annotations
+
+import numpy as np
+
+from .result import NlpResult
+
+COSTATE_SIGN = 1.0  # Drake's multiplier sign convention, checked on analytic problems (tests)
+
+
+class _Transcription:
+    """Scaling, bounds, boundary conditions, path constraints shared by both transcriptions."""
+
+    def __init__(self, problem, nodes: int):
+        self.problem = problem
+        self.N = nodes
+        self.sx, self.su, self.ts = problem.scales()
+        self.nx, self.nu = problem.n_states, problem.n_controls
+        self.t_lo, self.t_hi = problem.final_time_bounds
+        self.fixed_tf = self.t_lo == self.t_hi
+
+    # scaled <-> SI
+    def L_scaled(self, xs, us):
+        """Lagrangian at scaled (x, u): integrated over scaled time it gives J / time_scale."""
+        return self.problem.lagrangian(xs * self.sx, us * self.su)
+
+    def path_scaled(self, xs, us):
+        vals = self.problem.path_values(xs * self.sx, us * self.su)
+        return np.array([v / c.scale for v, c in zip(vals, self.problem.path)])
+
+    def add_bounds(self, prog, X, U, x_first, x_last):
+        xl, xh, ul, uh = self.problem.bounds_arrays()
+        for k in range(X.shape[0]):
+            prog.AddBoundingBoxConstraint(xl / self.sx, xh / self.sx, X[k])
+        for k in range(U.shape[0]):
+            prog.AddBoundingBoxConstraint(ul / self.su, uh / self.su, U[k])
+        for which, var in (("initial", x_first), ("final", x_last)):
+            lo, hi = self.problem.boundary_bounds(which)
+            prog.AddBoundingBoxConstraint(lo / self.sx, hi / self.sx, var)
+
+    def add_path(self, prog, X, U):
+        path = self.problem.path
+        if not path:
+            return
+        lo = np.array([c.min / c.scale for c in path])
+        hi = np.array([c.max / c.scale for c in path])
+        nx = self.nx
+        for k in range(X.shape[0]):
+            prog.AddConstraint(lambda z: self.path_scaled(z[:nx], z[nx:]), lo, hi,
+                               np.concatenate([X[k], U[k]]), description=f"path[{k}]")
+
+    def mayer_cost(self, prog, x_last, tf_vars):
+        """Mayer cost M(x_f, t_f) / time_scale; t_f (scaled) is the sum of ``tf_vars`` (the
+        LGL final time, or the DirectCollocation time steps), or fixed when None."""
+        if not self.problem.has_mayer:
+            return
+        nx = self.nx
+        if tf_vars is None:
+            tf = self.t_lo
+            prog.AddCost(lambda z: self.problem.mayer(z * self.sx, tf) / self.ts, x_last)
+        else:
+            prog.AddCost(lambda z: self.problem.mayer(z[:nx] * self.sx, z[nx:].sum() * self.ts) / self.ts,
+                         np.concatenate([x_last, np.atleast_1d(tf_vars)]))
+
+    def worst_violation(self, res) -> tuple[float, str]:
+        """(largest scaled constraint violation, the constraint's description) at ``res``."""
+        worst, where = 0.0, ""
+        for b in self.prog.GetAllConstraints():
+            v = res.EvalBinding(b)
+            lo, hi = b.evaluator().lower_bound(), b.evaluator().upper_bound()
+            viol = np.maximum(lo - v, 0.0) + np.maximum(v - hi, 0.0)
+            viol = viol[np.isfinite(viol)]
+            if viol.size and viol.max() > worst:
+                worst = float(viol.max())
+                where = b.evaluator().get_description() or type(b.evaluator()).__name__
+        return worst, where
+
+    def diagnose(self, res) -> str:
+        """Name the worst violated constraint at the returned point (infeasible problems)."""
+        worst, where = self.worst_violation(res)
+        return f"largest violation {worst:.3g} (scaled) in '{where}'" if worst > 0 else "no violated constraint"
+
+    def _message(self, res, solver) -> tuple[bool, str]:
+        ok = res.is_success()
+        detail = res.get_solution_result().name
+        try:
+            if solver == "ipopt":
+                detail += f" (Ipopt status {res.get_solver_details().status})"
+            else:
+                detail += f" (SNOPT info {res.get_solver_details().info})"
+        except Exception:  # noqa: BLE001 - details are a courtesy
+            pass
+        return ok, ("solved: " if ok else "not solved: ") + detail
+
+
+
+
+def _finish(tx, ok, msg, t, X, U, res, costates, t_costate, solve_time, build_time, transcription, solver):
+    problem = tx.problem
+    objective = float(res.get_optimal_cost()) * tx.ts
+    ham = None
+    if costates is not None:
+        Xc = X if len(t_costate) == len(t) else 0.5 * (X[:-1] + X[1:])
+        Uc = U if len(t_costate) == len(t) else 0.5 * (U[:-1] + U[1:])
+        ham = np.array([float(problem.lagrangian(x, u)) + float(lam @ np.asarray(problem.dynamics(x, u), float))
+                        for x, u, lam in zip(Xc, Uc, costates)])
+    viol = tx.worst_violation(res)[0]
+    return NlpResult(success=ok, message=msg, time=t, states=X, controls=U, objective=objective,
+                     costates=costates, costate_time=t_costate, hamiltonian=ham, solve_time=solve_time,
+                     build_time=build_time, transcription=transcription, solver=solver, nodes=tx.N,
+                     max_defect=viol, problem=problem)

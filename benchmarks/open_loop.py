@@ -7,7 +7,6 @@ cheapest setting of each that meets it is reported, and the ratio Drake / scipy.
 """
 from __future__ import annotations
 
-import numpy as np
 
 T_FINAL = 1500.0
 

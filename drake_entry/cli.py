@@ -88,16 +88,20 @@ def _cmd_fly(args) -> int:
 
 
 def _cmd_plan(args) -> int:
-    from .guidance import method_for
+    import importlib
+
+    from .guidance import REGISTRY, method_for
     from .scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
-    method = method_for(scenario.guidance)
-    try:
-        return method.plan_report(scenario, args.out)
-    except NotImplementedError as e:
-        print(f"drake-entry: {e}", file=sys.stderr)
+    package = REGISTRY[type(scenario.guidance)].rpartition(".")[0]
+    try:  # a method's CLI commands live beside it (docs/architecture.md)
+        commands = importlib.import_module(f"{package}.commands")
+    except ModuleNotFoundError:
+        print(f"drake-entry: guidance method '{method_for(scenario.guidance).name}' has no plan report",
+              file=sys.stderr)
         return 2
+    return commands.plan_report(scenario, args.out)
 
 
 def _cmd_campaign(args) -> int:

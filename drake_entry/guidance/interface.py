@@ -7,7 +7,9 @@ A method is one package under ``drake_entry/guidance/`` registered in
 - a scenario spec dataclass (``spec.py``, pure data, YAML tag ``!ClassName``);
 - a ``GuidanceMethod`` (``method.py``): a planner factory, ``add_systems`` that adds its
   Drake systems to the closed-loop ``DiagramBuilder`` and returns its command ports, and
-  ``summarise`` that reads its systems after a flight into per-sample fields.
+  ``summarise`` that reads its systems after a flight into per-sample fields;
+- optionally ``commands.py`` (CLI layer) with ``plan_report(scenario, out_dir) -> int`` for
+  ``drake-entry plan``.
 
 The closed loop (``drake_entry.diagrams.closed_loop``) builds only the shared parts:
 vehicle, atmosphere, navigation, bank and angle-of-attack actuators, termination monitor
@@ -123,7 +125,3 @@ class GuidanceMethod:
     def flight_plots(self, result, out_dir: str, *, title: str = "") -> list[str]:
         """Method-specific figures of one closed-loop flight (``drake-entry fly``); PNG paths."""
         return []
-
-    def plan_report(self, scenario, out_dir: str) -> int:
-        """``drake-entry plan``: the method's reference with its figures; the exit code."""
-        raise NotImplementedError(f"guidance method '{self.name}' has no plan report")

@@ -67,10 +67,5 @@ class DragEnergyMethod(GuidanceMethod):
 
         return tracking_plot(result.trajectory, out_dir, title=f"{title}: drag tracking")
 
-    def plan_report(self, scenario, out_dir: str) -> int:
-        from .commands import plan_report  # CLI layer: flies diagrams
-
-        return plan_report(scenario, out_dir)
-
 
 METHOD = DragEnergyMethod()

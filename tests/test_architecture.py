@@ -122,3 +122,14 @@ def test_the_layer_check_catches_violations():
 def test_benchmarks_live_outside_the_library(name):
     assert not (ROOT / "drake_entry" / f"{name}.py").exists()
     assert not any(n.startswith(name) for n in project_modules())
+
+
+def test_every_package_directory_is_installed():
+    """pyproject lists its packages explicitly (package-dir maps systems/ and diagrams/):
+    a new package directory missing from the list would be absent from the wheel."""
+    tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
+
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    code = {module_name(p.parent / "__init__.py") for d in ("drake_entry", "systems", "diagrams")
+            for p in (ROOT / d).rglob("__init__.py")}
+    assert code <= listed, sorted(code - listed)

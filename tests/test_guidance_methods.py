@@ -167,3 +167,15 @@ def test_a_method_commanding_alpha_flies_it_through_the_rate_limited_actuator():
     assert rate.min() >= -4.0 * (1 + 1e-3) and alpha.min() >= 15.0 - 1e-6
     assert np.abs(np.diff(rate) / np.diff(t)[1:]).max() <= 8.0 * 1.05
     assert 6.0 < t[np.argmax(alpha < 15.01)] < 9.0
+
+
+def test_cli_fly_and_plan_with_the_second_method(tmp_path, capsys):
+    from drake_entry.cli import main
+
+    path = tmp_path / "bank_profile.yaml"
+    path.write_text(yaml_dump_typed(_bank_profile_scenario()))
+    assert main(["fly", str(path), "--out", str(tmp_path / "fly"), "--format", "csv"]) == 0
+    s = json.loads((tmp_path / "fly" / "summary.json").read_text())
+    assert s["method"] == "bank_profile" and s["reversals"] >= 2 and s["distance_m"] < 100e3
+    assert main(["plan", str(path), "--out", str(tmp_path / "plan")]) == 2
+    assert "guidance method 'bank_profile' has no plan report" in capsys.readouterr().err

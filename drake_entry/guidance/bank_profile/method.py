@@ -8,6 +8,7 @@ The magnitude is open loop in energy (``BankProfile``: linear in normalised ener
 """
 from __future__ import annotations
 
+import dataclasses as dc
 import time
 
 import numpy as np
@@ -19,15 +20,14 @@ from ..interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, Plant
 from ..reversal import add_bank_reversal, reversal_count
 
 
+@dc.dataclass
 class BankProfilePlan(PlanResult):
-    """The bank-magnitude profile |sigma|(E) [rad vs J/kg] of a BankProfile spec."""
-
-    def __init__(self, schedule: Schedule, build_time: float):
-        super().__init__(success=True, message="bank magnitude linear in normalised energy", iterations=0,
-                         build_time=build_time, solve_time=0.0, objective=float("nan"))
-        self.schedule = schedule
+    """The bank-magnitude profile |sigma|(E) [rad vs J/kg] of a BankProfile spec (nothing is
+    optimised: objective nan, no iterations)."""
 
     variable = "energy"
+
+    schedule: Schedule | None = None
 
     def evaluate(self, energy) -> dict:
         """{'bank_magnitude_rad': |sigma|} at specific energies [J/kg]."""
@@ -42,7 +42,8 @@ class BankProfileMethod(GuidanceMethod):
         g = scenario.guidance
         E0, Ef = scenario.entry_energy(), scenario.guidance_terminal_state()[2]
         schedule = Schedule((Ef, E0), (np.radians(g.bank_end_deg), np.radians(g.bank_start_deg)), "energy")
-        return BankProfilePlan(schedule, time.perf_counter() - t0)
+        return BankProfilePlan(success=True, message="bank magnitude linear in normalised energy",
+                               build_time=time.perf_counter() - t0, schedule=schedule)
 
     def add_systems(self, builder, scenario, planner: BankProfilePlan, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance

@@ -30,7 +30,7 @@ class DragEnergyMethod(GuidanceMethod):
 
     def add_systems(self, builder, scenario, planner, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance
-        guidance = builder.AddNamedSystem("guidance", DragEnergyGuidance(
+        guidance = builder.AddNamedSystem("drag_energy_guidance", DragEnergyGuidance(
             planner, period=g.period_s, pre_guidance_min_s=g.pre_guidance_min_s, replan_period_s=g.replan_period_s,
             replan_until_e=g.replan_until_e))
         pre_bank = math.radians(g.pre_guidance_bank_deg)
@@ -50,7 +50,7 @@ class DragEnergyMethod(GuidanceMethod):
                                                                   REFERENCE_COLUMNS)})
 
     def summarise(self, diagram, context, planner) -> GuidanceSummary:
-        guidance = diagram.GetSubsystemByName("guidance")
+        guidance = diagram.GetSubsystemByName("drag_energy_guidance")
         mem = guidance.memory(guidance.GetMyContextFromRoot(context))
         active = mem.engaged_at is not None
         message = ""

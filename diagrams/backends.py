@@ -10,6 +10,7 @@ import multiprocessing as mp
 
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 from drake_entry.diagrams.sample import TRAJECTORY_STEP_S, run_sample, sample_seed
+
 from drake_entry.scenario import load_campaign_scenario
 
 BACKENDS = ("serial", "processes", "dask")

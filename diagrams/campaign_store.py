@@ -13,6 +13,8 @@ from __future__ import annotations
 import json
 import os
 
+from drake_entry.errors import ScenarioError
+
 IDENTITY_KEYS = ("scenario", "seed", "overrides")  # settings a resumed campaign must share
 
 
@@ -27,7 +29,7 @@ class CampaignStore:
             with open(meta_path) as f:
                 old = json.load(f)
             if {k: old.get(k) for k in IDENTITY_KEYS} != {k: settings.get(k) for k in IDENTITY_KEYS}:
-                raise ValueError(f"{out_dir} holds a campaign with other settings ({old}); use another --out")
+                raise ScenarioError(f"{out_dir} holds a campaign with other settings ({old}); use another --out")
         with open(meta_path, "w") as f:
             json.dump(settings, f, indent=2)
         for name in ("samples.jsonl", "trajectories.jsonl"):

@@ -19,25 +19,26 @@ import dataclasses as dc
 import math
 
 import numpy as np
-from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput
-
-from drake_entry.aerodynamics import ScaledAero
-from drake_entry.atmosphere import Atmosphere, DispersedAtmosphere
 from drake_entry.diagrams.common import run
-from drake_entry.dispersions import Draw
-from drake_entry.geodesy import range_and_crossrange
-from drake_entry.guidance import method_for
-from drake_entry.guidance.interface import GuidanceMethod, GuidanceSummary, PlantPorts
-from drake_entry.planet import Earth
-from drake_entry.scenario import Scenario
-from drake_entry.schedules import Schedule
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.navigation import Navigation
 from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.systems.vehicle import EntryVehicle
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import LogVectorOutput
+
+from drake_entry.aerodynamics import ScaledAero
+from drake_entry.atmosphere import Atmosphere, DispersedAtmosphere
+from drake_entry.dispersions import Draw
+from drake_entry.errors import ScenarioError
+from drake_entry.geodesy import range_and_crossrange
+from drake_entry.guidance import method_for
+from drake_entry.guidance.interface import GuidanceMethod, GuidanceSummary, PlantPorts
+from drake_entry.planet import Earth
+from drake_entry.scenario import Scenario
+from drake_entry.schedules import Schedule
 from drake_entry.trajectory import Trajectory
 from drake_entry.vehicles import Vehicle
 
@@ -161,7 +162,7 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
     else:
         lim = commands.alpha_limits
         if lim is None:
-            raise ValueError(f"guidance method '{setup.method.name}' commands alpha without alpha_limits")
+            raise ScenarioError(f"guidance method '{setup.method.name}' commands alpha without alpha_limits")
         alpha = builder.AddNamedSystem("alpha_actuator", AlphaActuator(
             alpha_min=lim.lower, alpha_max=lim.upper, rate_limit=lim.rate, accel_limit=lim.acceleration,
             initial_alpha=commands.initial_alpha, period=g.period_s))

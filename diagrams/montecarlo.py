@@ -11,8 +11,9 @@ import os
 
 from drake_entry.diagrams.backends import BACKENDS, run_dask, run_processes, run_serial
 from drake_entry.diagrams.campaign_store import CampaignStore, done_indices, finalise  # noqa: F401 (API)
-from drake_entry.diagrams.sample import (TIMING_COLUMNS, TRAJECTORY_STEP_S, campaign_row,  # noqa: F401 (API)
-                                         run_sample, sample_seed)
+from drake_entry.diagrams.sample import TIMING_COLUMNS, TRAJECTORY_STEP_S, campaign_row, run_sample, sample_seed  # noqa: F401 (API)
+
+from drake_entry.errors import ScenarioError
 from drake_entry.scenario import apply_overrides, load_campaign_scenario  # noqa: F401 (API)
 
 
@@ -32,11 +33,11 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     both are converted to Parquet and campaign.json records the settings.
     """
     if backend not in BACKENDS:
-        raise ValueError(f"backend '{backend}' is unknown; allowed: {', '.join(BACKENDS)}")
+        raise ScenarioError(f"backend '{backend}' is unknown; allowed: {', '.join(BACKENDS)}")
     if not runs >= 1:
-        raise ValueError(f"runs must be >= 1, got {runs}")
+        raise ScenarioError(f"runs must be >= 1, got {runs}")
     if not trajectory_step_s >= 0:
-        raise ValueError(f"trajectory_step_s must be >= 0 s (0 = no trajectories), got {trajectory_step_s}")
+        raise ScenarioError(f"trajectory_step_s must be >= 0 s (0 = no trajectories), got {trajectory_step_s}")
     store = CampaignStore(out_dir, {"scenario": scenario_path, "runs": runs, "seed": seed,
                                     "overrides": overrides or {}, "trajectory_step_s": trajectory_step_s,
                                     "dispersion": "scenario dispersions"})

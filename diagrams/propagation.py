@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses as dc
 
 import numpy as np
+from drake_entry.systems.ocp_plant import OptimalControlPlant
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
@@ -20,7 +21,6 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.geodesy import downtrack_crosstrack
 from drake_entry.planning.ocp import OptimalControlProblem
-from drake_entry.systems.ocp_plant import OptimalControlPlant
 
 
 @dc.dataclass

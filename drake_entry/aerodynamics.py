@@ -17,8 +17,8 @@ Models:
 from __future__ import annotations
 
 import bisect
-import math
 import csv
+import math
 from dataclasses import dataclass, field
 from importlib import resources
 from typing import Callable, NamedTuple, Sequence
@@ -27,6 +27,7 @@ import numpy as np
 from pydrake.autodiffutils import AutoDiffXd
 from scipy.interpolate import CubicSpline
 
+from .errors import ScenarioError
 from .scalar import clamp, is_autodiff, lift, value_of
 
 DEG = np.pi / 180.0
@@ -163,14 +164,14 @@ class TableAero(AeroModel):
         for name in ("CL", "CD"):
             arr = np.asarray(getattr(self, name), dtype=float)
             if arr.shape != shape:
-                raise ValueError(f"TableAero.{name} has shape {arr.shape}; expected {shape} (alpha x Mach)")
+                raise ScenarioError(f"TableAero.{name} has shape {arr.shape}; expected {shape} (alpha x Mach)")
             if np.isnan(arr).any():
-                raise ValueError(f"TableAero.{name} has empty cells; fill them before building a table model")
+                raise ScenarioError(f"TableAero.{name} has empty cells; fill them before building a table model")
             setattr(self, name, arr)
         if np.any(np.diff(self.alpha_deg) <= 0) or np.any(np.diff(self.mach) <= 0):
-            raise ValueError("TableAero.alpha_deg and TableAero.mach must be strictly increasing")
+            raise ScenarioError("TableAero.alpha_deg and TableAero.mach must be strictly increasing")
         if self.mach[0] <= 0:
-            raise ValueError(f"TableAero.mach must be > 0, got {self.mach[0]}")
+            raise ScenarioError(f"TableAero.mach must be > 0, got {self.mach[0]}")
         a = self.alpha_deg * DEG
         lnm = np.log(self.mach)
         self._splines = (_BicubicSpline(a, lnm, self.CL), _BicubicSpline(a, lnm, self.CD))
@@ -276,9 +277,9 @@ class HorusFitAero(AeroModel):
 
     def __post_init__(self):
         if len(self.aD) != 10:
-            raise ValueError(f"HorusFitAero.aD needs 10 coefficients (paper 000 eq. 32), got {len(self.aD)}")
+            raise ScenarioError(f"HorusFitAero.aD needs 10 coefficients (paper 000 eq. 32), got {len(self.aD)}")
         if len(self.aL) != 14:
-            raise ValueError(f"HorusFitAero.aL needs 14 coefficients (paper 000 eq. 33), got {len(self.aL)}")
+            raise ScenarioError(f"HorusFitAero.aL needs 14 coefficients (paper 000 eq. 33), got {len(self.aL)}")
         self.aD = [float(v) for v in self.aD]
         self.aL = [float(v) for v in self.aL]
 
@@ -400,7 +401,7 @@ class DragPolarAero(AeroModel):
 
     def __post_init__(self):
         if self.cd0 <= 0 or self.k < 0:
-            raise ValueError(f"DragPolarAero needs cd0 > 0 and k >= 0, got cd0={self.cd0}, k={self.k}")
+            raise ScenarioError(f"DragPolarAero needs cd0 > 0 and k >= 0, got cd0={self.cd0}, k={self.k}")
 
     def coefficients(self, alpha, mach):
         cl = self.cl_alpha * alpha
@@ -429,11 +430,11 @@ class PolynomialAero(AeroModel):
 
     def __post_init__(self):
         if self.alpha_unit not in ("deg", "rad"):
-            raise ValueError(f"PolynomialAero.alpha_unit must be 'deg' or 'rad', got '{self.alpha_unit}'")
+            raise ScenarioError(f"PolynomialAero.alpha_unit must be 'deg' or 'rad', got '{self.alpha_unit}'")
         for name in ("CL", "CD"):
             m = getattr(self, name)
             if not m or not all(isinstance(r, (list, tuple)) and len(r) == len(m[0]) for r in m):
-                raise ValueError(f"PolynomialAero.{name} must be a non-empty rectangular list of lists")
+                raise ScenarioError(f"PolynomialAero.{name} must be a non-empty rectangular list of lists")
 
     @staticmethod
     def _poly(c, a, x):
@@ -481,7 +482,7 @@ class CallableAero(AeroModel):
 
     def __post_init__(self):
         if not callable(self.cl) or not callable(self.cd):
-            raise ValueError("CallableAero needs callables cl(alpha, mach) and cd(alpha, mach)")
+            raise ScenarioError("CallableAero needs callables cl(alpha, mach) and cd(alpha, mach)")
 
     def coefficients(self, alpha, mach):
         return self.cl(alpha, mach), self.cd(alpha, mach)
@@ -497,7 +498,7 @@ class ScaledAero(AeroModel):
 
     def __post_init__(self):
         if not self.lift_scale > 0 or not self.drag_scale > 0:
-            raise ValueError(f"ScaledAero scales must be > 0, got {self.lift_scale}, {self.drag_scale}")
+            raise ScenarioError(f"ScaledAero scales must be > 0, got {self.lift_scale}, {self.drag_scale}")
 
     def coefficients(self, alpha, mach):
         cl, cd = self.base.coefficients(alpha, mach)

@@ -27,6 +27,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from .errors import ScenarioError
 from .scalar import clamp, is_autodiff, is_symbolic, lift, value_of
 
 # U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
@@ -63,7 +64,7 @@ def _check_range(name: str, h, lo: float, hi: float):
     hv = np.asarray(value_of(h), dtype=float)
     if hv.size and (np.nanmin(hv) < lo or np.nanmax(hv) > hi or np.isnan(hv).any()):
         bad = hv[(hv < lo) | (hv > hi) | np.isnan(hv)].flat[0]
-        raise ValueError(f"altitude h = {bad:.6g} m is outside the {name} range [{lo:.6g}, {hi:.6g}] m")
+        raise ScenarioError(f"altitude h = {bad:.6g} m is outside the {name} range [{lo:.6g}, {hi:.6g}] m")
 
 
 class Atmosphere:
@@ -297,11 +298,11 @@ class ExponentialAtmosphere(Atmosphere):
 
     def __post_init__(self):
         if not self.rho0 > 0:
-            raise ValueError(f"ExponentialAtmosphere.rho0 must be > 0 kg/m^3, got {self.rho0}")
+            raise ScenarioError(f"ExponentialAtmosphere.rho0 must be > 0 kg/m^3, got {self.rho0}")
         if not self.scale_height > 0:
-            raise ValueError(f"ExponentialAtmosphere.scale_height must be > 0 m, got {self.scale_height}")
+            raise ScenarioError(f"ExponentialAtmosphere.scale_height must be > 0 m, got {self.scale_height}")
         if self.temperature_K is not None and not self.temperature_K > 0:
-            raise ValueError(f"ExponentialAtmosphere.temperature_K must be > 0 K, got {self.temperature_K}")
+            raise ScenarioError(f"ExponentialAtmosphere.temperature_K must be > 0 K, got {self.temperature_K}")
 
     def density(self, h):
         return self.rho0 * np.exp(-h / self.scale_height)
@@ -337,7 +338,7 @@ class DispersedAtmosphere(Atmosphere):
     def __init__(self, base: Atmosphere, *, scale: float = 1.0, amplitude: float = 0.0,
                  wavelength: float = 8000.0, phase: float = 0.0):
         if not scale > 0 or not 0 <= amplitude < 1 or not wavelength > 0:
-            raise ValueError(f"DispersedAtmosphere needs scale > 0, 0 <= amplitude < 1, wavelength > 0 "
+            raise ScenarioError(f"DispersedAtmosphere needs scale > 0, 0 <= amplitude < 1, wavelength > 0 "
                              f"(got {scale}, {amplitude}, {wavelength})")
         self.base, self.scale, self.amplitude = base, scale, amplitude
         self.k, self.phase = 2.0 * math.pi / wavelength, phase
@@ -381,7 +382,7 @@ def make_atmosphere(name: str, **kwargs) -> Atmosphere:
         return US76Atmosphere()
     if name == "exponential":
         return ExponentialAtmosphere(**kwargs)
-    raise ValueError(f"atmosphere model '{name}' is unknown; allowed: 'us76', 'exponential'")
+    raise ScenarioError(f"atmosphere model '{name}' is unknown; allowed: 'us76', 'exponential'")
 
 
 def write_upper_table(path: str) -> None:

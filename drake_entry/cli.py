@@ -27,7 +27,6 @@ from .errors import ScenarioError
 
 def _cmd_simulate(args) -> int:
     from .diagrams.open_loop import simulate
-
     from .plots import trajectory_plots
     from .results import write_table
     from .scenario import load_scenario
@@ -145,7 +144,6 @@ def _cmd_fit_horus(args) -> int:
 
 def _cmd_optimize(args) -> int:
     from .diagrams.propagation import propagate
-
     from .planning import nlp
     from .planning.ocp_yaml import load_problem
     from .plots import nlp_solution_plots

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .errors import ScenarioError
+
 
 @dataclass(frozen=True)
 class HeatFlux:
@@ -29,7 +31,7 @@ class HeatFlux:
 
     def __post_init__(self):
         if not self.coefficient > 0:
-            raise ValueError(f"HeatFlux.coefficient must be > 0, got {self.coefficient}")
+            raise ScenarioError(f"HeatFlux.coefficient must be > 0, got {self.coefficient}")
 
     def __call__(self, rho, V):
         return self.coefficient * rho**self.density_exponent * V**self.velocity_exponent
@@ -62,7 +64,7 @@ class HeatFlux:
 
 def _check_nose(r):
     if not r > 0:
-        raise ValueError(f"nose_radius must be > 0 m, got {r}")
+        raise ScenarioError(f"nose_radius must be > 0 m, got {r}")
 
 
 def make_heat_flux(form: str, *, nose_radius: float, coefficient: float | None = None,
@@ -79,9 +81,9 @@ def make_heat_flux(form: str, *, nose_radius: float, coefficient: float | None =
         return HeatFlux.normalised(nose_radius, **({} if coefficient is None else {"c_star": coefficient}))
     if form == "lumped":
         if coefficient is None or velocity_exponent is None:
-            raise ValueError("heat_flux form 'lumped' needs coefficient and velocity_exponent")
+            raise ScenarioError("heat_flux form 'lumped' needs coefficient and velocity_exponent")
         return HeatFlux.lumped(coefficient, velocity_exponent)
-    raise ValueError(f"heat_flux.form '{form}' is unknown; allowed: chapman, sutton_graves, normalised, lumped")
+    raise ScenarioError(f"heat_flux.form '{form}' is unknown; allowed: chapman, sutton_graves, normalised, lumped")
 
 
 def dynamic_pressure(rho, V):
@@ -117,7 +119,7 @@ class PathLimits:
     def __post_init__(self):
         for name in ("heat_flux_max", "dynamic_pressure_max", "normal_load_max", "total_load_max"):
             if not getattr(self, name) > 0:
-                raise ValueError(f"PathLimits.{name} must be > 0, got {getattr(self, name)}")
+                raise ScenarioError(f"PathLimits.{name} must be > 0, got {getattr(self, name)}")
 
     def margins(self, *, heat_flux, dynamic_pressure, normal_load, total_load) -> dict:
         """Relative margins 1 - value/limit (negative means violated)."""

@@ -18,6 +18,7 @@ from scipy.optimize import brentq
 
 from .atmosphere import Atmosphere
 from .constraints import PathLimits
+from .errors import ScenarioError
 from .planet import Earth
 from .vehicles import Vehicle
 
@@ -83,7 +84,7 @@ def compute_corridor(energies, alpha_of_E: Callable[[float], float], vehicle: Ve
     """
     limits = limits or vehicle.limits
     if not 0.0 <= margin < 0.5:
-        raise ValueError(f"corridor margin must be in [0, 0.5), got {margin}")
+        raise ScenarioError(f"corridor margin must be in [0, 0.5), got {margin}")
     E_grid = np.sort(np.asarray(energies, float))
     mu, S_m, g0 = planet.mu, vehicle.area_over_mass, planet.g0
     upper = {k: np.full(E_grid.size, np.inf) for k in BOUND_NAMES}
@@ -93,7 +94,7 @@ def compute_corridor(energies, alpha_of_E: Callable[[float], float], vehicle: Ve
     for i, (E, alpha) in enumerate(zip(E_grid, alphas)):
         h_top = mu / (-E) - planet.reference_radius  # V = 0 on this energy level
         if not h_top > h_floor:
-            raise ValueError(f"energy {E:.6g} J/kg is below the surface energy; corridor undefined there")
+            raise ScenarioError(f"energy {E:.6g} J/kg is below the surface energy; corridor undefined there")
         h_hi = min(h_top - 1.0, atmosphere.h_max)
         sa, ca = math.sin(alpha), math.cos(alpha)
 

@@ -12,6 +12,7 @@ from scipy.integrate import solve_ivp
 
 from .actuator import actuator_rates
 from .dynamics import specific_energy, state_derivatives
+from .errors import ScenarioError
 from .scenario import Scenario
 
 
@@ -25,7 +26,7 @@ def solve_ivp_open_loop(scenario: Scenario, t_final: float, *, method: str = "DO
     alpha_s, bank_s = scenario.schedule("alpha"), scenario.schedule("bank")
     for which, sch in (("alpha", alpha_s), ("bank", bank_s)):
         if sch.variable not in ("time", "energy"):
-            raise ValueError(f"solve_ivp_open_loop supports time and energy schedules only ({which} is "
+            raise ScenarioError(f"solve_ivp_open_loop supports time and energy schedules only ({which} is "
                              f"'{sch.variable}')")
 
     def command(sch, t, y):

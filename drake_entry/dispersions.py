@@ -27,6 +27,8 @@ import typing
 import numpy as np
 import pydrake.common.schema as schema
 
+from .errors import ScenarioError
+
 Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
 Vector = typing.Union[schema.DeterministicVectorX, schema.GaussianVectorX, schema.UniformVectorX]
 
@@ -113,7 +115,7 @@ def draw(spec: DispersionSpec, generator) -> Draw:
     nav_seed = int(generator())  # last draw: seeds the navigation noise sequence
     for k in ("density_scale", "lift_scale", "drag_scale", "mass_scale"):
         if not scales[k] > 0:
-            raise ValueError(f"dispersions.{k} drew {scales[k]:g}; it must stay > 0 (narrow its distribution)")
+            raise ScenarioError(f"dispersions.{k} drew {scales[k]:g}; it must stay > 0 (narrow its distribution)")
     return Draw(delta, scales["density_scale"], scales["density_wave_amplitude"],
                 spec.density_wave_length_km * 1e3, phase, scales["lift_scale"], scales["drag_scale"],
                 scales["mass_scale"], bias, np.asarray(spec.nav_noise_sigma, float), nav_seed)
@@ -122,8 +124,8 @@ def draw(spec: DispersionSpec, generator) -> Draw:
 def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
     """Shape and range checks that do not need a draw."""
     if np.asarray(spec.nav_bias.Mean()).size != 6:
-        raise ValueError(f"{where}.nav_bias needs 6 entries [h, lon, lat, V, gamma, psi]")
+        raise ScenarioError(f"{where}.nav_bias needs 6 entries [h, lon, lat, V, gamma, psi]")
     if len(spec.nav_noise_sigma) != 6 or min(spec.nav_noise_sigma) < 0:
-        raise ValueError(f"{where}.nav_noise_sigma needs 6 entries >= 0")
+        raise ScenarioError(f"{where}.nav_noise_sigma needs 6 entries >= 0")
     if not spec.density_wave_length_km > 0:
-        raise ValueError(f"{where}.density_wave_length_km must be > 0, got {spec.density_wave_length_km}")
+        raise ScenarioError(f"{where}.density_wave_length_km must be > 0, got {spec.density_wave_length_km}")

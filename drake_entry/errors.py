@@ -7,9 +7,19 @@ import re
 from pydrake.common.yaml import yaml_load_typed
 
 
-class ScenarioError(ValueError):
-    """Bad user input (scenario, vehicle or problem file): one line naming the field and
-    the allowed range."""
+class DrakeEntryError(Exception):
+    """Base of every user-facing error: the CLI prints it as one line and exits 2. Anything
+    else that escapes is a bug and keeps its traceback."""
+
+
+class ScenarioError(DrakeEntryError, ValueError):
+    """Bad user input (scenario, vehicle or problem file, API argument): one line naming the
+    field, the value and the allowed range."""
+
+
+class CampaignError(DrakeEntryError):
+    """A campaign directory that cannot be used as asked (other settings, another writer,
+    nothing to report)."""
 
 
 def check_range(field: str, value, lo: float, hi: float):

@@ -11,6 +11,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import geodesy
+from .errors import ScenarioError
 
 # WGS-84 / EGM constants.
 MU_EARTH = 3.986004418e14  # m^3/s^2 (paper 000 eq. 28, corrected units)
@@ -46,11 +47,11 @@ class Earth:
     def __post_init__(self):
         for name, lo in (("mu", 0.0), ("reference_radius", 0.0), ("equatorial_radius", 0.0)):
             if not getattr(self, name) > lo:
-                raise ValueError(f"Earth.{name} must be > {lo}, got {getattr(self, name)}")
+                raise ScenarioError(f"Earth.{name} must be > {lo}, got {getattr(self, name)}")
         if not 0.0 <= self.flattening < 1.0:
-            raise ValueError(f"Earth.flattening must be in [0, 1), got {self.flattening}")
+            raise ScenarioError(f"Earth.flattening must be in [0, 1), got {self.flattening}")
         if self.g0 <= 0:
-            raise ValueError(f"Earth.g0 must be > 0, got {self.g0}")
+            raise ScenarioError(f"Earth.g0 must be > 0, got {self.g0}")
 
     @staticmethod
     def spherical(*, rotating: bool = True, j2: bool = False, **kwargs) -> "Earth":

@@ -17,11 +17,13 @@ from functools import lru_cache
 import numpy as np
 from numpy.polynomial import legendre
 
+from .errors import ScenarioError
+
 
 def lgl_nodes(n_nodes: int) -> np.ndarray:
     """LGL nodes on [-1, 1], increasing (Newton iteration from Chebyshev-Lobatto points)."""
     if n_nodes < 2:
-        raise ValueError(f"LGL needs at least 2 nodes, got {n_nodes}")
+        raise ScenarioError(f"LGL needs at least 2 nodes, got {n_nodes}")
     N = n_nodes - 1
     x = -np.cos(np.pi * np.arange(n_nodes) / N)
     for _ in range(100):
@@ -92,7 +94,7 @@ class LGL:
 
     def __post_init__(self):
         if self.a == self.b:
-            raise ValueError("LGL interval must have a != b")
+            raise ScenarioError("LGL interval must have a != b")
         self.tau, self.weights_tau, self.D1_tau, self.D2_tau, self.bary = _reference_operators(int(self.n_nodes))
         half = (self.b - self.a) / 2.0
         self.x = half * self.tau + (self.a + self.b) / 2.0  # eq. 12

@@ -10,10 +10,10 @@ from __future__ import annotations
 import json
 import os
 
+import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np
 
 from . import plots  # also sets the Agg backend
-import matplotlib.pyplot as plt  # noqa: E402
 
 ERROR_COLUMNS = (("err_altitude_m", "Δh", "m"), ("err_longitude_deg", "Δθ", "deg"),
                  ("err_latitude_deg", "Δφ", "deg"), ("err_velocity_m_s", "ΔV", "m/s"),

@@ -5,6 +5,8 @@ import os
 
 import numpy as np
 
+from .errors import ScenarioError
+
 
 def write_table(columns: dict, path: str) -> str:
     """Write {name: 1-D array} to ``path``; the suffix picks the format (.parquet or .csv)."""
@@ -19,7 +21,7 @@ def write_table(columns: dict, path: str) -> str:
         np.savetxt(path, np.column_stack([np.asarray(columns[n], float) for n in names]), delimiter=",",
                    header=",".join(names), comments="", fmt="%.10g")
     else:
-        raise ValueError(f"output '{path}' must end in .parquet or .csv")
+        raise ScenarioError(f"output '{path}' must end in .parquet or .csv")
     return path
 
 

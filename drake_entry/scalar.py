@@ -59,7 +59,8 @@ def lift(inputs, value: float, partials):
 def clamp(x, lo: float, hi: float):
     """x limited to [lo, hi]; the derivative is zero where the bound is active."""
     if is_symbolic(x):
-        from pydrake.symbolic import max as smax, min as smin
+        from pydrake.symbolic import max as smax
+        from pydrake.symbolic import min as smin
 
         return smin(smax(x, lo), hi)
     v = value_of(x)

@@ -283,7 +283,7 @@ def apply_overrides(scenario: Scenario, overrides: dict):
         for p in path:
             obj = getattr(obj, p)
         if not hasattr(obj, last):
-            raise ValueError(f"override '{key}': no such field")
+            raise ScenarioError(f"override '{key}': no such field")
         setattr(obj, last, value)
     scenario.validate()
 

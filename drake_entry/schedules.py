@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .errors import ScenarioError
+
 VARIABLES = ("time", "energy", "mach", "velocity")
 
 
@@ -34,11 +36,11 @@ class Schedule:
     def __post_init__(self):
         bp = np.asarray(self.breakpoints, float)
         if self.variable not in VARIABLES:
-            raise ValueError(f"Schedule.variable must be one of {VARIABLES}, got '{self.variable}'")
+            raise ScenarioError(f"Schedule.variable must be one of {VARIABLES}, got '{self.variable}'")
         if bp.size == 0 or bp.size != len(self.values):
-            raise ValueError(f"Schedule needs as many values as breakpoints (got {bp.size} and {len(self.values)})")
+            raise ScenarioError(f"Schedule needs as many values as breakpoints (got {bp.size} and {len(self.values)})")
         if np.any(np.diff(bp) <= 0):
-            raise ValueError("Schedule.breakpoints must be strictly increasing")
+            raise ScenarioError("Schedule.breakpoints must be strictly increasing")
 
     def _scalar(self, s: float) -> float:
         bp, v = self.breakpoints, self.values

@@ -114,9 +114,9 @@ class Vehicle:
         for field, unit in (("mass", "kg"), ("reference_area", "m^2"), ("nose_radius", "m")):
             v = getattr(self, field)
             if not (isinstance(v, (int, float)) and v > 0 and np.isfinite(v)):
-                raise ValueError(f"Vehicle.{field} must be a finite number > 0 {unit}, got {v}")
+                raise ScenarioError(f"Vehicle.{field} must be a finite number > 0 {unit}, got {v}")
         if not 0 < self.bank_limit <= np.pi:
-            raise ValueError(f"Vehicle.bank_limit must be in (0, 180] deg, got {np.degrees(self.bank_limit):.4g} deg")
+            raise ScenarioError(f"Vehicle.bank_limit must be in (0, 180] deg, got {np.degrees(self.bank_limit):.4g} deg")
         if self.heat_flux is None:
             self.heat_flux = HeatFlux.chapman(self.nose_radius)
 

@@ -24,6 +24,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.actuator import actuator_rates, integrate_actuator
+from drake_entry.errors import ScenarioError
 
 
 class LimitedActuator(LeafSystem):
@@ -37,9 +38,9 @@ class LimitedActuator(LeafSystem):
         super().__init__()
         for field, v in (("rate_limit", rate_limit), ("accel_limit", accel_limit), ("bandwidth", bandwidth)):
             if not v > 0:
-                raise ValueError(f"{type(self).__name__}.{field} must be > 0, got {v}")
+                raise ScenarioError(f"{type(self).__name__}.{field} must be > 0, got {v}")
         if not lower < upper:
-            raise ValueError(f"{type(self).__name__} needs lower < upper, got [{lower}, {upper}]")
+            raise ScenarioError(f"{type(self).__name__} needs lower < upper, got [{lower}, {upper}]")
         self.limits = dict(lower=lower, upper=upper, rate_limit=rate_limit, accel_limit=accel_limit,
                            bandwidth=bandwidth)
         self.cmd_port = self.DeclareVectorInputPort(f"{name}_command", 1)
@@ -54,7 +55,7 @@ class LimitedActuator(LeafSystem):
                                          prerequisites_of_calc=state)
             return
         if not 0 < substep <= period:
-            raise ValueError(f"{type(self).__name__}.substep must be in (0, period], got {substep}")
+            raise ScenarioError(f"{type(self).__name__}.substep must be in (0, period], got {substep}")
         self.n_sub = max(1, int(round(period / substep)))
         self._segment = self.DeclareAbstractState(AbstractValue.Make(_constant_segment(initial)))
         self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._plan_segment)
@@ -90,7 +91,7 @@ class BankActuator(LimitedActuator):
                  initial_bank: float = 0.0, period: float | None = None, substep: float = 0.02):
         """Args: bank_limit [rad] (> 0), the rest as LimitedActuator."""
         if not bank_limit > 0:
-            raise ValueError(f"BankActuator.bank_limit must be > 0, got {bank_limit}")
+            raise ScenarioError(f"BankActuator.bank_limit must be > 0, got {bank_limit}")
         super().__init__(name="bank", lower=-bank_limit, upper=bank_limit, rate_limit=rate_limit,
                          accel_limit=accel_limit, bandwidth=bandwidth, initial=initial_bank, period=period,
                          substep=substep)

@@ -19,6 +19,7 @@ import math
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
+from drake_entry.errors import ScenarioError
 from drake_entry.geodesy import bearing
 
 
@@ -27,9 +28,9 @@ class BankReversalLogic(LeafSystem):
                  corridor_velocity=(1000.0, 6000.0), period: float = 1.0, initial_sign: float = 1.0):
         super().__init__()
         if corridor_velocity[1] <= corridor_velocity[0]:
-            raise ValueError("BankReversalLogic corridor_velocity must be increasing")
+            raise ScenarioError("BankReversalLogic corridor_velocity must be increasing")
         if min(corridor_deg) <= 0:
-            raise ValueError("BankReversalLogic corridor_deg must be > 0")
+            raise ScenarioError("BankReversalLogic corridor_deg must be > 0")
         self.target = (target_lon, target_lat)
         self.corridor = (np.radians(corridor_deg), np.asarray(corridor_velocity, float))
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)

@@ -22,11 +22,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from drake_entry.systems.drag_energy_guidance import sensed_drag
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.errors import ScenarioError
 from drake_entry.planning.drag_energy import DragEnergyPlanner
-from drake_entry.systems.drag_energy_guidance import sensed_drag
 
 
 class DragTrackingController(LeafSystem):
@@ -38,11 +39,11 @@ class DragTrackingController(LeafSystem):
         bandwidth [rad/s]: if > 0, omega = bandwidth / (D V) at each update instead."""
         super().__init__()
         if not zeta < 0:
-            raise ValueError(f"DragTrackingController.zeta must be < 0 (energy decreases), got {zeta}")
+            raise ScenarioError(f"DragTrackingController.zeta must be < 0 (energy decreases), got {zeta}")
         if not omega > 0:
-            raise ValueError(f"DragTrackingController.omega must be > 0 per J/kg, got {omega}")
+            raise ScenarioError(f"DragTrackingController.omega must be > 0 per J/kg, got {omega}")
         if not 0 <= integral_ratio < 1:
-            raise ValueError(f"DragTrackingController.integral_ratio must be in [0, 1), got {integral_ratio}")
+            raise ScenarioError(f"DragTrackingController.integral_ratio must be in [0, 1), got {integral_ratio}")
         self.planner = planner
         self.zeta, self.omega, self.bandwidth = zeta, omega, bandwidth
         self.integral_ratio = integral_ratio

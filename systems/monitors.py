@@ -15,6 +15,7 @@ from __future__ import annotations
 from pydrake.systems.framework import EventStatus, LeafSystem, PublishEvent, WitnessFunctionDirection
 
 from drake_entry.dynamics import specific_energy
+from drake_entry.errors import ScenarioError
 from drake_entry.planet import Earth
 
 
@@ -30,7 +31,7 @@ class TerminationMonitor(LeafSystem):
         self.targets = {k: v for k, v in (("altitude", altitude), ("mach", mach), ("energy", energy),
                                           ("velocity", velocity)) if v is not None}
         if not self.targets:
-            raise ValueError("TerminationMonitor needs at least one of altitude, mach, energy, velocity")
+            raise ScenarioError("TerminationMonitor needs at least one of altitude, mach, energy, velocity")
         self._witnesses = []
         for name, target in self.targets.items():
             calc = self._make_calc(name, target)

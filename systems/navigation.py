@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
+from drake_entry.errors import ScenarioError
+
 
 class Navigation(LeafSystem):
     def __init__(self, *, bias=None, noise_sigma=None, period: float = 1.0, seed: int = 0):
@@ -21,11 +23,11 @@ class Navigation(LeafSystem):
         self.bias = np.zeros(6) if bias is None else np.asarray(bias, float)
         self.sigma = np.zeros(6) if noise_sigma is None else np.asarray(noise_sigma, float)
         if self.bias.shape != (6,) or self.sigma.shape != (6,):
-            raise ValueError("Navigation.bias and noise_sigma must have 6 entries (one per state)")
+            raise ScenarioError("Navigation.bias and noise_sigma must have 6 entries (one per state)")
         if np.any(self.sigma < 0):
-            raise ValueError("Navigation.noise_sigma must be >= 0")
+            raise ScenarioError("Navigation.noise_sigma must be >= 0")
         if not period > 0:
-            raise ValueError(f"Navigation.period must be > 0 s, got {period}")
+            raise ScenarioError(f"Navigation.period must be > 0 s, got {period}")
         self.seed = int(seed)
         self.period = float(period)
         self.true_port = self.DeclareVectorInputPort("true_state", 6)

@@ -13,6 +13,7 @@ from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, specific_energy
+from drake_entry.errors import ScenarioError
 from drake_entry.planet import Earth
 from drake_entry.schedules import Schedule
 
@@ -48,7 +49,7 @@ class ScheduleSource(LeafSystem):
         )
         if period is not None:
             if not period > 0:
-                raise ValueError(f"ScheduleSource.period must be > 0 s, got {period}")
+                raise ScenarioError(f"ScheduleSource.period must be > 0 s, got {period}")
             self._held = self.DeclareDiscreteState([initial_value])
             self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._sample)
             self.DeclareForcedDiscreteUpdateEvent(self._sample)

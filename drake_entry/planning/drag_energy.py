@@ -33,13 +33,14 @@ from scipy.optimize import brentq
 
 from ..atmosphere import Atmosphere
 from ..corridor import Corridor, compute_corridor
-from ..geodesy import bearing
 from ..drag_dynamics import AlphaProfile, DragDynamics, DragTerms, drag_acceleration, drag_dynamics
+from ..errors import ScenarioError
+from ..geodesy import bearing
 from ..planet import Earth
 from ..pseudospectral import LGL
-from .result import PlanResult
 from ..schedules import Schedule
 from ..vehicles import Vehicle
+from .result import PlanResult
 
 SOLVERS = {"clarabel": ClarabelSolver, "scs": ScsSolver}
 
@@ -88,16 +89,16 @@ class DragEnergyProblem:
 
     def validate(self):
         if not self.E0 > self.Ef:
-            raise ValueError(f"DragEnergyProblem needs E0 > Ef, got E0={self.E0:.6g}, Ef={self.Ef:.6g} J/kg")
+            raise ScenarioError(f"DragEnergyProblem needs E0 > Ef, got E0={self.E0:.6g}, Ef={self.Ef:.6g} J/kg")
         if not (self.corridor.energy[0] <= self.Ef and self.E0 <= self.corridor.energy[-1] + 1.0):
-            raise ValueError(f"corridor covers [{self.corridor.energy[0]:.6g}, {self.corridor.energy[-1]:.6g}] "
+            raise ScenarioError(f"corridor covers [{self.corridor.energy[0]:.6g}, {self.corridor.energy[-1]:.6g}] "
                              f"J/kg, not [{self.Ef:.6g}, {self.E0:.6g}]")
         if self.solver not in SOLVERS:
-            raise ValueError(f"solver '{self.solver}' is unknown; allowed: {', '.join(SOLVERS)}")
+            raise ScenarioError(f"solver '{self.solver}' is unknown; allowed: {', '.join(SOLVERS)}")
         if not 5 <= self.n_nodes <= 400:
-            raise ValueError(f"n_nodes must be in [5, 400], got {self.n_nodes}")
+            raise ScenarioError(f"n_nodes must be in [5, 400], got {self.n_nodes}")
         if not self.D0 > 0 or not self.range_to_go > 0:
-            raise ValueError(f"D0 and range_to_go must be > 0 (got {self.D0}, {self.range_to_go})")
+            raise ScenarioError(f"D0 and range_to_go must be > 0 (got {self.D0}, {self.range_to_go})")
 
 
 @dataclass
@@ -468,7 +469,7 @@ class DragEnergyPlanner:
                  solver: str = "clarabel", margin: float = 0.03, corridor_points: int = 300,
                  sigma_max: float | None = None, terminal_drag: float | None = None):
         if alpha.variable != "energy":
-            raise ValueError(f"the drag-energy planner needs alpha scheduled in energy, got '{alpha.variable}'")
+            raise ScenarioError(f"the drag-energy planner needs alpha scheduled in energy, got '{alpha.variable}'")
         self.vehicle, self.atmosphere, self.alpha = vehicle, atmosphere, alpha
         self.planet = planet.with_(j2=0.0)  # paper 000 eq. 37: central gravity in the planner
         self.target = (target_lon, target_lat)

@@ -19,8 +19,9 @@ from typing import Callable
 import numpy as np
 
 from ..atmosphere import Atmosphere
-from ..geodesy import central_angle_smooth, crossrange_from_great_circle
 from ..dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_derivatives
+from ..errors import ScenarioError
+from ..geodesy import central_angle_smooth, crossrange_from_great_circle
 from ..planet import Earth
 from ..vehicles import Vehicle
 
@@ -49,10 +50,10 @@ class PathConstraint:
 
     def __post_init__(self):
         if not callable(self.quantity) and self.quantity not in PATH_QUANTITIES:
-            raise ValueError(f"path constraint quantity '{self.quantity}' is unknown; allowed: "
+            raise ScenarioError(f"path constraint quantity '{self.quantity}' is unknown; allowed: "
                              f"{', '.join(PATH_QUANTITIES)} or a callable f(x, u, env)")
         if not self.min <= self.max or (math.isinf(self.min) and math.isinf(self.max)):
-            raise ValueError(f"path constraint '{self.label}' needs min <= max with one finite, got "
+            raise ScenarioError(f"path constraint '{self.label}' needs min <= max with one finite, got "
                              f"[{self.min}, {self.max}]")
         if self.scale is None:
             finite = [abs(v) for v in (self.min, self.max) if math.isfinite(v) and v != 0.0]
@@ -98,12 +99,12 @@ class ObjectiveTerm:
 
     def __post_init__(self):
         if self.kind not in LAGRANGE_KINDS + MAYER_KINDS:
-            raise ValueError(f"objective kind '{self.kind}' is unknown; allowed: "
+            raise ScenarioError(f"objective kind '{self.kind}' is unknown; allowed: "
                              f"{', '.join(LAGRANGE_KINDS + MAYER_KINDS)}")
         if self.kind in ("lagrange", "mayer") and self.function is None:
-            raise ValueError(f"objective kind '{self.kind}' needs a function")
+            raise ScenarioError(f"objective kind '{self.kind}' needs a function")
         if self.kind == "miss_distance" and self.target is None:
-            raise ValueError("objective 'miss_distance' needs target = (lon, lat) [rad]")
+            raise ScenarioError("objective 'miss_distance' needs target = (lon, lat) [rad]")
 
     @property
     def is_lagrange(self) -> bool:
@@ -132,13 +133,13 @@ class _ProblemLayout:
         for where, d in (("initial", self.initial), ("final", self.final), ("state_bounds", self.state_bounds)):
             for k in d:
                 if k not in self.state_names:
-                    raise ValueError(f"{where}: unknown state '{k}'; states are {', '.join(self.state_names)}")
+                    raise ScenarioError(f"{where}: unknown state '{k}'; states are {', '.join(self.state_names)}")
         for k in self.control_bounds:
             if k not in self.control_names:
-                raise ValueError(f"control_bounds: unknown control '{k}'; controls are {', '.join(self.control_names)}")
+                raise ScenarioError(f"control_bounds: unknown control '{k}'; controls are {', '.join(self.control_names)}")
         lo, hi = self.final_time_bounds
         if not 0.0 < lo <= hi:
-            raise ValueError(f"final_time must be > 0 with min <= max, got {self.final_time}")
+            raise ScenarioError(f"final_time must be > 0 with min <= max, got {self.final_time}")
 
     def _default_state_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         return np.full(self.n_states, -np.inf), np.full(self.n_states, np.inf)
@@ -203,7 +204,7 @@ class CustomProblem(_ProblemLayout):
     def __post_init__(self):
         self._check_layout()
         if self.lagrange_function is None and self.mayer_function is None:
-            raise ValueError("CustomProblem needs a lagrange_function or a mayer_function")
+            raise ScenarioError("CustomProblem needs a lagrange_function or a mayer_function")
 
     def dynamics(self, x, u):
         return np.asarray(self.dynamics_function(x, u))
@@ -260,13 +261,13 @@ class OptimalControlProblem(_ProblemLayout):
 
     def __post_init__(self):
         if self.controls not in ("rates", "direct"):
-            raise ValueError(f"controls must be 'rates' or 'direct', got '{self.controls}'")
+            raise ScenarioError(f"controls must be 'rates' or 'direct', got '{self.controls}'")
         self._check_layout()
         if not self.objective:
-            raise ValueError("objective needs at least one term")
+            raise ScenarioError("objective needs at least one term")
         for term in self.objective:
             if term.kind == "control_margin" and self.controls != "rates":
-                raise ValueError("objective 'control_margin' (paper 002 eq. 11) needs controls='rates'")
+                raise ScenarioError("objective 'control_margin' (paper 002 eq. 11) needs controls='rates'")
 
     # -- layout -------------------------------------------------------------------------
     @property
@@ -378,7 +379,7 @@ class OptimalControlProblem(_ProblemLayout):
     def _initial_value(self, i: int) -> float:
         v = self.initial.get(self.state_names[i])
         if v is None or isinstance(v, (tuple, list)):
-            raise ValueError(f"crossrange needs a fixed initial {self.state_names[i]}")
+            raise ScenarioError(f"crossrange needs a fixed initial {self.state_names[i]}")
         return float(v)
 
     def path_values(self, x, u) -> list:

@@ -32,6 +32,7 @@ import time as _time
 import numpy as np
 from pydrake.solvers import IpoptSolver, SnoptSolver, SolverOptions
 
+from ...errors import ScenarioError
 from .dircol import _DircolTranscription
 from .guess import initial_guess
 from .lgl import _LglTranscription
@@ -56,13 +57,13 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
       max_iterations: solver iteration limit.
     """
     if transcription not in TRANSCRIPTIONS:
-        raise ValueError(f"transcription '{transcription}' is unknown; allowed: {', '.join(TRANSCRIPTIONS)}")
+        raise ScenarioError(f"transcription '{transcription}' is unknown; allowed: {', '.join(TRANSCRIPTIONS)}")
     if solver not in SOLVERS:
-        raise ValueError(f"solver '{solver}' is unknown; allowed: {', '.join(SOLVERS)}")
+        raise ScenarioError(f"solver '{solver}' is unknown; allowed: {', '.join(SOLVERS)}")
     if not (isinstance(nodes, (int, np.integer)) and nodes >= 3):
-        raise ValueError(f"nodes must be an integer >= 3, got {nodes}")
+        raise ScenarioError(f"nodes must be an integer >= 3, got {nodes}")
     if not tolerance > 0:
-        raise ValueError(f"tolerance must be > 0, got {tolerance}")
+        raise ScenarioError(f"tolerance must be > 0, got {tolerance}")
     engine = IpoptSolver() if solver == "ipopt" else SnoptSolver()
     if not engine.available() or not engine.enabled():
         raise NlpError(f"solver '{solver}' is not available in this pydrake build")

@@ -6,7 +6,7 @@ from pydrake.autodiffutils import ExtractGradient, ExtractValue, InitializeAutoD
 from pydrake.solvers import MathematicalProgram
 
 from ...pseudospectral import LGL
-from .evaluator import _NodeEvaluator, _chain
+from .evaluator import _chain, _NodeEvaluator
 from .result import NlpResult
 from .transcription import COSTATE_SIGN, _finish, _Transcription
 

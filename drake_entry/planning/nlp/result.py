@@ -6,6 +6,7 @@ import dataclasses as dc
 
 import numpy as np
 
+from ...errors import DrakeEntryError, ScenarioError
 from ...pseudospectral import interpolation_matrix
 from ..ocp import OptimalControlProblem
 from ..result import PlanResult
@@ -81,7 +82,7 @@ class NlpResult(PlanResult):
         return lambda tt: np.column_stack([np.interp(np.atleast_1d(tt), t, X[:, j]) for j in range(X.shape[1])])
 
 
-class NlpError(RuntimeError):
+class NlpError(DrakeEntryError, RuntimeError):
     """The NLP could not be built (bad options or problem)."""
 
 
@@ -94,12 +95,12 @@ def extremal_controls(problem, result: NlpResult) -> np.ndarray:
     The paper prints u_max / (2 k) in eq. 23; differentiating its eq. 11 gives u_max^2
     (the square is missing in eqs. 22-23)."""
     if not isinstance(problem, OptimalControlProblem) or problem.controls != "rates":
-        raise ValueError("extremal_controls needs an entry problem with controls='rates'")
+        raise ScenarioError("extremal_controls needs an entry problem with controls='rates'")
     terms = [t for t in problem.objective if t.kind == "control_margin"]
     if len(terms) != 1 or any(t.kind in ("lagrange",) for t in problem.objective):
-        raise ValueError("extremal_controls needs exactly one control_margin term and no user Lagrange term")
+        raise ScenarioError("extremal_controls needs exactly one control_margin term and no user Lagrange term")
     if result.costates is None:
-        raise ValueError("the result has no costates (the solver returned no multipliers)")
+        raise ScenarioError("the result has no costates (the solver returned no multipliers)")
     t = terms[0]
     lam = result.costates
     u = np.column_stack([-t.u_alpha_max ** 2 * lam[:, 6] / (2.0 * t.weight * t.k[1]),

@@ -91,9 +91,12 @@ class ClosedLoopResult:
       errors: terminal errors (Table 3 form): altitude_m, longitude_deg, latitude_deg,
         velocity_m_s, range_to_go_m (along the heading, + short of the target),
         crossrange_m (+ target to the right), distance_m.
-      success: reached the terminal energy with the guidance active.
-      message: human summary. method: the guidance method's name.
+      success: reached the terminal energy with the guidance active, finite terminal errors,
+        and inside every criterion of the mission's acceptance box.
+      message: human summary (the criteria missed, when outside the box).
+      method: the guidance method's name.
       guidance: the method's GuidanceSummary (plans, planning time, its own fields and details).
+      box: the acceptance box per criterion given (acceptance_box).
     """
 
     trajectory: Trajectory
@@ -102,6 +105,7 @@ class ClosedLoopResult:
     message: str
     method: str
     guidance: GuidanceSummary
+    box: dict = dc.field(default_factory=dict)
 
 
 @dc.dataclass
@@ -196,6 +200,24 @@ def terminal_errors(x, setup: ClosedLoopSetup) -> dict:
             "range_to_go_m": rng, "crossrange_m": cross, "distance_m": dist}
 
 
+def acceptance_box(tr: Trajectory, setup: ClosedLoopSetup) -> dict:
+    """The mission's acceptance box (scenario.terminal tolerances, paper 000 Table 1) at the
+    final state: {criterion: {"error": e, "tolerance": tol, "inside": |e| <= tol}} for each
+    criterion whose tolerance is given: 'altitude' [m] about terminal.altitude_km, 'mach'
+    about terminal.mach, 'distance' [m] to the target."""
+    t, x = setup.scenario.terminal, tr.state[-1]
+    box = {}
+    if t.altitude_km is not None and t.altitude_tolerance_km is not None:
+        box["altitude"] = (float(x[0] - t.altitude_km * 1e3), t.altitude_tolerance_km * 1e3)
+    if t.mach is not None and t.mach_tolerance is not None:
+        box["mach"] = (float(tr.column("mach")[-1] - t.mach), t.mach_tolerance)
+    if t.distance_tolerance_km is not None:
+        tlon, tlat = math.radians(setup.scenario.target.longitude_deg), math.radians(setup.scenario.target.latitude_deg)
+        box["distance"] = (float(setup.planet.great_circle_distance(x[1], x[2], tlon, tlat)),
+                           t.distance_tolerance_km * 1e3)
+    return {k: {"error": e, "tolerance": tol, "inside": bool(abs(e) <= tol)} for k, (e, tol) in box.items()}
+
+
 def fly(scenario: Scenario | ClosedLoopSetup, planner=None, *, initial_state=None, nav_seed: int = 0,
         nav_bias=None, nav_noise=None, draw: Draw | None = None) -> ClosedLoopResult:
     """Fly the closed loop once (the nominal entry state unless ``initial_state`` or a
@@ -212,11 +234,23 @@ def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoo
     """ClosedLoopResult of a finished closed-loop simulation."""
     guidance = setup.method.summarise(diagram, ctx, setup.planner)
     errors = terminal_errors(tr.state[-1], setup)
-    ok = "energy" in tr.reason and guidance.active
-    if ok:
-        msg = f"reached E_f at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
+    box = acceptance_box(tr, setup)
+    missed = [f"{k} {_box_text(k, b)}" for k, b in box.items() if not b["inside"]]
+    if "energy" not in tr.reason:
+        ok, msg = False, f"stopped before E_f: {tr.reason}"
     elif not guidance.active:
-        msg = guidance.message
+        ok, msg = False, guidance.message
+    elif not all(math.isfinite(v) for v in errors.values()):
+        ok, msg = False, f"reached E_f with non-finite terminal errors {errors}"
+    elif missed:
+        ok, msg = False, f"outside the acceptance box: {'; '.join(missed)} (reached E_f at t = {tr.time[-1]:.1f} s)"
     else:
-        msg = f"stopped before E_f: {tr.reason}"
-    return ClosedLoopResult(tr, errors, ok, msg, setup.method.name, guidance)
+        ok = True
+        msg = f"reached E_f at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
+    return ClosedLoopResult(tr, errors, ok, msg, setup.method.name, guidance, box)
+
+
+def _box_text(name: str, b: dict) -> str:
+    if name == "mach":
+        return f"error {b['error']:+.3f} outside +-{b['tolerance']:g}"
+    return f"error {b['error'] / 1e3:+.3f} km outside +-{b['tolerance'] / 1e3:g} km"

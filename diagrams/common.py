@@ -8,6 +8,7 @@ import time as _time
 import numpy as np
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 
+from drake_entry.errors import NonFiniteStateError
 from drake_entry.scenario import Scenario
 from drake_entry.trajectory import Trajectory
 
@@ -29,7 +30,7 @@ def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loo
 
 
 def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason: str, wall_time: float,
-                       columns: dict | None = None) -> Trajectory:
+                       columns: dict | None = None, final_instant: bool = True) -> Trajectory:
     """Trajectory from the loggers, with every logged signal's value at the final instant
     appended (the witness-located stop).
 
@@ -37,19 +38,24 @@ def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason
       loggers: name -> VectorLogSink; must include 'state', 'conditions', 'bank', 'alpha'.
       sources: name -> (system name, output port name or index) giving each logged signal.
       columns: name -> table column names of the extra signals (Trajectory.extra_columns).
+      final_instant: append the signals at the context's time (False after a run stopped
+        inside a step, whose state is not a solution).
     """
     t_end = context.get_time()
     data = {}
     times = loggers["state"].FindLog(context).sample_times()
     keep = times < t_end - 1e-9
     for name, logger in loggers.items():
-        system_name, port = sources[name]
-        system = diagram.GetSubsystemByName(system_name)
-        port = system.GetOutputPort(port) if isinstance(port, str) else system.get_output_port(port)
-        final = port.Eval(system.GetMyContextFromRoot(context))
-        data[name] = np.column_stack([logger.FindLog(context).data()[:, keep], final]).T
+        logged = logger.FindLog(context).data()[:, keep]
+        if final_instant:
+            system_name, port = sources[name]
+            system = diagram.GetSubsystemByName(system_name)
+            port = system.GetOutputPort(port) if isinstance(port, str) else system.get_output_port(port)
+            logged = np.column_stack([logged, port.Eval(system.GetMyContextFromRoot(context))])
+        data[name] = logged.T
     extra = {k: v for k, v in data.items() if k not in ("state", "conditions", "bank", "alpha")}
-    return Trajectory(time=np.append(times[keep], t_end), state=data["state"], conditions=data["conditions"],
+    time = np.append(times[keep], t_end) if final_instant else times[keep]
+    return Trajectory(time=time, state=data["state"], conditions=data["conditions"],
                       bank=data["bank"][:, 0], alpha=data["alpha"][:, 0], reason=reason, wall_time=wall_time,
                       extra=extra, extra_columns={k: v for k, v in (columns or {}).items() if k in extra})
 
@@ -75,8 +81,13 @@ def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_st
     simulator = make_simulator(diagram, scenario, initial_state=initial_state, closed_loop=closed_loop)
     simulator.Initialize()
     t0 = _time.perf_counter()
-    status = simulator.AdvanceTo(scenario.simulation.max_time_s)
+    try:
+        reason = stop_reason(simulator.AdvanceTo(scenario.simulation.max_time_s))
+        final = True
+    except NonFiniteStateError as e:  # a NaN command or model: stop with the reason, keep the log
+        reason = f"stopped at t = {simulator.get_context().get_time():.3f} s: {e}"
+        final = False
     wall = _time.perf_counter() - t0
-    tr = collect_trajectory(diagram, loggers, simulator.get_context(), sources=sources, reason=stop_reason(status),
-                            wall_time=wall, columns=columns)
+    tr = collect_trajectory(diagram, loggers, simulator.get_context(), sources=sources, reason=reason,
+                            wall_time=wall, columns=columns, final_instant=final)
     return tr, simulator

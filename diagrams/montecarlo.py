@@ -7,20 +7,46 @@ RandomSimulation (diagrams.sample). The report is drake_entry.report.
 """
 from __future__ import annotations
 
+import hashlib
+import importlib.metadata
+import math
 import os
 
+import numpy as np
+from pydrake.common.yaml import yaml_dump_typed
+
+import drake_entry
 from drake_entry.diagrams.backends import BACKENDS, run_dask, run_processes, run_serial
-from drake_entry.diagrams.campaign_store import CampaignStore, done_indices, finalise  # noqa: F401 (API)
+from drake_entry.campaign_store import CampaignStore, done_indices, finalise  # noqa: F401 (API)
 from drake_entry.diagrams.sample import TIMING_COLUMNS, TRAJECTORY_STEP_S, campaign_row, run_sample, sample_seed  # noqa: F401 (API)
 
 from drake_entry.errors import ScenarioError
-from drake_entry.scenario import apply_overrides, load_campaign_scenario  # noqa: F401 (API)
+from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
+from drake_entry.vehicles import PACKAGED_VEHICLES
+
+
+def campaign_manifest(scenario_path: str, *, seed: int, trajectory_step_s: float, overrides: dict | None,
+                      runs: int) -> dict:
+    """The manifest of a campaign: the scenario as flown (loaded, overrides applied, a user
+    vehicle file made absolute and hashed), seed, trajectory step and versions. Raises a
+    ScenarioError for a scenario that does not load, before anything is written."""
+    scenario = load_campaign_scenario(scenario_path, overrides)
+    vehicle_sha = None
+    if scenario.vehicle not in PACKAGED_VEHICLES:
+        scenario.vehicle = os.path.abspath(scenario.vehicle)
+        with open(scenario.vehicle, "rb") as f:
+            vehicle_sha = hashlib.sha256(f.read()).hexdigest()
+    name = scenario_path if scenario_path in PACKAGED_SCENARIOS else os.path.abspath(scenario_path)
+    return {"scenario": name, "scenario_yaml": yaml_dump_typed(scenario), "vehicle_file_sha256": vehicle_sha,
+            "seed": int(seed), "trajectory_step_s": float(trajectory_step_s), "overrides": overrides or {},
+            "versions": {"drake_entry": drake_entry.__version__, "drake": importlib.metadata.version("drake")},
+            "runs": int(runs), "dispersion": "scenario dispersions"}
 
 
 def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, workers: int | None = None,
                  overrides: dict | None = None, progress: bool = True, backend: str = "processes",
                  scheduler: str | None = None, trajectory_step_s: float = TRAJECTORY_STEP_S) -> str:
-    """Run (or resume) a campaign of ``runs`` samples; returns out_dir.
+    """Run (or resume, or extend) a campaign of ``runs`` samples; returns out_dir.
 
     backend: 'serial', 'processes' (``workers`` local processes, default all cores) or
     'dask' (``scheduler`` address of a running Dask cluster, or a LocalCluster of
@@ -29,21 +55,28 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     trajectory_step_s: spacing [s] of the down-sampled trajectories kept per sample (0 keeps
     none: the smallest output for large campaigns; the report then omits the envelopes).
 
-    Rows stream to out_dir/samples.jsonl; trajectories to trajectories.jsonl; at the end
-    both are converted to Parquet and campaign.json records the settings.
+    The directory's manifest fingerprints the scenario content, seed, trajectory step and
+    versions: a directory holding another campaign is refused (CampaignError); a larger
+    ``runs`` with the same settings extends it. Rows stream to out_dir/samples.jsonl,
+    trajectories to trajectories.jsonl; at the end both are converted to Parquet.
     """
     if backend not in BACKENDS:
         raise ScenarioError(f"backend '{backend}' is unknown; allowed: {', '.join(BACKENDS)}")
-    if not runs >= 1:
-        raise ScenarioError(f"runs must be >= 1, got {runs}")
-    if not trajectory_step_s >= 0:
-        raise ScenarioError(f"trajectory_step_s must be >= 0 s (0 = no trajectories), got {trajectory_step_s}")
-    store = CampaignStore(out_dir, {"scenario": scenario_path, "runs": runs, "seed": seed,
-                                    "overrides": overrides or {}, "trajectory_step_s": trajectory_step_s,
-                                    "dispersion": "scenario dispersions"})
+    for name, value, lo in (("runs", runs, 1), ("seed", seed, 0)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value < 2**63:
+            raise ScenarioError(f"{name} = {value} is out of range; allowed: an integer >= {lo}")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer))
+                                or not 1 <= workers <= 4096):
+        raise ScenarioError(f"workers = {workers} is out of range; allowed: an integer in [1, 4096] (default: all cores)")
+    if not (isinstance(trajectory_step_s, (int, float)) and 0 <= trajectory_step_s < math.inf):
+        raise ScenarioError(f"trajectory_step_s = {trajectory_step_s} is out of range; allowed: >= 0 s "
+                            f"(0 = no trajectories)")
+    manifest = campaign_manifest(scenario_path, seed=seed, trajectory_step_s=trajectory_step_s, overrides=overrides,
+                                 runs=runs)
+    store = CampaignStore(out_dir, manifest)
     done = store.done_indices()
     todo = [i for i in range(runs) if i not in done]
-    workers = workers or os.cpu_count() or 1
+    workers = min(workers or os.cpu_count() or 1, max(len(todo), 1))
     bar = None
     if progress:
         from tqdm import tqdm
@@ -60,13 +93,14 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
                     failed += 1
                     bar.set_postfix(failed=failed)
 
+        scenario_yaml = manifest["scenario_yaml"]
         if backend == "serial" or (backend == "processes" and workers == 1):
-            run_serial(todo, record, scenario_path, overrides, seed, trajectory_step_s)
+            run_serial(todo, record, scenario_yaml, seed, trajectory_step_s)
         elif backend == "processes":
-            run_processes(todo, record, scenario_path, overrides, seed, workers, trajectory_step_s)
+            run_processes(todo, record, scenario_yaml, seed, workers, trajectory_step_s)
         else:
-            run_dask(todo, record, scenario_path, overrides, seed, workers, scheduler, trajectory_step_s)
+            run_dask(todo, record, scenario_yaml, seed, workers, scheduler, trajectory_step_s)
+        store.finalise()
     if bar is not None:
         bar.close()
-    store.finalise()
     return out_dir

@@ -55,8 +55,7 @@ def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
     try:
         RandomSimulation(make, output, scenario.simulation.max_time_s, RandomGenerator(seed))
         built, ctx = box["built"], box["context"]
-        reason = built.diagram.GetSubsystemByName("termination").reason
-        reason = f"reached {reason}" if reason else "max_time"
+        reason = built.diagram.GetSubsystemByName("termination").reason or "max_time"
         tr = collect_trajectory(built.diagram, built.loggers, ctx, sources=built.sources, reason=reason,
                                 wall_time=time.perf_counter() - t_wall, columns=built.columns)
         res = summarise(setup, built.diagram, ctx, tr)
@@ -90,6 +89,7 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
         "err_range_m": res.errors["range_to_go_m"], "err_crossrange_m": res.errors["crossrange_m"],
         "err_distance_m": res.errors["distance_m"],
         **metrics(tr, setup.vehicle.limits),
+        **{f"inside_{k}_box": b["inside"] for k, b in res.box.items()},
     }
 
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from .atmosphere import Atmosphere
 from .constraints import dynamic_pressure, normal_load_factor, total_load_factor
+from .errors import NonFiniteStateError
 from .planet import Earth
 from .scalar import promote
 from .vehicles import Vehicle
@@ -106,6 +107,11 @@ def equations_of_motion(x, bank, L, D, planet: Earth):
         + 2.0 * w * (sl - cl * tan_g * cp)
         + w * w * r / (V * cg) * sl * cl * sp
     )
+    if fn is math:  # float path: stop on NaN/inf here (an error-controlled integrator would
+        total = h_dot + lon_dot + lat_dot + V_dot + gamma_dot + psi_dot  # shrink its step for ever)
+        if total - total != 0.0:
+            raise NonFiniteStateError(f"non-finite state derivative at h = {h:.6g} m, V = {V:.6g} m/s, "
+                                      f"gamma = {gamma:.6g} rad, bank = {bank:.6g} rad, L = {L:.6g}, D = {D:.6g}")
     return np.array([h_dot, lon_dot, lat_dot, V_dot, gamma_dot, psi_dot])
 
 

@@ -17,6 +17,11 @@ class ScenarioError(DrakeEntryError, ValueError):
     field, the value and the allowed range."""
 
 
+class NonFiniteStateError(DrakeEntryError, FloatingPointError):
+    """The equations of motion produced NaN or infinity (a NaN command, model or state):
+    a simulation stops there with this as its reason instead of integrating garbage."""
+
+
 class CampaignError(DrakeEntryError):
     """A campaign directory that cannot be used as asked (other settings, another writer,
     nothing to report)."""

@@ -2,24 +2,26 @@
 
 ``summary_statistics(rows)`` gives mean, 1-sigma and percentiles of the terminal errors
 (paper 000 Table 3; paper 003 Table 3 counts inside 25/50/75 km) and the worst
-path-constraint margins. ``write_report(out_dir)`` reads a campaign directory
-(samples.parquet, trajectories.parquet) and writes report.md with its figures.
+path-constraint margins. ``write_report(out_dir)`` reads a campaign directory's streams
+(drake_entry.campaign_store) and writes report.md with its figures and what it covers.
 """
 from __future__ import annotations
 
 import json
 import os
 
-import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np
 
-from . import plots  # also sets the Agg backend
+from . import plots  # sets the Agg backend before pyplot is imported
+from .campaign_store import coverage, read_trajectories
+from .errors import CampaignError
+from .plots import plt
 
 ERROR_COLUMNS = (("err_altitude_m", "Δh", "m"), ("err_longitude_deg", "Δθ", "deg"),
                  ("err_latitude_deg", "Δφ", "deg"), ("err_velocity_m_s", "ΔV", "m/s"),
                  ("err_range_m", "ΔR (range to go)", "m"), ("err_crossrange_m", "cross-range", "m"),
                  ("err_distance_m", "distance to target", "m"))
-MARGIN_COLUMNS = ("margin_heat_flux", "margin_dynamic_pressure", "margin_normal_load")
+MARGIN_COLUMNS = ("margin_heat_flux", "margin_dynamic_pressure", "margin_normal_load", "margin_total_load")
 
 # paper 000 Table 3 (mean, 1-sigma), for side-by-side comparison
 PAPER000_TABLE3 = {"err_altitude_m": (168.6, 1107.3), "err_longitude_deg": (-0.0036, 0.0055),
@@ -27,44 +29,65 @@ PAPER000_TABLE3 = {"err_altitude_m": (168.6, 1107.3), "err_longitude_deg": (-0.0
                    "err_range_m": (312.3, 1529.7)}
 
 
+def _finite(rows: dict, col: str, n: int) -> np.ndarray:
+    """A column as floats (missing column or entry = nan)."""
+    v = rows.get(col)
+    return np.full(n, np.nan) if v is None else np.array([np.nan if x is None else x for x in v], float)
+
+
+def reached_terminal(rows: dict) -> np.ndarray:
+    """Samples whose flight reached the terminal interface (stopped at E_f) with finite
+    terminal errors: the population of the error statistics, inside the box or not."""
+    n = len(rows["index"])
+    stop = rows.get("stop") or [None] * n
+    return np.array([bool(s) and str(s).startswith("reached energy") for s in stop]) & np.isfinite(
+        _finite(rows, "err_distance_m", n))
+
+
 def summary_statistics(rows: dict) -> dict:
-    """Statistics over successful samples; rows is a column dict (e.g. from Parquet)."""
-    ok = np.asarray(rows["success"], bool)
-    n = int(ok.size)
-    out = {"samples": n, "successful": int(ok.sum()), "failed": int(n - ok.sum()), "errors": {}, "margins": {}}
+    """Statistics of a campaign's rows (a column dict, e.g. from Parquet).
+
+    Counts: samples, successful (inside the acceptance box), reached (terminal interface
+    reached, inside the box or not), failed (not successful) with their reasons, and the
+    samples inside each box criterion. Terminal-error statistics over the reached samples;
+    path-constraint margins over every sample that flew (a finite margin).
+    """
+    n = len(rows["index"])
+    ok = np.array([bool(v) for v in rows["success"]])
+    reached = reached_terminal(rows)
+    out = {"samples": n, "successful": int(ok.sum()), "reached": int(reached.sum()), "failed": int(n - ok.sum()),
+           "errors": {}, "margins": {}, "inside_box": {}}
     reasons = {}
-    for flag, msg in zip(ok, rows.get("message", [""] * n)):
+    for flag, msg in zip(ok, rows.get("message") or [""] * n):
         if not flag:
             key = str(msg).split(":")[0][:80]
             reasons[key] = reasons.get(key, 0) + 1
     out["failure_reasons"] = reasons
     for col, _, _ in ERROR_COLUMNS:
-        if col not in rows:
-            continue
-        v = np.asarray(rows[col], float)[ok]
-        v = v[np.isfinite(v)]
+        v = _finite(rows, col, n)[reached]
         if v.size == 0:
             continue
         out["errors"][col] = {"mean": float(v.mean()), "std": float(v.std(ddof=1)) if v.size > 1 else 0.0,
                               "p5": float(np.percentile(v, 5)), "p50": float(np.percentile(v, 50)),
                               "p95": float(np.percentile(v, 95)), "max_abs": float(np.abs(v).max())}
-    if "err_distance_m" in rows:
-        d = np.asarray(rows["err_distance_m"], float)[ok]
+    if reached.any():
+        d = _finite(rows, "err_distance_m", n)[reached]
         out["inside_km"] = {str(r): int((d <= r * 1e3).sum()) for r in (2, 25, 50, 75)}
+    for col in [c for c in rows if c.startswith("inside_") and c.endswith("_box")]:
+        out["inside_box"][col[len("inside_"):-len("_box")]] = int(sum(bool(v) for v in rows[col] if v is not None))
     for col in MARGIN_COLUMNS:
-        if col in rows:
-            m = np.asarray(rows[col], float)[ok]
-            if m.size:
-                out["margins"][col] = {"worst": float(m.min()), "violations": int((m < 0).sum()),
-                                       "worst_sample": int(np.asarray(rows["index"])[ok][m.argmin()])}
+        m = _finite(rows, col, n)
+        flew = np.isfinite(m)
+        if flew.any():
+            out["margins"][col] = {"worst": float(m[flew].min()), "violations": int((m[flew] < 0).sum()),
+                                   "worst_sample": int(np.asarray(rows["index"])[flew][m[flew].argmin()])}
     if "wall_time_s" in rows:
-        w = np.asarray(rows["wall_time_s"], float)
-        out["wall_time_s"] = {"mean": float(w.mean()), "total": float(w.sum())}
-        cost = {k: np.asarray(rows[k], float)[ok] for k in ("planning_wall_s", "plans", "derivative_evaluations")
-                if k in rows}
-        if len(cost) == 3 and cost["plans"].size:
-            out["cost"] = {"wall_s_per_sample": float(w[ok].mean()),
-                           "planning_share": float(cost["planning_wall_s"].sum() / w[ok].sum()),
+        w = _finite(rows, "wall_time_s", n)
+        out["wall_time_s"] = {"mean": float(np.nanmean(w)), "total": float(np.nansum(w))}
+        cost = {k: _finite(rows, k, n)[reached] for k in ("planning_wall_s", "plans", "derivative_evaluations")}
+        if reached.any() and all(np.isfinite(v).all() for v in cost.values()):
+            out["cost"] = {"wall_s_per_sample": float(w[reached].mean()),
+                           "planning_share": float(cost["planning_wall_s"].sum() / w[reached].sum()),
                            "plans_per_sample": float(cost["plans"].mean()),
                            "derivative_evaluations_per_sample": float(cost["derivative_evaluations"].mean())}
     return out
@@ -84,31 +107,103 @@ def table3_markdown(stats: dict) -> str:
     return "\n".join(lines)
 
 
-def _read(out_dir: str, name: str):
-    import pyarrow.parquet as pq
-
-    path = os.path.join(out_dir, name)
-    return pq.read_table(path).to_pydict() if os.path.exists(path) else None
+def _columns(records: list) -> dict:
+    keys = sorted({k for r in records for k in r if k != "traceback"})
+    return {k: [r.get(k) for r in records] for k in keys}
 
 
 def write_report(out_dir: str, *, title: str | None = None, limits=None) -> str:
-    """Write report.md, summary.json and PNG figures for the campaign in out_dir."""
-    rows = _read(out_dir, "samples.parquet")
-    if rows is None:
-        raise FileNotFoundError(f"{out_dir}/samples.parquet not found: run the campaign first")
-    traj = _read(out_dir, "trajectories.parquet")
+    """Write report.md, summary.json and PNG figures for the campaign in out_dir.
+
+    Reads the campaign's streams (samples.jsonl, trajectories.jsonl: the truth, also for a
+    killed or running campaign) and says what the report covers: samples requested and
+    done, lines cut or quarantined. Raises CampaignError when out_dir holds no campaign."""
+    cov = coverage(out_dir)
+    meta = cov["manifest"]
+    records = [cov["rows"][k] for k in sorted(cov["rows"])]
+    if not records:
+        raise CampaignError(f"{out_dir} holds a campaign without any finished sample yet: nothing to report")
+    rows = _columns(records)
+    trajs = read_trajectories(out_dir, set(cov["rows"]))
+    traj = None
+    if trajs:
+        traj = {}
+        for s in sorted(trajs):
+            for k, v in trajs[s].items():
+                traj.setdefault(k, []).extend(v)
     stats = summary_statistics(rows)
-    meta = json.load(open(os.path.join(out_dir, "campaign.json"))) if os.path.exists(
-        os.path.join(out_dir, "campaign.json")) else {}
+    stats["coverage"] = {"requested": cov["requested"], "done": len(records), "cut_lines": cov["cut"],
+                         "invalid_lines": cov["invalid"], "quarantined_lines": cov["quarantined"]}
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
         json.dump(stats, f, indent=2)
     figs = []
-    ok = np.asarray(rows["success"], bool)
+    reached = reached_terminal(rows)
+    if reached.any():
+        figs += _terminal_figures(rows, reached, out_dir)
+    if traj is not None:
+        figs += _trajectory_figures(traj, out_dir, limits)
 
+    c = stats["coverage"]
+    md = [f"# {title or 'Monte-Carlo campaign'}", "",
+          f"Scenario `{meta.get('scenario', '?')}` (method `{_method(rows)}`), seed {meta.get('seed', '?')}, "
+          f"dispersion {meta.get('dispersion', '?')}, overrides {meta.get('overrides', {})}.", "",
+          f"Covers {c['done']} of {c['requested']} requested samples"
+          + (f" (**incomplete**: {c['requested'] - c['done']} not run; re-run the campaign command to finish it)"
+             if c["done"] < c["requested"] else "") + ": "
+          f"{stats['successful']} inside the acceptance box, {stats['reached']} reached the terminal interface, "
+          f"{stats['failed']} not successful."]
+    if stats["inside_box"]:
+        md += ["", "Acceptance box (scenario `terminal` tolerances), samples inside each criterion: " + ", ".join(
+            f"{k} {v}" for k, v in stats["inside_box"].items()) + "."]
+    damaged = c["cut_lines"] + c["invalid_lines"] + c["quarantined_lines"]
+    if damaged:
+        md += ["", f"Stream damage: {c['cut_lines']} cut last line(s) and {c['invalid_lines']} invalid line(s) "
+               f"not counted, {c['quarantined_lines']} line(s) in quarantine.jsonl (their samples ran again)."]
+    md += [""]
+    if stats["errors"]:
+        md += ["## Terminal errors (paper 000 Table 3 form; samples that reached the terminal interface)", "",
+               table3_markdown(stats), "",
+               "ΔR is the range to go along the final heading (+ short of the target); the cross-range "
+               "is reported separately, the paper does not give it.", ""]
+    if stats.get("inside_km"):
+        md += ["Samples within a distance of the target: " + ", ".join(
+            f"{k} km: {v}" for k, v in stats["inside_km"].items()), ""]
+    if stats["margins"]:
+        md += ["## Path-constraint margins (worst over all runs; negative = violated)", "",
+               "| constraint | worst margin | violations | worst sample |", "|---|---|---|---|"]
+        for col, m in stats["margins"].items():
+            md.append(f"| {col.replace('margin_', '')} | {100 * m['worst']:.2f} % | {m['violations']} | "
+                      f"{m['worst_sample']} |")
+    if stats.get("cost"):
+        c = stats["cost"]
+        md += ["", f"Cost: {c['wall_s_per_sample']:.2f} s of one core per sample, {100 * c['planning_share']:.0f} % of "
+               f"it re-planning ({c['plans_per_sample']:.1f} plans), {c['derivative_evaluations_per_sample']:.0f} "
+               "plant derivative evaluations."]
+    if stats["failure_reasons"]:
+        md += ["", "## Samples not successful, by reason", ""] + [
+            f"- {k}: {v}" for k, v in stats["failure_reasons"].items()]
+    if traj is None:
+        md += ["", "Trajectories were not kept (`--trajectory-step 0`) or none finished: the state envelopes, "
+               "constraint histories, drag profiles and groundtracks are omitted."]
+    md += ["", "## Figures", ""] + [f"![{os.path.basename(p)}]({os.path.basename(p)})" for p in figs]
+    path = os.path.join(out_dir, "report.md")
+    with open(path, "w") as f:
+        f.write("\n".join(md) + "\n")
+    return path
+
+
+def _method(rows: dict) -> str:
+    names = sorted({str(m) for m in rows.get("method", []) if m})
+    return ", ".join(names) or "?"
+
+
+def _terminal_figures(rows: dict, reached, out_dir: str) -> list:
+    figs = []
+    n = len(rows["index"])
     # histograms of the terminal errors
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
     for ax, (col, label, unit) in zip(axes, (ERROR_COLUMNS[0], ERROR_COLUMNS[3], ERROR_COLUMNS[4])):
-        ax.hist(np.asarray(rows[col], float)[ok], bins=40, color="C0")
+        ax.hist(_finite(rows, col, n)[reached], bins=40, color="C0")
         ax.set_xlabel(f"{label} [{unit}]")
         ax.grid(True)
     axes[0].set_ylabel("samples")
@@ -116,8 +211,8 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None) -> str:
 
     # terminal footprint: range-to-go vs cross-range with a 2-sigma ellipse
     fig, ax = plt.subplots(figsize=(5.5, 5))
-    x = np.asarray(rows["err_crossrange_m"], float)[ok] / 1e3
-    y = np.asarray(rows["err_range_m"], float)[ok] / 1e3
+    x = _finite(rows, "err_crossrange_m", n)[reached] / 1e3
+    y = _finite(rows, "err_range_m", n)[reached] / 1e3
     ax.plot(x, y, ".", ms=3)
     if x.size > 2:
         cov = np.cov(np.vstack([x, y]))
@@ -131,39 +226,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None) -> str:
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(True)
     figs.append(_save(fig, out_dir, "footprint.png"))
-
-    if traj is not None:
-        figs += _trajectory_figures(traj, out_dir, limits)
-
-    md = [f"# {title or 'Monte-Carlo campaign'}", "",
-          f"Scenario `{meta.get('scenario', '?')}`, {stats['samples']} samples (seed {meta.get('seed', '?')}, "
-          f"dispersion {meta.get('dispersion', '?')}, overrides {meta.get('overrides', {})}); "
-          f"{stats['successful']} reached the terminal interface, {stats['failed']} failed.", "",
-          "## Terminal errors (paper 000 Table 3 form)", "", table3_markdown(stats), "",
-          "ΔR is the range to go along the final heading (+ short of the target); the cross-range "
-          "is reported separately, the paper does not give it.", ""]
-    if stats.get("inside_km"):
-        md += ["Samples within a distance of the target: " + ", ".join(
-            f"{k} km: {v}" for k, v in stats["inside_km"].items()), ""]
-    md += ["## Path-constraint margins (worst over all runs; negative = violated)", "",
-           "| constraint | worst margin | violations | worst sample |", "|---|---|---|---|"]
-    for col, m in stats["margins"].items():
-        md.append(f"| {col.replace('margin_', '')} | {100 * m['worst']:.2f} % | {m['violations']} | {m['worst_sample']} |")
-    if stats.get("cost"):
-        c = stats["cost"]
-        md += ["", f"Cost: {c['wall_s_per_sample']:.2f} s of one core per sample, {100 * c['planning_share']:.0f} % of "
-               f"it re-planning ({c['plans_per_sample']:.1f} plans), {c['derivative_evaluations_per_sample']:.0f} "
-               "plant derivative evaluations."]
-    if stats["failure_reasons"]:
-        md += ["", "## Failed samples", ""] + [f"- {k}: {v}" for k, v in stats["failure_reasons"].items()]
-    if traj is None:
-        md += ["", "Trajectories were not kept (`--trajectory-step 0`): the state envelopes, constraint "
-               "histories, drag profiles and groundtracks are omitted."]
-    md += ["", "## Figures", ""] + [f"![{os.path.basename(p)}]({os.path.basename(p)})" for p in figs]
-    path = os.path.join(out_dir, "report.md")
-    with open(path, "w") as f:
-        f.write("\n".join(md) + "\n")
-    return path
+    return figs
 
 
 def _trajectory_figures(traj: dict, out_dir: str, limits) -> list:

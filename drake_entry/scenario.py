@@ -45,16 +45,19 @@ class TargetSpec:
 
 @dc.dataclass
 class TerminalSpec:
-    """Terminal interface: the run stops at the first condition reached; tolerances are
-    the mission's acceptance box (paper 000 Table 1)."""
+    """Terminal interface: an open-loop run stops at the first condition reached. The
+    tolerances are the mission's acceptance box (paper 000 Table 1): a closed-loop flight
+    is a success only inside every box criterion given (altitude and Mach about the values
+    above, distance to the target); a criterion without its tolerance is not checked."""
 
     altitude_km: Optional[float] = None
     mach: Optional[float] = None
     velocity_m_s: Optional[float] = None
+    # specific energy E = V^2/2 - mu/r [MJ/kg] (negative: bound to the planet)
     energy_MJ_kg: Optional[float] = None
-    altitude_tolerance_km: float = 0.0
-    mach_tolerance: float = 0.0
-    distance_tolerance_km: float = 0.0
+    altitude_tolerance_km: Optional[float] = None
+    mach_tolerance: Optional[float] = None
+    distance_tolerance_km: Optional[float] = None
 
 
 @dc.dataclass
@@ -192,11 +195,22 @@ class Scenario:
             check_range("terminal.altitude_km", t.altitude_km, 0.0, self.entry.altitude_km)
         if t.mach is not None:
             check_range("terminal.mach", t.mach, 0.0, 50.0)
+        if t.velocity_m_s is not None:
+            check_range("terminal.velocity_m_s", t.velocity_m_s, 0.0, self.entry.velocity_m_s)
+        if t.energy_MJ_kg is not None:  # between rest on the surface and the entry energy
+            planet = self.make_planet().with_(j2=0.0)
+            check_range("terminal.energy_MJ_kg", t.energy_MJ_kg, planet.specific_energy(0.0, 0.0) / 1e6,
+                        self.entry_energy() / 1e6)
+        for name in ("altitude_tolerance_km", "mach_tolerance", "distance_tolerance_km"):
+            if getattr(t, name) is not None:
+                check_range(f"terminal.{name}", getattr(t, name), 0.0, 1e5)
+        check_range("guidance.period_s", self.guidance.period_s, 0.01, 60.0)  # before the step that divides it
         sim = self.simulation
         check_range("simulation.max_time_s", sim.max_time_s, 1.0, 1e5)
         check_range("simulation.accuracy", sim.accuracy, 1e-14, 1e-1)
         check_range("simulation.max_step_s", sim.max_step_s, 1e-4, 1e3)
         check_range("simulation.log_period_s", sim.log_period_s, 1e-3, 1e3)
+        check_range("simulation.closed_loop_step_s", sim.closed_loop_step_s, 0.0, 60.0)
         step, period = sim.closed_loop_step_s, self.guidance.period_s
         if step != 0.0 and not (0.0 < step <= period and abs(period / step - round(period / step)) < 1e-9):
             raise ScenarioError(f"simulation.closed_loop_step_s = {step:g} s must be 0 (error control) or divide "
@@ -204,6 +218,10 @@ class Scenario:
         if sim.integrator not in INTEGRATORS:
             raise ScenarioError(f"simulation.integrator '{sim.integrator}' is unknown; allowed: {', '.join(INTEGRATORS)}")
         for which in ("alpha", "bank"):
+            for field in ("breakpoints", "values_deg"):
+                for i, v in enumerate(getattr(getattr(self, which), field)):
+                    if not np.isfinite(v):
+                        raise ScenarioError(f"{which}.{field}[{i}] = {v} is not a finite number")
             if getattr(self, which).variable not in VARIABLES + ("normalized_energy",):
                 raise ScenarioError(f"{which}.variable '{getattr(self, which).variable}' is unknown; "
                                     f"allowed: {', '.join(VARIABLES)}")

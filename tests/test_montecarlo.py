@@ -8,6 +8,7 @@ import pytest
 
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 from drake_entry.diagrams.montecarlo import TIMING_COLUMNS, done_indices, run_campaign, run_sample, sample_seed
+from drake_entry.errors import CampaignError
 from drake_entry.planning.drag_energy import DragEnergyPlanner
 from drake_entry.report import summary_statistics, write_report
 from drake_entry.scenario import load_scenario
@@ -50,7 +51,7 @@ def test_campaign_resumes_without_losing_or_repeating_samples(tmp_path):
     lines = [json.loads(l) for l in open(f"{out}/samples.jsonl") if l.strip().endswith("}")]
     assert sorted(r["index"] for r in lines) == [0, 1]
     assert done_indices(out) == {0, 1}
-    with pytest.raises(ValueError, match="other settings"):
+    with pytest.raises(CampaignError, match="holds a campaign with another seed; extend it"):
         run_campaign("horus2b", runs=2, out_dir=out, seed=5, workers=1, progress=False)
     report = write_report(out)
     text = open(report).read()
@@ -71,20 +72,26 @@ def test_campaign_without_trajectories_keeps_rows_only(tmp_path):
     run_campaign("horus2b", runs=1, out_dir=out, seed=4, workers=1, progress=False, trajectory_step_s=0)
     assert os.path.exists(f"{out}/samples.parquet") and not os.path.exists(f"{out}/trajectories.parquet")
     assert "Trajectories were not kept" in open(write_report(out)).read()
-    with pytest.raises(ValueError, match="trajectory_step_s must be >= 0"):
+    with pytest.raises(ValueError, match=r"trajectory_step_s = -1.0 is out of range; allowed: >= 0 s"):
         run_campaign("horus2b", runs=1, out_dir=out, seed=4, trajectory_step_s=-1.0)
 
 
 def test_statistics_against_a_hand_computed_case():
-    rows = {"index": [0, 1, 2, 3], "success": [True, True, True, False],
-            "message": ["ok", "ok", "ok", "RuntimeError: boom"],
-            "err_range_m": [100.0, -200.0, 400.0, np.nan], "err_distance_m": [1000.0, 30000.0, 60000.0, np.nan],
-            "margin_heat_flux": [0.02, -0.01, 0.05, np.nan]}
+    """Errors over the samples that reached the terminal interface (inside the box or not),
+    margins over every sample that flew, failures by reason."""
+    rows = {"index": [0, 1, 2, 3, 4], "success": [True, True, True, False, False],
+            "stop": ["reached energy"] * 3 + [None, "reached energy"],
+            "message": ["ok", "ok", "ok", "RuntimeError: boom", "outside the acceptance box: distance +80 km"],
+            "err_range_m": [100.0, -200.0, 400.0, None, 700.0],
+            "err_distance_m": [1000.0, 30000.0, 60000.0, None, 80000.0],
+            "margin_heat_flux": [0.02, -0.01, 0.05, None, 0.01], "inside_distance_box": [True, True, True, None, False]}
     st = summary_statistics(rows)
-    assert st["successful"] == 3 and st["failed"] == 1 and st["failure_reasons"] == {"RuntimeError": 1}
-    assert st["errors"]["err_range_m"]["mean"] == pytest.approx(100.0)
-    assert st["errors"]["err_range_m"]["std"] == pytest.approx(300.0)  # sample std of (100, -200, 400)
+    assert (st["successful"], st["reached"], st["failed"]) == (3, 4, 2)
+    assert st["failure_reasons"] == {"RuntimeError": 1, "outside the acceptance box": 1}
+    assert st["errors"]["err_range_m"]["mean"] == pytest.approx(250.0)
+    assert st["errors"]["err_range_m"]["std"] == pytest.approx(387.2983346)  # sample std of (100, -200, 400, 700)
     assert st["inside_km"] == {"2": 1, "25": 1, "50": 2, "75": 3}
+    assert st["inside_box"] == {"distance": 3}
     assert st["margins"]["margin_heat_flux"] == {"worst": -0.01, "violations": 1, "worst_sample": 1}
 
 

@@ -137,9 +137,10 @@ def test_schedule_sources_native_and_python_agree():
     assert Schedule.ramp(0, 1, 0.0, 1.0, smooth=True)(0.5) == pytest.approx(0.5)
 
 
-def test_termination_monitor_needs_a_condition():
-    with pytest.raises(ValueError, match="at least one"):
-        TerminationMonitor()
+def test_termination_monitor_floor_must_be_below_its_ceiling():
+    TerminationMonitor()  # the altitude band alone: the surface and the ceiling
+    with pytest.raises(ValueError, match="must be below the ceiling"):
+        TerminationMonitor(altitude=2e6)
 
 
 @pytest.mark.parametrize("smooth", [False, True])

@@ -1,0 +1,285 @@
+"""The durable campaign directory: a fingerprinted manifest, one writer at a time, rows and
+trajectories streamed as samples finish.
+
+  campaign.json          manifest: the scenario as flown (canonical YAML, overrides applied),
+                         seed, trajectory step, versions, the fingerprint of all of these,
+                         and the number of samples requested so far
+  campaign.lock          held (flock) by the one process writing the directory
+  samples.jsonl          one row per finished sample, appended and flushed at once
+  trajectories.jsonl     its down-sampled trajectory, appended just before its row
+  quarantine.jsonl       lines that were not rows or trajectories, moved aside on resume
+  samples.parquet, trajectories.parquet   written by ``finalise`` (sorted by sample index)
+
+A sample counts as done when its row line is complete. An interrupted campaign resumes
+without losing or repeating a sample: a cut last line is dropped and that sample runs
+again; its earlier trajectory line (written before the row) is superseded by the new one.
+A directory holding a campaign with another fingerprint is refused with one line; more
+``runs`` with the same settings extend it.
+"""
+from __future__ import annotations
+
+import errno
+import fcntl
+import hashlib
+import json
+import os
+
+from .errors import CampaignError
+
+FORMAT = 2
+ROWS, TRAJECTORIES, QUARANTINE, MANIFEST, LOCK = ("samples.jsonl", "trajectories.jsonl", "quarantine.jsonl",
+                                                  "campaign.json", "campaign.lock")
+# what the fingerprint covers, and how a mismatch is named
+IDENTITY = {"scenario_yaml": "scenario content", "vehicle_file_sha256": "vehicle file content",
+            "seed": "seed", "trajectory_step_s": "trajectory step", "versions": "drake_entry/drake version"}
+
+
+def fingerprint(manifest: dict) -> str:
+    """sha256 of everything that defines a campaign's samples (IDENTITY)."""
+    ident = {k: manifest.get(k) for k in IDENTITY}
+    return hashlib.sha256(json.dumps(ident, sort_keys=True).encode()).hexdigest()
+
+
+class CampaignStore:
+    """One writer's handle on a campaign directory (a context manager holding the lock)."""
+
+    def __init__(self, out_dir: str, manifest: dict):
+        """Open (or create) ``out_dir`` for a campaign described by ``manifest`` (see
+        IDENTITY; ``runs`` is the number requested). Raises CampaignError when the directory
+        holds another campaign or another process writes it."""
+        if os.path.exists(out_dir) and not os.path.isdir(out_dir):
+            raise CampaignError(f"--out {out_dir} is a file, not a campaign directory")
+        self.out_dir = out_dir
+        os.makedirs(out_dir, exist_ok=True)
+        self._lock = os.open(self.path(LOCK), os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as e:
+            os.close(self._lock)
+            if e.errno in (errno.EWOULDBLOCK, errno.EACCES):
+                raise CampaignError(f"{out_dir} is being written by another campaign process; wait for it to "
+                                    f"finish or use another --out") from None
+            raise
+        os.ftruncate(self._lock, 0)
+        os.write(self._lock, str(os.getpid()).encode())
+        try:
+            self.manifest = self._check_manifest(manifest)
+            self.report = repair(out_dir)
+        except BaseException:
+            self.close()
+            raise
+        self._rows = self._traj = None
+
+    def _check_manifest(self, manifest: dict) -> dict:
+        manifest = dict(manifest, format=FORMAT)
+        manifest["fingerprint"] = fingerprint(manifest)
+        old = read_manifest(self.out_dir)
+        if old is not None:
+            if old.get("fingerprint") != manifest["fingerprint"]:
+                differs = [name for key, name in IDENTITY.items() if old.get(key) != manifest.get(key)]
+                raise CampaignError(
+                    f"{self.out_dir} holds a campaign with another {', '.join(differs) or 'format'}; extend it "
+                    f"with the same settings and a larger --runs, or start afresh with another --out")
+            manifest["runs"] = max(int(old.get("runs", 0)), int(manifest["runs"]))
+        _write_atomic(self.path(MANIFEST), json.dumps(manifest, indent=2))
+        return manifest
+
+    def path(self, name: str) -> str:
+        return os.path.join(self.out_dir, name)
+
+    def done_indices(self) -> set:
+        return set(read_rows(self.out_dir)[0])
+
+    def __enter__(self) -> "CampaignStore":
+        flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT
+        self._rows = os.open(self.path(ROWS), flags, 0o644)
+        self._traj = os.open(self.path(TRAJECTORIES), flags, 0o644)
+        return self
+
+    def __exit__(self, *exc):
+        for fd in (self._rows, self._traj):
+            if fd is not None:
+                os.close(fd)
+        self._rows = self._traj = None
+        self.close()
+
+    def close(self):
+        if self._lock is not None:
+            os.close(self._lock)  # releases the flock
+            self._lock = None
+
+    def record(self, row: dict, trajectory: dict | None):
+        """Commit one finished sample: its trajectory line, then its row line (the row is
+        what marks it done), each one write on an O_APPEND descriptor, then fsync."""
+        if trajectory is not None:
+            _append(self._traj, json.dumps(trajectory))
+        _append(self._rows, json.dumps(row, default=float))
+
+    def finalise(self):
+        finalise(self.out_dir)
+
+
+def _append(fd: int, line: str):
+    data = (line + "\n").encode()
+    if os.write(fd, data) != len(data):
+        raise OSError(f"short write of a campaign line ({len(data)} bytes)")
+    os.fsync(fd)
+
+
+def _write_atomic(path: str, text: str):
+    tmp = f"{path}.tmp{os.getpid()}"
+    with open(tmp, "w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def read_manifest(out_dir: str) -> dict | None:
+    path = os.path.join(out_dir, MANIFEST)
+    if not os.path.exists(path):
+        return None
+    try:
+        with open(path) as f:
+            manifest = json.load(f)
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise CampaignError(f"{path} is not a campaign manifest ({e}); start afresh with another --out") from None
+    if not isinstance(manifest, dict):
+        raise CampaignError(f"{path} is not a campaign manifest; start afresh with another --out")
+    return manifest
+
+
+def _is_row(r) -> bool:
+    return isinstance(r, dict) and isinstance(r.get("index"), int) and "success" in r
+
+
+def _is_trajectory(t) -> bool:
+    return (isinstance(t, dict) and isinstance(t.get("sample"), list) and len(t["sample"]) > 0
+            and all(isinstance(v, list) and len(v) == len(t["sample"]) for v in t.values()))
+
+
+def _read_lines(path: str) -> tuple[list, bool]:
+    """(complete lines, whether a cut last line was present)."""
+    if not os.path.exists(path):
+        return [], False
+    with open(path, "rb") as f:
+        data = f.read()
+    cut = bool(data) and not data.endswith(b"\n")
+    lines = data.split(b"\n")
+    return [line for line in lines[:-1] if line.strip()], cut
+
+
+def _parse(lines: list, valid) -> tuple[list, list]:
+    """(parsed objects that pass ``valid``, raw lines that do not)."""
+    good, bad = [], []
+    for raw in lines:
+        try:
+            obj = json.loads(raw)
+        except (json.JSONDecodeError, UnicodeDecodeError):
+            obj = None
+        if obj is not None and valid(obj):
+            good.append(obj)
+        else:
+            bad.append(raw)
+    return good, bad
+
+
+def read_rows(out_dir: str) -> tuple[dict, dict]:
+    """({index: row} of the complete rows (the first of duplicates), counts:
+    {'cut': cut last lines, 'invalid': lines that are not rows, 'duplicates': ...})."""
+    lines, cut = _read_lines(os.path.join(out_dir, ROWS))
+    rows, bad = _parse(lines, _is_row)
+    out, dup = {}, 0
+    for r in rows:
+        if r["index"] in out:
+            dup += 1
+        else:
+            out[r["index"]] = r
+    return out, {"cut": int(cut), "invalid": len(bad), "duplicates": dup}
+
+
+def read_trajectories(out_dir: str, done: set) -> dict:
+    """{sample: columns} of the samples in ``done``: the last trajectory line of each (a
+    sample that re-ran after an interruption supersedes its earlier line)."""
+    lines, _ = _read_lines(os.path.join(out_dir, TRAJECTORIES))
+    trajs, _ = _parse(lines, _is_trajectory)
+    out = {}
+    for t in trajs:
+        s = t["sample"][0]
+        if s in done:
+            out[s] = t
+    return out
+
+
+def repair(out_dir: str) -> dict:
+    """Make the streams appendable again (under the writer's lock): drop cut last lines and
+    move lines that are not rows or trajectories to quarantine.jsonl. Returns the counts."""
+    report = {}
+    for name, valid in ((ROWS, _is_row), (TRAJECTORIES, _is_trajectory)):
+        path = os.path.join(out_dir, name)
+        lines, cut = _read_lines(path)
+        _, bad = _parse(lines, valid)
+        report[name] = {"cut": int(cut), "quarantined": len(bad)}
+        if not cut and not bad:
+            continue
+        bad_set = set(bad)
+        keep = [line for line in lines if line not in bad_set]
+        if bad:
+            with open(os.path.join(out_dir, QUARANTINE), "ab") as q:
+                for raw in bad:
+                    q.write(json.dumps({"file": name, "line": raw.decode("utf-8", "replace")}).encode() + b"\n")
+        _write_atomic_bytes(path, b"".join(line + b"\n" for line in keep))
+    return report
+
+
+def _write_atomic_bytes(path: str, data: bytes):
+    tmp = f"{path}.tmp{os.getpid()}"
+    with open(tmp, "wb") as f:
+        f.write(data)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def finalise(out_dir: str):
+    """Write samples.parquet (every complete row, sorted by index) and trajectories.parquet
+    (the trajectory of each of those samples that kept one)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    rows, _ = read_rows(out_dir)
+    ordered = [rows[k] for k in sorted(rows)]
+    keys = sorted({k for r in ordered for k in r if k != "traceback"})
+    pq.write_table(pa.table({k: [r.get(k) for r in ordered] for k in keys}), os.path.join(out_dir, "samples.parquet"))
+    trajs = read_trajectories(out_dir, set(rows))
+    path = os.path.join(out_dir, "trajectories.parquet")
+    if trajs:
+        cols = {}
+        for s in sorted(trajs):
+            for k, v in trajs[s].items():
+                cols.setdefault(k, []).extend(v)
+        n = len(cols["sample"])
+        cols = {k: v for k, v in cols.items() if len(v) == n}  # columns every trajectory has
+        pq.write_table(pa.table(cols), path)
+    elif os.path.exists(path):
+        os.remove(path)
+
+
+def done_indices(out_dir: str) -> set:
+    """Sample indices with a complete row."""
+    return set(read_rows(out_dir)[0])
+
+
+def coverage(out_dir: str) -> dict:
+    """What a campaign directory holds, for reports: requested runs, complete rows, cut and
+    invalid lines still in the streams, quarantined lines. CampaignError when it holds no
+    campaign."""
+    if not os.path.isdir(out_dir):
+        raise CampaignError(f"{out_dir} is not a directory: no campaign to report")
+    manifest = read_manifest(out_dir)
+    rows, counts = read_rows(out_dir)
+    if manifest is None and not rows:
+        raise CampaignError(f"{out_dir} holds no campaign (no campaign.json, no rows): run `drake-entry campaign` first")
+    quarantined = len(_read_lines(os.path.join(out_dir, QUARANTINE))[0])
+    return {"manifest": manifest or {}, "rows": rows, "requested": int((manifest or {}).get("runs", len(rows))),
+            "quarantined": quarantined, **counts}

@@ -8,7 +8,7 @@ import time as _time
 import numpy as np
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 
-from drake_entry.errors import NonFiniteStateError
+from drake_entry.errors import ModelRangeError, NonFiniteStateError
 from drake_entry.scenario import Scenario
 from drake_entry.trajectory import Trajectory
 
@@ -84,7 +84,8 @@ def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_st
     try:
         reason = stop_reason(simulator.AdvanceTo(scenario.simulation.max_time_s))
         final = True
-    except NonFiniteStateError as e:  # a NaN command or model: stop with the reason, keep the log
+    except (NonFiniteStateError, ModelRangeError) as e:  # a NaN, or a state the models do not cover:
+        # stop with the reason, keep the log
         reason = f"stopped at t = {simulator.get_context().get_time():.3f} s: {e}"
         final = False
     wall = _time.perf_counter() - t0

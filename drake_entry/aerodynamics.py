@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import bisect
 import csv
+import functools
 import math
 from dataclasses import dataclass, field
 from importlib import resources
@@ -44,13 +45,45 @@ class CoefficientDerivatives(NamedTuple):
     d_mach_mach: float
 
 
+def _checked_coefficients(coefficients):
+    """Wrap a model's coefficients(alpha, mach): a NaN alpha or a Mach <= 0, NaN or infinite
+    in float input is a ScenarioError naming the model, not a silent NaN or clamp."""
+    @functools.wraps(coefficients)
+    def checked(self, alpha, mach):
+        if type(mach) is float and type(alpha) is float:
+            if not (0.0 < mach < math.inf) or alpha - alpha != 0.0:
+                _bad_input(self, alpha, mach)
+        elif isinstance(mach, np.ndarray) and mach.dtype.kind == "f":
+            if not (np.all(mach > 0.0) and np.all(np.isfinite(mach)) and np.all(np.isfinite(alpha))):
+                _bad_input(self, alpha, mach)
+        return coefficients(self, alpha, mach)
+    return checked
+
+
+def _bad_input(model, alpha, mach):
+    raise ScenarioError(f"{type(model).__name__}.coefficients: alpha = {alpha} rad must be finite and "
+                        f"mach = {mach} in (0, inf)")
+
+
+def _check_mach_range(model):
+    if not 0.0 < model.mach_min < model.mach_max < math.inf:
+        raise ScenarioError(f"{type(model).__name__}: mach_min = {model.mach_min} and mach_max = {model.mach_max} "
+                            f"need 0 < mach_min < mach_max < inf")
+
+
 class AeroDerivatives(NamedTuple):
     CL: CoefficientDerivatives
     CD: CoefficientDerivatives
 
 
 class AeroModel:
-    """Base class. Subclasses implement ``coefficients`` generically over the scalar type."""
+    """Base class. Subclasses implement ``coefficients`` generically over the scalar type;
+    float inputs are checked here (alpha finite, Mach > 0 and finite) before they run."""
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "coefficients" in cls.__dict__:
+            cls.coefficients = _checked_coefficients(cls.__dict__["coefficients"])
 
     def coefficients(self, alpha, mach):  # pragma: no cover - interface
         raise NotImplementedError
@@ -282,6 +315,7 @@ class HorusFitAero(AeroModel):
             raise ScenarioError(f"HorusFitAero.aL needs 14 coefficients (paper 000 eq. 33), got {len(self.aL)}")
         self.aD = [float(v) for v in self.aD]
         self.aL = [float(v) for v in self.aL]
+        _check_mach_range(self)
 
     def coefficients(self, alpha, mach):
         if isinstance(alpha, float) and isinstance(mach, float):  # plain floats are faster than numpy scalars
@@ -435,6 +469,7 @@ class PolynomialAero(AeroModel):
             m = getattr(self, name)
             if not m or not all(isinstance(r, (list, tuple)) and len(r) == len(m[0]) for r in m):
                 raise ScenarioError(f"PolynomialAero.{name} must be a non-empty rectangular list of lists")
+        _check_mach_range(self)
 
     @staticmethod
     def _poly(c, a, x):

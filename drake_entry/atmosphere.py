@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from .errors import ScenarioError
+from .errors import ModelRangeError, ScenarioError
 from .scalar import clamp, is_autodiff, is_symbolic, lift, value_of
 
 # U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
@@ -61,10 +61,13 @@ class Derivatives(NamedTuple):
 
 
 def _check_range(name: str, h, lo: float, hi: float):
+    if is_symbolic(h):  # symbolic work has no numbers to check
+        return
     hv = np.asarray(value_of(h), dtype=float)
-    if hv.size and (np.nanmin(hv) < lo or np.nanmax(hv) > hi or np.isnan(hv).any()):
-        bad = hv[(hv < lo) | (hv > hi) | np.isnan(hv)].flat[0]
-        raise ScenarioError(f"altitude h = {bad:.6g} m is outside the {name} range [{lo:.6g}, {hi:.6g}] m")
+    outside = ~((hv >= lo) & (hv <= hi))  # NaN is outside
+    if outside.any():
+        bad = hv[outside].flat[0]
+        raise ModelRangeError(f"altitude h = {bad:.6g} m is outside the {name} range [{lo:.6g}, {hi:.6g}] m")
 
 
 class Atmosphere:
@@ -304,10 +307,14 @@ class ExponentialAtmosphere(Atmosphere):
         if self.temperature_K is not None and not self.temperature_K > 0:
             raise ScenarioError(f"ExponentialAtmosphere.temperature_K must be > 0 K, got {self.temperature_K}")
 
+    H_MAX = 1e7  # [m]: the formula holds at any height; this only catches nonsense (and NaN)
+
     def density(self, h):
+        _check_range(self.name, h, US76_H_MIN, self.H_MAX)
         return self.rho0 * np.exp(-h / self.scale_height)
 
     def density_derivatives(self, h) -> Derivatives:
+        _check_range(self.name, h, US76_H_MIN, self.H_MAX)
         rho = self.rho0 * np.exp(-np.asarray(h, dtype=float) / self.scale_height)
         return Derivatives(rho, -rho / self.scale_height, rho / self.scale_height**2)
 
@@ -315,6 +322,7 @@ class ExponentialAtmosphere(Atmosphere):
         """US76 temperature (held at its range ends: the exponential density model has no
         altitude limit, and optimisers may step outside) or the constant temperature [K]."""
         if self.temperature_K is None:
+            _check_range(self.name, h, US76_H_MIN, self.H_MAX)
             return US76Atmosphere().temperature(clamp(h, US76_H_MIN, US76_H_MAX))
         return self.temperature_K + 0.0 * h  # keeps the scalar type of h
 

@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from .errors import ScenarioError
+from .errors import DrakeEntryError
 
 
 def _cmd_simulate(args) -> int:
@@ -59,10 +59,10 @@ def _cmd_simulate(args) -> int:
 
 def _cmd_fly(args) -> int:
     from .diagrams.closed_loop import ClosedLoopSetup, fly
+    from .diagrams.sample import campaign_row
     from .plots import trajectory_plots
     from .results import write_table
     from .scenario import load_scenario
-    from .trajectory import metrics
 
     scenario = load_scenario(args.scenario)
     setup = ClosedLoopSetup.from_scenario(scenario)
@@ -74,10 +74,7 @@ def _cmd_fly(args) -> int:
     trajectory_plots(tr, args.out, limits=setup.vehicle.limits,
                      target=(scenario.target.longitude_deg, scenario.target.latitude_deg), title=title)
     setup.method.flight_plots(res, args.out, title=scenario.name)
-    g = res.guidance
-    summary = {"success": res.success, "message": res.message, "method": res.method, "plans": g.plans,
-               "planning_wall_s": g.planning_wall_s, **g.fields, **res.errors, **metrics(tr, setup.vehicle.limits),
-               "wall_time_s": tr.wall_time}
+    summary = {**campaign_row(res, setup), "wall_time_s": tr.wall_time}  # the row a campaign would record
     with open(os.path.join(args.out, "summary.json"), "w") as f:
         json.dump(summary, f, indent=2, default=float)
     for k, v in summary.items():
@@ -113,19 +110,24 @@ def _cmd_campaign(args) -> int:
 
 
 def _cmd_report(args) -> int:
+    from .campaign_store import read_manifest
+    from .errors import load_yaml_typed
     from .report import table3_markdown, write_report
-    from .scenario import load_scenario
+    from .scenario import Scenario
 
-    meta_path = os.path.join(args.dir, "campaign.json")
+    manifest = read_manifest(args.dir) if os.path.isdir(args.dir) else None
     limits = None
-    if os.path.exists(meta_path):
-        limits = load_scenario(json.load(open(meta_path))["scenario"]).make_vehicle().limits
+    if manifest and manifest.get("scenario_yaml"):  # the scenario as flown, wherever the report runs
+        limits = load_yaml_typed(Scenario, text=manifest["scenario_yaml"], where="campaign scenario").make_vehicle().limits
     path = write_report(args.dir, limits=limits)
-    stats = json.load(open(os.path.join(args.dir, "summary.json")))
+    with open(os.path.join(args.dir, "summary.json")) as f:
+        stats = json.load(f)
     print(table3_markdown(stats))
     for k, m in stats["margins"].items():
         print(f"worst {k}: {100 * m['worst']:.2f} % ({m['violations']} violations)")
-    print(f"{stats['successful']}/{stats['samples']} samples reached the terminal interface; report: {path}")
+    c = stats["coverage"]
+    print(f"{c['done']}/{c['requested']} samples done; {stats['successful']} inside the acceptance box, "
+          f"{stats['reached']} reached the terminal interface; report: {path}")
     return 0
 
 
@@ -150,10 +152,10 @@ def _cmd_optimize(args) -> int:
     from .results import write_table
 
     problem, settings = load_problem(args.problem)
-    nodes = args.nodes or settings.nodes
+    nodes = settings.nodes if args.nodes is None else args.nodes
     transcription = args.transcription or settings.transcription
     solver = args.solver or settings.solver
-    tol = args.tolerance or settings.tolerance
+    tol = settings.tolerance if args.tolerance is None else args.tolerance
     guess = None
     coarse_nodes = settings.coarse_nodes if args.coarse is None else args.coarse
     if coarse_nodes and coarse_nodes < nodes:
@@ -244,8 +246,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except ScenarioError as e:
-        print(f"drake-entry: error: {e}", file=sys.stderr)
+    except DrakeEntryError as e:  # bad input, a refused campaign directory, an unusable solver: one line
+        print(f"drake-entry: error: {' '.join(str(e).split())}", file=sys.stderr)
         return 2
 
 

@@ -121,11 +121,36 @@ def draw(spec: DispersionSpec, generator) -> Draw:
                 scales["mass_scale"], bias, np.asarray(spec.nav_noise_sigma, float), nav_seed)
 
 
+def _check_distribution(where: str, d) -> None:
+    """Finite parameters; Uniform min <= max; Gaussian stddev >= 0 (scalars and vectors)."""
+    if isinstance(d, (int, float)):
+        params = {"value": d}
+    elif isinstance(d, (schema.Deterministic, schema.DeterministicVectorX)):
+        params = {"value": d.value}
+    elif isinstance(d, (schema.Gaussian, schema.GaussianVectorX)):
+        params = {"mean": d.mean, "stddev": d.stddev}
+    elif isinstance(d, (schema.Uniform, schema.UniformVectorX)):
+        params = {"min": d.min, "max": d.max}
+    else:
+        raise ScenarioError(f"{where}: {type(d).__name__} is not a supported distribution")
+    for name, v in params.items():
+        if not np.all(np.isfinite(np.asarray(v, float))):
+            raise ScenarioError(f"{where}.{name} = {v} is not finite")
+    if "stddev" in params and np.any(np.asarray(params["stddev"], float) < 0):
+        raise ScenarioError(f"{where}: Gaussian stddev = {params['stddev']} must be >= 0")
+    if "min" in params and np.any(np.asarray(params["min"], float) > np.asarray(params["max"], float)):
+        raise ScenarioError(f"{where}: Uniform min = {params['min']} is above max = {params['max']}")
+
+
 def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
     """Shape and range checks that do not need a draw."""
+    for f in dc.fields(EntryDispersionSpec):
+        _check_distribution(f"{where}.entry.{f.name}", getattr(spec.entry, f.name))
+    for name in ("density_scale", "density_wave_amplitude", "lift_scale", "drag_scale", "mass_scale", "nav_bias"):
+        _check_distribution(f"{where}.{name}", getattr(spec, name))
     if np.asarray(spec.nav_bias.Mean()).size != 6:
         raise ScenarioError(f"{where}.nav_bias needs 6 entries [h, lon, lat, V, gamma, psi]")
-    if len(spec.nav_noise_sigma) != 6 or min(spec.nav_noise_sigma) < 0:
+    if len(spec.nav_noise_sigma) != 6 or not all(0 <= v < math.inf for v in spec.nav_noise_sigma):
         raise ScenarioError(f"{where}.nav_noise_sigma needs 6 entries >= 0")
     if not spec.density_wave_length_km > 0:
         raise ScenarioError(f"{where}.density_wave_length_km must be > 0, got {spec.density_wave_length_km}")

@@ -22,6 +22,11 @@ class NonFiniteStateError(DrakeEntryError, FloatingPointError):
     a simulation stops there with this as its reason instead of integrating garbage."""
 
 
+class ModelRangeError(ScenarioError):
+    """A model evaluated outside its range (e.g. an altitude above the atmosphere table): bad
+    input to the API; inside a simulation, the run stops there with this as its reason."""
+
+
 class CampaignError(DrakeEntryError):
     """A campaign directory that cannot be used as asked (other settings, another writer,
     nothing to report)."""
@@ -39,8 +44,15 @@ def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None,
     if path is not None:
         if not os.path.exists(path):
             raise ScenarioError(f"file not found: {path}")
-        with open(path) as f:
-            text = f.read()
+        if os.path.isdir(path):
+            raise ScenarioError(f"{path} is a directory, not a YAML file")
+        try:
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+        except UnicodeDecodeError:
+            raise ScenarioError(f"{path} is not a text (UTF-8) YAML file") from None
+    if not text or not text.strip():
+        raise ScenarioError(f"{where}: the file is empty; a {schema.__name__} needs its fields")
     try:
         return yaml_load_typed(schema=schema, data=text)
     except RuntimeError as e:  # unknown fields, wrong structure

@@ -7,6 +7,8 @@ also build a ``Vehicle`` in Python with any ``AeroModel`` (e.g. ``CallableAero``
 """
 
 import dataclasses as dc
+import math
+import numbers
 import os
 from importlib import resources
 
@@ -111,10 +113,12 @@ class Vehicle:
     source: str = ""
 
     def __post_init__(self):
-        for field, unit in (("mass", "kg"), ("reference_area", "m^2"), ("nose_radius", "m")):
+        for field, unit in (("mass", "kg"), ("reference_area", "m^2"), ("nose_radius", "m"), ("bank_rate_limit", "rad/s"),
+                            ("bank_accel_limit", "rad/s^2")):
             v = getattr(self, field)
-            if not (isinstance(v, (int, float)) and v > 0 and np.isfinite(v)):
-                raise ScenarioError(f"Vehicle.{field} must be a finite number > 0 {unit}, got {v}")
+            if isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 < v < math.inf):
+                raise ScenarioError(f"Vehicle.{field} = {v!r} must be a finite number > 0 {unit}")
+            setattr(self, field, float(v))
         if not 0 < self.bank_limit <= np.pi:
             raise ScenarioError(f"Vehicle.bank_limit must be in (0, 180] deg, got {np.degrees(self.bank_limit):.4g} deg")
         if self.heat_flux is None:
@@ -182,6 +186,9 @@ def vehicle_from_spec(spec: VehicleSpec, aero: str | None = None, where: str = "
     for field in ("bank_limit_deg",):
         if not 0 < getattr(spec, field) <= 180:
             raise ScenarioError(f"{where}.{field} = {getattr(spec, field)} is out of range (0, 180] deg")
+    for field in ("bank_rate_limit_deg_s", "bank_accel_limit_deg_s2"):
+        if not 0 < getattr(spec, field) < math.inf:
+            raise ScenarioError(f"{where}.{field} = {getattr(spec, field)} is out of range: must be > 0 and finite")
     try:
         hf = make_heat_flux(spec.heat_flux.form, nose_radius=spec.nose_radius_m,
                             coefficient=spec.heat_flux.coefficient,

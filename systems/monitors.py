@@ -23,8 +23,9 @@ from drake_entry.dynamics import specific_energy
 from drake_entry.errors import ScenarioError
 from drake_entry.planet import Earth
 
-#: default ceiling [m]: 1 km under the top of the US76 model (1000 km)
-CEILING_M = US76_H_MAX - 1000.0
+#: default ceiling [m]: 100 km under the top of the US76 model (1000 km), so that an
+#: integrator's trial stages (10 s steps at several km/s) stay inside the model
+CEILING_M = US76_H_MAX - 100e3
 
 
 class TerminationMonitor(LeafSystem):

@@ -180,6 +180,6 @@ def test_cli_fly_and_plan_with_the_second_method(tmp_path, capsys):
     path.write_text(yaml_dump_typed(_bank_profile_scenario()))
     assert main(["fly", str(path), "--out", str(tmp_path / "fly"), "--format", "csv"]) == 1  # outside the box
     s = json.loads((tmp_path / "fly" / "summary.json").read_text())
-    assert s["method"] == "bank_profile" and s["reversals"] >= 2 and s["distance_m"] < 100e3
+    assert s["method"] == "bank_profile" and s["reversals"] >= 2 and s["err_distance_m"] < 100e3
     assert main(["plan", str(path), "--out", str(tmp_path / "plan")]) == 2
     assert "guidance method 'bank_profile' has no plan report" in capsys.readouterr().err

@@ -74,6 +74,6 @@ def test_cli_fly_reaches_the_terminal_interface_near_the_runway(tmp_path):
 
     assert main(["fly", "horus2b", "--out", str(tmp_path), "--format", "csv"]) == 0
     s = json.load(open(tmp_path / "summary.json"))
-    assert s["success"] and s["distance_m"] < 2000.0 and abs(s["altitude_m"]) < 200.0
+    assert s["success"] and s["err_distance_m"] < 2000.0 and abs(s["err_altitude_m"]) < 200.0
     assert s["peak_heat_flux_W_m2"] <= 530e3 and s["peak_normal_load_g"] <= 2.5 and s["method"] == "drag_energy"
     assert (tmp_path / "drag_tracking.png").exists()

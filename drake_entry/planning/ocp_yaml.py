@@ -100,6 +100,10 @@ class ProblemSpec:
 
 
 def _bound(where: str, b: BoundSpec, factor: float, *, allow_free: bool = True):
+    for name in ("value", "min", "max"):
+        v = getattr(b, name)
+        if v is not None and v != v:
+            raise ScenarioError(f"{where}.{name} = nan is not a number")
     if b.value is not None:
         if b.min is not None or b.max is not None:
             raise ScenarioError(f"{where}: give either value or min/max, not both")
@@ -184,7 +188,21 @@ def load_problem_spec(name_or_path: str) -> ProblemSpec:
                         f"nor a file")
 
 
+def validate_solve(s: SolveSpec) -> SolveSpec:
+    """One-line ScenarioError on a bad ``solve:`` field."""
+    for field, allowed in (("transcription", ("lgl", "dircol")), ("solver", ("ipopt", "snopt"))):
+        if getattr(s, field) not in allowed:
+            raise ScenarioError(f"solve.{field} = '{getattr(s, field)}' is unknown; allowed: {', '.join(allowed)}")
+    for field, lo in (("nodes", 3), ("max_iterations", 1), ("coarse_nodes", 0)):
+        v = getattr(s, field)
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+            raise ScenarioError(f"solve.{field} = {v} is out of range; allowed: an integer >= {lo}")
+    if not 0 < s.tolerance < 1:
+        raise ScenarioError(f"solve.tolerance = {s.tolerance} is out of range; allowed (0, 1)")
+    return s
+
+
 def load_problem(name_or_path: str) -> tuple[OptimalControlProblem, SolveSpec]:
     """(problem, solve settings) from a packaged name ('marv') or a YAML path."""
     spec = load_problem_spec(name_or_path)
-    return problem_from_spec(spec), spec.solve
+    return problem_from_spec(spec), validate_solve(spec.solve)

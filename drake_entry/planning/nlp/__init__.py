@@ -62,8 +62,10 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
         raise ScenarioError(f"solver '{solver}' is unknown; allowed: {', '.join(SOLVERS)}")
     if not (isinstance(nodes, (int, np.integer)) and nodes >= 3):
         raise ScenarioError(f"nodes must be an integer >= 3, got {nodes}")
-    if not tolerance > 0:
-        raise ScenarioError(f"tolerance must be > 0, got {tolerance}")
+    if not 0 < tolerance < 1:
+        raise ScenarioError(f"tolerance = {tolerance} is out of range; allowed (0, 1)")
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 1:
+        raise ScenarioError(f"max_iterations = {max_iterations} is out of range; allowed: an integer >= 1")
     engine = IpoptSolver() if solver == "ipopt" else SnoptSolver()
     if not engine.available() or not engine.enabled():
         raise NlpError(f"solver '{solver}' is not available in this pydrake build")
@@ -71,6 +73,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
         guess = initial_guess(problem)
     elif isinstance(guess, NlpResult):
         guess = (guess.time, guess.states, guess.controls)
+    _check_guess(problem, guess)
     t_build = _time.perf_counter()
     tx = _LglTranscription(problem, nodes) if transcription == "lgl" else _DircolTranscription(problem, nodes)
     tx.set_guess(*guess)
@@ -92,3 +95,18 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
     res = engine.Solve(tx.prog, tx.initial_guess, options)
     solve_time = _time.perf_counter() - t0
     return tx.result(res, solver, solve_time, build_time)
+
+
+def _check_guess(problem, guess):
+    """(t [s] (n,), states (n, n_states), controls (n, n_controls)), finite, t increasing."""
+    try:
+        t, X, U = (np.asarray(g, float) for g in guess)
+    except (TypeError, ValueError):
+        raise ScenarioError("guess must be an NlpResult or (t, states, controls) arrays") from None
+    n = t.shape[0] if t.ndim == 1 else -1
+    want = f"(t ({n},), states ({n}, {problem.n_states}), controls ({n}, {problem.n_controls}))"
+    if n < 2 or X.shape != (n, problem.n_states) or U.shape != (n, problem.n_controls):
+        raise ScenarioError(f"guess shapes t {t.shape}, states {X.shape}, controls {U.shape}; expected {want}")
+    if not (np.isfinite(t).all() and np.isfinite(X).all() and np.isfinite(U).all()) or np.any(np.diff(t) <= 0):
+        raise ScenarioError("guess must be finite with strictly increasing times")
+

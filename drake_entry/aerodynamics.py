@@ -250,21 +250,33 @@ class TableAero(AeroModel):
 def read_wide_table(path_or_file, *, fill=None) -> TableAero:
     """Read a table CSV in the M-692 layout (coefficient, alpha_deg, M1.2, M1.5, ...),
     optionally filling empty cells from a long-format CSV (coefficient, alpha_deg, mach, value)."""
+    name = getattr(path_or_file, "name", path_or_file)
     rows = _read_csv(path_or_file)
+    if len(rows) < 3 or len(rows[0]) < 4:
+        raise ScenarioError(f"aero table {name}: needs a header (coefficient, alpha_deg, M<mach>, ...) and data rows "
+                            f"for at least two angles of attack and two Mach numbers")
     header = rows[0]
-    mach = np.array([float(h.lstrip("Mm")) for h in header[2:]])
-    alphas = sorted({float(r[1]) for r in rows[1:]})
-    data = {c: np.full((len(alphas), mach.size), np.nan) for c in ("CL", "CD")}
-    for r in rows[1:]:
-        i = alphas.index(float(r[1]))
-        for j, v in enumerate(r[2:]):
-            if v.strip():
-                data[r[0]][i, j] = float(v)
-    if fill is not None:
-        for c, a, m, v in _read_csv(fill)[1:]:
-            i = alphas.index(float(a))
-            j = int(np.argmin(np.abs(mach - float(m))))
-            data[c][i, j] = float(v)
+    try:
+        mach = np.array([float(h.strip().lstrip("Mm")) for h in header[2:]])
+        alphas = sorted({float(r[1]) for r in rows[1:]})
+        data = {c: np.full((len(alphas), mach.size), np.nan) for c in ("CL", "CD")}
+        for k, r in enumerate(rows[1:], start=2):
+            if r[0] not in data or len(r) > len(header):
+                raise ValueError(f"row {k}: coefficient '{r[0]}' (allowed CL, CD) with {len(r)} cells "
+                                 f"(header has {len(header)})")
+            i = alphas.index(float(r[1]))
+            for j, v in enumerate(r[2:]):
+                if v.strip():
+                    data[r[0]][i, j] = float(v)
+        if fill is not None:
+            for c, a, m, v in _read_csv(fill)[1:]:
+                if c not in data:
+                    raise ValueError(f"fill table: coefficient '{c}' (allowed CL, CD)")
+                i = alphas.index(float(a))
+                j = int(np.argmin(np.abs(mach - float(m))))
+                data[c][i, j] = float(v)
+    except (ValueError, IndexError) as e:
+        raise ScenarioError(f"aero table {name}: {e}") from None
     return TableAero(np.array(alphas), mach, data["CL"], data["CD"])
 
 

@@ -300,12 +300,14 @@ class ExponentialAtmosphere(Atmosphere):
     name = "exponential"
 
     def __post_init__(self):
-        if not self.rho0 > 0:
-            raise ScenarioError(f"ExponentialAtmosphere.rho0 must be > 0 kg/m^3, got {self.rho0}")
-        if not self.scale_height > 0:
-            raise ScenarioError(f"ExponentialAtmosphere.scale_height must be > 0 m, got {self.scale_height}")
-        if self.temperature_K is not None and not self.temperature_K > 0:
-            raise ScenarioError(f"ExponentialAtmosphere.temperature_K must be > 0 K, got {self.temperature_K}")
+        if not 0 < self.rho0 <= 1e3:
+            raise ScenarioError(f"ExponentialAtmosphere.rho0 = {self.rho0} kg/m^3 is out of range; allowed (0, 1000]")
+        if not 100.0 <= self.scale_height <= 1e6:
+            raise ScenarioError(f"ExponentialAtmosphere.scale_height = {self.scale_height} m is out of range; "
+                                f"allowed [100, 1e6]")
+        if self.temperature_K is not None and not 0 < self.temperature_K <= 1e4:
+            raise ScenarioError(f"ExponentialAtmosphere.temperature_K = {self.temperature_K} is out of range; "
+                                f"allowed (0, 1e4]")
 
     H_MAX = 1e7  # [m]: the formula holds at any height; this only catches nonsense (and NaN)
 

@@ -156,6 +156,7 @@ def _cmd_optimize(args) -> int:
     transcription = args.transcription or settings.transcription
     solver = args.solver or settings.solver
     tol = settings.tolerance if args.tolerance is None else args.tolerance
+    max_iterations = settings.max_iterations if args.max_iterations is None else args.max_iterations
     guess = None
     coarse_nodes = settings.coarse_nodes if args.coarse is None else args.coarse
     if coarse_nodes and coarse_nodes < nodes:
@@ -237,6 +238,8 @@ def main(argv=None) -> int:
     o.add_argument("--coarse", type=int, default=None, metavar="N",
                    help="first solve with N nodes and start the full solve from it (0 = the propagated "
                         "guess; default: the YAML's coarse_nodes)")
+    o.add_argument("--max-iterations", type=int, default=None, metavar="N",
+                   help="solver iteration limit (default: the YAML's solve.max_iterations)")
     o.add_argument("--no-propagate", action="store_true", help="skip the Drake propagation check")
     o.add_argument("--out", default="out/optimize")
     o.add_argument("--format", choices=("parquet", "csv"), default="csv")

@@ -68,8 +68,10 @@ def test_altitude_outside_the_model_names_the_range(us76):
 
 
 def test_bad_exponential_parameters_are_rejected():
-    with pytest.raises(ValueError, match="scale_height must be > 0"):
+    with pytest.raises(ValueError, match=r"scale_height = -1.0 m is out of range; allowed \[100, 1e6\]"):
         ExponentialAtmosphere(scale_height=-1.0)
+    with pytest.raises(ValueError, match=r"scale_height = 1e\+300 m is out of range"):  # overflowed its square
+        ExponentialAtmosphere(scale_height=1e300)
 
 
 @pytest.mark.parametrize("h", [-4000.0, 0.0, 11000.0, 30500.0, 71000.0, 85999.0, 86001.0, 121500.0])

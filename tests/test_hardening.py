@@ -271,13 +271,28 @@ def test_bad_vehicle_values_are_one_line(tmp_path, capsys, old, new, needle):
     assert needle in err, err
 
 
+@pytest.mark.parametrize("csv_text", ["coefficient,alpha_deg,M2.0,M4.0\n",
+                                      "coefficient,alpha_deg,M2.0,M4.0\nCX,10,0.1,0.2\nCD,20,0.1,0.2\n",
+                                      "coefficient,alpha_deg,Mfoo,M4.0\nCL,10,0.1,0.2\nCD,20,0.1,0.2\n",
+                                      "coefficient,alpha_deg,M2.0,M4.0\nCL,ten,0.1,0.2\nCD,20,0.1,0.2\n"])
+def test_bad_aero_tables_are_one_line(tmp_path, capsys, csv_text):
+    (tmp_path / "aero.csv").write_text(csv_text)
+    text = (ROOT / "drake_entry/vehicles/horus2b.yaml").read_text().replace(
+        "table_csv: horus2b_clean_aero_m692.csv", f"table_csv: {tmp_path / 'aero.csv'}").replace(
+        "    fill_csv: horus2b_clean_aero_fill_2024.csv\n", "").replace("default_aero: fit", "default_aero: table")
+    (tmp_path / "v.yaml").write_text(text)
+    path = _scenario_file(tmp_path, "vehicle: horus2b\naero: fit", f"vehicle: {tmp_path / 'v.yaml'}\naero: table")
+    assert "aero table" in _one_line_error(capsys, ["simulate", path, "--out", str(tmp_path / "o")])
+
+
 def test_bad_problem_files_are_one_line(tmp_path, capsys):
     text = (ROOT / "drake_entry/problems/marv.yaml").read_text()
     for old, new, needle in (("solver: snopt", "solver: minos", "solve.solver = 'minos'"),
                              ("nodes: 125", "nodes: 1", "solve.nodes = 1"),
                              ("max_iterations: 3000", "max_iterations: -1", "solve.max_iterations = -1"),
                              ("tolerance: 1.0e-7", "tolerance: .nan", "solve.tolerance = nan"),
-                             ("coarse_nodes: 60", "coarse_nodes: -60", "solve.coarse_nodes = -60")):
+                             ("coarse_nodes: 60", "coarse_nodes: -60", "solve.coarse_nodes = -60"),
+                             ("altitude_km: {value: 0.0}", "altitude_km: {value: .nan}", "value = nan")):
         assert old in text, old
         path = tmp_path / "p.yaml"
         path.write_text(text.replace(old, new))

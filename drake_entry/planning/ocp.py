@@ -105,6 +105,17 @@ class ObjectiveTerm:
             raise ScenarioError(f"objective kind '{self.kind}' needs a function")
         if self.kind == "miss_distance" and self.target is None:
             raise ScenarioError("objective 'miss_distance' needs target = (lon, lat) [rad]")
+        if not math.isfinite(self.weight):
+            raise ScenarioError(f"objective '{self.kind}': weight = {self.weight} must be finite")
+        if self.kind == "control_margin":
+            if len(self.k) != 3 or not all(0 <= v < math.inf for v in self.k):
+                raise ScenarioError(f"objective 'control_margin': k = {list(self.k)} needs three finite weights >= 0")
+            for name in ("alpha_max", "u_alpha_max", "u_sigma_max"):
+                if not 0 < getattr(self, name) < math.inf:
+                    raise ScenarioError(f"objective 'control_margin': {name} = {getattr(self, name)} must be "
+                                        f"finite and > 0")
+        if not 0 < self.scale < math.inf:
+            raise ScenarioError(f"objective '{self.kind}': scale = {self.scale} must be finite and > 0")
 
     @property
     def is_lagrange(self) -> bool:
@@ -263,11 +274,27 @@ class OptimalControlProblem(_ProblemLayout):
         if self.controls not in ("rates", "direct"):
             raise ScenarioError(f"controls must be 'rates' or 'direct', got '{self.controls}'")
         self._check_layout()
+        self._check_physical()
         if not self.objective:
             raise ScenarioError("objective needs at least one term")
         for term in self.objective:
             if term.kind == "control_margin" and self.controls != "rates":
                 raise ScenarioError("objective 'control_margin' (paper 002 eq. 11) needs controls='rates'")
+
+    # states an entry vehicle can have (SI / rad): fixed boundary values must lie inside
+    PHYSICAL = {"h": (-5e3, 1e6), "lon": (-4 * math.pi, 4 * math.pi), "lat": (-math.pi / 2, math.pi / 2),
+                "V": (1.0, 2e4), "gamma": (-math.pi / 2, math.pi / 2), "psi": (-4 * math.pi, 4 * math.pi),
+                "alpha": (-math.pi, math.pi), "sigma": (-4 * math.pi, 4 * math.pi)}
+
+    def _check_physical(self):
+        for where, d in (("initial", self.initial), ("final", self.final)):
+            for name, v in d.items():
+                lo, hi = self.PHYSICAL[name]
+                values = v if isinstance(v, (tuple, list)) else (v,)
+                for x in values:
+                    if not (isinstance(v, (tuple, list)) and math.isinf(x)) and not lo <= x <= hi:
+                        raise ScenarioError(f"{where}.{name} = {x} is out of range for an entry state; "
+                                            f"allowed [{lo:g}, {hi:g}] (SI / rad)")
 
     # -- layout -------------------------------------------------------------------------
     @property

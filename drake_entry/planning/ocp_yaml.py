@@ -102,8 +102,10 @@ class ProblemSpec:
 def _bound(where: str, b: BoundSpec, factor: float, *, allow_free: bool = True):
     for name in ("value", "min", "max"):
         v = getattr(b, name)
-        if v is not None and v != v:
-            raise ScenarioError(f"{where}.{name} = nan is not a number")
+        if v is not None and (v != v or (name == "value" and math.isinf(v)) or (name == "min" and v == math.inf)
+                              or (name == "max" and v == -math.inf)):
+            raise ScenarioError(f"{where}.{name} = {v} is not allowed: a finite number"
+                                + ("" if name == "value" else " (or omit the bound)"))
     if b.value is not None:
         if b.min is not None or b.max is not None:
             raise ScenarioError(f"{where}: give either value or min/max, not both")
@@ -138,8 +140,8 @@ def problem_from_spec(spec: ProblemSpec) -> OptimalControlProblem:
         raise ScenarioError(f"controls = '{spec.controls}'; allowed: rates, direct")
     vehicle = load_vehicle(spec.vehicle, aero=spec.aero or None)
     if spec.mass_over_area_kg_m2 is not None:
-        if not spec.mass_over_area_kg_m2 > 0:
-            raise ScenarioError(f"mass_over_area_kg_m2 = {spec.mass_over_area_kg_m2}; allowed > 0")
+        if not 0 < spec.mass_over_area_kg_m2 <= 1e5:
+            raise ScenarioError(f"mass_over_area_kg_m2 = {spec.mass_over_area_kg_m2}; allowed (0, 1e5]")
         vehicle = dc.replace(vehicle, mass=spec.mass_over_area_kg_m2 * vehicle.reference_area)
     planet = planet_from_spec(spec.planet)
     atmosphere = atmosphere_from_spec(spec.atmosphere)

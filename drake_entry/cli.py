@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from .errors import DrakeEntryError
+from .errors import DrakeEntryError, ScenarioError
 
 
 def _cmd_simulate(args) -> int:
@@ -248,6 +248,9 @@ def main(argv=None) -> int:
     f.set_defaults(func=_cmd_fit_horus)
     args = parser.parse_args(argv)
     try:
+        out = getattr(args, "out", None)
+        if out is not None and os.path.exists(out) and not os.path.isdir(out):
+            raise ScenarioError(f"--out {out} is a file, not a directory")
         return args.func(args)
     except DrakeEntryError as e:  # bad input, a refused campaign directory, an unusable solver: one line
         print(f"drake-entry: error: {' '.join(str(e).split())}", file=sys.stderr)

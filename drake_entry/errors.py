@@ -27,6 +27,11 @@ class ModelRangeError(ScenarioError):
     input to the API; inside a simulation, the run stops there with this as its reason."""
 
 
+class UnsupportedScalarError(DrakeEntryError, TypeError):
+    """A model asked for a scalar type it cannot take (a table look-up with a symbolic
+    Expression)."""
+
+
 class CampaignError(DrakeEntryError):
     """A campaign directory that cannot be used as asked (other settings, another writer,
     nothing to report)."""

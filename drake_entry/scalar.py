@@ -12,6 +12,8 @@ import numpy as np
 from pydrake.autodiffutils import AutoDiffXd
 from pydrake.symbolic import Expression, Variable
 
+from .errors import UnsupportedScalarError
+
 
 def is_autodiff(x) -> bool:
     """True when x is a pydrake AutoDiffXd scalar."""
@@ -28,7 +30,7 @@ def value_of(x):
     if isinstance(x, AutoDiffXd):
         return x.value()
     if is_symbolic(x):
-        raise TypeError(
+        raise UnsupportedScalarError(
             "this model is a table look-up and cannot take a symbolic Expression; "
             "use an analytic model (ExponentialAtmosphere, an analytic aero fit) for symbolic work"
         )

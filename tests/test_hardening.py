@@ -135,6 +135,9 @@ def test_report_covers_partial_killed_and_all_failed_campaigns(tmp_path, capsys)
     text = Path(write_report(out)).read_text()
     assert "Covers 2 of 5 requested samples (**incomplete**: 3 not run" in text
     assert "1 cut last line(s)" in text
+    os.chdir(tmp_path / "failed")  # the report reads the scenario as flown from the manifest, anywhere
+    assert main(["report", str(Path(out).resolve())]) == 0
+    assert "2/5 samples done" in capsys.readouterr().out
 
 
 def test_lines_that_are_not_rows_are_quarantined_and_cut_rows_do_not_duplicate_trajectories(tmp_path):
@@ -215,7 +218,8 @@ def test_cli_bad_arguments_are_one_line(argv, needle, capsys, tmp_path):
 def test_out_naming_a_file_and_bad_scenario_files_are_one_line(tmp_path, capsys):
     f = tmp_path / "afile"
     f.write_text("x")
-    assert "is a file" in _one_line_error(capsys, ["campaign", "horus2b", "--runs", "1", "--out", str(f)])
+    for command in ("campaign", "simulate", "fly", "plan"):
+        assert "is a file" in _one_line_error(capsys, [command, "horus2b", "--out", str(f)])
     empty = tmp_path / "empty.yaml"
     empty.write_text("")
     _one_line_error(capsys, ["simulate", str(empty), "--out", str(tmp_path / "o")])

@@ -81,7 +81,7 @@ class CampaignStore:
                     f"{self.out_dir} holds a campaign with another {', '.join(differs) or 'format'}; extend it "
                     f"with the same settings and a larger --runs, or start afresh with another --out")
             manifest["runs"] = max(int(old.get("runs", 0)), int(manifest["runs"]))
-        _write_atomic(self.path(MANIFEST), json.dumps(manifest, indent=2))
+        _write_atomic(self.path(MANIFEST), json.dumps(manifest, indent=2).encode())
         return manifest
 
     def path(self, name: str) -> str:
@@ -126,10 +126,11 @@ def _append(fd: int, line: str):
     os.fsync(fd)
 
 
-def _write_atomic(path: str, text: str):
+def _write_atomic(path: str, data: bytes):
+    """Replace ``path`` by ``data`` atomically (write a temporary file, fsync, rename)."""
     tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "w") as f:
-        f.write(text)
+    with open(tmp, "wb") as f:
+        f.write(data)
         f.flush()
         os.fsync(f.fileno())
     os.replace(tmp, path)
@@ -228,17 +229,8 @@ def repair(out_dir: str) -> dict:
             with open(os.path.join(out_dir, QUARANTINE), "ab") as q:
                 for raw in bad:
                     q.write(json.dumps({"file": name, "line": raw.decode("utf-8", "replace")}).encode() + b"\n")
-        _write_atomic_bytes(path, b"".join(line + b"\n" for line in keep))
+        _write_atomic(path, b"".join(line + b"\n" for line in keep))
     return report
-
-
-def _write_atomic_bytes(path: str, data: bytes):
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "wb") as f:
-        f.write(data)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
 
 
 def finalise(out_dir: str):

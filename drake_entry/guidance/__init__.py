@@ -3,7 +3,7 @@
 ``REGISTRY`` maps each method's scenario spec (a dataclass; YAML tag ``!ClassName``) to
 the module that holds its ``GuidanceMethod`` as ``METHOD``. The spec modules are pure data
 and imported here; method modules (which import Drake systems) are imported on first use.
-Add a method: a new package beside ``drag_energy`` and one line below
+Add a method: a new package beside ``drag_energy``, its spec import and one entry below
 (docs/architecture.md).
 """
 from __future__ import annotations

@@ -84,8 +84,8 @@ def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_st
     try:
         reason = stop_reason(simulator.AdvanceTo(scenario.simulation.max_time_s))
         final = True
-    except (NonFiniteStateError, ModelRangeError) as e:  # a NaN, or a state the models do not cover:
-        # stop with the reason, keep the log
+    except (NonFiniteStateError, ModelRangeError, OverflowError) as e:  # a NaN, an overflow, or a state
+        # the models do not cover: stop with the reason, keep the log
         reason = f"stopped at t = {simulator.get_context().get_time():.3f} s: {e}"
         final = False
     wall = _time.perf_counter() - t0

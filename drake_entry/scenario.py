@@ -218,10 +218,18 @@ class Scenario:
         if sim.integrator not in INTEGRATORS:
             raise ScenarioError(f"simulation.integrator '{sim.integrator}' is unknown; allowed: {', '.join(INTEGRATORS)}")
         for which in ("alpha", "bank"):
+            spec = getattr(self, which)
             for field in ("breakpoints", "values_deg"):
-                for i, v in enumerate(getattr(getattr(self, which), field)):
+                for i, v in enumerate(getattr(spec, field)):
                     if not np.isfinite(v):
                         raise ScenarioError(f"{which}.{field}[{i}] = {v} is not a finite number")
+            lo, hi = SCHEDULE_VALUES_DEG[which]
+            for i, v in enumerate(spec.values_deg):
+                check_range(f"{which}.values_deg[{i}]", v, lo, hi)
+            if spec.variable in SCHEDULE_BREAKPOINTS:
+                lo, hi = SCHEDULE_BREAKPOINTS[spec.variable]
+                for i, v in enumerate(spec.breakpoints):
+                    check_range(f"{which}.breakpoints[{i}] ({spec.variable})", v, lo, hi)
             if getattr(self, which).variable not in VARIABLES + ("normalized_energy",):
                 raise ScenarioError(f"{which}.variable '{getattr(self, which).variable}' is unknown; "
                                     f"allowed: {', '.join(VARIABLES)}")
@@ -243,6 +251,10 @@ class Scenario:
 
 
 INTEGRATORS = ("runge_kutta5", "runge_kutta3", "radau3")
+# physical ranges of schedule values [deg] and breakpoints (by scheduling variable)
+SCHEDULE_VALUES_DEG = {"alpha": (-90.0, 90.0), "bank": (-360.0, 360.0)}
+SCHEDULE_BREAKPOINTS = {"time": (-1e5, 1e5), "normalized_energy": (-1.0, 2.0), "mach": (0.0, 100.0),
+                        "velocity": (0.0, 3e4), "energy": (-1e8, 0.0)}
 
 
 def planet_from_spec(p: PlanetSpec) -> Earth:

@@ -244,6 +244,8 @@ def _vehicle_file(tmp_path, **changes) -> str:
     ("pre_guidance_bank_deg: 0.0", "pre_guidance_bank_deg: .nan", "pre_guidance_bank_deg = nan"),
     ("pre_guidance_min_s: 100.0", "pre_guidance_min_s: .nan", "pre_guidance_min_s = nan"),
     ("values_deg: [40.0, 15.0]", "values_deg: [.nan, 15.0]", "alpha.values_deg[0] = nan"),
+    ("values_deg: [40.0, 15.0]", "values_deg: [1e6, 15.0]", "alpha.values_deg[0] = 1000000.0 is out of range"),
+    ("breakpoints: [0.87, 0.98]", "breakpoints: [0.87, 1e6]", "alpha.breakpoints[1] (normalized_energy)"),
     ("  period_s: 1.0", "  period_s: 0.0", "guidance.period_s = 0.0"),
     ("  period_s: 1.0", "  period_s: .nan", "guidance.period_s = nan"),
     ("  corridor_points: 300", "  corridor_points: 1", "corridor_points = 1"),

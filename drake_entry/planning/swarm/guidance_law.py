@@ -1,0 +1,100 @@
+"""Paper 004's guidance law, the pieces a trajectory evaluation applies at every guidance step:
+the bank magnitude linear in energy (eq. 17), the quasi-equilibrium-glide compensation
+(eqs. 46-48, eq. 47 corrected), and the angle of attack derived from the path constraints
+(load factor, eq. 31; heat rate, eq. 21).
+
+Units: the paper works in Lu's nondimensional units (r in R0, V in sqrt(g0 R0), time in
+sqrt(R0/g0), accelerations in g0, mu = 1); its gains (k2 = 10, beta = 920) are defined there,
+so the QEG functions take nondimensional arguments. The alpha functions are SI. Everything
+is vectorised over numpy arrays (a population of trajectories).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import ScenarioError
+
+
+def linear_bank(e, e0: float, ef: float, sigma0, sigmaf):
+    """|sigma| [rad] linear in the energy-like variable from sigma0 at e0 to sigmaf at ef
+    (paper 004 eq. 17; e = mu/r - V^2/2 increases along the flight, eqs. 10-11)."""
+    return sigma0 + (np.asarray(e) - e0) / (ef - e0) * (sigmaf - sigma0)
+
+
+def equilibrium_glide_radius(V, lift_coefficient_term, beta: float):
+    """r_eq(V) of paper 004 eq. 46, nondimensional: the radius where lift balances gravity
+    less centrifugal acceleration in an exponential atmosphere rho0 exp(-beta (r - 1)):
+    r_eq = 1 + ln(c V^2 / (1 - V^2)) / beta, with c = V_scale^2 rho0 S C_L / (2 m g0)
+    (``lift_coefficient_term``)."""
+    V = np.asarray(V, float)
+    return 1.0 + np.log(lift_coefficient_term * V * V / (1.0 - V * V)) / beta
+
+
+def qeg_sin_flight_path(r, V, D, beta: float):
+    """sin(gamma_QEGC), nondimensional (paper 004 eq. 47, corrected).
+
+    Equating dr/dV of the dynamics (dr/dt = V sin gamma, dV/dt = -D - sin gamma / r^2) with
+    d r_eq/dV = 2 / (beta V (1 - V^2)) from eq. 46 gives
+    sin gamma = -2 D / (beta V^2 (1 - V^2) + 2 / r^2).
+    The paper prints -D / (beta V^3 (1 - V^2) + 1/r^2), which is off by x0.56 to x1.25
+    (shared/notes/paper004-cavh.md); tests check this form against eq. 46's derivative."""
+    r, V, D = (np.asarray(v, float) for v in (r, V, D))
+    return -2.0 * D / (beta * V * V * (1.0 - V * V) + 2.0 / (r * r))
+
+
+def qeg_bank(sigma_base, L, D, sin_gamma, sin_gamma_qeg, k2: float):
+    """|sigma_cmd| [rad] of paper 004 eq. 48, nondimensional L and D:
+    L cos(sigma_cmd) = L cos(sigma_base) - k2 (dr/de - dr_QEGC/de), with dr/de = sin gamma / D
+    (eq. 11: de/dt = D V). Climbing faster than the glide (dr/de above) lowers the vertical
+    lift. cos(sigma_cmd) is clipped to [-1, 1] (the compensation saturates)."""
+    drde = (np.asarray(sin_gamma) - np.asarray(sin_gamma_qeg)) / np.asarray(D)
+    c = np.cos(sigma_base) - k2 * drde / np.asarray(L)
+    return np.arccos(np.clip(c, -1.0, 1.0))
+
+
+def _bisect_increasing(f, target, lo: float, hi: float, iterations: int = 60):
+    """x in [lo, hi] with f(x) = target for f increasing in x (vectorised); targets outside
+    [f(lo), f(hi)] give the bound (the constraint cannot be met exactly: saturate)."""
+    target = np.asarray(target, float)
+    a = np.full(target.shape, lo)
+    b = np.full(target.shape, hi)
+    for _ in range(iterations):
+        m = 0.5 * (a + b)
+        below = f(m) < target
+        a = np.where(below, m, a)
+        b = np.where(below, b, m)
+    return 0.5 * (a + b)
+
+
+def _check_bounds(lo: float, hi: float):
+    if not lo < hi:
+        raise ScenarioError(f"alpha bounds [{lo}, {hi}] rad need lower < upper")
+
+
+def alpha_for_load_factor(dynamic_pressure, mach, aero, area_over_mass: float, g0: float, load_max: float,
+                          lo: float, hi: float):
+    """alpha [rad] in [lo, hi] at which the total aerodynamic load equals ``load_max`` [g]
+    (paper 004 eq. 31: q S sqrt(C_L^2 + C_D^2) / (m g0) = a_max), for each (q [Pa], Mach).
+    Assumes sqrt(C_L^2 + C_D^2) increases with alpha on [lo, hi] (true of the CAV-H fit for
+    alpha > 0); where a_max cannot be reached the nearest bound is returned."""
+    _check_bounds(lo, hi)
+    q, mach = np.broadcast_arrays(np.asarray(dynamic_pressure, float), np.asarray(mach, float))
+
+    def coefficient(alpha):
+        cl, cd = aero.coefficients(alpha, mach)
+        return np.hypot(cl, cd)
+
+    return _bisect_increasing(coefficient, load_max * g0 / (q * area_over_mass), lo, hi)
+
+
+def alpha_for_heat_rate(alpha_previous, heat_ratio, mach, aero, lo: float, hi: float):
+    """alpha_Q [rad] of paper 004 eq. 21, one guidance step: the drag coefficient that keeps
+    the heat rate at its limit is C_DQ = C_D(alpha_previous) rho / rho_Q, and rho / rho_Q =
+    (Qdot / Qdot_max)^2 (eq. 13), so C_DQ = C_D(alpha_previous) * heat_ratio^2 with
+    heat_ratio = Qdot / Qdot_max; then C_D(alpha_Q, M) = C_DQ is solved on [lo, hi]. The
+    equation is a recursion on the previous alpha with gain heat_ratio^2 per step, so its
+    result depends on the guidance step (document it with the scenario)."""
+    _check_bounds(lo, hi)
+    a_prev, ratio, mach = np.broadcast_arrays(*(np.asarray(v, float) for v in (alpha_previous, heat_ratio, mach)))
+    target = aero.coefficients(a_prev, mach)[1] * ratio * ratio
+    return _bisect_increasing(lambda alpha: aero.coefficients(alpha, mach)[1], target, lo, hi)

@@ -1,0 +1,73 @@
+"""Paper 004's per-step guidance law: eq. 17 bank, eq. 47 (corrected) against the derivative
+of eq. 46, eq. 48's sign, and the constraint-derived alpha of eqs. 21 and 31 (CAV-H)."""
+import math
+
+import numpy as np
+import pytest
+
+from drake_entry.errors import ScenarioError
+from drake_entry.planning.swarm.guidance_law import (alpha_for_heat_rate, alpha_for_load_factor,
+                                                     equilibrium_glide_radius, linear_bank, qeg_bank,
+                                                     qeg_sin_flight_path)
+from drake_entry.vehicles import load_vehicle
+
+BETA = 920.0  # paper 004, below eq. 46
+D2R = math.radians
+
+
+def test_eq17_bank_is_linear_in_energy_between_its_ends():
+    e = np.array([0.2, 0.35, 0.5])
+    got = linear_bank(e, 0.2, 0.5, D2R(58.9), D2R(60.0))
+    assert np.degrees(got) == pytest.approx([58.9, 59.45, 60.0])
+
+
+@pytest.mark.parametrize("V, r, D", [(0.75, 1.0094, 0.05), (0.95, 1.011, 0.02), (0.4, 1.006, 0.3)])
+def test_eq47_corrected_follows_the_equilibrium_glide_radius_of_eq46(V, r, D):
+    """Flying sin(gamma_QEGC), the dynamics' dr/dV = V sin g / (-D - sin g / r^2) equals
+    d r_eq / dV of eq. 46 (central difference); the printed eq. 47 does not."""
+    s = qeg_sin_flight_path(r, V, D, BETA)
+    drdV_dynamics = V * s / (-D - s / r**2)
+    h = 1e-6
+    drdV_eq46 = (equilibrium_glide_radius(V + h, 5.0, BETA) - equilibrium_glide_radius(V - h, 5.0, BETA)) / (2 * h)
+    assert drdV_dynamics == pytest.approx(drdV_eq46, rel=1e-7)
+    printed = -D / (BETA * V**3 * (1 - V**2) + 1 / r**2)
+    assert not 0.9 < printed / s < 1.1  # the typo the feasibility study found (x0.56 to x1.25)
+
+
+def test_eq48_lowers_vertical_lift_when_climbing_above_the_glide():
+    base = D2R(60.0)
+    same = qeg_bank(base, L=0.5, D=0.2, sin_gamma=-0.001, sin_gamma_qeg=-0.001, k2=10.0)
+    climbing = qeg_bank(base, L=0.5, D=0.2, sin_gamma=0.001, sin_gamma_qeg=-0.001, k2=10.0)
+    sinking = qeg_bank(base, L=0.5, D=0.2, sin_gamma=-0.003, sin_gamma_qeg=-0.001, k2=10.0)
+    assert same == pytest.approx(base) and climbing > base > sinking
+    # L cos(sigma_cmd) = L cos(sigma_base) - k2 (dr/de - dr_QEGC/de), dr/de = sin gamma / D
+    assert 0.5 * math.cos(climbing) == pytest.approx(0.5 * math.cos(base) - 10.0 * 0.002 / 0.2)
+    assert qeg_bank(base, L=0.5, D=0.2, sin_gamma=0.5, sin_gamma_qeg=0.0, k2=10.0) == pytest.approx(math.pi)
+
+
+@pytest.fixture(scope="module")
+def cav_h():
+    return load_vehicle("cav_h")
+
+
+def test_eq31_alpha_puts_the_total_load_on_its_limit(cav_h):
+    q = np.array([20e3, 40e3, 60e3])
+    mach = np.array([15.0, 10.0, 6.0])
+    alpha = alpha_for_load_factor(q, mach, cav_h.aero, cav_h.area_over_mass, 9.80665, 2.0, D2R(10), D2R(20))
+    cl, cd = cav_h.aero.coefficients(alpha, mach)
+    load = q * cav_h.area_over_mass * np.hypot(cl, cd) / 9.80665
+    inside = (alpha > D2R(10) + 1e-9) & (alpha < D2R(20) - 1e-9)
+    assert inside.any() and load[inside] == pytest.approx(2.0, rel=1e-10)
+    thin = alpha_for_load_factor(100.0, 20.0, cav_h.aero, cav_h.area_over_mass, 9.80665, 2.0, D2R(10), D2R(20))
+    dense = alpha_for_load_factor(1e6, 5.0, cav_h.aero, cav_h.area_over_mass, 9.80665, 2.0, D2R(10), D2R(20))
+    assert thin == pytest.approx(D2R(20)) and dense == pytest.approx(D2R(10))  # saturated at the bounds
+
+
+def test_eq21_alpha_is_a_fixed_point_on_the_heat_limit_and_raises_drag_above_it(cav_h):
+    a0, mach = D2R(12.0), 18.0
+    assert alpha_for_heat_rate(a0, 1.0, mach, cav_h.aero, D2R(10), D2R(20)) == pytest.approx(a0, abs=1e-12)
+    a1 = alpha_for_heat_rate(a0, 1.1, mach, cav_h.aero, D2R(10), D2R(20))
+    assert a1 > a0
+    assert cav_h.aero.coefficients(a1, mach)[1] == pytest.approx(1.21 * cav_h.aero.coefficients(a0, mach)[1])
+    with pytest.raises(ScenarioError, match="lower < upper"):
+        alpha_for_heat_rate(a0, 1.0, mach, cav_h.aero, D2R(20), D2R(10))

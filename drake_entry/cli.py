@@ -162,12 +162,12 @@ def _cmd_optimize(args) -> int:
     if coarse_nodes and coarse_nodes < nodes:
         print(f"coarse solve: {transcription}, {coarse_nodes} nodes, {solver} ...", flush=True)
         coarse = nlp.solve(problem, transcription=transcription, solver=solver, nodes=coarse_nodes,
-                           tolerance=max(tol, 1e-6), max_iterations=settings.max_iterations)
+                           tolerance=max(tol, 1e-6), max_iterations=max_iterations)
         print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
         guess = coarse if coarse.success else None
     print(f"solve: {problem.name}, {transcription}, {nodes} nodes, {solver} ...", flush=True)
     result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
-                       max_iterations=settings.max_iterations, guess=guess)
+                       max_iterations=max_iterations, guess=guess)
     check = propagate(problem, result) if result.success and not args.no_propagate else None
     info = nlp.summary(problem, result, check)
     os.makedirs(args.out, exist_ok=True)

@@ -75,6 +75,10 @@ class CampaignStore:
         manifest["fingerprint"] = fingerprint(manifest)
         old = read_manifest(self.out_dir)
         if old is not None:
+            if old.get("format") != FORMAT:
+                raise CampaignError(f"{self.out_dir} holds a campaign written by an older drake_entry (format "
+                                    f"{old.get('format', 1)}); `drake-entry report` still reads it; extend nothing "
+                                    f"there: start afresh with another --out")
             if old.get("fingerprint") != manifest["fingerprint"]:
                 differs = [name for key, name in IDENTITY.items() if old.get(key) != manifest.get(key)]
                 raise CampaignError(

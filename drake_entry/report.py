@@ -203,7 +203,8 @@ def _terminal_figures(rows: dict, reached, out_dir: str) -> list:
     # histograms of the terminal errors
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
     for ax, (col, label, unit) in zip(axes, (ERROR_COLUMNS[0], ERROR_COLUMNS[3], ERROR_COLUMNS[4])):
-        ax.hist(_finite(rows, col, n)[reached], bins=40, color="C0")
+        v = _finite(rows, col, n)[reached]
+        ax.hist(v[np.isfinite(v)], bins=40, color="C0")
         ax.set_xlabel(f"{label} [{unit}]")
         ax.grid(True)
     axes[0].set_ylabel("samples")
@@ -213,6 +214,8 @@ def _terminal_figures(rows: dict, reached, out_dir: str) -> list:
     fig, ax = plt.subplots(figsize=(5.5, 5))
     x = _finite(rows, "err_crossrange_m", n)[reached] / 1e3
     y = _finite(rows, "err_range_m", n)[reached] / 1e3
+    both = np.isfinite(x) & np.isfinite(y)
+    x, y = x[both], y[both]
     ax.plot(x, y, ".", ms=3)
     if x.size > 2:
         cov = np.cov(np.vstack([x, y]))

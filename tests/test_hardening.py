@@ -140,6 +140,17 @@ def test_report_covers_partial_killed_and_all_failed_campaigns(tmp_path, capsys)
     assert "2/5 samples done" in capsys.readouterr().out
 
 
+def test_a_campaign_of_the_previous_format_is_reported_but_not_extended(tmp_path, capsys):
+    old = tmp_path / "old"
+    old.mkdir()
+    row = {"index": 0, "seed": 1, "success": True, "stop": "reached energy", "message": "ok", "err_distance_m": 10.0}
+    (old / "samples.jsonl").write_text(json.dumps(row) + "\n")
+    (old / "campaign.json").write_text(json.dumps({"scenario": "horus2b", "runs": 1, "seed": 0, "overrides": {}}))
+    assert "written by an older drake_entry (format 1)" in _one_line_error(
+        capsys, ["campaign", "horus2b", "--runs", "2", "--out", str(old)])
+    assert main(["report", str(old)]) == 0 and "1/1 samples done" in capsys.readouterr().out
+
+
 def test_lines_that_are_not_rows_are_quarantined_and_cut_rows_do_not_duplicate_trajectories(tmp_path):
     from drake_entry.campaign_store import read_rows
 

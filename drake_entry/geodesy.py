@@ -72,3 +72,12 @@ def crossrange_from_great_circle(lon, lat, lon0: float, lat0: float, heading0: f
     p = [fn.cos(lat) * fn.cos(lon), fn.cos(lat) * fn.sin(lon), fn.sin(lat)]
     s = -(n[0] * p[0] + n[1] * p[1] + n[2] * p[2])
     return radius * (math.asin(s) if isinstance(s, float) else np.arcsin(s))
+
+
+def destination(lon, lat, heading, distance, radius: float):
+    """(lon, lat) [rad] reached from (lon, lat) along the great circle with initial
+    ``heading`` (from north, clockwise) after ``distance`` [m]."""
+    d = distance / radius
+    lat2 = math.asin(math.sin(lat) * math.cos(d) + math.cos(lat) * math.sin(d) * math.cos(heading))
+    lon2 = lon + math.atan2(math.sin(heading) * math.sin(d) * math.cos(lat), math.cos(d) - math.sin(lat) * math.sin(lat2))
+    return lon2, lat2

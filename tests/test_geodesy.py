@@ -75,3 +75,12 @@ def test_metrics_peaks_heat_load_and_margins_of_the_finite_limits():
     assert m["margin_heat_flux"] == pytest.approx(0.5) and m["margin_normal_load"] == pytest.approx(0.2)
     assert m["peak_total_load_g"] == 2.5 and "margin_total_load" not in m  # no total-load limit given
     assert "margin_heat_flux" not in metrics(tr)
+
+
+def test_destination_lies_on_the_great_circle_at_the_distance():
+    from drake_entry.geodesy import destination
+
+    lon, lat = destination(D(-72.3), D(39.2), D(38.6), 11250e3, R)
+    assert R * central_angle(D(-72.3), D(39.2), lon, lat) == pytest.approx(11250e3, rel=1e-9)
+    assert crossrange_from_great_circle(lon, lat, D(-72.3), D(39.2), D(38.6), R) == pytest.approx(0.0, abs=1e-3)
+    assert destination(0.0, 0.0, 0.0, R * D(10), R) == pytest.approx((0.0, D(10)))

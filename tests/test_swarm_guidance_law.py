@@ -71,3 +71,41 @@ def test_eq21_alpha_is_a_fixed_point_on_the_heat_limit_and_raises_drag_above_it(
     assert cav_h.aero.coefficients(a1, mach)[1] == pytest.approx(1.21 * cav_h.aero.coefficients(a0, mach)[1])
     with pytest.raises(ScenarioError, match="lower < upper"):
         alpha_for_heat_rate(a0, 1.0, mach, cav_h.aero, D2R(20), D2R(10))
+
+
+def _case1_problem():
+    from drake_entry.geodesy import destination
+    from drake_entry.planning.swarm.evaluator import SwarmProblem
+    from drake_entry.scenario import load_scenario
+
+    s = load_scenario("cav_h")
+    x0 = s.initial_state()
+    planet = s.make_planet()
+    # the feasibility study's substitute target: on the entry great circle at 11 250 km
+    target = destination(x0[1], x0[2], x0[5], 11250e3, planet.reference_radius)
+    return SwarmProblem(s.make_vehicle(), planet, s.make_atmosphere(), x0, target, h_f=30e3, V_f=2000.0)
+
+
+def test_population_members_fly_independently():
+    from drake_entry.planning.swarm.evaluator import evaluate
+
+    p = _case1_problem()
+    both = evaluate(p, np.radians([57.0, 61.0]))
+    alone = evaluate(p, np.radians([61.0]))
+    assert both.trajectories == 2 and both.reached.all()
+    assert both.J[1] == pytest.approx(alone.J[0], rel=1e-12)
+    assert both.final_state[1] == pytest.approx(alone.final_state[0], rel=1e-12)
+
+
+def test_case1_optimum_is_where_the_feasibility_study_found_it():
+    """Case 1 on the substitute target (shared/notes/paper004-cavh.md: sigma0* 58.92 deg, dh 239 m,
+    peak heat 2.90 MW/m^2; paper 004: 58.89 deg): the signed range error changes sign between
+    58.8 and 59.0 deg, where the altitude error and peak heat rate match the study's."""
+    from drake_entry.planning.swarm.evaluator import evaluate
+
+    ev = evaluate(_case1_problem(), np.radians([58.8, 59.0]))
+    assert ev.range_error_m[0] > 0 > ev.range_error_m[1]
+    assert ev.altitude_error_m == pytest.approx(239.0, abs=30.0)
+    assert ev.peak_heat_flux_W_m2 == pytest.approx(2.90e6, rel=0.02)
+    assert (ev.peak_total_load_g <= 2.0 + 1e-3).all() and (np.abs(ev.velocity_error_m_s) < 5.0).all()
+    assert ev.J.min() < 0.4

@@ -32,6 +32,12 @@ def bearing(lon1, lat1, lon2, lat2) -> float:
                       math.cos(lat1) * math.sin(lat2) - math.sin(lat1) * math.cos(lat2) * math.cos(dlon))
 
 
+def bearings(lon1, lat1, lon2, lat2):
+    """``bearing`` for numpy arrays (the same formula; tests hold the two equal)."""
+    dlon = lon2 - lon1
+    return np.arctan2(np.sin(dlon) * np.cos(lat2), np.cos(lat1) * np.sin(lat2) - np.sin(lat1) * np.cos(lat2) * np.cos(dlon))
+
+
 def range_and_crossrange(lon, lat, heading, target_lon, target_lat, radius: float) -> tuple[float, float, float]:
     """(range to go, cross-range, distance) [m] of a target seen from (lon, lat) flying along
     ``heading``: the distance projected on the heading (+ target ahead, i.e. short of it) and

@@ -14,13 +14,12 @@ Ports:
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import ScenarioError
 from drake_entry.geodesy import bearing
+from drake_entry.reversal import corridor_half_width, reversal_sign, wrap_angle
 
 
 class BankReversalLogic(LeafSystem):
@@ -46,21 +45,13 @@ class BankReversalLogic(LeafSystem):
             prerequisites_of_calc={self.xd_ticket()})
 
     def heading_error(self, x) -> float:
-        d = x[5] - bearing(x[1], x[2], *self.target)
-        return (d + math.pi) % (2.0 * math.pi) - math.pi
+        return wrap_angle(x[5] - bearing(x[1], x[2], *self.target))
 
     def limit(self, V: float) -> float:
-        deg, vel = self.corridor
-        return float(np.interp(V, vel, deg))
+        return float(corridor_half_width(V, *self.corridor))
 
     def new_sign(self, x, sign: float) -> float:
-        err = self.heading_error(x)
-        lim = self.limit(x[3])
-        if err > lim:
-            return -1.0
-        if err < -lim:
-            return 1.0
-        return sign
+        return float(reversal_sign(self.heading_error(x), self.limit(x[3]), sign))
 
     def _update(self, context, discrete_state):
         sign, count = context.get_discrete_state(self._state).get_value()

@@ -84,3 +84,20 @@ def test_destination_lies_on_the_great_circle_at_the_distance():
     assert R * central_angle(D(-72.3), D(39.2), lon, lat) == pytest.approx(11250e3, rel=1e-9)
     assert crossrange_from_great_circle(lon, lat, D(-72.3), D(39.2), D(38.6), R) == pytest.approx(0.0, abs=1e-3)
     assert destination(0.0, 0.0, 0.0, R * D(10), R) == pytest.approx((0.0, D(10)))
+
+
+def test_array_bearings_equal_the_scalar_bearing():
+    from drake_entry.geodesy import bearings
+
+    rng = np.random.default_rng(4)
+    p = rng.uniform(-1.4, 1.4, (4, 30))
+    assert bearings(*p) == pytest.approx([bearing(*map(float, c)) for c in p.T], abs=1e-14)
+
+
+def test_reversal_sign_turns_back_at_the_corridor_edges():
+    from drake_entry.reversal import reversal_sign, wrap_angle
+
+    assert [reversal_sign(e, 0.1, s) for e, s in ((0.2, 1.0), (-0.2, -1.0), (0.05, -1.0), (0.2, -1.0))] == \
+        [-1.0, 1.0, -1.0, -1.0]
+    assert list(reversal_sign(np.array([0.2, -0.2, 0.0]), 0.1, np.array([1.0, -1.0, 1.0]))) == [-1.0, 1.0, 1.0]
+    assert wrap_angle(3 * math.pi / 2) == pytest.approx(-math.pi / 2)

@@ -20,7 +20,8 @@ import numpy as np
 
 from ...actuator import integrate_actuators
 from ...dynamics import state_derivatives
-from ...geodesy import downtrack_crosstrack
+from ...geodesy import bearings, downtrack_crosstrack
+from ...reversal import corridor_half_width, reversal_sign, wrap_angle
 from .guidance_law import alpha_for_heat_rate, alpha_for_load_factor, linear_bank, qeg_bank, qeg_sin_flight_path
 
 
@@ -103,15 +104,6 @@ class Evaluation:
     trajectories: int
 
 
-def _wrap(a):
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
-
-
-def _bearing(lon, lat, lon_t, lat_t):
-    dlon = lon_t - lon
-    return np.arctan2(np.sin(dlon) * np.cos(lat_t), np.cos(lat) * np.sin(lat_t) - np.sin(lat) * np.cos(lat_t) * np.cos(dlon))
-
-
 def evaluate(problem: SwarmProblem, sigma0) -> Evaluation:
     """Fly every sigma0 [rad] of the population (array) and return its Evaluation."""
     p, pl = problem, problem.planet
@@ -156,9 +148,8 @@ def evaluate(problem: SwarmProblem, sigma0) -> Evaluation:
         s_qeg = qeg_sin_flight_path(r_n, V_n, D / g0, p.beta)
         mag = np.minimum(qeg_bank(base, L / g0, D / g0, np.sin(gamma), s_qeg, p.k2), p.vehicle.bank_limit)
         # sign: heading-error corridor (positive bank turns right)
-        err = _wrap(xa[5] - _bearing(xa[1], xa[2], *p.target))
-        corridor = np.interp(V, p.reversal_velocity, p.reversal_heading)
-        new_sign = np.where(err > corridor, -1.0, np.where(err < -corridor, 1.0, sign[idx]))
+        err = wrap_angle(xa[5] - bearings(xa[1], xa[2], *p.target))
+        new_sign = reversal_sign(err, corridor_half_width(V, p.reversal_heading, p.reversal_velocity), sign[idx])
         reversals[idx] += new_sign != sign[idx]
         sign[idx] = new_sign
         bank = sign[idx] * mag

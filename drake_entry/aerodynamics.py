@@ -53,8 +53,9 @@ def _checked_coefficients(coefficients):
         if type(mach) is float and type(alpha) is float:
             if not (0.0 < mach < math.inf) or alpha - alpha != 0.0:
                 _bad_input(self, alpha, mach)
-        elif isinstance(mach, np.ndarray) and mach.dtype.kind == "f":
-            if not (np.all(mach > 0.0) and np.all(np.isfinite(mach)) and np.all(np.isfinite(alpha))):
+        elif isinstance(mach, np.ndarray) and mach.dtype.kind == "f" and mach.size:
+            # two reductions: a NaN or inf anywhere makes the sum non-finite
+            if not (mach.min() > 0.0 and math.isfinite(float(np.sum(mach)) + float(np.sum(alpha)))):
                 _bad_input(self, alpha, mach)
         return coefficients(self, alpha, mach)
     return checked

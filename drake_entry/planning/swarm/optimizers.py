@@ -50,6 +50,14 @@ def _bounds(bounds) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
+def _start(f, bounds, n: int, seed: int):
+    """The seeded initial swarm: (lo, hi, rng, X uniform in the bounds, V = 0, J = f(X))."""
+    lo, hi = _bounds(bounds)
+    rng = np.random.default_rng(seed)
+    X = lo + rng.random((n, lo.size)) * (hi - lo)
+    return lo, hi, rng, X, np.zeros_like(X), np.asarray(f(X), float)
+
+
 def _result(best_x, best_J, history, evaluations, tolerance) -> SwarmResult:
     history = np.asarray(history, float)
     converged = int(np.flatnonzero(history <= history[-1] + tolerance)[0])
@@ -62,11 +70,7 @@ def pio(f, bounds, *, n: int = 10, k_max: int = 20, k_c: int = 14, R: float = 0.
     R 0.2). f maps an (m, D) array of positions to m objectives."""
     if not (1 <= k_c <= k_max and n >= 2):
         raise ScenarioError(f"PIO needs n >= 2 and 1 <= k_c <= k_max, got n={n}, k_c={k_c}, k_max={k_max}")
-    lo, hi = _bounds(bounds)
-    rng = np.random.default_rng(seed)
-    X = lo + rng.random((n, lo.size)) * (hi - lo)
-    V = np.zeros_like(X)
-    J = np.asarray(f(X), float)
+    lo, hi, rng, X, V, J = _start(f, bounds, n, seed)
     evaluations = n
     g = int(np.argmin(J))
     best_x, best_J = X[g].copy(), J[g]
@@ -96,11 +100,7 @@ def pso(f, bounds, *, n: int = 10, k_max: int = 20, c1: float = 1.4, c2: float =
     paper 004's settings; ``PSO_CONSTRICTION`` for stable ones)."""
     if not (n >= 2 and k_max >= 1):
         raise ScenarioError(f"PSO needs n >= 2 and k_max >= 1, got n={n}, k_max={k_max}")
-    lo, hi = _bounds(bounds)
-    rng = np.random.default_rng(seed)
-    X = lo + rng.random((n, lo.size)) * (hi - lo)
-    V = np.zeros_like(X)
-    J = np.asarray(f(X), float)
+    lo, hi, rng, X, V, J = _start(f, bounds, n, seed)
     evaluations = n
     p_x, p_J = X.copy(), J.copy()
     g = int(np.argmin(J))

@@ -52,19 +52,33 @@ def qeg_bank(sigma_base, L, D, sin_gamma, sin_gamma_qeg, k2: float):
     return np.arccos(np.clip(c, -1.0, 1.0))
 
 
-def _bisect_increasing(f, target, lo: float, hi: float, iterations: int = 40):
-    """x in [lo, hi] with f(x) = target for f increasing in x (vectorised; 40 halvings of a
-    10-deg bracket leave 2e-13 rad); targets outside [f(lo), f(hi)] give the bound (the
-    constraint cannot be met exactly: saturate)."""
+def _solve_increasing(f, target, lo: float, hi: float, rtol: float = 1e-13, max_iterations: int = 60):
+    """x in [lo, hi] with f(x) = target for f increasing in x, vectorised: the Illinois
+    variant of false position (superlinear; about 8 evaluations instead of bisection's 40).
+    Targets outside [f(lo), f(hi)] give the bound (the constraint cannot be met exactly:
+    saturate)."""
     target = np.asarray(target, float)
-    a = np.full(target.shape, lo)
-    b = np.full(target.shape, hi)
-    for _ in range(iterations):
-        m = 0.5 * (a + b)
-        below = f(m) < target
-        a = np.where(below, m, a)
-        b = np.where(below, b, m)
-    return 0.5 * (a + b)
+    a, b = np.full(target.shape, lo), np.full(target.shape, hi)
+    fa, fb = f(a) - target, f(b) - target
+    x = np.where(fa >= 0.0, a, b)  # saturated answers; the bracketed ones are refined below
+    inside = (fa < 0.0) & (fb > 0.0)
+    side = np.zeros(target.shape)
+    tol = rtol * np.maximum(np.abs(target), 1.0)
+    for _ in range(max_iterations):
+        if not inside.any():
+            break
+        xi = np.where(inside, b - fb * (b - a) / np.where(inside, fb - fa, 1.0), x)
+        fx = np.where(inside, f(xi) - target, 0.0)
+        upper = inside & (fx > 0.0)  # the root is left of xi: xi becomes b
+        lower = inside & (fx <= 0.0)
+        fa = np.where(upper & (side == -1), 0.5 * fa, fa)  # Illinois: halve the stale end
+        fb = np.where(lower & (side == 1), 0.5 * fb, fb)
+        b, fb = np.where(upper, xi, b), np.where(upper, fx, fb)
+        a, fa = np.where(lower, xi, a), np.where(lower, fx, fa)
+        side = np.where(upper, -1.0, np.where(lower, 1.0, side))
+        x = np.where(inside, xi, x)
+        inside = inside & (np.abs(fx) > tol) & (b - a > 1e-15)
+    return x
 
 
 def _check_bounds(lo: float, hi: float):
@@ -85,7 +99,7 @@ def alpha_for_load_factor(dynamic_pressure, mach, aero, area_over_mass: float, g
         cl, cd = aero.coefficients(alpha, mach)
         return np.hypot(cl, cd)
 
-    return _bisect_increasing(coefficient, load_max * g0 / (q * area_over_mass), lo, hi)
+    return _solve_increasing(coefficient, load_max * g0 / (q * area_over_mass), lo, hi)
 
 
 def alpha_for_heat_rate(alpha_previous, heat_ratio, mach, aero, lo: float, hi: float):
@@ -98,4 +112,4 @@ def alpha_for_heat_rate(alpha_previous, heat_ratio, mach, aero, lo: float, hi: f
     _check_bounds(lo, hi)
     a_prev, ratio, mach = np.broadcast_arrays(*(np.asarray(v, float) for v in (alpha_previous, heat_ratio, mach)))
     target = aero.coefficients(a_prev, mach)[1] * ratio * ratio
-    return _bisect_increasing(lambda alpha: aero.coefficients(alpha, mach)[1], target, lo, hi)
+    return _solve_increasing(lambda alpha: aero.coefficients(alpha, mach)[1], target, lo, hi)

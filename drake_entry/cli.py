@@ -93,7 +93,9 @@ def _cmd_plan(args) -> int:
     package = REGISTRY[type(scenario.guidance)].rpartition(".")[0]
     try:  # a method's CLI commands live beside it (docs/architecture.md)
         commands = importlib.import_module(f"{package}.commands")
-    except ModuleNotFoundError:
+    except ModuleNotFoundError as e:
+        if e.name != f"{package}.commands":  # a missing import inside the module is a bug: raise it
+            raise
         print(f"drake-entry: guidance method '{method_for(scenario.guidance).name}' has no plan report",
               file=sys.stderr)
         return 2

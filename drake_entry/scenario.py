@@ -204,7 +204,13 @@ class Scenario:
         for name in ("altitude_tolerance_km", "mach_tolerance", "distance_tolerance_km"):
             if getattr(t, name) is not None:
                 check_range(f"terminal.{name}", getattr(t, name), 0.0, 1e5)
-        check_range("guidance.period_s", self.guidance.period_s, 0.01, 60.0)  # before the step that divides it
+        if not self.vehicle:
+            raise ScenarioError("vehicle: missing; give a packaged vehicle name or a vehicle YAML path")
+        try:
+            self.make_vehicle()
+        except ValueError as e:
+            raise ScenarioError(str(e)) from None
+        self.guidance.validate(self)  # the method's fields (period_s among them) before what depends on them
         sim = self.simulation
         check_range("simulation.max_time_s", sim.max_time_s, 1.0, 1e5)
         check_range("simulation.accuracy", sim.accuracy, 1e-14, 1e-1)
@@ -240,13 +246,6 @@ class Scenario:
             disp.validate(self.dispersions)
         except ValueError as e:
             raise ScenarioError(str(e)) from None
-        if not self.vehicle:
-            raise ScenarioError("vehicle: missing; give a packaged vehicle name or a vehicle YAML path")
-        try:
-            self.make_vehicle()
-        except ValueError as e:
-            raise ScenarioError(str(e)) from None
-        self.guidance.validate(self)
         return self
 
 

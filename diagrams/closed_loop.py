@@ -19,18 +19,12 @@ import dataclasses as dc
 import math
 
 import numpy as np
-from drake_entry.diagrams.common import run
-from drake_entry.systems.actuators import AlphaActuator, BankActuator
-from drake_entry.systems.atmosphere import AtmosphereSystem
-from drake_entry.systems.monitors import TerminationMonitor
-from drake_entry.systems.navigation import Navigation
-from drake_entry.systems.schedule import ScheduleSource
-from drake_entry.systems.vehicle import EntryVehicle
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from drake_entry.aerodynamics import ScaledAero
 from drake_entry.atmosphere import Atmosphere, DispersedAtmosphere
+from drake_entry.diagrams.common import run
 from drake_entry.dispersions import Draw
 from drake_entry.errors import ScenarioError
 from drake_entry.geodesy import range_and_crossrange
@@ -39,6 +33,12 @@ from drake_entry.guidance.interface import GuidanceMethod, GuidanceSummary, Plan
 from drake_entry.planet import Earth
 from drake_entry.scenario import Scenario
 from drake_entry.schedules import Schedule
+from drake_entry.systems.actuators import AlphaActuator, BankActuator
+from drake_entry.systems.atmosphere import AtmosphereSystem
+from drake_entry.systems.monitors import TerminationMonitor
+from drake_entry.systems.navigation import Navigation
+from drake_entry.systems.schedule import ScheduleSource
+from drake_entry.systems.vehicle import EntryVehicle
 from drake_entry.trajectory import Trajectory
 from drake_entry.vehicles import Vehicle
 

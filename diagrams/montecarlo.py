@@ -16,10 +16,9 @@ import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
 
 import drake_entry
-from drake_entry.diagrams.backends import BACKENDS, run_dask, run_processes, run_serial
 from drake_entry.campaign_store import CampaignStore, done_indices, finalise  # noqa: F401 (API)
+from drake_entry.diagrams.backends import BACKENDS, run_dask, run_processes, run_serial
 from drake_entry.diagrams.sample import TIMING_COLUMNS, TRAJECTORY_STEP_S, campaign_row, run_sample, sample_seed  # noqa: F401 (API)
-
 from drake_entry.errors import ScenarioError
 from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
 from drake_entry.vehicles import PACKAGED_VEHICLES

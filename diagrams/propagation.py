@@ -13,7 +13,6 @@ from __future__ import annotations
 import dataclasses as dc
 
 import numpy as np
-from drake_entry.systems.ocp_plant import OptimalControlPlant
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
@@ -21,6 +20,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.geodesy import downtrack_crosstrack
 from drake_entry.planning.ocp import OptimalControlProblem
+from drake_entry.systems.ocp_plant import OptimalControlPlant
 
 
 @dc.dataclass

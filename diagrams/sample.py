@@ -13,11 +13,11 @@ import time
 import traceback
 
 import numpy as np
-from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, build_closed_loop, summarise
-from drake_entry.diagrams.common import collect_trajectory, make_simulator
 from pydrake.common import RandomGenerator
 from pydrake.systems.analysis import RandomSimulation
 
+from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, build_closed_loop, summarise
+from drake_entry.diagrams.common import collect_trajectory, make_simulator
 from drake_entry.dispersions import draw
 from drake_entry.trajectory import metrics
 

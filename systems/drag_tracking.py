@@ -22,12 +22,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from drake_entry.systems.drag_energy_guidance import sensed_drag
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.errors import ScenarioError
 from drake_entry.planning.drag_energy import DragEnergyPlanner
+from drake_entry.systems.drag_energy_guidance import sensed_drag
 
 
 class DragTrackingController(LeafSystem):

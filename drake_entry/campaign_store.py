@@ -64,7 +64,7 @@ class CampaignStore:
         os.write(self._lock, str(os.getpid()).encode())
         try:
             self.manifest = self._check_manifest(manifest)
-            self.report = repair(out_dir)
+            repair(out_dir)
         except BaseException:
             self.close()
             raise
@@ -92,7 +92,7 @@ class CampaignStore:
         return os.path.join(self.out_dir, name)
 
     def done_indices(self) -> set:
-        return set(read_rows(self.out_dir)[0])
+        return done_indices(self.out_dir)
 
     def __enter__(self) -> "CampaignStore":
         flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT

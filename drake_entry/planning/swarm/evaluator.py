@@ -19,7 +19,8 @@ import math
 import numpy as np
 
 from ...actuator import integrate_actuators
-from ...dynamics import state_derivatives
+from ...constraints import dynamic_pressure
+from ...dynamics import aero_accelerations, state_derivatives
 from ...geodesy import bearings, downtrack_crosstrack
 from ...reversal import corridor_half_width, reversal_sign, wrap_angle
 from .guidance_law import alpha_for_heat_rate, alpha_for_load_factor, linear_bank, qeg_bank, qeg_sin_flight_path
@@ -134,15 +135,12 @@ def evaluate(problem: SwarmProblem, sigma0) -> Evaluation:
         xa = x[:, idx]
         h, V, gamma = xa[0], xa[3], xa[4]
         rho, a = p.atmosphere.air_data(pl.atmospheric_altitude(h, xa[2]))
-        mach = V / a
-        cl, cd = p.vehicle.aero.coefficients(alpha[idx], mach)
-        qS_m = 0.5 * rho * V * V * p.vehicle.area_over_mass
-        L, D = qS_m * cl, qS_m * cd
-        q = 0.5 * rho * V * V
+        mach, L, D = aero_accelerations(xa, alpha[idx], rho, a, p.vehicle)
+        q = dynamic_pressure(rho, V)
         heat = p.vehicle.heat_flux(rho, V)
         peaks[:, idx] = np.maximum(peaks[:, idx], [heat, q, np.hypot(L, D) / g0])
         # bank magnitude: eq. 17, then the QEG compensation (eqs. 46-48, nondimensional)
-        e = pl.mu / pl.radius(h) - 0.5 * V * V
+        e = p.energy(h, V)
         base = linear_bank(e, e0, ef, sigma0[idx], p.sigma_f)
         r_n, V_n = pl.radius(h) / R0, V / v_scale
         s_qeg = qeg_sin_flight_path(r_n, V_n, D / g0, p.beta)
@@ -173,7 +171,7 @@ def evaluate(problem: SwarmProblem, sigma0) -> Evaluation:
         xn = xa + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
         alpha[idx], alpha_rate[idx] = alpha_new, rate_new
         t += dt
-        e_new = pl.mu / pl.radius(xn[0]) - 0.5 * xn[3] ** 2
+        e_new = p.energy(xn[0], xn[3])
         done = e_new >= ef
         if done.any():  # the TAEM energy was crossed inside this step: interpolate in energy
             w = np.clip((ef - e[done]) / (e_new[done] - e[done]), 0.0, 1.0)

@@ -75,30 +75,41 @@ def integrate_actuator(sigma: float, rate: float, command: float, step: float, s
     return s_out, r_out
 
 
-def actuator_accelerations(x, rate, command, *, lower, upper, rate_limit: float, accel_limit: float,
-                           bandwidth: float):
-    """x_ddot of ``actuator_rates`` for numpy arrays (a population of actuators): the same law,
-    written with array operations (tests hold it equal to the scalar form)."""
-    e = np.clip(command, lower, upper) - x
-    ae = np.abs(e)
-    mag = np.minimum(np.minimum(bandwidth * ae, rate_limit), np.sqrt(accel_limit * ae))
-    acc = 4.0 * bandwidth * (np.where(e >= 0.0, mag, -mag) - rate)
-    return np.clip(acc, -accel_limit, accel_limit)
-
-
-def integrate_actuators(x, rate, command, step: float, steps: int, **limits):
-    """(x, x_dot) arrays after ``steps`` midpoint-RK2 steps of ``step`` seconds under constant
-    commands, and the positions at every step (steps + 1, n) for interpolation; the array
-    counterpart of ``integrate_actuator`` (which also uses the exact solution where no limit
-    is active; the two agree to RK2's O(step^2) there)."""
+def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upper, rate_limit: float,
+                        accel_limit: float, bandwidth: float):
+    """(x, x_dot) arrays after ``steps`` steps of ``step`` seconds under constant commands, and
+    the positions at every step (steps + 1, n) for interpolation: ``integrate_actuator`` for a
+    population (the same exact solution where no limit is active over the interval, the same
+    midpoint-RK2 steps for the members where one is; tests hold the two equal)."""
     x, rate = np.array(x, float), np.array(rate, float)
-    positions = [x.copy()]
-    h = 0.5 * step
-    for _ in range(steps):
-        a1 = actuator_accelerations(x, rate, command, **limits)
-        r_mid = rate + h * a1
-        a2 = actuator_accelerations(x + h * rate, r_mid, command, **limits)
-        x = x + step * r_mid
-        rate = rate + step * a2
-        positions.append(x.copy())
-    return x, rate, np.array(positions)
+    c = np.clip(np.broadcast_to(np.asarray(command, float), x.shape), lower, upper)
+    w = bandwidth
+    t = (np.arange(steps + 1) * step)[:, None]
+    x0 = x - c
+    B = rate + 2.0 * w * x0
+    decay = np.exp(-2.0 * w * t)
+    dev = (x0 + B * t) * decay
+    vel = (rate - 2.0 * w * B * t) * decay
+    linear = ((np.abs(dev).max(axis=0) <= min(rate_limit / w, accel_limit / (w * w)))
+              & (np.abs(4.0 * w * (w * dev + vel)).max(axis=0) <= accel_limit))
+    positions, rates = dev + c, vel
+    limited = np.flatnonzero(~linear)
+    if limited.size:
+        s, r, cl, hh = x[limited], rate[limited], c[limited], 0.5 * step
+        positions[0, limited], rates[0, limited] = s, r
+        for k in range(1, steps + 1):
+            a1 = _accelerations(cl - s, r, w, rate_limit, accel_limit)
+            r_mid = r + hh * a1
+            a2 = _accelerations(cl - (s + hh * r), r_mid, w, rate_limit, accel_limit)
+            s = s + step * r_mid
+            r = r + step * a2
+            positions[k, limited], rates[k, limited] = s, r
+    return positions[-1].copy(), rates[-1].copy(), positions
+
+
+def _accelerations(e, rate, omega: float, rate_limit: float, accel_limit: float):
+    """``_accel`` for arrays of position errors e = clipped command - x."""
+    ae = np.abs(e)
+    mag = np.minimum(np.minimum(omega * ae, rate_limit), np.sqrt(accel_limit * ae))
+    acc = 4.0 * omega * (np.copysign(mag, e) - rate)
+    return np.minimum(np.maximum(acc, -accel_limit), accel_limit)

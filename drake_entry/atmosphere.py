@@ -191,7 +191,8 @@ def _lower_layers(z: float):
 _H_BASE_LIST = _H_BASE.tolist()
 _LAPSE_LIST = _LAPSE.tolist()
 _T_BASE_LIST = _T_BASE.tolist()
-_LN_P_BASE_LIST = np.log(_P_BASE).tolist()
+_LN_P_BASE = np.log(_P_BASE)
+_LN_P_BASE_LIST = _LN_P_BASE.tolist()
 
 
 class _ScalarCubic:
@@ -200,11 +201,19 @@ class _ScalarCubic:
     def __init__(self, spline: CubicSpline):
         self.x = spline.x.tolist()
         self.c = spline.c.T.tolist()  # per interval: [c3, c2, c1, c0]
+        self._x, self._c = np.asarray(spline.x, float), np.asarray(spline.c.T, float)
 
     def __call__(self, x: float):
         i = min(max(bisect.bisect_right(self.x, x) - 1, 0), len(self.c) - 1)
         c3, c2, c1, c0 = self.c[i]
         t = x - self.x[i]
+        return ((c3 * t + c2) * t + c1) * t + c0, (3.0 * c3 * t + 2.0 * c2) * t + c1, 6.0 * c3 * t + 2.0 * c2
+
+    def evaluate(self, x: np.ndarray):
+        """(value, first, second derivative) arrays at an array of x (the same cubics)."""
+        i = np.clip(np.searchsorted(self._x, x, side="right") - 1, 0, len(self.c) - 1)
+        c3, c2, c1, c0 = self._c[i].T
+        t = x - self._x[i]
         return ((c3 * t + c2) * t + c1) * t + c0, (3.0 * c3 * t + 2.0 * c2) * t + c1, 6.0 * c3 * t + 2.0 * c2
 
 
@@ -232,6 +241,39 @@ def _upper_table() -> _UpperTable:
     return _UPPER
 
 
+def _lower_layers_array(z: np.ndarray):
+    """``_lower_layers`` for an array of altitudes <= 86 km (the same formulas with numpy)."""
+    r0 = R0_GEOPOTENTIAL
+    H = r0 * z / (r0 + z)
+    Hz = (r0 / (r0 + z)) ** 2
+    Hzz = -2.0 * r0 * r0 / (r0 + z) ** 3
+    i = np.maximum(np.searchsorted(_H_BASE, H, side="right") - 1, 0)
+    L, Tb, dH = _LAPSE[i], _T_BASE[i], H - _H_BASE[i]
+    T = Tb + L * dH
+    isothermal = L == 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lnP = _LN_P_BASE[i] + np.where(isothermal, -_GMR * dH / Tb, (_GMR / np.where(isothermal, 1.0, L)) * np.log(Tb / T))
+    ln_rho = lnP - np.log(R_AIR * T)
+    f_H = -(_GMR + L) / T
+    f_HH = (_GMR + L) * L / (T * T)
+    return ln_rho, f_H * Hz, f_HH * Hz * Hz + f_H * Hzz, T, L * Hz, L * Hzz
+
+
+def _us76_array(z: np.ndarray):
+    """The six US76 quantities for an array of altitudes, vectorised by layer; equal to the
+    scalar path to rounding (tests)."""
+    out = np.empty((6,) + z.shape)
+    lower = z <= US76_LOWER_TOP
+    if lower.all():
+        return list(_lower_layers_array(z))
+    if lower.any():
+        out[:, lower] = _lower_layers_array(z[lower])
+    upper = ~lower
+    table = _upper_table()
+    out[:, upper] = table.ln_rho.evaluate(z[upper]) + table.T.evaluate(z[upper])
+    return list(out)
+
+
 def _us76_scalar(z: float):
     return _lower_layers(z) if z <= US76_LOWER_TOP else _upper_table()(z)
 
@@ -255,9 +297,7 @@ class US76Atmosphere(Atmosphere):
                 self.check(z)
             return _us76_scalar(z)
         self.check(h)
-        z = np.asarray(h, dtype=float)
-        vals = np.array([_us76_scalar(v) for v in z.ravel().tolist()]).reshape(z.shape + (6,))
-        return [vals[..., k] for k in range(6)]
+        return _us76_array(np.asarray(h, dtype=float))
 
     def _air_data_float(self, h: float) -> tuple[float, float]:
         ln_rho, _, _, T, _, _ = self._evaluate(float(h))

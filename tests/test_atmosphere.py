@@ -51,8 +51,17 @@ def test_autodiff_density_gradient_is_the_analytic_derivative(us76):
 
 
 def test_vectorised_equals_scalar(us76):
-    h = np.array([1e3, 50e3, 90e3])
-    assert np.allclose(us76.density(h), [us76.density(float(v)) for v in h], rtol=1e-14)
+    """The array path (vectorised by layer) gives every altitude what the scalar path gives,
+    all six quantities, across every layer boundary and the 86 km table join."""
+    from drake_entry.atmosphere import US76_LOWER_TOP, _us76_scalar
+
+    h = np.concatenate([np.linspace(-5e3, 1000e3, 4001), [0.0, 11e3, 20e3, 32e3, 47e3, 51e3, 71e3],
+                        [US76_LOWER_TOP, np.nextafter(US76_LOWER_TOP, 1e9)]])
+    array = np.array(us76._evaluate(h))
+    scalar = np.array([_us76_scalar(float(v)) for v in h]).T
+    assert array == pytest.approx(scalar, rel=1e-13, abs=1e-300)
+    lower_only = np.linspace(1e3, 80e3, 50)
+    assert np.allclose(us76.density(lower_only), [us76.density(float(v)) for v in lower_only], rtol=1e-14)
 
 
 def test_exponential_is_paper000_eq29():

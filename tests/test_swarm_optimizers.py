@@ -59,3 +59,23 @@ def test_pio_on_cav_h_case1_finds_the_feasibility_study_optimum():
     problem = _case1_problem()
     r = pio(lambda X: evaluate(problem, np.radians(X[:, 0])).J, [(0.0, 89.0)], seed=0)
     assert r.x[0] == pytest.approx(58.917, abs=0.02) and r.J < 0.3 and r.evaluations == 163
+
+
+def test_searches_in_lockstep_equal_the_same_searches_run_alone():
+    """minimise() flies several seeds' populations in one objective call per round; each
+    search's result is what it gives alone, and the calls are one per round of the longest."""
+    from drake_entry.planning.swarm.optimizers import minimise, pio_search, pso_search
+
+    calls = []
+
+    def counted(X):
+        calls.append(len(X))
+        return v_shape(X)
+
+    together = minimise(counted, [pio_search([(0.0, 89.0)], seed=s) for s in range(3)]
+                        + [pso_search([(0.0, 89.0)], seed=7, **PSO_CONSTRICTION)])
+    assert len(calls) == 21 and calls[0] == 40
+    for s in range(3):
+        alone = pio(v_shape, [(0.0, 89.0)], seed=s)
+        assert together[s].x.tolist() == alone.x.tolist() and together[s].history.tolist() == alone.history.tolist()
+    assert together[3].x.tolist() == pso(v_shape, [(0.0, 89.0)], seed=7, **PSO_CONSTRICTION).x.tolist()

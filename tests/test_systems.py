@@ -187,3 +187,23 @@ def test_segment_integrator_equals_midpoint_steps_of_the_actuator_law():
     t = np.arange(101) * h
     assert small[:, 0] == pytest.approx(0.303 - 0.003 * (1 + 4 * t) * np.exp(-4 * t), abs=1e-15)
     assert integrate_actuator(0.3, 0.0, 0.3, h, 5, **lim) == ([0.3] * 6, [0.0] * 6)
+
+
+def test_population_actuator_equals_the_scalar_actuator_member_by_member():
+    """integrate_actuators (a population, used by the paper-004 evaluator) gives every member
+    what integrate_actuator gives it alone: limited reversals, settled members and linear
+    tracking mixed in one call."""
+    from drake_entry.actuator import integrate_actuator, integrate_actuators
+
+    lim = dict(lower=math.radians(10), upper=math.radians(20), rate_limit=math.radians(4), accel_limit=math.radians(8),
+               bandwidth=2.0)
+    x = np.radians([10.0, 20.0, 15.0, 15.0, 12.0])
+    rate = np.radians([0.0, 0.0, 1.0, 0.0, -3.0])
+    cmd = np.radians([25.0, 20.0, 15.1, 11.0, 19.0])  # above the upper bound, settled, linear, limited, limited
+    end, end_rate, positions = integrate_actuators(x, rate, cmd, 0.05, 20, **lim)
+    assert positions.shape == (21, 5)
+    for i in range(5):
+        s, r = integrate_actuator(x[i], rate[i], cmd[i], 0.05, 20, **lim)
+        assert positions[:, i] == pytest.approx(s, abs=1e-14)
+        assert (end[i], end_rate[i]) == pytest.approx((s[-1], r[-1]), abs=1e-14)
+    assert positions[:, 1] == pytest.approx(np.radians(20.0), abs=0)  # settled at the bound

@@ -20,7 +20,7 @@ import numpy as np
 
 from ...actuator import integrate_actuators
 from ...constraints import dynamic_pressure
-from ...dynamics import aero_accelerations, state_derivatives
+from ...dynamics import aero_accelerations, equations_of_motion, state_derivatives
 from ...geodesy import bearings, downtrack_crosstrack
 from ...reversal import corridor_half_width, reversal_sign, wrap_angle
 from .guidance_law import alpha_for_heat_rate, alpha_for_load_factor, linear_bank, qeg_bank, qeg_sin_flight_path
@@ -164,7 +164,7 @@ def evaluate(problem: SwarmProblem, sigma0) -> Evaluation:
                                                              dt / steps, steps, **lim)
         stage_alpha = (positions[0], positions[steps // 2], positions[-1])
         # one RK4 step of the plant's equations
-        k1 = np.asarray(state_derivatives(list(xa), bank, stage_alpha[0], p.vehicle, pl, p.atmosphere))
+        k1 = equations_of_motion(xa, bank, L, D, pl)  # the air data above are the first stage's
         k2 = np.asarray(state_derivatives(list(xa + 0.5 * dt * k1), bank, stage_alpha[1], p.vehicle, pl, p.atmosphere))
         k3 = np.asarray(state_derivatives(list(xa + 0.5 * dt * k2), bank, stage_alpha[1], p.vehicle, pl, p.atmosphere))
         k4 = np.asarray(state_derivatives(list(xa + dt * k3), bank, stage_alpha[2], p.vehicle, pl, p.atmosphere))

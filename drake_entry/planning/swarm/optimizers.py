@@ -50,12 +50,12 @@ def _bounds(bounds) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def _start(f, bounds, n: int, seed: int):
-    """The seeded initial swarm: (lo, hi, rng, X uniform in the bounds, V = 0, J = f(X))."""
+def _start(bounds, n: int, seed: int):
+    """The seeded initial swarm: (lo, hi, rng, X uniform in the bounds, V = 0)."""
     lo, hi = _bounds(bounds)
     rng = np.random.default_rng(seed)
     X = lo + rng.random((n, lo.size)) * (hi - lo)
-    return lo, hi, rng, X, np.zeros_like(X), np.asarray(f(X), float)
+    return lo, hi, rng, X, np.zeros_like(X)
 
 
 def _result(best_x, best_J, history, evaluations, tolerance) -> SwarmResult:
@@ -64,13 +64,15 @@ def _result(best_x, best_J, history, evaluations, tolerance) -> SwarmResult:
     return SwarmResult(np.asarray(best_x, float), float(best_J), history, int(evaluations), converged)
 
 
-def pio(f, bounds, *, n: int = 10, k_max: int = 20, k_c: int = 14, R: float = 0.2, seed: int = 0,
-        tolerance: float = 1e-3) -> SwarmResult:
-    """Minimise f over ``bounds`` [(lo, hi), ...] with PIO (paper 004: N 10, k_max 20, k_c 14,
-    R 0.2). f maps an (m, D) array of positions to m objectives."""
+def pio_search(bounds, *, n: int = 10, k_max: int = 20, k_c: int = 14, R: float = 0.2, seed: int = 0,
+               tolerance: float = 1e-3):
+    """PIO over ``bounds`` [(lo, hi), ...] (paper 004: N 10, k_max 20, k_c 14, R 0.2) as a
+    generator: it yields each population's positions (m, D) and is sent their objectives (m,);
+    its return value is the SwarmResult. ``pio`` and ``minimise`` drive it."""
     if not (1 <= k_c <= k_max and n >= 2):
         raise ScenarioError(f"PIO needs n >= 2 and 1 <= k_c <= k_max, got n={n}, k_c={k_c}, k_max={k_max}")
-    lo, hi, rng, X, V, J = _start(f, bounds, n, seed)
+    lo, hi, rng, X, V = _start(bounds, n, seed)
+    J = np.asarray((yield X), float)
     evaluations = n
     g = int(np.argmin(J))
     best_x, best_J = X[g].copy(), J[g]
@@ -85,7 +87,7 @@ def pio(f, bounds, *, n: int = 10, k_max: int = 20, k_c: int = 14, R: float = 0.
             w = 1.0 / (J + 1e-12)
             centre = (w[:, None] * X).sum(axis=0) / w.sum()
             X = np.clip(X + rng.random((len(X), 1)) * (centre - X), lo, hi)
-        J = np.asarray(f(X), float)
+        J = np.asarray((yield X), float)
         evaluations += len(X)
         g = int(np.argmin(J))
         if J[g] < best_J:
@@ -94,13 +96,14 @@ def pio(f, bounds, *, n: int = 10, k_max: int = 20, k_c: int = 14, R: float = 0.
     return _result(best_x, best_J, history, evaluations, tolerance)
 
 
-def pso(f, bounds, *, n: int = 10, k_max: int = 20, c1: float = 1.4, c2: float = 2.6, w_start: float = 1.0,
-        w_end: float = 0.4, seed: int = 0, tolerance: float = 1e-3) -> SwarmResult:
-    """Minimise f over ``bounds`` with PSO, inertia linearly from w_start to w_end (defaults:
-    paper 004's settings; ``PSO_CONSTRICTION`` for stable ones)."""
+def pso_search(bounds, *, n: int = 10, k_max: int = 20, c1: float = 1.4, c2: float = 2.6, w_start: float = 1.0,
+               w_end: float = 0.4, seed: int = 0, tolerance: float = 1e-3):
+    """PSO over ``bounds`` with inertia linearly from w_start to w_end (defaults: paper 004's
+    settings; ``PSO_CONSTRICTION`` for stable ones), a generator like ``pio_search``."""
     if not (n >= 2 and k_max >= 1):
         raise ScenarioError(f"PSO needs n >= 2 and k_max >= 1, got n={n}, k_max={k_max}")
-    lo, hi, rng, X, V, J = _start(f, bounds, n, seed)
+    lo, hi, rng, X, V = _start(bounds, n, seed)
+    J = np.asarray((yield X), float)
     evaluations = n
     p_x, p_J = X.copy(), J.copy()
     g = int(np.argmin(J))
@@ -110,7 +113,7 @@ def pso(f, bounds, *, n: int = 10, k_max: int = 20, c1: float = 1.4, c2: float =
         w = w_start + (w_end - w_start) * (k - 1) / max(k_max - 1, 1)
         V = w * V + c1 * rng.random(X.shape) * (p_x - X) + c2 * rng.random(X.shape) * (best_x - X)
         X = np.clip(X + V, lo, hi)
-        J = np.asarray(f(X), float)
+        J = np.asarray((yield X), float)
         evaluations += n
         better = J < p_J
         p_x[better], p_J[better] = X[better], J[better]
@@ -119,3 +122,40 @@ def pso(f, bounds, *, n: int = 10, k_max: int = 20, c1: float = 1.4, c2: float =
             best_x, best_J = p_x[g].copy(), p_J[g]
         history.append(best_J)
     return _result(best_x, best_J, history, evaluations, tolerance)
+
+
+def minimise(f, searches) -> list[SwarmResult]:
+    """Run searches (``pio_search``/``pso_search`` generators) in lockstep: each round
+    evaluates the positions of every unfinished search in one call f(X) -> J, so a
+    vectorised objective flies all their populations together (20 seeds of Table 1 cost
+    about what one run costs). Results in the order of ``searches``."""
+    searches = list(searches)
+    results: list = [None] * len(searches)
+    pending = {i: next(s) for i, s in enumerate(searches)}
+    while pending:
+        order = list(pending)
+        X = np.concatenate([pending[i] for i in order])
+        J = np.asarray(f(X), float)
+        if J.shape != (len(X),):
+            raise ScenarioError(f"swarm objective returned shape {J.shape}, expected ({len(X)},)")
+        start = 0
+        for i in order:
+            m = len(pending[i])
+            try:
+                pending[i] = searches[i].send(J[start:start + m])
+            except StopIteration as done:
+                results[i] = done.value
+                del pending[i]
+            start += m
+    return results
+
+
+def pio(f, bounds, **settings) -> SwarmResult:
+    """Minimise f over ``bounds`` with PIO (settings of ``pio_search``); f maps an (m, D)
+    array of positions to m objectives."""
+    return minimise(f, [pio_search(bounds, **settings)])[0]
+
+
+def pso(f, bounds, **settings) -> SwarmResult:
+    """Minimise f over ``bounds`` with PSO (settings of ``pso_search``)."""
+    return minimise(f, [pso_search(bounds, **settings)])[0]

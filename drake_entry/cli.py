@@ -227,7 +227,7 @@ def main(argv=None) -> int:
     pl.add_argument("--out", default="out/plan")
     pl.set_defaults(func=_cmd_plan)
     p = sub.add_parser("simulate", help="fly the open-loop diagram of a scenario")
-    p.add_argument("scenario", help="packaged scenario name (horus2b, shefex3, cav_h, marv) or a YAML path")
+    p.add_argument("scenario", help="packaged scenario name (horus2b, shefex3, cav_h, cav_h_paper004, marv) or a YAML path")
     p.add_argument("--out", default="out/simulate", help="output directory")
     p.add_argument("--format", choices=("parquet", "csv"), default="parquet")
     p.set_defaults(func=_cmd_simulate)

@@ -1,6 +1,6 @@
 """Scenario files: dataclass schemas read with ``pydrake.common.yaml.yaml_load_typed``.
 
-Packaged scenarios live in ``drake_entry/scenarios/*.yaml`` (horus2b, shefex3, cav_h,
+Packaged scenarios live in ``drake_entry/scenarios/*.yaml`` (horus2b, shefex3, cav_h, cav_h_paper004,
 marv); ``load_scenario(name_or_path)`` reads either. Fields not in SI carry their unit
 in the name. Every bad value raises a one-line ``ScenarioError`` naming the field and the
 allowed range.
@@ -158,7 +158,7 @@ class Scenario:
         """(h_f [m], V_f [m/s], E_f [J/kg]) of the guidance terminal interface."""
         g = self.guidance
         h = g.terminal_altitude_km * 1e3
-        V = g.terminal_mach * float(self.make_atmosphere().speed_of_sound(h))
+        V = g.terminal_speed(float(self.make_atmosphere().speed_of_sound(h)))
         return h, V, float(self.make_planet().with_(j2=0.0).specific_energy(h, V))
 
     def schedule(self, which: str) -> Schedule:
@@ -282,7 +282,7 @@ def atmosphere_from_spec(a: AtmosphereSpec) -> Atmosphere:
     raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential")
 
 
-PACKAGED_SCENARIOS = ("horus2b", "shefex3", "cav_h", "marv")
+PACKAGED_SCENARIOS = ("horus2b", "shefex3", "cav_h", "cav_h_paper004", "marv")
 
 
 def load_scenario(name_or_path: str) -> Scenario:

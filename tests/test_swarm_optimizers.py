@@ -46,8 +46,9 @@ def test_bad_swarm_settings_are_one_line():
 
 @pytest.mark.slow
 def test_pio_on_cav_h_case1_finds_the_feasibility_study_optimum():
-    """Paper 004 settings (N 10, k_max 20, k_c 14, R 0.2), Case 1 on the substitute target:
-    sigma0* within 0.02 deg of the study's 58.917 (paper 004: 58.89), J near its 0.260."""
+    """Paper 004 settings (N 10, k_max 20, k_c 14, R 0.2), Case 1 on the substitute mission:
+    sigma0* within 0.03 deg of the root of the signed range error (58.79 deg; paper 004: 58.89),
+    J within 5e-3 of the grid refinement's 0.5727."""
     import sys
     from pathlib import Path
 
@@ -58,7 +59,7 @@ def test_pio_on_cav_h_case1_finds_the_feasibility_study_optimum():
 
     problem = _case1_problem()
     r = pio(lambda X: evaluate(problem, np.radians(X[:, 0])).J, [(0.0, 89.0)], seed=0)
-    assert r.x[0] == pytest.approx(58.917, abs=0.02) and r.J < 0.3 and r.evaluations == 163
+    assert r.x[0] == pytest.approx(58.79, abs=0.03) and r.J < 0.5727 + 5e-3 and r.evaluations == 163
 
 
 def test_searches_in_lockstep_equal_the_same_searches_run_alone():

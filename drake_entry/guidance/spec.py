@@ -21,6 +21,11 @@ class GuidanceSpecBase:
     # guidance and control update period [s] (navigation, guidance, actuator sampling)
     period_s: float = 1.0
 
+    def terminal_speed(self, speed_of_sound: float) -> float:
+        """V_f [m/s] of the terminal interface given the speed of sound there [m/s] (a method
+        whose mission gives V_f rather than Mach overrides this)."""
+        return self.terminal_mach * speed_of_sound
+
     def validate(self, scenario) -> None:
         """Raise a one-line ScenarioError on a bad field (``scenario`` gives the context)."""
         check_range("guidance.period_s", self.period_s, 0.01, 60.0)

@@ -10,6 +10,9 @@ is vectorised over numpy arrays (a population of trajectories).
 """
 from __future__ import annotations
 
+import dataclasses as dc
+import math
+
 import numpy as np
 
 from ...errors import ScenarioError
@@ -113,3 +116,74 @@ def alpha_for_heat_rate(alpha_previous, heat_ratio, mach, aero, lo: float, hi: f
     a_prev, ratio, mach = np.broadcast_arrays(*(np.asarray(v, float) for v in (alpha_previous, heat_ratio, mach)))
     target = aero.coefficients(a_prev, mach)[1] * ratio * ratio
     return _solve_increasing(lambda alpha: aero.coefficients(alpha, mach)[1], target, lo, hi)
+
+
+@dc.dataclass
+class LawMemory:
+    """What the alpha law remembers between guidance steps (arrays over a population).
+
+    Attributes:
+      alpha_command: the previous alpha command [rad] (the eq. 21 recursion runs on it).
+      mach_was_above: Mach has exceeded Mach_shift (Case 2).
+      switched: Case 2 has switched to the load-factor law for good (Mach fell below Mach_shift
+        after exceeding it; latched, so a climb back above Mach_shift does not switch back).
+    """
+
+    alpha_command: np.ndarray
+    mach_was_above: np.ndarray
+    switched: np.ndarray
+
+    @staticmethod
+    def start(alpha_command, n: int, *, was_above: bool = False, switched: bool = False) -> "LawMemory":
+        return LawMemory(np.full(n, float(alpha_command)), np.full(n, bool(was_above)), np.full(n, bool(switched)))
+
+
+@dc.dataclass(frozen=True)
+class LawSettings:
+    """The constants of paper 004's law (SI, rad). sigma_f: eq. 17's terminal bank;
+    e0, ef: eq. 17's energies [J/kg] (e = mu/r - V^2/2); bank_limit; alpha_min, alpha_max;
+    load_max [g], heat_max [W/m^2]; case 'load' (Case 1) or 'heat' (Case 2); mach_shift;
+    k2, beta: eqs. 46-48 (nondimensional); R0 [m], g0 [m/s^2]: Lu's units; mu [m^3/s^2]."""
+
+    sigma_f: float
+    e0: float
+    ef: float
+    bank_limit: float
+    alpha_min: float
+    alpha_max: float
+    load_max: float
+    heat_max: float
+    case: str
+    mach_shift: float
+    k2: float
+    beta: float
+    R0: float
+    g0: float
+    mu: float
+
+
+def law_commands(s: LawSettings, sigma0, x, r, rho, mach, L, D, heat, q, aero, area_over_mass: float,
+                 memory: LawMemory, sigma_f=None):
+    """One guidance step of paper 004's law for a population: (|sigma| [rad], alpha command
+    [rad], the next LawMemory).
+
+    x: states (6, n) [h, lon, lat, V, gamma, psi]; r: radii [m]; rho, mach, L, D [m/s^2],
+    heat [W/m^2], q [Pa]: the air data and aerodynamic accelerations at the step (n,).
+    |sigma|: eq. 17 (linear in e from sigma0) with the QEG compensation (eqs. 46-48), limited
+    to bank_limit. alpha: eq. 31 (Case 1); Case 2: eq. 21 until Mach has fallen below
+    Mach_shift after exceeding it, then eq. 31. ``sigma_f``: per-member eq. 17 end banks
+    (default: the settings')."""
+    V, gamma = x[3], x[4]
+    e = s.mu / r - 0.5 * V * V
+    base = linear_bank(e, s.e0, s.ef, sigma0, s.sigma_f if sigma_f is None else sigma_f)
+    v_scale = math.sqrt(s.g0 * s.R0)
+    s_qeg = qeg_sin_flight_path(r / s.R0, V / v_scale, D / s.g0, s.beta)
+    magnitude = np.minimum(qeg_bank(base, L / s.g0, D / s.g0, np.sin(gamma), s_qeg, s.k2), s.bank_limit)
+    alpha = alpha_for_load_factor(q, mach, aero, area_over_mass, s.g0, s.load_max, s.alpha_min, s.alpha_max)
+    above, switched = memory.mach_was_above, memory.switched
+    if s.case == "heat":
+        above = above | (mach > s.mach_shift)
+        switched = switched | (above & (mach <= s.mach_shift))
+        heat_alpha = alpha_for_heat_rate(memory.alpha_command, heat / s.heat_max, mach, aero, s.alpha_min, s.alpha_max)
+        alpha = np.where(switched, alpha, heat_alpha)
+    return magnitude, alpha, LawMemory(alpha, above, switched)

@@ -1,0 +1,132 @@
+"""Paper 004's guidance as a GuidanceMethod.
+
+  estimate, flight conditions --> SwarmBankGuidance --|sigma|--> BankReversalLogic --sigma_cmd-->
+      (shared bank actuator);   SwarmBankGuidance --alpha_command--> (shared alpha actuator)
+
+The planner searches sigma_0 before flight (PIO by default, planning/swarm/search.py) on the
+evaluator that replicates this closed loop, and verifies the optimum's trajectory against the
+path limits (eqs. 13-15) before calling it a success.
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+import time
+
+import numpy as np
+
+from ...planning.result import PlanResult
+from ...planning.swarm.evaluator import HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
+from ...planning.swarm.search import SearchResult, problem_from_scenario, search
+from ...systems.swarm_bank_guidance import SwarmBankGuidance
+from ..interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
+from ..reversal import add_bank_reversal, reversal_count
+
+GUIDANCE_SYSTEM = "swarm_bank_guidance"
+#: relative slack on the path limits when verifying a plan (the alpha law holds the load at
+#: its limit; the actuator's lag crosses it by a fraction of a percent)
+LIMIT_SLACK = 0.01
+
+
+@dc.dataclass
+class SwarmPlan(PlanResult):
+    """sigma_0 [deg] of paper 004 eq. 17 for a mission, with the search that found it and the
+    evaluation of its trajectory (``evaluation``, one member with its recorded history).
+
+    success: the trajectory reaches the TAEM energy inside the path limits (heat rate, q, load
+    within LIMIT_SLACK); otherwise ``message`` names the violated limits with their values.
+    """
+
+    variable = "time"
+
+    problem: SwarmProblem | None = None
+    sigma0_deg: float = math.nan
+    search: SearchResult | None = None
+    evaluation: Evaluation | None = None
+    violations: dict = dc.field(default_factory=dict)
+
+    def evaluate(self, at) -> dict:
+        """The planned trajectory's HISTORY_COLUMNS interpolated at times ``at`` [s]."""
+        h = self.evaluation.history[0]
+        t = np.atleast_1d(np.asarray(at, float))
+        return {name: np.interp(t, h[:, 0], h[:, i]) for i, name in enumerate(HISTORY_COLUMNS)}
+
+
+def verify(problem: SwarmProblem, ev: Evaluation) -> dict:
+    """{limit: (peak, limit)} of the path limits the (single-member) evaluation violates."""
+    lim = problem.vehicle.limits
+    checks = {"heat_flux_W_m2": (ev.peak_heat_flux_W_m2[0], lim.heat_flux_max),
+              "dynamic_pressure_Pa": (ev.peak_dynamic_pressure_Pa[0], lim.dynamic_pressure_max),
+              "total_load_g": (ev.peak_total_load_g[0], lim.total_load_max)}
+    return {k: (float(v), float(m)) for k, (v, m) in checks.items() if v > m * (1.0 + LIMIT_SLACK)}
+
+
+def plan(scenario, problem: SwarmProblem | None = None) -> SwarmPlan:
+    """Search sigma_0 (unless the spec gives it), fly the answer once more with its history and
+    verify it."""
+    t0 = time.perf_counter()
+    g = scenario.guidance
+    problem = problem_from_scenario(scenario) if problem is None else problem
+    found = None
+    if g.bank_start_deg is None:
+        found = search(problem, g.optimizer, [tuple(g.bank_start_bounds_deg)], seed=g.seed, n=g.population,
+                       k_max=g.iterations, k_c=g.landmark_iteration, R=g.map_compass_factor)
+        sigma0 = float(found.x[0])
+    else:
+        sigma0 = float(g.bank_start_deg)
+    build = time.perf_counter() - t0
+    ev = evaluate(problem, np.radians([sigma0]), record=True)
+    violations = verify(problem, ev)
+    reached = bool(ev.reached[0])
+    parts = [f"sigma_0 = {sigma0:.3f} deg" + (f" by {found.method} ({found.trajectories} trajectories)" if found
+                                                 else " (given)"),
+             f"J = {ev.J[0]:.4f}: range error {ev.range_error_m[0] / 1e3:+.2f} km, altitude {ev.altitude_error_m[0]:+.0f} m, "
+             f"speed {ev.velocity_error_m_s[0]:+.1f} m/s, crossrange {ev.crossrange_m[0] / 1e3:+.2f} km"]
+    if not reached:
+        parts.append("the trajectory does not reach the TAEM energy")
+    if violations:
+        parts.append("violates " + ", ".join(f"{k} {v:.4g} > {m:.4g}" for k, (v, m) in violations.items()))
+    if found is not None and found.message:
+        parts.append(found.message)
+    return SwarmPlan(success=reached and not violations, message="; ".join(parts),
+                     iterations=len(found.swarm.history) - 1 if found is not None and found.swarm else 0,
+                     build_time=build, solve_time=time.perf_counter() - t0 - build, objective=float(ev.J[0]),
+                     problem=problem, sigma0_deg=sigma0, search=found, evaluation=ev, violations=violations)
+
+
+class SwarmBankMethod(GuidanceMethod):
+    name = "swarm_bank"
+
+    def make_planner(self, scenario) -> SwarmPlan:
+        return plan(scenario)
+
+    def add_systems(self, builder, scenario, planner: SwarmPlan, plant: PlantPorts) -> GuidanceCommands:
+        g, p = scenario.guidance, planner.problem
+        guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, SwarmBankGuidance(
+            p, math.radians(planner.sigma0_deg), period=g.period_s, resolve_period=g.resolve_period_s,
+            resolve_until_e=g.resolve_until_e, bounds_deg=tuple(g.bank_start_bounds_deg)))
+        builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
+        builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
+        reversal = add_bank_reversal(builder, scenario, plant, guidance.GetOutputPort("bank_magnitude"),
+                                     initial_sign=p.initial_sign)
+        builder.Connect(reversal.GetOutputPort("bank_command"), guidance.GetInputPort("bank_command"))
+        return GuidanceCommands(
+            bank=reversal.GetOutputPort("bank_command"), alpha=guidance.GetOutputPort("alpha_command"),
+            alpha_limits=ActuatorLimits(p.alpha_min, p.alpha_max, p.alpha_rate, p.alpha_accel),
+            initial_bank=p.initial_bank, initial_alpha=p.alpha_max if p.initial_alpha is None else p.initial_alpha,
+            logged={"alpha_command": LoggedSignal(guidance.GetOutputPort("alpha_command"), ("alpha_command_rad",)),
+                    "sigma0": LoggedSignal(guidance.GetOutputPort("sigma0"), ("sigma0_rad",))})
+
+    def summarise(self, diagram, context, planner: SwarmPlan) -> GuidanceSummary:
+        system = diagram.GetSubsystemByName(GUIDANCE_SYSTEM)
+        mine = system.GetMyContextFromRoot(context)
+        plans, failed, wall = system.GetOutputPort("plan_stats").Eval(mine)
+        sigma0 = math.degrees(system.GetOutputPort("sigma0").Eval(mine)[0])
+        return GuidanceSummary(True, plans=int(plans), planning_wall_s=float(wall),
+                               fields={"reversals": reversal_count(diagram, context),
+                                       "sigma0_planned_deg": planner.sigma0_deg, "sigma0_final_deg": sigma0,
+                                       "resolutions_unbracketed": int(failed)},
+                               details=planner)
+
+
+METHOD = SwarmBankMethod()

@@ -1,0 +1,87 @@
+"""Scenario spec of paper 004's guidance; YAML tag ``guidance: !SwarmBank``."""
+
+import dataclasses as dc
+import math
+import typing
+
+from ...errors import ScenarioError, check_range
+from ..spec import ReversingBankSpec
+
+#: sigma_0 searches: the paper's swarms and the scipy baselines (planning/swarm/search.py)
+OPTIMIZERS = ("pio", "pso", "pso_stable", "grid", "brentq", "bounded", "differential_evolution")
+
+
+@dc.dataclass
+class SwarmBank(ReversingBankSpec):
+    """|sigma| linear in e = mu/r - V^2/2 from bank_start_deg at entry to bank_end_deg at the
+    TAEM energy (paper 004 eq. 17) with the QEG compensation (eqs. 46-48); alpha from the load
+    factor (Case 1, eq. 31) or the heat rate until Mach_shift (Case 2, eq. 21); bank sign from
+    the shared reversal logic. bank_start_deg is searched before flight (``optimizer``) unless
+    given, and re-solved on board every ``resolve_period_s`` when > 0."""
+
+    # the TAEM interface of eq. 32 (r*, V*); the flight stops at its energy
+    terminal_altitude_km: float = 30.0
+    terminal_velocity_m_s: float = 2000.0
+    # eq. 17: sigma_0 (None = search it in bank_start_bounds_deg) and sigma_f [deg]
+    bank_start_deg: typing.Optional[float] = None
+    bank_start_bounds_deg: list[float] = dc.field(default_factory=lambda: [0.0, 89.0])
+    bank_end_deg: float = 60.0
+    # alpha law: 'load' (Case 1, eq. 31) or 'heat' (Case 2: eq. 21 until Mach < mach_shift)
+    alpha_law: str = "load"
+    mach_shift: float = 20.0
+    # alpha bounds and actuator limits (paper 004: [10, 20] deg, 4 deg/s, 8 deg/s^2)
+    alpha_min_deg: float = 10.0
+    alpha_max_deg: float = 20.0
+    alpha_rate_deg_s: float = 4.0
+    alpha_accel_deg_s2: float = 8.0
+    # QEG compensation (eq. 48 gain k2, eq. 46 nondimensional scale height beta)
+    qeg_gain: float = 10.0
+    qeg_beta: float = 920.0
+    # sigma_0 search: pio | pso | pso_stable | grid | brentq | bounded | differential_evolution
+    optimizer: str = "pio"
+    # swarm settings (paper 004: N 10, k_max 20, k_c 14, R 0.2)
+    population: int = 10
+    iterations: int = 20
+    landmark_iteration: int = 14
+    map_compass_factor: float = 0.2
+    seed: int = 0
+    # on-board re-solution of sigma_0 from the navigation estimate [s] (0 = fly the plan)
+    resolve_period_s: float = 0.0
+    # no re-solution past this normalised energy (little range is left to correct)
+    resolve_until_e: float = 0.95
+
+    def terminal_speed(self, speed_of_sound: float) -> float:
+        return self.terminal_velocity_m_s
+
+    def validate(self, scenario) -> None:
+        super().validate(scenario)
+        check_range("guidance.terminal_velocity_m_s", self.terminal_velocity_m_s, 1.0, scenario.entry.velocity_m_s)
+        bank_limit = math.degrees(scenario.make_vehicle().bank_limit)
+        if len(self.bank_start_bounds_deg) != 2 or not self.bank_start_bounds_deg[0] < self.bank_start_bounds_deg[1]:
+            raise ScenarioError(f"guidance.bank_start_bounds_deg = {self.bank_start_bounds_deg} needs [lower, upper] "
+                                "with lower < upper")
+        for v in self.bank_start_bounds_deg:  # eq. 17's sigma_0 may exceed the bank limit; |sigma| is clipped
+            check_range("guidance.bank_start_bounds_deg", v, 0.0, 90.0)
+        if self.bank_start_deg is not None:
+            check_range("guidance.bank_start_deg", self.bank_start_deg, 0.0, 90.0)
+        check_range("guidance.bank_end_deg", self.bank_end_deg, 0.0, bank_limit)
+        if self.alpha_law not in ("load", "heat"):
+            raise ScenarioError(f"guidance.alpha_law = {self.alpha_law!r}; allowed: 'load' (Case 1), 'heat' (Case 2)")
+        check_range("guidance.mach_shift", self.mach_shift, 0.5, 40.0)
+        check_range("guidance.alpha_min_deg", self.alpha_min_deg, -10.0, 60.0)
+        check_range("guidance.alpha_max_deg", self.alpha_max_deg, self.alpha_min_deg + 1e-6, 60.0)
+        check_range("guidance.alpha_rate_deg_s", self.alpha_rate_deg_s, 1e-3, 100.0)
+        check_range("guidance.alpha_accel_deg_s2", self.alpha_accel_deg_s2, 1e-3, 1000.0)
+        check_range("guidance.qeg_gain", self.qeg_gain, 0.0, 1e4)
+        check_range("guidance.qeg_beta", self.qeg_beta, 1.0, 1e5)
+        if self.optimizer not in OPTIMIZERS:
+            raise ScenarioError(f"guidance.optimizer = {self.optimizer!r}; allowed: {', '.join(OPTIMIZERS)}")
+        check_range("guidance.population", self.population, 2, 10000)
+        check_range("guidance.iterations", self.iterations, 1, 10000)
+        check_range("guidance.landmark_iteration", self.landmark_iteration, 1, self.iterations)
+        check_range("guidance.map_compass_factor", self.map_compass_factor, 0.0, 10.0)
+        check_range("guidance.resolve_period_s", self.resolve_period_s, 0.0, 1e4)
+        if self.resolve_period_s and self.resolve_period_s < self.period_s:
+            raise ScenarioError(f"guidance.resolve_period_s = {self.resolve_period_s} must be 0 or >= guidance.period_s "
+                                f"= {self.period_s}")
+        check_range("guidance.resolve_until_e", self.resolve_until_e, 0.0, 1.0)

@@ -1,0 +1,112 @@
+"""SwarmBankGuidance: paper 004's guidance law on board (drake_entry.planning.swarm).
+
+Every ``period`` seconds the law gives |sigma| (eq. 17 from sigma_0 with the QEG compensation,
+eqs. 46-48) and the alpha command (eq. 31, or eq. 21 until Mach_shift) from the navigation
+estimate and the sensed flight conditions; the shared reversal logic signs |sigma| and the
+shared actuators fly both. With ``resolve_period`` > 0, sigma_0 is re-solved on board from
+the estimate (planning.swarm.search.resolve_sigma0: predicted trajectories of the same law
+with the nominal models) until the normalised energy ``resolve_until_e``.
+
+Ports:
+  input  "estimated_state"    [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
+  input  "flight_conditions"  [9]  sensed rho, Mach, q, heat flux, loads, L, D, E (true vehicle)
+  input  "bank_command"       [1]  the signed bank command [rad] (its sign starts the on-board
+                                   predictions; read only when re-solving, so no feedthrough)
+  output "bank_magnitude"     [1]  |sigma| [rad]
+  output "alpha_command"      [1]  alpha [rad]
+  output "sigma0"             [1]  the sigma_0 in use [rad]
+  output "plan_stats"         [3]  re-solutions, re-solutions without a bracketed root, wall time [s]
+
+The commands are computed from the inputs and the law's memory (previous alpha command, Case 2
+switch) at each sample: the actuators sample them at the same instant, as the planner's
+evaluation assumes (planning/swarm/evaluator.py).
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+import time
+
+import numpy as np
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.errors import ScenarioError
+from drake_entry.planning.swarm.evaluator import SwarmProblem
+from drake_entry.planning.swarm.guidance_law import LawMemory, law_commands
+from drake_entry.planning.swarm.search import resolve_sigma0
+
+_FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
+# discrete state: law memory (3), sigma_0, re-solutions, failed ones, wall time, next re-solution time
+_ALPHA, _ABOVE, _SWITCHED, _SIGMA0, _PLANS, _FAILED, _WALL, _NEXT = range(8)
+
+
+class SwarmBankGuidance(LeafSystem):
+    def __init__(self, problem: SwarmProblem, sigma0: float, *, period: float = 1.0, resolve_period: float = 0.0,
+                 resolve_until_e: float = 0.95, bounds_deg=(0.0, 89.0)):
+        """Args: problem (the mission and law, nominal models); sigma0 [rad] planned; period [s];
+        resolve_period [s] (0 = fly sigma0); resolve_until_e: last normalised energy of a
+        re-solution; bounds_deg: sigma_0 bounds of a re-solution."""
+        super().__init__()
+        if not period > 0:
+            raise ScenarioError(f"SwarmBankGuidance.period must be > 0 s, got {period}")
+        if not math.isfinite(sigma0):
+            raise ScenarioError(f"SwarmBankGuidance.sigma0 = {sigma0} must be finite (the plan found no sigma_0)")
+        self.problem, self.law = problem, problem.law()
+        self.resolve_period, self.resolve_until_e, self.bounds_deg = resolve_period, resolve_until_e, bounds_deg
+        self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
+        self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
+        self.bank_port = self.DeclareVectorInputPort("bank_command", 1)
+        alpha0 = problem.alpha_max if problem.initial_alpha is None else problem.initial_alpha
+        start = [alpha0, 0.0, 0.0, sigma0, 0.0, 0.0, 0.0, resolve_period if resolve_period > 0 else math.inf]
+        self._state = self.DeclareDiscreteState(BasicVector(start))
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+        deps = {self.xd_ticket(), self.est_port.ticket(), self.fc_port.ticket()}
+        self.DeclareVectorOutputPort("bank_magnitude", 1, lambda c, o: o.SetAtIndex(0, self.commands(c)[0]),
+                                     prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort("alpha_command", 1, lambda c, o: o.SetAtIndex(0, self.commands(c)[1]),
+                                     prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort("sigma0", 1, lambda c, o: o.SetAtIndex(0, self._memory(c)[_SIGMA0]),
+                                     prerequisites_of_calc={self.xd_ticket()})
+        self.DeclareVectorOutputPort("plan_stats", 3, lambda c, o: o.SetFromVector(self._memory(c)[_PLANS:_NEXT]),
+                                     prerequisites_of_calc={self.xd_ticket()})
+
+    def _memory(self, context) -> np.ndarray:
+        return context.get_discrete_state(self._state).get_value()
+
+    def commands(self, context):
+        """(|sigma| [rad], alpha command [rad], next LawMemory) at this sample."""
+        m = self._memory(context)
+        x = np.asarray(self.est_port.Eval(context), float)[:, None]
+        fc = self.fc_port.Eval(context)
+        v = {k: np.array([fc[_FC[k]]]) for k in ("rho", "mach", "lift", "drag", "heat_flux", "dynamic_pressure")}
+        memory = LawMemory(np.array([m[_ALPHA]]), np.array([m[_ABOVE] > 0.5]), np.array([m[_SWITCHED] > 0.5]))
+        veh = self.problem.vehicle
+        magnitude, alpha, nxt = law_commands(self.law, np.array([m[_SIGMA0]]), x, self.problem.planet.radius(x[0]),
+                                             v["rho"], v["mach"], v["lift"], v["drag"], v["heat_flux"],
+                                             v["dynamic_pressure"], veh.aero, veh.area_over_mass, memory)
+        return float(magnitude[0]), float(alpha[0]), nxt
+
+    def _update(self, context, discrete_state):
+        m = self._memory(context).copy()
+        _, alpha, nxt = self.commands(context)
+        m[_ALPHA], m[_ABOVE], m[_SWITCHED] = alpha, float(nxt.mach_was_above[0]), float(nxt.switched[0])
+        t = context.get_time()
+        if t >= m[_NEXT] - 1e-9:
+            m[_NEXT] += self.resolve_period
+            x = np.asarray(self.est_port.Eval(context), float)
+            p = self.problem
+            e = p.energy(x[0], x[3])
+            if (e - p.start_energy) / (p.ef - p.start_energy) <= self.resolve_until_e:
+                t0 = time.perf_counter()
+                bank = float(self.bank_port.Eval(context)[0])
+                here = dc.replace(p, x0=x, e0=p.start_energy, origin=(p.x0[1], p.x0[2]), initial_alpha=alpha,
+                                  initial_bank=bank, initial_sign=1.0 if bank >= 0 else -1.0,
+                                  memory=(bool(nxt.mach_was_above[0]), bool(nxt.switched[0])),
+                                  max_time_s=max(p.max_time_s - t, p.guidance_step_s))
+                r = resolve_sigma0(here, math.degrees(m[_SIGMA0]), self.bounds_deg)
+                m[_SIGMA0] = math.radians(r.sigma0_deg)
+                m[_PLANS] += 1
+                m[_FAILED] += not r.bracketed
+                m[_WALL] += time.perf_counter() - t0
+        discrete_state.get_mutable_vector(self._state).SetFromVector(m)

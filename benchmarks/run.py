@@ -1,12 +1,13 @@
 """Benchmarks, each printing its figures and ratios measured side by side in one run.
 
-    python benchmarks/run.py [open-loop|socp|nlp|campaign|interface-cost|all] [options]
+    python benchmarks/run.py [open-loop|socp|nlp|campaign|interface-cost|paper004|all] [options]
 
 open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
 socp            drag-energy SOCP build/solve times, Clarabel vs SCS, by node count
 nlp             NLP path: LGL / DirectCollocation x Ipopt / SNOPT from the same starts
 campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios)
 interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline commit
+paper004        paper 004: Table 1 over seeds, scipy baselines, cases, two parameters, figures
 """
 import argparse
 import os
@@ -17,7 +18,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("which", nargs="?", default="all",
-                        choices=("all", "open-loop", "socp", "nlp", "campaign", "interface-cost"))
+                        choices=("all", "open-loop", "socp", "nlp", "campaign", "interface-cost", "paper004"))
     parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
     parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
     parser.add_argument("--nodes", type=int, default=40, help="nlp: nodes / samples")
@@ -25,6 +26,8 @@ if __name__ == "__main__":
     parser.add_argument("--baseline", default=None,
                         help="interface-cost: git revision to compare with (default: the commit before the "
                              "guidance-method interface)")
+    parser.add_argument("--seeds", type=int, default=20, help="paper004: seeds per swarm method (Table 1)")
+    parser.add_argument("--out", default="out/paper004", help="paper004: figure directory")
     args = parser.parse_args()
     if args.which in ("all", "open-loop"):
         from open_loop import open_loop_benchmark
@@ -46,3 +49,7 @@ if __name__ == "__main__":
         from interface_cost import interface_cost_benchmark
 
         interface_cost_benchmark(baseline=args.baseline, rounds=args.rounds)
+    if args.which in ("all", "paper004"):
+        from paper004 import paper004_study
+
+        paper004_study(seeds=args.seeds, out_dir=args.out)

@@ -107,8 +107,22 @@ def _cmd_campaign(args) -> int:
 
     backend = "dask" if args.scheduler else args.backend
     out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
-                       backend=backend, scheduler=args.scheduler, trajectory_step_s=args.trajectory_step)
+                       overrides=parse_overrides(args.overrides), backend=backend, scheduler=args.scheduler,
+                       trajectory_step_s=args.trajectory_step)
     return _cmd_report(argparse.Namespace(dir=out))
+
+
+def parse_overrides(items) -> dict:
+    """{'a.b': value} from ["a.b=value", ...]; values are read as YAML (numbers, booleans, lists)."""
+    import yaml
+
+    out = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        if not sep or not key:
+            raise ScenarioError(f"--set {item!r}: write FIELD=VALUE, e.g. guidance.resolve_period_s=100")
+        out[key.strip()] = yaml.safe_load(text)
+    return out
 
 
 def _cmd_report(args) -> int:
@@ -213,6 +227,9 @@ def main(argv=None) -> int:
                    help="Dask scheduler address (implies --backend dask); a LocalCluster when omitted")
     c.add_argument("--trajectory-step", type=float, default=10.0, metavar="SECONDS",
                    help="keep each sample's trajectory every SECONDS (default 10; 0 = none, rows only)")
+    c.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE", dest="overrides",
+                   help="override a scenario field, e.g. --set guidance.resolve_period_s=100 (repeatable; "
+                        "the value is read as YAML)")
     c.set_defaults(func=_cmd_campaign)
     r = sub.add_parser("report", help="write the report of a campaign directory")
     r.add_argument("dir")
@@ -222,7 +239,8 @@ def main(argv=None) -> int:
     fl.add_argument("--out", default="out/fly")
     fl.add_argument("--format", choices=("parquet", "csv"), default="parquet")
     fl.set_defaults(func=_cmd_fly)
-    pl = sub.add_parser("plan", help="corridor, reference and extraction plots (paper 000 Figs. 3-5)")
+    pl = sub.add_parser("plan", help="the guidance method's plan report (drag-energy: corridor, reference and "
+                        "extraction, paper 000 Figs. 3-5; swarm bank: sigma_0 search, Drake check, paper 004 figures)")
     pl.add_argument("scenario")
     pl.add_argument("--out", default="out/plan")
     pl.set_defaults(func=_cmd_plan)

@@ -6,6 +6,7 @@ beside the paper's, the two-parameter search, and figures in the form of Figs. 4
 """
 from __future__ import annotations
 
+import dataclasses as dc
 import time
 
 import numpy as np
@@ -13,8 +14,8 @@ import numpy as np
 
 def paper004_study(*, seeds: int = 20, out_dir: str = "out/paper004", scenario_name: str = "cav_h_paper004") -> dict:
     from drake_entry.planning.swarm.evaluator import HISTORY_COLUMNS
-    from drake_entry.planning.swarm.search import problem_from_scenario
-    from drake_entry.planning.swarm.study import (PAPER, baselines, case_optima, swarm_statistics,
+    from drake_entry.planning.swarm.search import problem_from_scenario, search
+    from drake_entry.planning.swarm.study import (PAPER, baselines, case_optima, case_problem, swarm_statistics,
                                                    two_parameter)
     from drake_entry.plots import swarm_case_plots, swarm_convergence_plot
     from drake_entry.scenario import load_scenario
@@ -62,6 +63,15 @@ def paper004_study(*, seeds: int = 20, out_dir: str = "out/paper004", scenario_n
                        "heat_MW": float(ev.peak_heat_flux_W_m2[0] / 1e6)}
     order = [c.search.x[0] for c in cases]
     print(f"sigma0 ordering Case 1 < shift 20 < 16 < 10 (the paper's): {bool(np.all(np.diff(order) > 0))}")
+
+    print("\n== The guidance step (eq. 21 is a recursion on it; the evaluator and the closed loop share it)")
+    for case in ("case 1", "mach_shift 16"):
+        line = []
+        for step in (0.5, 1.0, 2.0):
+            r = search(dc.replace(case_problem(problem, case), guidance_step_s=step), "brentq")
+            line.append(f"{step:g} s: {r.x[0]:.3f} deg (J {r.J:.3f})")
+            out[f"{case} step {step:g}"] = float(r.x[0])
+        print(f"{case:>14s} sigma0* at " + ", ".join(line))
 
     print("\n== Two parameters (sigma0, sigma_f), Case 1")
     for r in two_parameter(problem):

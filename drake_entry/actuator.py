@@ -96,14 +96,16 @@ def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upp
     limited = np.flatnonzero(~linear)
     if limited.size:
         s, r, cl, hh = x[limited], rate[limited], c[limited], 0.5 * step
-        positions[0, limited], rates[0, limited] = s, r
-        for k in range(1, steps + 1):
+        path_s, path_r = [s], [r]
+        for _ in range(steps):
             a1 = _accelerations(cl - s, r, w, rate_limit, accel_limit)
             r_mid = r + hh * a1
             a2 = _accelerations(cl - (s + hh * r), r_mid, w, rate_limit, accel_limit)
             s = s + step * r_mid
             r = r + step * a2
-            positions[k, limited], rates[k, limited] = s, r
+            path_s.append(s)
+            path_r.append(r)
+        positions[:, limited], rates[:, limited] = path_s, path_r
     return positions[-1].copy(), rates[-1].copy(), positions
 
 

@@ -114,6 +114,7 @@ def test_case2_switch_is_latched_once_mach_has_fallen_below_the_shift():
         assert bool(mem.switched[0]) is switched
 
 
+@pytest.mark.slow
 def test_campaign_rows_and_report_for_fixed_and_on_board_sigma0(tmp_path):
     """Two dispersed samples flown twice: sigma_0 fixed, and re-solved on board every 400 s.
     The rows carry the method's fields; on-board re-solution records its plans and wall time
@@ -135,3 +136,19 @@ def test_campaign_rows_and_report_for_fixed_and_on_board_sigma0(tmp_path):
     assert rows["fixed"]["sigma0_final_deg"] == pytest.approx([SIGMA0_CASE1] * 2, abs=1e-12)
     for fixed, onboard in zip(rows["fixed"]["err_distance_m"], rows["onboard"]["err_distance_m"]):
         assert onboard < fixed
+
+
+def test_cli_plan_report_searches_flies_and_plots(tmp_path, capsys):
+    """``drake-entry plan`` on a paper-004 scenario (brentq search to keep it short): exit 0
+    when the plan is verified and the Drake flight agrees with it; figures written."""
+    from pydrake.common.yaml import yaml_dump_typed
+
+    from drake_entry.cli import main
+    from drake_entry.scenario import Scenario
+
+    path = tmp_path / "p004.yaml"
+    path.write_text(yaml_dump_typed(_scenario(optimizer="brentq"), schema=Scenario))
+    assert main(["plan", str(path), "--out", str(tmp_path / "plan")]) == 0
+    out = capsys.readouterr().out
+    assert "by brentq" in out and "flown minus planned at TAEM" in out
+    assert (tmp_path / "plan" / "swarm_altitude.png").exists() and (tmp_path / "plan" / "swarm_heat.png").exists()

@@ -2,6 +2,7 @@
 bank and angle-of-attack actuators (systems/actuators.py) and the scipy cross-check."""
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -75,32 +76,37 @@ def integrate_actuator(sigma: float, rate: float, command: float, step: float, s
     return s_out, r_out
 
 
-def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upper, rate_limit: float,
-                        accel_limit: float, bandwidth: float):
+def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upper, rate_limit,
+                        accel_limit, bandwidth: float):
     """(x, x_dot) arrays after ``steps`` steps of ``step`` seconds under constant commands, and
     the positions at every step (steps + 1, n) for interpolation: ``integrate_actuator`` for a
     population (the same exact solution where no limit is active over the interval, the same
-    midpoint-RK2 steps for the members where one is; tests hold the two equal)."""
+    midpoint-RK2 steps for the members where one is; tests hold the two equal). The limits
+    may be scalars or per-member arrays, so actuators of different limits (bank and alpha)
+    integrate in one call."""
     x, rate = np.array(x, float), np.array(rate, float)
-    c = np.clip(np.broadcast_to(np.asarray(command, float), x.shape), lower, upper)
+    c = np.minimum(np.maximum(np.broadcast_to(command, x.shape), lower), upper)
+    if np.ndim(rate_limit) or np.ndim(accel_limit):
+        rate_limit, accel_limit = np.broadcast_to(rate_limit, x.shape), np.broadcast_to(accel_limit, x.shape)
     w = bandwidth
-    t = (np.arange(steps + 1) * step)[:, None]
+    t, decay = _time_grid(step, steps, w)
     x0 = x - c
     B = rate + 2.0 * w * x0
-    decay = np.exp(-2.0 * w * t)
     dev = (x0 + B * t) * decay
     vel = (rate - 2.0 * w * B * t) * decay
-    linear = ((np.abs(dev).max(axis=0) <= min(rate_limit / w, accel_limit / (w * w)))
+    linear = ((np.abs(dev).max(axis=0) <= np.minimum(rate_limit / w, accel_limit / (w * w)))
               & (np.abs(4.0 * w * (w * dev + vel)).max(axis=0) <= accel_limit))
     positions, rates = dev + c, vel
     limited = np.flatnonzero(~linear)
     if limited.size:
         s, r, cl, hh = x[limited], rate[limited], c[limited], 0.5 * step
+        rl, al = ((rate_limit[limited], accel_limit[limited]) if np.ndim(rate_limit) or np.ndim(accel_limit)
+                  else (rate_limit, accel_limit))
         path_s, path_r = [s], [r]
         for _ in range(steps):
-            a1 = _accelerations(cl - s, r, w, rate_limit, accel_limit)
+            a1 = _accelerations(cl - s, r, w, rl, al)
             r_mid = r + hh * a1
-            a2 = _accelerations(cl - (s + hh * r), r_mid, w, rate_limit, accel_limit)
+            a2 = _accelerations(cl - (s + hh * r), r_mid, w, rl, al)
             s = s + step * r_mid
             r = r + step * a2
             path_s.append(s)
@@ -109,8 +115,19 @@ def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upp
     return positions[-1].copy(), rates[-1].copy(), positions
 
 
+@functools.lru_cache(maxsize=16)
+def _time_grid(step: float, steps: int, omega: float):
+    """Times (steps + 1, 1) [s] and the exact solution's decay exp(-2 omega t) on them."""
+    t = (np.arange(steps + 1) * step)[:, None]
+    t.flags.writeable = False
+    decay = np.exp(-2.0 * omega * t)
+    decay.flags.writeable = False
+    return t, decay
+
+
 def _accelerations(e, rate, omega: float, rate_limit: float, accel_limit: float):
-    """``_accel`` for arrays of position errors e = clipped command - x."""
+    """``_accel`` for arrays of position errors e = clipped command - x (limits: scalars or
+    arrays like e)."""
     ae = np.abs(e)
     mag = np.minimum(np.minimum(omega * ae, rate_limit), np.sqrt(accel_limit * ae))
     acc = 4.0 * omega * (np.copysign(mag, e) - rate)

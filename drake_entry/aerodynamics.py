@@ -55,7 +55,8 @@ def _checked_coefficients(coefficients):
                 _bad_input(self, alpha, mach)
         elif isinstance(mach, np.ndarray) and mach.dtype.kind == "f" and mach.size:
             # two reductions: a NaN or inf anywhere makes the sum non-finite
-            if not (mach.min() > 0.0 and math.isfinite(float(np.sum(mach)) + float(np.sum(alpha)))):
+            total = mach.sum() + (alpha.sum() if isinstance(alpha, np.ndarray) else alpha)
+            if not (mach.min() > 0.0 and math.isfinite(total)):
                 _bad_input(self, alpha, mach)
         return coefficients(self, alpha, mach)
     return checked

@@ -241,12 +241,11 @@ def _upper_table() -> _UpperTable:
     return _UPPER
 
 
-def _lower_layers_array(z: np.ndarray):
-    """``_lower_layers`` for an array of altitudes <= 86 km (the same formulas with numpy)."""
+def _lower_layers_array(z: np.ndarray, derivatives: bool = True):
+    """``_lower_layers`` for an array of altitudes <= 86 km (the same formulas with numpy);
+    without ``derivatives`` only (ln rho, T)."""
     r0 = R0_GEOPOTENTIAL
     H = r0 * z / (r0 + z)
-    Hz = (r0 / (r0 + z)) ** 2
-    Hzz = -2.0 * r0 * r0 / (r0 + z) ** 3
     i = np.maximum(np.searchsorted(_H_BASE, H, side="right") - 1, 0)
     L, Tb, dH = _LAPSE[i], _T_BASE[i], H - _H_BASE[i]
     T = Tb + L * dH
@@ -254,6 +253,10 @@ def _lower_layers_array(z: np.ndarray):
     with np.errstate(divide="ignore", invalid="ignore"):
         lnP = _LN_P_BASE[i] + np.where(isothermal, -_GMR * dH / Tb, (_GMR / np.where(isothermal, 1.0, L)) * np.log(Tb / T))
     ln_rho = lnP - np.log(R_AIR * T)
+    if not derivatives:
+        return ln_rho, T
+    Hz = (r0 / (r0 + z)) ** 2
+    Hzz = -2.0 * r0 * r0 / (r0 + z) ** 3
     f_H = -(_GMR + L) / T
     f_HH = (_GMR + L) * L / (T * T)
     return ln_rho, f_H * Hz, f_HH * Hz * Hz + f_H * Hzz, T, L * Hz, L * Hzz
@@ -302,6 +305,15 @@ class US76Atmosphere(Atmosphere):
     def _air_data_float(self, h: float) -> tuple[float, float]:
         ln_rho, _, _, T, _, _ = self._evaluate(float(h))
         return math.exp(ln_rho), math.sqrt(GAMMA_AIR * R_AIR * T)
+
+    def air_data(self, h):
+        """(density, speed of sound); a float array below 86 km skips the altitude derivatives
+        (the paper-004 population evaluator's path; equal to ``properties``, tested)."""
+        if (isinstance(h, np.ndarray) and h.dtype.kind == "f" and h.size and h.max() <= US76_LOWER_TOP
+                and h.min() >= US76_H_MIN):  # NaN fails both: the general path names it
+            ln_rho, T = _lower_layers_array(h, derivatives=False)
+            return np.exp(ln_rho), np.sqrt(GAMMA_AIR * R_AIR * T)
+        return super().air_data(h)
 
     def density_derivatives(self, h) -> Derivatives:
         return self.derivatives(h)[0]

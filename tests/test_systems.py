@@ -207,3 +207,22 @@ def test_population_actuator_equals_the_scalar_actuator_member_by_member():
         assert positions[:, i] == pytest.approx(s, abs=1e-14)
         assert (end[i], end_rate[i]) == pytest.approx((s[-1], r[-1]), abs=1e-14)
     assert positions[:, 1] == pytest.approx(np.radians(20.0), abs=0)  # settled at the bound
+
+
+def test_population_actuator_takes_per_member_limits():
+    """Two actuators of different limits (alpha and bank, as the paper-004 evaluator stacks
+    them) in one call give each member what the scalar actuator gives it with its own limits."""
+    from drake_entry.actuator import integrate_actuator, integrate_actuators
+
+    alpha = dict(lower=math.radians(10), upper=math.radians(20), rate_limit=math.radians(4),
+                 accel_limit=math.radians(8), bandwidth=2.0)
+    bank = dict(lower=-math.radians(85), upper=math.radians(85), rate_limit=math.radians(20),
+                accel_limit=math.radians(10), bandwidth=2.0)
+    x, rate = np.radians([12.0, 15.0, 40.0, -30.0]), np.radians([0.0, 0.5, 5.0, 0.0])
+    cmd = np.radians([19.0, 15.1, -40.0, -30.2])
+    per = [alpha, alpha, bank, bank]
+    stacked = {k: np.array([p[k] for p in per]) for k in ("lower", "upper", "rate_limit", "accel_limit")}
+    _, _, positions = integrate_actuators(x, rate, cmd, 0.02, 50, bandwidth=2.0, **stacked)
+    for i, lim in enumerate(per):
+        s, _ = integrate_actuator(x[i], rate[i], cmd[i], 0.02, 50, **lim)
+        assert positions[:, i] == pytest.approx(s, abs=1e-14)

@@ -8,7 +8,7 @@ from ...errors import ScenarioError, check_range
 from ..spec import ReversingBankSpec
 
 #: sigma_0 searches: the paper's swarms and the scipy baselines (planning/swarm/search.py)
-OPTIMIZERS = ("pio", "pso", "pso_stable", "grid", "brentq", "bounded", "differential_evolution")
+OPTIMIZERS = ("pio", "pso", "pso_stable", "grid", "brentq", "secant", "bounded", "differential_evolution")
 
 
 @dc.dataclass
@@ -37,7 +37,7 @@ class SwarmBank(ReversingBankSpec):
     # QEG compensation (eq. 48 gain k2, eq. 46 nondimensional scale height beta)
     qeg_gain: float = 10.0
     qeg_beta: float = 920.0
-    # sigma_0 search: pio | pso | pso_stable | grid | brentq | bounded | differential_evolution
+    # sigma_0 search: pio | pso | pso_stable | grid | brentq | secant | bounded | differential_evolution
     optimizer: str = "pio"
     # swarm settings (paper 004: N 10, k_max 20, k_c 14, R 0.2)
     population: int = 10

@@ -159,10 +159,10 @@ def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = Fals
     active, reached = np.ones(n, bool), np.zeros(n, bool)
     final, t_end, peaks = x.copy(), np.zeros(n), np.zeros((3, n))
     ef = p.ef
-    alpha_limits = dict(lower=p.alpha_min, upper=p.alpha_max, rate_limit=p.alpha_rate, accel_limit=p.alpha_accel,
-                        bandwidth=2.0)
-    bank_limits = dict(lower=-veh.bank_limit, upper=veh.bank_limit, rate_limit=veh.bank_rate_limit,
-                       accel_limit=veh.bank_accel_limit, bandwidth=2.0)
+    # alpha (first n) and bank (last n) actuators integrate in one call with per-member limits
+    limits = {k: np.repeat([a, b], n) for k, a, b in (
+        ("lower", p.alpha_min, -veh.bank_limit), ("upper", p.alpha_max, veh.bank_limit),
+        ("rate_limit", p.alpha_rate, veh.bank_rate_limit), ("accel_limit", p.alpha_accel, veh.bank_accel_limit))}
     dt = p.guidance_step_s
     steps = max(1, int(round(dt / p.actuator_substep_s)))
     history = [[] for _ in range(n)] if record else None
@@ -191,10 +191,14 @@ def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = Fals
             for j, i in enumerate(idx):
                 history[i].append((t, *xa[:, j], alpha[i], bank[i], bank_cmd[j], alpha_cmd[j], mach[j], q[j],
                                    heat[j], load[j]))
-        alpha[idx], alpha_rate[idx], a_path = integrate_actuators(alpha[idx], alpha_rate[idx], alpha_cmd, dt / steps,
-                                                                  steps, **alpha_limits)
-        bank[idx], bank_rate[idx], b_path = integrate_actuators(bank[idx], bank_rate[idx], bank_cmd, dt / steps,
-                                                                steps, **bank_limits)
+        both = np.concatenate([idx, idx + n])
+        pos, rates, path = integrate_actuators(np.concatenate([alpha[idx], bank[idx]]),
+                                               np.concatenate([alpha_rate[idx], bank_rate[idx]]),
+                                               np.concatenate([alpha_cmd, bank_cmd]), dt / steps, steps,
+                                               bandwidth=2.0, **{k: v[both] for k, v in limits.items()})
+        m = idx.size
+        alpha[idx], bank[idx], alpha_rate[idx], bank_rate[idx] = pos[:m], pos[m:], rates[:m], rates[m:]
+        a_path, b_path = path[:, :m], path[:, m:]
         mid = steps // 2 if steps % 2 == 0 else None
         a_mid = a_path[mid] if mid is not None else 0.5 * (a_path[steps // 2] + a_path[steps // 2 + 1])
         b_mid = b_path[mid] if mid is not None else 0.5 * (b_path[steps // 2] + b_path[steps // 2 + 1])

@@ -9,6 +9,8 @@ Baselines (shared/notes/paper004-cavh.md measured their trajectory counts):
   brentq          one 16-point grid to bracket the signed range error, then scipy brentq
   bounded         scipy minimize_scalar(method='bounded') on J (Brent with bounds)
   differential_evolution  scipy's, vectorised over its population
+  secant          vectorised bracketing (16 points, then 2 rounds of 8 inside the bracket) and
+                  one regula-falsi point: the on-board re-solution's algorithm, 4 populations
 J(sigma_0) is V-shaped with false minima where the reversal count changes; the signed range
 error is the smooth quantity (its root is J's minimum up to the altitude and speed terms).
 """
@@ -27,7 +29,7 @@ from .evaluator import Evaluation, SwarmProblem, evaluate
 from .optimizers import PSO_CONSTRICTION, PSO_PAPER, SwarmResult, minimise, pio_search, pso_search
 
 SWARMS = ("pio", "pso", "pso_stable")
-BASELINES = ("grid", "brentq", "bounded", "differential_evolution")
+BASELINES = ("grid", "brentq", "secant", "bounded", "differential_evolution")
 
 
 class Objective:
@@ -111,6 +113,8 @@ def search(problem: SwarmProblem, method: str, bounds_deg=((0.0, 89.0),), *, see
         message = _grid_refinement(f, *bounds[0], points=16, rounds=4)
     elif method == "brentq":
         message = _bracketed_brentq(f, *bounds[0])
+    elif method == "secant":
+        message = _bracketed_secant(f, *bounds[0])
     else:
         raise ScenarioError(f"search method {method!r}; allowed: {', '.join(SWARMS + BASELINES)}")
     x, J = f.best()
@@ -171,6 +175,20 @@ def _bracketed_brentq(f: Objective, lo: float, hi: float) -> str:
     return ""
 
 
+def _secant(bracket) -> float:
+    """The regula-falsi point of a bracket (a, b, d(a), d(b)) of the signed range error."""
+    a, b, da, db = bracket
+    return float(a - da * (b - a) / (db - da))
+
+
+def _bracketed_secant(f: Objective, lo: float, hi: float) -> str:
+    found = _refine(f, np.linspace(lo, hi, 16), points=8, rounds=3)
+    if found is None:
+        return "no sign change of the signed range error on the 16-point grid: the best grid point is returned"
+    f.evaluate([[_secant(found)]])
+    return ""
+
+
 # ---------------------------------------------------------------------------------------
 # on-board re-solution
 # ---------------------------------------------------------------------------------------
@@ -202,8 +220,7 @@ def resolve_sigma0(problem: SwarmProblem, previous_deg: float, bounds_deg=(0.0, 
         X, d, _, ok = _samples(f)
         i = int(np.argmin(np.where(ok, np.abs(d), np.inf)))
         return Resolution(float(X[i]), False, float(d[i]), f.trajectories)
-    a, b, da, db = found
-    return Resolution(float(a - da * (b - a) / (db - da)), True, 0.0, f.trajectories)
+    return Resolution(_secant(found), True, 0.0, f.trajectories)
 
 
 # ---------------------------------------------------------------------------------------

@@ -67,9 +67,11 @@ class ClosedLoopSetup:
     terminal: tuple
 
     @staticmethod
-    def from_scenario(scenario: Scenario, planner=None) -> "ClosedLoopSetup":
-        """The setup of a scenario; ``planner`` overrides the method's own (tests, studies)."""
-        method = method_for(scenario.guidance)
+    def from_scenario(scenario: Scenario, planner=None, method: GuidanceMethod | None = None) -> "ClosedLoopSetup":
+        """The setup of a scenario; ``planner`` overrides the method's own (tests, studies);
+        ``method`` flies a GuidanceMethod of your own instead of the registered one of the
+        scenario's ``guidance:`` spec (which it may read; examples/02_custom_controller.py)."""
+        method = method_for(scenario.guidance) if method is None else method
         return ClosedLoopSetup(
             scenario=scenario, method=method, planner=method.make_planner(scenario) if planner is None else planner,
             vehicle=scenario.make_vehicle(), planet=scenario.make_planet(), atmosphere=scenario.make_atmosphere(),

@@ -1,0 +1,132 @@
+"""Example 2: fly your own drag-tracking controller in the closed loop, through the
+guidance-method interface, and compare it with paper 000's controller on the nominal flight.
+
+The drag-energy method (paper 000) wires
+
+    estimate, sensed drag --> DragEnergyGuidance --reference--> DragTrackingController
+        --|sigma|--> BankReversalLogic --> (shared bank actuator) --> EntryVehicle
+
+Here a GuidanceMethod of our own keeps the planner, the reference and the shared reversal
+logic, and puts a LeafSystem written below in place of DragTrackingController: a
+proportional-derivative law on the relative drag error,
+
+    cos|sigma| = clip(c0 + kp e + kd de/dt, cos(sigma_max), 1),  e = (D - D_ref) / D_ref,
+
+with dD_ref/dt = D'_ref dE/dt and dE/dt = -D V (no thrust). Nothing in the library is edited:
+the method is passed to ``ClosedLoopSetup.from_scenario(..., method=...)``.
+
+    python examples/02_custom_controller.py [--out out/examples/02]
+"""
+import argparse
+import math
+import os
+
+import matplotlib.pyplot as plt
+import numpy as np
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.guidance.drag_energy.method import REFERENCE_COLUMNS, DragEnergyMethod
+from drake_entry.guidance.interface import GuidanceCommands, LoggedSignal
+from drake_entry.guidance.reversal import add_bank_reversal
+from drake_entry.scenario import load_scenario
+from drake_entry.systems.drag_energy_guidance import DragEnergyGuidance
+
+DRAG = FLIGHT_CONDITION_NAMES.index("drag")
+
+
+class PdDragController(LeafSystem):
+    """|sigma| [rad] from the drag error, updated every ``period`` seconds.
+
+    Ports: input "reference" [4] (D_ref m/s^2, D'_ref 1/m, D''_ref, engaged flag) from
+    DragEnergyGuidance; input "flight_conditions" [9] (the sensed drag); input
+    "estimated_state" [6] (for V); output "bank_magnitude" [1].
+    """
+
+    def __init__(self, *, c0=0.4, kp=10.0, kd=200.0, sigma_max=math.radians(85.0), period=1.0, pre_guidance_bank=0.0):
+        super().__init__()
+        self.c0, self.kp, self.kd, self.cos_max, self.period = c0, kp, kd, math.cos(sigma_max), period
+        self.reference = self.DeclareVectorInputPort("reference", 4)
+        self.conditions = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
+        self.estimate = self.DeclareVectorInputPort("estimated_state", 6)
+        # discrete state: |sigma| held between updates, the previous drag error (nan: none yet)
+        self.memory = self.DeclareDiscreteState(BasicVector([abs(pre_guidance_bank), np.nan]))
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self.update)
+        self.DeclareVectorOutputPort(
+            "bank_magnitude", 1, lambda context, out: out.SetAtIndex(0, context.get_discrete_state(self.memory)[0]),
+            prerequisites_of_calc={self.xd_ticket()})  # depends on the state only: no algebraic loop
+
+    def update(self, context, state):
+        sigma, previous = context.get_discrete_state(self.memory).get_value()
+        D_ref, slope, _, engaged = self.reference.Eval(context)
+        if engaged < 0.5:  # pre-guidance: hold the initial bank
+            state.get_mutable_vector(self.memory).SetFromVector([sigma, np.nan])
+            return
+        D = self.conditions.Eval(context)[DRAG]
+        V = self.estimate.Eval(context)[3]
+        error = (D - D_ref) / D_ref
+        # de/dt by differencing (D_ref is read at the current energy, so this is the total rate)
+        rate = 0.0 if np.isnan(previous) else (error - previous) / self.period
+        u = self.c0 + self.kp * error + self.kd * rate
+        sigma = math.acos(min(max(u, self.cos_max), 1.0))
+        state.get_mutable_vector(self.memory).SetFromVector([sigma, error])
+
+
+class PdDragMethod(DragEnergyMethod):
+    """Paper 000's planner and reference, our controller, the shared reversal logic."""
+
+    name = "drag_energy_pd"
+
+    def add_systems(self, builder, scenario, planner, plant):
+        g = scenario.guidance
+        guidance = builder.AddNamedSystem("drag_energy_guidance", DragEnergyGuidance(
+            planner, period=g.period_s, pre_guidance_min_s=g.pre_guidance_min_s, replan_period_s=g.replan_period_s,
+            replan_until_e=g.replan_until_e))
+        controller = builder.AddNamedSystem("pd_drag", PdDragController(
+            period=g.period_s, pre_guidance_bank=math.radians(g.pre_guidance_bank_deg)))
+        builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
+        builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
+        builder.Connect(guidance.GetOutputPort("reference"), controller.GetInputPort("reference"))
+        builder.Connect(plant.flight_conditions, controller.GetInputPort("flight_conditions"))
+        builder.Connect(plant.estimated_state, controller.GetInputPort("estimated_state"))
+        reversal = add_bank_reversal(builder, scenario, plant, controller.GetOutputPort("bank_magnitude"))
+        return GuidanceCommands(bank=reversal.GetOutputPort("bank_command"),
+                                initial_bank=math.radians(g.pre_guidance_bank_deg),
+                                logged={"reference": LoggedSignal(guidance.GetOutputPort("reference"), REFERENCE_COLUMNS)})
+
+
+def main(quick: bool = False, out_dir: str = "out/examples/02") -> dict:
+    scenario = load_scenario("horus2b")  # both flights take a few seconds: ``quick`` changes nothing
+    paper = ClosedLoopSetup.from_scenario(scenario)  # plans the corridor once
+    ours = ClosedLoopSetup.from_scenario(scenario, planner=paper.planner, method=PdDragMethod())
+    results = {"paper 000 controller": fly(paper), "PD drag controller (this example)": fly(ours)}
+
+    os.makedirs(out_dir, exist_ok=True)
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
+    for label, r in results.items():
+        tr = r.trajectory
+        print(f"{label:36s} {r.message}; terminal errors: altitude {r.errors['altitude_m']:+.0f} m, "
+              f"range to go {r.errors['range_to_go_m'] / 1e3:+.2f} km, cross-range {r.errors['crossrange_m'] / 1e3:+.2f} km")
+        ref = tr.extra["reference"][:, 0]
+        engaged = tr.extra["reference"][:, 3] > 0.5
+        D = tr.column("drag")
+        ax1.plot(tr.time[engaged], 100 * (D[engaged] - ref[engaged]) / ref[engaged], label=label)
+        ax2.plot(tr.time, np.degrees(tr.bank), label=label)
+    ax1.set(xlabel="time [s]", ylabel="(D - D_ref) / D_ref [%]", title="drag tracking error")
+    ax2.set(xlabel="time [s]", ylabel="bank [deg]", title="bank angle flown")
+    ax1.legend()
+    fig.tight_layout()
+    path = os.path.join(out_dir, "controllers.png")
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    print(f"wrote {path}")
+    return results
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="accepted for uniformity; the example is quick")
+    parser.add_argument("--out", default="out/examples/02", help="figure directory")
+    args = parser.parse_args()
+    main(args.quick, args.out)

@@ -27,7 +27,7 @@ from drake_entry.vehicles import PACKAGED_VEHICLES
 def campaign_manifest(scenario_path: str, *, seed: int, trajectory_step_s: float, overrides: dict | None,
                       runs: int) -> dict:
     """The manifest of a campaign: the scenario as flown (loaded, overrides applied, a user
-    vehicle file made absolute and hashed), seed, trajectory step and versions. Raises a
+    vehicle file and an atmosphere table made absolute and hashed), seed, trajectory step and versions. Raises a
     ScenarioError for a scenario that does not load, before anything is written."""
     scenario = load_campaign_scenario(scenario_path, overrides)
     vehicle_sha = None
@@ -35,8 +35,14 @@ def campaign_manifest(scenario_path: str, *, seed: int, trajectory_step_s: float
         scenario.vehicle = os.path.abspath(scenario.vehicle)
         with open(scenario.vehicle, "rb") as f:
             vehicle_sha = hashlib.sha256(f.read()).hexdigest()
+    atmosphere_sha = None
+    if scenario.atmosphere.model == "table":
+        scenario.atmosphere.table_csv = os.path.abspath(scenario.atmosphere.table_csv)
+        with open(scenario.atmosphere.table_csv, "rb") as f:
+            atmosphere_sha = hashlib.sha256(f.read()).hexdigest()
     name = scenario_path if scenario_path in PACKAGED_SCENARIOS else os.path.abspath(scenario_path)
     return {"scenario": name, "scenario_yaml": yaml_dump_typed(scenario), "vehicle_file_sha256": vehicle_sha,
+            "atmosphere_file_sha256": atmosphere_sha,
             "seed": int(seed), "trajectory_step_s": float(trajectory_step_s), "overrides": overrides or {},
             "versions": {"drake_entry": drake_entry.__version__, "drake": importlib.metadata.version("drake")},
             "runs": int(runs), "dispersion": "scenario dispersions"}

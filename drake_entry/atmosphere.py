@@ -217,27 +217,36 @@ class _ScalarCubic:
         return ((c3 * t + c2) * t + c1) * t + c0, (3.0 * c3 * t + 2.0 * c2) * t + c1, 6.0 * c3 * t + 2.0 * c2
 
 
-class _UpperTable:
-    """Splines of ln rho(z) and T(z) from 86 to 1000 km (shipped US76 tabulation)."""
+class _SplineProfile:
+    """C2 cubic splines of ln rho(z) and T(z) through tabulated altitudes z [m]: the six
+    quantities (ln rho, its two derivatives, T, its two derivatives) at a float or an array.
+    Used by US76 above 86 km and by TableAtmosphere."""
 
-    def __init__(self):
-        with resources.files("drake_entry").joinpath("data/us76_upper.csv").open() as f:
-            data = np.loadtxt(f, delimiter=",", comments="#")
-        z, rho, T = data[:, 0], data[:, 1], data[:, 2]
+    def __init__(self, z, rho, T):
         self.ln_rho = _ScalarCubic(CubicSpline(z, np.log(rho)))
         self.T = _ScalarCubic(CubicSpline(z, T))
 
     def __call__(self, z: float):
         return self.ln_rho(z) + self.T(z)
 
+    def evaluate(self, z: np.ndarray):
+        return np.array(self.ln_rho.evaluate(z) + self.T.evaluate(z))
+
+
+def _load_upper_table() -> _SplineProfile:
+    """US76 from 86 to 1000 km (shipped tabulation)."""
+    with resources.files("drake_entry").joinpath("data/us76_upper.csv").open() as f:
+        data = np.loadtxt(f, delimiter=",", comments="#")
+    return _SplineProfile(data[:, 0], data[:, 1], data[:, 2])
+
 
 _UPPER = None
 
 
-def _upper_table() -> _UpperTable:
+def _upper_table() -> _SplineProfile:
     global _UPPER
     if _UPPER is None:
-        _UPPER = _UpperTable()
+        _UPPER = _load_upper_table()
     return _UPPER
 
 
@@ -273,7 +282,7 @@ def _us76_array(z: np.ndarray):
         out[:, lower] = _lower_layers_array(z[lower])
     upper = ~lower
     table = _upper_table()
-    out[:, upper] = table.ln_rho.evaluate(z[upper]) + table.T.evaluate(z[upper])
+    out[:, upper] = table.evaluate(z[upper])
     return list(out)
 
 
@@ -388,6 +397,71 @@ class ExponentialAtmosphere(Atmosphere):
         d = US76Atmosphere().temperature_derivatives(np.clip(h, US76_H_MIN, US76_H_MAX))
         return Derivatives(d.value, np.where(inside, d.d_h, 0.0) if np.ndim(h) else (d.d_h if inside else 0.0),
                            np.where(inside, d.d_hh, 0.0) if np.ndim(h) else (d.d_hh if inside else 0.0))
+
+
+class TableAtmosphere(Atmosphere):
+    """A tabulated atmosphere (for example a GRAM or NRLMSIS profile, or another planet's):
+    C2 cubic splines of ln rho and T through the table, so density and temperature have the
+    continuous first and second altitude derivatives the drag dynamics need. Defined on the
+    table's altitude range only (outside it a ModelRangeError names the range).
+
+    Args: altitude_m (increasing, at least 4 rows), density_kg_m3 (> 0), temperature_K (> 0),
+    source (where the numbers come from). ``TableAtmosphere.from_csv(path)`` reads a CSV with
+    the columns altitude_m, density_kg_m3, temperature_K (``#`` comment lines allowed).
+    """
+
+    name = "table"
+
+    def __init__(self, altitude_m, density_kg_m3, temperature_K, *, source: str = ""):
+        h, rho, T = (np.asarray(v, float) for v in (altitude_m, density_kg_m3, temperature_K))
+        if not (h.ndim == 1 and h.size >= 4 and rho.shape == h.shape and T.shape == h.shape):
+            raise ScenarioError(f"TableAtmosphere needs at least 4 rows of altitude_m, density_kg_m3, temperature_K "
+                                f"of one length, got {h.size}, {rho.size}, {T.size}")
+        for name, v, lo in (("altitude_m", h, -1e7), ("density_kg_m3", rho, 0.0), ("temperature_K", T, 0.0)):
+            bad = ~np.isfinite(v) | (v <= lo)
+            if bad.any():
+                raise ScenarioError(f"TableAtmosphere.{name} = {v[bad][0]} in row {int(np.flatnonzero(bad)[0]) + 1} is "
+                                    f"out of range; allowed: finite and > {lo:g}")
+        if np.any(np.diff(h) <= 0):
+            i = int(np.flatnonzero(np.diff(h) <= 0)[0])
+            raise ScenarioError(f"TableAtmosphere.altitude_m must increase: row {i + 2} ({h[i + 1]:g} m) follows "
+                                f"{h[i]:g} m")
+        self.h_min, self.h_max, self.source = float(h[0]), float(h[-1]), source
+        self._profile = _SplineProfile(h, rho, T)
+
+    @classmethod
+    def from_csv(cls, path_or_file, *, source: str = "") -> "TableAtmosphere":
+        name = getattr(path_or_file, "name", path_or_file)
+        expected = ["altitude_m", "density_kg_m3", "temperature_K"]
+        try:
+            if hasattr(path_or_file, "read"):
+                text = path_or_file.read()
+            else:
+                with open(path_or_file) as f:
+                    text = f.read()
+            rows = [[c.strip() for c in line.split(",")] for line in text.splitlines()
+                    if line.strip() and not line.lstrip().startswith("#")]
+            if not rows or rows[0] != expected:
+                raise ValueError(f"header {rows[0] if rows else 'missing'}; expected {','.join(expected)}")
+            values = np.array([[float(c) for c in r] for r in rows[1:]]).reshape(-1, 3)
+        except (ValueError, OSError, UnicodeDecodeError) as e:
+            raise ScenarioError(f"atmosphere table {name}: {e}") from None
+        return cls(values[:, 0], values[:, 1], values[:, 2], source=source or str(name))
+
+    def _evaluate(self, h):
+        self.check(h)
+        if isinstance(h, (float, int)) or np.ndim(h) == 0:
+            return self._profile(float(h))
+        return self._profile.evaluate(np.asarray(h, float))
+
+    def density_derivatives(self, h) -> Derivatives:
+        ln_rho, l1, l2, *_ = self._evaluate(h)
+        rho = np.exp(ln_rho) if isinstance(ln_rho, np.ndarray) else math.exp(ln_rho)
+        return Derivatives(rho, rho * l1, rho * (l2 + l1 * l1))
+
+    def temperature_derivatives(self, h) -> Derivatives:
+        *_, T, T1, T2 = self._evaluate(h)
+        return Derivatives(T, T1, T2)
 
 
 class DispersedAtmosphere(Atmosphere):

@@ -31,12 +31,15 @@ ROWS, TRAJECTORIES, QUARANTINE, MANIFEST, LOCK = ("samples.jsonl", "trajectories
                                                   "campaign.json", "campaign.lock")
 # what the fingerprint covers, and how a mismatch is named
 IDENTITY = {"scenario_yaml": "scenario content", "vehicle_file_sha256": "vehicle file content",
-            "seed": "seed", "trajectory_step_s": "trajectory step", "versions": "drake_entry/drake version"}
+            "seed": "seed", "trajectory_step_s": "trajectory step", "versions": "drake_entry/drake version",
+            "atmosphere_file_sha256": "atmosphere table content"}
+#: identity keys that count only when set (added after campaigns were written without them)
+OPTIONAL_IDENTITY = ("atmosphere_file_sha256",)
 
 
 def fingerprint(manifest: dict) -> str:
     """sha256 of everything that defines a campaign's samples (IDENTITY)."""
-    ident = {k: manifest.get(k) for k in IDENTITY}
+    ident = {k: manifest.get(k) for k in IDENTITY if k not in OPTIONAL_IDENTITY or manifest.get(k) is not None}
     return hashlib.sha256(json.dumps(ident, sort_keys=True).encode()).hexdigest()
 
 

@@ -13,7 +13,7 @@ from typing import Optional
 import numpy as np
 
 from . import dispersions as disp
-from .atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere, ExponentialAtmosphere, US76Atmosphere
+from .atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere, ExponentialAtmosphere, TableAtmosphere, US76Atmosphere
 from .errors import ScenarioError, check_range, load_yaml_typed
 from .guidance import GuidanceSpec, known_tags
 from .guidance.drag_energy.spec import DragEnergy
@@ -72,11 +72,14 @@ class PlanetSpec:
 
 @dc.dataclass
 class AtmosphereSpec:
-    # us76 | exponential
+    # us76 | exponential | table
     model: str = "us76"
     # exponential model only (paper 000 eq. 29)
     rho0_kg_m3: float = 1.2256
     scale_height_m: float = 7200.0
+    # table model only: CSV path with columns altitude_m, density_kg_m3, temperature_K
+    # (relative paths are read from the working directory)
+    table_csv: str = ""
 
 
 @dc.dataclass
@@ -279,7 +282,14 @@ def atmosphere_from_spec(a: AtmosphereSpec) -> Atmosphere:
             return ExponentialAtmosphere(a.rho0_kg_m3, a.scale_height_m)
         except ValueError as e:
             raise ScenarioError(f"atmosphere: {e}") from None
-    raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential")
+    if a.model == "table":
+        if not a.table_csv:
+            raise ScenarioError("atmosphere.table_csv is required for model 'table' (a CSV with the columns "
+                                "altitude_m, density_kg_m3, temperature_K)")
+        if not os.path.isfile(a.table_csv):
+            raise ScenarioError(f"atmosphere.table_csv = '{a.table_csv}' is not a file")
+        return TableAtmosphere.from_csv(a.table_csv)
+    raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential, table")
 
 
 PACKAGED_SCENARIOS = ("horus2b", "shefex3", "cav_h", "cav_h_paper004", "marv")

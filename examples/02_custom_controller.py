@@ -12,7 +12,7 @@ proportional-derivative law on the relative drag error,
 
     cos|sigma| = clip(c0 + kp e + kd de/dt, cos(sigma_max), 1),  e = (D - D_ref) / D_ref,
 
-with dD_ref/dt = D'_ref dE/dt and dE/dt = -D V (no thrust). Nothing in the library is edited:
+with de/dt by differencing e over the update period. Nothing in the library is edited:
 the method is passed to ``ClosedLoopSetup.from_scenario(..., method=...)``.
 
     python examples/02_custom_controller.py [--out out/examples/02]
@@ -40,8 +40,8 @@ class PdDragController(LeafSystem):
     """|sigma| [rad] from the drag error, updated every ``period`` seconds.
 
     Ports: input "reference" [4] (D_ref m/s^2, D'_ref 1/m, D''_ref, engaged flag) from
-    DragEnergyGuidance; input "flight_conditions" [9] (the sensed drag); input
-    "estimated_state" [6] (for V); output "bank_magnitude" [1].
+    DragEnergyGuidance; input "flight_conditions" [9] (the sensed drag); output
+    "bank_magnitude" [1].
     """
 
     def __init__(self, *, c0=0.4, kp=10.0, kd=200.0, sigma_max=math.radians(85.0), period=1.0, pre_guidance_bank=0.0):
@@ -49,7 +49,6 @@ class PdDragController(LeafSystem):
         self.c0, self.kp, self.kd, self.cos_max, self.period = c0, kp, kd, math.cos(sigma_max), period
         self.reference = self.DeclareVectorInputPort("reference", 4)
         self.conditions = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
-        self.estimate = self.DeclareVectorInputPort("estimated_state", 6)
         # discrete state: |sigma| held between updates, the previous drag error (nan: none yet)
         self.memory = self.DeclareDiscreteState(BasicVector([abs(pre_guidance_bank), np.nan]))
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self.update)
@@ -59,12 +58,11 @@ class PdDragController(LeafSystem):
 
     def update(self, context, state):
         sigma, previous = context.get_discrete_state(self.memory).get_value()
-        D_ref, slope, _, engaged = self.reference.Eval(context)
+        D_ref, _, _, engaged = self.reference.Eval(context)
         if engaged < 0.5:  # pre-guidance: hold the initial bank
             state.get_mutable_vector(self.memory).SetFromVector([sigma, np.nan])
             return
         D = self.conditions.Eval(context)[DRAG]
-        V = self.estimate.Eval(context)[3]
         error = (D - D_ref) / D_ref
         # de/dt by differencing (D_ref is read at the current energy, so this is the total rate)
         rate = 0.0 if np.isnan(previous) else (error - previous) / self.period
@@ -89,7 +87,6 @@ class PdDragMethod(DragEnergyMethod):
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
         builder.Connect(guidance.GetOutputPort("reference"), controller.GetInputPort("reference"))
         builder.Connect(plant.flight_conditions, controller.GetInputPort("flight_conditions"))
-        builder.Connect(plant.estimated_state, controller.GetInputPort("estimated_state"))
         reversal = add_bank_reversal(builder, scenario, plant, controller.GetOutputPort("bank_magnitude"))
         return GuidanceCommands(bank=reversal.GetOutputPort("bank_command"),
                                 initial_bank=math.radians(g.pre_guidance_bank_deg),

@@ -3,6 +3,7 @@ import pytest
 from pydrake.autodiffutils import AutoDiffXd
 
 from drake_entry.atmosphere import ExponentialAtmosphere
+from drake_entry.errors import ScenarioError
 
 # U.S. Standard Atmosphere 1976 reference densities (shared/data/README.md)
 US76_TABLE = [(0.0, 1.2250), (11019.0, 0.36392), (20063.0, 0.088035), (32162.0, 0.013225),
@@ -95,3 +96,72 @@ def test_air_data_fast_path_equals_properties_to_the_last_bit(us76, h):
         assert rho_v[0] == rho and a_v[0] == a
     with pytest.raises(ValueError, match="outside"):
         us76.air_data(1.1e6)
+
+
+# ---------------------------------------------------------------------------------------
+# tabulated atmosphere (a user's GRAM/MSIS profile)
+def _us76_table_csv(path, us76, heights):
+    rho, T, _ = us76.properties(np.asarray(heights, float))
+    rows = "\n".join(f"{h},{float(r)!r},{float(t)!r}" for h, r, t in zip(heights, rho, T))
+    path.write_text(f"# US76 sampled every 2 km\naltitude_m,density_kg_m3,temperature_K\n{rows}\n")
+    return path
+
+
+def test_table_atmosphere_reproduces_its_table_and_interpolates_us76(tmp_path, us76):
+    """Through its own rows exactly; between rows of a 2-km US76 sampling within 0.3 %
+    (density) and 0.5 K (temperature): the splines are of ln rho and T."""
+    from drake_entry.atmosphere import TableAtmosphere
+
+    heights = np.arange(20e3, 80001.0, 2e3)
+    atm = TableAtmosphere.from_csv(str(_us76_table_csv(tmp_path / "a.csv", us76, heights)))
+    rho, T, _ = us76.properties(heights)
+    assert atm.density(heights) == pytest.approx(rho, rel=1e-12)
+    mid = heights[:-1] + 1e3
+    r_mid, T_mid, _ = us76.properties(mid)
+    assert np.abs(atm.density(mid) / r_mid - 1).max() < 3e-3
+    assert np.abs(atm.temperature(mid) - T_mid).max() < 0.5
+    assert atm.air_data(45e3)[0] == pytest.approx(atm.properties(45e3).rho, rel=1e-15)
+
+
+@pytest.mark.parametrize("h", [25e3, 43.3e3, 61e3])
+def test_table_atmosphere_derivatives_equal_finite_differences(tmp_path, us76, h):
+    from drake_entry.atmosphere import TableAtmosphere
+
+    atm = TableAtmosphere.from_csv(str(_us76_table_csv(tmp_path / "a.csv", us76, np.arange(20e3, 80001.0, 2e3))))
+    d, t = atm.density_derivatives(h), atm.temperature_derivatives(h)
+    e = 0.5
+    assert d.d_h == pytest.approx((atm.density(h + e) - atm.density(h - e)) / (2 * e), rel=1e-6)
+    assert d.d_hh == pytest.approx((atm.density(h + e) - 2 * atm.density(h) + atm.density(h - e)) / e**2, rel=1e-4)
+    assert t.d_h == pytest.approx((atm.temperature(h + e) - atm.temperature(h - e)) / (2 * e), rel=1e-6, abs=1e-9)
+    assert atm.density(AutoDiffXd(h, [1.0])).derivatives()[0] == pytest.approx(d.d_h, rel=1e-12)
+
+
+@pytest.mark.parametrize("text, match", [
+    ("altitude_m,density_kg_m3\n0,1.2\n", "expected altitude_m,density_kg_m3,temperature_K"),
+    ("altitude_m,density_kg_m3,temperature_K\n0,1.2,288\n1000,1.1,281\n2000,1.0,275\n", "at least 4 rows"),
+    ("altitude_m,density_kg_m3,temperature_K\n0,1.2,288\n1000,-1.1,281\n2000,1.0,275\n3000,0.9,268\n",
+     r"density_kg_m3 = -1.1 in row 2 is out of range"),
+    ("altitude_m,density_kg_m3,temperature_K\n0,1.2,288\n2000,1.1,281\n1000,1.0,275\n3000,0.9,268\n",
+     "altitude_m must increase: row 3"),
+    ("altitude_m,density_kg_m3,temperature_K\n0,1.2,288\n1000,x,281\n", "could not convert"),
+])
+def test_bad_atmosphere_tables_are_one_line_errors(tmp_path, text, match):
+    from drake_entry.errors import ScenarioError
+    from drake_entry.scenario import AtmosphereSpec, atmosphere_from_spec
+
+    path = tmp_path / "bad.csv"
+    path.write_text(text)
+    with pytest.raises(ScenarioError, match=match):
+        atmosphere_from_spec(AtmosphereSpec(model="table", table_csv=str(path)))
+
+
+def test_table_atmosphere_outside_its_altitudes_names_the_range(tmp_path, us76):
+    from drake_entry.atmosphere import TableAtmosphere
+    from drake_entry.errors import ModelRangeError
+
+    atm = TableAtmosphere.from_csv(str(_us76_table_csv(tmp_path / "a.csv", us76, np.arange(20e3, 80001.0, 2e3))))
+    with pytest.raises(ModelRangeError, match=r"outside the TableAtmosphere range \[20000, 80000\]"):
+        atm.density(90e3)
+    with pytest.raises(ScenarioError, match="is not a file"):
+        from drake_entry.scenario import AtmosphereSpec, atmosphere_from_spec
+        atmosphere_from_spec(AtmosphereSpec(model="table", table_csv=str(tmp_path / "missing.csv")))

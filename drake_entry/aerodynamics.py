@@ -463,7 +463,7 @@ class DragPolarAero(AeroModel):
 
 @dataclass
 class PolynomialAero(AeroModel):
-    """C = sum_ij c[i][j] alpha^i (1/M)^j for C_L and C_D, Mach clamped to [mach_min, mach_max].
+    """``C = sum_ij c[i][j] alpha^i (1/M)^j`` for C_L and C_D, Mach clamped to [mach_min, mach_max].
 
     Attributes:
       CL, CD: coefficient matrices, rows = powers of alpha, columns = powers of 1/M.

@@ -112,10 +112,19 @@ class SwarmProblem:
 class Evaluation:
     """Per member (arrays): objective J (eq. 32), its parts, the final state and peaks.
 
-    Attributes: J; range_error_m (signed along-track: + beyond the target); crossrange_m;
-      altitude_error_m; velocity_error_m_s; final_state (n, 6); time_s; reached (bool);
-      peak_heat_flux_W_m2, peak_dynamic_pressure_Pa, peak_total_load_g; reversals;
-      trajectories: members evaluated; history: per member, the recorded steps (when asked).
+    Attributes:
+      J: objective of eq. 32 (inf where the TAEM energy was not reached).
+      range_error_m: signed along-track distance at TAEM [m], + beyond the target.
+      crossrange_m: cross-track distance from the entry-to-target great circle [m].
+      altitude_error_m: h - h_f at the TAEM energy [m].
+      velocity_error_m_s: V - V_f at the TAEM energy [m/s].
+      final_state: (n, 6) state at the TAEM energy (or where the member stopped).
+      time_s: time of the TAEM energy [s]. reached: the TAEM energy was reached.
+      peak_heat_flux_W_m2: largest heat rate along the trajectory.
+      peak_dynamic_pressure_Pa: largest dynamic pressure.
+      peak_total_load_g: largest total load factor.
+      reversals: bank reversals flown. trajectories: members evaluated.
+      history: per member, the recorded steps (HISTORY_COLUMNS), when asked.
     """
 
     J: np.ndarray

@@ -14,9 +14,9 @@ command) rotates through wings-level at the rate limit. Two realisations:
               the guidance period (a limiter updated once per period would limit-cycle).
 
 Ports (``name`` = "bank" or "alpha"):
-  input  "<name>_command"  [1]  command [rad]
-  output "<name>"          [1]  actuator position [rad] (no direct feedthrough)
-  output "<name>_rate"     [1]  its rate [rad/s]
+  - input  "<name>_command"  [1]  command [rad]
+  - output "<name>"          [1]  actuator position [rad] (no direct feedthrough)
+  - output "<name>_rate"     [1]  its rate [rad/s]
 """
 from __future__ import annotations
 

@@ -1,8 +1,8 @@
 """AtmosphereSystem: air data along the trajectory.
 
 Ports:
-  input  "state"     [6]  vehicle state [h m, lon, lat rad, V m/s, gamma, psi rad]
-  output "air_data"  [2]  density rho [kg/m^3], speed of sound a [m/s]
+  - input  "state"     [6]  vehicle state [h m, lon, lat rad, V m/s, gamma, psi rad]
+  - output "air_data"  [2]  density rho [kg/m^3], speed of sound a [m/s]
 
 A Monte-Carlo sample's density dispersion is a model, drake_entry.atmosphere.DispersedAtmosphere.
 """

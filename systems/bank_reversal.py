@@ -7,10 +7,10 @@ the corridor the bank sign is set to turn back (positive bank turns right, i.e. 
 psi), so reversals happen at the corridor edges.
 
 Ports:
-  input  "estimated_state"  [6]
-  input  "bank_magnitude"   [1]  |sigma| [rad]
-  output "bank_command"     [1]  sign * |sigma| [rad]
-  output "reversals"        [1]  number of reversals so far
+  - input  "estimated_state"  [6]
+  - input  "bank_magnitude"   [1]  |sigma| [rad]
+  - output "bank_command"     [1]  sign * |sigma| [rad]
+  - output "reversals"        [1]  number of reversals so far
 """
 from __future__ import annotations
 

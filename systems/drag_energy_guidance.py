@@ -8,10 +8,10 @@ normalised energy reaches ``replan_until_e``. A failed plan keeps the previous r
 (or stays in pre-guidance), is recorded, and is retried a period later.
 
 Ports:
-  input  "estimated_state"  [6]
-  input  "flight_conditions" [9]  only its drag entry is read: the accelerometer's drag
+  - input  "estimated_state"  [6]
+  - input  "flight_conditions" [9]  only its drag entry is read: the accelerometer's drag
                                   (EntryVehicle output; the plan starts from the sensed drag)
-  output "reference"        [4]  D_ref [m/s^2], D'_ref [1/m], D''_ref [s^2/m^3] at the
+  - output "reference"        [4]  D_ref [m/s^2], D'_ref [1/m], D''_ref [s^2/m^3] at the
                                  estimate's energy, engaged flag (1 after the first plan)
 """
 from __future__ import annotations

@@ -10,12 +10,12 @@ fraction of its Routh-Hurwitz limit, k = -ratio * 2 |zeta| omega^3. Before the g
 engages, the pre-guidance bank is commanded.
 
 Ports:
-  input  "estimated_state"  [6]
-  input  "reference"        [4]  DragEnergyGuidance output
-  input  "flight_conditions" [9] (optional) the accelerometer's drag is fed back, with the
+  - input  "estimated_state"  [6]
+  - input  "reference"        [4]  DragEnergyGuidance output
+  - input  "flight_conditions" [9] (optional) the accelerometer's drag is fed back, with the
                                  model's drag dynamics scaled to it (planner.drag_state)
-  output "bank_magnitude"   [1]  |sigma_cmd| [rad] (discrete state: no feedthrough)
-  output "vertical_control" [1]  u = (L/D) cos(sigma) demanded (before saturation)
+  - output "bank_magnitude"   [1]  |sigma_cmd| [rad] (discrete state: no feedthrough)
+  - output "vertical_control" [1]  u = (L/D) cos(sigma) demanded (before saturation)
 """
 from __future__ import annotations
 

@@ -10,8 +10,8 @@ triggers first ends the run; ``reason`` names it ("reached energy", "reached the
 "skipped out above the atmosphere", ...) and the termination message adds the value.
 
 Ports:
-  input "state"     [6]  vehicle state
-  input "air_data"  [2]  density, speed of sound (AtmosphereSystem output): Mach = V / a
+  - input "state"     [6]  vehicle state
+  - input "air_data"  [2]  density, speed of sound (AtmosphereSystem output): Mach = V / a
                          reuses the air data the vehicle already evaluated at that state
 """
 from __future__ import annotations

@@ -5,8 +5,8 @@ generator seeded with (seed, k), so any run is reproducible from its seed alone 
 independent of integrator steps or context resets.
 
 Ports:
-  input  "true_state"       [6]  [h m, lon, lat rad, V m/s, gamma, psi rad]
-  output "estimated_state"  [6]  true state + bias + noise
+  - input  "true_state"       [6]  [h m, lon, lat rad, V m/s, gamma, psi rad]
+  - output "estimated_state"  [6]  true state + bias + noise
 """
 from __future__ import annotations
 

@@ -7,8 +7,8 @@ and time t_s = t / time_scale, so dx_s/dt_s = time_scale / state_scale * f(x, u)
 scales 1 it is the physical plant.
 
 Ports:
-  input  "u"  [n_controls]  scaled controls (the problem's control order)
-  output "x"  [n_states]    scaled state (the problem's state order)
+  - input  "u"  [n_controls]  scaled controls (the problem's control order)
+  - output "x"  [n_states]    scaled state (the problem's state order)
 """
 from __future__ import annotations
 

@@ -1,9 +1,9 @@
 """ScheduleSource: an open-loop command (bank or angle of attack) from a ``Schedule``.
 
 Ports:
-  input  "state"              [6]  (energy-, Mach- or velocity-scheduled only) vehicle state
-  input  "flight_conditions"  [9]  (Mach-scheduled only) EntryVehicle flight conditions
-  output "command"            [1]  the scheduled value (rad for angles)
+  - input  "state"              [6]  (energy-, Mach- or velocity-scheduled only) vehicle state
+  - input  "flight_conditions"  [9]  (Mach-scheduled only) EntryVehicle flight conditions
+  - output "command"            [1]  the scheduled value (rad for angles)
 """
 from __future__ import annotations
 

@@ -8,14 +8,14 @@ the estimate (planning.swarm.search.resolve_sigma0: predicted trajectories of th
 with the nominal models) until the normalised energy ``resolve_until_e``.
 
 Ports:
-  input  "estimated_state"    [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
-  input  "flight_conditions"  [9]  sensed rho, Mach, q, heat flux, loads, L, D, E (true vehicle)
-  input  "bank_command"       [1]  the signed bank command [rad] (its sign starts the on-board
+  - input  "estimated_state"    [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
+  - input  "flight_conditions"  [9]  sensed rho, Mach, q, heat flux, loads, L, D, E (true vehicle)
+  - input  "bank_command"       [1]  the signed bank command [rad] (its sign starts the on-board
                                    predictions; read only when re-solving, so no feedthrough)
-  output "bank_magnitude"     [1]  |sigma| [rad]
-  output "alpha_command"      [1]  alpha [rad]
-  output "sigma0"             [1]  the sigma_0 in use [rad]
-  output "plan_stats"         [3]  re-solutions, re-solutions without a bracketed root, wall time [s]
+  - output "bank_magnitude"     [1]  |sigma| [rad]
+  - output "alpha_command"      [1]  alpha [rad]
+  - output "sigma0"             [1]  the sigma_0 in use [rad]
+  - output "plan_stats"         [3]  re-solutions, re-solutions without a bracketed root, wall time [s]
 
 The commands are computed from the inputs and the law's memory (previous alpha command, Case 2
 switch) at each sample: the actuators sample them at the same instant, as the planner's

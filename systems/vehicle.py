@@ -2,12 +2,12 @@
 symbolic Expression through Drake's scalar conversion).
 
 Ports:
-  input  "bank"               [1]  bank angle sigma [rad]
-  input  "alpha"              [1]  angle of attack [rad]
-  input  "air_data"           [2]  (only with air_data_input=True) density [kg/m^3] and
+  - input  "bank"               [1]  bank angle sigma [rad]
+  - input  "alpha"              [1]  angle of attack [rad]
+  - input  "air_data"           [2]  (only with air_data_input=True) density [kg/m^3] and
                                    speed of sound [m/s] from an ``AtmosphereSystem``
-  output "state"              [6]  [h m, lon rad, lat rad, V m/s, gamma rad, psi rad]
-  output "flight_conditions"  [9]  rho kg/m^3, Mach, q Pa, heat flux W/m^2, n_z g, n g,
+  - output "state"              [6]  [h m, lon rad, lat rad, V m/s, gamma rad, psi rad]
+  - output "flight_conditions"  [9]  rho kg/m^3, Mach, q Pa, heat flux W/m^2, n_z g, n g,
                                    L m/s^2, D m/s^2, E J/kg (drake_entry.dynamics.FlightConditions)
 """
 from __future__ import annotations

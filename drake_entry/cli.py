@@ -128,17 +128,18 @@ def parse_overrides(items) -> dict:
 def _cmd_report(args) -> int:
     from .campaign_store import read_manifest
     from .errors import load_yaml_typed
-    from .report import table3_markdown, write_report
+    from .report import errors_markdown, write_report
     from .scenario import Scenario
 
     manifest = read_manifest(args.dir) if os.path.isdir(args.dir) else None
-    limits = None
+    limits = reference = None
     if manifest and manifest.get("scenario_yaml"):  # the scenario as flown, wherever the report runs
-        limits = load_yaml_typed(Scenario, text=manifest["scenario_yaml"], where="campaign scenario").make_vehicle().limits
+        scenario = load_yaml_typed(Scenario, text=manifest["scenario_yaml"], where="campaign scenario")
+        limits, reference = scenario.make_vehicle().limits, scenario.reference_results
     path = write_report(args.dir, limits=limits)
     with open(os.path.join(args.dir, "summary.json")) as f:
         stats = json.load(f)
-    print(table3_markdown(stats))
+    print(errors_markdown(stats, reference))
     for k, m in stats["margins"].items():
         print(f"worst {k}: {100 * m['worst']:.2f} % ({m['violations']} violations)")
     c = stats["coverage"]

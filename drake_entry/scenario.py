@@ -112,6 +112,23 @@ class SimulationSpec:
 
 
 @dc.dataclass
+class ReferenceResultsSpec:
+    """Published Monte-Carlo statistics that a campaign's report puts beside its own (the
+    terminal errors' mean and 1-sigma); empty: the report shows the campaign alone."""
+
+    # where the numbers come from, e.g. "paper 000 Table 3"
+    source: str = ""
+    # row column (err_altitude_m, err_longitude_deg, err_latitude_deg, err_velocity_m_s,
+    # err_range_m, err_crossrange_m, err_distance_m) -> [mean, 1-sigma] in its unit
+    errors: dict[str, list[float]] = dc.field(default_factory=dict)
+
+
+#: the terminal-error columns of a campaign row that reference results may give
+ERROR_COLUMNS = ("err_altitude_m", "err_longitude_deg", "err_latitude_deg", "err_velocity_m_s", "err_range_m",
+                 "err_crossrange_m", "err_distance_m")
+
+
+@dc.dataclass
 class Scenario:
     """A mission: vehicle, environment, entry interface, target, terminal interface,
     open-loop command schedules and simulation settings."""
@@ -133,6 +150,8 @@ class Scenario:
     # the guidance method, selected by YAML tag (!DragEnergy, !BankProfile, ...; the
     # registry in drake_entry/guidance); untagged = drag-energy
     guidance: GuidanceSpec = dc.field(default_factory=DragEnergy)
+    # published campaign statistics for the report to compare with (optional)
+    reference_results: ReferenceResultsSpec = dc.field(default_factory=ReferenceResultsSpec)
     # Monte-Carlo dispersions (Drake schema distributions: !Uniform, !Gaussian, ...)
     dispersions: disp.DispersionSpec = dc.field(default_factory=disp.DispersionSpec)
 
@@ -207,6 +226,13 @@ class Scenario:
         for name in ("altitude_tolerance_km", "mach_tolerance", "distance_tolerance_km"):
             if getattr(t, name) is not None:
                 check_range(f"terminal.{name}", getattr(t, name), 0.0, 1e5)
+        for col, v in self.reference_results.errors.items():
+            if col not in ERROR_COLUMNS:
+                raise ScenarioError(f"reference_results.errors: '{col}' is not a terminal-error column; allowed: "
+                                    f"{', '.join(ERROR_COLUMNS)}")
+            if len(v) != 2 or not all(np.isfinite(v)) or v[1] < 0:
+                raise ScenarioError(f"reference_results.errors.{col} = {v}; allowed: [mean, 1-sigma] with a finite "
+                                    "mean and 1-sigma >= 0")
         if not self.vehicle:
             raise ScenarioError("vehicle: missing; give a packaged vehicle name or a vehicle YAML path")
         try:

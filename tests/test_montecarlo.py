@@ -109,3 +109,16 @@ def test_dask_backend_gives_the_same_rows_as_local_processes(tmp_path):
         assert rows["dask"][col] == rows["serial"][col], col
     with pytest.raises(ValueError, match="backend 'mpi' is unknown"):
         run_campaign("horus2b", runs=1, out_dir=str(tmp_path / "x"), backend="mpi")
+
+
+def test_error_table_shows_the_scenario_reference_only_when_it_gives_one():
+    from drake_entry.report import errors_markdown
+    from drake_entry.scenario import ReferenceResultsSpec
+
+    stats = {"errors": {"err_altitude_m": {"mean": 30.0, "std": 8.0}, "err_range_m": {"mean": -110.0, "std": 40.0}}}
+    alone = errors_markdown(stats).splitlines()
+    assert alone[0] == "| variable | this campaign: mean ± 1σ | unit |" and alone[2] == "| Δh | 30.0 ± 8.0 | m |"
+    ref = ReferenceResultsSpec("paper 000 Table 3", {"err_altitude_m": [168.6, 1107.3]})
+    beside = errors_markdown(stats, ref).splitlines()
+    assert beside[0] == "| variable | this campaign: mean ± 1σ | paper 000 Table 3 | unit |"
+    assert beside[2] == "| Δh | 30.0 ± 8.0 | 168.6 ± 1107.3 | m |" and beside[3].endswith("| — | m |")

@@ -7,7 +7,8 @@ The drag-energy method (paper 000) wires
         --|sigma|--> BankReversalLogic --> (shared bank actuator) --> EntryVehicle
 
 Here a GuidanceMethod of our own keeps the planner, the reference and the shared reversal
-logic, and puts a LeafSystem written below in place of DragTrackingController: a
+logic (it derives from the drag-energy method and overrides its ``add_controller`` hook), and
+puts a LeafSystem written below in place of DragTrackingController: a
 proportional-derivative law on the relative drag error,
 
     cos|sigma| = clip(c0 + kp e + kd de/dt, cos(sigma_max), 1),  e = (D - D_ref) / D_ref,
@@ -27,11 +28,8 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
 from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
-from drake_entry.guidance.drag_energy.method import REFERENCE_COLUMNS, DragEnergyMethod
-from drake_entry.guidance.interface import GuidanceCommands, LoggedSignal
-from drake_entry.guidance.reversal import add_bank_reversal
+from drake_entry.guidance.drag_energy.method import DragEnergyMethod
 from drake_entry.scenario import load_scenario
-from drake_entry.systems.drag_energy_guidance import DragEnergyGuidance
 
 DRAG = FLIGHT_CONDITION_NAMES.index("drag")
 
@@ -72,25 +70,18 @@ class PdDragController(LeafSystem):
 
 
 class PdDragMethod(DragEnergyMethod):
-    """Paper 000's planner and reference, our controller, the shared reversal logic."""
+    """Paper 000's planner, reference and reversal logic; our controller (add_controller is
+    the drag-energy method's hook for the controller: it returns the |sigma| port)."""
 
     name = "drag_energy_pd"
 
-    def add_systems(self, builder, scenario, planner, plant):
+    def add_controller(self, builder, scenario, planner, plant, reference):
         g = scenario.guidance
-        guidance = builder.AddNamedSystem("drag_energy_guidance", DragEnergyGuidance(
-            planner, period=g.period_s, pre_guidance_min_s=g.pre_guidance_min_s, replan_period_s=g.replan_period_s,
-            replan_until_e=g.replan_until_e))
         controller = builder.AddNamedSystem("pd_drag", PdDragController(
             period=g.period_s, pre_guidance_bank=math.radians(g.pre_guidance_bank_deg)))
-        builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
-        builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
-        builder.Connect(guidance.GetOutputPort("reference"), controller.GetInputPort("reference"))
+        builder.Connect(reference, controller.GetInputPort("reference"))
         builder.Connect(plant.flight_conditions, controller.GetInputPort("flight_conditions"))
-        reversal = add_bank_reversal(builder, scenario, plant, controller.GetOutputPort("bank_magnitude"))
-        return GuidanceCommands(bank=reversal.GetOutputPort("bank_command"),
-                                initial_bank=math.radians(g.pre_guidance_bank_deg),
-                                logged={"reference": LoggedSignal(guidance.GetOutputPort("reference"), REFERENCE_COLUMNS)})
+        return controller.GetOutputPort("bank_magnitude")
 
 
 def main(quick: bool = False, out_dir: str = "out/examples/02") -> dict:

@@ -33,21 +33,29 @@ class DragEnergyMethod(GuidanceMethod):
         guidance = builder.AddNamedSystem("drag_energy_guidance", DragEnergyGuidance(
             planner, period=g.period_s, pre_guidance_min_s=g.pre_guidance_min_s, replan_period_s=g.replan_period_s,
             replan_until_e=g.replan_until_e))
-        pre_bank = math.radians(g.pre_guidance_bank_deg)
-        controller = builder.AddNamedSystem("drag_tracking", DragTrackingController(
-            planner, zeta=g.zeta, omega=g.omega_per_J, integral_ratio=g.integral_ratio, period=g.period_s,
-            pre_guidance_bank=abs(pre_bank), bandwidth=g.bandwidth_rad_s))
-        reversal = add_bank_reversal(builder, scenario, plant, controller.GetOutputPort("bank_magnitude"),
-                                     initial_sign=1.0 if pre_bank >= 0 else -1.0)
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
-        builder.Connect(plant.estimated_state, controller.GetInputPort("estimated_state"))
-        builder.Connect(guidance.GetOutputPort("reference"), controller.GetInputPort("reference"))
         # the accelerometer's drag: guidance and feedback act on the drag actually felt
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
-        builder.Connect(plant.flight_conditions, controller.GetInputPort("flight_conditions"))
+        pre_bank = math.radians(g.pre_guidance_bank_deg)
+        magnitude = self.add_controller(builder, scenario, planner, plant, guidance.GetOutputPort("reference"))
+        reversal = add_bank_reversal(builder, scenario, plant, magnitude, initial_sign=1.0 if pre_bank >= 0 else -1.0)
         return GuidanceCommands(bank=reversal.GetOutputPort("bank_command"), initial_bank=pre_bank,
                                 logged={"reference": LoggedSignal(guidance.GetOutputPort("reference"),
                                                                   REFERENCE_COLUMNS)})
+
+    def add_controller(self, builder, scenario, planner, plant: PlantPorts, reference):
+        """Add the drag-tracking controller and return its bank-magnitude port |sigma| [rad];
+        ``reference`` is DragEnergyGuidance's output [D_ref m/s^2, D'_ref 1/m, D''_ref s^2/m^3,
+        engaged flag]. Override it to fly a controller of your own with paper 000's planner,
+        reference and reversal logic (examples/02_custom_controller.py)."""
+        g = scenario.guidance
+        controller = builder.AddNamedSystem("drag_tracking", DragTrackingController(
+            planner, zeta=g.zeta, omega=g.omega_per_J, integral_ratio=g.integral_ratio, period=g.period_s,
+            pre_guidance_bank=abs(math.radians(g.pre_guidance_bank_deg)), bandwidth=g.bandwidth_rad_s))
+        builder.Connect(plant.estimated_state, controller.GetInputPort("estimated_state"))
+        builder.Connect(reference, controller.GetInputPort("reference"))
+        builder.Connect(plant.flight_conditions, controller.GetInputPort("flight_conditions"))
+        return controller.GetOutputPort("bank_magnitude")
 
     def summarise(self, diagram, context, planner) -> GuidanceSummary:
         guidance = diagram.GetSubsystemByName("drag_energy_guidance")

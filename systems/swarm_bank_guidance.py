@@ -4,8 +4,12 @@ Every ``period`` seconds the law gives |sigma| (eq. 17 from sigma_0 with the QEG
 eqs. 46-48) and the alpha command (eq. 31, or eq. 21 until Mach_shift) from the navigation
 estimate and the sensed flight conditions; the shared reversal logic signs |sigma| and the
 shared actuators fly both. With ``resolve_period`` > 0, sigma_0 is re-solved on board from
-the estimate (planning.swarm.search.resolve_sigma0: predicted trajectories of the same law
-with the nominal models) until the normalised energy ``resolve_until_e``.
+the estimate (planning.swarm.search.resolve_sigma0: predicted trajectories of the same law)
+until the normalised energy ``resolve_until_e``. The predictions fly the nominal models with
+the lift and drag scaled by the ratios of the sensed to the modelled accelerations, low-passed
+over 30 s (``resolve_scaling``): a density or aerodynamic error the flight has shown is then
+predicted for the rest of it (with the nominal models the 1-sigma range miss of 100 dispersed
+flights was 31 km; scaled, see docs/methods/swarm-bank.md).
 
 Ports:
   - input  "estimated_state"    [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
@@ -30,23 +34,31 @@ import time
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.aerodynamics import ScaledAero
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
 from drake_entry.errors import ScenarioError
 from drake_entry.planning.swarm.evaluator import SwarmProblem
 from drake_entry.planning.swarm.guidance_law import LawMemory, law_commands
 from drake_entry.planning.swarm.search import resolve_sigma0
 
 _FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
-# discrete state: law memory (3), sigma_0, re-solutions, failed ones, wall time, next re-solution time
-_ALPHA, _ABOVE, _SWITCHED, _SIGMA0, _PLANS, _FAILED, _WALL, _NEXT = range(8)
+# discrete state: law memory (3), sigma_0, re-solutions, failed ones, wall time, next re-solution
+# time, filtered sensed/modelled lift and drag ratios
+_ALPHA, _ABOVE, _SWITCHED, _SIGMA0, _PLANS, _FAILED, _WALL, _NEXT, _KL, _KD = range(10)
+#: time constant [s] of the sensed/modelled acceleration ratios, and the drag [m/s^2] below
+#: which they are not updated (thin air: the ratio is noise)
+RATIO_TIME_CONSTANT_S, RATIO_MIN_DRAG = 30.0, 0.5
 
 
 class SwarmBankGuidance(LeafSystem):
     def __init__(self, problem: SwarmProblem, sigma0: float, *, period: float = 1.0, resolve_period: float = 0.0,
-                 resolve_until_e: float = 0.95, bounds_deg=(0.0, 89.0)):
+                 resolve_until_e: float = 0.95, bounds_deg=(0.0, 89.0), resolve_scaling: bool = True):
         """Args: problem (the mission and law, nominal models); sigma0 [rad] planned; period [s];
         resolve_period [s] (0 = fly sigma0); resolve_until_e: last normalised energy of a
-        re-solution; bounds_deg: sigma_0 bounds of a re-solution."""
+        re-solution; bounds_deg: sigma_0 bounds of a re-solution (eq. 17 stays anchored at the
+        entry energy); resolve_scaling: the predictions fly the nominal lift and drag times the
+        filtered ratios of the sensed to the modelled accelerations (a density or aerodynamic
+        error the flight has shown), instead of the nominal models."""
         super().__init__()
         if not period > 0:
             raise ScenarioError(f"SwarmBankGuidance.period must be > 0 s, got {period}")
@@ -54,11 +66,13 @@ class SwarmBankGuidance(LeafSystem):
             raise ScenarioError(f"SwarmBankGuidance.sigma0 = {sigma0} must be finite (the plan found no sigma_0)")
         self.problem, self.law = problem, problem.law()
         self.resolve_period, self.resolve_until_e, self.bounds_deg = resolve_period, resolve_until_e, bounds_deg
+        self.resolve_scaling, self.period = resolve_scaling, period
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self.bank_port = self.DeclareVectorInputPort("bank_command", 1)
         alpha0 = problem.alpha_max if problem.initial_alpha is None else problem.initial_alpha
-        start = [alpha0, 0.0, 0.0, sigma0, 0.0, 0.0, 0.0, resolve_period if resolve_period > 0 else math.inf]
+        start = [alpha0, 0.0, 0.0, sigma0, 0.0, 0.0, 0.0, resolve_period if resolve_period > 0 else math.inf,
+                 1.0, 1.0]
         self._state = self.DeclareDiscreteState(BasicVector(start))
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
         deps = {self.xd_ticket(), self.est_port.ticket(), self.fc_port.ticket()}
@@ -91,6 +105,8 @@ class SwarmBankGuidance(LeafSystem):
         m = self._memory(context).copy()
         _, alpha, nxt = self.commands(context)
         m[_ALPHA], m[_ABOVE], m[_SWITCHED] = alpha, float(nxt.mach_was_above[0]), float(nxt.switched[0])
+        if self.resolve_scaling:
+            self._update_ratios(context, m)
         t = context.get_time()
         if t >= m[_NEXT] - 1e-9:
             m[_NEXT] += self.resolve_period
@@ -100,7 +116,11 @@ class SwarmBankGuidance(LeafSystem):
             if (e - p.start_energy) / (p.ef - p.start_energy) <= self.resolve_until_e:
                 t0 = time.perf_counter()
                 bank = float(self.bank_port.Eval(context)[0])
-                here = dc.replace(p, x0=x, e0=p.start_energy, origin=(p.x0[1], p.x0[2]), initial_alpha=alpha,
+                vehicle = p.vehicle
+                if self.resolve_scaling:
+                    vehicle = dc.replace(vehicle, aero=ScaledAero(vehicle.aero, lift_scale=float(m[_KL]),
+                                                                  drag_scale=float(m[_KD])))
+                here = dc.replace(p, vehicle=vehicle, x0=x, e0=p.start_energy, origin=(p.x0[1], p.x0[2]), initial_alpha=alpha,
                                   initial_bank=bank, initial_sign=1.0 if bank >= 0 else -1.0,
                                   memory=(bool(nxt.mach_was_above[0]), bool(nxt.switched[0])),
                                   max_time_s=max(p.max_time_s - t, p.guidance_step_s))
@@ -110,3 +130,17 @@ class SwarmBankGuidance(LeafSystem):
                 m[_FAILED] += not r.bracketed
                 m[_WALL] += time.perf_counter() - t0
         discrete_state.get_mutable_vector(self._state).SetFromVector(m)
+
+    def _update_ratios(self, context, m):
+        """Low-pass the ratios of the sensed lift and drag to the nominal models' at the
+        estimate (alpha: the previous command) into m[_KL], m[_KD]."""
+        p = self.problem
+        x = np.asarray(self.est_port.Eval(context), float)
+        fc = self.fc_port.Eval(context)
+        rho, a = p.atmosphere.air_data(p.planet.atmospheric_altitude(float(x[0]), float(x[2])))
+        _, L, D = aero_accelerations(x, float(m[_ALPHA]), rho, a, p.vehicle)
+        if D < RATIO_MIN_DRAG or not L > 0:
+            return
+        w = min(1.0, self.period / RATIO_TIME_CONSTANT_S)
+        m[_KL] += w * (fc[_FC["lift"]] / L - m[_KL])
+        m[_KD] += w * (fc[_FC["drag"]] / D - m[_KD])

@@ -104,7 +104,8 @@ class SwarmBankMethod(GuidanceMethod):
         g, p = scenario.guidance, planner.problem
         guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, SwarmBankGuidance(
             p, math.radians(planner.sigma0_deg), period=g.period_s, resolve_period=g.resolve_period_s,
-            resolve_until_e=g.resolve_until_e, bounds_deg=tuple(g.bank_start_bounds_deg)))
+            resolve_until_e=g.resolve_until_e, bounds_deg=tuple(g.bank_start_bounds_deg),
+            resolve_scaling=g.resolve_scaling))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
         reversal = add_bank_reversal(builder, scenario, plant, guidance.GetOutputPort("bank_magnitude"),

@@ -49,6 +49,9 @@ class SwarmBank(ReversingBankSpec):
     resolve_period_s: float = 0.0
     # no re-solution past this normalised energy (little range is left to correct)
     resolve_until_e: float = 0.95
+    # the predictions fly the nominal lift and drag scaled by the filtered sensed/modelled
+    # ratios (what the flight has shown of a density or aerodynamic error)
+    resolve_scaling: bool = True
 
     def terminal_speed(self, speed_of_sound: float) -> float:
         return self.terminal_velocity_m_s
@@ -85,3 +88,4 @@ class SwarmBank(ReversingBankSpec):
             raise ScenarioError(f"guidance.resolve_period_s = {self.resolve_period_s} must be 0 or >= guidance.period_s "
                                 f"= {self.period_s}")
         check_range("guidance.resolve_until_e", self.resolve_until_e, 0.0, 1.0)
+

@@ -123,7 +123,7 @@ def test_case2_switch_is_latched_once_mach_has_fallen_below_the_shift():
 def test_campaign_rows_and_report_for_fixed_and_on_board_sigma0(tmp_path):
     """Two dispersed samples flown twice: sigma_0 fixed, and re-solved on board every 400 s.
     The rows carry the method's fields; on-board re-solution records its plans and wall time
-    and, on the same draws, misses by less (seed 3: 105 and 832 km fixed, 4 and 102 km re-solved 4 times)."""
+    and, on the same draws, misses by less (seed 3, fixed: 105 and 832 km)."""
     import pyarrow.parquet as pq
 
     from drake_entry.diagrams.montecarlo import run_campaign

@@ -158,3 +158,34 @@ def test_cli_plan_report_searches_flies_and_plots(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "by brentq" in out and "flown minus planned at TAEM" in out
     assert (tmp_path / "plan" / "swarm_altitude.png").exists() and (tmp_path / "plan" / "swarm_heat.png").exists()
+
+
+def test_on_board_predictions_learn_the_lift_and_drag_the_flight_shows():
+    """With sensed accelerations 4 % above (lift) and 3 % below (drag) the nominal models',
+    the guidance's filtered ratios converge to 1.04 and 0.97 (30 s time constant)."""
+    from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
+    from drake_entry.planning.swarm.search import problem_from_scenario
+    from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
+    from pydrake.systems.analysis import Simulator
+
+    p = problem_from_scenario(_scenario())
+    system = SwarmBankGuidance(p, math.radians(SIGMA0_CASE1), resolve_period=0.0)
+    context = system.CreateDefaultContext()
+    x = np.array([50e3, p.x0[1], p.x0[2], 5000.0, 0.0, p.x0[5]])
+    rho, a = p.atmosphere.air_data(50e3)
+    _, L, D = aero_accelerations(x, p.alpha_max, rho, a, p.vehicle)
+    fc = np.zeros(len(FLIGHT_CONDITION_NAMES))
+    fc[FLIGHT_CONDITION_NAMES.index("lift")], fc[FLIGHT_CONDITION_NAMES.index("drag")] = 1.04 * L, 0.97 * D
+    fc[FLIGHT_CONDITION_NAMES.index("rho")], fc[FLIGHT_CONDITION_NAMES.index("mach")] = rho, 5000.0 / a
+    fc[FLIGHT_CONDITION_NAMES.index("dynamic_pressure")] = 0.5 * rho * 5000.0**2
+    fc[FLIGHT_CONDITION_NAMES.index("heat_flux")] = p.vehicle.heat_flux(rho, 5000.0)
+    assert np.hypot(L, D) / p.planet.g0 < 1.0  # below the 2 g the Case 1 law holds
+    system.GetInputPort("estimated_state").FixValue(context, x)
+    system.GetInputPort("flight_conditions").FixValue(context, fc)
+    system.GetInputPort("bank_command").FixValue(context, [0.0])
+    simulator = Simulator(system, context)
+    simulator.AdvanceTo(300.0)  # 300 guidance periods; below 2 g the law holds alpha at its maximum
+    memory = context.get_discrete_state(0).value()
+    assert memory[0] == pytest.approx(p.alpha_max)
+    ratios = memory[-2:]
+    assert ratios == pytest.approx([1.04, 0.97], abs=1e-4)

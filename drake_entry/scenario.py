@@ -26,11 +26,11 @@ from .vehicles import Vehicle, load_vehicle
 class EntryStateSpec:
     """Entry-interface state (paper 000 Table 1 layout)."""
 
-    altitude_km: float = 0.0
-    longitude_deg: float = 0.0
-    latitude_deg: float = 0.0
-    velocity_m_s: float = 0.0
-    flight_path_deg: float = 0.0
+    altitude_km: float = 0.0  # geometric altitude above the reference sphere
+    longitude_deg: float = 0.0  # geocentric longitude
+    latitude_deg: float = 0.0  # geocentric latitude
+    velocity_m_s: float = 0.0  # Earth-relative speed
+    flight_path_deg: float = 0.0  # Earth-relative flight-path angle, + up
     # heading from north, clockwise
     heading_deg: float = 0.0
 
@@ -39,8 +39,8 @@ class EntryStateSpec:
 class TargetSpec:
     """Target site (runway or TAEM interface point)."""
 
-    longitude_deg: float = 0.0
-    latitude_deg: float = 0.0
+    longitude_deg: float = 0.0  # geocentric longitude
+    latitude_deg: float = 0.0  # geocentric latitude
 
 
 @dc.dataclass
@@ -50,22 +50,22 @@ class TerminalSpec:
     is a success only inside every box criterion given (altitude and Mach about the values
     above, distance to the target); a criterion without its tolerance is not checked."""
 
-    altitude_km: Optional[float] = None
-    mach: Optional[float] = None
-    velocity_m_s: Optional[float] = None
+    altitude_km: Optional[float] = None  # stop altitude (open loop) and the box centre
+    mach: Optional[float] = None  # stop Mach number and the box centre
+    velocity_m_s: Optional[float] = None  # stop speed (open loop)
     # specific energy E = V^2/2 - mu/r [MJ/kg] (negative: bound to the planet)
     energy_MJ_kg: Optional[float] = None
-    altitude_tolerance_km: Optional[float] = None
-    mach_tolerance: Optional[float] = None
-    distance_tolerance_km: Optional[float] = None
+    altitude_tolerance_km: Optional[float] = None  # acceptance box: |h - altitude_km| <= this
+    mach_tolerance: Optional[float] = None  # acceptance box: |M - mach| <= this
+    distance_tolerance_km: Optional[float] = None  # acceptance box: distance to the target <= this
 
 
 @dc.dataclass
 class PlanetSpec:
     # spherical | oblate
     model: str = "spherical"
-    rotating: bool = True
-    j2: bool = False
+    rotating: bool = True  # Earth rotation on (Coriolis and centrifugal terms)
+    j2: bool = False  # J2 gravity term on
     # sphere / ellipsoid radius override [m] (paper 002: R_e = 6378145 m); None = WGS-84
     radius_m: Optional[float] = None
 
@@ -76,7 +76,7 @@ class AtmosphereSpec:
     model: str = "us76"
     # exponential model only (paper 000 eq. 29)
     rho0_kg_m3: float = 1.2256
-    scale_height_m: float = 7200.0
+    scale_height_m: float = 7200.0  # exponential model only
     # table model only: CSV path with columns altitude_m, density_kg_m3, temperature_K
     # (relative paths are read from the working directory)
     table_csv: str = ""
@@ -87,10 +87,10 @@ class ScheduleSpec:
     """Piecewise-linear command: values [deg] at breakpoints of ``variable``
     (time s | energy J/kg | mach | velocity m/s)."""
 
-    variable: str = "time"
-    breakpoints: list[float] = dc.field(default_factory=lambda: [0.0])
-    values_deg: list[float] = dc.field(default_factory=lambda: [0.0])
-    smooth: bool = False
+    variable: str = "time"  # time | energy | mach | velocity
+    breakpoints: list[float] = dc.field(default_factory=lambda: [0.0])  # values of the variable (s, J/kg, -, m/s), increasing
+    values_deg: list[float] = dc.field(default_factory=lambda: [0.0])  # command at each breakpoint
+    smooth: bool = False  # quintic smoothstep between breakpoints (C2) instead of straight lines
 
 
 @dc.dataclass
@@ -101,7 +101,7 @@ class SimulationSpec:
     integrator: str = "runge_kutta5"
     # error-control accuracy (also the witness-function localisation accuracy)
     accuracy: float = 1e-8
-    max_step_s: float = 10.0
+    max_step_s: float = 10.0  # largest integration step [s] (error-controlled runs)
     # closed-loop flights only: a fixed integration step [s] (0 = the error-controlled settings
     # above). A closed loop samples its fast dynamics (bank actuator, guidance, control) at the
     # guidance period, so a step dividing that period is exact at every event; open-loop
@@ -133,20 +133,20 @@ class Scenario:
     """A mission: vehicle, environment, entry interface, target, terminal interface,
     open-loop command schedules and simulation settings."""
 
-    name: str = ""
-    description: str = ""
-    source: str = ""
-    vehicle: str = ""
+    name: str = ""  # short identifier, used in file names and reports
+    description: str = ""  # one line for humans
+    source: str = ""  # where the numbers come from (papers, data files)
+    vehicle: str = ""  # packaged vehicle name or a vehicle YAML path
     # which aero model of the vehicle file ('' = its default)
     aero: str = ""
-    planet: PlanetSpec = dc.field(default_factory=PlanetSpec)
-    atmosphere: AtmosphereSpec = dc.field(default_factory=AtmosphereSpec)
-    entry: EntryStateSpec = dc.field(default_factory=EntryStateSpec)
-    target: TargetSpec = dc.field(default_factory=TargetSpec)
-    terminal: TerminalSpec = dc.field(default_factory=TerminalSpec)
-    alpha: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
-    bank: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
-    simulation: SimulationSpec = dc.field(default_factory=SimulationSpec)
+    planet: PlanetSpec = dc.field(default_factory=PlanetSpec)  # the Earth model
+    atmosphere: AtmosphereSpec = dc.field(default_factory=AtmosphereSpec)  # the atmosphere model
+    entry: EntryStateSpec = dc.field(default_factory=EntryStateSpec)  # entry-interface state
+    target: TargetSpec = dc.field(default_factory=TargetSpec)  # target site (runway or TAEM point)
+    terminal: TerminalSpec = dc.field(default_factory=TerminalSpec)  # terminal interface and the acceptance box
+    alpha: ScheduleSpec = dc.field(default_factory=ScheduleSpec)  # open-loop angle-of-attack schedule (a guidance method may command alpha instead)
+    bank: ScheduleSpec = dc.field(default_factory=ScheduleSpec)  # open-loop bank schedule (open-loop runs; guidance replaces it in closed loop)
+    simulation: SimulationSpec = dc.field(default_factory=SimulationSpec)  # integrator, stop time and logging
     # the guidance method, selected by YAML tag (!DragEnergy, !BankProfile, ...; the
     # registry in drake_entry/guidance); untagged = drag-energy
     guidance: GuidanceSpec = dc.field(default_factory=DragEnergy)

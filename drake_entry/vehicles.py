@@ -64,24 +64,24 @@ class HeatFluxSpec:
 class VehicleSpec:
     """Schema of a vehicle YAML file."""
 
-    name: str = ""
-    description: str = ""
+    name: str = ""  # short identifier
+    description: str = ""  # one line for humans
     # true when the model is a labelled substitute, not the vehicle's real data
     representative: bool = False
-    source: str = ""
-    mass_kg: float = 0.0
-    reference_area_m2: float = 0.0
-    nose_radius_m: float = 0.0
-    aero: dict[str, AeroSpec] = dc.field(default_factory=dict)
-    default_aero: str = ""
-    heat_flux: HeatFluxSpec = dc.field(default_factory=HeatFluxSpec)
-    heat_flux_max_kW_m2: float = float("inf")
-    dynamic_pressure_max_kPa: float = float("inf")
-    normal_load_max_g: float = float("inf")
-    total_load_max_g: float = float("inf")
-    bank_limit_deg: float = 90.0
-    bank_rate_limit_deg_s: float = 20.0
-    bank_accel_limit_deg_s2: float = 10.0
+    source: str = ""  # where the numbers come from
+    mass_kg: float = 0.0  # vehicle mass
+    reference_area_m2: float = 0.0  # aerodynamic reference area
+    nose_radius_m: float = 0.0  # stagnation-point nose radius (heat flux)
+    aero: dict[str, AeroSpec] = dc.field(default_factory=dict)  # named aerodynamic models (see AeroSpec)
+    default_aero: str = ""  # the aero model used unless a scenario names one
+    heat_flux: HeatFluxSpec = dc.field(default_factory=HeatFluxSpec)  # stagnation-point heat-flux form (see HeatFluxSpec)
+    heat_flux_max_kW_m2: float = float("inf")  # path limit
+    dynamic_pressure_max_kPa: float = float("inf")  # path limit
+    normal_load_max_g: float = float("inf")  # path limit (body normal axis)
+    total_load_max_g: float = float("inf")  # path limit (sqrt(L^2 + D^2) / g0)
+    bank_limit_deg: float = 90.0  # largest |bank| the actuator commands
+    bank_rate_limit_deg_s: float = 20.0  # bank actuator rate limit
+    bank_accel_limit_deg_s2: float = 10.0  # bank actuator acceleration limit
 
 
 @dc.dataclass

@@ -88,7 +88,8 @@ class ScheduleSpec:
     (time s | energy J/kg | mach | velocity m/s)."""
 
     variable: str = "time"  # time | energy | mach | velocity
-    breakpoints: list[float] = dc.field(default_factory=lambda: [0.0])  # values of the variable (s, J/kg, -, m/s), increasing
+    # values of the variable (s, J/kg, -, m/s), increasing
+    breakpoints: list[float] = dc.field(default_factory=lambda: [0.0])
     values_deg: list[float] = dc.field(default_factory=lambda: [0.0])  # command at each breakpoint
     smooth: bool = False  # quintic smoothstep between breakpoints (C2) instead of straight lines
 
@@ -144,8 +145,10 @@ class Scenario:
     entry: EntryStateSpec = dc.field(default_factory=EntryStateSpec)  # entry-interface state
     target: TargetSpec = dc.field(default_factory=TargetSpec)  # target site (runway or TAEM point)
     terminal: TerminalSpec = dc.field(default_factory=TerminalSpec)  # terminal interface and the acceptance box
-    alpha: ScheduleSpec = dc.field(default_factory=ScheduleSpec)  # open-loop angle-of-attack schedule (a guidance method may command alpha instead)
-    bank: ScheduleSpec = dc.field(default_factory=ScheduleSpec)  # open-loop bank schedule (open-loop runs; guidance replaces it in closed loop)
+    # open-loop angle-of-attack schedule (a guidance method may command alpha instead)
+    alpha: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
+    # open-loop bank schedule (open-loop runs; guidance replaces it in closed loop)
+    bank: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
     simulation: SimulationSpec = dc.field(default_factory=SimulationSpec)  # integrator, stop time and logging
     # the guidance method, selected by YAML tag (!DragEnergy, !BankProfile, ...; the
     # registry in drake_entry/guidance); untagged = drag-energy

@@ -74,7 +74,8 @@ class VehicleSpec:
     nose_radius_m: float = 0.0  # stagnation-point nose radius (heat flux)
     aero: dict[str, AeroSpec] = dc.field(default_factory=dict)  # named aerodynamic models (see AeroSpec)
     default_aero: str = ""  # the aero model used unless a scenario names one
-    heat_flux: HeatFluxSpec = dc.field(default_factory=HeatFluxSpec)  # stagnation-point heat-flux form (see HeatFluxSpec)
+    # stagnation-point heat-flux form (see HeatFluxSpec)
+    heat_flux: HeatFluxSpec = dc.field(default_factory=HeatFluxSpec)
     heat_flux_max_kW_m2: float = float("inf")  # path limit
     dynamic_pressure_max_kPa: float = float("inf")  # path limit
     normal_load_max_g: float = float("inf")  # path limit (body normal axis)

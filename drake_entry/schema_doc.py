@@ -1,7 +1,7 @@
 """Markdown reference of the YAML schemas (scenario, vehicle, optimal-control problem), made
 from the schema dataclasses themselves: field names, types, defaults and the comment lines
 written beside each field in the source, so the reference cannot drift from the code. The
-documentation site generates its reference pages with it (docs/hooks/schema_reference.py).
+documentation site generates its reference pages with it (docs/hooks/reference.py).
 
     from drake_entry.schema_doc import schema_markdown
     from drake_entry.scenario import Scenario

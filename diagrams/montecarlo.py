@@ -24,22 +24,24 @@ from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campa
 from drake_entry.vehicles import PACKAGED_VEHICLES
 
 
+def _absolute_and_hash(path: str) -> tuple[str, str]:
+    """(absolute path, sha256 of the content) of a user file a campaign's samples read."""
+    path = os.path.abspath(path)
+    with open(path, "rb") as f:
+        return path, hashlib.sha256(f.read()).hexdigest()
+
+
 def campaign_manifest(scenario_path: str, *, seed: int, trajectory_step_s: float, overrides: dict | None,
                       runs: int) -> dict:
     """The manifest of a campaign: the scenario as flown (loaded, overrides applied, a user
-    vehicle file and an atmosphere table made absolute and hashed), seed, trajectory step and versions. Raises a
-    ScenarioError for a scenario that does not load, before anything is written."""
+    vehicle file and an atmosphere table made absolute and hashed), seed, trajectory step and
+    versions. Raises a ScenarioError for a scenario that does not load, before anything is written."""
     scenario = load_campaign_scenario(scenario_path, overrides)
-    vehicle_sha = None
+    vehicle_sha = atmosphere_sha = None
     if scenario.vehicle not in PACKAGED_VEHICLES:
-        scenario.vehicle = os.path.abspath(scenario.vehicle)
-        with open(scenario.vehicle, "rb") as f:
-            vehicle_sha = hashlib.sha256(f.read()).hexdigest()
-    atmosphere_sha = None
+        scenario.vehicle, vehicle_sha = _absolute_and_hash(scenario.vehicle)
     if scenario.atmosphere.model == "table":
-        scenario.atmosphere.table_csv = os.path.abspath(scenario.atmosphere.table_csv)
-        with open(scenario.atmosphere.table_csv, "rb") as f:
-            atmosphere_sha = hashlib.sha256(f.read()).hexdigest()
+        scenario.atmosphere.table_csv, atmosphere_sha = _absolute_and_hash(scenario.atmosphere.table_csv)
     name = scenario_path if scenario_path in PACKAGED_SCENARIOS else os.path.abspath(scenario_path)
     return {"scenario": name, "scenario_yaml": yaml_dump_typed(scenario), "vehicle_file_sha256": vehicle_sha,
             "atmosphere_file_sha256": atmosphere_sha,

@@ -86,7 +86,8 @@ def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upp
     integrate in one call."""
     x, rate = np.array(x, float), np.array(rate, float)
     c = np.minimum(np.maximum(np.broadcast_to(command, x.shape), lower), upper)
-    if np.ndim(rate_limit) or np.ndim(accel_limit):
+    per_member = bool(np.ndim(rate_limit) or np.ndim(accel_limit))
+    if per_member:
         rate_limit, accel_limit = np.broadcast_to(rate_limit, x.shape), np.broadcast_to(accel_limit, x.shape)
     w = bandwidth
     t, decay = _time_grid(step, steps, w)
@@ -100,8 +101,7 @@ def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upp
     limited = np.flatnonzero(~linear)
     if limited.size:
         s, r, cl, hh = x[limited], rate[limited], c[limited], 0.5 * step
-        rl, al = ((rate_limit[limited], accel_limit[limited]) if np.ndim(rate_limit) or np.ndim(accel_limit)
-                  else (rate_limit, accel_limit))
+        rl, al = (rate_limit[limited], accel_limit[limited]) if per_member else (rate_limit, accel_limit)
         path_s, path_r = [s], [r]
         for _ in range(steps):
             a1 = _accelerations(cl - s, r, w, rl, al)

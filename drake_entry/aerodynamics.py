@@ -17,7 +17,6 @@ Models:
 from __future__ import annotations
 
 import bisect
-import csv
 import functools
 import math
 from dataclasses import dataclass, field
@@ -30,6 +29,7 @@ from scipy.interpolate import CubicSpline
 
 from .errors import ScenarioError
 from .scalar import clamp, is_autodiff, lift, value_of
+from .tables import read_csv_rows
 
 DEG = np.pi / 180.0
 
@@ -253,7 +253,7 @@ def read_wide_table(path_or_file, *, fill=None) -> TableAero:
     """Read a table CSV in the M-692 layout (coefficient, alpha_deg, M1.2, M1.5, ...),
     optionally filling empty cells from a long-format CSV (coefficient, alpha_deg, mach, value)."""
     name = getattr(path_or_file, "name", path_or_file)
-    rows = _read_csv(path_or_file)
+    rows = read_csv_rows(path_or_file)
     if len(rows) < 3 or len(rows[0]) < 4:
         raise ScenarioError(f"aero table {name}: needs a header (coefficient, alpha_deg, M<mach>, ...) and data rows "
                             f"for at least two angles of attack and two Mach numbers")
@@ -271,7 +271,7 @@ def read_wide_table(path_or_file, *, fill=None) -> TableAero:
                 if v.strip():
                     data[r[0]][i, j] = float(v)
         if fill is not None:
-            for c, a, m, v in _read_csv(fill)[1:]:
+            for c, a, m, v in read_csv_rows(fill)[1:]:
                 if c not in data:
                     raise ValueError(f"fill table: coefficient '{c}' (allowed CL, CD)")
                 i = alphas.index(float(a))
@@ -280,15 +280,6 @@ def read_wide_table(path_or_file, *, fill=None) -> TableAero:
     except (ValueError, IndexError) as e:
         raise ScenarioError(f"aero table {name}: {e}") from None
     return TableAero(np.array(alphas), mach, data["CL"], data["CD"])
-
-
-def _read_csv(path_or_file):
-    if hasattr(path_or_file, "read"):
-        lines = path_or_file.read().splitlines()
-    else:
-        with open(path_or_file) as f:
-            lines = f.read().splitlines()
-    return [r for r in csv.reader(l for l in lines if l.strip() and not l.startswith("#"))]
 
 
 def packaged_data(name: str):
@@ -400,9 +391,9 @@ def fit_horus_forms(table_csv=None, *, pole_offset_min: float = -1.0, initial_aL
 
     if table_csv is None:
         with packaged_data("horus2b_clean_aero_m692.csv") as f:
-            rows = _read_csv(f)
+            rows = read_csv_rows(f)
     else:
-        rows = _read_csv(table_csv)
+        rows = read_csv_rows(table_csv)
     mach = [float(h.lstrip("Mm")) for h in rows[0][2:]]
     pts = {"CD": [], "CL": []}
     for r in rows[1:]:

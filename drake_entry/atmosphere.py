@@ -29,6 +29,7 @@ from scipy.interpolate import CubicSpline
 
 from .errors import ModelRangeError, ScenarioError
 from .scalar import clamp, is_autodiff, is_symbolic, lift, value_of
+from .tables import read_csv_rows
 
 # U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
 G0_US76 = 9.80665  # m/s^2
@@ -434,13 +435,7 @@ class TableAtmosphere(Atmosphere):
         name = getattr(path_or_file, "name", path_or_file)
         expected = ["altitude_m", "density_kg_m3", "temperature_K"]
         try:
-            if hasattr(path_or_file, "read"):
-                text = path_or_file.read()
-            else:
-                with open(path_or_file) as f:
-                    text = f.read()
-            rows = [[c.strip() for c in line.split(",")] for line in text.splitlines()
-                    if line.strip() and not line.lstrip().startswith("#")]
+            rows = [[c.strip() for c in r] for r in read_csv_rows(path_or_file)]
             if not rows or rows[0] != expected:
                 raise ValueError(f"header {rows[0] if rows else 'missing'}; expected {','.join(expected)}")
             values = np.array([[float(c) for c in r] for r in rows[1:]]).reshape(-1, 3)

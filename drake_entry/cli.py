@@ -136,7 +136,7 @@ def _cmd_report(args) -> int:
     if manifest and manifest.get("scenario_yaml"):  # the scenario as flown, wherever the report runs
         scenario = load_yaml_typed(Scenario, text=manifest["scenario_yaml"], where="campaign scenario")
         limits, reference = scenario.make_vehicle().limits, scenario.reference_results
-    path = write_report(args.dir, limits=limits)
+    path = write_report(args.dir, limits=limits, reference=reference)
     with open(os.path.join(args.dir, "summary.json")) as f:
         stats = json.load(f)
     print(errors_markdown(stats, reference))

@@ -14,14 +14,17 @@ import numpy as np
 
 from . import plots  # sets the Agg backend before pyplot is imported
 from .campaign_store import coverage, read_trajectories
-from .errors import CampaignError
+from .errors import CampaignError, DrakeEntryError, load_yaml_typed
 from .plots import plt
+from .scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
+from .scenario import Scenario
 
-ERROR_COLUMNS = (("err_altitude_m", "Δh", "m"), ("err_longitude_deg", "Δθ", "deg"),
-                 ("err_latitude_deg", "Δφ", "deg"), ("err_velocity_m_s", "ΔV", "m/s"),
-                 ("err_range_m", "ΔR (range to go)", "m"), ("err_crossrange_m", "cross-range", "m"),
-                 ("err_distance_m", "distance to target", "m"))
+# (row column, label, unit) of the terminal errors, in the scenario schema's order
+ERROR_COLUMNS = tuple(zip(ERROR_COLUMN_NAMES,
+                          ("Δh", "Δθ", "Δφ", "ΔV", "ΔR (range to go)", "cross-range", "distance to target"),
+                          ("m", "deg", "deg", "m/s", "m", "m", "m"), strict=True))
 MARGIN_COLUMNS = ("margin_heat_flux", "margin_dynamic_pressure", "margin_normal_load", "margin_total_load")
+
 
 def _finite(rows: dict, col: str, n: int) -> np.ndarray:
     """A column as floats (missing column or entry = nan)."""
@@ -105,17 +108,15 @@ def errors_markdown(stats: dict, reference=None) -> str:
     return "\n".join(lines)
 
 
-def _reference_results(meta: dict):
-    """The reference_results of the scenario a campaign flew (from its manifest), or None."""
-    text = meta.get("scenario_yaml")
+def flown_scenario(manifest: dict | None):
+    """The scenario a campaign flew, from its manifest (None for a manifest without one or of
+    another version)."""
+    text = (manifest or {}).get("scenario_yaml")
     if not text:
         return None
-    from .errors import load_yaml_typed
-    from .scenario import Scenario
-
     try:
-        return load_yaml_typed(Scenario, text=text, where="campaign manifest").reference_results
-    except Exception:  # a manifest of another version: report without the reference
+        return load_yaml_typed(Scenario, text=text, where="campaign manifest")
+    except DrakeEntryError:  # a manifest of another version: report without what it would give
         return None
 
 
@@ -124,12 +125,15 @@ def _columns(records: list) -> dict:
     return {k: [r.get(k) for r in records] for k in keys}
 
 
-def write_report(out_dir: str, *, title: str | None = None, limits=None) -> str:
+def write_report(out_dir: str, *, title: str | None = None, limits=None, reference=None) -> str:
     """Write report.md, summary.json and PNG figures for the campaign in out_dir.
 
     Reads the campaign's streams (samples.jsonl, trajectories.jsonl: the truth, also for a
     killed or running campaign) and says what the report covers: samples requested and
-    done, lines cut or quarantined. Raises CampaignError when out_dir holds no campaign."""
+    done, lines cut or quarantined. ``limits``: the vehicle's path limits drawn on the figures;
+    ``reference``: the scenario's reference_results put beside the terminal errors (default:
+    the flown scenario's, from the manifest). Raises CampaignError when out_dir holds no
+    campaign."""
     cov = coverage(out_dir)
     meta = cov["manifest"]
     records = [cov["rows"][k] for k in sorted(cov["rows"])]
@@ -174,7 +178,8 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None) -> str:
     md += [""]
     if stats["errors"]:
         md += ["## Terminal errors (samples that reached the terminal interface)", "",
-               errors_markdown(stats, _reference_results(meta)), "",
+               errors_markdown(stats, reference if reference is not None
+                               else getattr(flown_scenario(meta), "reference_results", None)), "",
                "ΔR is the range to go along the final heading (+ short of the target); the cross-range "
                "is reported separately.", ""]
     if stats.get("inside_km"):

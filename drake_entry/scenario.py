@@ -124,7 +124,7 @@ class ReferenceResultsSpec:
     errors: dict[str, list[float]] = dc.field(default_factory=dict)
 
 
-#: the terminal-error columns of a campaign row that reference results may give
+#: the terminal-error columns of a campaign row (reference results may give them; the report's order)
 ERROR_COLUMNS = ("err_altitude_m", "err_longitude_deg", "err_latitude_deg", "err_velocity_m_s", "err_range_m",
                  "err_crossrange_m", "err_distance_m")
 

@@ -82,14 +82,13 @@ def _default(f: dc.Field) -> str:
 def schema_markdown(root, title: str, *, intro: str = "") -> str:
     """Markdown: one table per schema dataclass reachable from ``root`` (breadth first), with
     each field's YAML key, type, default and description."""
-    hints_cache: dict = {}
     sections, queue, seen = [], [(root, "")], set()
     while queue:
         cls, path = queue.pop(0)
         if cls in seen:
             continue
         seen.add(cls)
-        hints = hints_cache.setdefault(cls, typing.get_type_hints(cls))
+        hints = typing.get_type_hints(cls)
         comments = {}
         for base in reversed(cls.__mro__):
             if _is_schema(base):

@@ -105,7 +105,7 @@ class SwarmBankGuidance(LeafSystem):
         m = self._memory(context).copy()
         _, alpha, nxt = self.commands(context)
         m[_ALPHA], m[_ABOVE], m[_SWITCHED] = alpha, float(nxt.mach_was_above[0]), float(nxt.switched[0])
-        if self.resolve_scaling:
+        if self.resolve_scaling and self.resolve_period > 0:  # only re-solutions read the ratios
             self._update_ratios(context, m)
         t = context.get_time()
         if t >= m[_NEXT] - 1e-9:
@@ -120,8 +120,8 @@ class SwarmBankGuidance(LeafSystem):
                 if self.resolve_scaling:
                     vehicle = dc.replace(vehicle, aero=ScaledAero(vehicle.aero, lift_scale=float(m[_KL]),
                                                                   drag_scale=float(m[_KD])))
-                here = dc.replace(p, vehicle=vehicle, x0=x, e0=p.start_energy, origin=(p.x0[1], p.x0[2]), initial_alpha=alpha,
-                                  initial_bank=bank, initial_sign=1.0 if bank >= 0 else -1.0,
+                here = dc.replace(p, vehicle=vehicle, x0=x, e0=p.start_energy, origin=(p.x0[1], p.x0[2]),
+                                  initial_alpha=alpha, initial_bank=bank, initial_sign=1.0 if bank >= 0 else -1.0,
                                   memory=(bool(nxt.mach_was_above[0]), bool(nxt.switched[0])),
                                   max_time_s=max(p.max_time_s - t, p.guidance_step_s))
                 r = resolve_sigma0(here, math.degrees(m[_SIGMA0]), self.bounds_deg)

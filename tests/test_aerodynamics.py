@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 from drake_entry.aerodynamics import (CallableAero, CavHAero, DragPolarAero, fit_horus_forms, horus2b_table,
-                                      horus_cd_form, horus_cl_form, packaged_data, _read_csv)
+                                      horus_cd_form, horus_cl_form, packaged_data)
+from drake_entry.tables import read_csv_rows
 from drake_entry.vehicles import load_vehicle
 
 
@@ -40,7 +41,7 @@ def test_packaged_horus_fit_residuals_as_documented():
     """horus2b.yaml states C_D RMS 0.0145 and C_L RMS 0.0087 over the published M-692 cells."""
     fit = load_vehicle("horus2b").aero
     with packaged_data("horus2b_clean_aero_m692.csv") as f:
-        rows = _read_csv(f)
+        rows = read_csv_rows(f)
     mach = [float(h[1:]) for h in rows[0][2:]]
     cells = {"CD": [], "CL": []}
     for r in rows[1:]:

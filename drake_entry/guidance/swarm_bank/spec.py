@@ -88,4 +88,3 @@ class SwarmBank(ReversingBankSpec):
             raise ScenarioError(f"guidance.resolve_period_s = {self.resolve_period_s} must be 0 or >= guidance.period_s "
                                 f"= {self.period_s}")
         check_range("guidance.resolve_until_e", self.resolve_until_e, 0.0, 1.0)
-

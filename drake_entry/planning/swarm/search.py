@@ -7,10 +7,10 @@ Angles are in degrees here (the paper's and the user's unit); the evaluator work
 Baselines (shared/notes/paper004-cavh.md measured their trajectory counts):
   grid            vectorised grid refinement on the signed range error (16 points, 4 rounds)
   brentq          one 16-point grid to bracket the signed range error, then scipy brentq
-  bounded         scipy minimize_scalar(method='bounded') on J (Brent with bounds)
-  differential_evolution  scipy's, vectorised over its population
   secant          vectorised bracketing (16 points, then 2 rounds of 8 inside the bracket) and
                   one regula-falsi point: the on-board re-solution's algorithm, 4 populations
+  bounded         scipy minimize_scalar(method='bounded') on J (Brent with bounds)
+  differential_evolution  scipy's, vectorised over its population
 J(sigma_0) is V-shaped with false minima where the reversal count changes; the signed range
 error is the smooth quantity (its root is J's minimum up to the altitude and speed terms).
 """

@@ -497,19 +497,39 @@ class NewtonianLiftingBodyAero(AeroModel):
 
     Normal force C_N = cn_linear sin(a) cos(a) + cp_max sin^2(a); axial force
     C_A = ca0 + ca_wave exp(-(M - 1)) (a transonic/supersonic wave-drag bump);
-    C_L = C_N cos a - C_A sin a, C_D = C_N sin a + C_A cos a.
+    C_L = C_N cos a - C_A sin a, C_D = C_N sin a + C_A cos a. Below Mach
+    ``subsonic_blend_mach[0]`` C_D is multiplied by ``subsonic_drag_factor`` (a Newtonian
+    model overpredicts subsonic drag of a lifting body); a quintic blend in Mach brings the
+    factor to 1 at ``subsonic_blend_mach[1]``.
     """
 
     cp_max: float = 1.84
     cn_linear: float = 0.0
     ca0: float = 0.05
     ca_wave: float = 0.0
+    subsonic_drag_factor: float = 1.0
+    subsonic_blend_mach: tuple = (0.8, 2.0)
+
+    def __post_init__(self):
+        lo, hi = self.subsonic_blend_mach
+        if not 0.0 < self.subsonic_drag_factor <= 10.0:
+            raise ScenarioError(f"NewtonianLiftingBodyAero.subsonic_drag_factor = {self.subsonic_drag_factor} "
+                                f"must be in (0, 10]")
+        if not 0.0 < lo < hi < math.inf:
+            raise ScenarioError(f"NewtonianLiftingBodyAero.subsonic_blend_mach = {self.subsonic_blend_mach} "
+                                f"needs 0 < low < high < inf")
 
     def coefficients(self, alpha, mach):
         s, c = np.sin(alpha), np.cos(alpha)
         cn = self.cn_linear * s * c + self.cp_max * s * s
         ca = self.ca0 + self.ca_wave * np.exp(-(clamp(mach, 1.0, 1e3) - 1.0))
-        return cn * c - ca * s, cn * s + ca * c
+        cl, cd = cn * c - ca * s, cn * s + ca * c
+        if self.subsonic_drag_factor == 1.0:
+            return cl, cd
+        lo, hi = self.subsonic_blend_mach  # C_D times a factor blended (C2) to 1 above Mach `hi`
+        t = clamp((mach - lo) / (hi - lo), 0.0, 1.0)
+        blend = t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
+        return cl, cd * (self.subsonic_drag_factor + (1.0 - self.subsonic_drag_factor) * blend)
 
 
 @dataclass

@@ -68,8 +68,12 @@ def _check_nose(r):
 
 
 def make_heat_flux(form: str, *, nose_radius: float, coefficient: float | None = None,
-                   velocity_exponent: float | None = None) -> HeatFlux:
-    """Heat-flux model by form name: 'chapman', 'sutton_graves', 'normalised' or 'lumped'."""
+                   velocity_exponent: float | None = None, circular_speed: float | None = None) -> HeatFlux:
+    """Heat-flux model by form name: 'chapman', 'sutton_graves', 'normalised' or 'lumped'
+    (``circular_speed`` [m/s] is the normalised form's V_c)."""
+    if circular_speed is not None and (form != "normalised" or not 0 < circular_speed < 1e5):
+        raise ScenarioError(f"heat_flux.circular_speed_m_s = {circular_speed} applies to form 'normalised' only "
+                            f"and must be in (0, 1e5) m/s")
     if form == "chapman":
         kw = {} if coefficient is None else {"C1": coefficient}
         if velocity_exponent is not None:
@@ -78,7 +82,12 @@ def make_heat_flux(form: str, *, nose_radius: float, coefficient: float | None =
     if form == "sutton_graves":
         return HeatFlux.sutton_graves(nose_radius, **({} if coefficient is None else {"k": coefficient}))
     if form == "normalised":
-        return HeatFlux.normalised(nose_radius, **({} if coefficient is None else {"c_star": coefficient}))
+        kw = {} if coefficient is None else {"c_star": coefficient}
+        if velocity_exponent is not None:
+            kw["m"] = velocity_exponent
+        if circular_speed is not None:
+            kw["v_circular"] = circular_speed
+        return HeatFlux.normalised(nose_radius, **kw)
     if form == "lumped":
         if coefficient is None or velocity_exponent is None:
             raise ScenarioError("heat_flux form 'lumped' needs coefficient and velocity_exponent")

@@ -79,29 +79,37 @@ def state_derivatives(x, bank, alpha, vehicle: Vehicle, planet: Earth, atmospher
 
 def equations_of_motion(x, bank, L, D, planet: Earth):
     """xdot given the lift and drag accelerations L, D [m/s^2] (paper 000 eq. 102)."""
+    fn = math if isinstance(x[4], float) and isinstance(bank, float) else np  # float fast path
+    return equations_of_motion_lift_components(x, L * fn.cos(bank), L * fn.sin(bank), D, planet)
+
+
+def equations_of_motion_lift_components(x, L_vertical, L_horizontal, D, planet: Earth):
+    """xdot given the lift components L cos(sigma), L sin(sigma) and the drag D [m/s^2].
+
+    The form the lossless bank relaxation needs (paper 001 eqs. 40-41: L u1, L u2 with
+    u1 = cos sigma, u2 = sin sigma); ``equations_of_motion`` calls it with the real bank."""
     h, lon, lat, V, gamma, psi = x
     r = planet.radius(h)
     g_r, g_n = planet.gravity(r, lat)
     w = planet.omega
-    fn = math if isinstance(gamma, float) and isinstance(bank, float) else np  # float fast path
+    fn = math if isinstance(gamma, float) and isinstance(L_vertical, float) else np  # float fast path
     sg, cg = fn.sin(gamma), fn.cos(gamma)
     sp, cp = fn.sin(psi), fn.cos(psi)
     sl, cl = fn.sin(lat), fn.cos(lat)
-    sb, cb = fn.sin(bank), fn.cos(bank)
     tan_g = sg / cg
     h_dot = V * sg
     lon_dot = V * cg * sp / (r * cl)
     lat_dot = V * cg * cp / r
     V_dot = -D - g_r * sg + g_n * cg * cp + w * w * r * cl * (sg * cl - cg * sl * cp)
     gamma_dot = (
-        L * cb / V
+        L_vertical / V
         + (V / r - g_r / V) * cg
         - g_n * sg * cp / V
         + 2.0 * w * cl * sp
         + w * w * r / V * cl * (cg * cl + sg * sl * cp)
     )
     psi_dot = (
-        L * sb / (V * cg)
+        L_horizontal / (V * cg)
         + V / r * cg * sp * sl / cl
         - g_n * sp / (V * cg)
         + 2.0 * w * (sl - cl * tan_g * cp)
@@ -111,7 +119,8 @@ def equations_of_motion(x, bank, L, D, planet: Earth):
         total = h_dot + lon_dot + lat_dot + V_dot + gamma_dot + psi_dot  # shrink its step for ever)
         if total - total != 0.0:
             raise NonFiniteStateError(f"non-finite state derivative at h = {h:.6g} m, V = {V:.6g} m/s, "
-                                      f"gamma = {gamma:.6g} rad, bank = {bank:.6g} rad, L = {L:.6g}, D = {D:.6g}")
+                                      f"gamma = {gamma:.6g} rad, L cos(bank) = {L_vertical:.6g}, "
+                                      f"L sin(bank) = {L_horizontal:.6g}, D = {D:.6g}")
     return np.array([h_dot, lon_dot, lat_dot, V_dot, gamma_dot, psi_dot])
 
 

@@ -133,6 +133,17 @@ class Earth:
         )
         return h, phi
 
+    def from_geodetic(self, altitude, latitude) -> tuple[float, float]:
+        """State altitude h [m] above the reference sphere and geocentric latitude [rad] of
+        a point at geodetic ``altitude`` [m] and ``latitude`` [rad] (exact; the inverse of
+        ``geodetic``). Paper 001 gives its entry point and sites geodetically."""
+        a, f = self.equatorial_radius, self.flattening
+        e2 = f * (2.0 - f)
+        s, c = np.sin(latitude), np.cos(latitude)
+        n = a / np.sqrt(1.0 - e2 * s * s)
+        p, z = (n + altitude) * c, (n * (1.0 - e2) + altitude) * s
+        return float(np.hypot(p, z) - self.reference_radius), float(np.arctan2(z, p))
+
     def atmospheric_altitude(self, h, lat):
         """Altitude [m] at which to evaluate the atmosphere for state altitude h, latitude lat.
 

@@ -113,3 +113,69 @@ class LGL:
     def integrate(self, values) -> float:
         """Quadrature of nodal values over [a, b] (eq. 16)."""
         return float(self.weights @ np.asarray(values, float))
+
+
+@lru_cache(maxsize=16)
+def lobatto_integration_matrix(n_nodes: int) -> np.ndarray:
+    """A with A[j-1, k] = integral from -1 to tau_j of the k-th Lagrange basis polynomial on
+    the LGL nodes tau (j = 1..n-1): x(tau_j) - x(-1) = sum_k A[j-1, k] xdot(tau_k) for every
+    polynomial x of degree <= n - 1. Collocating with it is the Lobatto IIIA method of
+    order 2n - 2 (n = 2: the trapezoid rule, n = 3: Simpson). Read-only."""
+    tau = _reference_operators(int(n_nodes))[0]
+    V = np.vander(tau, increasing=True)  # V @ c = nodal values of the monomial expansion
+    C = np.linalg.solve(V, np.eye(n_nodes))  # column k: monomial coefficients of l_k
+    powers = np.arange(1, n_nodes + 1)
+    upper = tau[1:, None] ** powers[None, :] / powers[None, :]  # integral of tau^p from 0
+    lower = (-1.0) ** powers / powers
+    A = (upper - lower[None, :]) @ C
+    A.flags.writeable = False
+    return A
+
+
+@dataclass
+class SegmentMesh:
+    """A mesh of ``n_segments`` equal segments of normalised time s in [0, 1], each with
+    ``nodes_per_segment`` LGL nodes; neighbouring segments share their end node.
+
+    Attributes:
+      s: the n_nodes node positions in [0, 1]; n_nodes = n_segments (nodes_per_segment - 1) + 1.
+      weights: quadrature weights on [0, 1] (sum 1; exact to degree 2 nodes_per_segment - 3).
+      segment_nodes: (n_segments, nodes_per_segment) global node indices of each segment.
+      integration: the segment's Lobatto integration matrix scaled to the segment length
+        (x_j - x_0 = sum_k integration[j-1, k] dx/ds(s_k)).
+    """
+
+    n_segments: int
+    nodes_per_segment: int
+
+    def __post_init__(self):
+        if not (isinstance(self.n_segments, (int, np.integer)) and self.n_segments >= 1):
+            raise ScenarioError(f"SegmentMesh.n_segments = {self.n_segments} must be an integer >= 1")
+        if not 2 <= self.nodes_per_segment <= 16:
+            raise ScenarioError(f"SegmentMesh.nodes_per_segment = {self.nodes_per_segment} must be in [2, 16]")
+        m = int(self.nodes_per_segment)
+        tau, w_tau, _, _, self._bary = _reference_operators(m)
+        self._tau = tau
+        h = 1.0 / self.n_segments
+        starts = np.arange(self.n_segments) * h
+        self.segment_nodes = np.arange(self.n_segments)[:, None] * (m - 1) + np.arange(m)[None, :]
+        self.n_nodes = self.n_segments * (m - 1) + 1
+        self.s = np.empty(self.n_nodes)
+        self.weights = np.zeros(self.n_nodes)
+        for k in range(self.n_segments):
+            self.s[self.segment_nodes[k]] = starts[k] + 0.5 * h * (tau + 1.0)
+            self.weights[self.segment_nodes[k]] += 0.5 * h * w_tau
+        self.s[-1] = 1.0
+        self.integration = 0.5 * h * lobatto_integration_matrix(m)
+
+    def interpolation(self, s) -> np.ndarray:
+        """Matrix (len(s), n_nodes) mapping nodal values to the segment polynomials at s in [0, 1]."""
+        s = np.clip(np.atleast_1d(np.asarray(s, float)), 0.0, 1.0)
+        seg = np.minimum((s * self.n_segments).astype(int), self.n_segments - 1)
+        out = np.zeros((s.size, self.n_nodes))
+        h = 1.0 / self.n_segments
+        for k in np.unique(seg):
+            rows = np.flatnonzero(seg == k)
+            t = 2.0 * (s[rows] - k * h) / h - 1.0
+            out[np.ix_(rows, self.segment_nodes[k])] = interpolation_matrix(self._tau, t, self._bary)
+        return out

@@ -47,6 +47,9 @@ class AeroSpec:
     cn_linear: float = 0.0
     ca0: float = 0.05
     ca_wave: float = 0.0
+    # newtonian: C_D times this factor below Mach subsonic_blend_mach[0], blended to 1 at [1]
+    subsonic_drag_factor: float = 1.0
+    subsonic_blend_mach: list[float] = dc.field(default_factory=lambda: [0.8, 2.0])
     # where the numbers come from
     source: str = ""
 
@@ -58,6 +61,8 @@ class HeatFluxSpec:
     # form constant (C1, k, c* or lumped k); empty = the form's published default
     coefficient: float | None = None
     velocity_exponent: float | None = None
+    # normalised form (paper 001 eq. 9): the circular speed V_c [m/s]; empty = 7905.0
+    circular_speed_m_s: float | None = None
 
 
 @dc.dataclass
@@ -165,7 +170,10 @@ def build_aero(spec: AeroSpec, where: str = "aero") -> aero_mod.AeroModel:
         if m == "polynomial":
             return aero_mod.PolynomialAero(spec.CL, spec.CD, spec.alpha_unit, spec.mach_min, spec.mach_max)
         if m == "newtonian":
-            return aero_mod.NewtonianLiftingBodyAero(spec.cp_max, spec.cn_linear, spec.ca0, spec.ca_wave)
+            if len(spec.subsonic_blend_mach) != 2:
+                raise ScenarioError(f"{where}.subsonic_blend_mach = {spec.subsonic_blend_mach} needs two Mach numbers")
+            return aero_mod.NewtonianLiftingBodyAero(spec.cp_max, spec.cn_linear, spec.ca0, spec.ca_wave,
+                                                     spec.subsonic_drag_factor, tuple(spec.subsonic_blend_mach))
     except ValueError as e:
         raise ScenarioError(f"{where}: {e}") from None
     raise ScenarioError(
@@ -193,7 +201,8 @@ def vehicle_from_spec(spec: VehicleSpec, aero: str | None = None, where: str = "
     try:
         hf = make_heat_flux(spec.heat_flux.form, nose_radius=spec.nose_radius_m,
                             coefficient=spec.heat_flux.coefficient,
-                            velocity_exponent=spec.heat_flux.velocity_exponent)
+                            velocity_exponent=spec.heat_flux.velocity_exponent,
+                            circular_speed=spec.heat_flux.circular_speed_m_s)
         limits = PathLimits(spec.heat_flux_max_kW_m2 * 1e3, spec.dynamic_pressure_max_kPa * 1e3,
                             spec.normal_load_max_g, spec.total_load_max_g)
     except ValueError as e:

@@ -119,7 +119,7 @@ class LGL:
 def lobatto_integration_matrix(n_nodes: int) -> np.ndarray:
     """A with A[j-1, k] = integral from -1 to tau_j of the k-th Lagrange basis polynomial on
     the LGL nodes tau (j = 1..n-1): x(tau_j) - x(-1) = sum_k A[j-1, k] xdot(tau_k) for every
-    polynomial x of degree <= n - 1. Collocating with it is the Lobatto IIIA method of
+    polynomial x of degree <= n. Collocating with it is the Lobatto IIIA method of
     order 2n - 2 (n = 2: the trapezoid rule, n = 3: Simpson). Read-only."""
     tau = _reference_operators(int(n_nodes))[0]
     V = np.vander(tau, increasing=True)  # V @ c = nodal values of the monomial expansion

@@ -89,3 +89,28 @@ def test_analytic_horus_drag_partials_equal_autodiff_and_differences():
         assert cl == pytest.approx(generic.CL.value, rel=1e-12)
         for field in ("value", "d_alpha", "d_mach", "d_alpha_alpha", "d_alpha_mach", "d_mach_mach"):
             assert getattr(analytic, field) == pytest.approx(getattr(generic.CD, field), rel=1e-5, abs=1e-9), field
+
+
+def test_sphynx_representative_aero_has_paper001_lift_to_drag():
+    """Paper 001 Sec. II.A quotes L/D about 1.2 supersonic and about 2 subsonic; the labelled
+    representative model gives max L/D 1.17 at Mach 10, 1.74 at Mach 1.2, 2.05 at Mach 0.5, and
+    its subsonic drag blend is C1 (finite-difference slope continuous across Mach 2)."""
+    from drake_entry.vehicles import load_vehicle
+
+    v = load_vehicle("sphynx")
+    assert (v.mass, v.reference_area, v.nose_radius) == (550.0, 2.408, 0.5)
+    alphas = np.radians(np.linspace(5.0, 45.0, 401))
+
+    def max_l_over_d(mach):
+        cl, cd = v.aero.coefficients(alphas, mach)
+        return np.max(cl / cd)
+
+    assert max_l_over_d(10.0) == pytest.approx(1.17, abs=0.02)
+    assert max_l_over_d(1.2) == pytest.approx(1.74, abs=0.03)
+    assert max_l_over_d(0.5) == pytest.approx(2.05, abs=0.03)
+    a = np.radians(25.0)
+    for m in (0.8, 2.0):
+        e = 1e-5
+        left = (v.aero.coefficients(a, m - e)[1] - v.aero.coefficients(a, m - 2 * e)[1]) / e
+        right = (v.aero.coefficients(a, m + 2 * e)[1] - v.aero.coefficients(a, m + e)[1]) / e
+        assert left == pytest.approx(right, abs=1e-3)

@@ -45,3 +45,18 @@ def test_geodetic_altitude_of_a_point_on_the_ellipsoid_is_zero():
 def test_bad_planet_parameters():
     with pytest.raises(ValueError, match="flattening must be in"):
         Earth(flattening=1.5)
+
+
+def test_from_geodetic_inverts_geodetic_at_paper001_site():
+    """The Azores site (paper 001: 36.974 deg N geodetic) lies 0.185 deg (20.5 km) further
+    south in geocentric latitude; a point at 0 m geodetic is 7.7 km below the WGS-84 equatorial
+    sphere's surface there (shared/notes/paper001-sphynx.md)."""
+    p = Earth.oblate()
+    h, lat = p.from_geodetic(0.0, np.radians(36.974))
+    assert np.degrees(lat) == pytest.approx(36.7895, abs=1e-3)
+    assert p.reference_radius * np.radians(36.974 - np.degrees(lat)) == pytest.approx(20.5e3, abs=0.3e3)
+    assert h == pytest.approx(-p.equatorial_radius * p.flattening * np.sin(lat) ** 2, rel=0.01)
+    for alt, glat in ((120e3, 0.3), (10e3, -1.1), (0.0, 0.0)):
+        h, lat = p.from_geodetic(alt, glat)
+        back_alt, back_lat = p.geodetic(p.radius(h), lat)
+        assert back_alt == pytest.approx(alt, abs=1e-3) and back_lat == pytest.approx(glat, abs=1e-12)

@@ -58,3 +58,34 @@ def test_interpolation_reproduces_runge_function_paper000_fig1b():
     err = np.abs(op.interpolation(xs) @ f(op.x) - f(xs)).max()
     assert err < 0.02  # equispaced degree-24 interpolation errs by about 1e3 here
     assert np.allclose(op.interpolation(op.x), np.eye(25))
+
+
+@pytest.mark.parametrize("m", [2, 3, 4, 6])
+def test_lobatto_segment_mesh_integrates_polynomials_of_its_order_exactly(m):
+    """Lobatto IIIA on a segment mesh: x_j - x_0 = integral of x' holds exactly for x of
+    degree <= m (x' interpolated exactly on m nodes; m = 2: trapezoid, exact for parabolas);
+    quadrature weights sum to 1."""
+    from drake_entry.pseudospectral import SegmentMesh
+
+    mesh = SegmentMesh(5, m)
+    assert mesh.n_nodes == 5 * (m - 1) + 1 and mesh.weights.sum() == pytest.approx(1.0, abs=1e-14)
+    for deg in range(1, m + 1):
+        x, xdot = mesh.s**deg, deg * mesh.s ** (deg - 1)
+        for seg in mesh.segment_nodes:
+            assert x[seg[1:]] - x[seg[0]] == pytest.approx(mesh.integration @ xdot[seg], abs=1e-13)
+    x, xdot = mesh.s ** (m + 1), (m + 1) * mesh.s**m  # one degree higher: no longer exact
+    errors = [np.abs(x[seg[1:]] - x[seg[0]] - mesh.integration @ xdot[seg]).max() for seg in mesh.segment_nodes]
+    assert max(errors) > 1e-10
+    # the segment interpolant reproduces degree m - 1 polynomials between the nodes
+    s = np.linspace(0.0, 1.0, 37)
+    assert mesh.interpolation(s) @ mesh.s ** (m - 1) == pytest.approx(s ** (m - 1), abs=1e-12)
+
+
+def test_segment_mesh_rejects_bad_sizes():
+    from drake_entry.errors import ScenarioError
+    from drake_entry.pseudospectral import SegmentMesh
+
+    with pytest.raises(ScenarioError, match="n_segments"):
+        SegmentMesh(0, 3)
+    with pytest.raises(ScenarioError, match="nodes_per_segment"):
+        SegmentMesh(4, 1)

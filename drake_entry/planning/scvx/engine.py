@@ -1,0 +1,369 @@
+"""Successive convexification (SCvx) on Drake ``MathematicalProgram`` SOCPs (paper 001 Sec. III).
+
+A ``ConvexifiableProblem`` states a non-convex problem in scaled variables z: a smooth
+objective J(z), equality defects c(z) = 0 (the discretised dynamics), smooth inequalities
+g(z) <= 0 (path and event constraints) and convex constraints it adds to the SOCP itself
+(cones, some with a buffer). Each iteration solves
+
+    min  J(zb) + dJ (z - zb) + w_nu |nu|_1 + w_xi (sum xi + sum convex buffers)
+    s.t. c(zb) + C (z - zb) + nu = 0            virtual controls (eq. 23)
+         g(zb) + G (z - zb) - xi <= 0, xi >= 0  virtual buffers (eq. 24)
+         convex constraints, lower <= z <= upper, |z - zb|_inf <= r  (hard trust region)
+
+which is CP4's L_a (eq. 28) with l1 penalties; the merit is the augmented objective J_a
+(eq. 27): J + w_nu |c|_1 + w_xi (sum max(0, g) + convex violations). The trust radius r
+adapts with rho = actual / predicted decrease of J_a (eq. 22; thresholds rho0 <= rho1 <= rho2,
+factor 2), optionally after a golden-section line search on J_a along the step (eq. 29, with
+the (alpha4 - alpha1) correction). Convergence is judged on the predicted decrease AND the
+defects and constraint violations, never on the step alone: a collapsing trust region also
+gives a small step.
+
+The SOCP is built once per problem size; each iteration only updates the coefficients of
+its linear constraints, cost and bounds (``UpdateCoefficients``, ``set_bounds``).
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+import time
+
+import numpy as np
+import scipy.sparse as sp
+from pydrake.solvers import ClarabelSolver, MathematicalProgram, ScsSolver, SolverOptions
+
+from ...errors import ScenarioError
+
+GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0  # Phi of eq. 29
+
+
+@dc.dataclass(frozen=True)
+class Evaluation:
+    """The non-convex problem at one z: scaled objective, defects (= 0), inequalities (<= 0)
+    and the violations of its buffered convex constraints (>= 0)."""
+
+    objective: float
+    defects: np.ndarray
+    inequalities: np.ndarray
+    convex_violations: np.ndarray
+
+
+@dc.dataclass(frozen=True)
+class Linearisation:
+    """First-order model at z: the evaluation and the gradients (Jacobians sparse)."""
+
+    evaluation: Evaluation
+    objective_gradient: np.ndarray
+    defect_jacobian: sp.spmatrix
+    inequality_jacobian: sp.spmatrix
+
+
+class ConvexifiableProblem:
+    """What the SCvx engine needs from a problem (all in scaled variables z).
+
+    Attributes set by subclasses: ``n_z``, ``lower``, ``upper`` (hard bounds), ``n_defects``,
+    ``n_inequalities``."""
+
+    n_z: int
+    lower: np.ndarray
+    upper: np.ndarray
+    n_defects: int
+    n_inequalities: int
+
+    def evaluate(self, z) -> Evaluation:
+        raise NotImplementedError
+
+    def linearise(self, z) -> Linearisation:
+        raise NotImplementedError
+
+    def add_convex_constraints(self, prog: MathematicalProgram, z) -> np.ndarray:
+        """Add the convex constraints on the decision variables z; return the buffer
+        variables (one per entry of ``Evaluation.convex_violations``, >= 0, penalised)."""
+        return np.empty(0, dtype=object)
+
+    def describe_defect(self, i: int) -> str:
+        return f"defect {i}"
+
+    def describe_inequality(self, i: int) -> str:
+        return f"inequality {i}"
+
+    def describe_convex(self, i: int) -> str:
+        return f"convex constraint {i}"
+
+
+@dc.dataclass
+class ScvxSettings:
+    """SCvx iteration settings (paper 001 Sec. III; its SCOPT defaults where it has them).
+
+    Attributes:
+      max_iterations: SOCP solves, accepted or rejected.
+      trust_radius, trust_radius_min, trust_radius_max: initial, smallest and largest
+        inf-norm radius of the hard trust region in scaled variables.
+      rho0, rho1, rho2: eq. 22 thresholds (reject below rho0; shrink below rho1; grow above rho2).
+      trust_factor: radius change factor.
+      virtual_control_weight, buffer_weight: l1 penalty weights of eqs. 27-28.
+      line_search_steps: golden-section steps (eq. 29); 0 takes the full step.
+      defect_tolerance: largest scaled defect at convergence.
+      constraint_tolerance: largest scaled inequality or convex violation at convergence.
+      decrease_tolerance: predicted decrease of J_a (relative to 1 + |J_a|) at convergence.
+      solver: 'clarabel' or 'scs'. solver_options: passed to the solver.
+    """
+
+    max_iterations: int = 60
+    trust_radius: float = 1.0
+    trust_radius_min: float = 1e-5
+    trust_radius_max: float = 10.0
+    rho0: float = 0.0
+    rho1: float = 0.2
+    rho2: float = 0.6
+    trust_factor: float = 2.0
+    virtual_control_weight: float = 1e3
+    buffer_weight: float = 1e2
+    line_search_steps: int = 5
+    defect_tolerance: float = 1e-6
+    constraint_tolerance: float = 1e-6
+    decrease_tolerance: float = 1e-4
+    solver: str = "clarabel"
+    solver_options: dict = dc.field(default_factory=dict)
+
+    def __post_init__(self):
+        if not 0.0 <= self.rho0 <= self.rho1 <= self.rho2 <= 1.0:
+            raise ScenarioError(f"ScvxSettings rho0 <= rho1 <= rho2 must lie in [0, 1], got "
+                                f"{self.rho0}, {self.rho1}, {self.rho2}")
+        if not self.trust_factor > 1.0:
+            raise ScenarioError(f"ScvxSettings.trust_factor = {self.trust_factor} must be > 1")
+        if not 0.0 < self.trust_radius_min <= self.trust_radius <= self.trust_radius_max:
+            raise ScenarioError("ScvxSettings needs 0 < trust_radius_min <= trust_radius <= trust_radius_max")
+        if not (isinstance(self.max_iterations, int) and self.max_iterations >= 1):
+            raise ScenarioError(f"ScvxSettings.max_iterations = {self.max_iterations} must be an integer >= 1")
+        if not (isinstance(self.line_search_steps, int) and 0 <= self.line_search_steps <= 30):
+            raise ScenarioError(f"ScvxSettings.line_search_steps = {self.line_search_steps} must be in [0, 30]")
+        for name in ("virtual_control_weight", "buffer_weight", "defect_tolerance", "constraint_tolerance",
+                     "decrease_tolerance"):
+            if not getattr(self, name) > 0.0:
+                raise ScenarioError(f"ScvxSettings.{name} = {getattr(self, name)} must be > 0")
+        if self.solver not in ("clarabel", "scs"):
+            raise ScenarioError(f"ScvxSettings.solver = '{self.solver}'; allowed: clarabel, scs")
+
+
+@dc.dataclass
+class IterationRecord:
+    """One SCvx iteration: merit J_a before, predicted and actual decrease, rho, step
+    length alpha, trust radius used, accepted, largest defect and violation after, times [s]."""
+
+    merit: float
+    predicted: float
+    actual: float
+    rho: float
+    alpha: float
+    trust_radius: float
+    accepted: bool
+    max_defect: float
+    max_violation: float
+    socp_time: float
+    model_time: float
+    solver_iterations: int
+
+
+@dc.dataclass
+class ScvxOutcome:
+    """The engine's answer: the last accepted z, its evaluation, whether it converged, why,
+    and the iteration history."""
+
+    z: np.ndarray
+    evaluation: Evaluation
+    converged: bool
+    message: str
+    history: list
+    socp_time: float
+    model_time: float
+
+    @property
+    def iterations(self) -> int:
+        return len(self.history)
+
+
+def merit(ev: Evaluation, s: ScvxSettings) -> float:
+    """J_a of eq. 27 with l1 penalties."""
+    return (ev.objective + s.virtual_control_weight * np.abs(ev.defects).sum()
+            + s.buffer_weight * (np.maximum(ev.inequalities, 0.0).sum() + ev.convex_violations.sum()))
+
+
+def max_violation(ev: Evaluation) -> float:
+    g = ev.inequalities.max(initial=-np.inf)
+    c = ev.convex_violations.max(initial=0.0)
+    return float(max(g, c, 0.0))
+
+
+def diagnose(problem: ConvexifiableProblem, ev: Evaluation) -> str:
+    """Which constraint is violated most, and where."""
+    parts = []
+    if ev.defects.size:
+        i = int(np.argmax(np.abs(ev.defects)))
+        parts.append(f"largest dynamics defect {abs(ev.defects[i]):.3g} ({problem.describe_defect(i)})")
+    if ev.inequalities.size and ev.inequalities.max() > 0:
+        i = int(np.argmax(ev.inequalities))
+        parts.append(f"largest violation {ev.inequalities[i]:.3g} ({problem.describe_inequality(i)})")
+    if ev.convex_violations.size and ev.convex_violations.max() > 0:
+        i = int(np.argmax(ev.convex_violations))
+        parts.append(f"convex violation {ev.convex_violations[i]:.3g} ({problem.describe_convex(i)})")
+    return "; ".join(parts) if parts else "no constraint violated"
+
+
+class ScvxSubproblem:
+    """The convex sub-problem, built once; ``solve`` updates its coefficients and solves it."""
+
+    def __init__(self, problem: ConvexifiableProblem, settings: ScvxSettings):
+        self.problem, self.settings = problem, settings
+        nz, nc, ng = problem.n_z, problem.n_defects, problem.n_inequalities
+        prog = self.prog = MathematicalProgram()
+        self.z = prog.NewContinuousVariables(nz, "z")
+        self.nu = prog.NewContinuousVariables(2 * nc, "nu")  # nu+ then nu-
+        self.xi = prog.NewContinuousVariables(ng, "xi")
+        self.buffers = problem.add_convex_constraints(prog, self.z)
+        slack = np.concatenate([self.nu, self.xi, self.buffers])
+        prog.AddBoundingBoxConstraint(0.0, np.inf, slack)
+        self.box = prog.AddBoundingBoxConstraint(problem.lower, problem.upper, self.z).evaluator()
+        eye_c = sp.identity(nc, format="csc")
+        self._eye_nu = sp.hstack([eye_c, -eye_c], format="csc")
+        self.dynamics = prog.AddLinearEqualityConstraint(
+            sp.csc_matrix((nc, nz + 2 * nc)), np.zeros(nc), np.concatenate([self.z, self.nu])).evaluator()
+        self._neg_eye_g = -sp.identity(ng, format="csc")
+        self.path = prog.AddLinearConstraint(
+            sp.csc_matrix((ng, nz + ng)), np.full(ng, -np.inf), np.zeros(ng),
+            np.concatenate([self.z, self.xi])).evaluator() if ng else None
+        self._penalty = np.concatenate([np.full(2 * nc, settings.virtual_control_weight),
+                                        np.full(ng + len(self.buffers), settings.buffer_weight)])
+        self.cost = prog.AddLinearCost(np.zeros(nz + slack.size), 0.0, np.concatenate([self.z, slack])).evaluator()
+        self._slack = slack
+        if settings.solver == "clarabel":
+            self.solver = ClarabelSolver()
+        else:
+            self.solver = ScsSolver()
+        self.options = SolverOptions()
+        for k, v in settings.solver_options.items():
+            self.options.SetOption(self.solver.solver_id(), k, v)
+
+    def solve(self, zb: np.ndarray, lin: Linearisation, radius: float):
+        """Solve the sub-problem around zb; returns (z*, predicted L_a, solver iterations) or
+        (None, message, 0) when the solver fails."""
+        p, ev = self.problem, lin.evaluation
+        C = lin.defect_jacobian
+        self.dynamics.UpdateCoefficients(sp.hstack([C, self._eye_nu], format="csc"), C @ zb - ev.defects)
+        if self.path is not None:
+            G = lin.inequality_jacobian
+            self.path.UpdateCoefficients(sp.hstack([G, self._neg_eye_g], format="csc"),
+                                         np.full(p.n_inequalities, -np.inf), G @ zb - ev.inequalities)
+        lo = np.maximum(p.lower, zb - radius)
+        hi = np.minimum(p.upper, zb + radius)
+        self.box.set_bounds(lo, np.maximum(hi, lo))
+        self.cost.UpdateCoefficients(np.concatenate([lin.objective_gradient, self._penalty]), 0.0)
+        result = self.solver.Solve(self.prog, None, self.options)
+        details = result.get_solver_details()
+        its = int(getattr(details, "iterations", getattr(details, "iter", 0)) or 0)
+        if not result.is_success():
+            return None, f"{self.solver.solver_id().name()} returned {result.get_solution_result().name}", its
+        z = result.GetSolution(self.z)
+        slack = result.GetSolution(self._slack)
+        predicted = ev.objective + lin.objective_gradient @ (z - zb) + self._penalty @ slack
+        return z, float(predicted), its
+
+
+def golden_section(merit_at, full_step_merit: float, steps: int) -> tuple[float, float]:
+    """Step length alpha in [0, 1] minimising the merit along the step (eq. 29, alpha1 = 0,
+    alpha4 = 1), ``steps`` interval reductions; returns (alpha, merit). The full step is kept
+    unless an interior point is better."""
+    a1, a4 = 0.0, 1.0
+    a2, a3 = a1 + (1.0 - GOLDEN) * (a4 - a1), a1 + GOLDEN * (a4 - a1)
+    m2, m3 = merit_at(a2), merit_at(a3)
+    best = min((full_step_merit, 1.0), (m2, a2), (m3, a3))
+    for _ in range(steps - 1):
+        if m2 <= m3:  # optimum in [a1, a3]
+            a4, a3, m3 = a3, a2, m2
+            a2 = a1 + (1.0 - GOLDEN) * (a4 - a1)
+            m2 = merit_at(a2)
+            best = min(best, (m2, a2))
+        else:  # optimum in [a2, a4]
+            a1, a2, m2 = a2, a3, m3
+            a3 = a1 + GOLDEN * (a4 - a1)
+            m3 = merit_at(a3)
+            best = min(best, (m3, a3))
+    return best[1], best[0]
+
+
+def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None = None,
+               progress=None) -> ScvxOutcome:
+    """Run SCvx from z0 (projected onto the hard bounds). ``progress(k, record)`` is called
+    after every iteration when given."""
+    s = settings or ScvxSettings()
+    t0 = time.perf_counter()
+    sub = ScvxSubproblem(problem, s)
+    z = np.clip(np.asarray(z0, float), problem.lower, problem.upper)
+    lin = problem.linearise(z)
+    model_time = time.perf_counter() - t0
+    socp_time = 0.0
+    ja = merit(lin.evaluation, s)
+    radius = s.trust_radius
+    history: list[IterationRecord] = []
+    converged, message = False, ""
+    for k in range(s.max_iterations):
+        t1 = time.perf_counter()
+        z_new, predicted, solver_its = sub.solve(z, lin, radius)
+        socp_time += time.perf_counter() - t1
+        if z_new is None:
+            if radius > s.trust_radius_min:
+                radius /= s.trust_factor
+                continue
+            message = f"the convex sub-problem failed ({predicted}) at trust radius {radius:.3g}"
+            break
+        t2 = time.perf_counter()
+        decrease = ja - predicted
+        ev = lin.evaluation
+        feasible = (np.abs(ev.defects).max(initial=0.0) <= s.defect_tolerance
+                    and max_violation(ev) <= s.constraint_tolerance)
+        if decrease <= s.decrease_tolerance * (1.0 + abs(ja)):
+            history.append(IterationRecord(ja, decrease, 0.0, math.nan, 0.0, radius, False,
+                                           float(np.abs(ev.defects).max(initial=0.0)), max_violation(ev),
+                                           time.perf_counter() - t1, 0.0, solver_its))
+            if feasible:
+                converged, message = True, f"converged in {k + 1} iterations"
+            else:
+                message = ("stationary at an infeasible point (no decrease of the penalised merit is "
+                           "predicted): " + diagnose(problem, ev))
+            break
+        step = z_new - z
+
+        def merit_at(a):
+            return merit(problem.evaluate(z + a * step), s)
+
+        ev_full = problem.evaluate(z_new)
+        ja_full = merit(ev_full, s)
+        alpha, ja_new = 1.0, ja_full
+        if s.line_search_steps:
+            alpha, ja_new = golden_section(merit_at, ja_full, s.line_search_steps)
+        actual = ja - ja_new
+        rho = actual / decrease  # eq. 22: J_a after the line search against L_a of the full step
+        accepted = rho >= s.rho0 and actual > 0.0
+        used_radius = radius
+        if accepted:
+            z = z + alpha * step
+            lin = problem.linearise(z)
+            ja = merit(lin.evaluation, s)
+        if not accepted or rho < s.rho1:
+            radius = max(radius / s.trust_factor, 0.0)
+        elif rho >= s.rho2:
+            radius = min(radius * s.trust_factor, s.trust_radius_max)
+        model_time += time.perf_counter() - t2
+        ev = lin.evaluation
+        rec = IterationRecord(ja, decrease, actual, rho, alpha, used_radius, accepted,
+                              float(np.abs(ev.defects).max(initial=0.0)), max_violation(ev),
+                              t2 - t1, time.perf_counter() - t2, solver_its)
+        history.append(rec)
+        if progress is not None:
+            progress(k, rec)
+        if radius < s.trust_radius_min:
+            message = (f"trust region collapsed (radius {radius:.2g}) after {k + 1} iterations: "
+                       + diagnose(problem, ev))
+            break
+    else:
+        message = f"no convergence in {s.max_iterations} iterations: " + diagnose(problem, lin.evaluation)
+    return ScvxOutcome(z, lin.evaluation, converged, message, history, socp_time, model_time)

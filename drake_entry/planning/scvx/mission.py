@@ -1,0 +1,106 @@
+"""An entry-to-landing-site mission for the SCvx planner (paper 001 Sec. II.B, Table 1,
+eqs. 64-70): entry interface, site, DRS box, state bounds, angle-of-attack law.
+
+Positions are given as the paper gives them: geodetic altitude and latitude on the WGS-84
+ellipsoid (on the site the geodetic and geocentric latitudes differ by 20 km); ``entry_state``
+and ``site`` convert them to the planner's state (altitude above the reference sphere,
+geocentric latitude).
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+
+import numpy as np
+
+from ...errors import ScenarioError
+from ...planet import Earth
+from ...schedules import Schedule
+
+
+@dc.dataclass
+class ScvxMission:
+    """Entry interface, landing site and terminal (DRS) conditions.
+
+    Attributes:
+      entry_altitude_m: geodetic altitude of the entry interface point (EIP) [m].
+      entry_longitude_deg, entry_latitude_deg: EIP longitude and geodetic latitude [deg].
+      entry_speed_m_s, entry_flight_path_deg, entry_heading_deg: Earth-relative speed [m/s],
+        flight-path angle and heading from north, clockwise [deg] at the EIP.
+      site_longitude_deg, site_latitude_deg: landing site, geodetic latitude [deg].
+      site_radius_m: largest miss of the DRS point from the site [m] (eq. 68).
+      final_altitude_m: geodetic DRS altitude window [m] (eq. 64).
+      final_mach_max: largest DRS Mach number (eq. 65: subsonic).
+      final_vertical_speed_min_m_s: lowest V sin(gamma) at the DRS point [m/s] (eq. 66).
+      flight_path_bounds_deg: path bounds on gamma [deg] (eq. 70), buffered.
+      heading_bounds_deg: hard bounds on the heading [deg] (eq. 70).
+      bank_min_deg: smallest bank magnitude [deg] (eq. 43).
+      alpha_deg, alpha_speeds_m_s: the angle-of-attack law: alpha_deg[0] above
+        alpha_speeds_m_s[1], alpha_deg[1] below alpha_speeds_m_s[0], a C2 blend between.
+      name: label.
+    """
+
+    entry_altitude_m: float = 120e3
+    entry_longitude_deg: float = -115.0
+    entry_latitude_deg: float = 30.0
+    entry_speed_m_s: float = 7643.7
+    entry_flight_path_deg: float = -1.29
+    entry_heading_deg: float = 43.04
+    site_longitude_deg: float = -25.165
+    site_latitude_deg: float = 36.974
+    site_radius_m: float = 10e3
+    final_altitude_m: tuple = (10e3, 13e3)
+    final_mach_max: float = 1.0
+    final_vertical_speed_min_m_s: float = -140.0
+    flight_path_bounds_deg: tuple = (-30.0, 0.5)
+    heading_bounds_deg: tuple = (-10.0, 270.0)
+    bank_min_deg: float = 5.0
+    alpha_deg: tuple = (40.0, 25.0)
+    alpha_speeds_m_s: tuple = (2000.0, 5000.0)
+    name: str = "paper001_nominal"
+
+    def __post_init__(self):
+        def check(field, value, lo, hi, unit):
+            if not (isinstance(value, (int, float)) and lo <= value <= hi):
+                raise ScenarioError(f"ScvxMission.{field} = {value!r} is out of range [{lo}, {hi}] {unit}")
+
+        check("entry_altitude_m", self.entry_altitude_m, 20e3, 200e3, "m")
+        check("entry_speed_m_s", self.entry_speed_m_s, 500.0, 12e3, "m/s")
+        check("entry_flight_path_deg", self.entry_flight_path_deg, -45.0, 5.0, "deg")
+        for f in ("entry_latitude_deg", "site_latitude_deg"):
+            check(f, getattr(self, f), -89.0, 89.0, "deg")
+        for f in ("entry_longitude_deg", "site_longitude_deg", "entry_heading_deg"):
+            check(f, getattr(self, f), -360.0, 360.0, "deg")
+        check("site_radius_m", self.site_radius_m, 1.0, 5e6, "m")
+        check("final_mach_max", self.final_mach_max, 0.1, 10.0, "-")
+        check("final_vertical_speed_min_m_s", self.final_vertical_speed_min_m_s, -2000.0, 0.0, "m/s")
+        check("bank_min_deg", self.bank_min_deg, 0.0, 45.0, "deg")
+        for f, lo, hi in (("final_altitude_m", 0.0, 100e3), ("flight_path_bounds_deg", -89.0, 30.0),
+                          ("heading_bounds_deg", -360.0, 720.0), ("alpha_deg", 0.0, 60.0),
+                          ("alpha_speeds_m_s", 0.0, 12e3)):
+            v = tuple(getattr(self, f))
+            if len(v) != 2 or not (lo <= v[0] < v[1] <= hi or (f == "alpha_deg" and lo <= min(v) and max(v) <= hi)):
+                raise ScenarioError(f"ScvxMission.{f} = {v} needs two values {lo} <= low < high <= {hi}")
+        if not self.flight_path_bounds_deg[0] <= self.entry_flight_path_deg <= self.flight_path_bounds_deg[1] + 1e-9:
+            raise ScenarioError(f"ScvxMission.entry_flight_path_deg = {self.entry_flight_path_deg} lies outside "
+                                f"flight_path_bounds_deg = {tuple(self.flight_path_bounds_deg)}")
+        if not self.heading_bounds_deg[0] <= self.entry_heading_deg <= self.heading_bounds_deg[1]:
+            raise ScenarioError(f"ScvxMission.entry_heading_deg = {self.entry_heading_deg} lies outside "
+                                f"heading_bounds_deg = {tuple(self.heading_bounds_deg)}")
+
+    def entry_state(self, planet: Earth) -> np.ndarray:
+        """[h, lon, lat, V, gamma, psi] at the EIP: altitude above the reference sphere,
+        geocentric latitude (paper 001 Table 1 converted)."""
+        h, lat = planet.from_geodetic(self.entry_altitude_m, math.radians(self.entry_latitude_deg))
+        return np.array([h, math.radians(self.entry_longitude_deg), lat, self.entry_speed_m_s,
+                         math.radians(self.entry_flight_path_deg), math.radians(self.entry_heading_deg)])
+
+    def site(self, planet: Earth) -> tuple[float, float]:
+        """Site longitude and geocentric latitude [rad]."""
+        return math.radians(self.site_longitude_deg), planet.from_geodetic(0.0, math.radians(self.site_latitude_deg))[1]
+
+    def alpha_schedule(self) -> Schedule:
+        """alpha(V) [rad], velocity-scheduled and C2 (its derivative enters the Jacobians)."""
+        lo, hi = self.alpha_speeds_m_s
+        return Schedule((float(lo), float(hi)), (math.radians(self.alpha_deg[1]), math.radians(self.alpha_deg[0])),
+                        "velocity", smooth=True)

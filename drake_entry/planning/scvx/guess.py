@@ -90,6 +90,8 @@ def propagate_glide(reference_bank: float, vehicle: Vehicle, planet: Earth, atmo
 
     def reverse(t, x, sign):
         distance = planet.great_circle_distance(x[1], x[2], *site)
+        if distance < 50e3:  # over the site the bearing swings: hold the bank side
+            return 1.0
         return sign * heading_error(x, site) + reversal_deadband(distance)
     reverse.terminal, reverse.direction = True, -1.0
 
@@ -102,7 +104,7 @@ def propagate_glide(reference_bank: float, vehicle: Vehicle, planet: Earth, atmo
     sign = 1.0 if heading_error(x, site) >= 0.0 else -1.0
     times, states, banks = [np.zeros(1)], [x[None, :]], [np.array([bank_at(x, sign)[0]])]
     t, done, reached_stop = 0.0, False, False
-    for _ in range(50):
+    for _ in range(1000):
         sol = solve_ivp(rhs, (t, max_time), x, method="DOP853", rtol=rtol, atol=atol, args=(sign,),
                         events=(reached, too_slow, reverse))
         if sol.status == -1:

@@ -1,12 +1,13 @@
 """Benchmarks, each printing its figures and ratios measured side by side in one run.
 
-    python benchmarks/run.py [open-loop|socp|nlp|campaign|interface-cost|paper004|all] [options]
+    python benchmarks/run.py [open-loop|socp|nlp|campaign|interface-cost|paper001|paper004|all] [options]
 
 open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
 socp            drag-energy SOCP build/solve times, Clarabel vs SCS, by node count
 nlp             NLP path: LGL / DirectCollocation x Ipopt / SNOPT from the same starts
 campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios)
 interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline commit
+paper001        paper 001: SCvx nominal plan time and iterations by mesh vs the paper, flown by Drake
 paper004        paper 004: Table 1 over seeds, scipy baselines, cases, two parameters, figures
 """
 import argparse
@@ -18,7 +19,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("which", nargs="?", default="all",
-                        choices=("all", "open-loop", "socp", "nlp", "campaign", "interface-cost", "paper004"))
+                        choices=("all", "open-loop", "socp", "nlp", "campaign", "interface-cost", "paper001",
+                                 "paper004"))
     parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
     parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
     parser.add_argument("--nodes", type=int, default=40, help="nlp: nodes / samples")
@@ -49,6 +51,10 @@ if __name__ == "__main__":
         from interface_cost import interface_cost_benchmark
 
         interface_cost_benchmark(baseline=args.baseline, rounds=args.rounds)
+    if args.which in ("all", "paper001"):
+        from paper001 import paper001_benchmark
+
+        paper001_benchmark()
     if args.which in ("all", "paper004"):
         from paper004 import paper004_study
 

@@ -18,7 +18,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 ORDER = ("model", "systems", "methods", "diagrams", "cli")
 EXCEPTIONS = {("drake_entry.planning.nlp.dircol", "drake_entry.systems.ocp_plant")}
-METHOD_PLANNERS = ("drake_entry.planning.drag_energy", "drake_entry.planning.nlp", "drake_entry.planning.swarm")
+METHOD_PLANNERS = ("drake_entry.planning.drag_energy", "drake_entry.planning.nlp", "drake_entry.planning.swarm",
+                   "drake_entry.planning.scvx")
 
 
 def module_name(path: Path) -> str:

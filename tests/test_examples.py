@@ -69,3 +69,11 @@ def test_example_06(tmp_path):
     assert plan.success and flight.trajectory.state[-1, 0] - plan.problem.h_f == pytest.approx(
         plan.evaluation.altitude_error_m[0], abs=20.0)
     assert abs(r["searches"]["secant"].x[0] - 58.79) < 0.05
+
+
+def test_example_07(tmp_path):
+    r = _run("07_scvx_entry", tmp_path)
+    plan, flight = r["plan"], r["flight"]
+    assert plan.success and plan.max_defect <= 1e-6
+    assert 500.0 < plan.objective < 540.0 and flight.from_site_m < 15e3 and flight.drs_ok
+    assert os.path.exists(r["plot"])

@@ -30,8 +30,9 @@ class ScvxPlan(PlanResult):
     """An SCvx entry plan (a PlanResult over time; ``objective``: heat load [MJ/m^2] or t_f [s]).
 
     Attributes:
-      time [s], states (n, 6) SI, controls (n, 2) = (u1, u2) at the mesh nodes; final_time [s].
-      bank [rad] = atan2(u2, u1), alpha [rad] = alpha(V), at the nodes.
+      time: node times [s]; states: (n, 6) SI; controls: (n, 2) = (u1, u2) at the mesh nodes;
+        final_time: t_f [s].
+      bank: atan2(u2, u1) [rad] and alpha: alpha(V) [rad], at the nodes.
       heat_load: integral of q dt [J/m^2] (the paper's objective, without the regulariser).
       lossless_gap: max(1 - |u|) over nodes where L >= 5 % g0; lossless_gap_all: over all nodes.
       max_defect, max_violation: largest scaled dynamics defect and constraint violation.

@@ -188,6 +188,11 @@ def merit(ev: Evaluation, s: ScvxSettings) -> float:
             + s.buffer_weight * (np.maximum(ev.inequalities, 0.0).sum() + ev.convex_violations.sum()))
 
 
+def max_defect(ev: Evaluation) -> float:
+    """Largest scaled dynamics defect."""
+    return float(np.abs(ev.defects).max(initial=0.0))
+
+
 def max_violation(ev: Evaluation) -> float:
     g = ev.inequalities.max(initial=-np.inf)
     c = ev.convex_violations.max(initial=0.0)
@@ -309,7 +314,10 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
         t1 = time.perf_counter()
         z_new, predicted, solver_its = sub.solve(z, lin, radius)
         socp_time += time.perf_counter() - t1
-        if z_new is None:
+        ev = lin.evaluation
+        if z_new is None:  # a failed solve counts as a rejected iteration
+            history.append(IterationRecord(ja, math.nan, 0.0, math.nan, 0.0, radius, False, max_defect(ev),
+                                           max_violation(ev), time.perf_counter() - t1, 0.0, solver_its))
             if radius > s.trust_radius_min:
                 radius /= s.trust_factor
                 continue
@@ -317,14 +325,13 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
             break
         t2 = time.perf_counter()
         decrease = ja - predicted
-        ev = lin.evaluation
-        feasible = (np.abs(ev.defects).max(initial=0.0) <= s.defect_tolerance
-                    and max_violation(ev) <= s.constraint_tolerance)
         if decrease <= s.decrease_tolerance * (1.0 + abs(ja)):
-            history.append(IterationRecord(ja, decrease, 0.0, math.nan, 0.0, radius, False,
-                                           float(np.abs(ev.defects).max(initial=0.0)), max_violation(ev),
-                                           time.perf_counter() - t1, 0.0, solver_its))
-            if feasible:
+            rec = IterationRecord(ja, decrease, 0.0, math.nan, 0.0, radius, False, max_defect(ev), max_violation(ev),
+                                  t2 - t1, 0.0, solver_its)
+            history.append(rec)
+            if progress is not None:
+                progress(k, rec)
+            if max_defect(ev) <= s.defect_tolerance and max_violation(ev) <= s.constraint_tolerance:
                 converged, message = True, f"converged in {k + 1} iterations"
             else:
                 message = ("stationary at an infeasible point (no decrease of the penalised merit is "
@@ -349,14 +356,13 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
             lin = problem.linearise(z)
             ja = merit(lin.evaluation, s)
         if not accepted or rho < s.rho1:
-            radius = max(radius / s.trust_factor, 0.0)
+            radius /= s.trust_factor
         elif rho >= s.rho2:
             radius = min(radius * s.trust_factor, s.trust_radius_max)
         model_time += time.perf_counter() - t2
         ev = lin.evaluation
-        rec = IterationRecord(ja, decrease, actual, rho, alpha, used_radius, accepted,
-                              float(np.abs(ev.defects).max(initial=0.0)), max_violation(ev),
-                              t2 - t1, time.perf_counter() - t2, solver_its)
+        rec = IterationRecord(ja, decrease, actual, rho, alpha, used_radius, accepted, max_defect(ev),
+                              max_violation(ev), t2 - t1, time.perf_counter() - t2, solver_its)
         history.append(rec)
         if progress is not None:
             progress(k, rec)

@@ -124,7 +124,7 @@ class EntryProblem(ConvexifiableProblem):
         x_lo = np.array([-2e3, -4 * math.pi, -deg(89.0), 10.0, -deg(89.0), deg(m.heading_bounds_deg[0])])
         x_hi = np.array([200e3, 4 * math.pi, deg(89.0), 12e3, deg(60.0), deg(m.heading_bounds_deg[1])])
         bank_max = self.vehicle.bank_limit
-        u_lo = np.array([math.cos(min(bank_max, math.pi)), -math.sin(min(bank_max, math.pi / 2))])
+        u_lo = np.array([math.cos(bank_max), -math.sin(min(bank_max, math.pi / 2))])
         u_hi = np.array([math.cos(deg(m.bank_min_deg)), math.sin(min(bank_max, math.pi / 2))])
         lower = np.concatenate([np.tile(x_lo, n), np.tile(u_lo, n), [0.3 * tf_guess]])
         upper = np.concatenate([np.tile(x_hi, n), np.tile(u_hi, n), [3.0 * tf_guess]])
@@ -203,7 +203,7 @@ class EntryProblem(ConvexifiableProblem):
             base = 1.0 / TIME_SCALE
         objective = tf * (base + self.heading_lambda * (w @ X[:, 5]))
         ev = Evaluation(float(objective), defects.ravel(), np.concatenate([path.ravel(), events]),
-                        np.array([max(0.0, self._miss(xf) - m.site_radius_m) / 1e3]))
+                        np.array([max(0.0, self.site_miss(xf) - m.site_radius_m) / 1e3]))
         if not gradients:
             return ev
         return self._linearise(ev, X, U, tf, nodes, jac, base)
@@ -214,7 +214,8 @@ class EntryProblem(ConvexifiableProblem):
     def linearise(self, z) -> Linearisation:
         return self._evaluate(z, gradients=True)
 
-    def _miss(self, xf) -> float:
+    def site_miss(self, xf) -> float:
+        """Distance [m] of state xf from the site as the site cone measures it (eqs. 67-68)."""
         return self.planet.reference_radius * math.hypot(math.cos(self.site_lat) * (xf[1] - self.site_lon),
                                                          xf[2] - self.site_lat)
 

@@ -33,15 +33,15 @@ from .mission import ScvxMission
 @dc.dataclass(frozen=True)
 class GlideGuess:
     """A propagated guess: times [s], states (n, 6), bank [rad] at those times, the
-    reference bank sigma_g [rad], and the signed along-track miss at the end [m]
-    (positive: the site is still ahead)."""
+    reference bank sigma_g [rad], the distance of its end from the site [m], and whether it
+    reached the middle of the DRS altitude window (it may stop earlier by speed or time)."""
 
     time: np.ndarray
     states: np.ndarray
     bank: np.ndarray
     reference_bank: float
-    miss_along_track: float
     miss: float
+    reached_drs_altitude: bool
 
     @property
     def final_time(self) -> float:
@@ -103,7 +103,7 @@ def propagate_glide(reference_bank: float, vehicle: Vehicle, planet: Earth, atmo
     atol = rtol * np.array([1e4, 1.0, 1.0, 1e3, 1.0, 1.0])
     sign = 1.0 if heading_error(x, site) >= 0.0 else -1.0
     times, states, banks = [np.zeros(1)], [x[None, :]], [np.array([bank_at(x, sign)[0]])]
-    t, done, reached_stop = 0.0, False, False
+    t, reached_stop = 0.0, False
     for _ in range(1000):
         sol = solve_ivp(rhs, (t, max_time), x, method="DOP853", rtol=rtol, atol=atol, args=(sign,),
                         events=(reached, too_slow, reverse))
@@ -115,17 +115,12 @@ def propagate_glide(reference_bank: float, vehicle: Vehicle, planet: Earth, atmo
         banks.append(np.array([bank_at(xk, sign)[0] for xk in sol.y.T[1:]]))
         t, x = sol.t[-1], sol.y[:, -1]
         reached_stop = bool(sol.t_events[0].size)
-        done = sol.status == 0 or reached_stop or bool(sol.t_events[1].size)
-        if done:
+        if sol.status == 0 or reached_stop or sol.t_events[1].size:
             break
         sign = -sign
     T, X, bank = np.concatenate(times), np.concatenate(states), np.concatenate(banks)
     xf = X[-1]
-    distance = planet.great_circle_distance(xf[1], xf[2], *site)
-    ahead = math.cos(heading_error(xf, site))
-    if not reached_stop:  # stopped by speed, time or too many reversals: count it as short
-        ahead = abs(ahead) + 1.0
-    return GlideGuess(T, X, bank, reference_bank, distance * ahead, distance)
+    return GlideGuess(T, X, bank, reference_bank, planet.great_circle_distance(xf[1], xf[2], *site), reached_stop)
 
 
 def glide_guess(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission: ScvxMission, *,

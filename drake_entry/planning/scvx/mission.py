@@ -76,11 +76,13 @@ class ScvxMission:
         check("final_vertical_speed_min_m_s", self.final_vertical_speed_min_m_s, -2000.0, 0.0, "m/s")
         check("bank_min_deg", self.bank_min_deg, 0.0, 45.0, "deg")
         for f, lo, hi in (("final_altitude_m", 0.0, 100e3), ("flight_path_bounds_deg", -89.0, 30.0),
-                          ("heading_bounds_deg", -360.0, 720.0), ("alpha_deg", 0.0, 60.0),
-                          ("alpha_speeds_m_s", 0.0, 12e3)):
+                          ("heading_bounds_deg", -360.0, 720.0), ("alpha_speeds_m_s", 0.0, 12e3)):
             v = tuple(getattr(self, f))
-            if len(v) != 2 or not (lo <= v[0] < v[1] <= hi or (f == "alpha_deg" and lo <= min(v) and max(v) <= hi)):
+            if len(v) != 2 or not lo <= v[0] < v[1] <= hi:
                 raise ScenarioError(f"ScvxMission.{f} = {v} needs two values {lo} <= low < high <= {hi}")
+        if len(self.alpha_deg) != 2 or not all(0.0 <= a <= 60.0 for a in self.alpha_deg):
+            raise ScenarioError(f"ScvxMission.alpha_deg = {tuple(self.alpha_deg)} needs two angles in [0, 60] deg "
+                                f"(high speed, low speed)")
         if not self.flight_path_bounds_deg[0] <= self.entry_flight_path_deg <= self.flight_path_bounds_deg[1] + 1e-9:
             raise ScenarioError(f"ScvxMission.entry_flight_path_deg = {self.entry_flight_path_deg} lies outside "
                                 f"flight_path_bounds_deg = {tuple(self.flight_path_bounds_deg)}")

@@ -10,11 +10,11 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from ...atmosphere import Atmosphere
-from ...dynamics import flight_conditions
+from ...dynamics import STATE_NAMES, flight_conditions
 from ...planet import Earth
 from ...vehicles import Vehicle
 from ..result import PlanResult
-from .engine import ScvxSettings, max_violation, solve_scvx
+from .engine import ScvxSettings, max_defect, max_violation, solve_scvx
 from .entry import EntryProblem, EntryProblemSettings
 from .guess import GlideGuess, glide_guess
 from .mission import ScvxMission
@@ -69,7 +69,7 @@ class ScvxPlan(PlanResult):
         t = np.clip(np.atleast_1d(np.asarray(at, float)), 0.0, self.final_time)
         P = self.problem.mesh.interpolation(t / self.final_time)
         X, U = P @ self.states, P @ self.controls
-        out = {n: X[:, i] for i, n in enumerate(("h", "lon", "lat", "V", "gamma", "psi"))}
+        out = {n: X[:, i] for i, n in enumerate(STATE_NAMES)}
         out.update(u1=U[:, 0], u2=U[:, 1], bank=np.arctan2(U[:, 1], U[:, 0]),
                    alpha=np.array([self.problem.alpha(float(v)) for v in X[:, 3]]))
         return out
@@ -84,7 +84,7 @@ def initial_decision(problem: EntryProblem, guess: GlideGuess) -> np.ndarray:
     return problem.pack(X, np.stack([np.cos(bank), np.sin(bank)], axis=1), guess.final_time)
 
 
-def _between_nodes(problem: EntryProblem, plan_states, plan_controls, tf) -> dict:
+def _between_nodes(problem: EntryProblem, plan_states, plan_controls) -> dict:
     """Worst excess of q, n (relative) and gamma (rad) over their limits between the nodes."""
     mesh = problem.mesh
     s = (np.arange(mesh.n_segments)[:, None] + (np.arange(8)[None, :] + 0.5) / 8.0).ravel() / mesh.n_segments
@@ -120,7 +120,7 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     problem = EntryProblem(vehicle, planet, atmosphere, mission, ps, tf0)
     if initial is not None:
         ref = initial.evaluate(problem.mesh.s * tf0)
-        X = np.stack([ref[k] for k in ("h", "lon", "lat", "V", "gamma", "psi")], axis=1)
+        X = np.stack([ref[k] for k in STATE_NAMES], axis=1)
         z0 = problem.pack(X, np.stack([ref["u1"], ref["u2"]], axis=1), tf0)
     else:
         z0 = initial_decision(problem, guess)
@@ -135,7 +135,8 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     norm_u = np.hypot(U[:, 0], U[:, 1])
     acting = lift >= GAP_LIFT_FRACTION * planet.g0
     gap = float(np.max(1.0 - norm_u[acting], initial=0.0))
-    between = _between_nodes(problem, X, U, tf)
+    heat_load = float(tf * (problem.mesh.weights @ q))
+    between = _between_nodes(problem, X, U)
     xf = X[-1]
     hstar = float(planet.atmospheric_altitude(xf[0], xf[2]))
     ev = outcome.evaluation
@@ -150,11 +151,11 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     return ScvxPlan(
         success=outcome.converged and checked, message=message, iterations=outcome.iterations,
         build_time=build, solve_time=time.perf_counter() - t0 - build,
-        objective=float(tf * (problem.mesh.weights @ q)) / 1e6 if ps.objective == "heat_load" else tf,
+        objective=heat_load / 1e6 if ps.objective == "heat_load" else tf,
         time=t, states=X, controls=U, final_time=tf, bank=np.arctan2(U[:, 1], U[:, 0]), alpha=alpha,
-        heat_load=float(tf * (problem.mesh.weights @ q)), lossless_gap=gap,
-        lossless_gap_all=float(np.max(1.0 - norm_u)), max_defect=float(np.abs(ev.defects).max(initial=0.0)),
-        max_violation=max_violation(ev), between_nodes=between, miss_m=problem._miss(xf),
+        heat_load=heat_load, lossless_gap=gap,
+        lossless_gap_all=float(np.max(1.0 - norm_u)), max_defect=max_defect(ev),
+        max_violation=max_violation(ev), between_nodes=between, miss_m=problem.site_miss(xf),
         drs={"altitude_m": hstar, "mach": float(conds[-1].mach), "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))},
         peaks={"heat_flux_W_m2": float(q.max()), "total_load_g": float(max(c.total_load for c in conds))},
         guess=guess, history=outcome.history, problem=problem)

@@ -1,12 +1,13 @@
 """Fly an SCvx plan's real bank with the Drake Simulator (paper 001 Table 3: the propagated
 miss) and compare the flown DRS point with the plan and the site.
 
-    TrajectorySource(sigma(t) = atan2(u2, u1)) --bank--> EntryVehicle --state--> VectorLogSink
+    TrajectorySource(sigma(t)) --bank--> EntryVehicle --state--> VectorLogSink
     ScheduleSource(alpha(V)) <--state-- EntryVehicle;  alpha --> EntryVehicle
+    (or TrajectorySource(alpha(t)) --alpha--> EntryVehicle where the plan planned alpha)
 
-The bank is the plan's segment polynomial of u sampled densely into a C2 spline; |u| < 1 in
-the relaxed plan means the flown lift is larger than planned there (the lossless gap shows
-up here as a position error).
+The bank (atan2(u2, u1) of the lossless plan, the bank state of the direct ones) is the plan's
+segment polynomial sampled densely into a C2 spline; |u| < 1 in a relaxed plan means the flown
+lift is larger than planned there (the lossless gap shows up here as a position error).
 """
 from __future__ import annotations
 
@@ -62,15 +63,23 @@ def fly_plan(plan: ScvxPlan, vehicle: Vehicle, planet: Earth, atmosphere: Atmosp
     problem, tf = plan.problem, plan.final_time
     mission = problem.mission
     tt = np.linspace(0.0, tf, samples_per_segment * problem.mesh.n_segments + 1)
-    bank = np.unwrap(plan.evaluate(tt)["bank"])
-    traj = PiecewisePolynomial.CubicWithContinuousSecondDerivatives(tt, bank.reshape(1, -1),
-                                                                   periodic_end_condition=False)
+    ref = plan.evaluate(tt)
+
+    def spline(values):
+        return TrajectorySource(PiecewisePolynomial.CubicWithContinuousSecondDerivatives(
+            tt, np.reshape(values, (1, -1)), periodic_end_condition=False))
+
+    scheduled_alpha = problem.i_alpha is None
     builder = DiagramBuilder()
-    plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, planet, atmosphere, initial_state=plan.states[0]))
-    source = builder.AddNamedSystem("bank", TrajectorySource(traj))
-    alpha = builder.AddNamedSystem("alpha", ScheduleSource(problem.alpha, planet))
+    plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, planet, atmosphere,
+                                                           initial_state=plan.states[0, :6]))
+    source = builder.AddNamedSystem("bank", spline(np.unwrap(ref["bank"])))
     builder.Connect(source.get_output_port(), plant.GetInputPort("bank"))
-    builder.Connect(plant.GetOutputPort("state"), alpha.GetInputPort("state"))
+    if scheduled_alpha:
+        alpha = builder.AddNamedSystem("alpha", ScheduleSource(problem.alpha, planet))
+        builder.Connect(plant.GetOutputPort("state"), alpha.GetInputPort("state"))
+    else:
+        alpha = builder.AddNamedSystem("alpha", spline(ref["alpha"]))
     builder.Connect(alpha.get_output_port(), plant.GetInputPort("alpha"))
     logger = LogVectorOutput(plant.GetOutputPort("state"), builder, tf / log_points)
     diagram = builder.Build()
@@ -88,14 +97,15 @@ def fly_plan(plan: ScvxPlan, vehicle: Vehicle, planet: Earth, atmosphere: Atmosp
     ground = planet.great_circle_distance(xf[1], xf[2], xp[1], xp[2])
     site = mission.site(planet)
     from_site = planet.great_circle_distance(xf[1], xf[2], *site)
-    a_f = float(problem.alpha(float(xf[3])))
+    alphas = ([float(problem.alpha(float(x[3]))) for x in X] if scheduled_alpha
+              else list(np.interp(T, tt, ref["alpha"])))
+    a_f = float(problem.alpha(float(xf[3]))) if scheduled_alpha else float(ref["alpha"][-1])
     cf = flight_conditions(xf, 0.0, a_f, vehicle, planet, atmosphere)
     h_geo = float(planet.atmospheric_altitude(xf[0], xf[2]))
     drs = {"altitude_m": h_geo, "mach": float(cf.mach), "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))}
     drs_ok = (mission.final_altitude_m[0] <= h_geo <= mission.final_altitude_m[1]
               and cf.mach <= mission.final_mach_max and drs["vertical_speed_m_s"] >= mission.final_vertical_speed_min_m_s
               and from_site <= SITE_TOLERANCE_M)
-    alphas = [float(problem.alpha(float(x[3]))) for x in X]
     conds = [flight_conditions(x, 0.0, a, vehicle, planet, atmosphere) for x, a in zip(X, alphas)]
     peaks = {"heat_flux_W_m2": float(max(c.heat_flux for c in conds)),
              "total_load_g": float(max(c.total_load for c in conds))}

@@ -16,7 +16,9 @@ adapts with rho = actual / predicted decrease of J_a (eq. 22; thresholds rho0 <=
 factor 2), optionally after a golden-section line search on J_a along the step (eq. 29, with
 the (alpha4 - alpha1) correction). Convergence is judged on the predicted decrease AND the
 defects and constraint violations, never on the step alone: a collapsing trust region also
-gives a small step.
+gives a small step. The one exception is named in the message: a feasible point where the
+trust region reaches its floor with a predicted decrease within ``FLOOR_DECREASE_FACTOR`` of
+the tolerance (the linear model still promises a little, no step realises it).
 
 The SOCP is built once per problem size; each iteration only updates the coefficients of
 its linear constraints, cost and bounds (``UpdateCoefficients``, ``set_bounds``).
@@ -34,6 +36,9 @@ from pydrake.solvers import ClarabelSolver, MathematicalProgram, ScsSolver, Solv
 from ...errors import ScenarioError
 
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0  # Phi of eq. 29
+#: a feasible point where the trust region reaches its floor is converged when the predicted
+#: decrease is within this factor of ``decrease_tolerance`` (said so in the message)
+FLOOR_DECREASE_FACTOR = 10.0
 
 
 @dc.dataclass(frozen=True)
@@ -367,8 +372,15 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
         if progress is not None:
             progress(k, rec)
         if radius < s.trust_radius_min:
-            message = (f"trust region collapsed (radius {radius:.2g}) after {k + 1} iterations: "
-                       + diagnose(problem, ev))
+            feasible = max_defect(ev) <= s.defect_tolerance and max_violation(ev) <= s.constraint_tolerance
+            floor = FLOOR_DECREASE_FACTOR * s.decrease_tolerance * (1.0 + abs(ja))
+            if feasible and decrease <= floor:
+                converged = True
+                message = (f"converged at the trust-region floor in {k + 1} iterations (feasible; predicted "
+                           f"decrease {decrease:.2g} <= {floor:.2g}, {FLOOR_DECREASE_FACTOR:g} x the tolerance)")
+            else:
+                message = (f"trust region collapsed (radius {radius:.2g}) after {k + 1} iterations: "
+                           + diagnose(problem, ev))
             break
     else:
         message = f"no convergence in {s.max_iterations} iterations: " + diagnose(problem, lin.evaluation)

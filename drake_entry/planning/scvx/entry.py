@@ -1,25 +1,41 @@
-"""The entry problem of paper 001 as a ``ConvexifiableProblem``: free final time, lossless
-bank convexification, path and DRS constraints, Lobatto segment discretisation.
+"""The entry problem of paper 001 as a ``ConvexifiableProblem``: free final time, the four
+control formulations of its Table 3, the objectives of its Table 2, path and DRS constraints,
+Lobatto segment discretisation.
 
-Decision vector z (scaled): the states x_k (6 per node, ``STATE_SCALE``), the controls
-u_k = (u1, u2) = (cos sigma, sin sigma) relaxed to |u| <= 1 (eqs. 37-42), and t_f / 1000 s.
-Normalised time s in [0, 1] with dx/ds = t_f f(x, u) (time dilation). The dynamics are the
-project's one set of equations (``dynamics.equations_of_motion_lift_components``, paper 001
-eqs. 1-7 with 40-41); their Jacobians come from AutoDiff of that code, never a second copy.
+Formulations (``FORMULATIONS``):
+  'lossless'    states (h, lon, lat, V, gamma, psi); controls u = (u1, u2) = (cos, sin) of the
+                bank relaxed to |u| <= 1 (eqs. 37-45); alpha(V) from the mission's law.
+  'hybrid'      lossless bank, alpha a state with its rate a control (eqs. 56-57).
+  'direct_bank' sigma a state, its rate the control (eqs. 34-36); alpha(V).
+  'direct'      sigma and alpha states, their rates the controls (eqs. 54-55): the form of the
+                paper's Tables 2 and 4-7.
+With the bank a state the flown bank is exactly the planned one (no lossless gap) and its rate
+is bounded (eq. 36, vehicle ``bank_rate_limit``); |sigma| >= sigma_min (eq. 43) is not imposed
+there (a non-convex set), as in the paper.
+
+Decision vector z (scaled): the states x_k (``n_x`` per node), the controls u_k (``n_u``),
+t_f / 1000 s, then the objective's epigraph variables, if any. Normalised time s in [0, 1]
+with dx/ds = t_f f(x, u) (time dilation). The dynamics are the project's one set of equations
+(``dynamics.equations_of_motion_lift_components``, paper 001 eqs. 1-7 with 40-41); their
+Jacobians come from AutoDiff of that code, never a second copy.
 
 Defects: on each segment of a ``SegmentMesh`` (Lobatto IIIA, ``nodes_per_segment`` LGL
 nodes; 2 nodes per segment is the paper's trapezoid, Sec. IV.B),
     x_j - x_0 - sum_k I[j, k] t_f f(x_k, u_k) = 0.
 
-Constraints: bank-magnitude bounds on u (eqs. 43-44, hard), |u| <= 1 (eq. 42, hard cone);
+Constraints: control bounds (eqs. 36, 43-44, hard), |u| <= 1 (eq. 42, hard cone, lossless);
 buffered (eq. 24) at every node: heat flux <= q_max (eq. 9), total load <= n_max (eq. 10),
 flight-path bounds (eq. 70); at the DRS point: geodetic altitude window (eq. 64), V <= M a
 (eq. 65), V sin(gamma) >= V_v,min (eq. 66), and a cone ||miss|| <= site radius (eqs. 67-68)
 with a buffer. Hard bounds on the other states (eq. 70) and the fixed entry state.
 
-Objectives (paper 001 Table 2, lossless forms): 'heat_load' (integral of q dt, scaled by
-500 MJ/m^2), 'time' (t_f). The heading regulariser lambda_chi integral chi dt (eq. 45)
-drives |u| to 1; its sign follows the geometry (``heading_regulariser_sign``).
+Objectives (paper 001 Table 2, ``OBJECTIVES``; the min-max ones through an epigraph variable
+mu with mu >= f_k at every node): 'heat_load' (integral of q dt), 'control_effort' (integral of
+the rate norm |(sigma_dot, alpha_dot)| dt, a cone per node), 'max_control_rate' (max of that
+norm), 'max_flight_path_rate' (max |gamma_dot|), 'max_heat_flux', 'max_load', 'time' (t_f),
+'miss' (DRS distance to the site, a cone). With the lossless bank the heading regulariser
+lambda_chi integral chi dt (eq. 45) drives |u| to 1; its sign follows the geometry
+(``heading_regulariser_sign``).
 """
 from __future__ import annotations
 
@@ -41,13 +57,34 @@ from ...vehicles import Vehicle
 from .engine import ConvexifiableProblem, Evaluation, Linearisation
 from .mission import ScvxMission
 
-STATE_SCALE = np.array([1e5, 1.0, 0.1, 7e3, 0.1, 0.5])  # m, rad, rad, m/s, rad, rad
+POSITION_SCALE = np.array([1e5, 1.0, 0.1, 7e3, 0.1, 0.5])  # m, rad, rad, m/s, rad, rad
+SIGMA_SCALE, ALPHA_SCALE = 1.0, 0.5  # rad
+SIGMA_RATE_SCALE, ALPHA_RATE_SCALE = 0.1, 0.02  # rad/s
 TIME_SCALE = 1000.0  # s
 HEAT_LOAD_SCALE = 5e8  # J/m^2 (500 MJ/m^2)
-OBJECTIVES = ("heat_load", "time")
+GAMMA_RATE_SCALE = 1e-3  # rad/s
+MISS_SCALE = 1e4  # m
+
+
+@dc.dataclass(frozen=True)
+class Formulation:
+    """How the bank and the angle of attack enter: bank 'lossless' (u1, u2) or 'rate' (sigma a
+    state, sigma_dot a control); alpha 'schedule' (the mission's alpha(V)) or 'rate'."""
+
+    bank: str
+    alpha: str
+
+
+FORMULATIONS = {"lossless": Formulation("lossless", "schedule"), "hybrid": Formulation("lossless", "rate"),
+                "direct_bank": Formulation("rate", "schedule"), "direct": Formulation("rate", "rate")}
+
+#: objective -> (unit of ``ScvxPlan.objective``, its value in SI per reported unit)
+OBJECTIVES = {"heat_load": ("MJ/m^2", 1e6), "control_effort": ("deg", math.radians(1.0)),
+              "max_control_rate": ("deg/s", math.radians(1.0)), "max_flight_path_rate": ("deg/s", math.radians(1.0)),
+              "max_heat_flux": ("kW/m^2", 1e3), "max_load": ("g", 1.0), "time": ("s", 1.0), "miss": ("km", 1e3)}
+RATE_OBJECTIVES = ("control_effort", "max_control_rate")
 PATH_NAMES = ("heat flux", "total load", "flight-path lower bound", "flight-path upper bound")
 EVENT_NAMES = ("DRS altitude lower bound", "DRS altitude upper bound", "DRS Mach", "DRS vertical speed")
-NODE_OUTPUTS = 10  # xdot (6), heat flux, total load, speed of sound, geodetic altitude
 
 
 def heading_regulariser_sign(x0, site_lat: float) -> float:
@@ -60,25 +97,38 @@ def heading_regulariser_sign(x0, site_lat: float) -> float:
 
 @dc.dataclass
 class EntryProblemSettings:
-    """Discretisation and objective of the entry problem.
+    """Discretisation, formulation and objective of the entry problem.
 
     Attributes:
       segments, nodes_per_segment: the Lobatto mesh (2 nodes per segment: trapezoid).
-      objective: one of OBJECTIVES.
+      formulation: one of FORMULATIONS.
+      objective: one of OBJECTIVES (the rate objectives need a rate formulation).
       heading_weight: |lambda_chi| of eq. 45 as a fraction of the scaled objective per
-        radian of mean heading (0 disables the regulariser).
+        radian of mean heading (0 disables the regulariser; lossless bank only).
       heading_sign: +1, -1, or 0 for the geometric rule ``heading_regulariser_sign``.
     """
 
     segments: int = 33
     nodes_per_segment: int = 4
+    formulation: str = "direct"
     objective: str = "heat_load"
     heading_weight: float = 0.02
     heading_sign: float = 0.0
 
     def __post_init__(self):
+        if self.formulation not in FORMULATIONS:
+            raise ScenarioError(f"EntryProblemSettings.formulation = '{self.formulation}'; allowed: "
+                                f"{', '.join(FORMULATIONS)}")
         if self.objective not in OBJECTIVES:
             raise ScenarioError(f"EntryProblemSettings.objective = '{self.objective}'; allowed: {', '.join(OBJECTIVES)}")
+        if self.objective in RATE_OBJECTIVES and self.formulation == "lossless":
+            raise ScenarioError(f"EntryProblemSettings.objective = '{self.objective}' needs a formulation with rate "
+                                f"controls (hybrid, direct_bank, direct), not 'lossless'")
+        if not (isinstance(self.segments, int) and 1 <= self.segments <= 2000):
+            raise ScenarioError(f"EntryProblemSettings.segments = {self.segments} must be an integer in [1, 2000]")
+        if not (isinstance(self.nodes_per_segment, int) and 2 <= self.nodes_per_segment <= 12):
+            raise ScenarioError(f"EntryProblemSettings.nodes_per_segment = {self.nodes_per_segment} must be an "
+                                f"integer in [2, 12]")
         if not 0.0 <= self.heading_weight <= 10.0:
             raise ScenarioError(f"EntryProblemSettings.heading_weight = {self.heading_weight} must be in [0, 10]")
         if self.heading_sign not in (-1.0, 0.0, 1.0):
@@ -86,14 +136,16 @@ class EntryProblemSettings:
 
 
 class EntryProblem(ConvexifiableProblem):
-    """Paper 001's entry problem (lossless bank) on a Lobatto segment mesh; see the module doc."""
+    """Paper 001's entry problem on a Lobatto segment mesh; see the module doc.
 
-    n_x, n_u = 6, 2
+    Attributes: formulation (a Formulation), n_x, n_u (states and controls per node),
+    i_sigma, i_alpha (state indices of sigma and alpha, or None), n_aux (epigraph variables)."""
 
     def __init__(self, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission: ScvxMission,
                  settings: EntryProblemSettings, final_time_guess: float):
         self.vehicle, self.planet, self.atmosphere, self.mission, self.settings = (
             vehicle, planet, atmosphere, mission, settings)
+        self.formulation = f = FORMULATIONS[settings.formulation]
         self.mesh = SegmentMesh(settings.segments, settings.nodes_per_segment)
         self.alpha = mission.alpha_schedule()
         self.x0 = mission.entry_state(planet)
@@ -102,77 +154,153 @@ class EntryProblem(ConvexifiableProblem):
         if not (math.isfinite(limits.heat_flux_max) and math.isfinite(limits.total_load_max)):
             raise ScenarioError(f"vehicle '{vehicle.name}' needs finite heat_flux_max_kW_m2 and total_load_max_g "
                                 f"for the SCvx planner")
-        n, nx, nu = self.mesh.n_nodes, self.n_x, self.n_u
-        self.n_nodes = n
-        self.n_z = n * (nx + nu) + 1
+        # layout of the states and controls per node
+        state_scale, control_scale = list(POSITION_SCALE), []
+        self.i_sigma = self.i_alpha = None
+        if f.bank == "rate":
+            self.i_sigma = len(state_scale)
+            state_scale.append(SIGMA_SCALE)
+        if f.alpha == "rate":
+            self.i_alpha = len(state_scale)
+            state_scale.append(ALPHA_SCALE)
+        self.rate_controls = []  # (control index, state index) of the rate controls
+        if f.bank == "lossless":
+            control_scale += [1.0, 1.0]
+        else:
+            self.rate_controls.append((len(control_scale), self.i_sigma))
+            control_scale.append(SIGMA_RATE_SCALE)
+        if f.alpha == "rate":
+            self.rate_controls.append((len(control_scale), self.i_alpha))
+            control_scale.append(ALPHA_RATE_SCALE)
+        self.state_scale, self.control_scale = np.array(state_scale), np.array(control_scale)
+        self.n_x, self.n_u = nx, nu = len(state_scale), len(control_scale)
+        self.out_q, self.out_n, self.out_a, self.out_h = nx, nx + 1, nx + 2, nx + 3
+        self.n_outputs = nx + 4
+        n = self.n_nodes = self.mesh.n_nodes
+        objective = settings.objective
+        self.n_aux = n if objective == "control_effort" else (0 if objective in ("heat_load", "time") else 1)
+        self.aux_scale = {"control_effort": 1.0, "max_control_rate": 0.01, "max_flight_path_rate": GAMMA_RATE_SCALE,
+                          "max_heat_flux": limits.heat_flux_max, "max_load": limits.total_load_max,
+                          "miss": MISS_SCALE}.get(objective, 1.0)
         self._x = slice(0, n * nx)
         self._u = slice(n * nx, n * (nx + nu))
         self.i_tf = n * (nx + nu)
-        self.scale = np.concatenate([np.tile(STATE_SCALE, n), np.ones(n * nu), [TIME_SCALE]])
+        self._aux = slice(self.i_tf + 1, self.i_tf + 1 + self.n_aux)
+        self.n_z = self.i_tf + 1 + self.n_aux
+        self.scale = np.concatenate([np.tile(self.state_scale, n), np.tile(self.control_scale, n), [TIME_SCALE],
+                                     np.full(self.n_aux, self.aux_scale)])
         self._set_bounds(final_time_guess)
         self.n_defects = settings.segments * (settings.nodes_per_segment - 1) * nx
         self.n_path = (n - 1) * len(PATH_NAMES)
-        self.n_inequalities = self.n_path + len(EVENT_NAMES)
+        self.n_epigraph = {"max_flight_path_rate": 2 * n, "max_heat_flux": n, "max_load": n}.get(objective, 0)
+        self.n_inequalities = self.n_path + self.n_epigraph + len(EVENT_NAMES)
         sign = settings.heading_sign or heading_regulariser_sign(self.x0, self.site_lat)
-        self.heading_lambda = sign * settings.heading_weight / final_time_guess  # per rad s, scaled objective
+        weight = settings.heading_weight if f.bank == "lossless" else 0.0
+        self.heading_lambda = sign * weight / final_time_guess  # per rad s, scaled objective
         self._gamma_bounds = np.radians(mission.flight_path_bounds_deg)
 
     # ----- layout -------------------------------------------------------------------------
     def _set_bounds(self, tf_guess):
-        m, n = self.mission, self.n_nodes
+        m, n, v = self.mission, self.n_nodes, self.vehicle
         deg = math.radians
-        x_lo = np.array([-2e3, -4 * math.pi, -deg(89.0), 10.0, -deg(89.0), deg(m.heading_bounds_deg[0])])
-        x_hi = np.array([200e3, 4 * math.pi, deg(89.0), 12e3, deg(60.0), deg(m.heading_bounds_deg[1])])
-        bank_max = self.vehicle.bank_limit
-        u_lo = np.array([math.cos(bank_max), -math.sin(min(bank_max, math.pi / 2))])
-        u_hi = np.array([math.cos(deg(m.bank_min_deg)), math.sin(min(bank_max, math.pi / 2))])
-        lower = np.concatenate([np.tile(x_lo, n), np.tile(u_lo, n), [0.3 * tf_guess]])
-        upper = np.concatenate([np.tile(x_hi, n), np.tile(u_hi, n), [3.0 * tf_guess]])
-        lower[:self.n_x] = upper[:self.n_x] = self.x0  # the entry state is fixed
+        x_lo = [-2e3, -4 * math.pi, -deg(89.0), 10.0, -deg(89.0), deg(m.heading_bounds_deg[0])]
+        x_hi = [200e3, 4 * math.pi, deg(89.0), 12e3, deg(60.0), deg(m.heading_bounds_deg[1])]
+        u_lo, u_hi = [], []
+        if self.formulation.bank == "lossless":
+            u_lo += [math.cos(v.bank_limit), -math.sin(min(v.bank_limit, math.pi / 2))]
+            u_hi += [math.cos(deg(m.bank_min_deg)), math.sin(min(v.bank_limit, math.pi / 2))]
+        else:
+            x_lo.append(-v.bank_limit)
+            x_hi.append(v.bank_limit)
+            u_lo.append(-v.bank_rate_limit)
+            u_hi.append(v.bank_rate_limit)
+        if self.formulation.alpha == "rate":
+            x_lo.append(deg(m.alpha_bounds_deg[0]))
+            x_hi.append(deg(m.alpha_bounds_deg[1]))
+            u_lo.append(-deg(m.alpha_rate_limit_deg_s))
+            u_hi.append(deg(m.alpha_rate_limit_deg_s))
+        lower = np.concatenate([np.tile(x_lo, n), np.tile(u_lo, n), [0.3 * tf_guess], np.zeros(self.n_aux)])
+        upper = np.concatenate([np.tile(x_hi, n), np.tile(u_hi, n), [3.0 * tf_guess],
+                                np.full(self.n_aux, 1e3 * self.aux_scale)])
+        lower[:6] = upper[:6] = self.x0  # the entry position and velocity are fixed
         self.lower, self.upper = lower / self.scale, upper / self.scale
 
     def pack(self, X, U, tf) -> np.ndarray:
-        """Scaled z from states (n, 6), controls (n, 2) and t_f [s], SI."""
-        return np.concatenate([np.ravel(X), np.ravel(U), [tf]]) / self.scale
+        """Scaled z from states (n, n_x), controls (n, n_u) and t_f [s], SI; the epigraph
+        variables are set to the objective's value there (the tightest feasible)."""
+        z = np.concatenate([np.ravel(X), np.ravel(U), [tf], np.zeros(self.n_aux)]) / self.scale
+        if self.n_aux:
+            z[self._aux] = self._tightest_aux(np.asarray(X, float), np.asarray(U, float))
+        return z
 
     def unpack(self, z):
-        """(X (n, 6), U (n, 2), t_f [s]) SI from scaled z."""
+        """(X (n, n_x), U (n, n_u), t_f [s]) SI from scaled z."""
         v = np.asarray(z, float) * self.scale
         return (v[self._x].reshape(-1, self.n_x), v[self._u].reshape(-1, self.n_u), float(v[self.i_tf]))
 
+    def rates(self, U) -> np.ndarray:
+        """(n, k) the rate controls [rad/s] (sigma_dot and/or alpha_dot) of controls U."""
+        return np.asarray(U)[:, [c for c, _ in self.rate_controls]]
+
+    def _tightest_aux(self, X, U) -> np.ndarray:
+        objective = self.settings.objective
+        if objective == "control_effort":
+            return np.linalg.norm(self.rates(U), axis=1) / self.aux_scale
+        if objective == "max_control_rate":
+            return np.array([np.linalg.norm(self.rates(U), axis=1).max() / self.aux_scale])
+        if objective == "miss":
+            return np.array([self.site_miss(X[-1]) / self.aux_scale])
+        nodes, _ = self._nodes(X, U, gradients=False)
+        column = {"max_flight_path_rate": 4, "max_heat_flux": self.out_q, "max_load": self.out_n}[objective]
+        return np.array([np.abs(nodes[:, column]).max() / self.aux_scale])
+
     # ----- the physics at one node ------------------------------------------------------
     def alpha_of(self, V):
-        """alpha(V) [rad] for float or AutoDiffXd V (the C2 schedule and its slope)."""
+        """alpha(V) [rad] of the mission's law for float or AutoDiffXd V (the C2 schedule and
+        its slope)."""
         value, slope, _ = self.alpha.derivatives(value_of(V))
         return lift([V], value, [slope])
 
+    def bank_and_alpha(self, x, u):
+        """(cos sigma, sin sigma) — relaxed (u1, u2) for the lossless bank — and alpha [rad] at a
+        node, any scalar type."""
+        if self.formulation.bank == "lossless":
+            c, s = u[0], u[1]
+        else:
+            c, s = np.cos(x[self.i_sigma]), np.sin(x[self.i_sigma])
+        alpha = x[self.i_alpha] if self.i_alpha is not None else self.alpha_of(x[3])
+        return c, s, alpha
+
     def node_outputs(self, x, u):
-        """[xdot (6), heat flux W/m^2, total load g, speed of sound m/s, geodetic altitude m]
-        at state x and relaxed control u (eqs. 1-10, 40-41). Any scalar type."""
-        rho, a = air_data(x, self.planet, self.atmosphere)
-        alpha = self.alpha_of(x[3])
-        _, L, D = aero_accelerations(x, alpha, rho, a, self.vehicle)
-        xdot = equations_of_motion_lift_components(x, L * u[0], L * u[1], D, self.planet)
+        """[xdot (n_x), heat flux W/m^2, total load g, speed of sound m/s, geodetic altitude m]
+        at state x and control u (eqs. 1-10, 34-41, 54-57). Any scalar type."""
+        position = x[:6]
+        rho, a = air_data(position, self.planet, self.atmosphere)
+        c, s, alpha = self.bank_and_alpha(x, u)
+        _, L, D = aero_accelerations(position, alpha, rho, a, self.vehicle)
+        xdot = list(equations_of_motion_lift_components(position, L * c, L * s, D, self.planet))
+        for control, _state in self.rate_controls:
+            xdot.append(u[control])
         q = self.vehicle.heat_flux(rho, x[3])
         n = total_load_factor(L, D, self.planet.g0)
         return [*xdot, q, n, a, self.planet.atmospheric_altitude(x[0], x[2])]
 
     def _nodes(self, X, U, gradients: bool):
-        """Node outputs (n, NODE_OUTPUTS) and, with gradients, their Jacobians
-        (n, NODE_OUTPUTS, 8) with respect to (x, u)."""
-        n = self.n_nodes
-        values = np.empty((n, NODE_OUTPUTS))
+        """Node outputs (n, n_outputs) and, with gradients, their Jacobians
+        (n, n_outputs, n_x + n_u) with respect to (x, u)."""
+        n, nx, nv = self.n_nodes, self.n_x, self.n_x + self.n_u
+        values = np.empty((n, self.n_outputs))
         if not gradients:
             for k in range(n):
                 values[k] = self.node_outputs(X[k], U[k])
             return values, None
-        jac = np.empty((n, NODE_OUTPUTS, self.n_x + self.n_u))
+        jac = np.empty((n, self.n_outputs, nv))
         for k in range(n):
             v = InitializeAutoDiff(np.concatenate([X[k], U[k]]))[:, 0]
-            out = np.array(self.node_outputs(v[:6], v[6:]), dtype=object)
+            out = np.array(self.node_outputs(v[:nx], v[nx:]), dtype=object)
             for i, o in enumerate(out):
                 if not isinstance(o, AutoDiffXd):
-                    out[i] = AutoDiffXd(float(o), np.zeros(8))
+                    out[i] = AutoDiffXd(float(o), np.zeros(nv))
             values[k] = ExtractValue(out)[:, 0]
             jac[k] = ExtractGradient(out)
         return values, jac
@@ -180,33 +308,44 @@ class EntryProblem(ConvexifiableProblem):
     # ----- evaluation ---------------------------------------------------------------------
     def _evaluate(self, z, gradients: bool):
         X, U, tf = self.unpack(z)
+        aux = np.asarray(z, float)[self._aux]
         nodes, jac = self._nodes(X, U, gradients)
         mesh, nx = self.mesh, self.n_x
         seg = mesh.segment_nodes
-        I = mesh.integration  # (m-1, m)
         F = tf * nodes[:, :nx]  # dx/ds
-        defects = (X[seg[:, 1:]] - X[seg[:, :1]] - np.einsum("jk,skc->sjc", I, F[seg])) / STATE_SCALE
-        q, load, a, hstar = nodes[1:, 6], nodes[1:, 7], nodes[:, 8], nodes[:, 9]
+        defects = (X[seg[:, 1:]] - X[seg[:, :1]] - np.einsum("jk,skc->sjc", mesh.integration, F[seg])) / self.state_scale
+        q, load, a, hstar = nodes[:, self.out_q], nodes[:, self.out_n], nodes[:, self.out_a], nodes[:, self.out_h]
         gam = X[1:, 4]
         lim, m = self.vehicle.limits, self.mission
         g_lo, g_hi = self._gamma_bounds
-        path = np.stack([q / lim.heat_flux_max - 1.0, load / lim.total_load_max - 1.0,
+        path = np.stack([q[1:] / lim.heat_flux_max - 1.0, load[1:] / lim.total_load_max - 1.0,
                          (g_lo - gam) / 0.1, (gam - g_hi) / 0.1], axis=1)
+        objective = self.settings.objective
+        if objective == "max_flight_path_rate":
+            epigraph = np.concatenate([nodes[:, 4], -nodes[:, 4]]) / self.aux_scale - aux[0]
+        elif objective in ("max_heat_flux", "max_load"):
+            epigraph = nodes[:, self.out_q if objective == "max_heat_flux" else self.out_n] / self.aux_scale - aux[0]
+        else:
+            epigraph = np.zeros(0)
         xf = X[-1]
         events = np.array([(m.final_altitude_m[0] - hstar[-1]) / 1e3, (hstar[-1] - m.final_altitude_m[1]) / 1e3,
                            (xf[3] - m.final_mach_max * a[-1]) / 100.0,
                            (m.final_vertical_speed_min_m_s - xf[3] * math.sin(xf[4])) / 100.0])
         w = mesh.weights
-        if self.settings.objective == "heat_load":
-            base = w @ nodes[:, 6] / HEAT_LOAD_SCALE
+        if objective == "heat_load":
+            value = tf * (w @ q) / HEAT_LOAD_SCALE
+        elif objective == "time":
+            value = tf / TIME_SCALE
+        elif objective == "control_effort":
+            value = tf * (w @ aux)
         else:
-            base = 1.0 / TIME_SCALE
-        objective = tf * (base + self.heading_lambda * (w @ X[:, 5]))
-        ev = Evaluation(float(objective), defects.ravel(), np.concatenate([path.ravel(), events]),
+            value = aux[0]
+        value += tf * self.heading_lambda * (w @ X[:, 5])
+        ev = Evaluation(float(value), defects.ravel(), np.concatenate([path.ravel(), epigraph, events]),
                         np.array([max(0.0, self.site_miss(xf) - m.site_radius_m) / 1e3]))
         if not gradients:
             return ev
-        return self._linearise(ev, X, U, tf, nodes, jac, base)
+        return self._linearise(ev, X, U, tf, aux, nodes, jac)
 
     def evaluate(self, z) -> Evaluation:
         return self._evaluate(z, gradients=False)
@@ -225,14 +364,15 @@ class EntryProblem(ConvexifiableProblem):
     def _col_u(self, node, comp):
         return self._u.start + node * self.n_u + comp
 
-    def _linearise(self, ev, X, U, tf, nodes, jac, base) -> Linearisation:
+    def _linearise(self, ev, X, U, tf, aux, nodes, jac) -> Linearisation:
         n, nx, nu = self.n_nodes, self.n_x, self.n_u
+        nv = nx + nu
         mesh = self.mesh
         seg = mesh.segment_nodes
         n_seg, m = seg.shape
         I = mesh.integration
         var_cols = np.concatenate([self._col_x(np.arange(n)[:, None], np.arange(nx)[None, :]),
-                                   self._col_u(np.arange(n)[:, None], np.arange(nu)[None, :])], axis=1)  # (n, 8)
+                                   self._col_u(np.arange(n)[:, None], np.arange(nu)[None, :])], axis=1)  # (n, nv)
         # --- defects: rows (segment, j, component) --------------------------------------
         rows_base = (np.arange(n_seg)[:, None] * (m - 1) + np.arange(m - 1)[None, :]) * nx  # (s, j)
         r_idx, c_idx, vals = [], [], []
@@ -242,7 +382,7 @@ class EntryProblem(ConvexifiableProblem):
             c_idx.append(self._col_x(node[..., None], comp).ravel())
             vals.append(np.full(rows_base.size * nx, sign))
         # -I[j,k] t_f d f(x_k, u_k) / d(x_k, u_k): shape (s, j, k, c, v)
-        dF = tf * jac[:, :nx, :]  # (n, 6, 8)
+        dF = tf * jac[:, :nx, :]  # (n, nx, nv)
         block = -I[None, :, :, None, None] * dF[seg][:, None, :, :, :]
         rr = np.broadcast_to(rows_base[:, :, None, None, None] + comp[None, None, None, :, None], block.shape)
         cc = np.broadcast_to(var_cols[seg][:, None, :, None, :], block.shape)
@@ -257,60 +397,107 @@ class EntryProblem(ConvexifiableProblem):
         r = np.concatenate(r_idx)
         c = np.concatenate(c_idx)
         v = np.concatenate(vals)
-        row_scale = np.tile(1.0 / STATE_SCALE, self.n_defects // nx)
+        row_scale = np.tile(1.0 / self.state_scale, self.n_defects // nx)
         v = v * row_scale[r] * self.scale[c]
         C = sp.csc_matrix((v, (r, c)), shape=(self.n_defects, self.n_z))
-        # --- path and event inequalities ----------------------------------------------------
+        # --- path, epigraph and event inequalities (rows of scaled-z coefficients) -----------
         lim, mi = self.vehicle.limits, self.mission
         k = np.arange(1, n)
         path_rows = (k - 1) * len(PATH_NAMES)
-        r_idx = [np.repeat(path_rows, 8), np.repeat(path_rows + 1, 8), path_rows + 2, path_rows + 3]
+        r_idx = [np.repeat(path_rows, nv), np.repeat(path_rows + 1, nv), path_rows + 2, path_rows + 3]
         c_idx = [var_cols[k].ravel(), var_cols[k].ravel(), self._col_x(k, 4), self._col_x(k, 4)]
-        vals = [(jac[k, 6, :] / lim.heat_flux_max).ravel(), (jac[k, 7, :] / lim.total_load_max).ravel(),
+        vals = [(jac[k, self.out_q, :] / lim.heat_flux_max).ravel(), (jac[k, self.out_n, :] / lim.total_load_max).ravel(),
                 np.full(n - 1, -1.0 / 0.1), np.full(n - 1, 1.0 / 0.1)]
+        objective = self.settings.objective
         e0 = self.n_path
+        if self.n_epigraph:
+            if objective == "max_flight_path_rate":
+                blocks = ((jac[:, 4, :], 0), (-jac[:, 4, :], n))
+            else:
+                blocks = ((jac[:, self.out_q if objective == "max_heat_flux" else self.out_n, :], 0),)
+            for d, offset in blocks:
+                rows = e0 + offset + np.arange(n)
+                r_idx += [np.repeat(rows, nv), rows]
+                c_idx += [var_cols.ravel(), np.full(n, self._aux.start)]
+                vals += [(d / self.aux_scale).ravel(), np.full(n, -1.0 / self.scale[self._aux.start])]
+        e0 += self.n_epigraph
         xf, jf = X[-1], jac[-1]
         fcols = var_cols[-1]
-        r_idx += [np.full(8, e0), np.full(8, e0 + 1), np.full(8, e0 + 2), np.full(2, e0 + 3)]
+        r_idx += [np.full(nv, e0), np.full(nv, e0 + 1), np.full(nv, e0 + 2), np.full(2, e0 + 3)]
         c_idx += [fcols, fcols, fcols, self._col_x(n - 1, np.array([3, 4]))]
-        d_mach = -mi.final_mach_max * jf[8, :]
+        d_mach = -mi.final_mach_max * jf[self.out_a, :]
         d_mach[3] += 1.0
-        vals += [-jf[9, :] / 1e3, jf[9, :] / 1e3, d_mach / 100.0,
+        vals += [-jf[self.out_h, :] / 1e3, jf[self.out_h, :] / 1e3, d_mach / 100.0,
                  -np.array([math.sin(xf[4]), xf[3] * math.cos(xf[4])]) / 100.0]
         r = np.concatenate(r_idx)
         c = np.concatenate(c_idx)
         v = np.concatenate(vals) * self.scale[c]
         G = sp.csc_matrix((v, (r, c)), shape=(self.n_inequalities, self.n_z))
-        # --- objective ------------------------------------------------------------------------
+        # --- objective (gradient in SI, scaled at the end) -------------------------------------
         w = mesh.weights
         grad = np.zeros(self.n_z)
-        if self.settings.objective == "heat_load":
-            np.add.at(grad, var_cols.ravel(), (tf * w[:, None] * jac[:, 6, :] / HEAT_LOAD_SCALE).ravel())
+        if objective == "heat_load":
+            np.add.at(grad, var_cols.ravel(), (tf * w[:, None] * jac[:, self.out_q, :] / HEAT_LOAD_SCALE).ravel())
+            grad[self.i_tf] = (w @ nodes[:, self.out_q]) / HEAT_LOAD_SCALE
+        elif objective == "time":
+            grad[self.i_tf] = 1.0 / TIME_SCALE
+        elif objective == "control_effort":
+            grad[self._aux] = tf * w / self.aux_scale
+            grad[self.i_tf] = w @ aux
+        else:
+            grad[self._aux] = 1.0 / self.aux_scale
         grad[self._col_x(np.arange(n), 5)] += tf * self.heading_lambda * w
-        grad[self.i_tf] = base + self.heading_lambda * (w @ X[:, 5])
+        grad[self.i_tf] += self.heading_lambda * (w @ X[:, 5])
         grad *= self.scale
         return Linearisation(ev, grad, C, G)
 
     # ----- convex constraints -------------------------------------------------------------
     def add_convex_constraints(self, prog, z):
-        """|u_k| <= 1 at every node (eq. 42) and the site cone with its buffer (eqs. 67-68)."""
+        """|u_k| <= 1 at every node (eq. 42, lossless bank), the epigraph cones of the rate and
+        miss objectives, and the site cone with its buffer (eqs. 67-68)."""
         U = z[self._u].reshape(-1, self.n_u)
-        A = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
-        b = np.array([1.0, 0.0, 0.0])
-        for k in range(self.n_nodes):
-            prog.AddLorentzConeConstraint(A, b, U[k])
-        buffer = prog.NewContinuousVariables(1, "site_buffer")
-        R, d = self.planet.reference_radius, 1e3  # cone rows in km
+        if self.formulation.bank == "lossless":
+            A = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+            b = np.array([1.0, 0.0, 0.0])
+            for k in range(self.n_nodes):
+                prog.AddLorentzConeConstraint(A, b, U[k, :2])
+        objective = self.settings.objective
+        if objective in RATE_OBJECTIVES:
+            # mu_k (or mu) >= |rates_k| in SI, each side in units of aux_scale
+            cols = [c for c, _ in self.rate_controls]
+            A = np.zeros((1 + len(cols), 1 + len(cols)))
+            A[0, 0] = 1.0
+            for i, c in enumerate(cols):
+                A[1 + i, 1 + i] = self.control_scale[c] / self.aux_scale
+            aux = z[self._aux]
+            for k in range(self.n_nodes):
+                mu = aux[k] if objective == "control_effort" else aux[0]
+                prog.AddLorentzConeConstraint(A, np.zeros(len(A)), np.concatenate([[mu], U[k, cols]]))
         lon_f, lat_f = z[self._col_x(self.n_nodes - 1, 1)], z[self._col_x(self.n_nodes - 1, 2)]
-        A = np.array([[0.0, 0.0, 1.0],
-                      [R * math.cos(self.site_lat) * STATE_SCALE[1] / d, 0.0, 0.0],
-                      [0.0, R * STATE_SCALE[2] / d, 0.0]])
-        b = np.array([self.mission.site_radius_m / d, -R * math.cos(self.site_lat) * self.site_lon / d,
-                      -R * self.site_lat / d])
-        prog.AddLorentzConeConstraint(A, b, np.array([lon_f, lat_f, buffer[0]]))
+        R, d = self.planet.reference_radius, 1e3  # cone rows in km
+        miss_rows = np.array([[R * math.cos(self.site_lat) * POSITION_SCALE[1] / d, 0.0],
+                              [0.0, R * POSITION_SCALE[2] / d]])
+        miss_offset = np.array([-R * math.cos(self.site_lat) * self.site_lon / d, -R * self.site_lat / d])
+        buffer = prog.NewContinuousVariables(1, "site_buffer")
+        A = np.zeros((3, 3))
+        A[0, 2] = 1.0
+        A[1:, :2] = miss_rows
+        prog.AddLorentzConeConstraint(A, np.concatenate([[self.mission.site_radius_m / d], miss_offset]),
+                                      np.array([lon_f, lat_f, buffer[0]]))
+        if objective == "miss":
+            A = np.zeros((3, 3))
+            A[0, 2] = self.aux_scale / d
+            A[1:, :2] = miss_rows
+            prog.AddLorentzConeConstraint(A, np.concatenate([[0.0], miss_offset]),
+                                          np.array([lon_f, lat_f, z[self._aux][0]]))
         return buffer
 
     # ----- diagnosis ------------------------------------------------------------------------
+    @property
+    def state_names(self) -> tuple:
+        extra = (["bank"] if self.i_sigma is not None else []) + (["alpha"] if self.i_alpha is not None else [])
+        return (*STATE_NAMES, *extra)
+
     def node_time(self, node: int, tf: float | None = None) -> str:
         s = self.mesh.s[node]
         return f"node {node} (s = {s:.3f})" if tf is None else f"node {node}, t = {s * tf:.0f} s"
@@ -319,11 +506,14 @@ class EntryProblem(ConvexifiableProblem):
         seg, rest = divmod(i, (self.settings.nodes_per_segment - 1) * self.n_x)
         j, c = divmod(rest, self.n_x)
         node = self.mesh.segment_nodes[seg, j + 1]
-        return f"{STATE_NAMES[c]} equation, segment {seg}, {self.node_time(node)}"
+        return f"{self.state_names[c]} equation, segment {seg}, {self.node_time(node)}"
 
     def describe_inequality(self, i: int) -> str:
+        if i >= self.n_path + self.n_epigraph:
+            return EVENT_NAMES[i - self.n_path - self.n_epigraph] + " at the DRS point"
         if i >= self.n_path:
-            return EVENT_NAMES[i - self.n_path] + " at the DRS point"
+            node = (i - self.n_path) % self.n_nodes
+            return f"{self.settings.objective} epigraph at {self.node_time(node)}"
         node, c = divmod(i, len(PATH_NAMES))
         return f"{PATH_NAMES[c]} at {self.node_time(node + 1)}"
 

@@ -57,6 +57,8 @@ class ScvxMission:
     bank_min_deg: float = 5.0
     alpha_deg: tuple = (40.0, 25.0)
     alpha_speeds_m_s: tuple = (2000.0, 5000.0)
+    alpha_bounds_deg: tuple = (15.0, 45.0)
+    alpha_rate_limit_deg_s: float = 1.0
     name: str = "paper001_nominal"
 
     def __post_init__(self):
@@ -75,8 +77,10 @@ class ScvxMission:
         check("final_mach_max", self.final_mach_max, 0.1, 10.0, "-")
         check("final_vertical_speed_min_m_s", self.final_vertical_speed_min_m_s, -2000.0, 0.0, "m/s")
         check("bank_min_deg", self.bank_min_deg, 0.0, 45.0, "deg")
+        check("alpha_rate_limit_deg_s", self.alpha_rate_limit_deg_s, 1e-3, 90.0, "deg/s")
         for f, lo, hi in (("final_altitude_m", 0.0, 100e3), ("flight_path_bounds_deg", -89.0, 30.0),
-                          ("heading_bounds_deg", -360.0, 720.0), ("alpha_speeds_m_s", 0.0, 12e3)):
+                          ("heading_bounds_deg", -360.0, 720.0), ("alpha_speeds_m_s", 0.0, 12e3),
+                          ("alpha_bounds_deg", 0.0, 60.0)):
             v = tuple(getattr(self, f))
             if len(v) != 2 or not lo <= v[0] < v[1] <= hi:
                 raise ScenarioError(f"ScvxMission.{f} = {v} needs two values {lo} <= low < high <= {hi}")

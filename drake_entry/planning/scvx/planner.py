@@ -7,10 +7,11 @@ import math
 import time
 
 import numpy as np
+from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
 from ...atmosphere import Atmosphere
-from ...dynamics import STATE_NAMES, flight_conditions
+from ...dynamics import STATE_NAMES, aero_accelerations, air_data, equations_of_motion, flight_conditions
 from ...planet import Earth
 from ...vehicles import Vehicle
 from ..result import PlanResult
@@ -23,27 +24,46 @@ from .mission import ScvxMission
 GAP_LIFT_FRACTION = 0.05
 #: between-node re-check: relative tolerance on heat flux and load, absolute on gamma [rad]
 BETWEEN_NODE_TOLERANCE = (0.02, 0.02, math.radians(0.2))
+#: evaluation points per mesh segment for the between-node check and the rate metrics
+POINTS_PER_SEGMENT = 8
+#: the plan's controls propagated must end within this of its terminal point [m] (issue 13)
+PROPAGATION_TOLERANCE_M = 5e3
+
+#: ``ScvxPlan.metrics`` keys of each objective (paper 001 Table 2)
+OBJECTIVE_METRIC = {"heat_load": "heat_load_MJ_m2", "control_effort": "control_effort_deg",
+                    "max_control_rate": "max_control_rate_deg_s", "max_flight_path_rate": "max_flight_path_rate_deg_s",
+                    "max_heat_flux": "max_heat_flux_kW_m2", "max_load": "max_load_g", "time": "final_time_s",
+                    "miss": "miss_km"}
 
 
 @dc.dataclass(kw_only=True)
 class ScvxPlan(PlanResult):
-    """An SCvx entry plan (a PlanResult over time; ``objective``: heat load [MJ/m^2] or t_f [s]).
+    """An SCvx entry plan (a PlanResult over time; ``objective`` in the unit of
+    ``entry.OBJECTIVES``: MJ/m^2, deg, deg/s, kW/m^2, g, s or km).
 
     Attributes:
-      time: node times [s]; states: (n, 6) SI; controls: (n, 2) = (u1, u2) at the mesh nodes;
-        final_time: t_f [s].
-      bank: atan2(u2, u1) [rad] and alpha: alpha(V) [rad], at the nodes.
-      heat_load: integral of q dt [J/m^2] (the paper's objective, without the regulariser).
-      lossless_gap: max(1 - |u|) over nodes where L >= 5 % g0; lossless_gap_all: over all nodes.
+      formulation: the EntryProblemSettings formulation ('lossless', 'hybrid', 'direct_bank', 'direct').
+      time: node times [s]; states: (n, n_x) SI, columns ``problem.state_names`` (h, lon, lat, V,
+        gamma, psi, then bank and alpha where they are states); controls: (n, n_u) at the nodes
+        ((u1, u2) of the lossless bank, then the rates [rad/s]); final_time: t_f [s].
+      bank, alpha: the bank and angle of attack [rad] at the nodes (atan2(u2, u1) and alpha(V)
+        where they are not states).
+      heat_load: integral of q dt [J/m^2] (without the regulariser).
+      lossless_gap: max(1 - |u|) over nodes where L >= 5 % g0; lossless_gap_all: over all nodes
+        (0 when the bank is a state: the flown bank is the planned one).
       max_defect, max_violation: largest scaled dynamics defect and constraint violation.
       between_nodes: worst relative excess of q and n and of gamma [rad] over their limits on
         the segment polynomials between the nodes (8 points per segment).
       miss_m: planned DRS point to the site [m]; drs: planned DRS altitude (geodetic) [m], Mach,
         vertical speed [m/s].
-      peaks: max heat flux [W/m^2], max total load [g].
+      metrics: the paper's Table 2, 3 and 6 quantities (``plan_metrics``).
+      propagated_error_m: the plan's real bank and alpha propagated from its entry state
+        (``propagate_plan``) end this far from its terminal point [m] (great circle and
+        altitude); ``success`` needs it <= PROPAGATION_TOLERANCE_M.
       guess: the glide guess it started from; history: the engine's IterationRecords.
     """
 
+    formulation: str
     time: np.ndarray
     states: np.ndarray
     controls: np.ndarray
@@ -58,48 +78,153 @@ class ScvxPlan(PlanResult):
     between_nodes: dict
     miss_m: float
     drs: dict
-    peaks: dict
+    metrics: dict
+    propagated_error_m: float
     guess: GlideGuess | None = None
     history: list = dc.field(default_factory=list, repr=False)
     problem: EntryProblem | None = dc.field(default=None, repr=False)
 
+    @property
+    def peaks(self) -> dict:
+        """Max heat flux [W/m^2] and total load [g] at the nodes."""
+        return {"heat_flux_W_m2": self.metrics["max_heat_flux_kW_m2"] * 1e3, "total_load_g": self.metrics["max_load_g"]}
+
     def evaluate(self, at) -> dict:
-        """States (h, lon, lat, V, gamma, psi), u1, u2, bank and alpha at times ``at`` [s], on the
-        plan's own segment polynomials."""
+        """The plan at times ``at`` [s] on its own segment polynomials: the states by name
+        (h, lon, lat, V, gamma, psi), bank and alpha [rad], and the controls ('u1', 'u2' for the
+        lossless bank, 'bank_rate', 'alpha_rate' [rad/s] for the rate formulations)."""
         t = np.clip(np.atleast_1d(np.asarray(at, float)), 0.0, self.final_time)
-        P = self.problem.mesh.interpolation(t / self.final_time)
+        p = self.problem
+        P = p.mesh.interpolation(t / self.final_time)
         X, U = P @ self.states, P @ self.controls
-        out = {n: X[:, i] for i, n in enumerate(STATE_NAMES)}
-        out.update(u1=U[:, 0], u2=U[:, 1], bank=np.arctan2(U[:, 1], U[:, 0]),
-                   alpha=np.array([self.problem.alpha(float(v)) for v in X[:, 3]]))
+        out = {name: X[:, i] for i, name in enumerate(p.state_names)}
+        bank_alpha = [p.bank_and_alpha(x, u) for x, u in zip(X, U)]
+        out["bank"] = np.array([math.atan2(s, c) for c, s, _ in bank_alpha])
+        out["alpha"] = np.array([float(a) for _, _, a in bank_alpha])
+        if p.formulation.bank == "lossless":
+            out.update(u1=U[:, 0], u2=U[:, 1])
+        names = {p.i_sigma: "bank_rate", p.i_alpha: "alpha_rate"}
+        for control, state in p.rate_controls:
+            out[names[state]] = U[:, control]
         return out
 
 
+def _rate_limited(t, target, rate_limit, lower, upper):
+    """A path that follows ``target`` within bounds and at most ``rate_limit`` [1/s], and its rate."""
+    path = np.empty(len(t))
+    path[0] = np.clip(target[0], lower, upper)
+    for k in range(1, len(t)):
+        step = rate_limit * (t[k] - t[k - 1])
+        path[k] = np.clip(path[k - 1] + np.clip(target[k] - path[k - 1], -step, step), lower, upper)
+    return path, np.clip(np.gradient(path, t), -rate_limit, rate_limit)
+
+
+def decision_from_trajectory(problem: EntryProblem, states, bank, alpha, tf: float, lossless_controls=None):
+    """Scaled z from a trajectory at the mesh nodes: states (n, 6), bank and alpha [rad] (n,),
+    t_f [s]. Where bank or alpha are states they follow the given ones within their bounds and
+    rate limits (their rates are the controls); the lossless bank takes ``lossless_controls``
+    (n, 2) if given, else (cos, sin) of the bank."""
+    t = problem.mesh.s * tf
+    X, U = [np.asarray(states, float)], []
+    f, m, v = problem.formulation, problem.mission, problem.vehicle
+    if f.bank == "lossless":
+        U.append(lossless_controls if lossless_controls is not None else np.stack([np.cos(bank), np.sin(bank)], axis=1))
+    else:
+        sigma, rate = _rate_limited(t, np.unwrap(bank), v.bank_rate_limit, -v.bank_limit, v.bank_limit)
+        X.append(sigma[:, None])
+        U.append(rate[:, None])
+    if f.alpha == "rate":
+        lo, hi = np.radians(m.alpha_bounds_deg)
+        a, rate = _rate_limited(t, alpha, math.radians(m.alpha_rate_limit_deg_s), lo, hi)
+        X.append(a[:, None])
+        U.append(rate[:, None])
+    return problem.pack(np.concatenate(X, axis=1), np.concatenate(U, axis=1), tf)
+
+
 def initial_decision(problem: EntryProblem, guess: GlideGuess) -> np.ndarray:
-    """z from a glide guess: states by cubic spline at the mesh times, u = (cos, sin) of its bank."""
+    """z from a glide guess: states by cubic spline at the mesh times, its bank and alpha(V)."""
     t = problem.mesh.s * guess.final_time
     T, idx = np.unique(guess.time, return_index=True)
     X = CubicSpline(T, guess.states[idx])(t)
     bank = np.interp(t, T, guess.bank[idx])
-    return problem.pack(X, np.stack([np.cos(bank), np.sin(bank)], axis=1), guess.final_time)
+    alpha = np.array([problem.alpha(float(V)) for V in X[:, 3]])
+    return decision_from_trajectory(problem, X, bank, alpha, guess.final_time)
 
 
-def _between_nodes(problem: EntryProblem, plan_states, plan_controls) -> dict:
-    """Worst excess of q, n (relative) and gamma (rad) over their limits between the nodes."""
+def _dense(problem: EntryProblem, X, U):
+    """Points between the nodes (POINTS_PER_SEGMENT per segment, and the ends): s, states, controls."""
     mesh = problem.mesh
-    s = (np.arange(mesh.n_segments)[:, None] + (np.arange(8)[None, :] + 0.5) / 8.0).ravel() / mesh.n_segments
+    inner = (np.arange(mesh.n_segments)[:, None] + (np.arange(POINTS_PER_SEGMENT)[None, :] + 0.5)
+             / POINTS_PER_SEGMENT).ravel() / mesh.n_segments
+    s = np.concatenate([[0.0], inner, [1.0]])
     P = mesh.interpolation(s)
-    X, U = P @ plan_states, P @ plan_controls
+    return s, P @ X, P @ U
+
+
+def _between_nodes(problem: EntryProblem, X, U) -> dict:
+    """Worst excess of q, n (relative) and gamma (rad) over their limits between the nodes."""
+    _, Xd, Ud = _dense(problem, X, U)
+    outputs = np.array([problem.node_outputs(x, u) for x, u in zip(Xd, Ud)])
     lim = problem.vehicle.limits
-    q = np.empty(len(s))
-    n = np.empty(len(s))
-    for k in range(len(s)):
-        out = problem.node_outputs(X[k], U[k])
-        q[k], n[k] = out[6], out[7]
     g_lo, g_hi = np.radians(problem.mission.flight_path_bounds_deg)
-    return {"heat_flux": float(max(q.max() / lim.heat_flux_max - 1.0, 0.0)),
-            "total_load": float(max(n.max() / lim.total_load_max - 1.0, 0.0)),
-            "flight_path_rad": float(max((g_lo - X[:, 4]).max(), (X[:, 4] - g_hi).max(), 0.0))}
+    return {"heat_flux": float(max(outputs[:, problem.out_q].max() / lim.heat_flux_max - 1.0, 0.0)),
+            "total_load": float(max(outputs[:, problem.out_n].max() / lim.total_load_max - 1.0, 0.0)),
+            "flight_path_rad": float(max((g_lo - Xd[:, 4]).max(), (Xd[:, 4] - g_hi).max(), 0.0))}
+
+
+def plan_metrics(problem: EntryProblem, X, U, tf: float) -> dict:
+    """Paper 001's Table 2/3/6 quantities of a plan: heat load [MJ/m^2] (node quadrature),
+    final time [s], max heat flux [kW/m^2], max total load [g] and max |gamma_dot| [deg/s] at the
+    nodes; integrated and max |sigma_dot|, |alpha_dot| and |(sigma_dot, alpha_dot)| [deg, deg/s]
+    on the segment polynomials (the bank and alpha histories differentiated, whatever the
+    formulation); the planned miss [km]."""
+    nodes, _ = problem._nodes(X, U, gradients=False)
+    s, Xd, Ud = _dense(problem, X, U)
+    t = s * tf
+    bank_alpha = [problem.bank_and_alpha(x, u) for x, u in zip(Xd, Ud)]
+    sigma = np.unwrap([math.atan2(sn, c) for c, sn, _ in bank_alpha])
+    alpha = np.array([float(a) for _, _, a in bank_alpha])
+    sigma_dot, alpha_dot = np.gradient(sigma, t), np.gradient(alpha, t)
+    norm = np.hypot(sigma_dot, alpha_dot)
+    deg = math.degrees
+    return {"heat_load_MJ_m2": float(tf * (problem.mesh.weights @ nodes[:, problem.out_q]) / 1e6),
+            "final_time_s": tf,
+            "max_heat_flux_kW_m2": float(nodes[:, problem.out_q].max() / 1e3),
+            "max_load_g": float(nodes[:, problem.out_n].max()),
+            "max_flight_path_rate_deg_s": deg(float(np.abs(nodes[:, 4]).max())),
+            "bank_effort_deg": deg(float(np.trapezoid(np.abs(sigma_dot), t))),
+            "max_bank_rate_deg_s": deg(float(np.abs(sigma_dot).max())),
+            "alpha_effort_deg": deg(float(np.trapezoid(np.abs(alpha_dot), t))),
+            "max_alpha_rate_deg_s": deg(float(np.abs(alpha_dot).max())),
+            "control_effort_deg": deg(float(np.trapezoid(norm, t))),
+            "max_control_rate_deg_s": deg(float(norm.max())),
+            "miss_km": problem.site_miss(X[-1]) / 1e3}
+
+
+def propagate_plan(plan: ScvxPlan, *, samples_per_segment: int = 32, rtol: float = 1e-9):
+    """Fly the plan's real bank (and planned alpha, or the alpha(V) law at the flown speed) from
+    its entry state to its t_f with scipy's DOP853 on the project's equations of motion: the
+    model-layer check of ``plan_entry`` (``diagrams.plan_flight.fly_plan`` flies the same
+    controls with the Drake Simulator). Returns the solve_ivp solution."""
+    p, tf = plan.problem, plan.final_time
+    tt = np.linspace(0.0, tf, samples_per_segment * p.mesh.n_segments + 1)
+    ref = plan.evaluate(tt)
+    bank = CubicSpline(tt, np.unwrap(ref["bank"]))
+    alpha = CubicSpline(tt, ref["alpha"]) if p.i_alpha is not None else None
+
+    def rhs(t, x):
+        rho, a = air_data(x, p.planet, p.atmosphere)
+        a_t = float(alpha(t)) if alpha is not None else float(p.alpha(float(x[3])))
+        _, L, D = aero_accelerations(x, a_t, rho, a, p.vehicle)
+        return equations_of_motion(list(x), float(bank(t)), L, D, p.planet)
+
+    atol = rtol * np.array([1e4, 1.0, 1.0, 1e3, 1.0, 1.0])
+    return solve_ivp(rhs, (0.0, tf), plan.states[0, :6], method="DOP853", rtol=rtol, atol=atol)
+
+
+def _terminal_error(planet: Earth, x, x_plan) -> float:
+    """Distance [m] between two terminal points: great circle and altitude, root sum square."""
+    return float(math.hypot(planet.great_circle_distance(x[1], x[2], x_plan[1], x_plan[2]), x[0] - x_plan[0]))
 
 
 def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission: ScvxMission, *,
@@ -108,8 +233,9 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     """Plan the mission: the glide guess (unless given), SCvx, then the between-node check.
 
     Args:
-      initial: a previous ScvxPlan to start from instead of the guess (a warm start; its
-        mesh may differ, it is interpolated).
+      initial: a previous ScvxPlan to start from instead of the guess (a warm start, or a
+        polish in another formulation, e.g. a 'lossless' plan refined as 'direct'; its mesh may
+        differ, it is interpolated).
       progress: ``progress(k, IterationRecord)`` after every iteration.
     """
     t0 = time.perf_counter()
@@ -120,25 +246,25 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     problem = EntryProblem(vehicle, planet, atmosphere, mission, ps, tf0)
     if initial is not None:
         ref = initial.evaluate(problem.mesh.s * tf0)
-        X = np.stack([ref[k] for k in STATE_NAMES], axis=1)
-        z0 = problem.pack(X, np.stack([ref["u1"], ref["u2"]], axis=1), tf0)
+        lossless = np.stack([ref["u1"], ref["u2"]], axis=1) if "u1" in ref else None
+        z0 = decision_from_trajectory(problem, np.stack([ref[k] for k in STATE_NAMES], axis=1), ref["bank"],
+                                      ref["alpha"], tf0, lossless)
     else:
         z0 = initial_decision(problem, guess)
     build = time.perf_counter() - t0
     outcome = solve_scvx(problem, z0, settings, progress=progress)
     X, U, tf = problem.unpack(outcome.z)
-    t = problem.mesh.s * tf
-    alpha = np.array([problem.alpha(float(v)) for v in X[:, 3]])
-    conds = [flight_conditions(x, 0.0, a, vehicle, planet, atmosphere) for x, a in zip(X, alpha)]
-    q = np.array([c.heat_flux for c in conds])
-    lift = np.array([c.lift for c in conds])
-    norm_u = np.hypot(U[:, 0], U[:, 1])
+    nodes, _ = problem._nodes(X, U, gradients=False)
+    bank_alpha = [problem.bank_and_alpha(x, u) for x, u in zip(X, U)]
+    bank = np.array([math.atan2(s, c) for c, s, _ in bank_alpha])
+    alpha = np.array([float(a) for _, _, a in bank_alpha])
+    norm_u = np.array([math.hypot(c, s) for c, s, _ in bank_alpha])
+    lift = np.array([flight_conditions(x[:6], 0.0, a, vehicle, planet, atmosphere).lift for x, a in zip(X, alpha)])
     acting = lift >= GAP_LIFT_FRACTION * planet.g0
     gap = float(np.max(1.0 - norm_u[acting], initial=0.0))
-    heat_load = float(tf * (problem.mesh.weights @ q))
+    metrics = plan_metrics(problem, X, U, tf)
     between = _between_nodes(problem, X, U)
     xf = X[-1]
-    hstar = float(planet.atmospheric_altitude(xf[0], xf[2]))
     ev = outcome.evaluation
     tol_q, tol_n, tol_g = BETWEEN_NODE_TOLERANCE
     checked = (between["heat_flux"] <= tol_q and between["total_load"] <= tol_n
@@ -148,14 +274,27 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
         message += (f"; converged but violated between the nodes (heat flux +{between['heat_flux']:.1%}, "
                     f"load +{between['total_load']:.1%}, gamma {math.degrees(between['flight_path_rad']):.2f} deg): "
                     f"refine the mesh")
-    return ScvxPlan(
-        success=outcome.converged and checked, message=message, iterations=outcome.iterations,
+    plan = ScvxPlan(
+        success=False, message=message, iterations=outcome.iterations,
         build_time=build, solve_time=time.perf_counter() - t0 - build,
-        objective=heat_load / 1e6 if ps.objective == "heat_load" else tf,
-        time=t, states=X, controls=U, final_time=tf, bank=np.arctan2(U[:, 1], U[:, 0]), alpha=alpha,
-        heat_load=heat_load, lossless_gap=gap,
+        objective=metrics[OBJECTIVE_METRIC[ps.objective]], formulation=ps.formulation,
+        time=problem.mesh.s * tf, states=X, controls=U, final_time=tf, bank=bank, alpha=alpha,
+        heat_load=metrics["heat_load_MJ_m2"] * 1e6, lossless_gap=gap,
         lossless_gap_all=float(np.max(1.0 - norm_u)), max_defect=max_defect(ev),
         max_violation=max_violation(ev), between_nodes=between, miss_m=problem.site_miss(xf),
-        drs={"altitude_m": hstar, "mach": float(conds[-1].mach), "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))},
-        peaks={"heat_flux_W_m2": float(q.max()), "total_load_g": float(max(c.total_load for c in conds))},
-        guess=guess, history=outcome.history, problem=problem)
+        drs={"altitude_m": float(nodes[-1, problem.out_h]), "mach": float(xf[3] / nodes[-1, problem.out_a]),
+             "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))},
+        metrics=metrics, propagated_error_m=math.nan, guess=guess, history=outcome.history, problem=problem)
+    flown = propagate_plan(plan)
+    plan.propagated_error_m = (_terminal_error(planet, flown.y[:, -1], xf) if flown.status == 0 else math.inf)
+    accurate = plan.propagated_error_m <= PROPAGATION_TOLERANCE_M
+    if outcome.converged and not accurate:
+        plan.message += (f"; converged but inaccurate: its controls propagated end "
+                         f"{plan.propagated_error_m / 1e3:.1f} km from its terminal point "
+                         f"(> {PROPAGATION_TOLERANCE_M / 1e3:g} km; "
+                         + (f"lossless gap {gap:.2f}: polish it with the 'direct' formulation)" if gap > 1e-2
+                            else "refine the mesh)"))
+    plan.success = outcome.converged and checked and accurate
+    plan.solve_time = time.perf_counter() - t0 - build
+    return plan
+

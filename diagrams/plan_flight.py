@@ -23,13 +23,13 @@ from pydrake.trajectories import PiecewisePolynomial
 from drake_entry.atmosphere import Atmosphere
 from drake_entry.dynamics import flight_conditions
 from drake_entry.planet import Earth
-from drake_entry.planning.scvx.planner import ScvxPlan
+from drake_entry.planning.scvx.planner import PROPAGATION_TOLERANCE_M, ScvxPlan, terminal_distance
 from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.systems.vehicle import EntryVehicle
 from drake_entry.vehicles import Vehicle
 
 #: acceptance of a flown plan (issue 13): DRS point within this of the plan and of the site [m]
-PLAN_TOLERANCE_M = 5e3
+PLAN_TOLERANCE_M = PROPAGATION_TOLERANCE_M
 SITE_TOLERANCE_M = 15e3
 
 
@@ -62,24 +62,23 @@ def fly_plan(plan: ScvxPlan, vehicle: Vehicle, planet: Earth, atmosphere: Atmosp
     """Fly ``plan``'s bank from its entry state to its t_f with the Drake Simulator (RK5)."""
     problem, tf = plan.problem, plan.final_time
     mission = problem.mission
-    tt = np.linspace(0.0, tf, samples_per_segment * problem.mesh.n_segments + 1)
-    ref = plan.evaluate(tt)
+    tt, bank, planned_alpha = plan.control_samples(samples_per_segment)
 
     def spline(values):
         return TrajectorySource(PiecewisePolynomial.CubicWithContinuousSecondDerivatives(
             tt, np.reshape(values, (1, -1)), periodic_end_condition=False))
 
-    scheduled_alpha = problem.i_alpha is None
+    scheduled_alpha = planned_alpha is None
     builder = DiagramBuilder()
     plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, planet, atmosphere,
                                                            initial_state=plan.states[0, :6]))
-    source = builder.AddNamedSystem("bank", spline(np.unwrap(ref["bank"])))
+    source = builder.AddNamedSystem("bank", spline(bank))
     builder.Connect(source.get_output_port(), plant.GetInputPort("bank"))
     if scheduled_alpha:
         alpha = builder.AddNamedSystem("alpha", ScheduleSource(problem.alpha, planet))
         builder.Connect(plant.GetOutputPort("state"), alpha.GetInputPort("state"))
     else:
-        alpha = builder.AddNamedSystem("alpha", spline(ref["alpha"]))
+        alpha = builder.AddNamedSystem("alpha", spline(planned_alpha))
     builder.Connect(alpha.get_output_port(), plant.GetInputPort("alpha"))
     logger = LogVectorOutput(plant.GetOutputPort("state"), builder, tf / log_points)
     diagram = builder.Build()
@@ -93,13 +92,11 @@ def fly_plan(plan: ScvxPlan, vehicle: Vehicle, planet: Earth, atmosphere: Atmosp
     T, X = log.sample_times(), log.data().T
     xf = diagram.GetSubsystemByName("vehicle").GetOutputPort("state").Eval(
         diagram.GetSubsystemContext(diagram.GetSubsystemByName("vehicle"), simulator.get_context()))
-    xp = plan.states[-1]
-    ground = planet.great_circle_distance(xf[1], xf[2], xp[1], xp[2])
     site = mission.site(planet)
     from_site = planet.great_circle_distance(xf[1], xf[2], *site)
     alphas = ([float(problem.alpha(float(x[3]))) for x in X] if scheduled_alpha
-              else list(np.interp(T, tt, ref["alpha"])))
-    a_f = float(problem.alpha(float(xf[3]))) if scheduled_alpha else float(ref["alpha"][-1])
+              else list(np.interp(T, tt, planned_alpha)))
+    a_f = float(problem.alpha(float(xf[3]))) if scheduled_alpha else float(planned_alpha[-1])
     cf = flight_conditions(xf, 0.0, a_f, vehicle, planet, atmosphere)
     h_geo = float(planet.atmospheric_altitude(xf[0], xf[2]))
     drs = {"altitude_m": h_geo, "mach": float(cf.mach), "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))}
@@ -109,6 +106,6 @@ def fly_plan(plan: ScvxPlan, vehicle: Vehicle, planet: Earth, atmosphere: Atmosp
     conds = [flight_conditions(x, 0.0, a, vehicle, planet, atmosphere) for x, a in zip(X, alphas)]
     peaks = {"heat_flux_W_m2": float(max(c.heat_flux for c in conds)),
              "total_load_g": float(max(c.total_load for c in conds))}
-    from_plan = float(math.hypot(ground, xf[0] - xp[0]))
+    from_plan = terminal_distance(planet, xf, plan.states[-1])
     return PlanFlight(T, X, from_plan, float(from_site), drs, bool(drs_ok), peaks,
                       bool(from_plan <= PLAN_TOLERANCE_M and drs_ok))

@@ -20,7 +20,7 @@ import numpy as np
 from drake_entry.atmosphere import US76Atmosphere
 from drake_entry.diagrams.plan_flight import fly_plan
 from drake_entry.planet import Earth
-from drake_entry.planning.scvx.entry import EntryProblemSettings
+from drake_entry.planning.scvx.entry import FORMULATIONS, EntryProblemSettings
 from drake_entry.planning.scvx.mission import ScvxMission
 from drake_entry.planning.scvx.planner import plan_entry
 from drake_entry.vehicles import load_vehicle
@@ -84,6 +84,6 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--out", default="out/examples/07")
-    parser.add_argument("--formulation", default="direct", choices=["lossless", "hybrid", "direct_bank", "direct"])
+    parser.add_argument("--formulation", default="direct", choices=list(FORMULATIONS))
     args = parser.parse_args()
     main(quick=args.quick, out_dir=args.out, formulation=args.formulation)

@@ -192,7 +192,11 @@ class EntryProblem(ConvexifiableProblem):
         self._set_bounds(final_time_guess)
         self.n_defects = settings.segments * (settings.nodes_per_segment - 1) * nx
         self.n_path = (n - 1) * len(PATH_NAMES)
-        self.n_epigraph = {"max_flight_path_rate": 2 * n, "max_heat_flux": n, "max_load": n}.get(objective, 0)
+        # the node output a min-max objective bounds (mu >= sign * output_k for each sign), or None
+        self._epigraph_output = {"max_flight_path_rate": 4, "max_heat_flux": self.out_q,
+                                 "max_load": self.out_n}.get(objective)
+        self._epigraph_signs = (1.0, -1.0) if objective == "max_flight_path_rate" else (1.0,)
+        self.n_epigraph = 0 if self._epigraph_output is None else len(self._epigraph_signs) * n
         self.n_inequalities = self.n_path + self.n_epigraph + len(EVENT_NAMES)
         sign = settings.heading_sign or heading_regulariser_sign(self.x0, self.site_lat)
         weight = settings.heading_weight if f.bank == "lossless" else 0.0
@@ -251,8 +255,8 @@ class EntryProblem(ConvexifiableProblem):
         if objective == "miss":
             return np.array([self.site_miss(X[-1]) / self.aux_scale])
         nodes, _ = self._nodes(X, U, gradients=False)
-        column = {"max_flight_path_rate": 4, "max_heat_flux": self.out_q, "max_load": self.out_n}[objective]
-        return np.array([np.abs(nodes[:, column]).max() / self.aux_scale])
+        bounded = max((sign * nodes[:, self._epigraph_output]).max() for sign in self._epigraph_signs)
+        return np.array([bounded / self.aux_scale])
 
     # ----- the physics at one node ------------------------------------------------------
     def alpha_of(self, V):
@@ -321,10 +325,9 @@ class EntryProblem(ConvexifiableProblem):
         path = np.stack([q[1:] / lim.heat_flux_max - 1.0, load[1:] / lim.total_load_max - 1.0,
                          (g_lo - gam) / 0.1, (gam - g_hi) / 0.1], axis=1)
         objective = self.settings.objective
-        if objective == "max_flight_path_rate":
-            epigraph = np.concatenate([nodes[:, 4], -nodes[:, 4]]) / self.aux_scale - aux[0]
-        elif objective in ("max_heat_flux", "max_load"):
-            epigraph = nodes[:, self.out_q if objective == "max_heat_flux" else self.out_n] / self.aux_scale - aux[0]
+        if self.n_epigraph:
+            epigraph = np.concatenate([sign * nodes[:, self._epigraph_output] for sign in self._epigraph_signs])
+            epigraph = epigraph / self.aux_scale - aux[0]
         else:
             epigraph = np.zeros(0)
         xf = X[-1]
@@ -411,15 +414,12 @@ class EntryProblem(ConvexifiableProblem):
         objective = self.settings.objective
         e0 = self.n_path
         if self.n_epigraph:
-            if objective == "max_flight_path_rate":
-                blocks = ((jac[:, 4, :], 0), (-jac[:, 4, :], n))
-            else:
-                blocks = ((jac[:, self.out_q if objective == "max_heat_flux" else self.out_n, :], 0),)
-            for d, offset in blocks:
-                rows = e0 + offset + np.arange(n)
+            for i, sign in enumerate(self._epigraph_signs):
+                rows = e0 + i * n + np.arange(n)
                 r_idx += [np.repeat(rows, nv), rows]
                 c_idx += [var_cols.ravel(), np.full(n, self._aux.start)]
-                vals += [(d / self.aux_scale).ravel(), np.full(n, -1.0 / self.scale[self._aux.start])]
+                vals += [(sign * jac[:, self._epigraph_output, :] / self.aux_scale).ravel(),
+                         np.full(n, -1.0 / self.scale[self._aux.start])]
         e0 += self.n_epigraph
         xf, jf = X[-1], jac[-1]
         fcols = var_cols[-1]

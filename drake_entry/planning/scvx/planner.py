@@ -108,6 +108,14 @@ class ScvxPlan(PlanResult):
             out[names[state]] = U[:, control]
         return out
 
+    def control_samples(self, samples_per_segment: int = 32):
+        """The controls to fly, sampled on the plan's polynomials: times [s] (``samples_per_segment``
+        per mesh segment), the bank unwrapped [rad], and the planned alpha [rad] (None where alpha
+        follows the mission's alpha(V) law, to be evaluated at the flown speed)."""
+        tt = np.linspace(0.0, self.final_time, samples_per_segment * self.problem.mesh.n_segments + 1)
+        ref = self.evaluate(tt)
+        return tt, np.unwrap(ref["bank"]), (ref["alpha"] if self.problem.i_alpha is not None else None)
+
 
 def _rate_limited(t, target, rate_limit, lower, upper):
     """A path that follows ``target`` within bounds and at most ``rate_limit`` [1/s], and its rate."""
@@ -206,11 +214,10 @@ def propagate_plan(plan: ScvxPlan, *, samples_per_segment: int = 32, rtol: float
     its entry state to its t_f with scipy's DOP853 on the project's equations of motion: the
     model-layer check of ``plan_entry`` (``diagrams.plan_flight.fly_plan`` flies the same
     controls with the Drake Simulator). Returns the solve_ivp solution."""
-    p, tf = plan.problem, plan.final_time
-    tt = np.linspace(0.0, tf, samples_per_segment * p.mesh.n_segments + 1)
-    ref = plan.evaluate(tt)
-    bank = CubicSpline(tt, np.unwrap(ref["bank"]))
-    alpha = CubicSpline(tt, ref["alpha"]) if p.i_alpha is not None else None
+    p = plan.problem
+    tt, bank_samples, alpha_samples = plan.control_samples(samples_per_segment)
+    bank = CubicSpline(tt, bank_samples)
+    alpha = CubicSpline(tt, alpha_samples) if alpha_samples is not None else None
 
     def rhs(t, x):
         rho, a = air_data(x, p.planet, p.atmosphere)
@@ -219,10 +226,10 @@ def propagate_plan(plan: ScvxPlan, *, samples_per_segment: int = 32, rtol: float
         return equations_of_motion(list(x), float(bank(t)), L, D, p.planet)
 
     atol = rtol * np.array([1e4, 1.0, 1.0, 1e3, 1.0, 1.0])
-    return solve_ivp(rhs, (0.0, tf), plan.states[0, :6], method="DOP853", rtol=rtol, atol=atol)
+    return solve_ivp(rhs, (0.0, plan.final_time), plan.states[0, :6], method="DOP853", rtol=rtol, atol=atol)
 
 
-def _terminal_error(planet: Earth, x, x_plan) -> float:
+def terminal_distance(planet: Earth, x, x_plan) -> float:
     """Distance [m] between two terminal points: great circle and altitude, root sum square."""
     return float(math.hypot(planet.great_circle_distance(x[1], x[2], x_plan[1], x_plan[2]), x[0] - x_plan[0]))
 
@@ -254,7 +261,6 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     build = time.perf_counter() - t0
     outcome = solve_scvx(problem, z0, settings, progress=progress)
     X, U, tf = problem.unpack(outcome.z)
-    nodes, _ = problem._nodes(X, U, gradients=False)
     bank_alpha = [problem.bank_and_alpha(x, u) for x, u in zip(X, U)]
     bank = np.array([math.atan2(s, c) for c, s, _ in bank_alpha])
     alpha = np.array([float(a) for _, _, a in bank_alpha])
@@ -265,6 +271,7 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     metrics = plan_metrics(problem, X, U, tf)
     between = _between_nodes(problem, X, U)
     xf = X[-1]
+    final = problem.node_outputs(xf, U[-1])
     ev = outcome.evaluation
     tol_q, tol_n, tol_g = BETWEEN_NODE_TOLERANCE
     checked = (between["heat_flux"] <= tol_q and between["total_load"] <= tol_n
@@ -275,18 +282,17 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
                     f"load +{between['total_load']:.1%}, gamma {math.degrees(between['flight_path_rad']):.2f} deg): "
                     f"refine the mesh")
     plan = ScvxPlan(
-        success=False, message=message, iterations=outcome.iterations,
-        build_time=build, solve_time=time.perf_counter() - t0 - build,
+        success=False, message=message, iterations=outcome.iterations, build_time=build,
         objective=metrics[OBJECTIVE_METRIC[ps.objective]], formulation=ps.formulation,
         time=problem.mesh.s * tf, states=X, controls=U, final_time=tf, bank=bank, alpha=alpha,
         heat_load=metrics["heat_load_MJ_m2"] * 1e6, lossless_gap=gap,
         lossless_gap_all=float(np.max(1.0 - norm_u)), max_defect=max_defect(ev),
         max_violation=max_violation(ev), between_nodes=between, miss_m=problem.site_miss(xf),
-        drs={"altitude_m": float(nodes[-1, problem.out_h]), "mach": float(xf[3] / nodes[-1, problem.out_a]),
+        drs={"altitude_m": float(final[problem.out_h]), "mach": float(xf[3] / final[problem.out_a]),
              "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))},
         metrics=metrics, propagated_error_m=math.nan, guess=guess, history=outcome.history, problem=problem)
     flown = propagate_plan(plan)
-    plan.propagated_error_m = (_terminal_error(planet, flown.y[:, -1], xf) if flown.status == 0 else math.inf)
+    plan.propagated_error_m = (terminal_distance(planet, flown.y[:, -1], xf) if flown.status == 0 else math.inf)
     accurate = plan.propagated_error_m <= PROPAGATION_TOLERANCE_M
     if outcome.converged and not accurate:
         plan.message += (f"; converged but inaccurate: its controls propagated end "

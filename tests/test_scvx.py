@@ -180,7 +180,7 @@ def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, no
     Tables 2 and 4-7), heat-load objective: converges with defects <= 1e-6 inside every limit, and
     its bank and alpha flown by the Drake Simulator end within 5 km of the plan, within 15 km of
     the site, inside the DRS box. Heat load 476.6 MJ/m^2 measured (the paper's 540.4 with its own
-    aero table; both about 8 % below their lossless plans)."""
+    aero table, Table 3; both about 8 % below their lossless plans)."""
     from drake_entry.diagrams.plan_flight import fly_plan
 
     vehicle, planet, atmosphere, mission, _ = sphynx_case
@@ -252,7 +252,7 @@ def test_warm_start_from_a_plan_on_a_finer_mesh_keeps_its_heat_load(sphynx_case,
 
 def test_min_max_load_objective_is_the_epigraph_of_the_peak_load(sphynx_case, lossless_plan):
     """Table 2's 'Min Maximum g-load' through the epigraph variable (mu >= n_k at every node):
-    the objective is the plan's peak load and lies below the heat-load plan's peak (paper: 1.111 g
+    the objective is the plan's peak load and lies below the heat-load plan's peak (Table 2: 1.111 g
     with its aero; measured here 1.17 g in 13 iterations)."""
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     plan = plan_entry(vehicle, planet, atmosphere, mission, guess=guess,

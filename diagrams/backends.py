@@ -1,20 +1,22 @@
-"""Where campaign samples run: 'serial' (this process), 'processes' (local worker
-processes, spawn) or 'dask' (Dask distributed: the cluster at ``scheduler`` or a
-LocalCluster). Each worker builds the campaign's ClosedLoopSetup (models, guidance method
-and its planner) once, from the scenario YAML the manifest fingerprinted, and runs
-samples with it; results come back as (row, trajectory). A worker whose set-up fails
-returns that failure as each sample's row instead of dying (a dying pool initializer is
-respawned for ever).
+"""Where campaign cases run: 'serial' (this process), 'processes' (local worker processes,
+spawn) or 'dask' (Dask distributed: the cluster at ``scheduler`` or a LocalCluster).
+
+A campaign is a ``Task`` and a list of cases. Each worker builds the task's state once
+(``Task.setup(config)``: for a Monte-Carlo campaign the ClosedLoopSetup with its planner,
+for an abort map the models and mission) and runs cases with it (``Task.run(state, case)``
+returns (row, trajectory or None)). The two functions are named "module:function" so a
+spawned process or a Dask worker imports them. A worker whose set-up fails returns that
+failure as each case's row instead of dying (a dying pool initializer is respawned for
+ever), and a case that raises becomes a failed row with its reason.
 """
 from __future__ import annotations
 
+import dataclasses as dc
 import hashlib
+import importlib
+import json
 import multiprocessing as mp
-
-from drake_entry.diagrams.closed_loop import ClosedLoopSetup
-from drake_entry.diagrams.sample import TRAJECTORY_STEP_S, run_sample, sample_seed
-from drake_entry.errors import load_yaml_typed
-from drake_entry.scenario import Scenario
+import traceback
 
 BACKENDS = ("serial", "processes", "dask")
 
@@ -26,53 +28,87 @@ DASK_QUIET_WORKERS = {
     "distributed.worker.memory.monitor-interval": "1000ms",
 }
 
+
+@dc.dataclass(frozen=True)
+class Task:
+    """What every case of a campaign runs.
+
+    Attributes:
+      setup: "module:function" building a worker's state from ``config`` (once per worker).
+      run: "module:function" mapping (state, case) to (row dict with 'index' and 'success',
+        trajectory columns or None).
+      config: JSON-serialisable settings of the setup (part of the campaign's identity).
+    """
+
+    setup: str
+    run: str
+    config: dict
+
+    def key(self) -> str:
+        """sha256 of the task (which worker state serves it)."""
+        return hashlib.sha256(json.dumps(dc.asdict(self), sort_keys=True).encode()).hexdigest()
+
+
+def _resolve(name: str):
+    module, _, function = name.partition(":")
+    return getattr(importlib.import_module(module), function)
+
+
 _WORKER = {}
 
 
-def init_worker(scenario_yaml: str, trajectory_step_s: float = TRAJECTORY_STEP_S):
-    """Build this process's ClosedLoopSetup once (the planner and its corridor included)."""
-    _WORKER.update(trajectory_step_s=trajectory_step_s, setup=None, error=None)
+def init_worker(task: Task):
+    """Build this process's state for ``task`` once."""
+    _WORKER.update(key=task.key(), run=None, state=None, error=None)
     try:
-        scenario = load_yaml_typed(Scenario, text=scenario_yaml, where="campaign scenario").validate()
-        _WORKER["setup"] = ClosedLoopSetup.from_scenario(scenario)
-    except Exception as e:  # reported per sample by work()
+        _WORKER["run"] = _resolve(task.run)
+        _WORKER["state"] = _resolve(task.setup)(task.config)
+    except Exception as e:  # reported per case by work()
         _WORKER["error"] = f"worker set-up failed: {type(e).__name__}: {e}".splitlines()[0][:500]
 
 
-def work(args):
-    seed, index = args
-    if _WORKER.get("setup") is None:
-        return {"index": int(index), "seed": sample_seed(seed, index), "success": False,
-                "message": _WORKER.get("error") or "worker not initialised"}, None
-    return run_sample(_WORKER["setup"], seed, index, trajectory_step_s=_WORKER["trajectory_step_s"])
+def failed_row(case: dict, message: str, trace: str | None = None) -> dict:
+    """The row of a case that produced no result: its identifying columns and the reason."""
+    row = {**case, "success": False, "message": message[:500]}
+    if trace:
+        row["traceback"] = trace[-2000:]
+    return row
 
 
-def run_serial(todo, record, scenario_yaml, seed, trajectory_step_s):
-    init_worker(scenario_yaml, trajectory_step_s)
-    for i in todo:
-        record(*work((seed, i)))
+def work(case: dict):
+    """One case on this worker: (row, trajectory or None); never raises."""
+    if _WORKER.get("error") is not None or _WORKER.get("run") is None:
+        return failed_row(case, _WORKER.get("error") or "worker not initialised"), None
+    try:
+        return _WORKER["run"](_WORKER["state"], case)
+    except Exception as e:  # one failed case never stops the campaign
+        return failed_row(case, f"{type(e).__name__}: {e}".splitlines()[0], traceback.format_exc(limit=3)), None
 
 
-def run_processes(todo, record, scenario_yaml, seed, workers, trajectory_step_s):
+def run_serial(task: Task, cases, record):
+    init_worker(task)
+    for case in cases:
+        record(*work(case))
+
+
+def run_processes(task: Task, cases, record, workers: int):
     ctx = mp.get_context("spawn")
-    with ctx.Pool(workers, initializer=init_worker, initargs=(scenario_yaml, trajectory_step_s)) as pool:
-        for row, traj in pool.imap_unordered(work, [(seed, i) for i in todo], chunksize=1):
+    with ctx.Pool(workers, initializer=init_worker, initargs=(task,)) as pool:
+        for row, traj in pool.imap_unordered(work, cases, chunksize=1):
             record(row, traj)
 
 
-def _dask_task(scenario_yaml: str, seed: int, index: int, trajectory_step_s: float):
-    """One sample on a Dask worker; the setup is built once per worker process."""
-    key = (hashlib.sha256(scenario_yaml.encode()).hexdigest(), trajectory_step_s)
-    if _WORKER.get("key") != key:
-        init_worker(scenario_yaml, trajectory_step_s)
-        _WORKER["key"] = key
-    return work((seed, index))
+def _dask_task(task: Task, case: dict):
+    """One case on a Dask worker; the state is built once per worker process and task."""
+    if _WORKER.get("key") != task.key():
+        init_worker(task)
+    return work(case)
 
 
-def run_dask(todo, record, scenario_yaml, seed, workers, scheduler, trajectory_step_s):
-    """Submit the samples to a Dask cluster. A LocalCluster is started with DASK_QUIET_WORKERS:
+def run_dask(task: Task, cases, record, workers: int, scheduler: str | None):
+    """Submit the cases to a Dask cluster. A LocalCluster is started with DASK_QUIET_WORKERS:
     the workers' statistical profiler and the event loop's 20 ms tick take the GIL from the
-    CPU-bound Python samples (the profiler cost 18 % of throughput; with it off, the tick and
+    CPU-bound Python cases (the profiler cost 18 % of throughput; with it off, the tick and
     monitors still cost 15-18 %, and 3-5 % at the intervals below). Start external workers
     with the same settings as environment variables (README)."""
     import dask
@@ -86,16 +122,24 @@ def run_dask(todo, record, scenario_yaml, seed, workers, scheduler, trajectory_s
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(cluster)
     try:
-        futures = {client.submit(_dask_task, scenario_yaml, seed, i, trajectory_step_s, pure=False): i for i in todo}
+        futures = {client.submit(_dask_task, task, case, pure=False): case for case in cases}
         for fut in as_completed(futures):
-            i = futures[fut]
             try:
                 row, traj = fut.result()
             except Exception as e:  # the worker itself died: record and go on
-                row, traj = {"index": i, "seed": sample_seed(seed, i), "success": False,
-                             "message": f"worker failure: {type(e).__name__}: {e}"[:500]}, None
+                row, traj = failed_row(futures[fut], f"worker failure: {type(e).__name__}: {e}"), None
             record(row, traj)
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def run_backend(backend: str, task: Task, cases: list, record, *, workers: int, scheduler: str | None = None):
+    """Run ``cases`` of ``task`` on ``backend`` and ``record(row, trajectory)`` each as it finishes."""
+    if backend == "serial" or (backend == "processes" and workers == 1):
+        run_serial(task, cases, record)
+    elif backend == "processes":
+        run_processes(task, cases, record, workers)
+    else:
+        run_dask(task, cases, record, workers, scheduler)

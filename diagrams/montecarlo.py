@@ -1,23 +1,22 @@
 """Monte-Carlo campaigns of the closed loop of any guidance method.
 
 ``run_campaign`` runs (or resumes) ``runs`` samples of a scenario's dispersions on a
-backend (diagrams.backends: serial, local processes, Dask) and streams each finished row
-into the campaign directory (diagrams.campaign_store); one sample is one Drake
-RandomSimulation (diagrams.sample). The report is drake_entry.report.
+backend as a campaign of cases (diagrams.campaign: serial, local processes, Dask), each
+finished row streamed into the campaign directory (campaign_store); one sample is one
+Drake RandomSimulation (diagrams.sample). The report is drake_entry.report.
 """
 from __future__ import annotations
 
 import hashlib
-import importlib.metadata
 import math
 import os
 
 import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
 
-import drake_entry
-from drake_entry.campaign_store import CampaignStore, done_indices, finalise  # noqa: F401 (API)
-from drake_entry.diagrams.backends import BACKENDS, run_dask, run_processes, run_serial
+from drake_entry.campaign_store import done_indices, finalise  # noqa: F401 (API)
+from drake_entry.diagrams.backends import Task
+from drake_entry.diagrams.campaign import check_backend, run_cases, versions
 from drake_entry.diagrams.sample import TIMING_COLUMNS, TRAJECTORY_STEP_S, campaign_row, run_sample, sample_seed  # noqa: F401 (API)
 from drake_entry.errors import ScenarioError
 from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
@@ -46,7 +45,7 @@ def campaign_manifest(scenario_path: str, *, seed: int, trajectory_step_s: float
     return {"scenario": name, "scenario_yaml": yaml_dump_typed(scenario), "vehicle_file_sha256": vehicle_sha,
             "atmosphere_file_sha256": atmosphere_sha,
             "seed": int(seed), "trajectory_step_s": float(trajectory_step_s), "overrides": overrides or {},
-            "versions": {"drake_entry": drake_entry.__version__, "drake": importlib.metadata.version("drake")},
+            "versions": versions(),
             "runs": int(runs), "dispersion": "scenario dispersions"}
 
 
@@ -67,47 +66,18 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     ``runs`` with the same settings extends it. Rows stream to out_dir/samples.jsonl,
     trajectories to trajectories.jsonl; at the end both are converted to Parquet.
     """
-    if backend not in BACKENDS:
-        raise ScenarioError(f"backend '{backend}' is unknown; allowed: {', '.join(BACKENDS)}")
+    check_backend(backend, workers)
     for name, value, lo in (("runs", runs, 1), ("seed", seed, 0)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value < 2**63:
             raise ScenarioError(f"{name} = {value} is out of range; allowed: an integer >= {lo}")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer))
-                                or not 1 <= workers <= 4096):
-        raise ScenarioError(f"workers = {workers} is out of range; allowed: an integer in [1, 4096] (default: all cores)")
     if not (isinstance(trajectory_step_s, (int, float)) and 0 <= trajectory_step_s < math.inf):
         raise ScenarioError(f"trajectory_step_s = {trajectory_step_s} is out of range; allowed: >= 0 s "
                             f"(0 = no trajectories)")
     manifest = campaign_manifest(scenario_path, seed=seed, trajectory_step_s=trajectory_step_s, overrides=overrides,
                                  runs=runs)
-    store = CampaignStore(out_dir, manifest)
-    done = store.done_indices()
-    todo = [i for i in range(runs) if i not in done]
-    workers = min(workers or os.cpu_count() or 1, max(len(todo), 1))
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=runs, initial=runs - len(todo), unit="run", desc="campaign", smoothing=0.05)
-    failed = 0
-    with store:
-        def record(row, traj):
-            nonlocal failed
-            store.record(row, traj)
-            if bar is not None:
-                bar.update(1)
-                if not row.get("success"):
-                    failed += 1
-                    bar.set_postfix(failed=failed)
-
-        scenario_yaml = manifest["scenario_yaml"]
-        if backend == "serial" or (backend == "processes" and workers == 1):
-            run_serial(todo, record, scenario_yaml, seed, trajectory_step_s)
-        elif backend == "processes":
-            run_processes(todo, record, scenario_yaml, seed, workers, trajectory_step_s)
-        else:
-            run_dask(todo, record, scenario_yaml, seed, workers, scheduler, trajectory_step_s)
-        store.finalise()
-    if bar is not None:
-        bar.close()
-    return out_dir
+    task = Task("drake_entry.diagrams.sample:setup_worker", "drake_entry.diagrams.sample:run_case",
+                {"scenario_yaml": manifest["scenario_yaml"], "seed": int(seed),
+                 "trajectory_step_s": float(trajectory_step_s)})
+    cases = [{"index": i, "seed": sample_seed(seed, i)} for i in range(int(runs))]
+    return run_cases(task, cases, out_dir, manifest, backend=backend, workers=workers, scheduler=scheduler,
+                     progress=progress, desc="campaign")

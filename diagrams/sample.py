@@ -19,6 +19,8 @@ from pydrake.systems.analysis import RandomSimulation
 from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, build_closed_loop, summarise
 from drake_entry.diagrams.common import collect_trajectory, make_simulator
 from drake_entry.dispersions import draw
+from drake_entry.errors import load_yaml_typed
+from drake_entry.scenario import Scenario
 from drake_entry.trajectory import metrics
 
 TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
@@ -29,6 +31,20 @@ TIMING_COLUMNS = ("wall_time_s", "planning_wall_s")
 def sample_seed(campaign_seed: int, index: int) -> int:
     """The RandomGenerator seed of sample ``index`` (independent streams per sample)."""
     return int(np.random.SeedSequence([int(campaign_seed), int(index)]).generate_state(1)[0])
+
+
+def setup_worker(config: dict) -> dict:
+    """A campaign worker's state (backends.Task.setup): the ClosedLoopSetup (models, guidance
+    method and its planner) built once from config['scenario_yaml'], the campaign seed and
+    the trajectory step."""
+    scenario = load_yaml_typed(Scenario, text=config["scenario_yaml"], where="campaign scenario").validate()
+    return {"setup": ClosedLoopSetup.from_scenario(scenario), "seed": int(config["seed"]),
+            "trajectory_step_s": float(config["trajectory_step_s"])}
+
+
+def run_case(state: dict, case: dict):
+    """Sample case['index'] of the campaign (backends.Task.run)."""
+    return run_sample(state["setup"], state["seed"], case["index"], trajectory_step_s=state["trajectory_step_s"])
 
 
 def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,

@@ -32,9 +32,11 @@ ROWS, TRAJECTORIES, QUARANTINE, MANIFEST, LOCK = ("samples.jsonl", "trajectories
 # what the fingerprint covers, and how a mismatch is named
 IDENTITY = {"scenario_yaml": "scenario content", "vehicle_file_sha256": "vehicle file content",
             "seed": "seed", "trajectory_step_s": "trajectory step", "versions": "drake_entry/drake version",
-            "atmosphere_file_sha256": "atmosphere table content"}
-#: identity keys that count only when set (added after campaigns were written without them)
-OPTIONAL_IDENTITY = ("atmosphere_file_sha256",)
+            "atmosphere_file_sha256": "atmosphere table content", "task": "task settings",
+            "cases_sha256": "case list"}
+#: identity keys that count only when set (added after campaigns were written without them;
+#: 'task' and 'cases_sha256' belong to campaigns of generic cases, diagrams.campaign)
+OPTIONAL_IDENTITY = ("atmosphere_file_sha256", "task", "cases_sha256")
 
 
 def fingerprint(manifest: dict) -> str:

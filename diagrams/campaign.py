@@ -1,0 +1,81 @@
+"""A campaign of independent cases, durable and resumable, on any backend.
+
+``run_cases`` runs the cases of a ``backends.Task`` that are not yet done in ``out_dir``
+(``campaign_store``: fingerprinted manifest, rows streamed as they finish, Parquet at the
+end) on 'serial', 'processes' or 'dask', with a progress bar. The Monte-Carlo runner
+(``montecarlo.run_campaign``) and the SCvx abort maps (``aborts``) are both campaigns of
+this kind; a case that fails is a row with its reason and never stops the others.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.metadata
+import json
+import os
+
+import numpy as np
+
+import drake_entry
+from drake_entry.campaign_store import CampaignStore
+from drake_entry.diagrams.backends import BACKENDS, Task, run_backend
+from drake_entry.errors import ScenarioError
+
+
+def versions() -> dict:
+    """The drake_entry and drake versions a campaign was run with (part of its identity)."""
+    return {"drake_entry": drake_entry.__version__, "drake": importlib.metadata.version("drake")}
+
+
+def task_manifest(task: Task, cases: list, **extra) -> dict:
+    """The manifest of a campaign of ``cases`` (dicts with an integer 'index') of ``task``:
+    the task, the case list's sha256 and the versions identify it."""
+    digest = hashlib.sha256(json.dumps(cases, sort_keys=True, default=float).encode()).hexdigest()
+    return {"task": {"setup": task.setup, "run": task.run, "config": task.config}, "cases_sha256": digest,
+            "versions": versions(), "runs": len(cases), **extra}
+
+
+def check_backend(backend: str, workers) -> None:
+    """One-line ScenarioErrors for an unknown backend or a bad worker count."""
+    if backend not in BACKENDS:
+        raise ScenarioError(f"backend '{backend}' is unknown; allowed: {', '.join(BACKENDS)}")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or not 1 <= workers <= 4096):
+        raise ScenarioError(f"workers = {workers} is out of range; allowed: an integer in [1, 4096] (default: all cores)")
+
+
+def run_cases(task: Task, cases: list, out_dir: str, manifest: dict, *, backend: str = "processes",
+              workers: int | None = None, scheduler: str | None = None, progress: bool = True,
+              desc: str = "campaign") -> str:
+    """Run the cases of ``cases`` (dicts, each with a unique integer 'index') not yet done in
+    ``out_dir``; returns out_dir. ``manifest`` identifies the campaign (``task_manifest``, or
+    the Monte-Carlo manifest); a directory holding another campaign is refused (CampaignError).
+    workers: local processes (default all cores, at most one per case)."""
+    check_backend(backend, workers)
+    indices = [c.get("index") for c in cases]
+    if any(isinstance(i, bool) or not isinstance(i, int) for i in indices) or len(set(indices)) != len(indices):
+        raise ScenarioError("cases need a unique integer 'index' each")
+    store = CampaignStore(out_dir, manifest)
+    done = store.done_indices()
+    todo = [c for c in cases if c["index"] not in done]
+    workers = min(workers or os.cpu_count() or 1, max(len(todo), 1))
+    total = int(store.manifest.get("runs", len(cases)))
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=total, initial=total - len(todo), unit="case", desc=desc, smoothing=0.05)
+    failed = 0
+    with store:
+        def record(row, traj):
+            nonlocal failed
+            store.record(row, traj)
+            if bar is not None:
+                bar.update(1)
+                if not row.get("success"):
+                    failed += 1
+                    bar.set_postfix(failed=failed)
+
+        run_backend(backend, task, todo, record, workers=workers, scheduler=scheduler)
+        store.finalise()
+    if bar is not None:
+        bar.close()
+    return out_dir

@@ -95,6 +95,12 @@ class ConvexifiableProblem:
         return f"convex constraint {i}"
 
 
+#: Clarabel options of the SCvx sub-problems unless ``solver_options`` overrides them:
+#: iterative refinement off halves the solve time (59 -> 32 ms per SOCP on the nominal, same
+#: IPM iterations, cost equal to 1e-7) and the plan (476.4 MJ/m^2) is unchanged
+CLARABEL_DEFAULTS = {"iterative_refinement_enable": False}
+
+
 @dc.dataclass
 class ScvxSettings:
     """SCvx iteration settings (paper 001 Sec. III; its SCOPT defaults where it has them).
@@ -110,7 +116,7 @@ class ScvxSettings:
       defect_tolerance: largest scaled defect at convergence.
       constraint_tolerance: largest scaled inequality or convex violation at convergence.
       decrease_tolerance: predicted decrease of J_a (relative to 1 + |J_a|) at convergence.
-      solver: 'clarabel' or 'scs'. solver_options: passed to the solver.
+      solver: 'clarabel' or 'scs'. solver_options: passed to the solver (over CLARABEL_DEFAULTS).
     """
 
     max_iterations: int = 60
@@ -250,7 +256,8 @@ class ScvxSubproblem:
         else:
             self.solver = ScsSolver()
         self.options = SolverOptions()
-        for k, v in settings.solver_options.items():
+        defaults = CLARABEL_DEFAULTS if settings.solver == "clarabel" else {}
+        for k, v in {**defaults, **settings.solver_options}.items():
             self.options.SetOption(self.solver.solver_id(), k, v)
 
     def solve(self, zb: np.ndarray, lin: Linearisation, radius: float):

@@ -25,7 +25,8 @@ nodes; 2 nodes per segment is the paper's trapezoid, Sec. IV.B),
 
 Constraints: control bounds (eqs. 36, 43-44, hard), |u| <= 1 (eq. 42, hard cone, lossless);
 buffered (eq. 24) at every node: heat flux <= q_max (eq. 9), total load <= n_max (eq. 10),
-flight-path bounds (eq. 70); at the DRS point: geodetic altitude window (eq. 64), V <= M a
+flight-path bounds (eq. 70); at the DRS point: geodetic altitude window (eq. 64, narrowed by
+the mission's final_altitude_margin_m), V <= M a
 (eq. 65), V sin(gamma) >= V_v,min (eq. 66), and a cone ||miss|| <= site radius (eqs. 67-68)
 with a buffer. Hard bounds on the other states (eq. 70) and the fixed entry state.
 
@@ -227,6 +228,9 @@ class EntryProblem(ConvexifiableProblem):
         upper = np.concatenate([np.tile(x_hi, n), np.tile(u_hi, n), [3.0 * tf_guess],
                                 np.full(self.n_aux, 1e3 * self.aux_scale)])
         lower[:6] = upper[:6] = self.x0  # the entry position and velocity are fixed
+        for index, held in ((self.i_sigma, m.entry_bank_deg), (self.i_alpha, m.entry_alpha_deg)):
+            if index is not None and held is not None:  # the attitude being flown (descent abort)
+                lower[index] = upper[index] = deg(held)
         self.lower, self.upper = lower / self.scale, upper / self.scale
 
     def pack(self, X, U, tf) -> np.ndarray:
@@ -331,7 +335,8 @@ class EntryProblem(ConvexifiableProblem):
         else:
             epigraph = np.zeros(0)
         xf = X[-1]
-        events = np.array([(m.final_altitude_m[0] - hstar[-1]) / 1e3, (hstar[-1] - m.final_altitude_m[1]) / 1e3,
+        h_lo, h_hi = m.final_altitude_m[0] + m.final_altitude_margin_m, m.final_altitude_m[1] - m.final_altitude_margin_m
+        events = np.array([(h_lo - hstar[-1]) / 1e3, (hstar[-1] - h_hi) / 1e3,
                            (xf[3] - m.final_mach_max * a[-1]) / 100.0,
                            (m.final_vertical_speed_min_m_s - xf[3] * math.sin(xf[4])) / 100.0])
         w = mesh.weights

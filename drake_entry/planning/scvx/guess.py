@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import minimize_scalar
 
 from ... import geodesy
 from ...atmosphere import Atmosphere
@@ -124,28 +125,21 @@ def propagate_glide(reference_bank: float, vehicle: Vehicle, planet: Earth, atmo
 
 
 def glide_guess(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission: ScvxMission, *,
-                scan: int = 10, refinements: int = 10) -> GlideGuess:
+                scan: int = 10, bank_tolerance: float = 1e-3) -> GlideGuess:
     """The glide guess whose reference bank ends closest to the site: a scan of sigma_g over
-    [bank_min, 85 deg] and a golden-section refinement around the best. The miss need not
-    be zero (near maximum range the lateral and longitudinal demands compete): the SCvx
-    virtual controls and the buffered site cone absorb it, and ``GlideGuess.miss`` says how far."""
+    [bank_min, 85 deg], then scipy's bounded Brent search between the best point's
+    neighbours to ``bank_tolerance`` [rad]. The miss need not be zero (near maximum range the
+    lateral and longitudinal demands compete): the SCvx virtual controls and the buffered
+    site cone absorb it, and ``GlideGuess.miss`` says how far."""
     lo, hi = math.radians(mission.bank_min_deg) + 1e-3, min(vehicle.bank_limit, math.radians(85.0))
     grid = np.linspace(lo, hi, scan)
-    guesses = [propagate_glide(b, vehicle, planet, atmosphere, mission) for b in grid]
-    k = int(np.argmin([g.miss for g in guesses]))
-    best = guesses[k]
-    a, b = grid[max(k - 1, 0)], grid[min(k + 1, scan - 1)]
-    phi = (math.sqrt(5.0) - 1.0) / 2.0
-    c, d = b - phi * (b - a), a + phi * (b - a)
-    gc, gd = (propagate_glide(x, vehicle, planet, atmosphere, mission) for x in (c, d))
-    for _ in range(refinements):
-        best = min((best, gc, gd), key=lambda g: g.miss)
-        if gc.miss < gd.miss:
-            b, d, gd = d, c, gc
-            c = b - phi * (b - a)
-            gc = propagate_glide(c, vehicle, planet, atmosphere, mission)
-        else:
-            a, c, gc = c, d, gd
-            d = a + phi * (b - a)
-            gd = propagate_glide(d, vehicle, planet, atmosphere, mission)
-    return min((best, gc, gd), key=lambda g: g.miss)
+    tried = [propagate_glide(b, vehicle, planet, atmosphere, mission) for b in grid]
+    k = int(np.argmin([g.miss for g in tried]))
+
+    def miss(bank):
+        tried.append(propagate_glide(float(bank), vehicle, planet, atmosphere, mission))
+        return tried[-1].miss
+
+    minimize_scalar(miss, bounds=(grid[max(k - 1, 0)], grid[min(k + 1, scan - 1)]), method="bounded",
+                    options={"xatol": bank_tolerance})
+    return min(tried, key=lambda g: g.miss)

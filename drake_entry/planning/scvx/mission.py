@@ -30,11 +30,17 @@ class ScvxMission:
       site_longitude_deg, site_latitude_deg: landing site, geodetic latitude [deg].
       site_radius_m: largest miss of the DRS point from the site [m] (eq. 68).
       final_altitude_m: geodetic DRS altitude window [m] (eq. 64).
+      final_altitude_margin_m: the plan keeps its DRS altitude this far inside final_altitude_m [m],
+        a design margin (not the paper's: it plans to the window's edges) so that the flown
+        point, within the plan's accuracy, stays inside the window; 0 plans to the edges.
       final_mach_max: largest DRS Mach number (eq. 65: subsonic).
       final_vertical_speed_min_m_s: lowest V sin(gamma) at the DRS point [m/s] (eq. 66).
       flight_path_bounds_deg: path bounds on gamma [deg] (eq. 70), buffered.
       heading_bounds_deg: hard bounds on the heading [deg] (eq. 70).
       bank_min_deg: smallest bank magnitude [deg] (eq. 43).
+      entry_bank_deg, entry_alpha_deg: the bank and angle of attack held at the start [deg], or
+        None (free). A descent abort starts from the attitude being flown (paper 001 Sec. IV.C);
+        they bind where bank or alpha are states (the rate formulations).
       alpha_deg, alpha_speeds_m_s: the angle-of-attack law: alpha_deg[0] above
         alpha_speeds_m_s[1], alpha_deg[1] below alpha_speeds_m_s[0], a C2 blend between.
       name: label.
@@ -50,11 +56,14 @@ class ScvxMission:
     site_latitude_deg: float = 36.974
     site_radius_m: float = 10e3
     final_altitude_m: tuple = (10e3, 13e3)
+    final_altitude_margin_m: float = 200.0
     final_mach_max: float = 1.0
     final_vertical_speed_min_m_s: float = -140.0
     flight_path_bounds_deg: tuple = (-30.0, 0.5)
     heading_bounds_deg: tuple = (-10.0, 270.0)
     bank_min_deg: float = 5.0
+    entry_bank_deg: float | None = None
+    entry_alpha_deg: float | None = None
     alpha_deg: tuple = (40.0, 25.0)
     alpha_speeds_m_s: tuple = (2000.0, 5000.0)
     alpha_bounds_deg: tuple = (15.0, 45.0)
@@ -84,6 +93,12 @@ class ScvxMission:
             v = tuple(getattr(self, f))
             if len(v) != 2 or not lo <= v[0] < v[1] <= hi:
                 raise ScenarioError(f"ScvxMission.{f} = {v} needs two values {lo} <= low < high <= {hi}")
+        check("final_altitude_margin_m", self.final_altitude_margin_m, 0.0,
+              0.49 * (self.final_altitude_m[1] - self.final_altitude_m[0]), "m (under half the DRS window)")
+        if self.entry_bank_deg is not None:
+            check("entry_bank_deg", self.entry_bank_deg, -180.0, 180.0, "deg")
+        if self.entry_alpha_deg is not None:
+            check("entry_alpha_deg", self.entry_alpha_deg, *self.alpha_bounds_deg, "deg (alpha_bounds_deg)")
         if len(self.alpha_deg) != 2 or not all(0.0 <= a <= 60.0 for a in self.alpha_deg):
             raise ScenarioError(f"ScvxMission.alpha_deg = {tuple(self.alpha_deg)} needs two angles in [0, 60] deg "
                                 f"(high speed, low speed)")

@@ -130,20 +130,24 @@ def _rate_limited(t, target, rate_limit, lower, upper):
 def decision_from_trajectory(problem: EntryProblem, states, bank, alpha, tf: float, lossless_controls=None):
     """Scaled z from a trajectory at the mesh nodes: states (n, 6), bank and alpha [rad] (n,),
     t_f [s]. Where bank or alpha are states they follow the given ones within their bounds and
-    rate limits (their rates are the controls); the lossless bank takes ``lossless_controls``
+    rate limits (their rates are the controls), starting from the mission's held entry bank and
+    alpha where it holds them; the lossless bank takes ``lossless_controls``
     (n, 2) if given, else (cos, sin) of the bank."""
     t = problem.mesh.s * tf
     X, U = [np.asarray(states, float)], []
     f, m, v = problem.formulation, problem.mission, problem.vehicle
+    held = (lambda path, value: np.concatenate([[math.radians(value)], path[1:]]) if value is not None else path)
     if f.bank == "lossless":
         U.append(lossless_controls if lossless_controls is not None else np.stack([np.cos(bank), np.sin(bank)], axis=1))
     else:
-        sigma, rate = _rate_limited(t, np.unwrap(bank), v.bank_rate_limit, -v.bank_limit, v.bank_limit)
+        sigma, rate = _rate_limited(t, held(np.unwrap(bank), m.entry_bank_deg), v.bank_rate_limit, -v.bank_limit,
+                                    v.bank_limit)
         X.append(sigma[:, None])
         U.append(rate[:, None])
     if f.alpha == "rate":
         lo, hi = np.radians(m.alpha_bounds_deg)
-        a, rate = _rate_limited(t, alpha, math.radians(m.alpha_rate_limit_deg_s), lo, hi)
+        a, rate = _rate_limited(t, held(np.asarray(alpha, float), m.entry_alpha_deg),
+                                math.radians(m.alpha_rate_limit_deg_s), lo, hi)
         X.append(a[:, None])
         U.append(rate[:, None])
     return problem.pack(np.concatenate(X, axis=1), np.concatenate(U, axis=1), tf)
@@ -182,8 +186,8 @@ def _between_nodes(problem: EntryProblem, X, U) -> dict:
 
 def plan_metrics(problem: EntryProblem, X, U, tf: float) -> dict:
     """Paper 001's Table 2/3/6 quantities of a plan: heat load [MJ/m^2] (node quadrature),
-    final time [s], max heat flux [kW/m^2], max total load [g] and max |gamma_dot| [deg/s] at the
-    nodes; integrated and max |sigma_dot|, |alpha_dot| and |(sigma_dot, alpha_dot)| [deg, deg/s]
+    final time [s], max heat flux [kW/m^2], max total load [g], max |gamma_dot| [deg/s] and max
+    dynamic pressure [kPa] at the nodes; integrated and max |sigma_dot|, |alpha_dot| and |(sigma_dot, alpha_dot)| [deg, deg/s]
     on the segment polynomials (the bank and alpha histories differentiated, whatever the
     formulation); the planned miss [km]."""
     nodes, _ = problem._nodes(X, U, gradients=False)
@@ -200,6 +204,8 @@ def plan_metrics(problem: EntryProblem, X, U, tf: float) -> dict:
             "max_heat_flux_kW_m2": float(nodes[:, problem.out_q].max() / 1e3),
             "max_load_g": float(nodes[:, problem.out_n].max()),
             "max_flight_path_rate_deg_s": deg(float(np.abs(nodes[:, 4]).max())),
+            "max_dynamic_pressure_kPa": max(0.5 * air_data(x, problem.planet, problem.atmosphere)[0] * x[3] ** 2
+                                            for x in X) / 1e3,
             "bank_effort_deg": deg(float(np.trapezoid(np.abs(sigma_dot), t))),
             "max_bank_rate_deg_s": deg(float(np.abs(sigma_dot).max())),
             "alpha_effort_deg": deg(float(np.trapezoid(np.abs(alpha_dot), t))),

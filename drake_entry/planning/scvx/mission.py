@@ -75,7 +75,7 @@ class ScvxMission:
             if not (isinstance(value, (int, float)) and lo <= value <= hi):
                 raise ScenarioError(f"ScvxMission.{field} = {value!r} is out of range [{lo}, {hi}] {unit}")
 
-        check("entry_altitude_m", self.entry_altitude_m, 20e3, 200e3, "m")
+        check("entry_altitude_m", self.entry_altitude_m, 0.0, 200e3, "m")
         check("entry_speed_m_s", self.entry_speed_m_s, 500.0, 12e3, "m/s")
         check("entry_flight_path_deg", self.entry_flight_path_deg, -45.0, 5.0, "deg")
         for f in ("entry_latitude_deg", "site_latitude_deg"):

@@ -1,0 +1,137 @@
+"""Abort reachability (paper 001 Sec. VI) and the generic campaign of cases it runs on: the EIP
+grid and descent-abort cases, feasibility and the Tables 4-7 statistics, a failing case
+recorded without losing the others, and one real orbital abort planned and flown by Drake."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from drake_entry.campaign_store import read_rows
+from drake_entry.diagrams.backends import Task
+from drake_entry.diagrams.campaign import run_cases, task_manifest
+from drake_entry.errors import CampaignError, ScenarioError
+from drake_entry.planet import Earth
+from drake_entry.planning.scvx.aborts import (PAPER_TABLES, abort_statistics, case_mission, descent_abort_cases,
+                                              feasible, heading_offset, orbital_abort_cases, statistics_markdown)
+from drake_entry.planning.scvx.mission import ScvxMission
+
+
+# ----- the generic campaign of cases ---------------------------------------------------------
+def toy_setup(config):
+    return {"scale": config["scale"]}
+
+
+def toy_run(state, case):
+    if case["x"] < 0:
+        raise ValueError(f"negative x {case['x']}")
+    return {"index": case["index"], "success": True, "y": state["scale"] * case["x"] ** 2}, None
+
+
+TOY = Task("test_aborts:toy_setup", "test_aborts:toy_run", {"scale": 3.0})
+
+
+@pytest.mark.parametrize("backend, workers", [("serial", 1), ("processes", 2)])
+def test_a_failing_case_is_a_row_with_its_reason_and_the_others_finish(tmp_path, backend, workers):
+    cases = [{"index": i, "x": x} for i, x in enumerate([1.0, -2.0, 3.0])]
+    run_cases(TOY, cases, str(tmp_path), task_manifest(TOY, cases), backend=backend, workers=workers,
+              progress=False)
+    rows, _ = read_rows(str(tmp_path))
+    assert rows[0]["y"] == 3.0 and rows[2]["y"] == 27.0
+    assert rows[1]["success"] is False and "ValueError: negative x -2.0" in rows[1]["message"]
+    assert rows[1]["x"] == -2.0  # the case's columns identify it
+
+
+def test_cases_resume_and_another_case_list_is_refused(tmp_path):
+    cases = [{"index": i, "x": float(i)} for i in range(3)]
+    out = str(tmp_path)
+    run_cases(TOY, cases[:2], out, task_manifest(TOY, cases), backend="serial", progress=False)
+    with open(tmp_path / "samples.jsonl") as f:
+        assert len(f.readlines()) == 2
+    run_cases(TOY, cases, out, task_manifest(TOY, cases), backend="serial", progress=False)
+    with open(tmp_path / "samples.jsonl") as f:
+        assert [json.loads(line)["index"] for line in f] == [0, 1, 2]  # only the missing case ran
+    other = [{"index": 0, "x": 5.0}]
+    with pytest.raises(CampaignError, match="case list"):
+        run_cases(TOY, other, out, task_manifest(TOY, other), backend="serial", progress=False)
+    with pytest.raises(ScenarioError, match="unique integer 'index'"):
+        run_cases(TOY, [{"index": 0}, {"index": 0}], str(tmp_path / "x"), {}, backend="serial", progress=False)
+
+
+def test_a_worker_whose_setup_fails_reports_it_on_every_case(tmp_path):
+    bad = Task("test_aborts:no_such_function", "test_aborts:toy_run", {})
+    cases = [{"index": 0, "x": 1.0}, {"index": 1, "x": 2.0}]
+    run_cases(bad, cases, str(tmp_path), task_manifest(bad, cases), backend="serial", progress=False)
+    rows, _ = read_rows(str(tmp_path))
+    assert all(not r["success"] and "worker set-up failed: AttributeError" in r["message"] for r in rows.values())
+
+
+# ----- abort cases ----------------------------------------------------------------------------
+def test_orbital_grid_is_centred_on_the_nominal_eip_and_sees_the_site_as_it_does():
+    planet, mission = Earth.oblate(), ScvxMission()
+    cases = orbital_abort_cases(mission, planet)
+    assert len(cases) == 81 and [c["index"] for c in cases] == list(range(81))
+    lon = sorted({c["entry_longitude_deg"] for c in cases})
+    lat = sorted({c["entry_latitude_deg"] for c in cases})
+    assert np.diff(lon) == pytest.approx(np.full(8, 5.0)) and np.diff(lat) == pytest.approx(np.full(8, 5.0))
+    centre = cases[40]
+    assert (centre["entry_longitude_deg"], centre["entry_latitude_deg"]) == (-115.0, 30.0)
+    assert centre["entry_heading_deg"] == pytest.approx(mission.entry_heading_deg, abs=1e-9)
+    assert centre["range_km"] == pytest.approx(8076.0, abs=5.0)  # paper 001 Table 1 mission (notes: 8076 km)
+    assert heading_offset(mission, planet) == pytest.approx(-14.05, abs=0.01)
+    for c in cases:  # every EIP keeps the nominal's heading offset from the bearing to the site
+        assert heading_offset(case_mission(mission, c), planet) == pytest.approx(-14.05, abs=0.01)
+    with pytest.raises(ScenarioError, match="rows = 0"):
+        orbital_abort_cases(mission, planet, shape=(0, 3))
+    with pytest.raises(ScenarioError, match="within 80 deg"):
+        orbital_abort_cases(mission, planet, shape=(23, 3), spacing_deg=5.0)
+
+
+def test_descent_abort_cases_start_from_the_flown_state_and_attitude():
+    planet = Earth.oblate()
+    t = np.linspace(0.0, 400.0, 81)
+    x0 = ScvxMission().entry_state(planet)
+    states = np.array([x0 + [-100.0 * s, 1e-5 * s, 5e-6 * s, -2.0 * s, 0.0, 1e-4 * s] for s in t])
+    bank, alpha = np.radians(30.0 + 0.01 * t), np.radians(np.full(t.size, 38.0))
+    cases = descent_abort_cases(t, states, bank, alpha, planet, site=(-7.95, 32.23), spacing_s=100.0)
+    assert [c["abort_time_s"] for c in cases] == [100.0, 200.0, 300.0]
+    for c in cases:
+        mission = case_mission(ScvxMission(), c)
+        k = int(np.searchsorted(t, c["abort_time_s"]))
+        assert mission.entry_state(planet) == pytest.approx(states[k], rel=1e-9, abs=1e-6)  # geodetic round trip
+        assert c["entry_bank_deg"] == pytest.approx(30.0 + 0.01 * c["abort_time_s"])
+        assert (mission.site_longitude_deg, mission.site_latitude_deg) == (-7.95, 32.23)
+
+
+def test_feasibility_and_tables_4_to_7_statistics():
+    base = {"plan_success": True, "planned_miss_km": 9.9, **{q: 1.0 for t in PAPER_TABLES.values() for q in t}}
+    rows = [dict(base, flown_miss_km=5.0, heat_load_MJ_m2=500.0), dict(base, flown_miss_km=30.0, heat_load_MJ_m2=600.0),
+            dict(base, flown_miss_km=50.0), dict(base, plan_success=False, flown_miss_km=1.0),
+            dict(base, planned_miss_km=12.0, flown_miss_km=1.0)]
+    assert [feasible(r, 10e3) for r in rows] == [True, False, False, False, False]
+    assert [feasible(r, 40e3) for r in rows] == [True, True, False, False, False]
+    stats = abort_statistics(rows, 40e3)
+    assert stats["Table 4"]["heat_load_MJ_m2"] == pytest.approx((550.0, 50.0, 600.0, 500.0))
+    text = statistics_markdown(stats)
+    assert "550 / 564.9" in text and "Table 7 form" in text
+    assert all(math.isnan(v) for v in abort_statistics(rows[3:], 40e3)["Table 5"]["drs_mach"])
+
+
+def test_one_orbital_abort_is_planned_flown_and_reported(tmp_path):
+    """The nominal EIP as a 1 x 1 map through the campaign engine: the plan succeeds and its
+    Drake flight ends inside the 10-km radius (measured 9.97 km flown, 476 MJ/m^2); the report
+    carries the Tables 4-7 form and the maps."""
+    from drake_entry.diagrams.aborts import run_orbital_aborts
+    from drake_entry.planning.scvx.abort_report import write_abort_report
+
+    out = run_orbital_aborts(str(tmp_path), shape=(1, 1), backend="serial", progress=False)
+    rows, _ = read_rows(out)
+    row = rows[0]
+    assert row["plan_success"], row["message"]
+    assert row["feasible_10km"] and row["feasible_40km"] and row["success"]
+    assert 460.0 < row["heat_load_MJ_m2"] < 500.0
+    assert row["flown_from_plan_km"] < 5.0 and row["max_heat_flux_kW_m2"] <= 670.0 * (1 + 1e-6)
+    assert row["mean_socp_iterations"] > 5 and row["iterations"] <= 60
+    report = open(write_abort_report(out)).read()
+    assert "Feasible at 10 km" in report and "**Table 4 form**" in report
+    assert (tmp_path / "reachability_map.png").exists() and (tmp_path / "attitude.png").exists()

@@ -8,6 +8,7 @@ nlp             NLP path: LGL / DirectCollocation x Ipopt / SNOPT from the same 
 campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios)
 interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline commit
 paper001        paper 001: SCvx nominal plan time and iterations by mesh vs the paper, flown by Drake
+aborts          paper 001: the 9 x 9 orbital-abort map through the campaign engine vs the 15-min goal
 paper004        paper 004: Table 1 over seeds, scipy baselines, cases, two parameters, figures
 """
 import argparse
@@ -20,7 +21,7 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("which", nargs="?", default="all",
                         choices=("all", "open-loop", "socp", "nlp", "campaign", "interface-cost", "paper001",
-                                 "paper004"))
+                                 "aborts", "paper004"))
     parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
     parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
     parser.add_argument("--nodes", type=int, default=40, help="nlp: nodes / samples")
@@ -28,6 +29,8 @@ if __name__ == "__main__":
     parser.add_argument("--baseline", default=None,
                         help="interface-cost: git revision to compare with (default: the commit before the "
                              "guidance-method interface)")
+    parser.add_argument("--grid", type=int, nargs=2, default=(9, 9), metavar=("ROWS", "COLUMNS"),
+                        help="aborts: EIP grid size")
     parser.add_argument("--seeds", type=int, default=20, help="paper004: seeds per swarm method (Table 1)")
     parser.add_argument("--out", default="out/paper004", help="paper004: figure directory")
     args = parser.parse_args()
@@ -55,6 +58,10 @@ if __name__ == "__main__":
         from paper001 import paper001_benchmark
 
         paper001_benchmark()
+    if args.which in ("all", "aborts"):
+        from aborts import aborts_benchmark
+
+        aborts_benchmark(rows=args.grid[0], columns=args.grid[1])
     if args.which in ("all", "paper004"):
         from paper004 import paper004_study
 

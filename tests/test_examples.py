@@ -78,3 +78,17 @@ def test_example_07(tmp_path):
     assert plan.formulation == "direct"
     assert 460.0 < plan.objective < 500.0 and flight.from_plan_m < 5e3 and flight.from_site_m < 15e3 and flight.drs_ok
     assert os.path.exists(r["plot"])
+
+
+def test_example_08(tmp_path):
+    """Orbital aborts from the nominal EIP and its two longitude neighbours, two descent aborts
+    (300 s and 600 s to Ben Guerir): rows, reports and maps written; the nominal EIP is feasible."""
+    r = _run("08_abort_maps", tmp_path)
+    orbital, descent = r["orbital"], r["descent"]
+    assert len(orbital["rows"]) == 3 and len(descent["rows"]) == 2
+    centre = next(row for row in orbital["rows"] if row["entry_longitude_deg"] == -115.0)
+    assert centre["plan_success"] and centre["feasible_40km"], centre["message"]
+    assert sorted(row["abort_time_s"] for row in descent["rows"]) == [300.0, 600.0]
+    assert all(os.path.exists(x["report"]) for x in (orbital, descent))
+    assert os.path.exists(os.path.join(orbital["directory"], "reachability_map.png"))
+    assert os.path.exists(os.path.join(descent["directory"], "descent_tracks.png"))

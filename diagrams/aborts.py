@@ -24,7 +24,7 @@ from drake_entry.diagrams.plan_flight import fly_plan
 from drake_entry.errors import ScenarioError
 from drake_entry.planet import Earth
 from drake_entry.planning.scvx.aborts import (ALTERNATIVE_SITES, DESCENT_ABORT_SPACING_S, FEASIBLE_RADII_M,
-                                              GRID_SHAPE, GRID_SPACING_DEG, case_mission, descent_abort_cases,
+                                              GRID_SHAPE, GRID_SPACING_DEG, OPEN_SITE_RADIUS_M, case_mission, descent_abort_cases,
                                               feasible, orbital_abort_cases)
 from drake_entry.planning.scvx.engine import ScvxSettings
 from drake_entry.planning.scvx.entry import EntryProblemSettings
@@ -53,24 +53,15 @@ class AbortStudy:
     scvx: dict = dc.field(default_factory=dict)
 
     def config(self) -> dict:
-        """The settings as plain JSON (validated by building them once)."""
+        """The settings as a plain dict (validated by building them once)."""
         self.models()
-        return json_ready(dc.asdict(self))
+        return dc.asdict(self)
 
     def models(self):
         """(vehicle, planet, atmosphere, mission, problem settings, SCvx settings): the oblate
         J2 Earth and US76 of the paper's case."""
         return (load_vehicle(self.vehicle), Earth.oblate(), US76Atmosphere(), ScvxMission(**self.mission),
                 EntryProblemSettings(**self.problem), ScvxSettings(**self.scvx))
-
-
-def json_ready(value):
-    """Tuples to lists, recursively (a manifest written and read back compares equal)."""
-    if isinstance(value, dict):
-        return {k: json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [json_ready(v) for v in value]
-    return value
 
 
 def setup_worker(config: dict) -> tuple:
@@ -89,10 +80,9 @@ def abort_row(case: dict, plan, flight, wall_s: float) -> dict:
            **{k: float(v) for k, v in plan.metrics.items()},
            "planned_miss_km": plan.miss_m / 1e3, "drs_altitude_km": plan.drs["altitude_m"] / 1e3,
            "drs_mach": plan.drs["mach"], "drs_vertical_speed_m_s": plan.drs["vertical_speed_m_s"],
-           "propagated_error_km": plan.propagated_error_m / 1e3, "max_defect": plan.max_defect}
-    if flight is not None:
-        row.update(flown_miss_km=flight.from_site_m / 1e3, flown_from_plan_km=flight.from_plan_m / 1e3,
-                   flown_drs_ok=flight.drs_ok)
+           "propagated_error_km": plan.propagated_error_m / 1e3, "max_defect": plan.max_defect,
+           "flown_miss_km": flight.from_site_m / 1e3, "flown_from_plan_km": flight.from_plan_m / 1e3,
+           "flown_drs_ok": flight.drs_ok}
     for radius in FEASIBLE_RADII_M:
         row[f"feasible_{radius / 1e3:g}km"] = feasible(row, radius)
     row["success"] = row[f"feasible_{FEASIBLE_RADII_M[-1] / 1e3:g}km"]
@@ -115,13 +105,12 @@ def run_case(models: tuple, case: dict):
     plan = plan_entry(vehicle, planet, atmosphere, case_mission(mission, case), problem_settings=problem,
                       settings=scvx)
     wall = time.perf_counter() - t0
-    flight = fly_plan(plan, vehicle, planet, atmosphere) if plan.iterations else None
-    return abort_row(case, plan, flight, wall), plan_trajectory(plan, case["index"])
+    return abort_row(case, plan, fly_plan(plan, vehicle, planet, atmosphere), wall), plan_trajectory(plan, case["index"])
 
 
 def _run(study: AbortStudy, cases: list, out_dir: str, kind: str, extra: dict, **campaign) -> str:
     task = Task("drake_entry.diagrams.aborts:setup_worker", "drake_entry.diagrams.aborts:run_case", study.config())
-    manifest = task_manifest(task, cases, kind=kind, **json_ready(extra))
+    manifest = task_manifest(task, cases, kind=kind, **extra)
     return run_cases(task, cases, out_dir, manifest, desc=kind.replace("_", " "), **campaign)
 
 
@@ -165,7 +154,7 @@ def run_descent_aborts(out_dir: str, *, study: AbortStudy | None = None, site: s
     plan, flight = fly_nominal(study)
     ref = plan.evaluate(flight.time)
     planet = plan.problem.planet
-    radius = 5e6 if objective == "miss" else plan.problem.mission.site_radius_m
+    radius = OPEN_SITE_RADIUS_M if objective == "miss" else plan.problem.mission.site_radius_m
     cases = descent_abort_cases(flight.time, flight.states, ref["bank"], ref["alpha"], planet,
                                 site=ALTERNATIVE_SITES[site], spacing_s=spacing_s, site_radius_m=radius,
                                 flight_path_bounds_deg=plan.problem.mission.flight_path_bounds_deg)

@@ -28,7 +28,7 @@ import numpy as np
 from ... import geodesy
 from ...errors import ScenarioError
 from ...planet import Earth
-from .mission import ScvxMission
+from .mission import SITE_RADIUS_MAX_M, ScvxMission
 
 #: the paper's grid spacing [deg] and the smallest map the issue asks for
 GRID_SPACING_DEG = 5.0
@@ -37,6 +37,8 @@ GRID_SHAPE = (9, 9)
 FEASIBLE_RADII_M = (10e3, 40e3)
 #: descent-abort trigger spacing [s] (paper 001 Sec. VI.B)
 DESCENT_ABORT_SPACING_S = 50.0
+#: the site cone of a minimum-miss descent abort [m]: opened to the largest a mission accepts
+OPEN_SITE_RADIUS_M = SITE_RADIUS_MAX_M
 #: alternative sites (longitude, geodetic latitude) [deg]. Not given in the paper: public
 #: approximate locations (town centres), labelled substitutes.
 ALTERNATIVE_SITES = {"ben_guerir": (-7.95, 32.23), "gran_canaria": (-15.39, 27.93)}
@@ -118,8 +120,8 @@ def case_mission(mission: ScvxMission, case: dict) -> ScvxMission:
 
 
 def descent_abort_cases(time, states, bank, alpha, planet: Earth, *, site: tuple, spacing_s: float =
-                        DESCENT_ABORT_SPACING_S, site_radius_m: float = 10e3, flight_path_bounds_deg=(-30.0, 0.5)
-                        ) -> list[dict]:
+                        DESCENT_ABORT_SPACING_S, site_radius_m: float = 10e3,
+                        flight_path_bounds_deg=ScvxMission.flight_path_bounds_deg) -> list[dict]:
     """Descent aborts along a flown nominal: every ``spacing_s`` seconds (from spacing_s to the
     end) its state (time [s], states (n, 6) SI, bank and alpha [rad] at those times) becomes an
     abort's entry state and held attitude, with the alternative ``site`` (longitude, geodetic

@@ -503,9 +503,8 @@ class EntryProblem(ConvexifiableProblem):
         extra = (["bank"] if self.i_sigma is not None else []) + (["alpha"] if self.i_alpha is not None else [])
         return (*STATE_NAMES, *extra)
 
-    def node_time(self, node: int, tf: float | None = None) -> str:
-        s = self.mesh.s[node]
-        return f"node {node} (s = {s:.3f})" if tf is None else f"node {node}, t = {s * tf:.0f} s"
+    def node_time(self, node: int) -> str:
+        return f"node {node} (s = {self.mesh.s[node]:.3f})"
 
     def describe_defect(self, i: int) -> str:
         seg, rest = divmod(i, (self.settings.nodes_per_segment - 1) * self.n_x)

@@ -17,6 +17,9 @@ from ...errors import ScenarioError
 from ...planet import Earth
 from ...schedules import Schedule
 
+#: the largest site radius a mission accepts [m] (a minimum-miss abort opens its cone to it)
+SITE_RADIUS_MAX_M = 5e6
+
 
 @dc.dataclass
 class ScvxMission:
@@ -82,7 +85,7 @@ class ScvxMission:
             check(f, getattr(self, f), -89.0, 89.0, "deg")
         for f in ("entry_longitude_deg", "site_longitude_deg", "entry_heading_deg"):
             check(f, getattr(self, f), -360.0, 360.0, "deg")
-        check("site_radius_m", self.site_radius_m, 1.0, 5e6, "m")
+        check("site_radius_m", self.site_radius_m, 1.0, SITE_RADIUS_MAX_M, "m")
         check("final_mach_max", self.final_mach_max, 0.1, 10.0, "-")
         check("final_vertical_speed_min_m_s", self.final_vertical_speed_min_m_s, -2000.0, 0.0, "m/s")
         check("bank_min_deg", self.bank_min_deg, 0.0, 45.0, "deg")

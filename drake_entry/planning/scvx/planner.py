@@ -11,6 +11,7 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
 from ...atmosphere import Atmosphere
+from ...constraints import dynamic_pressure
 from ...dynamics import STATE_NAMES, aero_accelerations, air_data, equations_of_motion, flight_conditions
 from ...planet import Earth
 from ...vehicles import Vehicle
@@ -204,7 +205,7 @@ def plan_metrics(problem: EntryProblem, X, U, tf: float) -> dict:
             "max_heat_flux_kW_m2": float(nodes[:, problem.out_q].max() / 1e3),
             "max_load_g": float(nodes[:, problem.out_n].max()),
             "max_flight_path_rate_deg_s": deg(float(np.abs(nodes[:, 4]).max())),
-            "max_dynamic_pressure_kPa": max(0.5 * air_data(x, problem.planet, problem.atmosphere)[0] * x[3] ** 2
+            "max_dynamic_pressure_kPa": max(dynamic_pressure(air_data(x, problem.planet, problem.atmosphere)[0], x[3])
                                             for x in X) / 1e3,
             "bank_effort_deg": deg(float(np.trapezoid(np.abs(sigma_dot), t))),
             "max_bank_rate_deg_s": deg(float(np.abs(sigma_dot).max())),

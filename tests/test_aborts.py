@@ -113,7 +113,7 @@ def test_feasibility_and_tables_4_to_7_statistics():
     stats = abort_statistics(rows, 40e3)
     assert stats["Table 4"]["heat_load_MJ_m2"] == pytest.approx((550.0, 50.0, 600.0, 500.0))
     text = statistics_markdown(stats)
-    assert "550 / 564.9" in text and "Table 7 form" in text
+    assert "550 / 564.9" in text and "Table 7 form" in text  # 564.9 MJ/m^2: paper 001 Table 4 mean heat load
     assert all(math.isnan(v) for v in abort_statistics(rows[3:], 40e3)["Table 5"]["drs_mach"])
 
 

@@ -10,8 +10,9 @@ from drake_entry.atmosphere import US76Atmosphere
 from drake_entry.errors import ScenarioError
 from drake_entry.planet import Earth
 from drake_entry.planning.scvx.engine import (ConvexifiableProblem, Evaluation, Linearisation, ScvxSettings,
-                                              golden_section, solve_scvx)
-from drake_entry.planning.scvx.entry import EntryProblem, EntryProblemSettings, heading_regulariser_sign
+                                              defect_correction, golden_section, solve_scvx)
+from drake_entry.planning.scvx.entry import (PAPER_LOSSLESS, EntryProblem, EntryProblemSettings,
+                                             heading_regulariser_sign)
 from drake_entry.planning.scvx.guess import glide_guess
 from drake_entry.planning.scvx.mission import ScvxMission
 from drake_entry.planning.scvx.planner import initial_decision, plan_entry
@@ -44,7 +45,9 @@ def test_engine_finds_the_optimum_on_a_circle(y_min, expected):
     # from the left: (sqrt(3)/2, -1/2) is a local minimum too (f rises along the arc from it)
     out = solve_scvx(Circle(y_min), np.array([-2.0, 0.5]), ScvxSettings(max_iterations=60))
     assert out.converged, out.message
-    assert out.z == pytest.approx(expected, abs=1e-4)
+    # first-order stationarity to the decrease tolerance: the objective to 1e-6, z along the arc to 1e-3
+    assert out.z.sum() == pytest.approx(sum(expected), abs=1e-6)
+    assert out.z == pytest.approx(expected, abs=1e-3)
     assert abs(out.evaluation.defects[0]) <= 1e-6
 
 
@@ -58,6 +61,33 @@ def test_engine_reports_an_infeasible_problem_with_its_constraint():
     out = solve_scvx(Named(y_min=2.0), np.array([0.5, 0.5]), ScvxSettings(max_iterations=40))
     assert not out.converged
     assert "y lower bound" in out.message or "defect" in out.message
+
+
+def test_defect_correction_is_the_least_norm_step_that_cancels_the_defects():
+    """The second-order correction: C dz = -c with dz = 0 on the fixed variables and |dz| the
+    smallest such (numpy's least-norm solution on the free columns)."""
+    rng = np.random.default_rng(3)
+    C = sp.random(6, 10, density=0.5, random_state=rng, format="csc") + sp.eye(6, 10, k=2, format="csc")
+    c = rng.normal(size=6)
+    free = np.ones(10, bool)
+    free[[0, 5]] = False
+    dz = defect_correction(C, c, free)
+    assert C @ dz == pytest.approx(-c, abs=1e-12)
+    assert dz[~free] == pytest.approx(0.0, abs=0.0)
+    assert dz[free] == pytest.approx(np.linalg.lstsq(C.toarray()[:, free], -c, rcond=None)[0], abs=1e-12)
+
+
+def test_second_order_correction_cuts_the_iterations_on_the_circle():
+    """On the circle the correction returns each step to x^2 + y^2 = 1: the optimum (within the
+    first-order tolerance: 5e-4 along the arc is 2e-7 of objective) in fewer iterations than the
+    plain linear model (measured 22 against 27)."""
+    plain = solve_scvx(Circle(), np.array([-2.0, 0.5]), ScvxSettings(second_order_correction=False))
+    corrected = solve_scvx(Circle(), np.array([-2.0, 0.5]), ScvxSettings())
+    assert corrected.converged and plain.converged
+    assert corrected.z == pytest.approx([-math.sqrt(0.5)] * 2, abs=1e-3)
+    assert corrected.z.sum() == pytest.approx(-math.sqrt(2.0), abs=1e-6)
+    assert abs(corrected.evaluation.defects[0]) <= 1e-6
+    assert corrected.iterations < plain.iterations
 
 
 def test_golden_section_finds_the_minimum_of_a_parabola_within_its_bracket():
@@ -103,7 +133,20 @@ def test_mission_converts_the_paper001_table1_interface_and_site(sphynx_case):
     assert heading_regulariser_sign(x0, lat) == 1.0  # site north of the entry point
 
 
-@pytest.mark.parametrize("formulation, objective", [("lossless", "heat_load"), ("hybrid", "max_heat_flux"),
+def test_mission_from_geocentric_inverts_entry_state_and_site(sphynx_case):
+    """``ScvxMission.from_geocentric`` (the closed loop's and a re-plan's entry) is the exact
+    inverse of ``entry_state`` and ``site`` on the oblate Earth."""
+    _, planet, _, mission, _ = sphynx_case
+    x0 = mission.entry_state(planet)
+    again = ScvxMission.from_geocentric(planet, x0, *mission.site(planet))
+    assert again.entry_state(planet) == pytest.approx(x0, abs=1e-9)
+    assert again.site(planet) == pytest.approx(mission.site(planet), abs=1e-12)
+    assert again.entry_altitude_m == pytest.approx(120e3, abs=1e-6)
+    assert again.site_latitude_deg == pytest.approx(36.974, abs=1e-9)
+
+
+@pytest.mark.parametrize("formulation, objective", [("lossless", "heat_load"), ("paper_lossless", "heat_load"),
+                                                   ("hybrid", "max_heat_flux"),
                                                    ("direct_bank", "max_flight_path_rate"), ("direct", "control_effort"),
                                                    ("direct", "max_load"), ("direct", "miss")])
 def test_entry_jacobians_equal_central_differences(sphynx_case, formulation, objective):
@@ -111,9 +154,10 @@ def test_entry_jacobians_equal_central_differences(sphynx_case, formulation, obj
     the project's one set of equations against central differences, on a small mesh at the glide
     guess, for each formulation and the epigraph objectives."""
     vehicle, planet, atmosphere, mission, guess = sphynx_case
+    form = PAPER_LOSSLESS if formulation == "paper_lossless" else {"formulation": formulation}
     problem = EntryProblem(vehicle, planet, atmosphere, mission,
                            EntryProblemSettings(segments=3, nodes_per_segment=3, heading_weight=0.02,
-                                                formulation=formulation, objective=objective), guess.final_time)
+                                                objective=objective, **form), guess.final_time)
     z = initial_decision(problem, guess)
     lin = problem.linearise(z)
     C, G = lin.defect_jacobian.toarray(), lin.inequality_jacobian.toarray()
@@ -175,6 +219,13 @@ def lossless_plan(sphynx_case):
                       problem_settings=EntryProblemSettings(formulation="lossless"))
 
 
+@pytest.fixture(scope="module")
+def paper_lossless_plan(sphynx_case):
+    vehicle, planet, atmosphere, mission, guess = sphynx_case
+    return plan_entry(vehicle, planet, atmosphere, mission, guess=guess,
+                      problem_settings=EntryProblemSettings(**PAPER_LOSSLESS))
+
+
 def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, nominal_plan):
     """Paper 001 nominal (Table 1 interface, Azores site), direct bank and alpha (the form of its
     Tables 2 and 4-7), heat-load objective: converges with defects <= 1e-6 inside every limit, and
@@ -206,32 +257,56 @@ def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, no
     assert mid["bank"][0] == pytest.approx(plan.bank[len(plan.time) // 2], abs=1e-12)
 
 
-def test_lossless_plan_reports_its_gap_and_is_refused_when_its_bank_does_not_fly(lossless_plan):
-    """The lossless bank (Table 3 'Lossless Bank') converges near the study's 520 MJ/m^2 with
-    |u| < 1 at the skip and the final dive; flying atan2(u2, u1) ends 5.7 km from the plan
-    (measured), beyond the 5 km the planner accepts, so the plan says 'converged but inaccurate'
-    and points to the direct polish instead of claiming success."""
+def test_nominal_lossless_plan_converges_in_35_iterations_and_its_real_bank_flies(sphynx_case, lossless_plan):
+    """Issue 13's evidence: the nominal lossless heat-load plan (u = (cos, sin) of the bank, eqs.
+    37-45, with the floor |u| >= 0.99 and the bank-rate chords) converges from the glide guess in
+    <= 35 iterations (measured 34) with defects <= 1e-6, reports its gap (<= 0.01), and its real
+    bank atan2(u2, u1) flown by the Drake Simulator ends <= 5 km from the plan (measured 1.7 km),
+    <= 15 km from the site (8.7), inside the DRS box. Heat load 521.2 MJ/m^2 measured (the paper's
+    lossless 573.5 with its aero table, Table 3)."""
+    from drake_entry.diagrams.plan_flight import fly_plan
+
+    vehicle, planet, atmosphere, mission, _ = sphynx_case
     plan = lossless_plan
+    assert plan.success, plan.message
+    assert plan.iterations <= 35
+    assert plan.max_defect <= 1e-6 and plan.max_violation <= 1e-6
+    assert plan.lossless_gap <= 0.01 + 1e-6 and plan.lossless_gap_all <= 0.01 + 1e-6
+    assert 500.0 < plan.objective < 540.0
+    turns = plan.problem.bank_turns(plan.controls)
+    assert np.all(turns <= plan.problem.bank_turn_limits(plan.final_time) * (1 + 1e-6) + 1e-6)
+    flight = fly_plan(plan, vehicle, planet, atmosphere)
+    assert flight.ok and flight.drs_ok, (flight.from_plan_m, flight.drs)
+    assert flight.from_plan_m <= 5e3 and flight.from_site_m <= 15e3
+
+
+def test_paper_lossless_plan_reports_its_gap_and_is_refused_when_its_bank_does_not_fly(paper_lossless_plan):
+    """The paper's lossless relaxation (Table 3 'Lossless Bank': no floor on |u|, no rate limit,
+    the heading regulariser) converges near the study's 520 MJ/m^2 with |u| < 1 at the skip and
+    the final dive; flying atan2(u2, u1) ends 6-19 km from the plan (measured, by trust-region
+    path), beyond the 5 km the planner accepts, so the plan says 'converged but inaccurate' and
+    points to the direct polish instead of claiming success."""
+    plan = paper_lossless_plan
     assert plan.message.startswith("converged in")
     assert plan.max_defect <= 1e-6 and plan.max_violation <= 1e-6
     assert 500.0 < plan.objective < 540.0
-    assert 0.01 < plan.lossless_gap < 0.2
+    assert 0.01 < plan.lossless_gap < 0.5  # 0.1-0.3 measured, by trust-region path
     assert plan.success == (plan.propagated_error_m <= 5e3)
     if not plan.success:
         assert "converged but inaccurate" in plan.message and "'direct'" in plan.message
 
 
-def test_direct_polish_of_the_lossless_plan_flies(sphynx_case, lossless_plan):
+def test_direct_polish_of_the_lossless_plan_flies(sphynx_case, paper_lossless_plan):
     """``plan_entry(initial=lossless plan)`` in the direct formulation: the bank becomes a state
     (rate-limited from atan2(u2, u1)) and alpha is freed; the polished plan flies within 5 km
     and lowers the heat load (alpha planned)."""
     vehicle, planet, atmosphere, mission, _ = sphynx_case
-    polished = plan_entry(vehicle, planet, atmosphere, mission, initial=lossless_plan,
+    polished = plan_entry(vehicle, planet, atmosphere, mission, initial=paper_lossless_plan,
                           problem_settings=EntryProblemSettings(formulation="direct"))
     assert polished.success, polished.message
     assert polished.guess is None
     assert polished.propagated_error_m < 5e3
-    assert polished.objective < lossless_plan.objective
+    assert polished.objective < paper_lossless_plan.objective
 
 
 def test_warm_start_from_a_plan_on_a_finer_mesh_keeps_its_heat_load(sphynx_case, nominal_plan):
@@ -253,10 +328,11 @@ def test_warm_start_from_a_plan_on_a_finer_mesh_keeps_its_heat_load(sphynx_case,
 def test_min_max_load_objective_is_the_epigraph_of_the_peak_load(sphynx_case, lossless_plan):
     """Table 2's 'Min Maximum g-load' through the epigraph variable (mu >= n_k at every node):
     the objective is the plan's peak load and lies below the heat-load plan's peak (Table 2: 1.111 g
-    with its aero; measured here 1.17 g in 13 iterations)."""
+    with its aero; measured here 1.17 g in 16 iterations), in the paper's relaxation (with the
+    |u| floor and the rate chords it does not converge in 60: the peak alone shapes the plan)."""
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     plan = plan_entry(vehicle, planet, atmosphere, mission, guess=guess,
-                      problem_settings=EntryProblemSettings(formulation="lossless", objective="max_load"))
+                      problem_settings=EntryProblemSettings(objective="max_load", **PAPER_LOSSLESS))
     assert plan.success, plan.message
     assert plan.objective == pytest.approx(plan.metrics["max_load_g"], rel=1e-6)
     assert plan.objective < 0.6 * lossless_plan.metrics["max_load_g"]

@@ -31,6 +31,7 @@ import time
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from pydrake.solvers import ClarabelSolver, MathematicalProgram, ScsSolver, SolverOptions
 
 from ...errors import ScenarioError
@@ -85,6 +86,11 @@ class ConvexifiableProblem:
         variables (one per entry of ``Evaluation.convex_violations``, >= 0, penalised)."""
         return np.empty(0, dtype=object)
 
+    def correction_variables(self) -> np.ndarray:
+        """Boolean mask of the variables the second-order correction may move (default: every
+        variable not fixed by its bounds)."""
+        return self.upper > self.lower
+
     def describe_defect(self, i: int) -> str:
         return f"defect {i}"
 
@@ -116,6 +122,10 @@ class ScvxSettings:
       defect_tolerance: largest scaled defect at convergence.
       constraint_tolerance: largest scaled inequality or convex violation at convergence.
       decrease_tolerance: predicted decrease of J_a (relative to 1 + |J_a|) at convergence.
+      second_order_correction: after each SOCP step, also try the step plus the minimum-norm
+        correction that cancels the defects it created (``defect_correction``) and keep the
+        better point; near the solution the created defects are what makes the linear model
+        over-predict, so rho stays near 1 and the trust region need not collapse.
       solver: 'clarabel' or 'scs'. solver_options: passed to the solver (over CLARABEL_DEFAULTS).
     """
 
@@ -133,6 +143,7 @@ class ScvxSettings:
     defect_tolerance: float = 1e-6
     constraint_tolerance: float = 1e-6
     decrease_tolerance: float = 1e-4
+    second_order_correction: bool = True
     solver: str = "clarabel"
     solver_options: dict = dc.field(default_factory=dict)
 
@@ -285,6 +296,20 @@ class ScvxSubproblem:
         return z, float(predicted), its
 
 
+def defect_correction(defect_jacobian: sp.spmatrix, defects: np.ndarray, free: np.ndarray) -> np.ndarray:
+    """The least-norm change dz of the free variables (boolean mask ``free``) with
+    C dz = -defects: a second-order correction of an SQP step (Nocedal & Wright, Sec. 15.4),
+    C the defect Jacobian of the current linearisation, ``defects`` those at the trial point."""
+    Cf = sp.csc_matrix(defect_jacobian)[:, free]
+    n = Cf.shape[1]
+    # the KKT system [I C^T; C 0] keeps C's sparsity (C C^T is dense through the t_f column)
+    kkt = sp.bmat([[sp.identity(n), Cf.T], [Cf, None]], format="csc")
+    solution = spla.splu(kkt).solve(np.concatenate([np.zeros(n), -np.asarray(defects, float)]))
+    dz = np.zeros(len(free))
+    dz[free] = solution[:n]
+    return dz
+
+
 def golden_section(merit_at, full_step_merit: float, steps: int) -> tuple[float, float]:
     """Step length alpha in [0, 1] minimising the merit along the step (eq. 29, alpha1 = 0,
     alpha4 = 1), ``steps`` interval reductions; returns (alpha, merit). The full step is kept
@@ -315,6 +340,7 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
     t0 = time.perf_counter()
     sub = ScvxSubproblem(problem, s)
     z = np.clip(np.asarray(z0, float), problem.lower, problem.upper)
+    free = problem.correction_variables() & (problem.upper > problem.lower)
     lin = problem.linearise(z)
     model_time = time.perf_counter() - t0
     socp_time = 0.0
@@ -349,13 +375,18 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
                 message = ("stationary at an infeasible point (no decrease of the penalised merit is "
                            "predicted): " + diagnose(problem, ev))
             break
+        ja_full = merit(problem.evaluate(z_new), s)
+        if s.second_order_correction and problem.n_defects:
+            z_soc = np.clip(z_new + defect_correction(lin.defect_jacobian, problem.evaluate(z_new).defects, free),
+                            problem.lower, problem.upper)
+            ja_soc = merit(problem.evaluate(z_soc), s)
+            if ja_soc < ja_full:
+                z_new, ja_full = z_soc, ja_soc
         step = z_new - z
 
         def merit_at(a):
             return merit(problem.evaluate(z + a * step), s)
 
-        ev_full = problem.evaluate(z_new)
-        ja_full = merit(ev_full, s)
         alpha, ja_new = 1.0, ja_full
         if s.line_search_steps:
             alpha, ja_new = golden_section(merit_at, ja_full, s.line_search_steps)
@@ -369,7 +400,7 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
             ja = merit(lin.evaluation, s)
         if not accepted or rho < s.rho1:
             radius /= s.trust_factor
-        elif rho >= s.rho2:
+        elif rho >= s.rho2 and (not history or history[-1].accepted):
             radius = min(radius * s.trust_factor, s.trust_radius_max)
         model_time += time.perf_counter() - t2
         ev = lin.evaluation

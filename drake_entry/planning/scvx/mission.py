@@ -59,7 +59,7 @@ class ScvxMission:
     site_latitude_deg: float = 36.974
     site_radius_m: float = 10e3
     final_altitude_m: tuple = (10e3, 13e3)
-    final_altitude_margin_m: float = 200.0
+    final_altitude_margin_m: float = 500.0
     final_mach_max: float = 1.0
     final_vertical_speed_min_m_s: float = -140.0
     flight_path_bounds_deg: tuple = (-30.0, 0.5)
@@ -111,6 +111,20 @@ class ScvxMission:
         if not self.heading_bounds_deg[0] <= self.entry_heading_deg <= self.heading_bounds_deg[1]:
             raise ScenarioError(f"ScvxMission.entry_heading_deg = {self.entry_heading_deg} lies outside "
                                 f"heading_bounds_deg = {tuple(self.heading_bounds_deg)}")
+
+    @staticmethod
+    def from_geocentric(planet: Earth, x0, site_longitude: float, site_latitude: float, **fields) -> "ScvxMission":
+        """The mission from a state x0 = [h above the reference sphere, lon, geocentric lat, V,
+        gamma, psi] (SI, rad) and a site on the surface at geocentric (lon, lat) [rad]: the
+        inverse of ``entry_state`` and ``site`` (exact); ``fields`` set the rest."""
+        h, lat = planet.geodetic(planet.radius(float(x0[0])), float(x0[2]))
+        e2 = planet.flattening * (2.0 - planet.flattening)
+        site_lat = math.atan2(math.tan(site_latitude), 1.0 - e2) if abs(site_latitude) < math.pi / 2 else site_latitude
+        deg = math.degrees
+        return ScvxMission(entry_altitude_m=float(h), entry_longitude_deg=deg(float(x0[1])),
+                           entry_latitude_deg=deg(float(lat)), entry_speed_m_s=float(x0[3]),
+                           entry_flight_path_deg=deg(float(x0[4])), entry_heading_deg=deg(float(x0[5])),
+                           site_longitude_deg=deg(site_longitude), site_latitude_deg=deg(site_lat), **fields)
 
     def entry_state(self, planet: Earth) -> np.ndarray:
         """[h, lon, lat, V, gamma, psi] at the EIP: altitude above the reference sphere,

@@ -139,6 +139,8 @@ def decision_from_trajectory(problem: EntryProblem, states, bank, alpha, tf: flo
     f, m, v = problem.formulation, problem.mission, problem.vehicle
     held = (lambda path, value: np.concatenate([[math.radians(value)], path[1:]]) if value is not None else path)
     if f.bank == "lossless":
+        if lossless_controls is None and problem.rate_chords:
+            bank, _ = _rate_limited(t, np.unwrap(bank), v.bank_rate_limit, -math.inf, math.inf)
         U.append(lossless_controls if lossless_controls is not None else np.stack([np.cos(bank), np.sin(bank)], axis=1))
     else:
         sigma, rate = _rate_limited(t, held(np.unwrap(bank), m.entry_bank_deg), v.bank_rate_limit, -v.bank_limit,
@@ -311,3 +313,39 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     plan.solve_time = time.perf_counter() - t0 - build
     return plan
 
+
+
+#: ScvxMission fields a re-plan takes from the state flown (the rest stay the mission's)
+_ENTRY_FIELDS = ("entry_altitude_m", "entry_longitude_deg", "entry_latitude_deg", "entry_speed_m_s",
+                 "entry_flight_path_deg", "entry_heading_deg", "site_longitude_deg", "site_latitude_deg",
+                 "entry_bank_deg", "entry_alpha_deg")
+
+
+def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float, *,
+                settings: ScvxSettings | None = None) -> ScvxPlan:
+    """Re-plan ``previous``'s mission from state ``x`` [h, lon, lat, V, gamma, psi] reached
+    ``elapsed`` [s] into it, holding the bank and alpha being flown [rad] where they are
+    states (the rate formulations): the same site, DRS box, limits, formulation and mesh,
+    warm-started from the rest of the previous plan (its states from ``elapsed`` to its t_f,
+    stretched over the new interval). A state outside the mission's bounds (e.g. gamma above
+    0.5 deg in a dispersed skip) is clipped into them for the new entry point."""
+    p = previous.problem
+    m = p.mission
+    x = np.array(x, float)
+    x[4] = np.clip(x[4], *np.radians(m.flight_path_bounds_deg))
+    fields = {k: v for k, v in dc.asdict(m).items() if k not in _ENTRY_FIELDS}
+    f = p.formulation
+    if f.bank == "rate":
+        fields["entry_bank_deg"] = float(np.clip(math.degrees(bank), -180.0, 180.0))
+    if f.alpha == "rate":
+        fields["entry_alpha_deg"] = float(np.clip(math.degrees(alpha), *m.alpha_bounds_deg))
+    mission = ScvxMission.from_geocentric(p.planet, x, p.site_lon, p.site_lat, **fields)
+    rest = np.linspace(min(elapsed, previous.final_time), previous.final_time, 200)
+    ref = previous.evaluate(rest)
+    states = np.stack([ref[k] for k in STATE_NAMES], axis=1)
+    states[0] = x
+    guess = GlideGuess(rest - rest[0], states, ref["bank"], math.nan, math.nan, True)
+    if guess.final_time <= 0.0:
+        raise ValueError(f"the previous plan has no time left at {elapsed:.1f} s (t_f {previous.final_time:.1f} s)")
+    return plan_entry(p.vehicle, p.planet, p.atmosphere, mission, problem_settings=p.settings,
+                      settings=settings, guess=guess)

@@ -175,8 +175,9 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
         builder.Connect(commands.alpha, alpha.get_input_port())
         alpha_out = alpha.GetOutputPort("alpha")
     builder.Connect(alpha_out, plant.GetInputPort("alpha"))
-    monitor = builder.AddNamedSystem("termination", TerminationMonitor(
-        energy=setup.terminal[2], altitude=ALTITUDE_FLOOR_M, planet=setup.energy_planet))
+    stop = ({"altitude": setup.terminal[0]} if g.stops_at_altitude
+            else {"energy": setup.terminal[2], "altitude": ALTITUDE_FLOOR_M})
+    monitor = builder.AddNamedSystem("termination", TerminationMonitor(**stop, planet=setup.energy_planet))
     builder.Connect(state, monitor.GetInputPort("state"))
     builder.Connect(air.GetOutputPort("air_data"), monitor.GetInputPort("air_data"))
 
@@ -236,17 +237,19 @@ def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoo
     errors = terminal_errors(tr.state[-1], setup)
     box = acceptance_box(tr, setup, errors["distance_m"])
     missed = [f"{k} {_box_text(k, b)}" for k, b in box.items() if not b["inside"]]
-    if "energy" not in tr.reason:
-        ok, msg = False, f"stopped before E_f: {tr.reason}"
+    by_altitude = setup.scenario.guidance.stops_at_altitude
+    name = "h_f" if by_altitude else "E_f"
+    if ("altitude" if by_altitude else "energy") not in tr.reason:
+        ok, msg = False, f"stopped before {name}: {tr.reason}"
     elif not guidance.active:
         ok, msg = False, guidance.message
     elif not all(math.isfinite(v) for v in errors.values()):
-        ok, msg = False, f"reached E_f with non-finite terminal errors {errors}"
+        ok, msg = False, f"reached {name} with non-finite terminal errors {errors}"
     elif missed:
-        ok, msg = False, f"outside the acceptance box: {'; '.join(missed)} (reached E_f at t = {tr.time[-1]:.1f} s)"
+        ok, msg = False, f"outside the acceptance box: {'; '.join(missed)} (reached {name} at t = {tr.time[-1]:.1f} s)"
     else:
         ok = True
-        msg = f"reached E_f at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
+        msg = f"reached {name} at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
     return ClosedLoopResult(tr, errors, ok, msg, setup.method.name, guidance, box)
 
 

@@ -1,6 +1,6 @@
 """Scenario files: dataclass schemas read with ``pydrake.common.yaml.yaml_load_typed``.
 
-Packaged scenarios live in ``drake_entry/scenarios/*.yaml`` (horus2b, shefex3, cav_h, cav_h_paper004,
+Packaged scenarios live in ``drake_entry/scenarios/*.yaml`` (horus2b, shefex3, cav_h, cav_h_paper004, sphynx_paper001,
 marv); ``load_scenario(name_or_path)`` reads either. Fields not in SI carry their unit
 in the name. Every bad value raises a one-line ``ScenarioError`` naming the field and the
 allowed range.
@@ -321,7 +321,7 @@ def atmosphere_from_spec(a: AtmosphereSpec) -> Atmosphere:
     raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential, table")
 
 
-PACKAGED_SCENARIOS = ("horus2b", "shefex3", "cav_h", "cav_h_paper004", "marv")
+PACKAGED_SCENARIOS = ("horus2b", "shefex3", "cav_h", "cav_h_paper004", "marv", "sphynx_paper001")
 
 
 def load_scenario(name_or_path: str) -> Scenario:

@@ -14,12 +14,14 @@ from typing import Union
 from ..errors import ScenarioError
 from .bank_profile.spec import BankProfile
 from .drag_energy.spec import DragEnergy
+from .scvx.spec import Scvx
 from .swarm_bank.spec import SwarmBank
 
 REGISTRY = {
     DragEnergy: "drake_entry.guidance.drag_energy.method",
     BankProfile: "drake_entry.guidance.bank_profile.method",
     SwarmBank: "drake_entry.guidance.swarm_bank.method",
+    Scvx: "drake_entry.guidance.scvx.method",
 }
 
 #: the scenario's ``guidance:`` field type (the first is the default when untagged)

@@ -14,6 +14,10 @@ from ..errors import ScenarioError, check_range
 class GuidanceSpecBase:
     """Fields of every guidance method."""
 
+    #: the closed loop stops at the terminal energy (False) or on reaching the terminal altitude
+    #: (True: a mission whose terminal box is an altitude window, e.g. paper 001's DRS)
+    stops_at_altitude = False
+
     # guidance terminal interface: the closed loop stops at the (central-gravity) energy of
     # this altitude and Mach, and its terminal errors are measured there
     terminal_altitude_km: float = 25.0

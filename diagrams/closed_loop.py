@@ -99,6 +99,8 @@ class ClosedLoopResult:
       method: the guidance method's name.
       guidance: the method's GuidanceSummary (plans, planning time, its own fields and details).
       box: the acceptance box per criterion given (acceptance_box).
+      reached: the flight stopped at the terminal interface (E_f, or h_f for a spec that
+        stops at its altitude), inside the box or not.
     """
 
     trajectory: Trajectory
@@ -108,6 +110,7 @@ class ClosedLoopResult:
     method: str
     guidance: GuidanceSummary
     box: dict = dc.field(default_factory=dict)
+    reached: bool = False
 
 
 @dc.dataclass
@@ -239,7 +242,8 @@ def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoo
     missed = [f"{k} {_box_text(k, b)}" for k, b in box.items() if not b["inside"]]
     by_altitude = setup.scenario.guidance.stops_at_altitude
     name = "h_f" if by_altitude else "E_f"
-    if ("altitude" if by_altitude else "energy") not in tr.reason:
+    reached = ("altitude" if by_altitude else "energy") in tr.reason
+    if not reached:
         ok, msg = False, f"stopped before {name}: {tr.reason}"
     elif not guidance.active:
         ok, msg = False, guidance.message
@@ -250,7 +254,7 @@ def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoo
     else:
         ok = True
         msg = f"reached {name} at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
-    return ClosedLoopResult(tr, errors, ok, msg, setup.method.name, guidance, box)
+    return ClosedLoopResult(tr, errors, ok, msg, setup.method.name, guidance, box, reached)
 
 
 def _box_text(name: str, b: dict) -> str:

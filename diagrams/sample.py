@@ -96,7 +96,8 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
     tr, x = res.trajectory, res.trajectory.state[-1]
     g = res.guidance
     return {
-        "success": bool(res.success), "message": res.message, "stop": tr.reason, "method": res.method,
+        "success": bool(res.success), "message": res.message, "stop": tr.reason,
+        "reached_terminal": bool(res.reached), "method": res.method,
         "flight_time_s": float(tr.time[-1]), "plans": int(g.plans), "planning_wall_s": g.planning_wall_s, **g.fields,
         "final_altitude_m": float(x[0]), "final_velocity_m_s": float(x[3]),
         "final_longitude_deg": math.degrees(x[1]), "final_latitude_deg": math.degrees(x[2]),

@@ -33,12 +33,16 @@ def _finite(rows: dict, col: str, n: int) -> np.ndarray:
 
 
 def reached_terminal(rows: dict) -> np.ndarray:
-    """Samples whose flight reached the terminal interface (stopped at E_f) with finite
-    terminal errors: the population of the error statistics, inside the box or not."""
+    """Samples whose flight reached the terminal interface (E_f, or the terminal altitude of a
+    method that stops there: the row's ``reached_terminal``; campaigns written before that
+    column: stopped at E_f) with finite terminal errors: the population of the error
+    statistics, inside the box or not."""
     n = len(rows["index"])
     stop = rows.get("stop") or [None] * n
-    return np.array([bool(s) and str(s).startswith("reached energy") for s in stop]) & np.isfinite(
-        _finite(rows, "err_distance_m", n))
+    flag = rows.get("reached_terminal") or [None] * n
+    reached = [bool(f) if f is not None else (bool(s) and str(s).startswith("reached energy"))
+               for f, s in zip(flag, stop)]
+    return np.array(reached, bool) & np.isfinite(_finite(rows, "err_distance_m", n))
 
 
 def summary_statistics(rows: dict) -> dict:

@@ -44,7 +44,7 @@ def test_paper000_campaign_rows_are_unchanged_and_beat_table3(tmp_path):
             assert new["err_distance_m"] == pytest.approx(old["err_distance_m"], abs=50.0)
     added = set(rows[0]) - set(recorded["rows"][0]) - set(TIMING_COLUMNS)
     assert added == {"method", "peak_total_load_g", "heat_load_J_m2", "inside_altitude_box", "inside_mach_box",
-                     "inside_distance_box"}
+                     "inside_distance_box", "reached_terminal"}
     st = summary_statistics(pq.read_table(f"{out}/samples.parquet").to_pydict())
     assert st["successful"] == 20
     assert abs(st["errors"]["err_range_m"]["mean"]) < 312.3

@@ -3,7 +3,7 @@ nominal mission flown through the shared Drake closed loop (navigation, bank and
 actuators), re-planned on board from the navigation estimate every 200 s, then a small
 Monte-Carlo campaign of it with its report.
 
-The pre-flight plan alone, flown through the actuators, ends about 23 km from the site (their
+The pre-flight plan alone, flown through the actuators, ends about 21.5 km from the site (their
 lag accumulates); each re-plan starts from the estimated state holding the bank and alpha being
 flown, so the flight ends at the plan's 10 km. The scenario ``sphynx_paper001`` converts paper
 001's geodetic Table 1 entry and site; its dispersions are a labelled choice (the paper flies

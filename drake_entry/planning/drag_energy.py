@@ -232,6 +232,10 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
     return ref
 
 
+#: SCS options of the drag-energy SOCP (first-order: converges slowly here; drake-entry bench-socp)
+SCS_OPTIONS = {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iters": 20000}
+
+
 def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyReference:
     """One SOCP of eqs. 82-92 on the LGL operator ``op`` with corridor bounds D_lo, D_hi [m/s^2]
     at its nodes and fixed range weights kappa (``plan`` iterates it and extracts the states)."""
@@ -265,8 +269,8 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
     t1 = time.perf_counter()
     solver = SOLVERS[p.solver]()
     options = SolverOptions()
-    if p.solver == "scs":  # first-order: converges slowly here (drake-entry bench-socp); cap the work
-        for k, v in (("eps_abs", 1e-7), ("eps_rel", 1e-7), ("max_iters", 20000)):
+    if p.solver == "scs":
+        for k, v in SCS_OPTIONS.items():
             options.SetOption(solver.solver_id(), k, v)
     else:  # Clarabel's iterative refinement of each KKT solve took about 30 % of the solve time here
         # and moved the 40-node solution by 5e-9 (relative); _check_solution verifies the result.

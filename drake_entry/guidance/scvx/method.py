@@ -14,9 +14,6 @@ import math
 
 import numpy as np
 
-from ...planning.scvx.engine import ScvxSettings
-from ...planning.scvx.entry import EntryProblemSettings
-from ...planning.scvx.mission import ScvxMission
 from ...planning.scvx.planner import ScvxPlan, plan_entry
 from ...systems.scvx_guidance import ScvxGuidance
 from ..interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
@@ -27,46 +24,24 @@ GUIDANCE_SYSTEM = "scvx_guidance"
 ALPHA_ACCELERATION_DEG_S2 = 5.0
 
 
-def mission_of(scenario) -> ScvxMission:
-    """The ScvxMission of a scenario with a ``!Scvx`` guidance spec: entry state and target from
-    the scenario (geocentric, converted to paper 001's geodetic form), the rest from the spec."""
-    g = scenario.guidance
-    t = scenario.target
-    return ScvxMission.from_geocentric(
-        scenario.make_planet(), scenario.initial_state(), math.radians(t.longitude_deg), math.radians(t.latitude_deg),
-        site_radius_m=g.site_radius_km * 1e3, final_altitude_m=tuple(1e3 * h for h in g.drs_altitude_km),
-        final_altitude_margin_m=g.drs_altitude_margin_m, final_mach_max=g.drs_mach_max,
-        final_vertical_speed_min_m_s=g.drs_vertical_speed_min_m_s,
-        flight_path_bounds_deg=tuple(g.flight_path_bounds_deg), heading_bounds_deg=tuple(g.heading_bounds_deg),
-        bank_min_deg=g.bank_min_deg, alpha_deg=tuple(g.alpha_deg), alpha_speeds_m_s=tuple(g.alpha_speeds_m_s),
-        alpha_bounds_deg=tuple(g.alpha_bounds_deg), alpha_rate_limit_deg_s=g.alpha_rate_deg_s, name=scenario.name)
-
-
-def settings_of(scenario) -> tuple[EntryProblemSettings, ScvxSettings]:
-    g = scenario.guidance
-    return (EntryProblemSettings(segments=g.segments, nodes_per_segment=g.nodes_per_segment,
-                                 formulation=g.formulation, objective=g.objective),
-            ScvxSettings(max_iterations=g.max_iterations, solver=g.solver))
-
-
 class ScvxMethod(GuidanceMethod):
     name = "scvx"
 
     def make_planner(self, scenario) -> ScvxPlan:
-        problem, scvx = settings_of(scenario)
+        problem, scvx = scenario.guidance.planner_settings()
         return plan_entry(scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere(),
-                          mission_of(scenario), problem_settings=problem, settings=scvx)
+                          scenario.guidance.mission(scenario), problem_settings=problem, settings=scvx)
 
     def add_systems(self, builder, scenario, planner: ScvxPlan, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance
         guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, ScvxGuidance(
             planner, period=g.period_s, replan_period=g.replan_period_s, min_time_to_go=g.replan_min_time_to_go_s,
-            scvx_settings=settings_of(scenario)[1]))
+            scvx_settings=g.planner_settings()[1]))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         lo, hi = np.radians(g.alpha_bounds_deg)
         return GuidanceCommands(
             bank=guidance.GetOutputPort("bank_command"), alpha=guidance.GetOutputPort("alpha_command"),
-            alpha_limits=ActuatorLimits(float(lo), float(hi), math.radians(g.alpha_rate_deg_s),
+            alpha_limits=ActuatorLimits(float(lo), float(hi), math.radians(g.alpha_rate_limit_deg_s),
                                         math.radians(ALPHA_ACCELERATION_DEG_S2)),
             initial_bank=float(planner.bank[0]), initial_alpha=float(planner.alpha[0]),
             logged={"alpha_command": LoggedSignal(guidance.GetOutputPort("alpha_command"), ("alpha_command_rad",)),

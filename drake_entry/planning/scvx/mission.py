@@ -59,7 +59,7 @@ class ScvxMission:
     site_latitude_deg: float = 36.974
     site_radius_m: float = 10e3
     final_altitude_m: tuple = (10e3, 13e3)
-    final_altitude_margin_m: float = 500.0
+    final_altitude_margin_m: float = 200.0
     final_mach_max: float = 1.0
     final_vertical_speed_min_m_s: float = -140.0
     flight_path_bounds_deg: tuple = (-30.0, 0.5)

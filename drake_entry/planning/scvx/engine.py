@@ -299,11 +299,13 @@ class ScvxSubproblem:
 def defect_correction(defect_jacobian: sp.spmatrix, defects: np.ndarray, free: np.ndarray) -> np.ndarray:
     """The least-norm change dz of the free variables (boolean mask ``free``) with
     C dz = -defects: a second-order correction of an SQP step (Nocedal & Wright, Sec. 15.4),
-    C the defect Jacobian of the current linearisation, ``defects`` those at the trial point."""
+    C the Jacobian of the current linearisation (the defects', and the rows of the
+    inequalities violated at the trial point), ``defects`` their values at the trial point."""
     Cf = sp.csc_matrix(defect_jacobian)[:, free]
     n = Cf.shape[1]
-    # the KKT system [I C^T; C 0] keeps C's sparsity (C C^T is dense through the t_f column)
-    kkt = sp.bmat([[sp.identity(n), Cf.T], [Cf, None]], format="csc")
+    # the KKT system [I C^T; C -delta I] keeps C's sparsity (C C^T is dense through the t_f
+    # column); the tiny -delta I makes it quasi-definite, so dependent rows do not make it singular
+    kkt = sp.bmat([[sp.identity(n), Cf.T], [Cf, -1e-12 * sp.identity(Cf.shape[0])]], format="csc")
     solution = spla.splu(kkt).solve(np.concatenate([np.zeros(n), -np.asarray(defects, float)]))
     dz = np.zeros(len(free))
     dz[free] = solution[:n]
@@ -375,10 +377,13 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
                 message = ("stationary at an infeasible point (no decrease of the penalised merit is "
                            "predicted): " + diagnose(problem, ev))
             break
-        ja_full = merit(problem.evaluate(z_new), s)
+        ev_new = problem.evaluate(z_new)
+        ja_full = merit(ev_new, s)
         if s.second_order_correction and problem.n_defects:
-            z_soc = np.clip(z_new + defect_correction(lin.defect_jacobian, problem.evaluate(z_new).defects, free),
-                            problem.lower, problem.upper)
+            violated = ev_new.inequalities > 0.0  # corrected onto their bounds with the defects
+            rows = sp.vstack([lin.defect_jacobian, lin.inequality_jacobian[violated]], format="csc")
+            targets = np.concatenate([ev_new.defects, ev_new.inequalities[violated]])
+            z_soc = np.clip(z_new + defect_correction(rows, targets, free), problem.lower, problem.upper)
             ja_soc = merit(problem.evaluate(z_soc), s)
             if ja_soc < ja_full:
                 z_new, ja_full = z_soc, ja_soc

@@ -68,7 +68,8 @@ class Scvx(GuidanceSpecBase):
         """The ScvxMission: entry state and target from the scenario (geocentric, converted to
         paper 001's geodetic form), the rest from this spec."""
         t = scenario.target
-        fields = {k: (tuple(v) if isinstance(v, list) else v) for k in MISSION_FIELDS for v in [getattr(self, k)]}
+        fields = {k: getattr(self, k) for k in MISSION_FIELDS}
+        fields.update({k: tuple(v) for k, v in fields.items() if isinstance(v, list)})  # ScvxMission's pairs
         return _named(lambda: ScvxMission.from_geocentric(
             scenario.make_planet(), scenario.initial_state(), math.radians(t.longitude_deg),
             math.radians(t.latitude_deg), name=scenario.name, **fields))

@@ -87,9 +87,9 @@ class ConvexifiableProblem:
         return np.empty(0, dtype=object)
 
     def correction_variables(self) -> np.ndarray:
-        """Boolean mask of the variables the second-order correction may move (default: every
-        variable not fixed by its bounds)."""
-        return self.upper > self.lower
+        """Boolean mask of the variables the second-order correction may move (default: all;
+        the engine never moves a variable its bounds fix)."""
+        return np.ones(self.n_z, bool)
 
     def describe_defect(self, i: int) -> str:
         return f"defect {i}"
@@ -122,10 +122,11 @@ class ScvxSettings:
       defect_tolerance: largest scaled defect at convergence.
       constraint_tolerance: largest scaled inequality or convex violation at convergence.
       decrease_tolerance: predicted decrease of J_a (relative to 1 + |J_a|) at convergence.
-      second_order_correction: after each SOCP step, also try the step plus the minimum-norm
-        correction that cancels the defects it created (``defect_correction``) and keep the
-        better point; near the solution the created defects are what makes the linear model
-        over-predict, so rho stays near 1 and the trust region need not collapse.
+      second_order_correction: after each SOCP step, also try the step plus the least-norm
+        correction that cancels the defects it created and the inequalities it violates
+        (``defect_correction``) and keep the better point; near the solution they are what
+        makes the linear model over-predict, so rho stays near 1 and the trust region need
+        not collapse.
       solver: 'clarabel' or 'scs'. solver_options: passed to the solver (over CLARABEL_DEFAULTS).
     """
 
@@ -296,17 +297,17 @@ class ScvxSubproblem:
         return z, float(predicted), its
 
 
-def defect_correction(defect_jacobian: sp.spmatrix, defects: np.ndarray, free: np.ndarray) -> np.ndarray:
+def defect_correction(jacobian: sp.spmatrix, residuals: np.ndarray, free: np.ndarray) -> np.ndarray:
     """The least-norm change dz of the free variables (boolean mask ``free``) with
-    C dz = -defects: a second-order correction of an SQP step (Nocedal & Wright, Sec. 15.4),
-    C the Jacobian of the current linearisation (the defects', and the rows of the
-    inequalities violated at the trial point), ``defects`` their values at the trial point."""
-    Cf = sp.csc_matrix(defect_jacobian)[:, free]
+    C dz = -residuals: a second-order correction of an SQP step (Nocedal & Wright, Sec. 15.4),
+    C the rows of the current linearisation to re-satisfy (the defects', and those of the
+    inequalities violated at the trial point), ``residuals`` their values at the trial point."""
+    Cf = sp.csc_matrix(jacobian)[:, free]
     n = Cf.shape[1]
     # the KKT system [I C^T; C -delta I] keeps C's sparsity (C C^T is dense through the t_f
     # column); the tiny -delta I makes it quasi-definite, so dependent rows do not make it singular
     kkt = sp.bmat([[sp.identity(n), Cf.T], [Cf, -1e-12 * sp.identity(Cf.shape[0])]], format="csc")
-    solution = spla.splu(kkt).solve(np.concatenate([np.zeros(n), -np.asarray(defects, float)]))
+    solution = spla.splu(kkt).solve(np.concatenate([np.zeros(n), -np.asarray(residuals, float)]))
     dz = np.zeros(len(free))
     dz[free] = solution[:n]
     return dz

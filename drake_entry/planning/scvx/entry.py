@@ -558,12 +558,11 @@ class EntryProblem(ConvexifiableProblem):
                               [0.0, R * POSITION_SCALE[2] / d]])
         miss_offset = np.array([-R * math.cos(self.site_lat) * self.site_lon / d, -R * self.site_lat / d])
         buffers = prog.NewContinuousVariables(1 + (self.n_nodes - 1 if self.rate_chords else 0), "convex_buffer")
-        buffer = buffers[:1]
         A = np.zeros((3, 3))
         A[0, 2] = 1.0
         A[1:, :2] = miss_rows
         prog.AddLorentzConeConstraint(A, np.concatenate([[self.mission.site_radius_m / d], miss_offset]),
-                                      np.array([lon_f, lat_f, buffer[0]]))
+                                      np.array([lon_f, lat_f, buffers[0]]))
         if objective == "miss":
             A = np.zeros((3, 3))
             A[0, 2] = self.aux_scale / d
@@ -571,7 +570,7 @@ class EntryProblem(ConvexifiableProblem):
             prog.AddLorentzConeConstraint(A, np.concatenate([[0.0], miss_offset]),
                                           np.array([lon_f, lat_f, z[self._aux][0]]))
         if self.rate_chords:  # |u_k+1 - u_k| <= sigma_dot_max ds_k t_f + buffer_k
-            limits = self.vehicle.bank_rate_limit * np.diff(self.mesh.s) * TIME_SCALE
+            limits = self.bank_turn_limits(TIME_SCALE)  # per unit of the scaled t_f
             A = np.zeros((3, 6))
             A[0, 1] = 1.0
             A[1:, 2:4], A[1:, 4:6] = -np.eye(2), np.eye(2)

@@ -314,7 +314,6 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     return plan
 
 
-
 #: ScvxMission fields a re-plan takes from the state flown (the rest stay the mission's)
 _ENTRY_FIELDS = ("entry_altitude_m", "entry_longitude_deg", "entry_latitude_deg", "entry_speed_m_s",
                  "entry_flight_path_deg", "entry_heading_deg", "site_longitude_deg", "site_latitude_deg",
@@ -326,8 +325,8 @@ def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float
     """Re-plan ``previous``'s mission from state ``x`` [h, lon, lat, V, gamma, psi] reached
     ``elapsed`` [s] into it, holding the bank and alpha being flown [rad] where they are
     states (the rate formulations): the same site, DRS box, limits, formulation and mesh,
-    warm-started from the rest of the previous plan (its states from ``elapsed`` to its t_f,
-    stretched over the new interval). A state outside the mission's bounds (e.g. gamma above
+    warm-started from the rest of the previous plan (its states and bank from ``elapsed`` to
+    its t_f, the state at ``elapsed`` replaced by ``x``; the remaining time its t_f guess). A state outside the mission's bounds (e.g. gamma above
     0.5 deg in a dispersed skip) is clipped into them for the new entry point."""
     p = previous.problem
     m = p.mission

@@ -44,12 +44,15 @@ class Circle(ConvexifiableProblem):
                                              (-0.5, (-math.sqrt(0.75), -0.5))])
 def test_engine_finds_the_optimum_on_a_circle(y_min, expected):
     # from the left: (sqrt(3)/2, -1/2) is a local minimum too (f rises along the arc from it)
-    out = solve_scvx(Circle(y_min), np.array([-2.0, 0.5]), ScvxSettings(max_iterations=60))
-    assert out.converged, out.message
-    # first-order stationarity to the decrease tolerance: the objective to 1e-6, z along the arc to 1e-3
-    assert out.z.sum() == pytest.approx(sum(expected), abs=1e-6)
-    assert out.z == pytest.approx(expected, abs=1e-3)
-    assert abs(out.evaluation.defects[0]) <= 1e-6
+    for tolerance in (1e-4, 1e-6):  # the default, and a tighter one the objective must then meet
+        out = solve_scvx(Circle(y_min), np.array([-2.0, 0.5]),
+                         ScvxSettings(max_iterations=60, decrease_tolerance=tolerance))
+        assert out.converged, out.message
+        # first-order stationarity to the decrease tolerance (the default's converges 2.7e-5 from
+        # the vertex: the projection makes it feasible with the objective's decrease below 2.4e-4)
+        assert out.z.sum() == pytest.approx(sum(expected), abs=tolerance * (1 + abs(sum(expected))))
+        assert out.z == pytest.approx(expected, abs=1e-3)
+        assert abs(out.evaluation.defects[0]) <= 1e-6
 
 
 def test_engine_reports_an_infeasible_problem_with_its_constraint():
@@ -263,10 +266,10 @@ def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, no
 def test_nominal_lossless_plan_converges_in_35_iterations_and_its_real_bank_flies(sphynx_case, lossless_plan):
     """Issue 13's evidence: the nominal lossless heat-load plan (u = (cos, sin) of the bank, eqs.
     37-45, with the floor |u| >= 0.99 and the bank-rate chords) converges from the glide guess
-    (the issue asks <= 35 iterations: measured 37, 34 before the violated inequalities joined the
-    second-order correction, which cut the direct plan's 60 to 46; open) with defects <= 1e-6,
+    in <= 35 iterations (measured 27: the projection of nearly feasible points and the
+    convergence test at feasible points cut the tail of 37) with defects <= 1e-6,
     reports its gap (<= 0.01), and its real
-    bank atan2(u2, u1) flown by the Drake Simulator ends <= 5 km from the plan (measured 1.7 km),
+    bank atan2(u2, u1) flown by the Drake Simulator ends <= 5 km from the plan (measured 1.5 km),
     <= 15 km from the site (8.7), inside the DRS box. Heat load 521.2 MJ/m^2 measured (the paper's
     lossless 573.5 with its aero table, Table 3)."""
     from drake_entry.diagrams.plan_flight import fly_plan
@@ -274,7 +277,7 @@ def test_nominal_lossless_plan_converges_in_35_iterations_and_its_real_bank_flie
     vehicle, planet, atmosphere, mission, _ = sphynx_case
     plan = lossless_plan
     assert plan.success, plan.message
-    assert plan.iterations <= 40
+    assert plan.iterations <= 35
     assert plan.max_defect <= 1e-6 and plan.max_violation <= 1e-6
     assert plan.lossless_gap <= 0.01 + 1e-6 and plan.lossless_gap_all <= 0.01 + 1e-6
     assert 500.0 < plan.objective < 540.0

@@ -8,15 +8,20 @@ g(z) <= 0 (path and event constraints) and convex constraints it adds to the SOC
     min  J(zb) + dJ (z - zb) + w_nu |nu|_1 + w_xi (sum xi + sum convex buffers)
     s.t. c(zb) + C (z - zb) + nu = 0            virtual controls (eq. 23)
          g(zb) + G (z - zb) - xi <= 0, xi >= 0  virtual buffers (eq. 24)
-         convex constraints, lower <= z <= upper, |z - zb|_inf <= r  (hard trust region)
+         convex constraints, lower <= z <= upper, |z - zb|_inf <= r  (hard trust region; not on
+                                                 variables entering linearly, e.g. epigraphs)
 
 which is CP4's L_a (eq. 28) with l1 penalties; the merit is the augmented objective J_a
 (eq. 27): J + w_nu |c|_1 + w_xi (sum max(0, g) + convex violations). The trust radius r
 adapts with rho = actual / predicted decrease of J_a (eq. 22; thresholds rho0 <= rho1 <= rho2,
 factor 2), optionally after a golden-section line search on J_a along the step (eq. 29, with
-the (alpha4 - alpha1) correction). Convergence is judged on the predicted decrease AND the
+the (alpha4 - alpha1) correction). Each trial point is tightened (epigraph variables at their
+constraints' value, ``tighten``), corrected to second order and, once accepted and nearly
+feasible, projected onto its constraints (``feasibility_projection``). Convergence is judged on the predicted decrease AND the
 defects and constraint violations, never on the step alone: a collapsing trust region also
-gives a small step. The one exception is named in the message: a feasible point where the
+gives a small step; at a point feasible within the tolerances the predicted decrease counts
+only what goes beyond removing its remaining penalty (some 600 defects each below 1e-7 weigh
+1e-3 in J_a, five times the tolerance, and no step removes them all). The one exception is named in the message: a feasible point where the
 trust region reaches its floor with a predicted decrease within ``FLOOR_DECREASE_FACTOR`` of
 the tolerance (the linear model still promises a little, no step realises it).
 
@@ -91,6 +96,20 @@ class ConvexifiableProblem:
         the engine never moves a variable its bounds fix)."""
         return np.ones(self.n_z, bool)
 
+    def tighten(self, z) -> np.ndarray:
+        """z with its epigraph variables (if any) set to the tightest value their constraints
+        allow at z (default: z unchanged). The engine tightens every trial point: with l1
+        penalty weights above 1 this never raises the merit, and it makes the merit of a
+        min-max objective the true maximum."""
+        return z
+
+    def trust_region_variables(self) -> np.ndarray:
+        """Boolean mask of the variables the trust region bounds (default: all). A variable
+        that enters the objective and every constraint linearly (an epigraph variable) has an
+        exact linear model and needs none: bounding it only limits its decrease to the radius
+        per iteration."""
+        return np.ones(self.n_z, bool)
+
     def describe_defect(self, i: int) -> str:
         return f"defect {i}"
 
@@ -127,6 +146,12 @@ class ScvxSettings:
         (``defect_correction``) and keep the better point; near the solution they are what
         makes the linear model over-predict, so rho stays near 1 and the trust region need
         not collapse.
+      feasibility_projection: project each accepted point whose largest defect is at most
+        ``projection_defect_limit`` onto its defects and violated inequalities (same KKT
+        solve; kept if the merit falls). The tail of small infeasibilities then costs no SOCP
+        iterations: nominal direct plan 23 iterations instead of 44, lossless 27 instead of 33,
+        9 x 9 abort map 52 feasible of 81 instead of 49. Farther from feasibility the
+        projection's linearisation is poor (limits 1e-2 and above converged 0.2 % higher).
       solver: 'clarabel' or 'scs'. solver_options: passed to the solver (over CLARABEL_DEFAULTS).
     """
 
@@ -145,6 +170,8 @@ class ScvxSettings:
     constraint_tolerance: float = 1e-6
     decrease_tolerance: float = 1e-4
     second_order_correction: bool = True
+    feasibility_projection: bool = True
+    projection_defect_limit: float = 1e-3
     solver: str = "clarabel"
     solver_options: dict = dc.field(default_factory=dict)
 
@@ -161,7 +188,7 @@ class ScvxSettings:
         if not (isinstance(self.line_search_steps, int) and 0 <= self.line_search_steps <= 30):
             raise ScenarioError(f"ScvxSettings.line_search_steps = {self.line_search_steps} must be in [0, 30]")
         for name in ("virtual_control_weight", "buffer_weight", "defect_tolerance", "constraint_tolerance",
-                     "decrease_tolerance"):
+                     "decrease_tolerance", "projection_defect_limit"):
             if not getattr(self, name) > 0.0:
                 raise ScenarioError(f"ScvxSettings.{name} = {getattr(self, name)} must be > 0")
         if self.solver not in ("clarabel", "scs"):
@@ -263,6 +290,7 @@ class ScvxSubproblem:
                                         np.full(ng + len(self.buffers), settings.buffer_weight)])
         self.cost = prog.AddLinearCost(np.zeros(nz + slack.size), 0.0, np.concatenate([self.z, slack])).evaluator()
         self._slack = slack
+        self._bounded = problem.trust_region_variables()
         if settings.solver == "clarabel":
             self.solver = ClarabelSolver()
         else:
@@ -282,8 +310,8 @@ class ScvxSubproblem:
             G = lin.inequality_jacobian
             self.path.UpdateCoefficients(sp.hstack([G, self._neg_eye_g], format="csc"),
                                          np.full(p.n_inequalities, -np.inf), G @ zb - ev.inequalities)
-        lo = np.maximum(p.lower, zb - radius)
-        hi = np.minimum(p.upper, zb + radius)
+        lo = np.where(self._bounded, np.maximum(p.lower, zb - radius), p.lower)
+        hi = np.where(self._bounded, np.minimum(p.upper, zb + radius), p.upper)
         self.box.set_bounds(lo, np.maximum(hi, lo))
         self.cost.UpdateCoefficients(np.concatenate([lin.objective_gradient, self._penalty]), 0.0)
         result = self.solver.Solve(self.prog, None, self.options)
@@ -311,6 +339,26 @@ def defect_correction(jacobian: sp.spmatrix, residuals: np.ndarray, free: np.nda
     dz = np.zeros(len(free))
     dz[free] = solution[:n]
     return dz
+
+
+def project_accepted(problem: ConvexifiableProblem, z, lin: Linearisation, ja: float, free, s: ScvxSettings):
+    """A Newton projection of an accepted, nearly feasible point onto its defects and violated
+    inequalities (the ``defect_correction`` of its own linearisation); kept only if it lowers the
+    merit. Returns (z, linearisation, merit) of the point kept."""
+    ev = lin.evaluation
+    if max_defect(ev) <= s.defect_tolerance and max_violation(ev) <= s.constraint_tolerance:
+        return z, lin, ja
+    if max_defect(ev) > s.projection_defect_limit:
+        return z, lin, ja
+    violated = ev.inequalities > 0.0
+    rows = sp.vstack([lin.defect_jacobian, lin.inequality_jacobian[violated]], format="csc")
+    targets = np.concatenate([ev.defects, ev.inequalities[violated]])
+    zp = np.clip(z + defect_correction(rows, targets, free), problem.lower, problem.upper)
+    ev_p = problem.evaluate(zp)
+    if merit(ev_p, s) < ja:
+        lin = problem.linearise(zp)
+        return zp, lin, merit(lin.evaluation, s)
+    return z, lin, ja
 
 
 def golden_section(merit_at, full_step_merit: float, steps: int) -> tuple[float, float]:
@@ -366,7 +414,9 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
             break
         t2 = time.perf_counter()
         decrease = ja - predicted
-        if decrease <= s.decrease_tolerance * (1.0 + abs(ja)):
+        feasible_now = max_defect(ev) <= s.defect_tolerance and max_violation(ev) <= s.constraint_tolerance
+        objective_decrease = decrease - (ja - ev.objective) if feasible_now else decrease
+        if objective_decrease <= s.decrease_tolerance * (1.0 + abs(ja)):
             rec = IterationRecord(ja, decrease, 0.0, math.nan, 0.0, radius, False, max_defect(ev), max_violation(ev),
                                   t2 - t1, 0.0, solver_its)
             history.append(rec)
@@ -378,20 +428,21 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
                 message = ("stationary at an infeasible point (no decrease of the penalised merit is "
                            "predicted): " + diagnose(problem, ev))
             break
+        z_new = problem.tighten(z_new)
         ev_new = problem.evaluate(z_new)
         ja_full = merit(ev_new, s)
         if s.second_order_correction and problem.n_defects:
             violated = ev_new.inequalities > 0.0  # corrected onto their bounds with the defects
             rows = sp.vstack([lin.defect_jacobian, lin.inequality_jacobian[violated]], format="csc")
             targets = np.concatenate([ev_new.defects, ev_new.inequalities[violated]])
-            z_soc = np.clip(z_new + defect_correction(rows, targets, free), problem.lower, problem.upper)
+            z_soc = problem.tighten(np.clip(z_new + defect_correction(rows, targets, free), problem.lower,
+                                            problem.upper))
             ja_soc = merit(problem.evaluate(z_soc), s)
             if ja_soc < ja_full:
                 z_new, ja_full = z_soc, ja_soc
         step = z_new - z
-
         def merit_at(a):
-            return merit(problem.evaluate(z + a * step), s)
+            return merit(problem.evaluate(problem.tighten(z + a * step)), s)
 
         alpha, ja_new = 1.0, ja_full
         if s.line_search_steps:
@@ -401,9 +452,11 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
         accepted = rho >= s.rho0 and actual > 0.0
         used_radius = radius
         if accepted:
-            z = z + alpha * step
+            z = z_new if alpha == 1.0 else problem.tighten(z + alpha * step)
             lin = problem.linearise(z)
             ja = merit(lin.evaluation, s)
+            if s.feasibility_projection and problem.n_defects:
+                z, lin, ja = project_accepted(problem, z, lin, ja, free, s)
         if not accepted or rho < s.rho1:
             radius /= s.trust_factor
         elif rho >= s.rho2 and (not history or history[-1].accepted):

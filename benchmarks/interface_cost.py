@@ -29,7 +29,7 @@ try:  # the guidance-method interface
     from drake_entry.diagrams.sample import run_sample
     args = (ClosedLoopSetup.from_scenario(load_scenario("horus2b")),)
 except ImportError:  # before it
-    from diagrams.montecarlo import run_sample
+    from drake_entry.diagrams.montecarlo import run_sample
     from drake_entry.planning.drag_energy import DragEnergyPlanner
     s = load_scenario("horus2b")
     args = (s, DragEnergyPlanner.from_scenario(s))

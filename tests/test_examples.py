@@ -78,6 +78,7 @@ def test_example_07(tmp_path):
     assert plan.formulation == "direct"
     assert 460.0 < plan.objective < 500.0 and flight.from_plan_m < 5e3 and flight.from_site_m < 15e3 and flight.drs_ok
     assert os.path.exists(r["plot"])
+    assert r["nlp"].success and plan.objective == pytest.approx(r["nlp"].objective / 1e6, rel=0.01)  # 0.24 %
 
 
 def test_example_09(tmp_path):

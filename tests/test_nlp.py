@@ -54,6 +54,21 @@ def test_lgl_double_integrator_control_objective_and_costates_are_exact(solver):
     assert np.abs(r.hamiltonian - r.hamiltonian.mean()).max() < 1e-5  # constant H (autonomous)
 
 
+@pytest.mark.parametrize("transcription, nodes, tol", [("lgl", 12, 1e-6), ("dircol", 48, 5e-3)])
+def test_terminal_constraint_binds_on_the_final_node_only(transcription, nodes, tol):
+    """x(1) free but x(1) + v(1) >= 1 at the final node with v(1) = 0: the rest-to-rest optimum
+    (J = 6) with the constraint active; the same row on the path would forbid the start."""
+    reach = PathConstraint(lambda x, u, env: x[0] + x[1], min=1.0, name="reach")
+    r = nlp.solve(double_integrator(final={"v": 0.0}, terminal=[reach]), transcription=transcription, nodes=nodes)
+    assert r.success, r.message
+    assert r.states[-1, 0] == pytest.approx(1.0, abs=1e-7)
+    assert r.objective == pytest.approx(6.0, rel=tol)
+    loose = PathConstraint(lambda x, u, env: x[0] + x[1], min=0.5, name="reach")
+    r = nlp.solve(double_integrator(final={"v": 0.0}, terminal=[loose]), transcription=transcription, nodes=nodes)
+    assert r.states[-1, 0] == pytest.approx(0.5, abs=1e-7)  # still active, at its own bound
+    assert r.objective == pytest.approx(6.0 * 0.25, rel=tol)  # J scales with the distance squared
+
+
 def test_dircol_double_integrator_converges_at_second_order():
     errs = []
     for n in (12, 24, 48):

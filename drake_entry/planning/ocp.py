@@ -29,6 +29,7 @@ PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
     "dynamic_pressure": ("dynamic_pressure", "Pa"), "heat_flux": ("heat_flux", "W/m^2"),
     "normal_load": ("normal_load", "g"), "total_load": ("total_load", "g"),
     "sensed_acceleration": ("total_load", "g"),  # paper 002 eq. 7, a = sqrt(L^2 + D^2), in g
+    "mach": ("mach", "-"),
 }
 LAGRANGE_KINDS = ("control_margin", "heat_load", "lagrange")
 MAYER_KINDS = ("final_time", "miss_distance", "final_latitude", "final_crossrange", "final_velocity", "mayer")
@@ -36,7 +37,8 @@ MAYER_KINDS = ("final_time", "miss_distance", "final_latitude", "final_crossrang
 
 @dc.dataclass
 class PathConstraint:
-    """min <= value(x, u) <= max at every node.
+    """min <= value(x, u) <= max at every node (in a problem's ``terminal`` list: at the final
+    node only).
 
     quantity: a PATH_QUANTITIES name (SI units as listed) or a callable
     ``f(x, u, env) -> scalar`` with env the node's FlightConditions; ``scale`` is the
@@ -191,7 +193,7 @@ class CustomProblem(_ProblemLayout):
       state_names, control_names: names (their order is the vector order).
       dynamics_function: f(x, u) -> xdot. lagrange_function: L(x, u) or None.
       mayer_function: M(xf, tf) or None. path: PathConstraint list whose quantity is a
-        callable f(x, u, env) (env is None here).
+        callable f(x, u, env) (env is None here); terminal: the same at the final node.
       initial, final, final_time, state_bounds, control_bounds: as OptimalControlProblem.
       state_scale, control_scale, time_scale: typical sizes used to scale the NLP.
     """
@@ -207,6 +209,7 @@ class CustomProblem(_ProblemLayout):
     state_bounds: dict = dc.field(default_factory=dict)
     control_bounds: dict = dc.field(default_factory=dict)
     path: list = dc.field(default_factory=list)
+    terminal: list = dc.field(default_factory=list)
     state_scale: tuple | None = None
     control_scale: tuple | None = None
     time_scale: float = 1.0
@@ -237,6 +240,9 @@ class CustomProblem(_ProblemLayout):
     def path_values(self, x, u) -> list:
         return [c.quantity(x, u, None) for c in self.path]
 
+    def terminal_values(self, x, u) -> list:
+        return [c.quantity(x, u, None) for c in self.terminal]
+
     def scales(self) -> tuple[np.ndarray, np.ndarray, float]:
         sx = np.ones(self.n_states) if self.state_scale is None else np.asarray(self.state_scale, float)
         su = np.ones(self.n_controls) if self.control_scale is None else np.asarray(self.control_scale, float)
@@ -255,6 +261,8 @@ class OptimalControlProblem(_ProblemLayout):
       controls: 'rates' (alpha, sigma are states, controls are their rates) or 'direct'.
       state_bounds, control_bounds: name -> (min, max) along the whole trajectory.
       path: path constraints. objective: terms (at least one).
+      terminal: constraints on the final node (PathConstraint: the same quantities or a
+        callable f(x, u, env)), e.g. a geodetic altitude window, a Mach bound, a landing cone.
     """
 
     vehicle: Vehicle
@@ -268,6 +276,7 @@ class OptimalControlProblem(_ProblemLayout):
     state_bounds: dict = dc.field(default_factory=dict)
     control_bounds: dict = dc.field(default_factory=dict)
     path: list = dc.field(default_factory=list)
+    terminal: list = dc.field(default_factory=list)
     name: str = "problem"
 
     def __post_init__(self):
@@ -412,6 +421,10 @@ class OptimalControlProblem(_ProblemLayout):
     def path_values(self, x, u) -> list:
         env = self.conditions(x, u)
         return [c.value(x, u, env) for c in self.path]
+
+    def terminal_values(self, x, u) -> list:
+        env = self.conditions(x, u)
+        return [c.value(x, u, env) for c in self.terminal]
 
     def with_(self, **changes) -> "OptimalControlProblem":
         return dc.replace(self, **changes)

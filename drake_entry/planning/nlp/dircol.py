@@ -33,6 +33,7 @@ class _DircolTranscription(_Transcription):
         self.H = np.array([self.dc.time_step(k)[0] for k in range(N - 1)])
         self.add_bounds(prog, self.X, self.U, self.dc.initial_state(), self.dc.final_state())
         self.add_path(prog, self.X, self.U)
+        self.add_terminal(prog, self.X[-1], self.U[-1])
         if problem.has_lagrange:  # trapezoid rule over the samples
             for k in range(N - 1):
                 prog.AddCost(lambda z: 0.5 * z[-1] * (self.L_scaled(z[:nx], z[nx:nx + nu])

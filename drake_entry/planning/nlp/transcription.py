@@ -50,6 +50,18 @@ class _Transcription:
             prog.AddConstraint(lambda z: self.path_scaled(z[:nx], z[nx:]), lo, hi,
                                np.concatenate([X[k], U[k]]), description=f"path[{k}]")
 
+    def add_terminal(self, prog, x_last, u_last):
+        """The problem's terminal constraints on the final node, each row scaled as a path row."""
+        terminal = self.problem.terminal
+        if not terminal:
+            return
+        nx = self.nx
+        prog.AddConstraint(
+            lambda z: np.array([v / c.scale for v, c in zip(
+                self.problem.terminal_values(z[:nx] * self.sx, z[nx:] * self.su), terminal)]),
+            np.array([c.min / c.scale for c in terminal]), np.array([c.max / c.scale for c in terminal]),
+            np.concatenate([x_last, u_last]), description="terminal")
+
     def mayer_cost(self, prog, x_last, tf_vars):
         """Mayer cost M(x_f, t_f) / time_scale; t_f (scaled) is the sum of ``tf_vars`` (the
         LGL final time, or the DirectCollocation time steps), or fixed when None."""

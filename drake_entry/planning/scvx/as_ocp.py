@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from ...atmosphere import Atmosphere
+from ...errors import ScenarioError
 from ...planet import Earth
 from ...vehicles import Vehicle
 from ..ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
@@ -31,7 +32,8 @@ def mission_problem(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mis
     """The SCvx direct problem of ``mission`` as an OptimalControlProblem; ``final_time`` the
     (min, max) bounds of the free final time [s]."""
     if objective not in NLP_OBJECTIVES:
-        raise ValueError(f"objective '{objective}' has no NLP form here; allowed: {', '.join(NLP_OBJECTIVES)}")
+        raise ScenarioError(f"mission_problem objective = '{objective}' has no NLP form here; allowed: "
+                            f"{', '.join(NLP_OBJECTIVES)}")
     deg = math.radians
     x0 = mission.entry_state(planet)
     site_lon, site_lat = mission.site(planet)
@@ -76,7 +78,7 @@ def nlp_guess(problem, z) -> tuple:
     ``planner.initial_decision`` of its glide guess) in the OptimalControlProblem's order
     ([h, lon, lat, V, gamma, psi, alpha, sigma], [u_alpha, u_sigma])."""
     if problem.i_sigma is None or problem.i_alpha is None:
-        raise ValueError(f"an NLP guess needs the bank and alpha as states (the 'direct' formulation), "
+        raise ScenarioError(f"nlp_guess needs the bank and alpha as states (the 'direct' formulation), "
                          f"got '{problem.settings.formulation}'")
     X, U, tf = problem.unpack(z)
     rate = {state: control for control, state in problem.rate_controls}

@@ -122,14 +122,10 @@ def nlp_crosscheck(case, solves=(("dircol", "snopt", 100), ("lgl", "snopt", 60))
     (``planning.scvx.as_ocp``), its controls flown by the Drake Simulator, beside the SCvx plan."""
     from drake_entry.diagrams.propagation import propagate
     from drake_entry.planning import nlp
-    from drake_entry.planning.scvx.as_ocp import mission_problem, nlp_guess
-    from drake_entry.planning.scvx.planner import initial_decision
+    from drake_entry.planning.scvx.as_ocp import nlp_form
 
-    vehicle, planet, atmosphere, mission, guess, _ = case
     plan, wall, _ = _plan_and_fly(case)
-    problem = mission_problem(vehicle, planet, atmosphere, mission,
-                              final_time=(0.3 * guess.final_time, 3.0 * guess.final_time))
-    start = nlp_guess(plan.problem, initial_decision(plan.problem, guess))
+    problem, start = nlp_form(plan)
     print("\nNLP cross-check: minimum heat load, direct formulation, both from the glide guess")
     print(f"{'method':>22s} {'Q MJ/m2':>8s} {'/SCvx':>7s} {'t_f s':>6s} {'solve s':>8s} {'/SCvx':>7s} "
           f"{'flown-plan km':>13s} success")

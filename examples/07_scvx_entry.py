@@ -25,10 +25,10 @@ from drake_entry.diagrams.plan_flight import fly_plan
 from drake_entry.planet import Earth
 from drake_entry.diagrams.propagation import propagate
 from drake_entry.planning import nlp
-from drake_entry.planning.scvx.as_ocp import mission_problem, nlp_guess
+from drake_entry.planning.scvx.as_ocp import nlp_form
 from drake_entry.planning.scvx.entry import FORMULATIONS, EntryProblemSettings
 from drake_entry.planning.scvx.mission import ScvxMission
-from drake_entry.planning.scvx.planner import initial_decision, plan_entry
+from drake_entry.planning.scvx.planner import plan_entry
 from drake_entry.vehicles import load_vehicle
 
 
@@ -57,11 +57,9 @@ def main(quick: bool = False, out_dir: str = "out/examples/07", formulation: str
           f"vertical speed {flight.drs['vertical_speed_m_s']:.1f} m/s; DRS box met: {flight.drs_ok}")
     crosscheck = None
     if formulation == "direct":  # the same problem by the NLP path, from the same glide guess
-        guess = plan.guess
-        problem = mission_problem(vehicle, planet, atmosphere, mission,
-                                  final_time=(0.3 * guess.final_time, 3.0 * guess.final_time))
+        problem, start = nlp_form(plan)
         crosscheck = nlp.solve(problem, transcription="dircol", solver="snopt", nodes=70 if quick else 100,
-                               guess=nlp_guess(plan.problem, initial_decision(plan.problem, guess)), tolerance=1e-6)
+                               guess=start, tolerance=1e-6)
         flown = propagate(problem, crosscheck).terminal_error.get("position_m", math.nan)
         print(f"NLP path (DirectCollocation + SNOPT, {crosscheck.nodes} samples): {crosscheck.message}; heat load "
               f"{crosscheck.objective / 1e6:.2f} MJ/m^2 (SCvx {plan.objective / (crosscheck.objective / 1e6) - 1:+.2%}), "

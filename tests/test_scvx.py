@@ -273,13 +273,13 @@ def test_nominal_heat_load_matches_the_nlp_path(sphynx_case, nominal_plan):
     terminal point."""
     from drake_entry.diagrams.propagation import propagate
     from drake_entry.planning import nlp
-    from drake_entry.planning.scvx.as_ocp import mission_problem, nlp_guess
+    from drake_entry.planning.scvx.as_ocp import nlp_form
 
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     plan = nominal_plan
-    problem = mission_problem(vehicle, planet, atmosphere, mission,
-                              final_time=(0.3 * guess.final_time, 3.0 * guess.final_time))
-    start = nlp_guess(plan.problem, initial_decision(plan.problem, guess))
+    problem, start = nlp_form(plan)
+    assert plan.guess is guess and problem.final_time_bounds == pytest.approx(
+        (0.3 * guess.final_time, 3.0 * guess.final_time), rel=1e-12)  # the SCvx problem's bounds
     assert start[1][0, :6] == pytest.approx(mission.entry_state(planet), rel=1e-12)  # the OCP's layout
     result = nlp.solve(problem, transcription="dircol", solver="snopt", nodes=100, guess=start, tolerance=1e-6)
     assert result.success, result.message

@@ -35,8 +35,9 @@ class _LglTranscription(_Transcription):
         self.n_path = len(problem.path)
         z = [self.X.ravel(), self.U.ravel()] + ([[self.tf]] if self.tf is not None else [])
         self.z = np.concatenate(z)
-        lo = np.concatenate([np.zeros(N * nx)] + [np.full(N, c.min / c.scale) for c in problem.path])
-        hi = np.concatenate([np.zeros(N * nx)] + [np.full(N, c.max / c.scale) for c in problem.path])
+        path_lo, path_hi = self.scaled_bounds(problem.path)
+        lo = np.concatenate([np.zeros(N * nx), np.repeat(path_lo, N)])
+        hi = np.concatenate([np.zeros(N * nx), np.repeat(path_hi, N)])
         # path rows are ordered path-major: row N nx + c N + k
         self.collocation = prog.AddConstraint(self._constraint, lo, hi, self.z, description="LGL defects and path")
         self.collocation.evaluator().SetGradientSparsityPattern(self._sparsity())

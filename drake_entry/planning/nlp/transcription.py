@@ -25,9 +25,15 @@ class _Transcription:
         """Lagrangian at scaled (x, u): integrated over scaled time it gives J / time_scale."""
         return self.problem.lagrangian(xs * self.sx, us * self.su)
 
-    def path_scaled(self, xs, us):
-        vals = self.problem.path_values(xs * self.sx, us * self.su)
-        return np.array([v / c.scale for v, c in zip(vals, self.problem.path)])
+    def _scaled_rows(self, values, constraints, xs, us):
+        """``values(x, u)`` (path_values or terminal_values) at scaled (x, u), each row divided
+        by its constraint's scale."""
+        return np.array([v / c.scale for v, c in zip(values(xs * self.sx, us * self.su), constraints)])
+
+    @staticmethod
+    def scaled_bounds(constraints) -> tuple[np.ndarray, np.ndarray]:
+        """(min, max) of ``constraints`` divided by their scales."""
+        return np.array([c.min / c.scale for c in constraints]), np.array([c.max / c.scale for c in constraints])
 
     def add_bounds(self, prog, X, U, x_first, x_last):
         xl, xh, ul, uh = self.problem.bounds_arrays()
@@ -43,11 +49,10 @@ class _Transcription:
         path = self.problem.path
         if not path:
             return
-        lo = np.array([c.min / c.scale for c in path])
-        hi = np.array([c.max / c.scale for c in path])
+        lo, hi = self.scaled_bounds(path)
         nx = self.nx
         for k in range(X.shape[0]):
-            prog.AddConstraint(lambda z: self.path_scaled(z[:nx], z[nx:]), lo, hi,
+            prog.AddConstraint(lambda z: self._scaled_rows(self.problem.path_values, path, z[:nx], z[nx:]), lo, hi,
                                np.concatenate([X[k], U[k]]), description=f"path[{k}]")
 
     def add_terminal(self, prog, x_last, u_last):
@@ -56,11 +61,8 @@ class _Transcription:
         if not terminal:
             return
         nx = self.nx
-        prog.AddConstraint(
-            lambda z: np.array([v / c.scale for v, c in zip(
-                self.problem.terminal_values(z[:nx] * self.sx, z[nx:] * self.su), terminal)]),
-            np.array([c.min / c.scale for c in terminal]), np.array([c.max / c.scale for c in terminal]),
-            np.concatenate([x_last, u_last]), description="terminal")
+        prog.AddConstraint(lambda z: self._scaled_rows(self.problem.terminal_values, terminal, z[:nx], z[nx:]),
+                           *self.scaled_bounds(terminal), np.concatenate([x_last, u_last]), description="terminal")
 
     def mayer_cost(self, prog, x_last, tf_vars):
         """Mayer cost M(x_f, t_f) / time_scale; t_f (scaled) is the sum of ``tf_vars`` (the

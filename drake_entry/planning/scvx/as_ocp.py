@@ -22,6 +22,7 @@ from ...planet import Earth
 from ...vehicles import Vehicle
 from ..ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
 from .mission import ScvxMission
+from .planner import initial_decision
 
 #: OptimalControlProblem objective kind of each SCvx objective the NLP path can pose
 NLP_OBJECTIVES = {"heat_load": "heat_load", "time": "final_time"}
@@ -49,7 +50,7 @@ def mission_problem(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mis
     def vertical_speed(x, u, env):
         return x[3] * np.sin(x[4])
 
-    def site_miss_squared(x, u, env):  # (miss / R)^2 as ScvxEntryProblem.site_miss measures it
+    def site_miss_squared(x, u, env):  # (miss / R)^2 as EntryProblem.site_miss measures it
         return (cos_site * (x[1] - site_lon)) ** 2 + (x[2] - site_lat) ** 2
 
     return OptimalControlProblem(
@@ -85,3 +86,17 @@ def nlp_guess(problem, z) -> tuple:
     states = np.column_stack([X[:, :6], X[:, problem.i_alpha], X[:, problem.i_sigma]])
     controls = np.column_stack([U[:, rate[problem.i_alpha]], U[:, rate[problem.i_sigma]]])
     return problem.mesh.s * tf, states, controls
+
+
+def nlp_form(plan) -> tuple:
+    """(OptimalControlProblem, guess) of an SCvx direct plan for ``nlp.solve``: its mission and
+    models with its problem's final-time bounds, started from the glide guess the plan started
+    from (``plan.guess``), so the two methods solve the same problem from the same point."""
+    p = plan.problem
+    if plan.guess is None:
+        raise ScenarioError("nlp_form needs a plan started from a glide guess (plan.guess is None: "
+                            "it was warm-started from another plan)")
+    i = p.i_tf
+    problem = mission_problem(p.vehicle, p.planet, p.atmosphere, p.mission,
+                              final_time=(p.lower[i] * p.scale[i], p.upper[i] * p.scale[i]))
+    return problem, nlp_guess(p, initial_decision(p, plan.guess))

@@ -17,13 +17,14 @@ adapts with rho = actual / predicted decrease of J_a (eq. 22; thresholds rho0 <=
 factor 2), optionally after a golden-section line search on J_a along the step (eq. 29, with
 the (alpha4 - alpha1) correction). Each trial point is tightened (epigraph variables at their
 constraints' value, ``tighten``), corrected to second order and, once accepted and nearly
-feasible, projected onto its constraints (``feasibility_projection``). Convergence is judged on the predicted decrease AND the
-defects and constraint violations, never on the step alone: a collapsing trust region also
-gives a small step; at a point feasible within the tolerances the predicted decrease counts
-only what goes beyond removing its remaining penalty (some 600 defects each below 1e-7 weigh
-1e-3 in J_a, five times the tolerance, and no step removes them all). The one exception is named in the message: a feasible point where the
-trust region reaches its floor with a predicted decrease within ``FLOOR_DECREASE_FACTOR`` of
-the tolerance (the linear model still promises a little, no step realises it).
+feasible, projected onto its constraints (``feasibility_projection``). Convergence is judged
+on the predicted decrease AND the defects and constraint violations, never on the step alone:
+a collapsing trust region also gives a small step; at a point feasible within the tolerances
+the predicted decrease counts only what goes beyond removing its remaining penalty (some 600
+defects each below 1e-7 weigh 1e-3 in J_a, five times the tolerance, and no step removes them
+all). The one exception is named in the message: a feasible point where the trust region
+reaches its floor with a predicted decrease within ``FLOOR_DECREASE_FACTOR`` of the tolerance
+(the linear model still promises a little, no step realises it).
 
 The SOCP is built once per problem size; each iteration only updates the coefficients of
 its linear constraints, cost and bounds (``UpdateCoefficients``, ``set_bounds``).
@@ -252,6 +253,11 @@ def max_violation(ev: Evaluation) -> float:
     return float(max(g, c, 0.0))
 
 
+def within_tolerances(ev: Evaluation, s: ScvxSettings) -> bool:
+    """Defects and constraint violations all within the settings' tolerances."""
+    return max_defect(ev) <= s.defect_tolerance and max_violation(ev) <= s.constraint_tolerance
+
+
 def diagnose(problem: ConvexifiableProblem, ev: Evaluation) -> str:
     """Which constraint is violated most, and where."""
     parts = []
@@ -344,6 +350,15 @@ def defect_correction(jacobian: sp.spmatrix, residuals: np.ndarray, free: np.nda
     return dz
 
 
+def constraint_correction(lin: Linearisation, ev: Evaluation, free) -> np.ndarray:
+    """``defect_correction`` with the rows of ``lin`` for the defects and for the inequalities
+    ``ev`` violates, cancelling ``ev``'s residuals: the second-order correction of a trial point
+    (``lin`` at the step's start) or a Newton projection (``lin`` at ``ev``'s own point)."""
+    violated = ev.inequalities > 0.0
+    rows = sp.vstack([lin.defect_jacobian, lin.inequality_jacobian[violated]], format="csc")
+    return defect_correction(rows, np.concatenate([ev.defects, ev.inequalities[violated]]), free)
+
+
 def project_accepted(problem: ConvexifiableProblem, z, lin: Linearisation, ja: float, free, s: ScvxSettings):
     """Newton projections of an accepted, nearly feasible point onto its defects and violated
     inequalities (the ``defect_correction`` of each point's own linearisation), at most
@@ -351,14 +366,11 @@ def project_accepted(problem: ConvexifiableProblem, z, lin: Linearisation, ja: f
     (z, linearisation, merit) of the point kept."""
     for _ in range(PROJECTION_STEPS):
         ev = lin.evaluation
-        if max_defect(ev) <= s.defect_tolerance and max_violation(ev) <= s.constraint_tolerance:
+        if within_tolerances(ev, s):
             break
         if max_defect(ev) > s.projection_defect_limit:
             break
-        violated = ev.inequalities > 0.0
-        rows = sp.vstack([lin.defect_jacobian, lin.inequality_jacobian[violated]], format="csc")
-        targets = np.concatenate([ev.defects, ev.inequalities[violated]])
-        zp = np.clip(z + defect_correction(rows, targets, free), problem.lower, problem.upper)
+        zp = np.clip(z + constraint_correction(lin, ev, free), problem.lower, problem.upper)
         if merit(problem.evaluate(zp), s) >= ja:
             break
         z, lin = zp, problem.linearise(zp)
@@ -419,15 +431,14 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
             break
         t2 = time.perf_counter()
         decrease = ja - predicted
-        feasible_now = max_defect(ev) <= s.defect_tolerance and max_violation(ev) <= s.constraint_tolerance
-        objective_decrease = decrease - (ja - ev.objective) if feasible_now else decrease
+        objective_decrease = decrease - (ja - ev.objective) if within_tolerances(ev, s) else decrease
         if objective_decrease <= s.decrease_tolerance * (1.0 + abs(ja)):
             rec = IterationRecord(ja, decrease, 0.0, math.nan, 0.0, radius, False, max_defect(ev), max_violation(ev),
                                   t2 - t1, 0.0, solver_its)
             history.append(rec)
             if progress is not None:
                 progress(k, rec)
-            if max_defect(ev) <= s.defect_tolerance and max_violation(ev) <= s.constraint_tolerance:
+            if within_tolerances(ev, s):
                 converged, message = True, f"converged in {k + 1} iterations"
             else:
                 message = ("stationary at an infeasible point (no decrease of the penalised merit is "
@@ -437,15 +448,13 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
         ev_new = problem.evaluate(z_new)
         ja_full = merit(ev_new, s)
         if s.second_order_correction and problem.n_defects:
-            violated = ev_new.inequalities > 0.0  # corrected onto their bounds with the defects
-            rows = sp.vstack([lin.defect_jacobian, lin.inequality_jacobian[violated]], format="csc")
-            targets = np.concatenate([ev_new.defects, ev_new.inequalities[violated]])
-            z_soc = problem.tighten(np.clip(z_new + defect_correction(rows, targets, free), problem.lower,
+            z_soc = problem.tighten(np.clip(z_new + constraint_correction(lin, ev_new, free), problem.lower,
                                             problem.upper))
             ja_soc = merit(problem.evaluate(z_soc), s)
             if ja_soc < ja_full:
                 z_new, ja_full = z_soc, ja_soc
         step = z_new - z
+
         def merit_at(a):
             return merit(problem.evaluate(problem.tighten(z + a * step)), s)
 
@@ -474,9 +483,8 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
         if progress is not None:
             progress(k, rec)
         if radius < s.trust_radius_min:
-            feasible = max_defect(ev) <= s.defect_tolerance and max_violation(ev) <= s.constraint_tolerance
             floor = FLOOR_DECREASE_FACTOR * s.decrease_tolerance * (1.0 + abs(ja))
-            if feasible and decrease <= floor:
+            if within_tolerances(ev, s) and decrease <= floor:
                 converged = True
                 message = (f"converged at the trust-region floor in {k + 1} iterations (feasible; predicted "
                            f"decrease {decrease:.2g} <= {floor:.2g}, {FLOOR_DECREASE_FACTOR:g} x the tolerance)")

@@ -3,7 +3,8 @@
     python benchmarks/run.py [open-loop|socp|nlp|campaign|interface-cost|paper001|paper004|all] [options]
 
 open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
-socp            drag-energy SOCP build/solve times, Clarabel vs SCS, by node count
+socp            both SOCP planners with Clarabel vs SCS: drag-energy SOCP by node count, SCvx
+                nominal plan, closed-loop drag-energy campaign
 nlp             NLP path: LGL / DirectCollocation x Ipopt / SNOPT from the same starts
 campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios)
 interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline commit
@@ -39,9 +40,11 @@ if __name__ == "__main__":
 
         open_loop_benchmark(repeats=args.repeats)
     if args.which in ("all", "socp"):
-        from socp import socp_benchmark
+        from socp import campaign_solver_benchmark, scvx_solver_benchmark, socp_benchmark
 
         socp_benchmark(repeats=max(args.repeats, 5))
+        scvx_solver_benchmark()
+        campaign_solver_benchmark()
     if args.which in ("all", "nlp"):
         from nlp import nlp_benchmark
 

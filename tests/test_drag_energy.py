@@ -95,14 +95,12 @@ def test_socp_solution_satisfies_range_bounds_and_initial_conditions(reference):
 
 
 def test_clarabel_is_optimal_against_an_independent_scs_solution(reference):
-    """An SCS (first-order) answer is either flagged inaccurate by the planner's own check,
-    or feasible and never cheaper than Clarabel's interior-point optimum (cost
-    s' + s'' = ||D1 I|| + ||D2 I||, eq. 92)."""
+    """SCS (first-order) on the conditioned SOCP at SCS_OPTIONS passes the planner's own check,
+    and its answer is never cheaper than Clarabel's interior-point optimum (cost
+    s' + s'' = ||D1 I|| + ||D2 I||, eq. 92) and within 1 % of it (0.25 % measured at 40 nodes)."""
     p = dc.replace(reference.problem, solver="scs", range_iterations=1, kappa_guess=reference.kappa_at)
     scs = plan(p)
-    if not scs.success:
-        assert "inaccurate solution" in scs.message and "%" in scs.message or "range" in scs.message
-        return
+    assert scs.success, scs.message
     op = reference.lgl
 
     def cost(ref):
@@ -112,6 +110,8 @@ def test_clarabel_is_optimal_against_an_independent_scs_solution(reference):
     assert np.all(scs.D <= hi * (1 + 1e-3)) and np.all(scs.D >= lo * (1 - 1e-3))  # the planner's check
     assert scs.range_flown() == pytest.approx(p.range_to_go, rel=1e-5)
     assert cost(reference) <= cost(scs) * (1 + 1e-6)
+    assert cost(scs) <= cost(reference) * 1.01
+    assert scs.objective == pytest.approx(cost(scs) / p.D0, rel=1e-9)  # the reported eq. 92 value
 
 
 def test_extraction_reproduces_energy_drag_and_drag_slope(reference, planner):

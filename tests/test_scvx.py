@@ -55,6 +55,43 @@ def test_engine_finds_the_optimum_on_a_circle(y_min, expected):
         assert abs(out.evaluation.defects[0]) <= 1e-6
 
 
+class CircleInDisc(Circle):
+    """min x + y on x^2 + y^2 = 1 inside the disc |z - (0, 1)| <= 1 (a buffered Lorentz cone the
+    engine re-centres on each step): the arc 30-150 deg, optimum (-sqrt(3)/2, 1/2)."""
+
+    def evaluate(self, z):
+        ev = super().evaluate(z)
+        return dc.replace(ev, convex_violations=np.array([max(0.0, np.hypot(z[0], z[1] - 1.0) - 1.0)]))
+
+    def add_convex_constraints(self, prog, z):
+        buffer = prog.NewContinuousVariables(1, "buffer")
+        A = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+        prog.AddLorentzConeConstraint(A, np.array([1.0, 0.0, -1.0]), np.concatenate([z, buffer]))
+        return buffer
+
+
+@pytest.mark.parametrize("solver", ["clarabel", "scs"])
+def test_engine_keeps_a_convex_cone_on_z_while_solving_for_the_step(solver):
+    """The sub-problem's variables are the step dz = z - zb; the problem's cone, stated on z,
+    is shifted to each zb (ShiftedCone). Both solvers end at the cone-bound optimum; SCS with
+    its own tolerances (ScvxSettings.for_solver) and accuracy refinement."""
+    out = solve_scvx(CircleInDisc(), np.array([-2.0, 0.5]), ScvxSettings.for_solver(solver, max_iterations=80))
+    assert out.converged, out.message
+    tol = 1e-5 if solver == "clarabel" else 1e-3  # SCS: 8e-4 measured
+    assert out.z == pytest.approx([-math.sqrt(0.75), 0.5], abs=tol)
+    assert out.evaluation.convex_violations[0] <= (1e-6 if solver == "clarabel" else 1e-5)
+
+
+def test_engine_refuses_a_convex_constraint_it_cannot_shift():
+    class WithLinear(Circle):
+        def add_convex_constraints(self, prog, z):
+            prog.AddLinearConstraint(z[0] >= -0.5)
+            return np.empty(0, dtype=object)
+
+    with pytest.raises(TypeError, match="Lorentz cones only"):
+        solve_scvx(WithLinear(), np.array([-2.0, 0.5]))
+
+
 def test_engine_reports_an_infeasible_problem_with_its_constraint():
     """x^2 + y^2 = 1 with y >= 2 cannot hold: the engine stops with the violated constraint named."""
 

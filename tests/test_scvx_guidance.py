@@ -38,6 +38,13 @@ def test_spec_names_the_bad_field_and_its_allowed_values(scenario, field, value,
         bad.guidance.validate(bad)
 
 
+@pytest.mark.parametrize("solver, defect_tolerance", [("clarabel", 1e-6), ("scs", 1e-5)])
+def test_spec_gives_each_solver_its_scvx_tolerances(scenario, solver, defect_tolerance):
+    spec = dc.replace(scenario.guidance, solver=solver, max_iterations=70)
+    settings = spec.planner_settings()[1]
+    assert (settings.solver, settings.max_iterations, settings.defect_tolerance) == (solver, 70, defect_tolerance)
+
+
 def test_mission_of_the_scenario_is_paper001_table1(scenario):
     """The scenario's geocentric entry and target convert back to Table 1's geodetic figures."""
     m = scenario.guidance.mission(scenario)

@@ -58,7 +58,10 @@ class DragEnergyProblem:
       range_to_go: ground distance to fly [m].
       Df, Df_prime: optional terminal drag and slope (eq. 85).
       lat0, latf, heading0, headingf: [rad] linear profiles for the Earth-rate term (eq. 50).
-      n_nodes: LGL nodes. solver: 'clarabel' or 'scs'. range_iterations: see module doc.
+      n_nodes: LGL nodes. range_iterations: see module doc.
+      solver: 'clarabel' (default) or 'scs' (``SCS_OPTIONS``; ``python benchmarks/run.py socp``:
+        smooth to 0.7 % of Clarabel's eq. 92 at 20-40 nodes, 14x its time at 40; at 80 and 160
+        nodes feasible but rough, eq. 92 6x and 84x, as SCS's tolerance is reached first).
       sigma_max: bank limit for extraction [rad].
     """
 
@@ -232,13 +235,22 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
     return ref
 
 
-#: SCS options of the drag-energy SOCP (first-order: converges slowly here; drake-entry bench-socp)
-SCS_OPTIONS = {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iters": 20000}
+#: SCS options of the drag-energy SOCP on its conditioned form (``solve_socp``): eps 1e-5 meets
+#: the planner's own check (``_check_solution``) with the objective within 0.3 % of Clarabel's at
+#: 20-40 nodes in 1 200-9 800 iterations (5-100 ms); see docs/methods/drag-energy.md
+SCS_OPTIONS = {"eps_abs": 1e-5, "eps_rel": 1e-5, "max_iters": 100000}
 
 
 def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyReference:
     """One SOCP of eqs. 82-92 on the LGL operator ``op`` with corridor bounds D_lo, D_hi [m/s^2]
-    at its nodes and fixed range weights kappa (``plan`` iterates it and extracts the states)."""
+    at its nodes and fixed range weights kappa (``plan`` iterates it and extracts the states).
+
+    Conditioned for a first-order solver (SCS measures its residuals relative to the largest
+    row): the range row (eq. 83) is divided by the range to go [m], the initial-drag rows
+    (eq. 84-85) by their largest entry, and each cone of eq. 91 by its operator's 2-norm (|D2|
+    is 3e5 at 40 nodes), the cost weighted to stay eq. 92 divided by |D2|. Clarabel's optimum
+    moved by at most 3e-4 (relative); unconditioned, SCS needed 28 000 iterations at 40 nodes and
+    did not converge at 80."""
     t0 = time.perf_counter()
     n = p.n_nodes
     scale = p.D0  # I_hat = I * scale is O(1)
@@ -246,8 +258,8 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
     I = prog.NewContinuousVariables(n, "I")
     s = prog.NewContinuousVariables(2, "s")
     prog.AddBoundingBoxConstraint(scale / D_hi, scale / D_lo, I)  # eq. 86
-    # eq. 83 with the ground-range weights kappa: R = -sum w_i kappa_i I_i
-    prog.AddLinearEqualityConstraint((-op.weights * kappa / scale)[None, :], [p.range_to_go], I)
+    # eq. 83 with the ground-range weights kappa: R = -sum w_i kappa_i I_i, divided by R
+    prog.AddLinearEqualityConstraint((-op.weights * kappa / (scale * p.range_to_go))[None, :], [1.0], I)
     # eq. 84 (corrected): I0 = 1/D0, dI/dtau(-1) = (dE/dtau) * (-D0'/D0^2)
     half = (op.b - op.a) / 2.0
     A0 = np.vstack([np.eye(n)[0], op.D1_tau[0]])
@@ -258,14 +270,16 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
         if p.Df_prime is not None:
             A0 = np.vstack([A0, op.D1_tau[-1]])
             b0 = np.append(b0, half * (-p.Df_prime / p.Df**2) * scale)
-    prog.AddLinearEqualityConstraint(A0, b0, I)
-    # eq. 91: ||D1 I|| <= s', ||D2 I|| <= s'' as Lorentz cones on [s_k, I]
+    row = np.abs(A0).max(axis=1)
+    prog.AddLinearEqualityConstraint(A0 / row[:, None], b0 / row, I)
+    # eq. 91: ||D1 I|| / |D1| <= s1, ||D2 I|| / |D2| <= s2 as Lorentz cones on [s_k, I]
+    norms = np.array([np.linalg.norm(Dk, 2) for Dk in (op.D1_tau, op.D2_tau)])
     for k, Dk in enumerate((op.D1_tau, op.D2_tau)):
         A = np.zeros((n + 1, n + 1))
         A[0, 0] = 1.0
-        A[1:, 1:] = Dk
+        A[1:, 1:] = Dk / norms[k]
         prog.AddLorentzConeConstraint(A, np.zeros(n + 1), np.concatenate([[s[k]], I]))
-    prog.AddLinearCost(np.ones(2), 0.0, s)  # eq. 92
+    prog.AddLinearCost(norms / norms[1], 0.0, s)  # eq. 92 divided by |D2|
     t1 = time.perf_counter()
     solver = SOLVERS[p.solver]()
     options = SolverOptions()
@@ -301,7 +315,12 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
             ok, msg = False, f"{p.solver} returned an inaccurate solution: {problem_msg}"
     return DragEnergyReference(success=ok, message=msg, problem=p, lgl=op, I=I_sol if ok else None, solver=p.solver,
                                build_time=t1 - t0, solve_time=t2 - t1, iterations=iters,
-                               objective=float(result.get_optimal_cost()) / scale if ok else math.nan)
+                               objective=_smoothness(op, I_sol) if ok else math.nan)
+
+
+def _smoothness(op: LGL, I) -> float:
+    """The objective of eq. 92 at I [s^2/m]: ||D1 I|| + ||D2 I|| (tau derivatives)."""
+    return float(np.linalg.norm(op.D1_tau @ I) + np.linalg.norm(op.D2_tau @ I))
 
 
 def _check_solution(p: DragEnergyProblem, op: LGL, I, D_lo, D_hi, kappa, tol: float = 1e-3,

@@ -9,12 +9,12 @@ from ...planning.scvx.entry import EntryProblemSettings
 from ...planning.scvx.mission import ScvxMission
 from ..spec import GuidanceSpecBase
 
-#: spec fields passed to ScvxMission, EntryProblemSettings and ScvxSettings under the same names
+#: spec fields passed to ScvxMission and EntryProblemSettings under the same names (max_iterations
+#: and solver go to ScvxSettings.for_solver)
 MISSION_FIELDS = ("site_radius_m", "final_altitude_m", "final_altitude_margin_m", "final_mach_max",
                   "final_vertical_speed_min_m_s", "flight_path_bounds_deg", "heading_bounds_deg", "bank_min_deg",
                   "alpha_deg", "alpha_speeds_m_s", "alpha_bounds_deg", "alpha_rate_limit_deg_s")
 PROBLEM_FIELDS = ("formulation", "objective", "segments", "nodes_per_segment")
-SCVX_FIELDS = ("max_iterations", "solver")
 
 
 @dc.dataclass
@@ -76,7 +76,7 @@ class Scvx(GuidanceSpecBase):
 
     def planner_settings(self) -> tuple[EntryProblemSettings, ScvxSettings]:
         return (_named(lambda: EntryProblemSettings(**{k: getattr(self, k) for k in PROBLEM_FIELDS})),
-                _named(lambda: ScvxSettings(**{k: getattr(self, k) for k in SCVX_FIELDS})))
+                _named(lambda: ScvxSettings.for_solver(self.solver, max_iterations=self.max_iterations)))
 
     def validate(self, scenario) -> None:
         super().validate(scenario)

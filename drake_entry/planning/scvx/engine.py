@@ -38,7 +38,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from pydrake.solvers import ClarabelSolver, MathematicalProgram, ScsSolver, SolverOptions
+from pydrake.solvers import ClarabelSolver, LorentzConeConstraint, MathematicalProgram, ScsSolver, SolverOptions
 
 from ...errors import ScenarioError
 
@@ -128,6 +128,21 @@ class ConvexifiableProblem:
 #: iterative refinement off halves the solve time (59 -> 32 ms per SOCP on the nominal, same
 #: IPM iterations, cost equal to 1e-7) and the plan (476.4 MJ/m^2) is unchanged
 CLARABEL_DEFAULTS = {"iterative_refinement_enable": False}
+#: SCS options of the SCvx sub-problems unless ``solver_options`` overrides them: a loose start
+#: (the early steps need no accuracy; SCS's iterations grow fast as eps falls), tightened by
+#: ``SCS_REFINE_FACTOR`` whenever an answer is too inexact to be a step, down to
+#: ``SCS_EPS_FLOOR`` (docs/methods/scvx.md, "SCS")
+SCS_DEFAULTS = {"eps_abs": 1e-4, "eps_rel": 1e-4, "max_iters": 100000}
+SCS_REFINE_FACTOR = 10.0
+SCS_EPS_FLOOR = 1e-7
+#: sub-problem variables by solver: the step z - zb (True) or z. In the step its right-hand sides
+#: are the defects and violations themselves (c, not C zb - c), which go to zero at convergence,
+#: so SCS's tolerance, relative to the largest one, tightens with them (on z it stalled at
+#: defects 0.37, on the step it reaches 2e-6). Clarabel solves z: on the step its (more exact)
+#: answers cost 8 % more SCvx iterations over the paper001 benchmark (66 x 4 mesh 30 instead of 21).
+STEP_FORM = {"clarabel": False, "scs": True}
+#: convergence tolerances by solver where they differ from ScvxSettings' (``for_solver``)
+SOLVER_TOLERANCES = {"scs": {"defect_tolerance": 1e-5, "constraint_tolerance": 1e-5, "decrease_tolerance": 1e-3}}
 
 
 @dc.dataclass
@@ -156,7 +171,8 @@ class ScvxSettings:
         iterations: nominal direct plan 23 iterations instead of 44, lossless 27 instead of 33,
         9 x 9 abort map 52 feasible of 81 instead of 49. Farther from feasibility the
         projection's linearisation is poor (limits 1e-2 and above converged 0.2 % higher).
-      solver: 'clarabel' or 'scs'. solver_options: passed to the solver (over CLARABEL_DEFAULTS).
+      solver: 'clarabel' or 'scs' (``for_solver`` gives SCS its tolerances). solver_options:
+        passed to the solver (over CLARABEL_DEFAULTS or SCS_DEFAULTS).
     """
 
     max_iterations: int = 60
@@ -178,6 +194,14 @@ class ScvxSettings:
     projection_defect_limit: float = 1e-3
     solver: str = "clarabel"
     solver_options: dict = dc.field(default_factory=dict)
+
+    @classmethod
+    def for_solver(cls, solver: str, **fields) -> "ScvxSettings":
+        """Settings for ``solver`` with its convergence tolerances (``SOLVER_TOLERANCES``: SCS's
+        first-order answers cannot show a decrease of 1e-4 of J_a; on the nominal plan it stalled
+        at defects 1.6e-6 with the defaults, converged in 41 iterations with its own), ``fields``
+        over them."""
+        return cls(solver=solver, **{**SOLVER_TOLERANCES.get(solver, {}), **fields})
 
     def __post_init__(self):
         if not 0.0 <= self.rho0 <= self.rho1 <= self.rho2 <= 1.0:
@@ -273,54 +297,101 @@ def diagnose(problem: ConvexifiableProblem, ev: Evaluation) -> str:
     return "; ".join(parts) if parts else "no constraint violated"
 
 
+class ShiftedCone:
+    """A Lorentz cone the problem added on z, kept true on the sub-problem's step variables
+    y = z - zb (``STEP_FORM``): A z + b = A y + (A zb + b), so each iteration only shifts its b."""
+
+    def __init__(self, prog: MathematicalProgram, binding, y):
+        self.evaluator = binding.evaluator()
+        if not isinstance(self.evaluator, LorentzConeConstraint):
+            raise TypeError(f"ConvexifiableProblem.add_convex_constraints added a "
+                            f"{type(self.evaluator).__name__}; the SCvx engine shifts Lorentz cones only")
+        self.A = np.asfortranarray(self.evaluator.A().toarray())
+        self.b = np.array(self.evaluator.b())
+        position = {prog.FindDecisionVariableIndex(v): i for i, v in enumerate(y)}
+        index = [position.get(j, -1) for j in prog.FindDecisionVariableIndices(binding.variables())]
+        self.columns = np.array([c for c, i in enumerate(index) if i >= 0], int)
+        self.step_index = np.array([i for i in index if i >= 0], int)
+
+    def shift(self, zb: np.ndarray):
+        """Re-centre the cone at zb."""
+        self.evaluator.UpdateCoefficients(self.A, self.b + self.A[:, self.columns] @ zb[self.step_index])
+
+
 class ScvxSubproblem:
-    """The convex sub-problem, built once; ``solve`` updates its coefficients and solves it."""
+    """The convex sub-problem, built once; ``solve`` updates its coefficients and solves it.
+    Its variables are y = z - origin: z itself (origin 0) for an interior-point solver, the step
+    z - zb (origin zb) for a first-order one (``STEP_FORM``)."""
 
     def __init__(self, problem: ConvexifiableProblem, settings: ScvxSettings):
         self.problem, self.settings = problem, settings
         nz, nc, ng = problem.n_z, problem.n_defects, problem.n_inequalities
         prog = self.prog = MathematicalProgram()
-        self.z = prog.NewContinuousVariables(nz, "z")
+        self.step_form = STEP_FORM[settings.solver]
+        self.y = prog.NewContinuousVariables(nz, "y")  # z - origin
         self.nu = prog.NewContinuousVariables(2 * nc, "nu")  # nu+ then nu-
         self.xi = prog.NewContinuousVariables(ng, "xi")
-        self.buffers = problem.add_convex_constraints(prog, self.z)
+        self.buffers = problem.add_convex_constraints(prog, self.y)
+        self._cones = [ShiftedCone(prog, binding, self.y) for binding in prog.GetAllConstraints()]
         slack = np.concatenate([self.nu, self.xi, self.buffers])
         prog.AddBoundingBoxConstraint(0.0, np.inf, slack)
-        self.box = prog.AddBoundingBoxConstraint(problem.lower, problem.upper, self.z).evaluator()
+        self.box = prog.AddBoundingBoxConstraint(problem.lower, problem.upper, self.y).evaluator()
         eye_c = sp.identity(nc, format="csc")
         self._eye_nu = sp.hstack([eye_c, -eye_c], format="csc")
         self.dynamics = prog.AddLinearEqualityConstraint(
-            sp.csc_matrix((nc, nz + 2 * nc)), np.zeros(nc), np.concatenate([self.z, self.nu])).evaluator()
+            sp.csc_matrix((nc, nz + 2 * nc)), np.zeros(nc), np.concatenate([self.y, self.nu])).evaluator()
         self._neg_eye_g = -sp.identity(ng, format="csc")
         self.path = prog.AddLinearConstraint(
             sp.csc_matrix((ng, nz + ng)), np.full(ng, -np.inf), np.zeros(ng),
-            np.concatenate([self.z, self.xi])).evaluator() if ng else None
+            np.concatenate([self.y, self.xi])).evaluator() if ng else None
         self._penalty = np.concatenate([np.full(2 * nc, settings.virtual_control_weight),
                                         np.full(ng + len(self.buffers), settings.buffer_weight)])
-        self.cost = prog.AddLinearCost(np.zeros(nz + slack.size), 0.0, np.concatenate([self.z, slack])).evaluator()
-        self._slack = slack
+        self.cost = prog.AddLinearCost(np.zeros(nz + slack.size), 0.0, np.concatenate([self.y, slack])).evaluator()
         self._bounded = problem.trust_region_variables()
         if settings.solver == "clarabel":
             self.solver = ClarabelSolver()
         else:
             self.solver = ScsSolver()
+        defaults = CLARABEL_DEFAULTS if settings.solver == "clarabel" else SCS_DEFAULTS
+        self.option_values = {**defaults, **settings.solver_options}
+        self._set_options()
+
+    def _set_options(self):
         self.options = SolverOptions()
-        defaults = CLARABEL_DEFAULTS if settings.solver == "clarabel" else {}
-        for k, v in {**defaults, **settings.solver_options}.items():
+        for k, v in self.option_values.items():
             self.options.SetOption(self.solver.solver_id(), k, v)
+
+    def refine(self) -> bool:
+        """Ask an inexact (first-order) solver for a more accurate answer: SCS's eps_abs and
+        eps_rel divided by ``SCS_REFINE_FACTOR`` down to ``SCS_EPS_FLOOR``. False when there is
+        nothing left to tighten (Clarabel, or SCS at the floor)."""
+        if self.settings.solver != "scs":
+            return False
+        eps = {k: self.option_values.get(k, 1e-4) for k in ("eps_abs", "eps_rel")}
+        if max(eps.values()) <= SCS_EPS_FLOOR:
+            return False
+        for k, v in eps.items():
+            self.option_values[k] = max(v / SCS_REFINE_FACTOR, SCS_EPS_FLOOR)
+        self._set_options()
+        return True
 
     def solve(self, zb: np.ndarray, lin: Linearisation, radius: float):
         """Solve the sub-problem around zb; returns (z*, predicted L_a, solver iterations) or
         (None, message, 0) when the solver fails."""
         p, ev = self.problem, lin.evaluation
-        C = lin.defect_jacobian
-        self.dynamics.UpdateCoefficients(sp.hstack([C, self._eye_nu], format="csc"), C @ zb - ev.defects)
-        if self.path is not None:
+        origin = zb if self.step_form else np.zeros_like(zb)
+        d = zb - origin  # the current point in y
+        C = lin.defect_jacobian  # c + C (y - d) + nu = 0 (eq. 23)
+        self.dynamics.UpdateCoefficients(sp.hstack([C, self._eye_nu], format="csc"), C @ d - ev.defects)
+        if self.path is not None:  # g + G (y - d) - xi <= 0 (eq. 24)
             G = lin.inequality_jacobian
             self.path.UpdateCoefficients(sp.hstack([G, self._neg_eye_g], format="csc"),
-                                         np.full(p.n_inequalities, -np.inf), G @ zb - ev.inequalities)
-        lo = np.where(self._bounded, np.maximum(p.lower, zb - radius), p.lower)
-        hi = np.where(self._bounded, np.minimum(p.upper, zb + radius), p.upper)
+                                         np.full(p.n_inequalities, -np.inf), G @ d - ev.inequalities)
+        if self.step_form:
+            for cone in self._cones:
+                cone.shift(zb)
+        lo = np.where(self._bounded, np.maximum(p.lower, zb - radius), p.lower) - origin
+        hi = np.where(self._bounded, np.minimum(p.upper, zb + radius), p.upper) - origin
         self.box.set_bounds(lo, np.maximum(hi, lo))
         self.cost.UpdateCoefficients(np.concatenate([lin.objective_gradient, self._penalty]), 0.0)
         result = self.solver.Solve(self.prog, None, self.options)
@@ -328,10 +399,20 @@ class ScvxSubproblem:
         its = int(getattr(details, "iterations", getattr(details, "iter", 0)) or 0)
         if not result.is_success():
             return None, f"{self.solver.solver_id().name()} returned {result.get_solution_result().name}", its
-        z = result.GetSolution(self.z)
-        slack = result.GetSolution(self._slack)
-        predicted = ev.objective + lin.objective_gradient @ (z - zb) + self._penalty @ slack
-        return z, float(predicted), its
+        # clipped: a first-order solver meets the bounds only to its tolerance
+        z = np.clip(origin + result.GetSolution(self.y), p.lower, p.upper)
+        return z, self.model_merit(zb, lin, z, result.GetSolution(self.buffers)), its
+
+    def model_merit(self, zb, lin: Linearisation, z, buffers) -> float:
+        """L_a (eq. 28) of the linear model at z: the penalties evaluated from z itself, not
+        read from the solver's slack variables (a first-order solver such as SCS meets the
+        slacks' equalities only to its tolerance; predicted decreases from them were off by
+        more than the merit itself)."""
+        s, ev, dz = self.settings, lin.evaluation, z - zb
+        defects = ev.defects + lin.defect_jacobian @ dz
+        inequalities = ev.inequalities + lin.inequality_jacobian @ dz
+        return float(ev.objective + lin.objective_gradient @ dz + s.virtual_control_weight * np.abs(defects).sum()
+                     + s.buffer_weight * (np.maximum(inequalities, 0.0).sum() + np.maximum(buffers, 0.0).sum()))
 
 
 def defect_correction(jacobian: sp.spmatrix, residuals: np.ndarray, free: np.ndarray) -> np.ndarray:
@@ -421,6 +502,14 @@ def solve_scvx(problem: ConvexifiableProblem, z0, settings: ScvxSettings | None 
         z_new, predicted, solver_its = sub.solve(z, lin, radius)
         socp_time += time.perf_counter() - t1
         ev = lin.evaluation
+        if z_new is not None and ja - predicted < -s.decrease_tolerance * (1.0 + abs(ja)):
+            # dz = 0 is feasible in the sub-problem with the model at J_a: an exact solution never
+            # raises the model merit. An inexact one (a first-order solver's) is not a step.
+            z_new, predicted = None, f"an inexact solution raising the model merit by {predicted - ja:.3g}"
+            if sub.refine():  # the same sub-problem, solved more accurately
+                history.append(IterationRecord(ja, math.nan, 0.0, math.nan, 0.0, radius, False, max_defect(ev),
+                                               max_violation(ev), time.perf_counter() - t1, 0.0, solver_its))
+                continue
         if z_new is None:  # a failed solve counts as a rejected iteration
             history.append(IterationRecord(ja, math.nan, 0.0, math.nan, 0.0, radius, False, max_defect(ev),
                                            max_violation(ev), time.perf_counter() - t1, 0.0, solver_its))

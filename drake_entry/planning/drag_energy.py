@@ -60,7 +60,7 @@ class DragEnergyProblem:
       lat0, latf, heading0, headingf: [rad] linear profiles for the Earth-rate term (eq. 50).
       n_nodes: LGL nodes. range_iterations: see module doc.
       solver: 'clarabel' (default) or 'scs' (``SCS_OPTIONS``; ``python benchmarks/run.py socp``:
-        smooth to 0.7 % of Clarabel's eq. 92 at 20-40 nodes, 14x its time at 40; at 80 and 160
+        smooth to 0.7 % of Clarabel's eq. 92 at 20-40 nodes, 15x its time at 40; at 80 and 160
         nodes feasible but rough, eq. 92 6x and 84x, as SCS's tolerance is reached first).
       sigma_max: bank limit for extraction [rad].
     """
@@ -248,9 +248,11 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
     Conditioned for a first-order solver (SCS measures its residuals relative to the largest
     row): the range row (eq. 83) is divided by the range to go [m], the initial-drag rows
     (eq. 84-85) by their largest entry, and each cone of eq. 91 by its operator's 2-norm (|D2|
-    is 3e5 at 40 nodes), the cost weighted to stay eq. 92 divided by |D2|. Clarabel's optimum
-    moved by at most 3e-4 (relative); unconditioned, SCS needed 28 000 iterations at 40 nodes and
-    did not converge at 80."""
+    is 3e5 at 40 nodes), the cost weighted to stay eq. 92 divided by |D2|; unconditioned, SCS
+    needed 28 000 iterations at 40 nodes and did not converge at 80. Clarabel (interior point)
+    solves the plain form: conditioned, its optimum moved by up to 3e-4 (relative, within its
+    tolerance on this flat optimum) and the closed-loop campaign rows by up to 327 m."""
+    conditioned = p.solver == "scs"
     t0 = time.perf_counter()
     n = p.n_nodes
     scale = p.D0  # I_hat = I * scale is O(1)
@@ -258,8 +260,9 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
     I = prog.NewContinuousVariables(n, "I")
     s = prog.NewContinuousVariables(2, "s")
     prog.AddBoundingBoxConstraint(scale / D_hi, scale / D_lo, I)  # eq. 86
-    # eq. 83 with the ground-range weights kappa: R = -sum w_i kappa_i I_i, divided by R
-    prog.AddLinearEqualityConstraint((-op.weights * kappa / (scale * p.range_to_go))[None, :], [1.0], I)
+    # eq. 83 with the ground-range weights kappa: R = -sum w_i kappa_i I_i (divided by R if conditioned)
+    R = p.range_to_go if conditioned else 1.0
+    prog.AddLinearEqualityConstraint((-op.weights * kappa / (scale * R))[None, :], [p.range_to_go / R], I)
     # eq. 84 (corrected): I0 = 1/D0, dI/dtau(-1) = (dE/dtau) * (-D0'/D0^2)
     half = (op.b - op.a) / 2.0
     A0 = np.vstack([np.eye(n)[0], op.D1_tau[0]])
@@ -270,16 +273,16 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
         if p.Df_prime is not None:
             A0 = np.vstack([A0, op.D1_tau[-1]])
             b0 = np.append(b0, half * (-p.Df_prime / p.Df**2) * scale)
-    row = np.abs(A0).max(axis=1)
+    row = np.abs(A0).max(axis=1) if conditioned else np.ones(len(A0))
     prog.AddLinearEqualityConstraint(A0 / row[:, None], b0 / row, I)
-    # eq. 91: ||D1 I|| / |D1| <= s1, ||D2 I|| / |D2| <= s2 as Lorentz cones on [s_k, I]
-    norms = np.array([np.linalg.norm(Dk, 2) for Dk in (op.D1_tau, op.D2_tau)])
+    # eq. 91: ||D1 I|| / |D1| <= s1, ||D2 I|| / |D2| <= s2 as Lorentz cones on [s_k, I] (norms 1 if plain)
+    norms = np.array([np.linalg.norm(Dk, 2) for Dk in (op.D1_tau, op.D2_tau)]) if conditioned else np.ones(2)
     for k, Dk in enumerate((op.D1_tau, op.D2_tau)):
         A = np.zeros((n + 1, n + 1))
         A[0, 0] = 1.0
         A[1:, 1:] = Dk / norms[k]
         prog.AddLorentzConeConstraint(A, np.zeros(n + 1), np.concatenate([[s[k]], I]))
-    prog.AddLinearCost(norms / norms[1], 0.0, s)  # eq. 92 divided by |D2|
+    prog.AddLinearCost(norms / norms[1], 0.0, s)  # eq. 92 (divided by |D2| if conditioned)
     t1 = time.perf_counter()
     solver = SOLVERS[p.solver]()
     options = SolverOptions()

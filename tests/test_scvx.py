@@ -72,9 +72,10 @@ class CircleInDisc(Circle):
 
 @pytest.mark.parametrize("solver", ["clarabel", "scs"])
 def test_engine_keeps_a_convex_cone_on_z_while_solving_for_the_step(solver):
-    """The sub-problem's variables are the step dz = z - zb; the problem's cone, stated on z,
-    is shifted to each zb (ShiftedCone). Both solvers end at the cone-bound optimum; SCS with
-    its own tolerances (ScvxSettings.for_solver) and accuracy refinement."""
+    """With SCS the sub-problem's variables are the step dz = z - zb and the problem's cone,
+    stated on z, is shifted to each zb (ShiftedCone); Clarabel solves z. Both end at the
+    cone-bound optimum; SCS with its own tolerances (ScvxSettings.for_solver) and accuracy
+    refinement."""
     out = solve_scvx(CircleInDisc(), np.array([-2.0, 0.5]), ScvxSettings.for_solver(solver, max_iterations=80))
     assert out.converged, out.message
     tol = 1e-5 if solver == "clarabel" else 1e-3  # SCS: 8e-4 measured
@@ -83,13 +84,15 @@ def test_engine_keeps_a_convex_cone_on_z_while_solving_for_the_step(solver):
 
 
 def test_engine_refuses_a_convex_constraint_it_cannot_shift():
+    """On the step (SCS) every convex constraint must be re-centred; only Lorentz cones are."""
+
     class WithLinear(Circle):
         def add_convex_constraints(self, prog, z):
             prog.AddLinearConstraint(z[0] >= -0.5)
             return np.empty(0, dtype=object)
 
     with pytest.raises(TypeError, match="Lorentz cones only"):
-        solve_scvx(WithLinear(), np.array([-2.0, 0.5]))
+        solve_scvx(WithLinear(), np.array([-2.0, 0.5]), ScvxSettings.for_solver("scs"))
 
 
 def test_engine_reports_an_infeasible_problem_with_its_constraint():

@@ -236,8 +236,8 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
 
 
 #: SCS options of the drag-energy SOCP on its conditioned form (``solve_socp``): eps 1e-5 meets
-#: the planner's own check (``_check_solution``) with the objective within 0.3 % of Clarabel's at
-#: 20-40 nodes in 1 200-9 800 iterations (5-100 ms); see docs/methods/drag-energy.md
+#: the planner's own check (``_check_solution``) with eq. 92 within 0.7 % of Clarabel's at
+#: 20-40 nodes in 800-4 925 iterations (3-48 ms); see docs/methods/drag-energy.md
 SCS_OPTIONS = {"eps_abs": 1e-5, "eps_rel": 1e-5, "max_iters": 100000}
 
 

@@ -18,6 +18,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
+from drake_entry.errors import ModelRangeError, NonFiniteStateError
 from drake_entry.geodesy import downtrack_crosstrack
 from drake_entry.planning.ocp import OptimalControlProblem
 from drake_entry.systems.ocp_plant import OptimalControlPlant
@@ -65,7 +66,8 @@ def propagate(problem, result, *, accuracy: float = 1e-11, samples_per_interval:
     failure = None
     try:
         simulator.AdvanceTo(tf)
-    except RuntimeError as e:  # e.g. the flight-path angle reaching the -90 deg singularity
+    except (RuntimeError, ModelRangeError, NonFiniteStateError) as e:  # e.g. gamma reaching -90 deg, h below the
+        # atmosphere model
         failure = f"propagation stopped at t = {ctx.get_time():.2f} s of {tf:.2f} s: {str(e).splitlines()[0][:200]}"
     log = logger.FindLog(ctx)
     t_end = ctx.get_time()

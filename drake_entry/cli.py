@@ -162,7 +162,6 @@ def _cmd_fit_horus(args) -> int:
 
 
 def _cmd_optimize(args) -> int:
-    from .diagrams.propagation import propagate
     from .planning import nlp
     from .planning.ocp_yaml import load_problem
     from .plots import nlp_solution_plots
@@ -181,11 +180,11 @@ def _cmd_optimize(args) -> int:
         coarse = nlp.solve(problem, transcription=transcription, solver=solver, nodes=coarse_nodes,
                            tolerance=max(tol, 1e-6), max_iterations=max_iterations)
         print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
-        guess = coarse if coarse.success else None
+        guess = coarse if coarse.converged else None
     print(f"solve: {problem.name}, {transcription}, {nodes} nodes, {solver} ...", flush=True)
     result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
-                       max_iterations=max_iterations, guess=guess)
-    check = propagate(problem, result) if result.success and not args.no_propagate else None
+                       max_iterations=max_iterations, guess=guess, verify=not args.no_propagate)
+    check = result.verification.flight if result.verification is not None else None
     info = nlp.summary(problem, result, check)
     os.makedirs(args.out, exist_ok=True)
     cols = {"time_s": result.time}
@@ -261,7 +260,8 @@ def main(argv=None) -> int:
                         "guess; default: the YAML's coarse_nodes)")
     o.add_argument("--max-iterations", type=int, default=None, metavar="N",
                    help="solver iteration limit (default: the YAML's solve.max_iterations)")
-    o.add_argument("--no-propagate", action="store_true", help="skip the Drake propagation check")
+    o.add_argument("--no-propagate", action="store_true",
+                   help="skip the verification (between-node dynamics and the Drake propagation)")
     o.add_argument("--out", default="out/optimize")
     o.add_argument("--format", choices=("parquet", "csv"), default="csv")
     o.set_defaults(func=_cmd_optimize)

@@ -5,10 +5,11 @@
 The problem is paper 002's maneuvering re-entry (eqs. 1-11, 16-19) written out field by
 field: from 37 km and 7137.9 m/s to the ground 2800 km downrange, arriving vertically, with
 q >= 12 kPa and a <= 45 g, maximising the control margin of eq. 11. Change any field: it is
-plain Python. At 30 nodes the solver converges but the flown controls miss the planned end by
-about 11 km (the discretisation is too coarse: an answer to check, not to trust); at 60 nodes
-they follow the plan until the flight-path angle nears the -90 deg singularity of eqs. 1 just
-before t_f, where the propagation stops and says so.
+plain Python. At 30 nodes the solver converges but ``solve`` reports "converged but
+inaccurate": the dynamics between the nodes are off by 1 % and the flown controls miss the
+planned end by about 11 km (the discretisation is too coarse); at 60 nodes they follow the plan
+until the flight-path angle nears the -90 deg singularity of eqs. 1 just before t_f, where the
+propagation stops and says so.
 
     python examples/05_optimal_control.py [--quick] [--out out/examples/05]
 """

@@ -57,9 +57,12 @@ def test_example_04(tmp_path):
 def test_example_05(tmp_path):
     r = _run("05_optimal_control", tmp_path)
     res, flown = r["result"], r["flown"]
-    assert res.success and res.costates is not None and np.all(np.isfinite(res.costates))
+    assert res.converged and res.costates is not None and np.all(np.isfinite(res.costates))
+    # 30 nodes (quick): converged, but the verification sees the between-node error and the miss
+    assert not res.success and res.message.startswith("converged but inaccurate")
+    assert res.verification.dynamics_error > 1e-3 and not res.verification.propagation_error <= 1e-4
     assert res.states[-1, 0] == pytest.approx(0.0, abs=1.0) and math.degrees(res.states[-1, 4]) == pytest.approx(-89.0)
-    assert flown.time[-1] > 0.99 * res.final_time
+    assert flown.time[-1] == pytest.approx(res.verification.flight.time[-1])  # the example flies what solve() flew
 
 
 def test_example_06(tmp_path):
@@ -78,7 +81,8 @@ def test_example_07(tmp_path):
     assert plan.formulation == "direct"
     assert 460.0 < plan.objective < 500.0 and flight.from_plan_m < 5e3 and flight.from_site_m < 15e3 and flight.drs_ok
     assert os.path.exists(r["plot"])
-    assert r["nlp"].success and plan.objective == pytest.approx(r["nlp"].objective / 1e6, rel=0.01)  # 0.24 %
+    # 70 samples (quick) converge; the verification finds the last interval's gamma off by 0.0015 > 1e-3
+    assert r["nlp"].converged and plan.objective == pytest.approx(r["nlp"].objective / 1e6, rel=0.01)  # 0.24 %
 
 
 def test_example_09(tmp_path):

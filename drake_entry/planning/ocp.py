@@ -138,9 +138,15 @@ class _ProblemLayout:
 
     @property
     def final_time_bounds(self) -> tuple:
-        if isinstance(self.final_time, (int, float)):
-            return float(self.final_time), float(self.final_time)
-        return float(self.final_time[0]), float(self.final_time[1])
+        """(min, max) of t_f [s]: a number is fixed; None is free, (0, inf); (min, max) with
+        either end None (0 or inf) is an interval."""
+        t = self.final_time
+        if t is None:
+            return 0.0, math.inf
+        if isinstance(t, (int, float, np.integer, np.floating)) and not isinstance(t, bool):
+            return float(t), float(t)
+        lo, hi = t
+        return (0.0 if lo is None else float(lo)), (math.inf if hi is None else float(hi))
 
     def _check_layout(self):
         for where, d in (("initial", self.initial), ("final", self.final), ("state_bounds", self.state_bounds)):
@@ -150,9 +156,13 @@ class _ProblemLayout:
         for k in self.control_bounds:
             if k not in self.control_names:
                 raise ScenarioError(f"control_bounds: unknown control '{k}'; controls are {', '.join(self.control_names)}")
-        lo, hi = self.final_time_bounds
-        if not 0.0 < lo <= hi:
-            raise ScenarioError(f"final_time must be > 0 with min <= max, got {self.final_time}")
+        try:
+            lo, hi = self.final_time_bounds
+        except (TypeError, ValueError):
+            raise ScenarioError(f"final_time = {self.final_time!r}: allowed a number [s], (min, max) with None for an "
+                                f"open end, or None (free)") from None
+        if math.isnan(lo) or math.isnan(hi) or not (0.0 <= lo <= hi and hi > 0.0):
+            raise ScenarioError(f"final_time = {self.final_time!r}: allowed 0 <= min <= max, max > 0 [s]")
 
     def _default_state_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         return np.full(self.n_states, -np.inf), np.full(self.n_states, np.inf)
@@ -195,7 +205,8 @@ class CustomProblem(_ProblemLayout):
       mayer_function: M(xf, tf) or None. path: PathConstraint list whose quantity is a
         callable f(x, u, env) (env is None here); terminal: the same at the final node.
       initial, final, final_time, state_bounds, control_bounds: as OptimalControlProblem.
-      state_scale, control_scale, time_scale: typical sizes used to scale the NLP.
+      state_scale, control_scale, time_scale: typical sizes [SI] the NLP divides by; None
+        (default) lets the solver choose them from the guess and bounds (nlp.scaling).
     """
 
     state_names: tuple
@@ -203,7 +214,7 @@ class CustomProblem(_ProblemLayout):
     dynamics_function: Callable
     initial: dict
     final: dict
-    final_time: float | tuple
+    final_time: float | tuple | None
     lagrange_function: Callable | None = None
     mayer_function: Callable | None = None
     state_bounds: dict = dc.field(default_factory=dict)
@@ -212,7 +223,7 @@ class CustomProblem(_ProblemLayout):
     terminal: list = dc.field(default_factory=list)
     state_scale: tuple | None = None
     control_scale: tuple | None = None
-    time_scale: float = 1.0
+    time_scale: float | None = None
     name: str = "custom"
 
     def __post_init__(self):
@@ -243,10 +254,11 @@ class CustomProblem(_ProblemLayout):
     def terminal_values(self, x, u) -> list:
         return [c.quantity(x, u, None) for c in self.terminal]
 
-    def scales(self) -> tuple[np.ndarray, np.ndarray, float]:
-        sx = np.ones(self.n_states) if self.state_scale is None else np.asarray(self.state_scale, float)
-        su = np.ones(self.n_controls) if self.control_scale is None else np.asarray(self.control_scale, float)
-        return sx, su, float(self.time_scale)
+    def scales(self) -> tuple:
+        """(state, control, time) scales the user gave [SI]; None where nlp.scaling chooses."""
+        sx = None if self.state_scale is None else np.asarray(self.state_scale, float)
+        su = None if self.control_scale is None else np.asarray(self.control_scale, float)
+        return sx, su, (None if self.time_scale is None else float(self.time_scale))
 
 
 @dc.dataclass
@@ -257,7 +269,7 @@ class OptimalControlProblem(_ProblemLayout):
       vehicle, planet, atmosphere: the models.
       initial, final: state name -> fixed value, (min, max) or None (free), SI / rad.
         States not named are free.
-      final_time: fixed t_f [s] or (min, max) for a free final time; t_0 = 0.
+      final_time: fixed t_f [s], (min, max) (None for an open end) or None (free); t_0 = 0.
       controls: 'rates' (alpha, sigma are states, controls are their rates) or 'direct'.
       state_bounds, control_bounds: name -> (min, max) along the whole trajectory.
       path: path constraints. objective: terms (at least one).
@@ -270,7 +282,7 @@ class OptimalControlProblem(_ProblemLayout):
     atmosphere: Atmosphere
     initial: dict
     final: dict
-    final_time: float | tuple
+    final_time: float | tuple | None
     objective: list
     controls: str = "rates"
     state_bounds: dict = dc.field(default_factory=dict)
@@ -319,6 +331,7 @@ class OptimalControlProblem(_ProblemLayout):
         # altitude within the atmosphere model's range (a solver step never leaves it)
         xl[0] = max(getattr(self.atmosphere, "h_min", -np.inf), -4000.0)
         xh[0] = min(getattr(self.atmosphere, "h_max", np.inf), 1.0e6)
+        xl[2], xh[2] = -math.radians(89.99), math.radians(89.99)  # the poles are singular (1 / cos lat)
         xl[3] = 1.0  # speed stays positive (the equations divide by V)
         xl[4], xh[4] = -math.radians(89.99), math.radians(89.99)  # gamma = +-90 deg is singular
         return xl, xh
@@ -402,9 +415,19 @@ class OptimalControlProblem(_ProblemLayout):
 
     @property
     def alpha_bar(self) -> float:
-        """alpha at maximum L/D (paper 002: sqrt(C_D0/K) for the drag polar)."""
+        """alpha at maximum L/D [rad]: the aero model's own (paper 002: sqrt(C_D0/K) for the
+        drag polar), else the largest C_L/C_D over 0-60 deg at the initial Mach number
+        (0.01 deg grid), else 10 deg when the initial state is not fixed."""
         a = getattr(self.vehicle.aero, "alpha_max_lift_to_drag", None)
-        return float(a) if a is not None else math.radians(10.0)
+        if a is not None:
+            return float(a)
+        h0, v0 = self.initial.get("h"), self.initial.get("V")
+        if not isinstance(h0, (int, float)) or not isinstance(v0, (int, float)):
+            return math.radians(10.0)
+        mach = v0 / self.atmosphere.air_data(float(h0))[1]
+        alphas = np.radians(np.arange(0.0, 60.0 + 1e-9, 0.01))
+        cl, cd = (np.asarray(c, float) for c in self.vehicle.aero.coefficients(alphas, np.full_like(alphas, mach)))
+        return float(alphas[int(np.argmax(np.where(cd > 0, cl / np.where(cd > 0, cd, 1.0), -np.inf)))])
 
     def crossrange(self, x):
         """Signed distance [m] of x from the great circle through the initial position along

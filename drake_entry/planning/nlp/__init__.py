@@ -4,8 +4,9 @@ DirectCollocation, solved with Ipopt or SNOPT (paper 002).
     result = solve(problem, transcription="lgl" | "dircol", solver="ipopt" | "snopt", nodes=N)
 
 ``problem`` is an ``OptimalControlProblem`` (entry dynamics, planning/ocp.py) or a
-``CustomProblem``. The NLP runs in scaled units (problem.scales(): canonical units as in
-paper 002, altitude in 10 km, controls by their bounds); results are SI.
+``CustomProblem``. The NLP runs in scaled units (scaling: canonical units as in paper 002,
+altitude in 10 km, controls by their bounds, the objective by its gradient at the guess;
+reported in ``result.scaling``); results are SI.
 
 LGL (paper 002 eqs. 12-14, Fahroo & Ross): states and controls at the N LGL nodes
 tau_k of [-1, 1], t = (tau + 1) t_f / 2. The defects are split so every nonlinear
@@ -22,11 +23,17 @@ The result reports the Hamiltonian H = L + lambda' f along the solution (zero on
 extremal with free final time, paper 002 Fig. 10) and ``propagate`` (diagrams.propagation)
 flies the controls with the Drake Simulator to check the terminal state.
 
-Modules: result (NlpResult, extremal controls, summary), guess (initial guesses),
-evaluator (node values and Jacobians), transcription (shared parts), lgl, dircol.
+``success`` means verified (verify: dynamics between the nodes and the controls flown by the
+Drake Simulator); a converged answer that fails the check says "converged but inaccurate".
+
+Modules: result (NlpResult, extremal controls, summary), guess (initial guesses), scaling
+(the factors the solver sees), status (solver verdicts in words), verify, evaluator (node
+values and Jacobians), transcription (shared parts), lgl, dircol, catalogue (published
+problems with their optima).
 """
 from __future__ import annotations
 
+import tempfile
 import time as _time
 
 import numpy as np
@@ -37,15 +44,21 @@ from .dircol import _DircolTranscription
 from .guess import initial_guess
 from .lgl import _LglTranscription
 from .result import NlpError, NlpResult, extremal_controls, summary  # noqa: F401 (API)
+from .scaling import Scaling, resolve as resolve_scaling  # noqa: F401 (API)
+from .status import verdict
 from .transcription import COSTATE_SIGN  # noqa: F401 (API)
+from .verify import DYNAMICS_TOLERANCE, PROPAGATION_TOLERANCE, Verification, verify as verify_solution  # noqa: F401
 
 TRANSCRIPTIONS = ("lgl", "dircol")
 SOLVERS = ("ipopt", "snopt")
 
 
 def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: int = 40, guess=None,
-          tolerance: float = 1e-8, max_iterations: int = 3000, verbose: bool = False) -> NlpResult:
-    """Solve ``problem`` (see module docstring).
+          tolerance: float = 1e-8, max_iterations: int = 3000, verbose: bool = False, scaling=None,
+          solver_options: dict | None = None, log_file: str | None = None, verify: bool = True,
+          dynamics_tolerance: float = DYNAMICS_TOLERANCE,
+          propagation_tolerance: float = PROPAGATION_TOLERANCE) -> NlpResult:
+    """Solve ``problem`` (see module docstring); ``success`` only when verified.
 
     Args:
       transcription: 'lgl' (Legendre pseudospectral, paper 002 eqs. 12-14) or 'dircol'.
@@ -54,7 +67,17 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
       guess: an NlpResult, or (t [s], states (n, nx), controls (n, nu)) SI, or None for the
         built-in propagated guess (``initial_guess``).
       tolerance: solver optimality and feasibility tolerance (scaled units).
-      max_iterations: solver iteration limit.
+      max_iterations: solver (major) iteration limit.
+      verbose: the solver's log (Ipopt: to the console; SNOPT: to ``log_file`` or a
+        temporary file named in the result).
+      scaling: override any of the automatic scale factors (nlp.scaling: a dict with
+        states, controls, time, objective, or a Scaling).
+      solver_options: further options by the solver's own names, set last (e.g.
+        {"linear_solver": "mumps"} for Ipopt, {"Hessian full memory": 1} for SNOPT).
+      log_file: where the solver writes its log.
+      verify: check the solution between the nodes and by flying its controls
+        (nlp.verify); without it ``success`` is the solver's word only.
+      dynamics_tolerance, propagation_tolerance: the verification's tolerances (relative).
     """
     if transcription not in TRANSCRIPTIONS:
         raise ScenarioError(f"transcription '{transcription}' is unknown; allowed: {', '.join(TRANSCRIPTIONS)}")
@@ -66,35 +89,76 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
         raise ScenarioError(f"tolerance = {tolerance} is out of range; allowed (0, 1)")
     if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 1:
         raise ScenarioError(f"max_iterations = {max_iterations} is out of range; allowed: an integer >= 1")
+    for name, value in (("dynamics_tolerance", dynamics_tolerance), ("propagation_tolerance", propagation_tolerance)):
+        if not 0 < value < 1:
+            raise ScenarioError(f"{name} = {value} is out of range; allowed (0, 1)")
     engine = IpoptSolver() if solver == "ipopt" else SnoptSolver()
     if not engine.available() or not engine.enabled():
         raise NlpError(f"solver '{solver}' is not available in this pydrake build")
+    t_guess = _time.perf_counter()
     if guess is None:
         guess = initial_guess(problem)
     elif isinstance(guess, NlpResult):
         guess = (guess.time, guess.states, guess.controls)
-    _check_guess(problem, guess)
+    guess = _check_guess(problem, guess)
+    guess_time = _time.perf_counter() - t_guess
     t_build = _time.perf_counter()
-    tx = _LglTranscription(problem, nodes) if transcription == "lgl" else _DircolTranscription(problem, nodes)
+    scales = resolve_scaling(problem, guess, scaling)
+    tx = (_LglTranscription(problem, nodes, scales) if transcription == "lgl"
+          else _DircolTranscription(problem, nodes, scales, float(guess[0][-1])))
     tx.set_guess(*guess)
+    tx.scale_objective()
     build_time = _time.perf_counter() - t_build
-    options = SolverOptions()
-    if solver == "ipopt":
-        options.SetOption(engine.solver_id(), "tol", tolerance)
-        options.SetOption(engine.solver_id(), "constr_viol_tol", tolerance)
-        options.SetOption(engine.solver_id(), "max_iter", int(max_iterations))
-        options.SetOption(engine.solver_id(), "print_level", 5 if verbose else 0)
-    else:
-        options.SetOption(engine.solver_id(), "Major optimality tolerance", tolerance)
-        options.SetOption(engine.solver_id(), "Major feasibility tolerance", tolerance)
-        options.SetOption(engine.solver_id(), "Major iterations limit", int(max_iterations))
-        options.SetOption(engine.solver_id(), "Iterations limit", int(max_iterations) * 100)
-        if verbose:
-            options.SetOption(engine.solver_id(), "Print file", "snopt.out")
+    options, log_file = _solver_options(engine, solver, tolerance, max_iterations, verbose, solver_options, log_file)
     t0 = _time.perf_counter()
     res = engine.Solve(tx.prog, tx.initial_guess, options)
     solve_time = _time.perf_counter() - t0
-    return tx.result(res, solver, solve_time, build_time)
+    result = tx.result(res)
+    converged, words = verdict(res, solver)
+    result.solver, result.converged, result.log_file = solver, converged, log_file
+    result.guess_time, result.build_time, result.solve_time = guess_time, build_time, solve_time
+    if not converged:
+        result.success, result.message = False, f"not solved: {words}; {tx.diagnose(res)}"
+        return result
+    if not verify:
+        result.success, result.message = True, f"solved (not verified): {words}"
+        return result
+    t_verify = _time.perf_counter()
+    check = verify_solution(problem, result, dynamics_tolerance=dynamics_tolerance,
+                            propagation_tolerance=propagation_tolerance)
+    result.verify_time = _time.perf_counter() - t_verify
+    result.verification = check
+    result.success = check.verified
+    result.message = (f"solved and verified: {words}; " if check.verified else
+                      f"converged but inaccurate: {words}; ") + check.summary()
+    return result
+
+
+def _solver_options(engine, solver, tolerance, max_iterations, verbose, extra, log_file):
+    """SolverOptions: ours first, then the user's ``extra`` by the solver's own names."""
+    options = SolverOptions()
+    sid = engine.solver_id()
+    if solver == "ipopt":
+        ours = {"tol": tolerance, "constr_viol_tol": tolerance, "max_iter": int(max_iterations),
+                "print_level": 5 if verbose else 0}
+        if log_file:
+            ours.update(output_file=str(log_file), file_print_level=5)
+    else:
+        ours = {"Major optimality tolerance": tolerance, "Major feasibility tolerance": tolerance,
+                "Major iterations limit": int(max_iterations), "Iterations limit": int(max_iterations) * 100}
+        if verbose and not log_file:
+            log_file = tempfile.NamedTemporaryFile(prefix="snopt_", suffix=".out", delete=False).name
+        if log_file:
+            ours["Print file"] = str(log_file)
+    if extra is not None and not isinstance(extra, dict):
+        raise ScenarioError("solver_options must be a dict of option name -> value")
+    for key, value in {**ours, **(extra or {})}.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float, str, np.integer, np.floating)):
+            raise ScenarioError(f"solver_options['{key}'] = {value!r}: allowed an int, float or str")
+        value = int(value) if isinstance(value, np.integer) else float(value) if isinstance(value, np.floating) \
+            else value
+        options.SetOption(sid, key, value)
+    return options, (str(log_file) if log_file else None)
 
 
 def _check_guess(problem, guess):
@@ -109,4 +173,5 @@ def _check_guess(problem, guess):
         raise ScenarioError(f"guess shapes t {t.shape}, states {X.shape}, controls {U.shape}; expected {want}")
     if not (np.isfinite(t).all() and np.isfinite(X).all() and np.isfinite(U).all()) or np.any(np.diff(t) <= 0):
         raise ScenarioError("guess must be finite with strictly increasing times")
+    return t, X, U
 

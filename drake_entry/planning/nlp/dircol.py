@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .result import NlpResult
-from .transcription import COSTATE_SIGN, _finish, _Transcription
+from .transcription import _Transcription
 
 DIRCOL_COSTATE_FACTOR = 1.5
 
@@ -14,18 +14,22 @@ DIRCOL_COSTATE_FACTOR = 1.5
 class _DircolTranscription(_Transcription):
     """Drake DirectCollocation (Hermite-Simpson) of the scaled plant."""
 
-    def __init__(self, problem, nodes):
-        super().__init__(problem, nodes)
+    def __init__(self, problem, nodes, scaling, guess_final_time):
+        super().__init__(problem, nodes, scaling)
         from pydrake.planning import DirectCollocation
 
         from drake_entry.systems.ocp_plant import OptimalControlPlant  # the transcription needs a Drake System
 
         self.plant = OptimalControlPlant(problem, self.sx, self.su, self.ts)
-        h_min = self.t_lo / self.ts / (nodes - 1) * 0.2
-        h_max = (self.t_hi if np.isfinite(self.t_hi) else 10 * self.t_lo) / self.ts / (nodes - 1) * 5.0
-        self.dc = DirectCollocation(self.plant, self.plant.CreateDefaultContext(), nodes, h_min, h_max)
+        # equal steps, loosely bounded (t_f's own bounds are the duration bounds): Drake needs
+        # finite step bounds, so an open end becomes 1e-6 / 1e6 x the guess's final time (no
+        # cap a solve can reach); a fixed t_f keeps a step range (Ipopt fails on lb = ub here)
+        lo = 0.5 * self.t_lo if self.t_lo > 0 else 1e-6 * guess_final_time
+        hi = 2.0 * self.t_hi if np.isfinite(self.t_hi) else 1e6 * guess_final_time
+        self.dc = DirectCollocation(self.plant, self.plant.CreateDefaultContext(), nodes,
+                                    lo / self.ts / (nodes - 1), hi / self.ts / (nodes - 1))
         self.dc.AddEqualTimeIntervalsConstraints()
-        self.dc.AddDurationBounds(self.t_lo / self.ts, min(self.t_hi, 1e12) / self.ts)
+        self.dc.AddDurationBounds(self.t_lo / self.ts, self.t_hi / self.ts)
         prog = self.prog = self.dc.prog()
         N, nx, nu = nodes, self.nx, self.nu
         self.X = np.array([self.dc.state(k) for k in range(N)])
@@ -36,8 +40,8 @@ class _DircolTranscription(_Transcription):
         self.add_terminal(prog, self.X[-1], self.U[-1])
         if problem.has_lagrange:  # trapezoid rule over the samples
             for k in range(N - 1):
-                prog.AddCost(lambda z: 0.5 * z[-1] * (self.L_scaled(z[:nx], z[nx:nx + nu])
-                                                      + self.L_scaled(z[nx + nu:2 * nx + nu], z[2 * nx + nu:-1])),
+                prog.AddCost(lambda z: 0.5 * self.cost_factor * z[-1] * (
+                    self.L_scaled(z[:nx], z[nx:nx + nu]) + self.L_scaled(z[nx + nu:2 * nx + nu], z[2 * nx + nu:-1])),
                              np.concatenate([self.X[k], self.U[k], self.X[k + 1], self.U[k + 1], [self.H[k]]]))
         self.collocation = [b for b in prog.GetAllConstraints()
                             if b.evaluator().get_description().startswith("collocation constraint")]
@@ -53,8 +57,7 @@ class _DircolTranscription(_Transcription):
                                      PiecewisePolynomial.FirstOrderHold(t, Xs))
         self.initial_guess = self.prog.GetInitialGuess(self.prog.decision_variables())
 
-    def result(self, res, solver, solve_time, build_time) -> NlpResult:
-        ok, msg = self._message(res, solver)
+    def result(self, res) -> NlpResult:
         t = self.dc.GetSampleTimes(res) * self.ts
         X = np.reshape(self.dc.GetStateSamples(res), (self.nx, self.N)).T * self.sx
         U = np.reshape(self.dc.GetInputSamples(res), (self.nu, self.N)).T * self.su
@@ -62,10 +65,7 @@ class _DircolTranscription(_Transcription):
         try:  # collocation multipliers at the segment midpoints
             h = np.diff(t) / self.ts
             nu = np.vstack([res.GetDualSolution(b) for b in self.collocation])
-            costates = COSTATE_SIGN * DIRCOL_COSTATE_FACTOR * nu / h[:, None] * self.ts / self.sx
+            costates = self.costates_from(DIRCOL_COSTATE_FACTOR * nu / h[:, None])
         except Exception:  # noqa: BLE001
             costates = None
-        if not ok:
-            msg += "; " + self.diagnose(res)
-        return _finish(self, ok, msg, t, X, U, res, costates, t_mid if costates is not None else None,
-                       solve_time, build_time, "dircol", solver)
+        return self.make_result(res, t, X, U, costates, t_mid if costates is not None else None, "dircol")

@@ -20,30 +20,9 @@ class _NodeEvaluator:
     def _models(self, Xs, Us):
         """f_scaled (nx, M), path_scaled (np, M), L (M,) at M scaled points (columns)."""
         tx = self.tx
-        x = Xs * tx.sx[:, None]
-        u = Us * tx.su[:, None]
-        if self.vectorised:
-            try:
-                return self._call(x, u)
-            except Exception:  # noqa: BLE001 - a model without array support
-                self.vectorised = False
-        cols = [self._call(x[:, m], u[:, m]) for m in range(x.shape[1])]
-        return (np.column_stack([c[0] for c in cols]), np.column_stack([c[1] for c in cols]),
-                np.array([c[2] for c in cols], float))
-
-    def _call(self, x, u):
-        tx, p = self.tx, self.tx.problem
-        xs, us = list(x), list(u)
-        m = np.shape(x)[1:] or ()
-        f = np.array([np.broadcast_to(np.asarray(v, float), m) for v in p.dynamics(xs, us)])
-        f = f * (tx.ts / tx.sx).reshape((-1,) + (1,) * len(m))
-        if p.path:
-            g = np.array([np.broadcast_to(np.asarray(v, float), m) / c.scale
-                          for v, c in zip(p.path_values(xs, us), p.path)])
-        else:
-            g = np.zeros((0,) + tuple(m))
-        L = np.broadcast_to(np.asarray(p.lagrangian(xs, us), float), m) if p.has_lagrange else np.zeros(m)
-        return f, g, L
+        f, g, L, self.vectorised = model_values(tx.problem, Xs * tx.sx[:, None], Us * tx.su[:, None], self.vectorised)
+        scale = np.array([c.scale for c in tx.problem.path], float).reshape(-1, 1)
+        return f * (tx.ts / tx.sx)[:, None], g / scale, L
 
     def evaluate(self, Xs, Us):
         """Values and node Jacobians: f (N, nx), g (N, np), L (N,), and df (N, nx, nx+nu),
@@ -77,6 +56,32 @@ class _NodeEvaluator:
             dL[:, j] = (L[a] - L[b]) / den
         self._key, self._out = key, (f0, g0, L0, df, dg, dL)
         return self._out
+
+
+def model_values(problem, x, u, vectorised: bool = True):
+    """Dynamics f (nx, M), path values (np, M) and Lagrangian (M,), SI, at the M columns of
+    x (nx, M), u (nu, M): one vectorised model call, or column by column when the models
+    take scalars only. Returns (f, g, L, vectorised)."""
+    if vectorised:
+        try:
+            return (*_call(problem, x, u), True)
+        except Exception:  # noqa: BLE001 - a model without array support
+            pass
+    cols = [_call(problem, x[:, m], u[:, m]) for m in range(x.shape[1])]
+    return (np.column_stack([c[0] for c in cols]), np.column_stack([c[1] for c in cols]).reshape(-1, x.shape[1]),
+            np.array([c[2] for c in cols], float), False)
+
+
+def _call(problem, x, u):
+    xs, us = list(x), list(u)
+    m = np.shape(x)[1:] or ()
+    f = np.array([np.broadcast_to(np.asarray(v, float), m) for v in problem.dynamics(xs, us)])
+    if problem.path:
+        g = np.array([np.broadcast_to(np.asarray(v, float), m) for v in problem.path_values(xs, us)])
+    else:
+        g = np.zeros((0,) + tuple(m))
+    L = np.broadcast_to(np.asarray(problem.lagrangian(xs, us), float), m) if problem.has_lagrange else np.zeros(m)
+    return f, g, L
 
 
 def _chain(J, G):

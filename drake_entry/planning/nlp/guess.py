@@ -14,10 +14,12 @@ def initial_guess(problem, samples: int = 200):
     """(t, states, controls) SI: a propagated guess.
 
     Entry problems: fly a constant angle of attack (alpha-bar, within the bounds) and a
-    constant bank magnitude found by bisection so the flight ends at the final altitude
-    near the final position (or at the fixed/maximum final time), with controls at rest.
-    Other problems: the straight line between the boundary values over the mean final
-    time, controls at the middle of their bounds (or zero).
+    constant bank (within its bounds) whose magnitude is found by bisection so the flight
+    ends at the final altitude near the final position (or at the fixed/maximum final time),
+    with controls at rest; then each state is shifted linearly in time to end inside its
+    final bounds, and clipped to the state bounds. Other problems: the straight line between
+    the boundary values over the mean final time (free: the problem's time scale or 1 s),
+    controls at the middle of their bounds (or zero).
     """
     if isinstance(problem, OptimalControlProblem):
         return _entry_guess(problem, samples)
@@ -36,7 +38,12 @@ def _mid(lo, hi, default):
 
 def _straight_line_guess(problem, samples):
     t_lo, t_hi = problem.final_time_bounds
-    tf = 0.5 * (t_lo + t_hi) if np.isfinite(t_hi) else t_lo * 2.0
+    if np.isfinite(t_hi):
+        tf = 0.5 * (t_lo + t_hi)
+    elif t_lo > 0:
+        tf = 2.0 * t_lo
+    else:  # free: the problem's time scale, else 1 s
+        tf = (problem.scales()[2] or 1.0) if hasattr(problem, "scales") else 1.0
     x0l, x0h = problem.boundary_bounds("initial")
     xfl, xfh = problem.boundary_bounds("final")
     xl, xh, ul, uh = problem.bounds_arrays()
@@ -45,7 +52,7 @@ def _straight_line_guess(problem, samples):
     t = np.linspace(0.0, tf, samples)
     X = x0[None, :] + (t / tf)[:, None] * (xf - x0)[None, :]
     U = np.tile([_mid(a, b, 0.0) for a, b in zip(ul, uh)], (samples, 1))
-    return t, X, U
+    return t, np.clip(X, xl, xh), U
 
 
 def _entry_guess(problem: OptimalControlProblem, samples):
@@ -90,12 +97,17 @@ def _entry_guess(problem: OptimalControlProblem, samples):
     def too_long(sol):  # did not land, or landed beyond the final position
         return sol.status != 1 or (target is not None and miss(sol) > 0)
 
-    # bisection on a constant bank magnitude: more bank = shorter flight
-    lo, hi = 0.0, math.radians(89.0)
-    best = fly(hi)
+    # bisection on a constant bank magnitude (more bank = shorter flight), on the side the
+    # bank bounds allow most of
+    b_lo, b_hi = (xl[7], xh[7]) if problem.controls == "rates" else (ul[1], uh[1])
+    side = 1.0 if b_hi >= -b_lo else -1.0
+    m_lo = max(0.0, side * (b_lo if side > 0 else b_hi))
+    m_hi = min(math.radians(89.0), side * (b_hi if side > 0 else b_lo))
+    lo, hi = m_lo, max(m_hi, m_lo)
+    best = fly(side * hi)
     for _ in range(25):
         mid = 0.5 * (lo + hi)
-        s = fly(mid)
+        s = fly(side * mid)
         if too_long(s):
             lo = mid
         else:
@@ -109,7 +121,20 @@ def _entry_guess(problem: OptimalControlProblem, samples):
     if problem.controls == "rates":
         U = np.zeros((samples, 2))
     else:
-        U = np.column_stack([np.full(samples, alpha), np.full(samples, hi)])
+        U = np.column_stack([np.full(samples, alpha), np.full(samples, side * hi)])
     if t[-1] < t_lo or t[-1] > t_hi:  # stretch to the allowed final time
         t = t * np.clip(t[-1], t_lo, t_hi) / t[-1]
-    return t, X, U
+    return t, _meet_final(problem, t, X), U
+
+
+def _meet_final(problem, t, X):
+    """Shift each state linearly in time so it ends inside its final bounds (the flight keeps
+    its shape), then clip to the state bounds."""
+    xfl, xfh = problem.boundary_bounds("final")
+    xl, xh, _, _ = problem.bounds_arrays()
+    X = X.copy()
+    ramp = (t - t[0]) / (t[-1] - t[0])
+    for i in range(X.shape[1]):
+        end = float(np.clip(X[-1, i], xfl[i], xfh[i]))
+        X[:, i] += ramp * (end - X[-1, i])
+    return np.clip(X, xl, xh)

@@ -8,7 +8,7 @@ from pydrake.solvers import MathematicalProgram
 from ...pseudospectral import LGL
 from .evaluator import _chain, _NodeEvaluator
 from .result import NlpResult
-from .transcription import COSTATE_SIGN, _finish, _Transcription
+from .transcription import _Transcription
 
 
 class _LglTranscription(_Transcription):
@@ -21,8 +21,8 @@ class _LglTranscription(_Transcription):
     (t_f / 2) sum w_k L_k (eq. 12) plus the Mayer term. Costates: the defect rows'
     multipliers divided by the LGL weights (eq. 15)."""
 
-    def __init__(self, problem, nodes):
-        super().__init__(problem, nodes)
+    def __init__(self, problem, nodes, scaling):
+        super().__init__(problem, nodes, scaling)
         self.lgl = LGL(nodes)
         prog = self.prog = MathematicalProgram()
         N, nx, nu = nodes, self.nx, self.nu
@@ -30,7 +30,7 @@ class _LglTranscription(_Transcription):
         self.U = prog.NewContinuousVariables(N, nu, "u")
         self.tf = None if self.fixed_tf else prog.NewContinuousVariables(1, "tf")[0]
         if self.tf is not None:
-            prog.AddBoundingBoxConstraint(self.t_lo / self.ts, min(self.t_hi, 1e12) / self.ts, self.tf)
+            prog.AddBoundingBoxConstraint(self.t_lo / self.ts, self.t_hi / self.ts, self.tf)
         self.nodes_eval = _NodeEvaluator(self)
         self.n_path = len(problem.path)
         z = [self.X.ravel(), self.U.ravel()] + ([[self.tf]] if self.tf is not None else [])
@@ -112,12 +112,13 @@ class _LglTranscription(_Transcription):
         Xs, Us, tf = self._split(zv)
         *_, L, _, _, dL = self.nodes_eval.evaluate(Xs, Us)
         w = self.lgl.weights_tau
-        value = 0.5 * tf * float(w @ L)
+        c = self.cost_factor
+        value = 0.5 * c * tf * float(w @ L)
         grad = np.zeros(zv.size)
-        grad[:N * nx] = (0.5 * tf * w[:, None] * dL[:, :nx]).ravel()
-        grad[N * nx:N * (nx + nu)] = (0.5 * tf * w[:, None] * dL[:, nx:]).ravel()
+        grad[:N * nx] = (0.5 * c * tf * w[:, None] * dL[:, :nx]).ravel()
+        grad[N * nx:N * (nx + nu)] = (0.5 * c * tf * w[:, None] * dL[:, nx:]).ravel()
         if self.tf is not None:
-            grad[-1] = 0.5 * float(w @ L)
+            grad[-1] = 0.5 * c * float(w @ L)
         return value, grad
 
     def _lagrange_cost(self, z):
@@ -139,21 +140,16 @@ class _LglTranscription(_Transcription):
         if self.tf is not None:
             self.prog.SetDecisionVariableValueInVector(self.tf, tf / self.ts, guess)
 
-    def result(self, res, solver, solve_time, build_time) -> NlpResult:
-        ok, msg = self._message(res, solver)
+    def result(self, res) -> NlpResult:
         Xs = np.reshape(res.GetSolution(self.X), (self.N, self.nx))
         Us = np.reshape(res.GetSolution(self.U), (self.N, self.nu))
         tf = self.t_lo if self.tf is None else float(res.GetSolution(self.tf)) * self.ts
         t = (self.lgl.tau + 1.0) * 0.5 * tf
-        X, U = Xs * self.sx, Us * self.su
         costates = None
         try:  # eq. 15: lambda_k = nu_k / w_k (scaled), then d J / d x in SI
             nu = np.asarray(res.GetDualSolution(self.collocation))[:self.N * self.nx].reshape(self.N, self.nx)
-            lam_scaled = nu / self.lgl.weights_tau[:, None]
-            costates = COSTATE_SIGN * lam_scaled * self.ts / self.sx
+            costates = self.costates_from(nu / self.lgl.weights_tau[:, None])
         except Exception:  # noqa: BLE001 - a solver without duals
             costates = None
-        if not ok:
-            msg += "; " + self.diagnose(res)
-        return _finish(self, ok, msg, t, X, U, res, costates, t if costates is not None else None,
-                       solve_time, build_time, "lgl", solver)
+        return self.make_result(res, t, Xs * self.sx, Us * self.su, costates, t if costates is not None else None,
+                                "lgl")

@@ -18,7 +18,10 @@ class NlpResult(PlanResult):
     states and controls at times t [s]).
 
     Attributes:
-      success, message: solver verdict in words.
+      success: the solver converged AND the solution is verified (``verification``: the
+        dynamics between the nodes and the Drake-propagated controls within tolerance).
+      message: the solver's verdict and the verification in words ("converged but
+        inaccurate: ..." with the figures when the check fails).
       time: node times [s] (nodes,). states: (nodes, n_states) SI in the problem's state
         order ([h, lon, lat, V, gamma, psi] first). controls: (nodes, n_controls) SI.
       objective: J in the problem's cost units (Lagrange terms integrated in seconds).
@@ -26,10 +29,15 @@ class NlpResult(PlanResult):
         midpoints, see costate_time), or None if the solver returned no multipliers.
       costate_time: times of the costate rows [s].
       hamiltonian: H = L + lambda' f at costate_time [cost units / s].
-      solve_time: wall time of the solver [s]; build_time: transcription [s].
+      converged: the solver's own verdict (SNOPT info 1, Ipopt status 0).
+      verification: nlp.verify.Verification (None when solve(verify=False)).
+      scaling: nlp.scaling.Scaling, the factors the solver saw.
+      guess_time, build_time, solve_time, verify_time: wall time [s] of the initial guess,
+        the transcription, the solver and the verification; ``total_time`` their sum.
       transcription, solver, nodes; iterations: 0 (Drake's Ipopt and SNOPT bindings do not
-        report them).
-      max_defect: largest scaled dynamics/constraint violation at the solution.
+        report them); mesh_history: (nodes, largest interval error) per mesh of a refined solve.
+      max_defect: largest scaled dynamics/constraint violation at the nodes.
+      log_file: the solver's log (solve(log_file=...) or verbose SNOPT), else None.
     """
 
     time: np.ndarray
@@ -39,10 +47,22 @@ class NlpResult(PlanResult):
     costate_time: np.ndarray | None
     hamiltonian: np.ndarray | None
     transcription: str
-    solver: str
     nodes: int
     max_defect: float
+    solver: str = ""
+    converged: bool = False
+    verification: object = None
+    scaling: object = None
+    guess_time: float = 0.0
+    verify_time: float = 0.0
+    mesh_history: list = dc.field(default_factory=list)
+    log_file: str | None = None
     problem: object = dc.field(repr=False, default=None)
+
+    @property
+    def total_time(self) -> float:
+        """Wall time of the whole solve() [s]: guess, transcription, solver, verification."""
+        return self.guess_time + self.build_time + self.solve_time + self.verify_time
 
     @property
     def final_time(self) -> float:
@@ -74,12 +94,19 @@ class NlpResult(PlanResult):
         return u
 
     def state_function(self):
-        """x(t) [SI] between the nodes (Lagrange interpolant for LGL, linear for dircol)."""
+        """x(t) [SI] between the nodes: the Lagrange interpolant for LGL, the cubic Hermite
+        spline with the dynamics as slopes for dircol (Hermite-Simpson's own)."""
         t, X = self.time, self.states
         if self.transcription == "lgl":
             tau_nodes = 2.0 * t / t[-1] - 1.0
             return lambda tt: interpolation_matrix(tau_nodes, np.clip(2.0 * np.atleast_1d(tt) / t[-1] - 1.0, -1, 1)) @ X
-        return lambda tt: np.column_stack([np.interp(np.atleast_1d(tt), t, X[:, j]) for j in range(X.shape[1])])
+        if self.problem is None:
+            return lambda tt: np.column_stack([np.interp(np.atleast_1d(tt), t, X[:, j]) for j in range(X.shape[1])])
+        from scipy.interpolate import CubicHermiteSpline
+
+        F = np.array([np.asarray(self.problem.dynamics(x, u), float) for x, u in zip(X, self.controls)])
+        spline = CubicHermiteSpline(t, X, F, axis=0)
+        return lambda tt: spline(np.clip(np.atleast_1d(tt), t[0], t[-1]))
 
 
 class NlpError(DrakeEntryError, RuntimeError):
@@ -114,10 +141,14 @@ def summary(problem, result: NlpResult, check=None) -> dict:
     final time, solve time, the local altitude maxima and the dynamic pressure there,
     final bank, largest |H| at interior nodes, extremal-control match and, with ``check``
     (a diagrams.propagation.PropagationCheck), the propagated terminal errors."""
-    out = {"success": result.success, "message": result.message, "transcription": result.transcription,
-           "solver": result.solver, "nodes": result.nodes, "objective": result.objective,
-           "final_time_s": result.final_time, "solve_time_s": result.solve_time, "build_time_s": result.build_time,
-           "max_constraint_violation_scaled": result.max_defect}
+    out = {"success": result.success, "converged": result.converged, "message": result.message,
+           "transcription": result.transcription, "solver": result.solver, "nodes": result.nodes,
+           "objective": result.objective, "final_time_s": result.final_time, "solve_time_s": result.solve_time,
+           "build_time_s": result.build_time, "guess_time_s": result.guess_time, "verify_time_s": result.verify_time,
+           "total_time_s": result.total_time, "max_constraint_violation_scaled": result.max_defect,
+           "verification": None if result.verification is None else result.verification.as_dict(),
+           "scaling": None if result.scaling is None else result.scaling.as_dict(),
+           "mesh_history": [list(m) for m in result.mesh_history]}
     if result.hamiltonian is not None:
         inner = result.hamiltonian[1:-1] if result.hamiltonian.size > 2 else result.hamiltonian
         out["hamiltonian_interior_max_abs"] = float(np.abs(inner).max())

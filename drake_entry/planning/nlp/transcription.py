@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .result import NlpResult
+from .scaling import objective_factor
 
 COSTATE_SIGN = 1.0  # Drake's multiplier sign convention, checked on analytic problems (tests)
 
@@ -12,13 +13,35 @@ COSTATE_SIGN = 1.0  # Drake's multiplier sign convention, checked on analytic pr
 class _Transcription:
     """Scaling, bounds, boundary conditions, path constraints shared by both transcriptions."""
 
-    def __init__(self, problem, nodes: int):
+    def __init__(self, problem, nodes: int, scaling):
         self.problem = problem
         self.N = nodes
-        self.sx, self.su, self.ts = problem.scales()
+        self.scaling = scaling
+        self.sx, self.su, self.ts = scaling.states, scaling.controls, scaling.time
+        self.cost_factor = 1.0  # the solver minimises cost_factor * J / ts (set by scale_objective)
         self.nx, self.nu = problem.n_states, problem.n_controls
         self.t_lo, self.t_hi = problem.final_time_bounds
         self.fixed_tf = self.t_lo == self.t_hi
+
+    def scale_objective(self):
+        """Choose the objective factor at the guess (scaling.objective_factor) unless the user
+        gave one; record it as cost units per solver unit."""
+        if self.scaling.objective is not None:
+            self.cost_factor = self.ts / self.scaling.objective
+            return
+        factor, how = objective_factor(self.prog, self.initial_guess)
+        self.cost_factor = factor
+        self.scaling.objective = self.ts / factor
+        self.scaling.source["objective"] = how
+
+    def objective_value(self, res) -> float:
+        """J [cost units] from the solver's optimal cost."""
+        return float(res.get_optimal_cost()) * self.ts / self.cost_factor
+
+    def costates_from(self, nu_scaled):
+        """d J / d x [SI] from multipliers of scaled defect rows already divided by the
+        quadrature weight (eq. 15)."""
+        return COSTATE_SIGN * nu_scaled * self.ts / (self.sx * self.cost_factor)
 
     # scaled <-> SI
     def L_scaled(self, xs, us):
@@ -72,10 +95,10 @@ class _Transcription:
         nx = self.nx
         if tf_vars is None:
             tf = self.t_lo
-            prog.AddCost(lambda z: self.problem.mayer(z * self.sx, tf) / self.ts, x_last)
+            prog.AddCost(lambda z: self.problem.mayer(z * self.sx, tf) * (self.cost_factor / self.ts), x_last)
         else:
-            prog.AddCost(lambda z: self.problem.mayer(z[:nx] * self.sx, z[nx:].sum() * self.ts) / self.ts,
-                         np.concatenate([x_last, np.atleast_1d(tf_vars)]))
+            prog.AddCost(lambda z: self.problem.mayer(z[:nx] * self.sx, z[nx:].sum() * self.ts)
+                         * (self.cost_factor / self.ts), np.concatenate([x_last, np.atleast_1d(tf_vars)]))
 
     def worst_violation(self, res) -> tuple[float, str]:
         """(largest scaled constraint violation, the constraint's description) at ``res``."""
@@ -95,32 +118,18 @@ class _Transcription:
         worst, where = self.worst_violation(res)
         return f"largest violation {worst:.3g} (scaled) in '{where}'" if worst > 0 else "no violated constraint"
 
-    def _message(self, res, solver) -> tuple[bool, str]:
-        ok = res.is_success()
-        detail = res.get_solution_result().name
-        try:
-            if solver == "ipopt":
-                detail += f" (Ipopt status {res.get_solver_details().status})"
-            else:
-                detail += f" (SNOPT info {res.get_solver_details().info})"
-        except Exception:  # noqa: BLE001 - details are a courtesy
-            pass
-        return ok, ("solved: " if ok else "not solved: ") + detail
 
 
-
-
-def _finish(tx, ok, msg, t, X, U, res, costates, t_costate, solve_time, build_time, transcription, solver):
-    problem = tx.problem
-    objective = float(res.get_optimal_cost()) * tx.ts
-    ham = None
-    if costates is not None:
-        Xc = X if len(t_costate) == len(t) else 0.5 * (X[:-1] + X[1:])
-        Uc = U if len(t_costate) == len(t) else 0.5 * (U[:-1] + U[1:])
-        ham = np.array([float(problem.lagrangian(x, u)) + float(lam @ np.asarray(problem.dynamics(x, u), float))
-                        for x, u, lam in zip(Xc, Uc, costates)])
-    viol = tx.worst_violation(res)[0]
-    return NlpResult(success=ok, message=msg, time=t, states=X, controls=U, objective=objective,
-                     costates=costates, costate_time=t_costate, hamiltonian=ham, solve_time=solve_time,
-                     build_time=build_time, transcription=transcription, solver=solver, nodes=tx.N,
-                     max_defect=viol, problem=problem)
+    def make_result(self, res, t, X, U, costates, t_costate, transcription: str) -> NlpResult:
+        """The solution as an NlpResult (SI, the Hamiltonian at the costate times); solve()
+        adds the verdict, the verification and the timings."""
+        problem = self.problem
+        ham = None
+        if costates is not None:
+            Xc = X if len(t_costate) == len(t) else 0.5 * (X[:-1] + X[1:])
+            Uc = U if len(t_costate) == len(t) else 0.5 * (U[:-1] + U[1:])
+            ham = np.array([float(problem.lagrangian(x, u)) + float(lam @ np.asarray(problem.dynamics(x, u), float))
+                            for x, u, lam in zip(Xc, Uc, costates)])
+        return NlpResult(time=t, states=X, controls=U, objective=self.objective_value(res), costates=costates,
+                         costate_time=t_costate, hamiltonian=ham, transcription=transcription, nodes=self.N,
+                         max_defect=self.worst_violation(res)[0], problem=problem, scaling=self.scaling)

@@ -77,7 +77,8 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
       log_file: where the solver writes its log.
       verify: check the solution between the nodes and by flying its controls
         (nlp.verify); without it ``success`` is the solver's word only.
-      dynamics_tolerance, propagation_tolerance: the verification's tolerances (relative).
+      dynamics_tolerance: the verification's between-node tolerance (relative).
+      propagation_tolerance: the verification's tolerance on the flown controls (relative).
     """
     if transcription not in TRANSCRIPTIONS:
         raise ScenarioError(f"transcription '{transcription}' is unknown; allowed: {', '.join(TRANSCRIPTIONS)}")

@@ -5,10 +5,10 @@ import math
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
 
 from drake_entry.errors import ScenarioError
 from drake_entry.planning import nlp
+from drake_entry.planning.nlp import catalogue
 from drake_entry.planning.ocp import CustomProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
 
@@ -23,23 +23,14 @@ def double_integrator(**kw):
     return CustomProblem(**args)
 
 
-G = 9.81
-
-
 def brachistochrone(xf=2.0, yf=1.0):
-    """Minimum time from (0, 0) at rest to (xf, yf), y down, theta from the vertical."""
-    return CustomProblem(
-        state_names=("x", "y", "v"), control_names=("theta",),
-        dynamics_function=lambda s, u: np.array([s[2] * np.sin(u[0]), s[2] * np.cos(u[0]), G * np.cos(u[0])]),
-        initial={"x": 0.0, "y": 0.0, "v": 0.0}, final={"x": xf, "y": yf}, final_time=(0.1, 5.0),
-        mayer_function=lambda xf_, tf: tf, control_bounds={"theta": (0.0, math.pi)})
+    """Minimum time from (0, 0) at rest to (xf, yf), y down (nlp.catalogue), t_f in [0.1, 5] s."""
+    return dc.replace(catalogue.brachistochrone(xf, yf)[0], final_time=(0.1, 5.0))
 
 
 def cycloid_time(xf, yf):
-    """Exact minimum time: the cycloid x = R(p - sin p), y = R(1 - cos p) through (xf, yf)."""
-    p = brentq(lambda p: (p - math.sin(p)) / (1 - math.cos(p)) - xf / yf, 1e-6, 2 * math.pi - 1e-6)
-    R = yf / (1 - math.cos(p))
-    return p * math.sqrt(R / G)
+    """Exact minimum time: the cycloid through (xf, yf) (nlp.catalogue)."""
+    return catalogue.brachistochrone(xf, yf)[1]["final_time_s"]
 
 
 @pytest.mark.parametrize("solver", ["ipopt", "snopt"])
@@ -232,9 +223,7 @@ def test_marv_60_nodes_reproduces_the_reported_solution():
 # -- issue 14: scaling, free final time, verified success, statuses, options, guesses -------------------
 
 def test_objective_scale_is_chosen_from_the_gradient_reported_and_overridable():
-    from drake_entry.planning.nlp.catalogue import brachistochrone as published
-
-    p, best = published()
+    p, best = catalogue.brachistochrone()
     r = nlp.solve(p, nodes=20)
     assert r.success, r.message
     assert r.scaling.source["objective"] == "gradient" and r.scaling.source["time"] == "guess final time"

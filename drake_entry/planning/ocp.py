@@ -13,6 +13,7 @@ State order: [h, lon, lat, V, gamma, psi] (the canonical order, DESIGN.md), then
 from __future__ import annotations
 
 import dataclasses as dc
+import functools
 import math
 from typing import Callable
 
@@ -413,11 +414,12 @@ class OptimalControlProblem(_ProblemLayout):
     def has_mayer(self) -> bool:
         return any(not t.is_lagrange for t in self.objective)
 
-    @property
+    @functools.cached_property
     def alpha_bar(self) -> float:
         """alpha at maximum L/D [rad]: the aero model's own (paper 002: sqrt(C_D0/K) for the
         drag polar), else the largest C_L/C_D over 0-60 deg at the initial Mach number
-        (0.01 deg grid), else 10 deg when the initial state is not fixed."""
+        (0.01 deg grid; found once per problem: the eq. 11 cost reads it at every evaluation),
+        else 10 deg when the initial state is not fixed."""
         a = getattr(self.vehicle.aero, "alpha_max_lift_to_drag", None)
         if a is not None:
             return float(a)

@@ -119,7 +119,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
     result.solver, result.converged, result.log_file = solver, converged, log_file
     result.guess_time, result.build_time, result.solve_time = guess_time, build_time, solve_time
     if not converged:
-        result.success, result.message = False, f"not solved: {words}; {tx.diagnose(res)}"
+        result.success, result.message = False, f"not solved: {words}; {tx.diagnose()}"
         return result
     if not verify:
         result.success, result.message = True, f"solved (not verified): {words}"

@@ -16,13 +16,13 @@ class _NodeEvaluator:
         self.tx, self.step = tx, step
         self._key, self._out = None, None
         self.vectorised = True
+        self.path_scale = np.array([c.scale for c in tx.problem.path], float).reshape(-1, 1)
 
     def _models(self, Xs, Us):
         """f_scaled (nx, M), path_scaled (np, M), L (M,) at M scaled points (columns)."""
         tx = self.tx
         f, g, L, self.vectorised = model_values(tx.problem, Xs * tx.sx[:, None], Us * tx.su[:, None], self.vectorised)
-        scale = np.array([c.scale for c in tx.problem.path], float).reshape(-1, 1)
-        return f * (tx.ts / tx.sx)[:, None], g / scale, L
+        return f * (tx.ts / tx.sx)[:, None], g / self.path_scale, L
 
     def evaluate(self, Xs, Us):
         """Values and node Jacobians: f (N, nx), g (N, np), L (N,), and df (N, nx, nx+nu),

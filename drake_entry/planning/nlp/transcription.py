@@ -113,17 +113,17 @@ class _Transcription:
                 where = b.evaluator().get_description() or type(b.evaluator()).__name__
         return worst, where
 
-    def diagnose(self, res) -> str:
-        """Name the worst violated constraint at the returned point (infeasible problems)."""
-        worst, where = self.worst_violation(res)
+    def diagnose(self) -> str:
+        """Name the worst violated constraint at the returned point (infeasible problems),
+        as make_result measured it."""
+        worst, where = self.worst
         return f"largest violation {worst:.3g} (scaled) in '{where}'" if worst > 0 else "no violated constraint"
-
-
 
     def make_result(self, res, t, X, U, costates, t_costate, transcription: str) -> NlpResult:
         """The solution as an NlpResult (SI, the Hamiltonian at the costate times); solve()
         adds the verdict, the verification and the timings."""
         problem = self.problem
+        self.worst = self.worst_violation(res)
         ham = None
         if costates is not None:
             Xc = X if len(t_costate) == len(t) else 0.5 * (X[:-1] + X[1:])
@@ -132,4 +132,4 @@ class _Transcription:
                             for x, u, lam in zip(Xc, Uc, costates)])
         return NlpResult(time=t, states=X, controls=U, objective=self.objective_value(res), costates=costates,
                          costate_time=t_costate, hamiltonian=ham, transcription=transcription, nodes=self.N,
-                         max_defect=self.worst_violation(res)[0], problem=problem, scaling=self.scaling)
+                         max_defect=self.worst[0], problem=problem, scaling=self.scaling)

@@ -8,7 +8,8 @@ eq. 39): an error in state i divided by 1 + max_k |x_i(t_k)|.
    x(t_k+1) - x(t_k) = integral of f(x(t), u(t)) dt; the integral is Gauss-Legendre with
    ``QUADRATURE_POINTS`` points, so an interpolant that swings between the nodes (an
    under-resolved solution) shows here although the defects vanish at the nodes. The
-   largest error per interval is the mesh-refinement estimate (nlp.mesh).
+   largest error per interval (``Verification.interval_errors``) is the estimate a mesh
+   refinement would use.
 2. The controls flown open loop by the Drake Simulator (diagrams.propagation: RK5,
    accuracy 1e-11) from the first node must end at the last node.
 
@@ -122,7 +123,7 @@ def verify(problem, result, *, dynamics_tolerance: float = DYNAMICS_TOLERANCE,
     else:
         rel = np.abs(check.states[-1] - result.states[-1]) / state_magnitudes(result)
         prop_err = float(rel.max())
-        check.terminal_error["worst_state"] = names[int(np.argmax(rel))] if err.size else ""
+        check.terminal_error["worst_state"] = names[int(np.argmax(rel))]
     ok = bool(err.max() <= dynamics_tolerance and prop_err <= propagation_tolerance)
     return Verification(ok, float(err.max()), where, err.max(axis=1), prop_err, check.terminal_error, viol,
                         dynamics_tolerance, propagation_tolerance, check)

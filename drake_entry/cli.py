@@ -181,9 +181,13 @@ def _cmd_optimize(args) -> int:
                            tolerance=max(tol, 1e-6), max_iterations=max_iterations)
         print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
         guess = coarse if coarse.converged else None
-    print(f"solve: {problem.name}, {transcription}, {nodes} nodes, {solver} ...", flush=True)
+    refine = args.refine or settings.refine
+    max_nodes = (args.max_nodes or settings.max_nodes or None) if refine else None
+    how = f"mesh refinement from {nodes} nodes" if refine else f"{nodes} nodes"
+    print(f"solve: {problem.name}, {transcription}, {how}, {solver} ...", flush=True)
     result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
-                       max_iterations=max_iterations, guess=guess, verify=not args.no_propagate)
+                       max_iterations=max_iterations, guess=guess, verify=not args.no_propagate,
+                       refine=refine, max_nodes=max_nodes)
     check = result.verification.flight if result.verification is not None else None
     info = nlp.summary(problem, result, check)
     os.makedirs(args.out, exist_ok=True)
@@ -205,7 +209,7 @@ def _cmd_optimize(args) -> int:
     except ValueError:
         pass
     pngs = nlp_solution_plots(problem, result, args.out, propagated=check, extremal=ext,
-                              title=f"{problem.name}: {transcription.upper()} {nodes} nodes, {solver}")
+                              title=f"{problem.name}: {transcription.upper()} {result.nodes} nodes, {result.solver}")
     print(json.dumps(info, indent=2, default=float))
     print(f"wrote solution, summary.json and {len(pngs)} plots to {args.out}")
     return 0 if result.success else 1
@@ -253,13 +257,19 @@ def main(argv=None) -> int:
     o.add_argument("problem", help="packaged problem (marv) or a problem YAML path")
     o.add_argument("--nodes", type=int, default=None, help="LGL nodes / collocation samples (default: the YAML)")
     o.add_argument("--transcription", choices=("lgl", "dircol"), default=None)
-    o.add_argument("--solver", choices=("ipopt", "snopt"), default=None)
+    o.add_argument("--solver", choices=("auto", "ipopt", "snopt"), default=None)
     o.add_argument("--tolerance", type=float, default=None)
     o.add_argument("--coarse", type=int, default=None, metavar="N",
                    help="first solve with N nodes and start the full solve from it (0 = the propagated "
                         "guess; default: the YAML's coarse_nodes)")
     o.add_argument("--max-iterations", type=int, default=None, metavar="N",
                    help="solver iteration limit (default: the YAML's solve.max_iterations)")
+    o.add_argument("--refine", action="store_true",
+                   help="mesh refinement: raise the node count until the between-node error meets the "
+                        "verification tolerance (default: the YAML's solve.refine)")
+    o.add_argument("--max-nodes", type=int, default=None, metavar="N",
+                   help="mesh refinement's node cap (default: the YAML's solve.max_nodes, else 150 LGL / "
+                        "400 dircol)")
     o.add_argument("--no-propagate", action="store_true",
                    help="skip the verification (between-node dynamics and the Drake propagation)")
     o.add_argument("--out", default="out/optimize")

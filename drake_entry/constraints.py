@@ -1,12 +1,14 @@
 """Path constraints: heat flux (every form the papers use), dynamic pressure, load factors,
 and the equilibrium-glide condition. Functions are generic over the scalar type.
 
-All heat-flux forms reduce to q_dot = K rho^n V^m [W/m^2]; the named constructors keep
-each paper's constants and never mix the V^3 and V^3.15 families (data/README.md).
+All heat-flux forms reduce to q_dot = q_a(alpha) K rho^n V^m [W/m^2], with the angle-of-attack
+factor q_a = 1 unless a form gives one (Betts' shuttle wing leading edge: a cubic in alpha);
+the named constructors keep each paper's constants and never mix the V^3 and V^3.15
+families (data/README.md).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -15,26 +17,67 @@ from .errors import ScenarioError
 
 @dataclass(frozen=True)
 class HeatFlux:
-    """Stagnation-point heat flux q_dot = coefficient * rho^density_exponent * V^velocity_exponent.
+    """Heat flux q_dot = q_a(alpha) * coefficient * rho^density_exponent * V^velocity_exponent.
 
     Attributes:
       coefficient: K in SI units such that q_dot is in W/m^2.
       density_exponent: n (0.5 for every form in the papers).
       velocity_exponent: m (3 or 3.15).
       form: a label saying which published form produced the constants.
+      alpha_factor: coefficients c_0, c_1, ... of q_a = sum c_i alpha^i (empty: q_a = 1).
+      alpha_unit: 'deg' or 'rad', the unit of alpha in q_a.
     """
 
     coefficient: float
     density_exponent: float = 0.5
     velocity_exponent: float = 3.15
     form: str = "custom"
+    alpha_factor: tuple = ()
+    alpha_unit: str = "deg"
 
     def __post_init__(self):
         if not self.coefficient > 0:
             raise ScenarioError(f"HeatFlux.coefficient must be > 0, got {self.coefficient}")
+        if self.alpha_unit not in ("deg", "rad"):
+            raise ScenarioError(f"HeatFlux.alpha_unit = '{self.alpha_unit}'; allowed: deg, rad")
+        if not all(np.isfinite(c) for c in self.alpha_factor):
+            raise ScenarioError(f"HeatFlux.alpha_factor = {list(self.alpha_factor)} must be finite numbers")
+        object.__setattr__(self, "alpha_factor", tuple(float(c) for c in self.alpha_factor))
 
-    def __call__(self, rho, V):
-        return self.coefficient * rho**self.density_exponent * V**self.velocity_exponent
+    @property
+    def depends_on_alpha(self) -> bool:
+        return bool(self.alpha_factor)
+
+    def __call__(self, rho, V, alpha=None):
+        """q_dot [W/m^2] at density rho [kg/m^3], speed V [m/s] and, for a form with an
+        angle-of-attack factor, alpha [rad]."""
+        q = self.coefficient * rho**self.density_exponent * V**self.velocity_exponent
+        if not self.alpha_factor:
+            return q
+        if alpha is None:
+            raise ScenarioError(f"heat-flux form '{self.form}' has an angle-of-attack factor: this caller "
+                                f"gives no alpha (use it where alpha is known, e.g. the NLP path)")
+        a = alpha * (180.0 / np.pi) if self.alpha_unit == "deg" else alpha
+        factor = 0.0
+        for c in reversed(self.alpha_factor):  # Horner
+            factor = factor * a + c
+        return factor * q
+
+    def factor(self, alpha):
+        """q_a(alpha) [-] (1 without an angle-of-attack factor); alpha [rad]."""
+        return self(1.0, 1.0, alpha) / self.coefficient
+
+    @staticmethod
+    def betts_shuttle() -> "HeatFlux":
+        """Space Shuttle wing leading edge (Betts, Practical Methods for Optimal Control,
+        2nd ed., 2010, Sec. 6.1): q = q_a q_r [BTU/ft^2/s] with q_r = 17 700 sqrt(rho)
+        (1e-4 V)^3.07 (rho slug/ft^3, V ft/s) and q_a = 1.0672181 - 0.19213774e-1 a
+        + 0.21286289e-3 a^2 - 0.10117249e-5 a^3 (a in deg); converted to SI exactly."""
+        ft, slug = 0.3048, 14.593902937
+        btu_ft2_s = 1055.05585262 / ft ** 2  # W/m^2
+        k = 17700.0 * (ft ** 3 / slug) ** 0.5 * (1e-4 / ft) ** 3.07 * btu_ft2_s
+        return HeatFlux(k, 0.5, 3.07, "betts_shuttle",
+                        (1.0672181, -0.19213774e-1, 0.21286289e-3, -0.10117249e-5), "deg")
 
     @staticmethod
     def chapman(nose_radius: float, C1: float = 5.28137e-5, m: float = 3.15) -> "HeatFlux":
@@ -68,9 +111,20 @@ def _check_nose(r):
 
 
 def make_heat_flux(form: str, *, nose_radius: float, coefficient: float | None = None,
-                   velocity_exponent: float | None = None, circular_speed: float | None = None) -> HeatFlux:
-    """Heat-flux model by form name: 'chapman', 'sutton_graves', 'normalised' or 'lumped'
-    (``circular_speed`` [m/s] is the normalised form's V_c)."""
+                   velocity_exponent: float | None = None, circular_speed: float | None = None,
+                   alpha_factor=(), alpha_unit: str = "deg") -> HeatFlux:
+    """Heat-flux model by form name: 'chapman', 'sutton_graves', 'normalised', 'lumped' or
+    'betts_shuttle' (``circular_speed`` [m/s] is the normalised form's V_c); ``alpha_factor``
+    (c_0, c_1, ... in ``alpha_unit``) multiplies any form by q_a(alpha)."""
+    hf = _heat_flux_form(form, nose_radius, coefficient, velocity_exponent, circular_speed)
+    if alpha_factor:
+        if hf.alpha_factor:
+            raise ScenarioError(f"heat_flux form '{form}' has its own angle-of-attack factor; give no alpha_factor")
+        hf = replace(hf, alpha_factor=tuple(alpha_factor), alpha_unit=alpha_unit)
+    return hf
+
+
+def _heat_flux_form(form, nose_radius, coefficient, velocity_exponent, circular_speed) -> HeatFlux:
     if circular_speed is not None and (form != "normalised" or not 0 < circular_speed < 1e5):
         raise ScenarioError(f"heat_flux.circular_speed_m_s = {circular_speed} applies to form 'normalised' only "
                             f"and must be in (0, 1e5) m/s")
@@ -92,7 +146,12 @@ def make_heat_flux(form: str, *, nose_radius: float, coefficient: float | None =
         if coefficient is None or velocity_exponent is None:
             raise ScenarioError("heat_flux form 'lumped' needs coefficient and velocity_exponent")
         return HeatFlux.lumped(coefficient, velocity_exponent)
-    raise ScenarioError(f"heat_flux.form '{form}' is unknown; allowed: chapman, sutton_graves, normalised, lumped")
+    if form == "betts_shuttle":
+        if coefficient is not None or velocity_exponent is not None:
+            raise ScenarioError("heat_flux form 'betts_shuttle' takes no coefficient or velocity_exponent")
+        return HeatFlux.betts_shuttle()
+    raise ScenarioError(f"heat_flux.form '{form}' is unknown; allowed: chapman, sutton_graves, normalised, lumped, "
+                        f"betts_shuttle")
 
 
 def dynamic_pressure(rho, V):

@@ -138,7 +138,7 @@ def conditions_from(x, alpha, rho, mach, L, D, vehicle: Vehicle, planet: Earth) 
         rho=rho,
         mach=mach,
         dynamic_pressure=dynamic_pressure(rho, V),
-        heat_flux=vehicle.heat_flux(rho, V),
+        heat_flux=vehicle.heat_flux(rho, V, alpha),
         normal_load=normal_load_factor(L, D, alpha, planet.g0),
         total_load=total_load_factor(L, D, planet.g0),
         lift=L,

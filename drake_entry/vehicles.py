@@ -56,13 +56,16 @@ class AeroSpec:
 
 @dc.dataclass
 class HeatFluxSpec:
-    # chapman | sutton_graves | normalised | lumped
+    # chapman | sutton_graves | normalised | lumped | betts_shuttle
     form: str = "chapman"
     # form constant (C1, k, c* or lumped k); empty = the form's published default
     coefficient: float | None = None
     velocity_exponent: float | None = None
     # normalised form (paper 001 eq. 9): the circular speed V_c [m/s]; empty = 7905.0
     circular_speed_m_s: float | None = None
+    # angle-of-attack factor q_a = c_0 + c_1 alpha + ... multiplying the form (empty: 1)
+    alpha_factor: list[float] = dc.field(default_factory=list)
+    alpha_unit: str = "deg"  # unit of alpha in alpha_factor: deg | rad
 
 
 @dc.dataclass
@@ -202,7 +205,8 @@ def vehicle_from_spec(spec: VehicleSpec, aero: str | None = None, where: str = "
         hf = make_heat_flux(spec.heat_flux.form, nose_radius=spec.nose_radius_m,
                             coefficient=spec.heat_flux.coefficient,
                             velocity_exponent=spec.heat_flux.velocity_exponent,
-                            circular_speed=spec.heat_flux.circular_speed_m_s)
+                            circular_speed=spec.heat_flux.circular_speed_m_s,
+                            alpha_factor=spec.heat_flux.alpha_factor, alpha_unit=spec.heat_flux.alpha_unit)
         limits = PathLimits(spec.heat_flux_max_kW_m2 * 1e3, spec.dynamic_pressure_max_kPa * 1e3,
                             spec.normal_load_max_g, spec.total_load_max_g)
     except ValueError as e:

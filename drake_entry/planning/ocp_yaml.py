@@ -70,12 +70,16 @@ class ObjectiveSpec:
 @dc.dataclass
 class SolveSpec:
     transcription: str = "lgl"
-    solver: str = "ipopt"
+    solver: str = "auto"  # auto (SNOPT when available, else Ipopt) | snopt | ipopt
     nodes: int = 40
     tolerance: float = 1.0e-8
     max_iterations: int = 3000
     # solve first on this many nodes and start from that solution (0 = propagated guess)
     coarse_nodes: int = 0
+    # mesh refinement: raise the node count from `nodes` until the between-node error meets
+    # the verification tolerance (nlp.mesh), up to max_nodes (0 = the transcription's default)
+    refine: bool = False
+    max_nodes: int = 0
 
 
 @dc.dataclass
@@ -192,10 +196,10 @@ def load_problem_spec(name_or_path: str) -> ProblemSpec:
 
 def validate_solve(s: SolveSpec) -> SolveSpec:
     """One-line ScenarioError on a bad ``solve:`` field."""
-    for field, allowed in (("transcription", ("lgl", "dircol")), ("solver", ("ipopt", "snopt"))):
+    for field, allowed in (("transcription", ("lgl", "dircol")), ("solver", ("auto", "ipopt", "snopt"))):
         if getattr(s, field) not in allowed:
             raise ScenarioError(f"solve.{field} = '{getattr(s, field)}' is unknown; allowed: {', '.join(allowed)}")
-    for field, lo in (("nodes", 3), ("max_iterations", 1), ("coarse_nodes", 0)):
+    for field, lo in (("nodes", 3), ("max_iterations", 1), ("coarse_nodes", 0), ("max_nodes", 0)):
         v = getattr(s, field)
         if isinstance(v, bool) or not isinstance(v, int) or v < lo:
             raise ScenarioError(f"solve.{field} = {v} is out of range; allowed: an integer >= {lo}")

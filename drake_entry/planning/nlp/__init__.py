@@ -1,7 +1,7 @@
 """NLP path: entry optimal control by Legendre pseudospectral (LGL) collocation or Drake's
 DirectCollocation, solved with Ipopt or SNOPT (paper 002).
 
-    result = solve(problem, transcription="lgl" | "dircol", solver="ipopt" | "snopt", nodes=N)
+    result = solve(problem, transcription="lgl" | "dircol", solver="auto" | "snopt" | "ipopt", nodes=N)
 
 ``problem`` is an ``OptimalControlProblem`` (entry dynamics, planning/ocp.py) or a
 ``CustomProblem``. The NLP runs in scaled units (scaling: canonical units as in paper 002,
@@ -33,6 +33,7 @@ problems with their optima).
 """
 from __future__ import annotations
 
+import math
 import tempfile
 import time as _time
 
@@ -43,26 +44,32 @@ from ...errors import ScenarioError
 from .dircol import _DircolTranscription
 from .guess import initial_guess
 from .lgl import _LglTranscription
+from .mesh import MAX_NODES, MeshStep, mesh_error, next_nodes  # noqa: F401 (API)
 from .result import NlpError, NlpResult, extremal_controls, summary  # noqa: F401 (API)
 from .scaling import Scaling, resolve as resolve_scaling  # noqa: F401 (API)
-from .status import verdict
+from .status import restartable, verdict
 from .transcription import COSTATE_SIGN  # noqa: F401 (API)
 from .verify import DYNAMICS_TOLERANCE, PROPAGATION_TOLERANCE, Verification, verify as verify_solution  # noqa: F401
 
 TRANSCRIPTIONS = ("lgl", "dircol")
+#: a solver stopped near an optimum (status.restartable) at a point this feasible (largest
+#: scaled violation) is restarted once from that point
+RESTART_VIOLATION = 1e-6
 SOLVERS = ("ipopt", "snopt")
 
 
-def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: int = 40, guess=None,
+def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: int = 40, guess=None,
           tolerance: float = 1e-8, max_iterations: int = 3000, verbose: bool = False, scaling=None,
           solver_options: dict | None = None, log_file: str | None = None, verify: bool = True,
           dynamics_tolerance: float = DYNAMICS_TOLERANCE,
-          propagation_tolerance: float = PROPAGATION_TOLERANCE) -> NlpResult:
+          propagation_tolerance: float = PROPAGATION_TOLERANCE, refine: bool = False,
+          max_nodes: int | None = None) -> NlpResult:
     """Solve ``problem`` (see module docstring); ``success`` only when verified.
 
     Args:
       transcription: 'lgl' (Legendre pseudospectral, paper 002 eqs. 12-14) or 'dircol'.
-      solver: 'ipopt' (default) or 'snopt'.
+      solver: 'snopt', 'ipopt' or 'auto' (default: SNOPT when this pydrake build has it,
+        else Ipopt; see default_solver()).
       nodes: LGL nodes or DirectCollocation samples (>= 3).
       guess: an NlpResult, or (t [s], states (n, nx), controls (n, nu)) SI, or None for the
         built-in propagated guess (``initial_guess``).
@@ -79,11 +86,19 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
         (nlp.verify); without it ``success`` is the solver's word only.
       dynamics_tolerance: the verification's between-node tolerance (relative).
       propagation_tolerance: the verification's tolerance on the flown controls (relative).
+      refine: mesh refinement (nlp.mesh): start on ``nodes`` and raise the node count,
+        each mesh warm-started from the last solution, until the between-node error meets
+        ``dynamics_tolerance`` (and the flown controls ``propagation_tolerance``) or
+        ``max_nodes`` is reached; the meshes are in ``result.mesh_history``.
+      max_nodes: refinement's node cap (default nlp.mesh.MAX_NODES: LGL 150, dircol 400).
     """
     if transcription not in TRANSCRIPTIONS:
         raise ScenarioError(f"transcription '{transcription}' is unknown; allowed: {', '.join(TRANSCRIPTIONS)}")
-    if solver not in SOLVERS:
-        raise ScenarioError(f"solver '{solver}' is unknown; allowed: {', '.join(SOLVERS)}")
+    if solver not in SOLVERS + ("auto",):
+        raise ScenarioError(f"solver '{solver}' is unknown; allowed: auto, {', '.join(SOLVERS)}")
+    names = auto_solvers() if solver == "auto" else (solver,)
+    if solver == "auto" and solver_options:
+        raise ScenarioError("solver_options are by the solver's own names: give solver='snopt' or 'ipopt' with them")
     if not (isinstance(nodes, (int, np.integer)) and nodes >= 3):
         raise ScenarioError(f"nodes must be an integer >= 3, got {nodes}")
     if not 0 < tolerance < 1:
@@ -93,9 +108,10 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
     for name, value in (("dynamics_tolerance", dynamics_tolerance), ("propagation_tolerance", propagation_tolerance)):
         if not 0 < value < 1:
             raise ScenarioError(f"{name} = {value} is out of range; allowed (0, 1)")
-    engine = IpoptSolver() if solver == "ipopt" else SnoptSolver()
-    if not engine.available() or not engine.enabled():
-        raise NlpError(f"solver '{solver}' is not available in this pydrake build")
+    engines = {name: _engine(name) for name in names}
+    cap = max(MAX_NODES[transcription], nodes) if max_nodes is None else max_nodes
+    if refine and not (isinstance(cap, (int, np.integer)) and cap >= nodes):
+        raise ScenarioError(f"max_nodes = {max_nodes} is out of range; allowed: an integer >= nodes ({nodes})")
     t_guess = _time.perf_counter()
     if guess is None:
         guess = initial_guess(problem)
@@ -103,6 +119,91 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
         guess = (guess.time, guess.states, guess.controls)
     guess = _check_guess(problem, guess)
     guess_time = _time.perf_counter() - t_guess
+    options = {name: _solver_options(engine, name, tolerance, max_iterations, verbose, solver_options, log_file)
+               for name, engine in engines.items()}
+    history, build_time, solve_time, target = [], 0.0, 0.0, dynamics_tolerance
+    while True:
+        mesh_time, failed = 0.0, []
+        for name, engine in engines.items():  # auto: SNOPT, then Ipopt from the same start if it fails
+            result, words, diagnosis = _solve_mesh(problem, transcription, engine, nodes, guess, scaling,
+                                                   options[name][0])
+            mesh_time, build_time = mesh_time + result.solve_time, build_time + result.build_time
+            if result.converged:
+                break
+            failed.append(words)
+        if failed and len(engines) > 1:
+            words = f"{words} (auto solver after '{failed[0]}')" if result.converged else "; ".join(failed)
+        solve_time += mesh_time
+        result.solver, result.log_file, result.guess_time = name, options[name][1], guess_time
+        result.build_time, result.solve_time, result.mesh_history = build_time, solve_time, history
+        if refine:
+            error = mesh_error(problem, result) if result.converged else math.nan
+            history.append(MeshStep(int(nodes), error, result.converged, mesh_time))
+        if not result.converged:
+            mesh = f" on mesh {len(history)} ({nodes} nodes)" if refine else ""
+            result.success, result.message = False, f"not solved{mesh}: {words}; {diagnosis}"
+            return result
+        if not verify and not refine:
+            result.success, result.message = True, f"solved (not verified): {words}"
+            return result
+        if refine and history[-1].error > target and nodes < cap:
+            nodes, guess = next_nodes(transcription, history, target, cap), (result.time, result.states,
+                                                                             result.controls)
+            continue
+        if not verify:
+            result.success = history[-1].error <= target
+            result.message = (f"solved (propagation not verified): {words}; " if result.success else
+                              f"converged but inaccurate: {words}; ") + _mesh_words(history, target, cap)
+            return result
+        t_verify = _time.perf_counter()
+        check = verify_solution(problem, result, dynamics_tolerance=dynamics_tolerance,
+                                propagation_tolerance=propagation_tolerance)
+        result.verify_time = _time.perf_counter() - t_verify
+        result.verification = check
+        if refine and not check.verified and nodes < cap and check.dynamics_error <= target:
+            # between the nodes it meets the tolerance, the flight does not: tighten and go on
+            target = check.dynamics_error / 10.0
+            nodes, guess = next_nodes(transcription, history, target, cap), (result.time, result.states,
+                                                                             result.controls)
+            continue
+        result.success = check.verified
+        result.message = (f"solved and verified: {words}; " if check.verified else
+                          f"converged but inaccurate: {words}; ") + check.summary()
+        if refine:
+            result.message += "; " + _mesh_words(history, dynamics_tolerance, cap)
+        return result
+
+
+def auto_solvers() -> tuple:
+    """The solvers solver='auto' tries in turn: SNOPT (when this pydrake build has it), then
+    Ipopt from the same start when SNOPT does not converge. SNOPT first for speed: Drake
+    gives Ipopt no Hessian of Python constraints, so Ipopt runs limited-memory BFGS and needs
+    hundreds to thousands of iterations on entry problems (Betts' shuttle at 40 LGL nodes:
+    1 610 Ipopt iterations, 60 s; SNOPT 5 s). Ipopt second for robustness: on the
+    brachistochrone's singular start (v = 0) SNOPT can stop at info 3 or 13 where Ipopt's
+    interior point converges from the same guess (docs/methods/nlp.md)."""
+    return tuple(name for name in ("snopt", "ipopt") if _engine(name, check=False) is not None)
+
+
+def default_solver() -> str:
+    """The first solver solver='auto' tries ('snopt' when available, else 'ipopt')."""
+    return auto_solvers()[0]
+
+
+def _engine(name: str, check: bool = True):
+    """The Drake solver object (None, or NlpError with ``check``, when this build lacks it)."""
+    engine = IpoptSolver() if name == "ipopt" else SnoptSolver()
+    if engine.available() and engine.enabled():
+        return engine
+    if check:
+        raise NlpError(f"solver '{name}' is not available in this pydrake build")
+    return None
+
+
+def _solve_mesh(problem, transcription, engine, nodes, guess, scaling, options):
+    """One transcription and solve on ``nodes`` nodes: (NlpResult with ``converged`` and this
+    mesh's build and solve times, the solver's verdict in words, the violation diagnosis
+    when not converged)."""
     t_build = _time.perf_counter()
     scales = resolve_scaling(problem, guess, scaling)
     tx = (_LglTranscription(problem, nodes, scales) if transcription == "lgl"
@@ -110,29 +211,26 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "ipopt", nodes: 
     tx.set_guess(*guess)
     tx.scale_objective()
     build_time = _time.perf_counter() - t_build
-    options, log_file = _solver_options(engine, solver, tolerance, max_iterations, verbose, solver_options, log_file)
+    solver = "ipopt" if engine.solver_id() == IpoptSolver.id() else "snopt"
     t0 = _time.perf_counter()
     res = engine.Solve(tx.prog, tx.initial_guess, options)
+    converged, words = verdict(res, solver)
+    if not converged and restartable(res, solver) and tx.worst_violation(res)[0] <= RESTART_VIOLATION:
+        res = engine.Solve(tx.prog, res.GetSolution(), options)  # one warm restart (status.restartable)
+        converged, restart_words = verdict(res, solver)
+        words = f"{restart_words} after a warm restart from '{words}'"
     solve_time = _time.perf_counter() - t0
     result = tx.result(res)
-    converged, words = verdict(res, solver)
-    result.solver, result.converged, result.log_file = solver, converged, log_file
-    result.guess_time, result.build_time, result.solve_time = guess_time, build_time, solve_time
-    if not converged:
-        result.success, result.message = False, f"not solved: {words}; {tx.diagnose()}"
-        return result
-    if not verify:
-        result.success, result.message = True, f"solved (not verified): {words}"
-        return result
-    t_verify = _time.perf_counter()
-    check = verify_solution(problem, result, dynamics_tolerance=dynamics_tolerance,
-                            propagation_tolerance=propagation_tolerance)
-    result.verify_time = _time.perf_counter() - t_verify
-    result.verification = check
-    result.success = check.verified
-    result.message = (f"solved and verified: {words}; " if check.verified else
-                      f"converged but inaccurate: {words}; ") + check.summary()
-    return result
+    result.converged = converged
+    result.build_time, result.solve_time = build_time, solve_time
+    return result, words, ("" if result.converged else tx.diagnose())
+
+
+def _mesh_words(history, tolerance, cap) -> str:
+    """The refinement in words: node counts and errors per mesh."""
+    steps = ", ".join(f"{m.nodes}: {m.error:.2g}" for m in history)
+    end = "" if history[-1].error <= tolerance else f"; stopped at max_nodes = {cap} above the tolerance {tolerance:g}"
+    return f"mesh refinement (nodes: between-node error) {steps}{end}"
 
 
 def _solver_options(engine, solver, tolerance, max_iterations, verbose, extra, log_file):

@@ -35,7 +35,9 @@ class NlpResult(PlanResult):
       guess_time, build_time, solve_time, verify_time: wall time [s] of the initial guess,
         the transcription, the solver and the verification; ``total_time`` their sum.
       transcription, solver, nodes; iterations: 0 (Drake's Ipopt and SNOPT bindings do not
-        report them); mesh_history: (nodes, largest interval error) per mesh of a refined solve.
+        report them); mesh_history: nlp.mesh.MeshStep (nodes, between-node error, converged,
+        solve time) per mesh of a refined solve (empty otherwise); build_time and solve_time
+        are summed over the meshes.
       max_defect: largest scaled dynamics/constraint violation at the nodes.
       log_file: the solver's log (solve(log_file=...) or verbose SNOPT), else None.
     """

@@ -1,11 +1,13 @@
 """Benchmarks, each printing its figures and ratios measured side by side in one run.
 
-    python benchmarks/run.py [open-loop|socp|nlp|campaign|interface-cost|paper001|paper004|all] [options]
+    python benchmarks/run.py [open-loop|socp|nlp|dymos|campaign|interface-cost|paper001|aborts|paper004|all] [options]
 
 open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
 socp            both SOCP planners with Clarabel vs SCS: drag-energy SOCP by node count, SCvx
                 nominal plan, closed-loop drag-energy campaign
 nlp             NLP path: LGL / DirectCollocation x Ipopt / SNOPT from the same starts
+dymos           NLP path vs dymos (pip extra "bench"; not in "all") on the Brachistochrone and
+                Betts' shuttle, same problem and nodes (default 31)
 campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios)
 interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline commit
 paper001        paper 001: SCvx nominal plan time and iterations by mesh vs the paper, flown by Drake
@@ -21,7 +23,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("which", nargs="?", default="all",
-                        choices=("all", "open-loop", "socp", "nlp", "campaign", "interface-cost", "paper001",
+                        choices=("all", "open-loop", "socp", "nlp", "dymos", "campaign", "interface-cost", "paper001",
                                  "aborts", "paper004"))
     parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
     parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
@@ -49,6 +51,10 @@ if __name__ == "__main__":
         from nlp import nlp_benchmark
 
         nlp_benchmark(nodes=args.nodes)
+    if args.which == "dymos":  # needs the 'bench' extra, so not part of 'all'
+        from dymos_peer import dymos_benchmark
+
+        dymos_benchmark(nodes=args.nodes if args.nodes != 40 else 31)
     if args.which in ("all", "campaign"):
         from campaign import campaign_benchmark
 

@@ -108,3 +108,14 @@ def test_example_08(tmp_path):
     assert all(os.path.exists(x["report"]) for x in (orbital, descent))
     assert os.path.exists(os.path.join(orbital["directory"], "reachability_map.png"))
     assert os.path.exists(os.path.join(descent["directory"], "descent_tracks.png"))
+
+
+def test_example_10(tmp_path):
+    """Every catalogue problem with the defaults: verified and within 1e-4 of its published
+    optimum; the refined brachistochrone starts above the tolerance and ends below it."""
+    r = _run("10_published_optima", tmp_path)
+    for name in ("brachistochrone", "goddard_rocket", "shuttle_crossrange", "shuttle_crossrange_heating"):
+        assert r[name]["result"].success and r[name]["relative"] <= 1e-4, (name, r[name]["relative"])
+    steps = r["brachistochrone_refined"]["result"].mesh_history
+    assert steps[0].error > 1e-4 >= steps[-1].error and r["brachistochrone_refined"]["result"].success
+    assert os.path.exists(r["plot"])

@@ -26,10 +26,13 @@ flies the controls with the Drake Simulator to check the terminal state.
 ``success`` means verified (verify: dynamics between the nodes and the controls flown by the
 Drake Simulator); a converged answer that fails the check says "converged but inaccurate".
 
+``refine=True`` raises the node count until the between-node error meets the tolerance
+(mesh); ``solver='auto'`` (default) tries SNOPT, then Ipopt from the same start.
+
 Modules: result (NlpResult, extremal controls, summary), guess (initial guesses), scaling
-(the factors the solver sees), status (solver verdicts in words), verify, evaluator (node
-values and Jacobians), transcription (shared parts), lgl, dircol, catalogue (published
-problems with their optima).
+(the factors the solver sees), status (solver verdicts in words), verify, mesh (refinement),
+evaluator (node values and Jacobians), transcription (shared parts), lgl, dircol, catalogue
+(published problems with their optima).
 """
 from __future__ import annotations
 

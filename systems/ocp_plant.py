@@ -16,16 +16,23 @@ import numpy as np
 from pydrake.systems.framework import BasicVector_, ContinuousStateIndex, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
+from drake_entry.errors import DrakeEntryError
+
 
 @TemplateSystem.define("OptimalControlPlant_")
 def OptimalControlPlant_(T):
     class Impl(LeafSystem_[T]):
         def _construct(self, problem, state_scale=None, control_scale=None, time_scale: float = 1.0,
-                       converter=None):
+                       undefined_as_nan: bool = False, converter=None):
             """Args: problem with n_states, n_controls and dynamics(x, u) (SI); scales (SI per
-            scaled unit; default 1)."""
+            scaled unit; default 1); undefined_as_nan: where a model is undefined (a
+            DrakeEntryError, e.g. an altitude below the atmosphere's range) the derivatives
+            are NaN instead of the error, which a solver's line search backs off from (an NLP
+            may probe such points, e.g. a Hermite-Simpson midpoint); the Simulator's users
+            keep the error."""
             LeafSystem_[T].__init__(self, converter)
             self.problem = problem
+            self.undefined_as_nan = undefined_as_nan
             nx, nu = problem.n_states, problem.n_controls
             self.sx = np.ones(nx) if state_scale is None else np.asarray(state_scale, float)
             self.su = np.ones(nu) if control_scale is None else np.asarray(control_scale, float)
@@ -35,13 +42,19 @@ def OptimalControlPlant_(T):
             self.DeclareStateOutputPort("x", ContinuousStateIndex(0))
 
         def _construct_copy(self, other, converter=None):
-            Impl._construct(self, other.problem, other.sx, other.su, other.ts, converter=converter)
+            Impl._construct(self, other.problem, other.sx, other.su, other.ts, other.undefined_as_nan,
+                            converter=converter)
 
         def DoCalcTimeDerivatives(self, context, derivatives):
             xs = context.get_continuous_state_vector().CopyToVector()
             us = self.u_port.Eval(context)
-            f = self.problem.dynamics(xs * self.sx, us * self.su)
-            derivatives.get_mutable_vector().SetFromVector(np.asarray(f) * (self.ts / self.sx))
+            try:
+                f = np.asarray(self.problem.dynamics(xs * self.sx, us * self.su)) * (self.ts / self.sx)
+            except DrakeEntryError:
+                if not self.undefined_as_nan:
+                    raise
+                f = np.array([T(np.nan) for _ in range(len(xs))]) if T != float else np.full(len(xs), np.nan)
+            derivatives.get_mutable_vector().SetFromVector(f)
 
     return Impl
 

@@ -437,3 +437,30 @@ def test_heating_limit_holds_at_the_nodes_of_the_constrained_shuttle():
     limit = 70.0 * catalogue.BTU_FT2_S
     assert q.max() <= limit * (1 + 1e-6) and q.max() >= limit * (1 - 1e-6)
     assert math.degrees(-r.objective) < 34.1412 - 3.0
+
+
+def test_plant_reports_undefined_models_as_nan_to_the_solver_and_raises_for_the_simulator():
+    """A Hermite-Simpson midpoint may probe an altitude below the atmosphere's range (Betts'
+    shuttle on DirectCollocation: h = -9.8 km raised out of the solve before): with
+    undefined_as_nan the derivatives are NaN (the line search backs off), else the error."""
+    from pydrake.autodiffutils import AutoDiffXd
+
+    from drake_entry.errors import ModelRangeError
+    from drake_entry.systems.ocp_plant import OptimalControlPlant
+
+    problem, _ = catalogue.shuttle_crossrange()
+    below = np.array([-20e3, 0.0, 0.0, 7000.0, -0.1, 1.5])
+    for undefined_as_nan in (True, False):
+        plant = OptimalControlPlant(problem, undefined_as_nan=undefined_as_nan)
+        for system in (plant, plant.ToAutoDiffXd()):
+            context = system.CreateDefaultContext()
+            scalar = AutoDiffXd if system is not plant else float
+            context.SetContinuousState([scalar(v) for v in below])
+            system.get_input_port(0).FixValue(context, [scalar(0.3), scalar(-0.5)])
+            if undefined_as_nan:
+                xdot = system.EvalTimeDerivatives(context).CopyToVector()
+                values = [v.value() if scalar is AutoDiffXd else v for v in xdot]
+                assert np.all(np.isnan(values))
+            else:
+                with pytest.raises(ModelRangeError, match="outside the exponential range"):
+                    system.EvalTimeDerivatives(context)

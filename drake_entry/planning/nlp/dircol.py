@@ -20,7 +20,7 @@ class _DircolTranscription(_Transcription):
 
         from drake_entry.systems.ocp_plant import OptimalControlPlant  # the transcription needs a Drake System
 
-        self.plant = OptimalControlPlant(problem, self.sx, self.su, self.ts)
+        self.plant = OptimalControlPlant(problem, self.sx, self.su, self.ts, undefined_as_nan=True)
         # equal steps, loosely bounded (t_f's own bounds are the duration bounds): Drake needs
         # finite step bounds, so an open end becomes 1e-6 / 1e6 x the guess's final time (no
         # cap a solve can reach); a fixed t_f keeps a step range (Ipopt fails on lb = ub here)

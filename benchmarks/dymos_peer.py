@@ -90,14 +90,25 @@ def _dymos_shuttle(nodes: int):
 
 
 def _run_dymos(build, nodes):
-    t0 = time.perf_counter()
-    with warnings.catch_warnings():
+    """Build and run one dymos problem inside a temporary directory (OpenMDAO writes its
+    reports and coloring files into <problem>_out/ under the working directory)."""
+    import os
+    import tempfile
+
+    here = os.getcwd()
+    with tempfile.TemporaryDirectory(prefix="dymos_") as work, warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        p, objective = build(nodes)
-        failed = p.run_driver()
-    wall = time.perf_counter() - t0
+        os.chdir(work)
+        try:
+            t0 = time.perf_counter()
+            p, objective = build(nodes)
+            failed = p.run_driver()
+            wall = time.perf_counter() - t0
+            value = objective()
+        finally:
+            os.chdir(here)
     ok = not (failed.success is False if hasattr(failed, "success") else bool(failed))
-    return {"ok": ok, "objective": objective(), "wall_s": wall}
+    return {"ok": ok, "objective": value, "wall_s": wall}
 
 
 def dymos_benchmark(*, nodes: int = 31) -> dict:

@@ -102,12 +102,12 @@ def _run_dymos(build, nodes):
         try:
             t0 = time.perf_counter()
             p, objective = build(nodes)
-            failed = p.run_driver()
+            outcome = p.run_driver()
             wall = time.perf_counter() - t0
             value = objective()
         finally:
             os.chdir(here)
-    ok = not (failed.success is False if hasattr(failed, "success") else bool(failed))
+    ok = bool(getattr(outcome, "success", not outcome))  # a DriverResult, or True on failure (older OpenMDAO)
     return {"ok": ok, "objective": value, "wall_s": wall}
 
 

@@ -14,6 +14,11 @@ import numpy as np
 
 from .errors import ScenarioError
 
+# US customary units (exact SI conversions) for forms published in them
+FT = 0.3048  # m
+SLUG = 14.593902937  # kg
+BTU_FT2_S = 1055.05585262 / FT ** 2  # W/m^2 per BTU/ft^2/s (international-table BTU)
+
 
 @dataclass(frozen=True)
 class HeatFlux:
@@ -44,10 +49,6 @@ class HeatFlux:
             raise ScenarioError(f"HeatFlux.alpha_factor = {list(self.alpha_factor)} must be finite numbers")
         object.__setattr__(self, "alpha_factor", tuple(float(c) for c in self.alpha_factor))
 
-    @property
-    def depends_on_alpha(self) -> bool:
-        return bool(self.alpha_factor)
-
     def __call__(self, rho, V, alpha=None):
         """q_dot [W/m^2] at density rho [kg/m^3], speed V [m/s] and, for a form with an
         angle-of-attack factor, alpha [rad]."""
@@ -73,9 +74,7 @@ class HeatFlux:
         2nd ed., 2010, Sec. 6.1): q = q_a q_r [BTU/ft^2/s] with q_r = 17 700 sqrt(rho)
         (1e-4 V)^3.07 (rho slug/ft^3, V ft/s) and q_a = 1.0672181 - 0.19213774e-1 a
         + 0.21286289e-3 a^2 - 0.10117249e-5 a^3 (a in deg); converted to SI exactly."""
-        ft, slug = 0.3048, 14.593902937
-        btu_ft2_s = 1055.05585262 / ft ** 2  # W/m^2
-        k = 17700.0 * (ft ** 3 / slug) ** 0.5 * (1e-4 / ft) ** 3.07 * btu_ft2_s
+        k = 17700.0 * (FT ** 3 / SLUG) ** 0.5 * (1e-4 / FT) ** 3.07 * BTU_FT2_S
         return HeatFlux(k, 0.5, 3.07, "betts_shuttle",
                         (1.0672181, -0.19213774e-1, 0.21286289e-3, -0.10117249e-5), "deg")
 

@@ -128,7 +128,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
     while True:
         mesh_time, failed = 0.0, []
         for name, engine in engines.items():  # auto: SNOPT, then Ipopt from the same start if it fails
-            result, words, diagnosis = _solve_mesh(problem, transcription, engine, nodes, guess, scaling,
+            result, words, diagnosis = _solve_mesh(problem, transcription, name, engine, nodes, guess, scaling,
                                                    options[name][0])
             mesh_time, build_time = mesh_time + result.solve_time, build_time + result.build_time
             if result.converged:
@@ -203,7 +203,7 @@ def _engine(name: str, check: bool = True):
     return None
 
 
-def _solve_mesh(problem, transcription, engine, nodes, guess, scaling, options):
+def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, options):
     """One transcription and solve on ``nodes`` nodes: (NlpResult with ``converged`` and this
     mesh's build and solve times, the solver's verdict in words, the violation diagnosis
     when not converged)."""
@@ -214,7 +214,6 @@ def _solve_mesh(problem, transcription, engine, nodes, guess, scaling, options):
     tx.set_guess(*guess)
     tx.scale_objective()
     build_time = _time.perf_counter() - t_build
-    solver = "ipopt" if engine.solver_id() == IpoptSolver.id() else "snopt"
     t0 = _time.perf_counter()
     res = engine.Solve(tx.prog, tx.initial_guess, options)
     converged, words = verdict(res, solver)

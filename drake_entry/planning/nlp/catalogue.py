@@ -1,6 +1,6 @@
 """Published optimal-control problems with known optima, posed as a user would pose them
 (issue 14's suite): each function returns (problem, published) where ``published`` holds the
-optimum and its source (tests/test_nlp.py, benchmarks/nlp_suite.py).
+optimum and its source (tests/test_nlp.py, examples/10_published_optima.py, benchmarks/dymos_peer.py).
 """
 from __future__ import annotations
 
@@ -11,14 +11,11 @@ from scipy.optimize import brentq
 
 from ...aerodynamics import PolynomialAero
 from ...atmosphere import ExponentialAtmosphere
-from ...constraints import HeatFlux
+from ...constraints import BTU_FT2_S, FT, SLUG, HeatFlux
 from ...planet import Earth
 from ...vehicles import Vehicle
 from ..ocp import CustomProblem, ObjectiveTerm, OptimalControlProblem, PathConstraint
 
-FT = 0.3048  # m
-SLUG = 14.593902937  # kg
-BTU_FT2_S = 1055.05585262 / FT ** 2  # W/m^2 per BTU/ft^2/s
 G_BRACHISTOCHRONE = 9.81  # m/s^2
 
 

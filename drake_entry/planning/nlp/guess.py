@@ -17,9 +17,9 @@ def initial_guess(problem, samples: int = 200):
     constant bank (within its bounds) whose magnitude is found by bisection so the flight
     ends at the final altitude near the final position (or at the fixed/maximum final time),
     with controls at rest; then each state is shifted linearly over the last 5 % of the
-    flight to end inside its final bounds, and clipped to the state bounds. Other problems: the straight line between
-    the boundary values over the mean final time (free: the problem's time scale or 1 s),
-    controls at the middle of their bounds (or zero).
+    flight to end inside its final bounds, and clipped to the state bounds. Other problems:
+    the straight line between the boundary values over the mean final time (free: the
+    problem's time scale or 1 s), controls at the middle of their bounds (or zero).
     """
     if isinstance(problem, OptimalControlProblem):
         return _entry_guess(problem, samples)

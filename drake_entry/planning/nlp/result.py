@@ -10,6 +10,7 @@ from ...errors import DrakeEntryError, ScenarioError
 from ...pseudospectral import interpolation_matrix
 from ..ocp import OptimalControlProblem
 from ..result import PlanResult
+from .evaluator import model_values
 
 
 @dc.dataclass
@@ -106,8 +107,8 @@ class NlpResult(PlanResult):
             return lambda tt: np.column_stack([np.interp(np.atleast_1d(tt), t, X[:, j]) for j in range(X.shape[1])])
         from scipy.interpolate import CubicHermiteSpline
 
-        F = np.array([np.asarray(self.problem.dynamics(x, u), float) for x, u in zip(X, self.controls)])
-        spline = CubicHermiteSpline(t, X, F, axis=0)
+        f, _, _, _ = model_values(self.problem, X.T, self.controls.T)
+        spline = CubicHermiteSpline(t, X, f.T, axis=0)
         return lambda tt: spline(np.clip(np.atleast_1d(tt), t[0], t[-1]))
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .evaluator import model_values
 from .result import NlpResult
 from .scaling import objective_factor
 
@@ -128,8 +129,8 @@ class _Transcription:
         if costates is not None:
             Xc = X if len(t_costate) == len(t) else 0.5 * (X[:-1] + X[1:])
             Uc = U if len(t_costate) == len(t) else 0.5 * (U[:-1] + U[1:])
-            ham = np.array([float(problem.lagrangian(x, u)) + float(lam @ np.asarray(problem.dynamics(x, u), float))
-                            for x, u, lam in zip(Xc, Uc, costates)])
+            f, _, L, _ = model_values(problem, Xc.T, Uc.T)
+            ham = L + np.sum(costates * f.T, axis=1)
         return NlpResult(time=t, states=X, controls=U, objective=self.objective_value(res), costates=costates,
                          costate_time=t_costate, hamiltonian=ham, transcription=transcription, nodes=self.N,
                          max_defect=self.worst[0], problem=problem, scaling=self.scaling)

@@ -23,7 +23,7 @@ from drake_entry.errors import DrakeEntryError
 def OptimalControlPlant_(T):
     class Impl(LeafSystem_[T]):
         def _construct(self, problem, state_scale=None, control_scale=None, time_scale: float = 1.0,
-                       undefined_as_nan: bool = False, converter=None):
+                       undefined_as_nan: bool = False, timer=None, converter=None):
             """Args: problem with n_states, n_controls and dynamics(x, u) (SI); scales (SI per
             scaled unit; default 1); undefined_as_nan: where a model is undefined (a
             DrakeEntryError, e.g. an altitude below the atmosphere's range) the derivatives
@@ -33,6 +33,8 @@ def OptimalControlPlant_(T):
             LeafSystem_[T].__init__(self, converter)
             self.problem = problem
             self.undefined_as_nan = undefined_as_nan
+            self.timer = timer
+            self._derivatives = self._time_derivatives if timer is None else timer.wrap(self._time_derivatives)
             nx, nu = problem.n_states, problem.n_controls
             self.sx = np.ones(nx) if state_scale is None else np.asarray(state_scale, float)
             self.su = np.ones(nu) if control_scale is None else np.asarray(control_scale, float)
@@ -42,10 +44,13 @@ def OptimalControlPlant_(T):
             self.DeclareStateOutputPort("x", ContinuousStateIndex(0))
 
         def _construct_copy(self, other, converter=None):
-            Impl._construct(self, other.problem, other.sx, other.su, other.ts, other.undefined_as_nan,
+            Impl._construct(self, other.problem, other.sx, other.su, other.ts, other.undefined_as_nan, other.timer,
                             converter=converter)
 
         def DoCalcTimeDerivatives(self, context, derivatives):
+            self._derivatives(context, derivatives)
+
+        def _time_derivatives(self, context, derivatives):
             xs = context.get_continuous_state_vector().CopyToVector()
             us = self.u_port.Eval(context)
             try:

@@ -464,3 +464,29 @@ def test_plant_reports_undefined_models_as_nan_to_the_solver_and_raises_for_the_
             else:
                 with pytest.raises(ModelRangeError, match="outside the exponential range"):
                     system.EvalTimeDerivatives(context)
+
+
+@pytest.mark.parametrize("transcription", ["lgl", "dircol"])
+def test_solve_time_is_split_into_our_callbacks_and_the_solver(transcription):
+    """callback_calls / callback_time count the Python callbacks the solver made (LGL: the
+    one constraint and the cost; dircol: the plant's derivatives, once per sample and
+    midpoint) and nothing outside the solver: the model calls match, the time is a share
+    of solve_time."""
+    calls = {"n": 0}
+    base = brachistochrone()
+
+    def dynamics(x, u):
+        calls["n"] += 1
+        return base.dynamics_function(x, u)
+
+    problem = dc.replace(base, dynamics_function=dynamics)
+    r = nlp.solve(problem, transcription=transcription, solver="ipopt", nodes=12, verify=False)
+    assert r.converged
+    assert 0.0 < r.callback_time < r.solve_time
+    if transcription == "lgl":
+        # one vectorised model call per new point, cached between the constraint and the cost
+        assert 0 < r.callback_calls and calls["n"] <= r.callback_calls
+    else:
+        # the plant evaluates the dynamics once per call; the other callbacks (the Mayer cost,
+        # once per NLP evaluation) are under 1 / 23 of them (23 samples and midpoints)
+        assert r.callback_calls >= 10 * 12 and calls["n"] >= (1 - 1 / 23) * r.callback_calls

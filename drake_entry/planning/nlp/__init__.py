@@ -9,10 +9,10 @@ altitude in 10 km, controls by their bounds, the objective by its gradient at th
 reported in ``result.scaling``); results are SI.
 
 LGL (paper 002 eqs. 12-14, Fahroo & Ross): states and controls at the N LGL nodes
-tau_k of [-1, 1], t = (tau + 1) t_f / 2. The defects are split so every nonlinear
-binding stays small (one per node): F_k = (t_f / 2) f(x_k, u_k) (nonlinear, per node) and
-D X = F (linear, per state). Costates come from the KKT multipliers of D X = F (eq. 15):
-lambda(t_k) = nu_k / w_k, converted back to SI.
+tau_k of [-1, 1], t = (tau + 1) t_f / 2. One constraint holds the defects
+D X - (t_f / 2) f(X, U) = 0 and the path rows, evaluated by one vectorised model call with
+its exact sparse Jacobian (lgl, evaluator). Costates come from the defects' KKT multipliers
+(eq. 15): lambda(t_k) = nu_k / w_k, converted back to SI.
 
 DirectCollocation: Drake's Hermite-Simpson transcription of systems.ocp_plant (the same
 scaled dynamics as a Drake System) with N samples; the running cost is the trapezoid rule
@@ -125,12 +125,14 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
     options = {name: _solver_options(engine, name, tolerance, max_iterations, verbose, solver_options, log_file)
                for name, engine in engines.items()}
     history, build_time, solve_time, target = [], 0.0, 0.0, dynamics_tolerance
+    calls, callback_time = 0, 0.0
     while True:
         mesh_time, failed = 0.0, []
         for name, engine in engines.items():  # auto: SNOPT, then Ipopt from the same start if it fails
             result, words, diagnosis = _solve_mesh(problem, transcription, name, engine, nodes, guess, scaling,
                                                    options[name][0])
             mesh_time, build_time = mesh_time + result.solve_time, build_time + result.build_time
+            calls, callback_time = calls + result.callback_calls, callback_time + result.callback_time
             if result.converged:
                 break
             failed.append(words)
@@ -139,6 +141,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
         solve_time += mesh_time
         result.solver, result.log_file, result.guess_time = name, options[name][1], guess_time
         result.build_time, result.solve_time, result.mesh_history = build_time, solve_time, history
+        result.callback_calls, result.callback_time = calls, callback_time
         if refine:
             error = mesh_error(problem, result) if result.converged else math.nan
             history.append(MeshStep(int(nodes), error, result.converged, mesh_time))
@@ -214,7 +217,7 @@ def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, o
     tx.set_guess(*guess)
     tx.scale_objective()
     build_time = _time.perf_counter() - t_build
-    t0 = _time.perf_counter()
+    t0, calls0, seconds0 = _time.perf_counter(), tx.timer.calls, tx.timer.seconds
     res = engine.Solve(tx.prog, tx.initial_guess, options)
     converged, words = verdict(res, solver)
     if not converged and restartable(res, solver) and tx.worst_violation(res)[0] <= RESTART_VIOLATION:
@@ -222,9 +225,11 @@ def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, o
         converged, restart_words = verdict(res, solver)
         words = f"{restart_words} after a warm restart from '{words}'"
     solve_time = _time.perf_counter() - t0
+    calls, seconds = tx.timer.calls - calls0, tx.timer.seconds - seconds0
     result = tx.result(res)
     result.converged = converged
     result.build_time, result.solve_time = build_time, solve_time
+    result.callback_calls, result.callback_time = calls, seconds
     return result, words, ("" if result.converged else tx.diagnose())
 
 

@@ -20,7 +20,8 @@ class _DircolTranscription(_Transcription):
 
         from drake_entry.systems.ocp_plant import OptimalControlPlant  # the transcription needs a Drake System
 
-        self.plant = OptimalControlPlant(problem, self.sx, self.su, self.ts, undefined_as_nan=True)
+        self.plant = OptimalControlPlant(problem, self.sx, self.su, self.ts, undefined_as_nan=True,
+                                         timer=self.timer)
         # equal steps, loosely bounded (t_f's own bounds are the duration bounds): Drake needs
         # finite step bounds, so an open end becomes 1e-6 / 1e6 x the guess's final time (no
         # cap a solve can reach); a fixed t_f keeps a step range (Ipopt fails on lb = ub here)
@@ -40,8 +41,8 @@ class _DircolTranscription(_Transcription):
         self.add_terminal(prog, self.X[-1], self.U[-1])
         if problem.has_lagrange:  # trapezoid rule over the samples
             for k in range(N - 1):
-                prog.AddCost(lambda z: 0.5 * self.cost_factor * z[-1] * (
-                    self.L_scaled(z[:nx], z[nx:nx + nu]) + self.L_scaled(z[nx + nu:2 * nx + nu], z[2 * nx + nu:-1])),
+                prog.AddCost(self.timer.wrap(lambda z: 0.5 * self.cost_factor * z[-1] * (
+                    self.L_scaled(z[:nx], z[nx:nx + nu]) + self.L_scaled(z[nx + nu:2 * nx + nu], z[2 * nx + nu:-1]))),
                              np.concatenate([self.X[k], self.U[k], self.X[k + 1], self.U[k + 1], [self.H[k]]]))
         self.collocation = [b for b in prog.GetAllConstraints()
                             if b.evaluator().get_description().startswith("collocation constraint")]

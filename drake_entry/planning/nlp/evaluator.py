@@ -1,7 +1,31 @@
-"""Model values and Jacobians at all nodes from one vectorised call (central differences)."""
+"""Model values and Jacobians at all nodes from one vectorised call (central differences),
+and the timer of the Python callbacks a solver calls."""
 from __future__ import annotations
 
+import functools
+import time
+
 import numpy as np
+
+
+class CallbackTimer:
+    """Calls and wall time [s] of the Python callbacks handed to the solver (model values,
+    Jacobians, AutoDiff packing): the rest of a solve's time is the solver's own and Drake's."""
+
+    def __init__(self):
+        self.calls, self.seconds = 0, 0.0
+
+    def wrap(self, fn):
+        """``fn`` counted and timed."""
+        @functools.wraps(fn)
+        def timed(*args):
+            t0 = time.perf_counter()
+            try:
+                return fn(*args)
+            finally:
+                self.seconds += time.perf_counter() - t0
+                self.calls += 1
+        return timed
 
 
 class _NodeEvaluator:

@@ -39,6 +39,10 @@ class NlpResult(PlanResult):
         report them); mesh_history: nlp.mesh.MeshStep (nodes, between-node error, converged,
         solve time) per mesh of a refined solve (empty otherwise); build_time and solve_time
         are summed over the meshes.
+      callback_calls, callback_time: calls of the Python callbacks the solver made (the
+        constraint, costs, and for dircol the plant's derivatives) and their wall time [s]
+        (models, Jacobians, AutoDiff packing), summed like solve_time; solve_time minus
+        callback_time is the solver's own time with Drake's conversions.
       max_defect: largest scaled dynamics/constraint violation at the nodes.
       log_file: the solver's log (solve(log_file=...) or verbose SNOPT), else None.
     """
@@ -58,6 +62,8 @@ class NlpResult(PlanResult):
     scaling: object = None
     guess_time: float = 0.0
     verify_time: float = 0.0
+    callback_calls: int = 0
+    callback_time: float = 0.0
     mesh_history: list = dc.field(default_factory=list)
     log_file: str | None = None
     problem: object = dc.field(repr=False, default=None)
@@ -148,6 +154,7 @@ def summary(problem, result: NlpResult, check=None) -> dict:
            "transcription": result.transcription, "solver": result.solver, "nodes": result.nodes,
            "objective": result.objective, "final_time_s": result.final_time, "solve_time_s": result.solve_time,
            "build_time_s": result.build_time, "guess_time_s": result.guess_time, "verify_time_s": result.verify_time,
+           "callback_calls": result.callback_calls, "callback_time_s": result.callback_time,
            "total_time_s": result.total_time, "max_constraint_violation_scaled": result.max_defect,
            "verification": None if result.verification is None else result.verification.as_dict(),
            "scaling": None if result.scaling is None else result.scaling.as_dict(),

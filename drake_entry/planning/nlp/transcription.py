@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .evaluator import model_values
+from .evaluator import CallbackTimer, model_values
 from .result import NlpResult
 from .scaling import objective_factor
 
@@ -23,6 +23,7 @@ class _Transcription:
         self.nx, self.nu = problem.n_states, problem.n_controls
         self.t_lo, self.t_hi = problem.final_time_bounds
         self.fixed_tf = self.t_lo == self.t_hi
+        self.timer = CallbackTimer()  # every Python callback handed to the solver goes through it
 
     def scale_objective(self):
         """Choose the objective factor at the guess (scaling.objective_factor) unless the user
@@ -76,7 +77,8 @@ class _Transcription:
         lo, hi = self.scaled_bounds(path)
         nx = self.nx
         for k in range(X.shape[0]):
-            prog.AddConstraint(lambda z: self._scaled_rows(self.problem.path_values, path, z[:nx], z[nx:]), lo, hi,
+            prog.AddConstraint(self.timer.wrap(lambda z: self._scaled_rows(self.problem.path_values, path, z[:nx],
+                                                                           z[nx:])), lo, hi,
                                np.concatenate([X[k], U[k]]), description=f"path[{k}]")
 
     def add_terminal(self, prog, x_last, u_last):
@@ -85,7 +87,8 @@ class _Transcription:
         if not terminal:
             return
         nx = self.nx
-        prog.AddConstraint(lambda z: self._scaled_rows(self.problem.terminal_values, terminal, z[:nx], z[nx:]),
+        prog.AddConstraint(self.timer.wrap(lambda z: self._scaled_rows(self.problem.terminal_values, terminal,
+                                                                       z[:nx], z[nx:])),
                            *self.scaled_bounds(terminal), np.concatenate([x_last, u_last]), description="terminal")
 
     def mayer_cost(self, prog, x_last, tf_vars):
@@ -96,10 +99,12 @@ class _Transcription:
         nx = self.nx
         if tf_vars is None:
             tf = self.t_lo
-            prog.AddCost(lambda z: self.problem.mayer(z * self.sx, tf) * (self.cost_factor / self.ts), x_last)
+            prog.AddCost(self.timer.wrap(lambda z: self.problem.mayer(z * self.sx, tf) * (self.cost_factor / self.ts)),
+                         x_last)
         else:
-            prog.AddCost(lambda z: self.problem.mayer(z[:nx] * self.sx, z[nx:].sum() * self.ts)
-                         * (self.cost_factor / self.ts), np.concatenate([x_last, np.atleast_1d(tf_vars)]))
+            prog.AddCost(self.timer.wrap(lambda z: self.problem.mayer(z[:nx] * self.sx, z[nx:].sum() * self.ts)
+                                         * (self.cost_factor / self.ts)),
+                         np.concatenate([x_last, np.atleast_1d(tf_vars)]))
 
     def worst_violation(self, res) -> tuple[float, str]:
         """(largest scaled constraint violation, the constraint's description) at ``res``."""

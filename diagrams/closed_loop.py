@@ -209,12 +209,14 @@ def terminal_errors(x, setup: ClosedLoopSetup) -> dict:
 def acceptance_box(tr: Trajectory, setup: ClosedLoopSetup, distance_m: float) -> dict:
     """The mission's acceptance box (scenario.terminal tolerances, paper 000 Table 1) at the
     final state: {criterion: {"error": e, "tolerance": tol, "inside": |e| <= tol}} for each
-    criterion whose tolerance is given: 'altitude' [m] about terminal.altitude_km, 'mach'
+    criterion whose tolerance is given: 'altitude' [m] about terminal.altitude_km (geodetic with
+    altitude_datum 'ellipsoid'), 'mach'
     about terminal.mach, 'distance' [m] to the target (``distance_m``, terminal_errors')."""
     t, x = setup.scenario.terminal, tr.state[-1]
     box = {}
     if t.altitude_km is not None and t.altitude_tolerance_km is not None:
-        box["altitude"] = (float(x[0] - t.altitude_km * 1e3), t.altitude_tolerance_km * 1e3)
+        h = setup.planet.atmospheric_altitude(x[0], x[2]) if setup.scenario.altitude_datum == "ellipsoid" else x[0]
+        box["altitude"] = (float(h - t.altitude_km * 1e3), t.altitude_tolerance_km * 1e3)
     if t.mach is not None and t.mach_tolerance is not None:
         box["mach"] = (float(tr.column("mach")[-1] - t.mach), t.mach_tolerance)
     if t.distance_tolerance_km is not None:

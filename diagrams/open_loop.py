@@ -40,7 +40,8 @@ def build_open_loop(scenario: Scenario):
     t = scenario.terminal
     monitor = builder.AddNamedSystem("termination", TerminationMonitor(
         altitude=None if t.altitude_km is None else t.altitude_km * 1e3, mach=t.mach,
-        velocity=t.velocity_m_s, energy=None if t.energy_MJ_kg is None else t.energy_MJ_kg * 1e6, planet=planet))
+        velocity=t.velocity_m_s, energy=None if t.energy_MJ_kg is None else t.energy_MJ_kg * 1e6, planet=planet,
+        geodetic=scenario.altitude_datum == "ellipsoid"))
     state = plant.GetOutputPort("state")
     conditions = plant.GetOutputPort("flight_conditions")
     builder.Connect(state, air.get_input_port())

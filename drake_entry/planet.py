@@ -156,6 +156,14 @@ class Earth:
         s = np.sin(lat)
         return self.radius(h) - self.equatorial_radius * (1.0 - self.flattening * s * s)
 
+    def state_altitude(self, geodetic_altitude, lat):
+        """State altitude h [m] whose ``atmospheric_altitude`` at latitude ``lat`` [rad] is
+        ``geodetic_altitude`` [m] (its exact inverse; any scalar type)."""
+        if self.is_spherical:
+            return geodetic_altitude
+        s = np.sin(lat)
+        return geodetic_altitude + self.equatorial_radius * (1.0 - self.flattening * s * s) - self.reference_radius
+
     def specific_energy(self, h, V, lat=0.0):
         """Specific mechanical energy E = V^2/2 + potential [J/kg] (paper 000 Sec. V.A)."""
         return 0.5 * V * V + self.potential(self.radius(h), lat)

@@ -141,6 +141,10 @@ class Scenario:
     # which aero model of the vehicle file ('' = its default)
     aero: str = ""
     planet: PlanetSpec = dc.field(default_factory=PlanetSpec)  # the Earth model
+    # what entry.altitude_km and terminal.altitude_km are measured from: 'sphere' (the state
+    # altitude, above the reference sphere) or 'ellipsoid' (geodetic altitude above WGS-84, the
+    # atmosphere's altitude; an oblate planet); latitudes stay geocentric either way
+    altitude_datum: str = "sphere"
     atmosphere: AtmosphereSpec = dc.field(default_factory=AtmosphereSpec)  # the atmosphere model
     entry: EntryStateSpec = dc.field(default_factory=EntryStateSpec)  # entry-interface state
     target: TargetSpec = dc.field(default_factory=TargetSpec)  # target site (runway or TAEM point)
@@ -169,9 +173,13 @@ class Scenario:
         return atmosphere_from_spec(self.atmosphere)
 
     def initial_state(self) -> np.ndarray:
-        """Entry state x0 = [h, lon, lat, V, gamma, psi] in SI / rad."""
+        """Entry state x0 = [h, lon, lat, V, gamma, psi] in SI / rad (h: the state altitude,
+        converted from the geodetic entry altitude with altitude_datum 'ellipsoid')."""
         e = self.entry
-        return np.array([e.altitude_km * 1e3, np.radians(e.longitude_deg), np.radians(e.latitude_deg),
+        h = e.altitude_km * 1e3
+        if self.altitude_datum == "ellipsoid":
+            h = self.make_planet().state_altitude(h, np.radians(e.latitude_deg))
+        return np.array([h, np.radians(e.longitude_deg), np.radians(e.latitude_deg),
                          e.velocity_m_s, np.radians(e.flight_path_deg), np.radians(e.heading_deg)])
 
     def entry_energy(self) -> float:
@@ -205,6 +213,10 @@ class Scenario:
 
     def validate(self) -> "Scenario":
         """Check every field against its allowed range; return self."""
+        if self.altitude_datum not in ("sphere", "ellipsoid"):
+            raise ScenarioError(f"altitude_datum = '{self.altitude_datum}' is unknown; allowed: sphere, ellipsoid")
+        if self.altitude_datum == "ellipsoid" and self.planet.model != "oblate":
+            raise ScenarioError("altitude_datum 'ellipsoid' needs planet.model 'oblate' (a sphere has one datum)")
         check_range("entry.altitude_km", self.entry.altitude_km, US76_H_MIN / 1e3, US76_H_MAX / 1e3)
         check_range("entry.velocity_m_s", self.entry.velocity_m_s, 1.0, 12000.0)
         check_range("entry.flight_path_deg", self.entry.flight_path_deg, -89.0, 89.0)

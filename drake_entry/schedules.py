@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ScenarioError
+from .scalar import is_autodiff, lift, value_of
 
 VARIABLES = ("time", "energy", "mach", "velocity")
 
@@ -95,3 +96,29 @@ class Schedule:
         blend = t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
         out = v[i] + (v[i + 1] - v[i]) * blend
         return out if np.ndim(s) else float(out)
+
+    def slope(self, s):
+        """d value / d s at s (float or ndarray; zero outside the breakpoints, the right-hand
+        slope at a corner)."""
+        bp = np.asarray(self.breakpoints, float)
+        v = np.asarray(self.values, float)
+        s_arr = np.asarray(s, float)
+        if bp.size == 1:
+            return np.zeros_like(s_arr) if np.ndim(s) else 0.0
+        i = np.clip(np.searchsorted(bp, s_arr, side="right") - 1, 0, bp.size - 2)
+        width = bp[i + 1] - bp[i]
+        t = (s_arr - bp[i]) / width
+        inside = (s_arr >= bp[0]) & (s_arr < bp[-1])
+        d = (v[i + 1] - v[i]) / width * (30.0 * t * t * (1.0 - t) ** 2 if self.smooth else 1.0)
+        out = np.where(inside, d, 0.0)
+        return out if np.ndim(s) else float(out)
+
+    def at(self, s):
+        """Value at s of any scalar type the models take: float, ndarray of floats, or
+        AutoDiffXd (the chain rule through ``slope``)."""
+        if is_autodiff(s):
+            x = value_of(s)
+            return lift([s], self(float(x)), [self.slope(float(x))])
+        if isinstance(s, np.ndarray) and s.dtype == object:
+            return np.array([self.at(e) for e in s.ravel()], dtype=object).reshape(s.shape)
+        return self(float(s) if np.ndim(s) == 0 else s)

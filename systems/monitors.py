@@ -3,7 +3,8 @@ interface (witness functions, located by Drake's event isolation).
 
 Conditions: Mach below ``mach``, specific energy below ``energy`` [J/kg], speed below
 ``velocity`` [m/s] (each optional), and always an altitude band: below ``altitude`` [m]
-(the terminal altitude or a crash floor; the surface, 0 m, when not given) or above
+(the terminal altitude or a crash floor; the surface, 0 m, when not given; the state
+altitude, or with ``geodetic=True`` the altitude above the ellipsoid) or above
 ``ceiling`` [m] (skipped out: the vehicle left the atmosphere model). The band is one
 witness, min(h - floor, ceiling - h), so the ceiling costs nothing per step. Whichever
 triggers first ends the run; ``reason`` names it ("reached energy", "reached the surface",
@@ -31,11 +32,13 @@ CEILING_M = US76_H_MAX - 100e3
 class TerminationMonitor(LeafSystem):
     def __init__(self, *, altitude: float | None = None, mach: float | None = None,
                  energy: float | None = None, velocity: float | None = None, planet: Earth | None = None,
-                 ceiling: float = CEILING_M):
+                 ceiling: float = CEILING_M, geodetic: bool = False):
         """Targets in SI: altitude [m] (floor; default the surface), Mach, energy [J/kg]
-        (with ``planet``), velocity [m/s]; ceiling [m] above which the vehicle skipped out."""
+        (with ``planet``), velocity [m/s]; ceiling [m] above which the vehicle skipped out;
+        geodetic: the floor is a geodetic altitude (planet.atmospheric_altitude)."""
         super().__init__()
         self.planet = planet or Earth()
+        self.geodetic = bool(geodetic)
         self.state_port = self.DeclareVectorInputPort("state", 6)
         self.air_port = self.DeclareVectorInputPort("air_data", 2)
         self.reason = None
@@ -56,6 +59,12 @@ class TerminationMonitor(LeafSystem):
     def _make_calc(self, name):
         if name == "altitude":  # the band [floor, ceiling]
             floor, ceiling = self.floor, self.ceiling
+            if self.geodetic:
+                def band(c):
+                    x = self.state_port.Eval(c)
+                    h = self.planet.atmospheric_altitude(x[0], x[2])
+                    return min(h - floor, ceiling - h)
+                return band
             return lambda c: min(self.state_port.Eval(c)[0] - floor, ceiling - self.state_port.Eval(c)[0])
         target = self.targets[name]
         if name == "velocity":

@@ -8,7 +8,10 @@ and user callables are evaluated with floats and with Drake AutoDiffXd.
 
 State order: [h, lon, lat, V, gamma, psi] (the canonical order, DESIGN.md), then, with
 ``controls='rates'``, [alpha, sigma] driven by the controls [u_alpha, u_sigma]
-(paper 002 eq. 6); with ``controls='direct'`` the controls are [alpha, sigma].
+(paper 002 eq. 6); with ``controls='direct'`` the controls are [alpha, sigma]; with
+``controls='bank_rate'`` alpha follows ``alpha_schedule`` in time (paper 003 Table 2) and
+the states end with [sigma, t] (sigma' = u_sigma, the control, paper 003 eq. 2; t' = 1, a
+clock that starts at initial['t'], default 0 s).
 """
 from __future__ import annotations
 
@@ -24,6 +27,7 @@ from ..dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_d
 from ..errors import ScenarioError
 from ..geodesy import central_angle_smooth, crossrange_from_great_circle
 from ..planet import Earth
+from ..schedules import Schedule
 from ..vehicles import Vehicle
 
 PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
@@ -31,9 +35,15 @@ PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
     "normal_load": ("normal_load", "g"), "total_load": ("total_load", "g"),
     "sensed_acceleration": ("total_load", "g"),  # paper 002 eq. 7, a = sqrt(L^2 + D^2), in g
     "mach": ("mach", "-"),
+    # geodetic altitude above the ellipsoid (the atmosphere's altitude, planet.atmospheric_altitude)
+    "geodetic_altitude": (None, "m"),
 }
-LAGRANGE_KINDS = ("control_margin", "heat_load", "lagrange")
-MAYER_KINDS = ("final_time", "miss_distance", "final_latitude", "final_crossrange", "final_velocity", "mayer")
+LAGRANGE_KINDS = ("control_margin", "bank_effort", "heat_load", "lagrange")
+MAYER_KINDS = ("final_time", "miss_distance", "final_latitude", "final_crossrange", "final_velocity",
+               "terminal_deviation", "mayer")
+CONTROL_LAYOUTS = ("rates", "direct", "bank_rate")
+#: the states terminal_deviation may weigh
+DEVIATION_STATES = ("h", "lon", "lat", "V", "gamma", "psi")
 
 
 @dc.dataclass
@@ -66,9 +76,11 @@ class PathConstraint:
     def label(self) -> str:
         return self.name or (self.quantity if isinstance(self.quantity, str) else "user")
 
-    def value(self, x, u, env: FlightConditions):
+    def value(self, x, u, env: FlightConditions, planet: Earth | None = None):
         if callable(self.quantity):
             return self.quantity(x, u, env)
+        if self.quantity == "geodetic_altitude":
+            return planet.atmospheric_altitude(x[0], x[2])
         return getattr(env, PATH_QUANTITIES[self.quantity][0])
 
 
@@ -79,12 +91,18 @@ class ObjectiveTerm:
     Lagrange kinds (integrated over time):
       control_margin  paper 002 eq. 11: k1 ((alpha - alpha_bar)/alpha_max)^2
                       + k2 (u_alpha/u_alpha_max)^2 + k3 (u_sigma/u_sigma_max)^2 [1/s]
+      bank_effort     (sigma/bank_max)^2 + rate_weight (u_sigma/u_sigma_max)^2 [1/s] (bank a
+                      state: controls 'rates' or 'bank_rate'); a unique minimiser among the
+                      bankings that meet hard terminal conditions (paper 003 database)
       heat_load       heat flux [W/m^2] (J = heat load [J/m^2])
       lagrange        ``function(x, u, env)``
     Mayer kinds (at the final node): final_time [s]; miss_distance [m] to ``target``
       (lon, lat rad), squared and divided by ``scale`` unless ``squared=False``;
       final_latitude [rad]; final_crossrange [m] from the great circle through the initial
-      position along the initial heading; final_velocity [m/s]; mayer ``function(xf, tf)``.
+      position along the initial heading; final_velocity [m/s]; terminal_deviation
+      (paper 003 eq. 1): sum over ``weights`` {state: w} of w ((x_f - reference[state]) / unit)^2,
+      reference SI, unit 1 (rad, m, m/s) with units='si' or canonical (h / R_ref,
+      V / sqrt(mu / R_ref), angles in rad) with units='canonical'; mayer ``function(xf, tf)``.
     Use a negative weight to maximise (e.g. final_latitude with weight -1).
     """
 
@@ -99,6 +117,11 @@ class ObjectiveTerm:
     scale: float = 1.0
     squared: bool = True
     function: Callable | None = None
+    bank_max: float = math.radians(60.0)
+    rate_weight: float = 0.1
+    reference: dict | None = None
+    weights: dict | None = None
+    units: str = "si"
 
     def __post_init__(self):
         if self.kind not in LAGRANGE_KINDS + MAYER_KINDS:
@@ -119,6 +142,25 @@ class ObjectiveTerm:
                                         f"finite and > 0")
         if not 0 < self.scale < math.inf:
             raise ScenarioError(f"objective '{self.kind}': scale = {self.scale} must be finite and > 0")
+        if self.kind == "bank_effort":
+            for name in ("bank_max", "u_sigma_max"):
+                if not 0 < getattr(self, name) < math.inf:
+                    raise ScenarioError(f"objective 'bank_effort': {name} = {getattr(self, name)} must be finite and > 0")
+            if not 0 <= self.rate_weight < math.inf:
+                raise ScenarioError(f"objective 'bank_effort': rate_weight = {self.rate_weight} must be finite and >= 0")
+        if self.kind == "terminal_deviation":
+            if not self.weights or not self.reference:
+                raise ScenarioError("objective 'terminal_deviation' needs weights and reference {state: value}")
+            for name, w in self.weights.items():
+                if name not in DEVIATION_STATES:
+                    raise ScenarioError(f"objective 'terminal_deviation': weights.{name} is not a state; allowed: "
+                                        f"{', '.join(DEVIATION_STATES)}")
+                if name not in self.reference:
+                    raise ScenarioError(f"objective 'terminal_deviation': weights.{name} has no reference.{name}")
+                if not 0 <= w < math.inf:
+                    raise ScenarioError(f"objective 'terminal_deviation': weights.{name} = {w} must be finite and >= 0")
+            if self.units not in ("si", "canonical"):
+                raise ScenarioError(f"objective 'terminal_deviation': units = '{self.units}'; allowed: si, canonical")
 
     @property
     def is_lagrange(self) -> bool:
@@ -271,7 +313,12 @@ class OptimalControlProblem(_ProblemLayout):
       initial, final: state name -> fixed value, (min, max) or None (free), SI / rad.
         States not named are free.
       final_time: fixed t_f [s], (min, max) (None for an open end) or None (free); t_0 = 0.
-      controls: 'rates' (alpha, sigma are states, controls are their rates) or 'direct'.
+      controls: 'rates' (alpha, sigma are states, controls are their rates), 'direct', or
+        'bank_rate' (alpha = alpha_schedule(t); sigma and a clock t are states, u_sigma the
+        control).
+      alpha_schedule: the angle-of-attack law over time [s] -> [rad] for 'bank_rate'
+        (schedules.Schedule, variable 'time'; paper 003 Table 2: 42 deg to 58 s, linear to
+        17.5 deg at 88 s).
       state_bounds, control_bounds: name -> (min, max) along the whole trajectory.
       path: path constraints. objective: terms (at least one).
       terminal: constraints on the final node (PathConstraint: the same quantities or a
@@ -291,10 +338,18 @@ class OptimalControlProblem(_ProblemLayout):
     path: list = dc.field(default_factory=list)
     terminal: list = dc.field(default_factory=list)
     name: str = "problem"
+    alpha_schedule: Schedule | None = None
 
     def __post_init__(self):
-        if self.controls not in ("rates", "direct"):
-            raise ScenarioError(f"controls must be 'rates' or 'direct', got '{self.controls}'")
+        if self.controls not in CONTROL_LAYOUTS:
+            raise ScenarioError(f"controls must be one of {', '.join(CONTROL_LAYOUTS)}, got '{self.controls}'")
+        if (self.controls == "bank_rate") != (self.alpha_schedule is not None):
+            raise ScenarioError("alpha_schedule is given exactly with controls='bank_rate' (alpha over time)")
+        if self.alpha_schedule is not None:
+            if self.alpha_schedule.variable != "time":
+                raise ScenarioError(f"alpha_schedule.variable = '{self.alpha_schedule.variable}'; allowed: time")
+            if "t" not in self.initial:  # the clock starts at 0 s unless told
+                self.initial = {**self.initial, "t": 0.0}
         self._check_layout()
         self._check_physical()
         if not self.objective:
@@ -302,11 +357,13 @@ class OptimalControlProblem(_ProblemLayout):
         for term in self.objective:
             if term.kind == "control_margin" and self.controls != "rates":
                 raise ScenarioError("objective 'control_margin' (paper 002 eq. 11) needs controls='rates'")
+            if term.kind == "bank_effort" and self.controls == "direct":
+                raise ScenarioError("objective 'bank_effort' needs the bank as a state: controls='rates' or 'bank_rate'")
 
     # states an entry vehicle can have (SI / rad): fixed boundary values must lie inside
     PHYSICAL = {"h": (-5e3, 1e6), "lon": (-4 * math.pi, 4 * math.pi), "lat": (-math.pi / 2, math.pi / 2),
                 "V": (1.0, 2e4), "gamma": (-math.pi / 2, math.pi / 2), "psi": (-4 * math.pi, 4 * math.pi),
-                "alpha": (-math.pi, math.pi), "sigma": (-4 * math.pi, 4 * math.pi)}
+                "alpha": (-math.pi, math.pi), "sigma": (-4 * math.pi, 4 * math.pi), "t": (0.0, 1e6)}
 
     def _check_physical(self):
         for where, d in (("initial", self.initial), ("final", self.final)):
@@ -319,13 +376,29 @@ class OptimalControlProblem(_ProblemLayout):
                                             f"allowed [{lo:g}, {hi:g}] (SI / rad)")
 
     # -- layout -------------------------------------------------------------------------
+    @staticmethod
+    def layout_names(controls: str) -> tuple:
+        """(state names, control names) of a control layout."""
+        extra = {"rates": ("alpha", "sigma"), "direct": (), "bank_rate": ("sigma", "t")}[controls]
+        return STATE_NAMES + extra, {"rates": ("u_alpha", "u_sigma"), "direct": ("alpha", "sigma"),
+                                     "bank_rate": ("u_sigma",)}[controls]
+
     @property
     def state_names(self) -> tuple:
-        return STATE_NAMES + (("alpha", "sigma") if self.controls == "rates" else ())
+        return self.layout_names(self.controls)[0]
 
     @property
     def control_names(self) -> tuple:
-        return ("u_alpha", "u_sigma") if self.controls == "rates" else ("alpha", "sigma")
+        return self.layout_names(self.controls)[1]
+
+    @property
+    def bank_index(self) -> tuple:
+        """Where the bank is: ('state', i) or ('control', j)."""
+        return {"rates": ("state", 7), "direct": ("control", 1), "bank_rate": ("state", 6)}[self.controls]
+
+    def bank_and_rate(self, x, u):
+        """(sigma [rad], u_sigma [rad/s]) for the layouts with the bank as a state."""
+        return (x[7], u[1]) if self.controls == "rates" else (x[6], u[0])
 
     def _default_state_bounds(self):
         xl, xh = np.full(self.n_states, -np.inf), np.full(self.n_states, np.inf)
@@ -345,6 +418,8 @@ class OptimalControlProblem(_ProblemLayout):
         Vc = math.sqrt(self.planet.mu / R)
         sx = np.ones(self.n_states)
         sx[0], sx[3] = 1.0e4, Vc
+        if self.controls == "bank_rate":
+            sx[7] = R / Vc  # the clock in time units
         _, _, ul, uh = self.bounds_arrays()
         su = np.array([max(abs(lo), abs(hi)) if np.isfinite(lo) and np.isfinite(hi) else 1.0
                        for lo, hi in zip(ul, uh)])
@@ -352,6 +427,8 @@ class OptimalControlProblem(_ProblemLayout):
 
     # -- models (float and AutoDiffXd) ---------------------------------------------------
     def alpha_sigma(self, x, u):
+        if self.controls == "bank_rate":
+            return self.alpha_schedule.at(x[7]), x[6]
         return (x[6], x[7]) if self.controls == "rates" else (u[0], u[1])
 
     def dynamics(self, x, u) -> np.ndarray:
@@ -360,6 +437,8 @@ class OptimalControlProblem(_ProblemLayout):
         xdot = state_derivatives(x[:6], sigma, alpha, self.vehicle, self.planet, self.atmosphere)
         if self.controls == "rates":
             return np.concatenate([xdot, [u[0], u[1]]])
+        if self.controls == "bank_rate":
+            return np.concatenate([xdot, [u[0], 1.0 + 0.0 * x[7]]])  # sigma' = u_sigma, t' = 1
         return xdot
 
     def conditions(self, x, u) -> FlightConditions:
@@ -378,6 +457,9 @@ class OptimalControlProblem(_ProblemLayout):
                 a_bar = self.alpha_bar if term.alpha_bar is None else term.alpha_bar
                 v = (k1 * ((x[6] - a_bar) / term.alpha_max) ** 2 + k2 * (u[0] / term.u_alpha_max) ** 2
                      + k3 * (u[1] / term.u_sigma_max) ** 2)
+            elif term.kind == "bank_effort":
+                sigma, rate = self.bank_and_rate(x, u)
+                v = (sigma / term.bank_max) ** 2 + term.rate_weight * (rate / term.u_sigma_max) ** 2
             else:
                 env = env if env is not None else self.conditions(x, u)
                 v = env.heat_flux if term.kind == "heat_load" else term.function(x, u, env)
@@ -401,6 +483,8 @@ class OptimalControlProblem(_ProblemLayout):
                 v = xf[3]
             elif term.kind == "final_crossrange":
                 v = self.crossrange(xf)
+            elif term.kind == "terminal_deviation":  # paper 003 eq. 1
+                v = self.terminal_deviation(xf, term)
             else:
                 v = term.function(xf, tf)
             total = total + term.weight * v
@@ -431,6 +515,16 @@ class OptimalControlProblem(_ProblemLayout):
         cl, cd = (np.asarray(c, float) for c in self.vehicle.aero.coefficients(alphas, np.full_like(alphas, mach)))
         return float(alphas[int(np.argmax(np.where(cd > 0, cl / np.where(cd > 0, cd, 1.0), -np.inf)))])
 
+    def terminal_deviation(self, xf, term: ObjectiveTerm):
+        """Paper 003 eq. 1: sum of w ((x_f - reference) / unit)^2 over the weighted states."""
+        R = self.planet.reference_radius
+        unit = {"h": R, "V": math.sqrt(self.planet.mu / R)} if term.units == "canonical" else {}
+        total = 0.0
+        for name, w in term.weights.items():
+            d = (xf[STATE_NAMES.index(name)] - term.reference[name]) / unit.get(name, 1.0)
+            total = total + w * d * d
+        return total
+
     def crossrange(self, x):
         """Signed distance [m] of x from the great circle through the initial position along
         the initial heading (+ right of the initial heading)."""
@@ -445,11 +539,11 @@ class OptimalControlProblem(_ProblemLayout):
 
     def path_values(self, x, u) -> list:
         env = self.conditions(x, u)
-        return [c.value(x, u, env) for c in self.path]
+        return [c.value(x, u, env, self.planet) for c in self.path]
 
     def terminal_values(self, x, u) -> list:
         env = self.conditions(x, u)
-        return [c.value(x, u, env) for c in self.terminal]
+        return [c.value(x, u, env, self.planet) for c in self.terminal]
 
     def with_(self, **changes) -> "OptimalControlProblem":
         return dc.replace(self, **changes)

@@ -9,12 +9,15 @@ bounded, or absent = free):
   planet: {model: spherical, rotating: true, j2: false, radius_m: 6378145.0}   # as in scenarios
   atmosphere: {model: exponential, rho0_kg_m3: 1.225, scale_height_m: 7200.0}  # (default us76)
   controls: rates               # rates (alpha, sigma states; u_alpha, u_sigma controls) | direct
+                                # | bank_rate (alpha over time; sigma, t states; u_sigma control)
+  alpha_schedule: {breakpoints_s: [58, 88], values_deg: [42, 17.5]}   # bank_rate only
   initial: {altitude_km: {value: 37.0}, ...}
   final: {...}
   final_time_s: {min: 100.0, max: 2000.0}     # or {value: ...}
   state_bounds: {alpha_deg: {min: 0.0, max: 25.0}, ...}
   control_bounds: {alpha_rate_deg_s: {min: -10, max: 10}, bank_rate_deg_s: {...}}
   path: [{quantity: dynamic_pressure, min: 12000.0}, {quantity: sensed_acceleration, max: 45.0}]
+  terminal: [{quantity: geodetic_altitude, min: 21000.0, max: 26000.0}]   # final node only
   objective: [{kind: control_margin, weight: 1.0, k: [1, 18, 20]}, ...]
   solve: {transcription: lgl, solver: snopt, nodes: 125, tolerance: 1.0e-7, coarse_nodes: 60}
 """
@@ -27,16 +30,17 @@ from typing import Dict, List, Optional
 from ..errors import ScenarioError, load_yaml_typed
 from ..scenario import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
 from ..vehicles import load_vehicle
-from .ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
+from ..schedules import Schedule
+from .ocp import CONTROL_LAYOUTS, DEVIATION_STATES, ObjectiveTerm, OptimalControlProblem, PathConstraint
 
 # YAML field -> (state or control name, factor to SI)
 STATE_FIELDS = {"altitude_km": ("h", 1e3), "longitude_deg": ("lon", math.pi / 180), "latitude_deg": ("lat", math.pi / 180),
                 "velocity_m_s": ("V", 1.0), "flight_path_deg": ("gamma", math.pi / 180),
                 "heading_deg": ("psi", math.pi / 180), "alpha_deg": ("alpha", math.pi / 180),
-                "bank_deg": ("sigma", math.pi / 180)}
+                "bank_deg": ("sigma", math.pi / 180), "time_s": ("t", 1.0)}
 CONTROL_FIELDS = {"alpha_rate_deg_s": ("u_alpha", math.pi / 180), "bank_rate_deg_s": ("u_sigma", math.pi / 180),
                   "alpha_deg": ("alpha", math.pi / 180), "bank_deg": ("sigma", math.pi / 180)}
-PACKAGED_PROBLEMS = ("marv",)
+PACKAGED_PROBLEMS = ("marv", "shefex3")
 
 
 @dc.dataclass
@@ -51,6 +55,13 @@ class PathSpec:
     quantity: str = ""
     min: Optional[float] = None
     max: Optional[float] = None
+    scale: Optional[float] = None  # the row's typical size (default: the finite bound)
+
+
+@dc.dataclass
+class AlphaScheduleSpec:
+    breakpoints_s: List[float] = dc.field(default_factory=list)
+    values_deg: List[float] = dc.field(default_factory=list)
 
 
 @dc.dataclass
@@ -65,6 +76,12 @@ class ObjectiveSpec:
     target_longitude_deg: Optional[float] = None
     target_latitude_deg: Optional[float] = None
     scale: float = 1.0
+    bank_max_deg: float = 60.0  # bank_effort
+    rate_weight: float = 0.1  # bank_effort
+    # terminal_deviation (paper 003 eq. 1): state field (altitude_km, ...) -> reference / weight
+    reference: Dict[str, float] = dc.field(default_factory=dict)
+    weights: Dict[str, float] = dc.field(default_factory=dict)
+    units: str = "si"  # terminal_deviation: si (rad, m, m/s) | canonical (h / R, V / sqrt(mu / R))
 
 
 @dc.dataclass
@@ -91,14 +108,20 @@ class ProblemSpec:
     aero: str = ""
     mass_over_area_kg_m2: Optional[float] = None
     planet: PlanetSpec = dc.field(default_factory=PlanetSpec)
+    # initial.altitude_km above the reference sphere (the state altitude) or the WGS-84
+    # ellipsoid (geodetic, at the fixed initial latitude; an oblate planet); a geodetic final
+    # altitude is a terminal constraint: {quantity: geodetic_altitude, min, max}
+    altitude_datum: str = "sphere"
     atmosphere: AtmosphereSpec = dc.field(default_factory=AtmosphereSpec)
     controls: str = "rates"
+    alpha_schedule: Optional[AlphaScheduleSpec] = None
     initial: Dict[str, BoundSpec] = dc.field(default_factory=dict)
     final: Dict[str, BoundSpec] = dc.field(default_factory=dict)
     final_time_s: BoundSpec = dc.field(default_factory=BoundSpec)
     state_bounds: Dict[str, BoundSpec] = dc.field(default_factory=dict)
     control_bounds: Dict[str, BoundSpec] = dc.field(default_factory=dict)
     path: List[PathSpec] = dc.field(default_factory=list)
+    terminal: List[PathSpec] = dc.field(default_factory=list)
     objective: List[ObjectiveSpec] = dc.field(default_factory=list)
     solve: SolveSpec = dc.field(default_factory=SolveSpec)
 
@@ -138,10 +161,43 @@ def _named(where: str, specs: dict, fields: dict, allowed: tuple) -> dict:
     return out
 
 
+def _deviation_fields(where: str, values: dict, *, convert: bool) -> dict:
+    """terminal_deviation's {YAML state field: value} as {state: value} (SI when ``convert``)."""
+    out = {}
+    for key, v in values.items():
+        if key not in STATE_FIELDS or STATE_FIELDS[key][0] not in DEVIATION_STATES:
+            names = [k for k, (n, _) in STATE_FIELDS.items() if n in DEVIATION_STATES]
+            raise ScenarioError(f"{where}.{key}: unknown field; allowed: {', '.join(names)}")
+        name, factor = STATE_FIELDS[key]
+        out[name] = v * factor if convert else v
+    return out
+
+
+def _constraints(where: str, specs: list) -> list:
+    out = []
+    for i, c in enumerate(specs):
+        try:
+            out.append(PathConstraint(c.quantity, -math.inf if c.min is None else c.min,
+                                      math.inf if c.max is None else c.max, scale=c.scale))
+        except ValueError as e:
+            raise ScenarioError(f"{where}[{i}]: {e}") from None
+    return out
+
+
 def problem_from_spec(spec: ProblemSpec) -> OptimalControlProblem:
     """OptimalControlProblem of a ProblemSpec (SI inside); one-line ScenarioError on bad input."""
-    if spec.controls not in ("rates", "direct"):
-        raise ScenarioError(f"controls = '{spec.controls}'; allowed: rates, direct")
+    if spec.controls not in CONTROL_LAYOUTS:
+        raise ScenarioError(f"controls = '{spec.controls}'; allowed: {', '.join(CONTROL_LAYOUTS)}")
+    if (spec.controls == "bank_rate") != (spec.alpha_schedule is not None):
+        raise ScenarioError("alpha_schedule: give it exactly with controls: bank_rate (alpha over time)")
+    schedule = None
+    if spec.alpha_schedule is not None:
+        a = spec.alpha_schedule
+        try:
+            schedule = Schedule(tuple(float(v) for v in a.breakpoints_s), tuple(math.radians(v) for v in a.values_deg),
+                                "time")
+        except ValueError as e:
+            raise ScenarioError(f"alpha_schedule: {e}") from None
     vehicle = load_vehicle(spec.vehicle, aero=spec.aero or None)
     if spec.mass_over_area_kg_m2 is not None:
         if not 0 < spec.mass_over_area_kg_m2 <= 1e5:
@@ -149,9 +205,21 @@ def problem_from_spec(spec: ProblemSpec) -> OptimalControlProblem:
         vehicle = dc.replace(vehicle, mass=spec.mass_over_area_kg_m2 * vehicle.reference_area)
     planet = planet_from_spec(spec.planet)
     atmosphere = atmosphere_from_spec(spec.atmosphere)
-    states = ("h", "lon", "lat", "V", "gamma", "psi") + (("alpha", "sigma") if spec.controls == "rates" else ())
-    controls = ("u_alpha", "u_sigma") if spec.controls == "rates" else ("alpha", "sigma")
+    layout = OptimalControlProblem.layout_names(spec.controls)
+    states, controls = layout
     tf = _bound("final_time_s", spec.final_time_s, 1.0, allow_free=False)
+    initial = _named("initial", spec.initial, STATE_FIELDS, states)
+    if spec.altitude_datum not in ("sphere", "ellipsoid"):
+        raise ScenarioError(f"altitude_datum = '{spec.altitude_datum}' is unknown; allowed: sphere, ellipsoid")
+    if spec.altitude_datum == "ellipsoid":
+        if spec.planet.model != "oblate":
+            raise ScenarioError("altitude_datum 'ellipsoid' needs planet.model 'oblate' (a sphere has one datum)")
+        if "altitude_km" in spec.final:
+            raise ScenarioError("final.altitude_km with altitude_datum 'ellipsoid': give the geodetic final altitude "
+                                "as terminal: [{quantity: geodetic_altitude, min, max}] (metres)")
+        if not all(isinstance(initial.get(k), float) for k in ("h", "lat")):
+            raise ScenarioError("altitude_datum 'ellipsoid' needs a fixed initial altitude_km and latitude_deg")
+        initial["h"] = planet.state_altitude(initial["h"], initial["lat"])
     terms = []
     for i, o in enumerate(spec.objective):
         target = None
@@ -162,24 +230,24 @@ def problem_from_spec(spec: ProblemSpec) -> OptimalControlProblem:
                                        alpha_bar=None if o.alpha_bar_deg is None else math.radians(o.alpha_bar_deg),
                                        alpha_max=math.radians(o.alpha_max_deg),
                                        u_alpha_max=math.radians(o.alpha_rate_max_deg_s),
-                                       u_sigma_max=math.radians(o.bank_rate_max_deg_s), target=target, scale=o.scale))
+                                       u_sigma_max=math.radians(o.bank_rate_max_deg_s), target=target, scale=o.scale,
+                                       bank_max=math.radians(o.bank_max_deg), rate_weight=o.rate_weight,
+                                       reference=_deviation_fields(f"objective[{i}].reference", o.reference,
+                                                                   convert=True) or None,
+                                       weights=_deviation_fields(f"objective[{i}].weights", o.weights,
+                                                                 convert=False) or None,
+                                       units=o.units))
         except ValueError as e:
             raise ScenarioError(f"objective[{i}]: {e}") from None
-    path = []
-    for i, c in enumerate(spec.path):
-        try:
-            path.append(PathConstraint(c.quantity, -math.inf if c.min is None else c.min,
-                                       math.inf if c.max is None else c.max))
-        except ValueError as e:
-            raise ScenarioError(f"path[{i}]: {e}") from None
     try:
         return OptimalControlProblem(
-            vehicle=vehicle, planet=planet, atmosphere=atmosphere, controls=spec.controls,
-            initial=_named("initial", spec.initial, STATE_FIELDS, states),
+            vehicle=vehicle, planet=planet, atmosphere=atmosphere, controls=spec.controls, alpha_schedule=schedule,
+            initial=initial,
             final=_named("final", spec.final, STATE_FIELDS, states), final_time=tf,
             state_bounds=_named("state_bounds", spec.state_bounds, STATE_FIELDS, states),
             control_bounds=_named("control_bounds", spec.control_bounds, CONTROL_FIELDS, controls),
-            path=path, objective=terms, name=spec.name)
+            path=_constraints("path", spec.path), terminal=_constraints("terminal", spec.terminal),
+            objective=terms, name=spec.name)
     except ValueError as e:
         raise ScenarioError(f"problem '{spec.name}': {e}") from None
 

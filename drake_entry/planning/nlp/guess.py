@@ -6,18 +6,22 @@ import math
 
 import numpy as np
 
-from ...geodesy import central_angle_smooth
+from ...geodesy import bearing, central_angle_smooth
 from ..ocp import OptimalControlProblem
 
 
 def initial_guess(problem, samples: int = 200):
     """(t, states, controls) SI: a propagated guess.
 
-    Entry problems: fly a constant angle of attack (alpha-bar, within the bounds) and a
-    constant bank (within its bounds) whose magnitude is found by bisection so the flight
+    Entry problems: fly a constant angle of attack (alpha-bar, within the bounds, or the
+    problem's alpha schedule) and a
+    constant bank (within its bounds, turning towards a fixed final position) whose magnitude
+    is found by bisection so the flight
     ends at the final altitude near the final position (or at the fixed/maximum final time),
     with controls at rest; then each state is shifted linearly over the last 5 % of the
-    flight to end inside its final bounds, and clipped to the state bounds. Other problems:
+    flight to end inside its final bounds, and clipped to the state bounds. The flight ends at
+    the final altitude (its lower bound), else in the middle of a terminal geodetic-altitude
+    window, else on the ground. Other problems:
     the straight line between the boundary values over the mean final time (free: the
     problem's time scale or 1 s), controls at the middle of their bounds (or zero).
     """
@@ -64,30 +68,37 @@ def _entry_guess(problem: OptimalControlProblem, samples):
     x0 = x0l.copy()
     xl, xh, ul, uh = problem.bounds_arrays()
     xfl, xfh = problem.boundary_bounds("final")
-    h_end = xfl[0] if np.isfinite(xfl[0]) else 0.0
-    alpha = float(np.clip(problem.alpha_bar, xl[6] if problem.controls == "rates" else ul[0],
-                          xh[6] if problem.controls == "rates" else uh[0]))
+    height = _end_height(problem, xfl)
+    layout = problem.controls
+    # alpha: scheduled ('bank_rate'), else alpha-bar within its bounds (a state or a control)
+    alpha = None if layout == "bank_rate" else float(np.clip(
+        problem.alpha_bar, xl[6] if layout == "rates" else ul[0], xh[6] if layout == "rates" else uh[0]))
+    bank_where, bank_i = problem.bank_index
     t_lo, t_hi = problem.final_time_bounds
     t_max = t_hi if np.isfinite(t_hi) else 5000.0
     target = None
     if np.isfinite(xfl[1]) and np.isfinite(xfl[2]):
         target = (xfl[1], xfl[2])
 
+    def attitude(y, bank):
+        """y with the attitude states at rest (alpha-bar, ``bank``)."""
+        y = y.copy()
+        if layout == "rates":
+            y[6] = alpha
+        if bank_where == "state":
+            y[bank_i] = bank
+        return y
+
     def fly(bank):
+        u = np.zeros(problem.n_controls) if layout != "direct" else np.array([alpha, bank])
+
         def f(t, y):
-            u = np.zeros(problem.n_controls) if problem.controls == "rates" else np.array([alpha, bank])
-            x = y.copy()
-            if problem.controls == "rates":
-                x[6], x[7] = alpha, bank
-            return problem.dynamics(x, u)
+            return problem.dynamics(attitude(y, bank), u)
 
         def ground(t, y):
-            return y[0] - h_end
+            return height(y)
         ground.terminal, ground.direction = True, -1
-        y0 = x0.copy()
-        if problem.controls == "rates":
-            y0[6], y0[7] = alpha, bank
-        return solve_ivp(f, (0.0, t_max), y0, events=ground, rtol=1e-7, atol=1e-9, max_step=5.0)
+        return solve_ivp(f, (0.0, t_max), attitude(x0, bank), events=ground, rtol=1e-7, atol=1e-9, max_step=5.0)
 
     def miss(sol):  # flown central angle beyond the target's [rad]
         xf = sol.y[:, -1]
@@ -99,8 +110,12 @@ def _entry_guess(problem: OptimalControlProblem, samples):
 
     # bisection on a constant bank magnitude (more bank = shorter flight), on the side the
     # bank bounds allow most of
-    b_lo, b_hi = (xl[7], xh[7]) if problem.controls == "rates" else (ul[1], uh[1])
+    b_lo, b_hi = (xl[bank_i], xh[bank_i]) if bank_where == "state" else (ul[bank_i], uh[bank_i])
     side = 1.0 if b_hi >= -b_lo else -1.0
+    if target is not None:  # turn towards the target (bank > 0 turns right) when the bounds allow it
+        turn = math.remainder(bearing(float(x0[1]), float(x0[2]), *target) - float(x0[5]), 2.0 * math.pi)
+        if abs(turn) > 1e-6 and (b_hi if turn > 0 else -b_lo) > 0:
+            side = math.copysign(1.0, turn)
     m_lo = max(0.0, side * (b_lo if side > 0 else b_hi))
     m_hi = min(math.radians(89.0), side * (b_hi if side > 0 else b_lo))
     lo, hi = m_lo, max(m_hi, m_lo)
@@ -118,13 +133,27 @@ def _entry_guess(problem: OptimalControlProblem, samples):
     from scipy.interpolate import interp1d
 
     X = interp1d(best.t, best.y, axis=1)(t).T
-    if problem.controls == "rates":
-        U = np.zeros((samples, 2))
+    if layout != "direct":
+        U = np.zeros((samples, problem.n_controls))
     else:
         U = np.column_stack([np.full(samples, alpha), np.full(samples, side * hi)])
     if t[-1] < t_lo or t[-1] > t_hi:  # stretch to the allowed final time
         t = t * np.clip(t[-1], t_lo, t_hi) / t[-1]
     return t, _meet_final(problem, t, X), U
+
+
+def _end_height(problem: OptimalControlProblem, xfl):
+    """y -> height [m] above where the guess ends: the final altitude's lower bound, else the
+    middle of a terminal geodetic-altitude window, else the surface (state altitude 0)."""
+    h = problem.final.get("h")
+    if h is not None and np.isfinite(xfl[0]):  # a final altitude given (not only the state bound)
+        return lambda y: y[0] - xfl[0]
+    for c in problem.terminal:
+        if c.quantity == "geodetic_altitude":
+            lo, hi = c.min, c.max
+            end = 0.5 * (lo + hi) if np.isfinite(lo) and np.isfinite(hi) else (lo if np.isfinite(lo) else hi)
+            return lambda y: problem.planet.atmospheric_altitude(y[0], y[2]) - end
+    return lambda y: y[0]
 
 
 #: the share of the guess's flight over which its states are shifted to the final conditions

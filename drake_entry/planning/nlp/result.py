@@ -172,9 +172,11 @@ def summary(problem, result: NlpResult, check=None) -> dict:
         out["altitude_maxima"] = [{"time_s": float(t[i]), "altitude_km": float(h[i] / 1e3),
                                    "dynamic_pressure_kPa": float(problem.conditions(x[i], np.zeros(problem.n_controls))
                                                                   .dynamic_pressure / 1e3)} for i in peaks]
+        if problem.bank_index[0] == "state":
+            bank = result.states[:, problem.bank_index[1]]
+            out["final_bank_deg"] = float(np.degrees(bank[-1]))
+            out["max_bank_deg"] = float(np.degrees(np.abs(bank).max()))
         if problem.controls == "rates":
-            out["final_bank_deg"] = float(np.degrees(result.states[-1, 7]))
-            out["max_bank_deg"] = float(np.degrees(np.abs(result.states[:, 7]).max()))
             out["max_alpha_deg"] = float(np.degrees(result.states[:, 6].max()))
             try:
                 ext = extremal_controls(problem, result)

@@ -187,7 +187,8 @@ def _cmd_optimize(args) -> int:
     print(f"solve: {problem.name}, {transcription}, {how}, {solver} ...", flush=True)
     result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
                        max_iterations=max_iterations, guess=guess, verify=not args.no_propagate,
-                       refine=refine, max_nodes=max_nodes)
+                       refine=refine, max_nodes=max_nodes, dynamics_tolerance=settings.dynamics_tolerance,
+                       propagation_tolerance=settings.propagation_tolerance)
     check = result.verification.flight if result.verification is not None else None
     info = nlp.summary(problem, result, check)
     os.makedirs(args.out, exist_ok=True)

@@ -119,3 +119,11 @@ def test_example_10(tmp_path):
     steps = r["brachistochrone_refined"]["result"].mesh_history
     assert steps[0].error > 1e-4 >= steps[-1].error and r["brachistochrone_refined"]["result"].success
     assert os.path.exists(r["plot"])
+
+
+def test_example_11(tmp_path):
+    r = _run("11_shefex3_problem", tmp_path)
+    assert 590.0 < r["open_loop"].time[-1] < 620.0
+    assert r["result"].success and 580.0 < r["result"].final_time < 630.0
+    assert r["eq1"].converged and r["eq1_miss_m"] > 1e3  # eq. 1's flat valley: kilometres off the target
+    assert os.path.exists(r["plot"])

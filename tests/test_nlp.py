@@ -490,3 +490,12 @@ def test_solve_time_is_split_into_our_callbacks_and_the_solver(transcription):
         # the plant evaluates the dynamics once per call; the other callbacks (the Mayer cost,
         # once per NLP evaluation) are under 1 / 23 of them (23 samples and midpoints)
         assert r.callback_calls >= 10 * 12 and calls["n"] >= (1 - 1 / 23) * r.callback_calls
+
+
+def test_yaml_verification_tolerances_default_to_the_library_and_are_checked():
+    from drake_entry.planning.ocp_yaml import SolveSpec, validate_solve
+
+    s = SolveSpec()
+    assert (s.dynamics_tolerance, s.propagation_tolerance) == (nlp.DYNAMICS_TOLERANCE, nlp.PROPAGATION_TOLERANCE)
+    with pytest.raises(ScenarioError, match=r"solve.dynamics_tolerance = 2.0 is out of range; allowed \(0, 1\)"):
+        validate_solve(dc.replace(s, dynamics_tolerance=2.0))

@@ -107,7 +107,7 @@ def test_packaged_problem_is_paper_003_with_labelled_substitutes():
     assert problem.terminal_values(x, np.zeros(1))[0] == pytest.approx(23.5e3)
     assert {c.quantity: c.max for c in problem.path} == {"dynamic_pressure": 50e3, "heat_flux": 6.5e6,
                                                           "normal_load": 10.0}
-    assert solve.nodes == 60
+    assert (solve.transcription, solve.nodes) == ("dircol", 100)
 
 
 def test_terminal_deviation_is_paper_003_eq_1():
@@ -148,3 +148,24 @@ def test_entry_guess_turns_towards_the_target_and_ends_in_the_geodetic_window():
     assert X[0, 6] < 0  # the target lies left of the entry heading: a left bank
     assert np.degrees(X[-1, 1]) == pytest.approx(-45.75) and np.degrees(X[-1, 2]) == pytest.approx(67.30)
     assert 570.0 <= X[-1, 3] <= 620.0 and np.all(U == 0.0)
+
+
+def test_packaged_problem_solves_verified_within_the_limits():
+    """The packaged settings (Hermite-Simpson, 100 samples) from the built-in guess: verified
+    (between nodes < 1e-3, the flown bank ends within 1e-2), t_f about 600 s as the paper's
+    database, the path limits held between the nodes and the terminal windows met."""
+    from drake_entry.planning import nlp
+
+    problem, settings = load_problem("shefex3")
+    r = nlp.solve(problem, transcription=settings.transcription, nodes=settings.nodes,
+                  tolerance=settings.tolerance)
+    assert r.success, r.message
+    assert 580.0 < r.final_time < 630.0 and 0.0 < r.objective < 20.0
+    x = r.states[-1]
+    assert problem.planet.atmospheric_altitude(x[0], x[2]) == pytest.approx(23.5e3, abs=2.5e3 + 1.0)
+    assert 570.0 - 1e-3 <= x[3] <= 620.0 + 1e-3
+    assert math.degrees(x[2]) == pytest.approx(67.30, abs=1e-6) and math.degrees(x[1]) == pytest.approx(-45.75, abs=1e-6)
+    assert np.abs(np.degrees(r.states[:, 6])).max() <= 60.0 + 1e-6
+    assert np.abs(np.degrees(r.controls[:, 0])).max() <= 5.0 + 1e-6
+    assert r.verification.path_violation < 1e-2
+    assert r.verification.propagation["position_m"] < 2e3  # the flown bank ends within 2 km of the plan

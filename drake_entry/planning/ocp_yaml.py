@@ -97,6 +97,10 @@ class SolveSpec:
     # the verification tolerance (nlp.mesh), up to max_nodes (0 = the transcription's default)
     refine: bool = False
     max_nodes: int = 0
+    # the verification's tolerances (relative, GPOPS-II form; nlp.verify): between the nodes,
+    # and the controls flown by the Drake Simulator
+    dynamics_tolerance: float = 1.0e-3
+    propagation_tolerance: float = 1.0e-2
 
 
 @dc.dataclass
@@ -271,8 +275,9 @@ def validate_solve(s: SolveSpec) -> SolveSpec:
         v = getattr(s, field)
         if isinstance(v, bool) or not isinstance(v, int) or v < lo:
             raise ScenarioError(f"solve.{field} = {v} is out of range; allowed: an integer >= {lo}")
-    if not 0 < s.tolerance < 1:
-        raise ScenarioError(f"solve.tolerance = {s.tolerance} is out of range; allowed (0, 1)")
+    for field in ("tolerance", "dynamics_tolerance", "propagation_tolerance"):
+        if not 0 < getattr(s, field) < 1:
+            raise ScenarioError(f"solve.{field} = {getattr(s, field)} is out of range; allowed (0, 1)")
     return s
 
 

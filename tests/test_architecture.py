@@ -22,6 +22,7 @@ ORDER = ("model", "systems", "methods", "diagrams", "cli")
 EXCEPTIONS = {("drake_entry.planning.nlp.dircol", "drake_entry.systems.ocp_plant"),
               ("drake_entry.planning.nlp.verify", "drake_entry.diagrams.propagation")}
 METHOD_PLANNERS = ("drake_entry.planning.drag_energy", "drake_entry.planning.nlp", "drake_entry.planning.swarm",
+                   "drake_entry.planning.ampi",
                    "drake_entry.planning.scvx")
 
 

@@ -185,3 +185,22 @@ def test_table_1_target_lies_outside_the_representative_vehicles_footprint():
     assert r.success, r.message
     miss = problem.planet.great_circle_distance(r.states[-1, 1], r.states[-1, 2], *target)
     assert 20e3 < miss < 60e3
+
+
+def test_problem_yaml_reads_eq_1_and_names_bad_fields(tmp_path):
+    from importlib import resources
+
+    text = resources.files("drake_entry").joinpath("problems/shefex3.yaml").read_text()
+    eq1 = ("objective:\n  - {kind: terminal_deviation, units: si, reference: {longitude_deg: -45.75, latitude_deg: 67.30, "
+           "velocity_m_s: 595.0}, weights: {longitude_deg: 1.0, latitude_deg: 1.0, velocity_m_s: 1.0e-4}}\nsolve:")
+    start, end = text.index("objective:"), text.index("solve:")
+    path = tmp_path / "eq1.yaml"
+    path.write_text(text[:start] + eq1 + text[end + len("solve:"):])
+    problem, _ = load_problem(str(path))
+    term = problem.objective[0]
+    assert term.reference == pytest.approx({"lon": math.radians(-45.75), "lat": math.radians(67.30), "V": 595.0})
+    assert term.weights == {"lon": 1.0, "lat": 1.0, "V": 1e-4}
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text[:start] + eq1.replace("velocity_m_s: 1.0e-4", "mach: 1.0") + text[end + len("solve:"):])
+    with pytest.raises(ScenarioError, match=r"objective\[0\].weights.mach: unknown field; allowed: altitude_km"):
+        load_problem(str(bad))

@@ -152,13 +152,19 @@ def _bound(where: str, b: BoundSpec, factor: float, *, allow_free: bool = True):
     return (lo, hi)
 
 
+def _field(where: str, key: str, fields: dict, allowed: tuple) -> tuple:
+    """(state or control name, factor to SI) of YAML field ``key``; a one-line error naming
+    the allowed fields otherwise."""
+    if key not in fields or fields[key][0] not in allowed:
+        names = [k for k, (n, _) in fields.items() if n in allowed]
+        raise ScenarioError(f"{where}.{key}: unknown field; allowed: {', '.join(names)}")
+    return fields[key]
+
+
 def _named(where: str, specs: dict, fields: dict, allowed: tuple) -> dict:
     out = {}
     for key, b in specs.items():
-        if key not in fields or fields[key][0] not in allowed:
-            names = [k for k, (n, _) in fields.items() if n in allowed]
-            raise ScenarioError(f"{where}.{key}: unknown field; allowed: {', '.join(names)}")
-        name, factor = fields[key]
+        name, factor = _field(where, key, fields, allowed)
         v = _bound(f"{where}.{key}", b, factor)
         if v is not None:
             out[name] = v
@@ -169,10 +175,7 @@ def _deviation_fields(where: str, values: dict, *, convert: bool) -> dict:
     """terminal_deviation's {YAML state field: value} as {state: value} (SI when ``convert``)."""
     out = {}
     for key, v in values.items():
-        if key not in STATE_FIELDS or STATE_FIELDS[key][0] not in DEVIATION_STATES:
-            names = [k for k, (n, _) in STATE_FIELDS.items() if n in DEVIATION_STATES]
-            raise ScenarioError(f"{where}.{key}: unknown field; allowed: {', '.join(names)}")
-        name, factor = STATE_FIELDS[key]
+        name, factor = _field(where, key, STATE_FIELDS, DEVIATION_STATES)
         out[name] = v * factor if convert else v
     return out
 

@@ -124,6 +124,7 @@ def test_example_10(tmp_path):
 def test_example_11(tmp_path):
     r = _run("11_shefex3_problem", tmp_path)
     assert 590.0 < r["open_loop"].time[-1] < 620.0
-    assert r["result"].success and 580.0 < r["result"].final_time < 630.0
-    assert r["eq1"].converged and r["eq1_miss_m"] > 1e3  # eq. 1's flat valley: kilometres off the target
+    assert r["result"].success and 550.0 < r["result"].final_time < 630.0
+    # eq. 1 reaches the target too, with another bank history: its minimisers are not unique
+    assert r["eq1"].converged and r["eq1_miss_m"] < 1e3 and r["eq1_bank_gap_deg"] > 5.0
     assert os.path.exists(r["plot"])

@@ -146,7 +146,7 @@ def test_entry_guess_turns_towards_the_target_and_ends_in_the_geodetic_window():
     h_end = problem.planet.atmospheric_altitude(X[-1, 0], X[-1, 2])
     assert 21e3 <= h_end <= 26e3
     assert X[0, 6] < 0  # the target lies left of the entry heading: a left bank
-    assert np.degrees(X[-1, 1]) == pytest.approx(-45.75) and np.degrees(X[-1, 2]) == pytest.approx(67.30)
+    assert np.degrees(X[-1, 1]) == pytest.approx(-44.60) and np.degrees(X[-1, 2]) == pytest.approx(68.10)
     assert 570.0 <= X[-1, 3] <= 620.0 and np.all(U == 0.0)
 
 
@@ -160,11 +160,11 @@ def test_packaged_problem_solves_verified_within_the_limits():
     r = nlp.solve(problem, transcription=settings.transcription, nodes=settings.nodes,
                   tolerance=settings.tolerance)
     assert r.success, r.message
-    assert 580.0 < r.final_time < 630.0 and 0.0 < r.objective < 20.0
+    assert 550.0 < r.final_time < 630.0 and 0.0 < r.objective < 100.0
     x = r.states[-1]
     assert problem.planet.atmospheric_altitude(x[0], x[2]) == pytest.approx(23.5e3, abs=2.5e3 + 1.0)
     assert 570.0 - 1e-3 <= x[3] <= 620.0 + 1e-3
-    assert math.degrees(x[2]) == pytest.approx(67.30, abs=1e-6) and math.degrees(x[1]) == pytest.approx(-45.75, abs=1e-6)
+    assert math.degrees(x[2]) == pytest.approx(68.10, abs=1e-6) and math.degrees(x[1]) == pytest.approx(-44.60, abs=1e-6)
     assert np.abs(np.degrees(r.states[:, 6])).max() <= 60.0 + 1e-6
     assert np.abs(np.degrees(r.controls[:, 0])).max() <= 5.0 + 1e-6
     assert r.verification.path_violation < 1e-2
@@ -172,7 +172,7 @@ def test_packaged_problem_solves_verified_within_the_limits():
 
 
 def test_table_1_target_lies_outside_the_representative_vehicles_footprint():
-    """Why the packaged problem aims at 67.30 N (a labelled substitute): with the representative
+    """Why the packaged problem aims elsewhere (a labelled substitute): with the representative
     aerodynamics and the Table 1 windows hard, the least miss of the Table 1 target (66.40 N,
     45.75 W) is 31 km (verified solve; the feasibility study's prototype found 54 km)."""
     from drake_entry.planning import nlp
@@ -191,14 +191,14 @@ def test_problem_yaml_reads_eq_1_and_names_bad_fields(tmp_path):
     from importlib import resources
 
     text = resources.files("drake_entry").joinpath("problems/shefex3.yaml").read_text()
-    eq1 = ("objective:\n  - {kind: terminal_deviation, units: si, reference: {longitude_deg: -45.75, latitude_deg: 67.30, "
+    eq1 = ("objective:\n  - {kind: terminal_deviation, units: si, reference: {longitude_deg: -44.60, latitude_deg: 68.10, "
            "velocity_m_s: 595.0}, weights: {longitude_deg: 1.0, latitude_deg: 1.0, velocity_m_s: 1.0e-4}}\nsolve:")
     start, end = text.index("objective:"), text.index("solve:")
     path = tmp_path / "eq1.yaml"
     path.write_text(text[:start] + eq1 + text[end + len("solve:"):])
     problem, _ = load_problem(str(path))
     term = problem.objective[0]
-    assert term.reference == pytest.approx({"lon": math.radians(-45.75), "lat": math.radians(67.30), "V": 595.0})
+    assert term.reference == pytest.approx({"lon": math.radians(-44.60), "lat": math.radians(68.10), "V": 595.0})
     assert term.weights == {"lon": 1.0, "lat": 1.0, "V": 1e-4}
     bad = tmp_path / "bad.yaml"
     bad.write_text(text[:start] + eq1.replace("velocity_m_s: 1.0e-4", "mach: 1.0") + text[end + len("solve:"):])

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ...geodesy import bearing, central_angle_smooth
+from ...geodesy import bearing, central_angle_smooth, crossrange_from_great_circle
 from ..ocp import OptimalControlProblem
 
 
@@ -16,7 +16,8 @@ def initial_guess(problem, samples: int = 200):
     Entry problems: fly a constant angle of attack (alpha-bar, within the bounds, or the
     problem's alpha schedule) and a
     constant bank (within its bounds, turning towards a fixed final position) whose magnitude
-    is found by bisection so the flight
+    is found by bisection so the flight (with one bank reversal, its time found by bisection,
+    when the final position is off the initial heading and the constant bank turns past it)
     ends at the final altitude near the final position (or at the fixed/maximum final time),
     with controls at rest; then each state is shifted linearly over the last 5 % of the
     flight to end inside its final bounds, and clipped to the state bounds. The flight ends at
@@ -89,16 +90,21 @@ def _entry_guess(problem: OptimalControlProblem, samples):
             y[bank_i] = bank
         return y
 
-    def fly(bank):
-        u = np.zeros(problem.n_controls) if layout != "direct" else np.array([alpha, bank])
+    def bank_at(t, mag, t_rev):
+        return side * mag if t < t_rev else -side * mag
 
+    def fly(mag, t_rev=math.inf):
+        """The flight with |bank| = mag towards ``side``, reversed at t_rev [s]."""
         def f(t, y):
+            bank = bank_at(t, mag, t_rev)
+            u = np.zeros(problem.n_controls) if layout != "direct" else np.array([alpha, bank])
             return problem.dynamics(attitude(y, bank), u)
 
         def ground(t, y):
             return height(y)
         ground.terminal, ground.direction = True, -1
-        return solve_ivp(f, (0.0, t_max), attitude(x0, bank), events=ground, rtol=1e-7, atol=1e-9, max_step=5.0)
+        return solve_ivp(f, (0.0, t_max), attitude(x0, side * mag), events=ground, rtol=1e-7, atol=1e-9,
+                         max_step=5.0)
 
     def miss(sol):  # flown central angle beyond the target's [rad]
         xf = sol.y[:, -1]
@@ -108,35 +114,65 @@ def _entry_guess(problem: OptimalControlProblem, samples):
     def too_long(sol):  # did not land, or landed beyond the final position
         return sol.status != 1 or (target is not None and miss(sol) > 0)
 
+    def lateral(sol):  # end's distance [m] right of the great circle from the start to the target
+        xf = sol.y[:, -1]
+        heading = bearing(float(x0[1]), float(x0[2]), *target)
+        return float(crossrange_from_great_circle(float(xf[1]), float(xf[2]), float(x0[1]), float(x0[2]), heading,
+                                                  problem.planet.reference_radius))
+
+    def range_fit(t_rev, steps):
+        """Bisection on the bank magnitude (more bank = shorter flight): (magnitude, flight)."""
+        lo, hi = m_lo, max(m_hi, m_lo)
+        best = fly(hi, t_rev)
+        for _ in range(steps):
+            mid = 0.5 * (lo + hi)
+            s = fly(mid, t_rev)
+            if too_long(s):
+                lo = mid
+            else:
+                hi, best = mid, s  # best is always the flight with bank hi
+            if hi - lo < 1e-4:
+                break
+        return hi, best
+
     # bisection on a constant bank magnitude (more bank = shorter flight), on the side the
     # bank bounds allow most of
     b_lo, b_hi = (xl[bank_i], xh[bank_i]) if bank_where == "state" else (ul[bank_i], uh[bank_i])
-    side = 1.0 if b_hi >= -b_lo else -1.0
+    side, turn = (1.0 if b_hi >= -b_lo else -1.0), 0.0
     if target is not None:  # turn towards the target (bank > 0 turns right) when the bounds allow it
         turn = math.remainder(bearing(float(x0[1]), float(x0[2]), *target) - float(x0[5]), 2.0 * math.pi)
         if abs(turn) > 1e-6 and (b_hi if turn > 0 else -b_lo) > 0:
             side = math.copysign(1.0, turn)
     m_lo = max(0.0, side * (b_lo if side > 0 else b_hi))
     m_hi = min(math.radians(89.0), side * (b_hi if side > 0 else b_lo))
-    lo, hi = m_lo, max(m_hi, m_lo)
-    best = fly(side * hi)
-    for _ in range(25):
-        mid = 0.5 * (lo + hi)
-        s = fly(side * mid)
-        if too_long(s):
-            lo = mid
-        else:
-            hi, best = mid, s  # best is always the flight with bank hi
-        if hi - lo < 1e-4:
-            break
+    hi, best = range_fit(math.inf, 25)
+    t_rev = math.inf
+    # the constant bank turned past the target: one reversal, its time by bisection (earlier =
+    # less turn), the magnitude fitted to the range at each (both signs within the bounds)
+    reversible = b_lo <= -m_hi and m_hi <= b_hi
+    if (target is not None and reversible and abs(turn) > REVERSAL_MIN_TURN and best.status == 1
+            and side * lateral(best) > REVERSAL_TRIGGER_M):
+        lo_t, hi_t = 0.0, float(best.t[-1])
+        for _ in range(REVERSAL_STEPS):
+            mid = 0.5 * (lo_t + hi_t)
+            m, s = range_fit(mid, 12)
+            if s.status == 1 and abs(lateral(s)) < abs(lateral(best)):
+                hi, best, t_rev = m, s, mid
+            if s.status == 1 and side * lateral(s) > 0:
+                hi_t = mid
+            else:
+                lo_t = mid
     t = np.linspace(0.0, best.t[-1], samples)
     from scipy.interpolate import interp1d
 
     X = interp1d(best.t, best.y, axis=1)(t).T
+    bank = np.array([bank_at(tk, hi, t_rev) for tk in t])
+    if bank_where == "state":
+        X[:, bank_i] = bank
     if layout != "direct":
         U = np.zeros((samples, problem.n_controls))
     else:
-        U = np.column_stack([np.full(samples, alpha), np.full(samples, side * hi)])
+        U = np.column_stack([np.full(samples, alpha), bank])
     if t[-1] < t_lo or t[-1] > t_hi:  # stretch to the allowed final time
         t = t * np.clip(t[-1], t_lo, t_hi) / t[-1]
     return t, _meet_final(problem, t, X), U
@@ -155,6 +191,15 @@ def _end_height(problem: OptimalControlProblem, xfl):
             return lambda y: problem.planet.atmospheric_altitude(y[0], y[2]) - end
     return lambda y: y[0]
 
+
+#: a constant-bank guess towards a final position off the initial heading (by more than
+#: REVERSAL_MIN_TURN) that ends farther than REVERSAL_TRIGGER_M [m] past it gets one bank
+#: reversal (SHEFEX-3 towards 68.10 N: the constant bank ends 221 km off and the cold NLP solve
+#: takes 85 s at J = 37.1; with the reversal it ends on the target, 3.4 s, J = 20.8). A final
+#: position straight ahead (MARV) keeps its constant bank.
+REVERSAL_TRIGGER_M = 10e3
+REVERSAL_MIN_TURN = math.radians(1.0)
+REVERSAL_STEPS = 12
 
 #: the share of the guess's flight over which its states are shifted to the final conditions
 MEET_FINAL_SHARE = 0.05

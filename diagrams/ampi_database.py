@@ -28,6 +28,7 @@ from drake_entry.errors import ScenarioError
 from drake_entry.planning import nlp
 from drake_entry.planning.ampi import ParameterGrid, TrajectoryDatabase
 from drake_entry.planning.ocp_yaml import load_problem
+from drake_entry.pseudospectral import lgl_nodes
 
 DATABASE_FILE = "database.npz"
 
@@ -105,8 +106,7 @@ def solve_case(state: dict, case: dict):
                   dynamics_tolerance=s["dynamics_tolerance"],
                   propagation_tolerance=s["propagation_tolerance"])
     wall = time.perf_counter() - t0
-    tau = TrajectoryDatabase.empty(grid, state["ld_nodes"], (), ()).tau
-    t = 0.5 * (tau + 1.0) * r.final_time
+    t = 0.5 * (lgl_nodes(state["ld_nodes"]) + 1.0) * r.final_time  # the LD times
     X, U = r.state_function()(t), r.control_function()(t)
     row = {"index": index, "success": bool(r.success), "converged": bool(r.converged), "message": r.message[:300],
            "objective": float(r.objective), "final_time_s": float(r.final_time), "wall_s": wall,
@@ -118,9 +118,15 @@ def solve_case(state: dict, case: dict):
     return row, cols
 
 
+def _arrays(traj: dict, problem) -> tuple[np.ndarray, np.ndarray]:
+    """(states, controls) of a stored case's trajectory columns."""
+    return (np.column_stack([traj[n] for n in problem.state_names]),
+            np.column_stack([traj[n] for n in problem.control_names]))
+
+
 def _guess(traj: dict, problem) -> dict:
-    return {"t": traj["time"], "states": np.column_stack([traj[n] for n in problem.state_names]).tolist(),
-            "controls": np.column_stack([traj[n] for n in problem.control_names]).tolist()}
+    X, U = _arrays(traj, problem)
+    return {"t": traj["time"], "states": X.tolist(), "controls": U.tolist()}
 
 
 def _read(out_dir: str):
@@ -203,8 +209,6 @@ def _assemble(grid, problem, ld_nodes, rows, trajs) -> TrajectoryDatabase:
     db = TrajectoryDatabase.empty(grid, ld_nodes, problem.state_names, problem.control_names)
     for i, row in rows.items():
         if i in trajs and math.isfinite(row.get("objective", math.nan)):
-            tr = trajs[i]
-            X = np.column_stack([tr[n] for n in problem.state_names])
-            U = np.column_stack([tr[n] for n in problem.control_names])
+            X, U = _arrays(trajs[i], problem)
             db.set_case(i, X, U, row["final_time_s"], row["objective"], row["success"])
     return db

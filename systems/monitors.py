@@ -56,16 +56,19 @@ class TerminationMonitor(LeafSystem):
             self._witnesses.append(self.MakeWitnessFunction(
                 f"reached {name}", WitnessFunctionDirection.kPositiveThenNonPositive, self._make_calc(name), event))
 
+    def _altitude(self, context) -> float:
+        """The altitude the band bounds [m]: the state altitude, or the geodetic one."""
+        x = self.state_port.Eval(context)
+        return self.planet.atmospheric_altitude(x[0], x[2]) if self.geodetic else x[0]
+
     def _make_calc(self, name):
         if name == "altitude":  # the band [floor, ceiling]
             floor, ceiling = self.floor, self.ceiling
-            if self.geodetic:
-                def band(c):
-                    x = self.state_port.Eval(c)
-                    h = self.planet.atmospheric_altitude(x[0], x[2])
-                    return min(h - floor, ceiling - h)
-                return band
-            return lambda c: min(self.state_port.Eval(c)[0] - floor, ceiling - self.state_port.Eval(c)[0])
+
+            def band(c):
+                h = self._altitude(c)
+                return min(h - floor, ceiling - h)
+            return band
         target = self.targets[name]
         if name == "velocity":
             return lambda c: self.state_port.Eval(c)[3] - target
@@ -77,7 +80,7 @@ class TerminationMonitor(LeafSystem):
         def handler(context, event):
             if name != "altitude":
                 self.reason, detail = f"reached {name}", f" = {self.targets[name]:g}"
-            elif self.state_port.Eval(context)[0] > 0.5 * (self.floor + self.ceiling):
+            elif self._altitude(context) > 0.5 * (self.floor + self.ceiling):
                 self.reason, detail = "skipped out above the atmosphere", f" (h = {self.ceiling / 1e3:g} km)"
             elif "altitude" in self.targets:
                 self.reason, detail = "reached altitude", f" = {self.floor:g}"

@@ -20,7 +20,7 @@ import numpy as np
 from ...errors import ScenarioError
 from ...pseudospectral import interpolation_matrix, lgl_nodes
 from .grid import ParameterGrid
-from .synthesis import interpolate, nearest_case
+from .synthesis import interpolate_corners, nearest_case, select_subspace
 
 #: consistency with the neighbours (``TrajectoryDatabase.inconsistent``): a case whose
 #: objective exceeds this factor times the median of its neighbours' (a worse local branch:
@@ -138,20 +138,17 @@ class TrajectoryDatabase:
         return Synthesis(t, traj[:, :nx], traj[:, nx:], tf, outside, cases)
 
     def _interpolate(self, arrays, x):
-        from .synthesis import select_subspace
-
-        lower, _, _ = select_subspace(self.grid.levels, x)
+        """Algorithm 1 once, then Algorithm 2 on each array (grid shape + value shape):
+        (interpolated values, extrapolated flags, the enclosing case indices)."""
+        lower, frac, outside = select_subspace(self.grid.levels, x)
         cases = [self.grid.index(tuple(j + b for j, b in zip(lower, bits)))
                  for bits in np.ndindex(*(2,) * len(lower))]
         missing = [c for c in cases if not self.verified[c]]
         if missing:
             raise ScenarioError(f"database cases {missing} enclosing offsets {list(x)} are not verified: re-solve them "
                                 f"before interpolating")
-        out, flags = [], None
-        for a in arrays:
-            v, flags = interpolate(a, self.grid.levels, x)
-            out.append(v)
-        return out, flags, cases
+        corners = tuple(slice(j, j + 2) for j in lower)
+        return [interpolate_corners(a[corners], frac) for a in arrays], outside, cases
 
     def nearest(self, offsets) -> int:
         """NTT: the index of the stored case nearest to ``offsets`` (in grid steps)."""

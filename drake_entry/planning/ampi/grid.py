@@ -13,7 +13,6 @@ closer to the centre.
 from __future__ import annotations
 
 import dataclasses as dc
-import itertools
 import math
 
 import numpy as np
@@ -134,9 +133,6 @@ class ParameterGrid:
         for i in range(self.size):
             by.setdefault(self.distance(i), []).append(i)
         return [by[k] for k in sorted(by)]
-
-    def all_multi_indices(self):
-        return itertools.product(*(range(n) for n in self.shape))
 
     def as_dict(self) -> dict:
         """JSON-able form (a campaign's identity)."""

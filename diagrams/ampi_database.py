@@ -80,15 +80,21 @@ def setup_worker(config: dict) -> dict:
 
 
 def case_problem(problem, grid: ParameterGrid, index: int):
-    """The problem of case ``index``: the nominal entry state plus the case's offsets (eq. 6).
-    An altitude offset is geodetic, and the geodetic entry altitude is kept when the latitude
-    is offset (on an oblate planet the state altitude is converted at the new latitude)."""
+    """The problem of case ``index``: the nominal entry state plus the case's offsets (eq. 6)."""
+    return offset_problem(problem, grid.offsets(index))
+
+
+def offset_problem(problem, offsets: dict):
+    """The problem with its entry state offset by ``offsets`` ({state name: offset}, SI /
+    rad; eq. 6). An altitude offset is geodetic, and the geodetic entry altitude is kept when
+    the latitude is offset (on an oblate planet the state altitude is converted at the new
+    latitude)."""
     initial = dict(problem.initial)
     planet = problem.planet
     geodetic = planet.atmospheric_altitude(initial["h"], initial["lat"])
-    for name, offset in grid.offsets(index).items():
+    for name, offset in offsets.items():
         initial[name] = initial[name] + offset
-    initial["h"] = float(planet.state_altitude(geodetic + grid.offsets(index).get("h", 0.0), initial["lat"]))
+    initial["h"] = float(planet.state_altitude(geodetic + offsets.get("h", 0.0), initial["lat"]))
     return dc.replace(problem, initial=initial)
 
 
@@ -170,7 +176,7 @@ def build_database(out_dir: str, study: DatabaseStudy | None = None, *, backend:
         if cases:
             run_cases(task, cases, out_dir, manifest, desc=f"database wave {k}", **campaign)
     rows, trajs = _read(out_dir)
-    db = _assemble(grid, problem, state["ld_nodes"], rows, trajs)
+    db = _assemble(grid, problem, state["ld_nodes"], rows, trajs, config)
     bank = problem.state_names.index("sigma") if "sigma" in problem.state_names else None
     resolved = 0
     for r in range(1, resolve_rounds + 1):
@@ -194,7 +200,7 @@ def build_database(out_dir: str, study: DatabaseStudy | None = None, *, backend:
             if row.get("success") and (not old.get("success") or row["objective"] < old["objective"]):
                 rows[i], trajs[i] = row, new_trajs[i]
                 resolved += 1
-        db = _assemble(grid, problem, state["ld_nodes"], rows, trajs)
+        db = _assemble(grid, problem, state["ld_nodes"], rows, trajs, config)
     db.save(os.path.join(out_dir, DATABASE_FILE))
     left = db.inconsistent(bank)
     report = {"cases": grid.size, "verified": int(db.verified.sum()), "re_solved": resolved,
@@ -205,8 +211,8 @@ def build_database(out_dir: str, study: DatabaseStudy | None = None, *, backend:
     return db, report
 
 
-def _assemble(grid, problem, ld_nodes, rows, trajs) -> TrajectoryDatabase:
-    db = TrajectoryDatabase.empty(grid, ld_nodes, problem.state_names, problem.control_names)
+def _assemble(grid, problem, ld_nodes, rows, trajs, study: dict) -> TrajectoryDatabase:
+    db = TrajectoryDatabase.empty(grid, ld_nodes, problem.state_names, problem.control_names, {"study": study})
     for i, row in rows.items():
         if i in trajs and math.isfinite(row.get("objective", math.nan)):
             X, U = _arrays(trajs[i], problem)

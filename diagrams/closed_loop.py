@@ -178,9 +178,11 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
         builder.Connect(commands.alpha, alpha.get_input_port())
         alpha_out = alpha.GetOutputPort("alpha")
     builder.Connect(alpha_out, plant.GetInputPort("alpha"))
-    stop = ({"altitude": setup.terminal[0]} if g.stops_at_altitude
+    # altitudes of the stop and the floor are geodetic with altitude_datum 'ellipsoid'
+    stop = ({"altitude": g.terminal_altitude_km * 1e3} if g.stops_at_altitude
             else {"energy": setup.terminal[2], "altitude": ALTITUDE_FLOOR_M})
-    monitor = builder.AddNamedSystem("termination", TerminationMonitor(**stop, planet=setup.energy_planet))
+    monitor = builder.AddNamedSystem("termination", TerminationMonitor(
+        **stop, planet=setup.energy_planet, geodetic=scenario.altitude_datum == "ellipsoid"))
     builder.Connect(state, monitor.GetInputPort("state"))
     builder.Connect(air.GetOutputPort("air_data"), monitor.GetInputPort("air_data"))
 

@@ -1,7 +1,7 @@
 """Scenario files: dataclass schemas read with ``pydrake.common.yaml.yaml_load_typed``.
 
-Packaged scenarios live in ``drake_entry/scenarios/*.yaml`` (horus2b, shefex3, cav_h, cav_h_paper004, sphynx_paper001,
-marv); ``load_scenario(name_or_path)`` reads either. Fields not in SI carry their unit
+Packaged scenarios live in ``drake_entry/scenarios/*.yaml`` (horus2b, shefex3, shefex3_ampi, cav_h,
+cav_h_paper004, sphynx_paper001, marv); ``load_scenario(name_or_path)`` reads either. Fields not in SI carry their unit
 in the name. Every bad value raises a one-line ``ScenarioError`` naming the field and the
 allowed range.
 """
@@ -188,11 +188,16 @@ class Scenario:
         return float(self.make_planet().with_(j2=0.0).specific_energy(x0[0], x0[3]))
 
     def guidance_terminal_state(self) -> tuple[float, float, float]:
-        """(h_f [m], V_f [m/s], E_f [J/kg]) of the guidance terminal interface."""
+        """(h_f [m], V_f [m/s], E_f [J/kg]) of the guidance terminal interface: h_f the state
+        altitude (with altitude_datum 'ellipsoid' the guidance's geodetic terminal altitude
+        converted at the target's latitude), the speed of sound at the geodetic altitude."""
         g = self.guidance
-        h = g.terminal_altitude_km * 1e3
-        V = g.terminal_speed(float(self.make_atmosphere().speed_of_sound(h)))
-        return h, V, float(self.make_planet().with_(j2=0.0).specific_energy(h, V))
+        geodetic = g.terminal_altitude_km * 1e3
+        V = g.terminal_speed(float(self.make_atmosphere().speed_of_sound(geodetic)))
+        planet = self.make_planet()
+        h = (float(planet.state_altitude(geodetic, np.radians(self.target.latitude_deg)))
+             if self.altitude_datum == "ellipsoid" else geodetic)
+        return h, V, float(planet.with_(j2=0.0).specific_energy(h, V))
 
     def schedule(self, which: str) -> Schedule:
         """The alpha or bank schedule in SI; 'normalized_energy' breakpoints
@@ -333,7 +338,7 @@ def atmosphere_from_spec(a: AtmosphereSpec) -> Atmosphere:
     raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential, table")
 
 
-PACKAGED_SCENARIOS = ("horus2b", "shefex3", "cav_h", "cav_h_paper004", "marv", "sphynx_paper001")
+PACKAGED_SCENARIOS = ("horus2b", "shefex3", "shefex3_ampi", "cav_h", "cav_h_paper004", "marv", "sphynx_paper001")
 
 
 def load_scenario(name_or_path: str) -> Scenario:

@@ -12,6 +12,7 @@ import importlib
 from typing import Union
 
 from ..errors import ScenarioError
+from .ampi.spec import Ampi
 from .bank_profile.spec import BankProfile
 from .drag_energy.spec import DragEnergy
 from .scvx.spec import Scvx
@@ -22,6 +23,7 @@ REGISTRY = {
     BankProfile: "drake_entry.guidance.bank_profile.method",
     SwarmBank: "drake_entry.guidance.swarm_bank.method",
     Scvx: "drake_entry.guidance.scvx.method",
+    Ampi: "drake_entry.guidance.ampi.method",
 }
 
 #: the scenario's ``guidance:`` field type (the first is the default when untagged)

@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import dataclasses as dc
 import json
+import os
 from functools import lru_cache
+from importlib import resources
 
 import numpy as np
 
@@ -30,6 +32,18 @@ from .synthesis import interpolate_corners, nearest_case, select_subspace
 OBJECTIVE_FACTOR = 1.5
 FINAL_TIME_JUMP_S = 30.0
 BANK_JUMP_DEG = 15.0
+#: packaged databases: drake_entry/data/ampi/<name>.npz (built by diagrams/ampi_database.py)
+PACKAGED_DATABASES = ("shefex3",)
+
+
+def database_path(name_or_path: str) -> str:
+    """The file of a packaged database name or a path."""
+    if name_or_path in PACKAGED_DATABASES:
+        return str(resources.files("drake_entry").joinpath(f"data/ampi/{name_or_path}.npz"))
+    if os.path.exists(name_or_path):
+        return name_or_path
+    raise ScenarioError(f"database '{name_or_path}' is neither a packaged database ({', '.join(PACKAGED_DATABASES)}) "
+                        f"nor a file")
 
 
 @dc.dataclass
@@ -69,6 +83,8 @@ class TrajectoryDatabase:
       values: (grid.size, n_ld, n_states + n_controls) states then controls at the LD nodes, SI.
       final_time: (grid.size,) t_f [s]; objective: (grid.size,); verified: (grid.size,) bool
         (False: not solved, or solved but not verified: such a case is not interpolated from).
+      provenance: how it was made (JSON-able; the database builder stores its study: the
+        problem, the grid, the NLP settings), saved with it.
     """
 
     grid: ParameterGrid
@@ -78,14 +94,17 @@ class TrajectoryDatabase:
     final_time: np.ndarray
     objective: np.ndarray
     verified: np.ndarray
+    provenance: dict = dc.field(default_factory=dict)
 
     @staticmethod
-    def empty(grid: ParameterGrid, n_ld: int, state_names, control_names) -> "TrajectoryDatabase":
+    def empty(grid: ParameterGrid, n_ld: int, state_names, control_names, provenance: dict | None = None
+              ) -> "TrajectoryDatabase":
         if not 3 <= n_ld <= 400:
             raise ScenarioError(f"n_ld = {n_ld}: allowed 3..400 LD nodes")
         n = len(state_names) + len(control_names)
         return TrajectoryDatabase(grid, tuple(state_names), tuple(control_names), np.full((grid.size, n_ld, n), np.nan),
-                                  np.full(grid.size, np.nan), np.full(grid.size, np.nan), np.zeros(grid.size, bool))
+                                  np.full(grid.size, np.nan), np.full(grid.size, np.nan), np.zeros(grid.size, bool),
+                                  dict(provenance or {}))
 
     @property
     def n_ld(self) -> int:
@@ -121,15 +140,32 @@ class TrajectoryDatabase:
         trajectory and t_f interpolated from the 2^d enclosing entries, then expanded to
         ``hd_points`` equally spaced times by eq. 11 (None: the LD nodes). Refuses when an
         enclosing entry is not verified."""
+        x = self._offsets(offsets)
+        shape = self.grid.shape
+        values = self.values.reshape(shape + self.values.shape[1:])
+        (traj, tf), outside, cases = self._interpolate([values, self.final_time.reshape(shape)], x)
+        return self._expanded(traj, float(tf), hd_points, outside, cases)
+
+    def entry(self, index: int, hd_points: int | None = None) -> Synthesis:
+        """Stored case ``index`` as a Synthesis (NTT's reference), expanded like ``synthesise``."""
+        if not self.verified[index]:
+            raise ScenarioError(f"database case {index} is not verified: re-solve it before flying it")
+        return self._expanded(self.values[index], float(self.final_time[index]), hd_points,
+                              np.zeros(len(self.grid.names), bool), [int(index)])
+
+    def _offsets(self, offsets) -> np.ndarray:
         x = np.asarray(offsets, float)
         if x.shape != (len(self.grid.names),):
             raise ScenarioError(f"offsets need {len(self.grid.names)} values ({', '.join(self.grid.names)}), "
                                 f"got shape {x.shape}")
-        shape = self.grid.shape
-        values = self.values.reshape(shape + self.values.shape[1:])
-        (traj, tf), outside, cases = self._interpolate([values, self.final_time.reshape(shape)], x)
-        tf = float(tf)
+        return x
+
+    def _expanded(self, traj, tf, hd_points, outside, cases) -> Synthesis:
+        """eq. 11: LD samples ``traj`` (n_ld, n) of a trajectory of duration tf to hd_points
+        equally spaced times (None: kept at the LD nodes)."""
         if hd_points is not None:
+            if not 2 <= int(hd_points) <= 100000:
+                raise ScenarioError(f"hd_points = {hd_points}: allowed 2..100000")
             traj = hd_matrix(self.n_ld, int(hd_points)) @ traj
             t = 0.5 * (np.linspace(-1.0, 1.0, int(hd_points)) + 1.0) * tf
         else:
@@ -152,7 +188,7 @@ class TrajectoryDatabase:
 
     def nearest(self, offsets) -> int:
         """NTT: the index of the stored case nearest to ``offsets`` (in grid steps)."""
-        return self.grid.index(nearest_case(self.grid.levels, np.asarray(offsets, float)))
+        return self.grid.index(nearest_case(self.grid.levels, self._offsets(offsets)))
 
     # -- consistency --------------------------------------------------------------------
     def inconsistent(self, bank_column: int | None = None) -> dict:
@@ -182,7 +218,7 @@ class TrajectoryDatabase:
     def save(self, path: str):
         """One .npz file: the arrays and the layout (JSON)."""
         meta = {"grid": self.grid.as_dict(), "state_names": list(self.state_names),
-                "control_names": list(self.control_names)}
+                "control_names": list(self.control_names), "provenance": self.provenance}
         np.savez_compressed(path, values=self.values, final_time=self.final_time, objective=self.objective,
                             verified=self.verified, meta=np.array(json.dumps(meta)))
 
@@ -192,4 +228,4 @@ class TrajectoryDatabase:
             meta = json.loads(str(f["meta"]))
             return TrajectoryDatabase(ParameterGrid.from_dict(meta["grid"]), tuple(meta["state_names"]),
                                       tuple(meta["control_names"]), f["values"], f["final_time"], f["objective"],
-                                      f["verified"].astype(bool))
+                                      f["verified"].astype(bool), meta.get("provenance", {}))

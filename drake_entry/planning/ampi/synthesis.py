@@ -16,6 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
+#: how a reference is made from the database: AMPI (Algorithms 1-2) or the nearest entry (NTT)
+MODES = ("ampi", "ntt")
+
 
 def select_subspace(levels, x) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Algorithm 1 (fixed): for query offsets ``x`` (d,) and the grid ``levels`` (d sequences),

@@ -1,0 +1,61 @@
+"""Paper 003's guidance as a GuidanceMethod.
+
+  estimate --> ReferenceTracker (at entry: the database reference for the measured state,
+      AMPI or NTT, and its TVLQR; then sigma_c' = u_ref - K (x - x_ref)) --bank_command-->
+      (shared bank actuator);   alpha: the scenario's schedule (Table 2)
+
+The planner (``make_planner``) loads the database once per mission and checks it (every case
+verified, none out of line with its neighbours); each flight makes its own reference at
+t = 0 from the navigation estimate.
+"""
+from __future__ import annotations
+
+import math
+
+from ...planning.ampi.reference import DatabaseReference
+from ...systems.reference_tracking import ReferenceTracker
+from ..interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
+
+GUIDANCE_SYSTEM = "reference_tracker"
+
+
+class AmpiMethod(GuidanceMethod):
+    name = "ampi"
+
+    def make_planner(self, scenario) -> DatabaseReference:
+        g = scenario.guidance
+        return DatabaseReference.load(g.database, g.reference, hd_points=g.hd_points, weights=g.weights(),
+                                      gain_samples=g.gain_samples)
+
+    def add_systems(self, builder, scenario, planner: DatabaseReference, plant: PlantPorts) -> GuidanceCommands:
+        vehicle = scenario.make_vehicle()
+        bank0 = float(planner.evaluate([0.0])["sigma"][0])
+        tracker = builder.AddNamedSystem(GUIDANCE_SYSTEM, ReferenceTracker(
+            planner, bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit,
+            period=scenario.guidance.period_s, initial_bank=bank0,
+            lead=scenario.guidance.bank_lead_s))
+        builder.Connect(plant.estimated_state, tracker.GetInputPort("estimated_state"))
+        return GuidanceCommands(
+            bank=tracker.GetOutputPort("bank_command"), initial_bank=bank0,
+            logged={"reference_state": LoggedSignal(tracker.GetOutputPort("reference_state"), (
+                "h_ref_m", "lon_ref_rad", "lat_ref_rad", "V_ref_m_s", "gamma_ref_rad", "psi_ref_rad", "bank_ref_rad"))})
+
+    def summarise(self, diagram, context, planner: DatabaseReference) -> GuidanceSummary:
+        system = diagram.GetSubsystemByName(GUIDANCE_SYSTEM)
+        mem = system.memory(system.GetMyContextFromRoot(context))
+        ref = mem.reference
+        if ref is None:
+            return GuidanceSummary(False, f"no reference at entry: {mem.message}")
+        syn = ref.synthesis
+        fields = {"reference_mode": ref.mode, "reference_final_time_s": syn.final_time,
+                  "reference_extrapolated": int(syn.extrapolated.sum()), "reference_case": syn.cases[0],
+                  "synthesis_ms": ref.synthesis_s * 1e3, "gains_s": ref.gains_s}
+        units = {"h": ("m", 1.0), "V": ("m_s", 1.0)}
+        for n, v in zip(planner.database.grid.names, ref.offsets):
+            unit, factor = units.get(n, ("deg", math.degrees(1.0)))
+            fields[f"entry_offset_{n}_{unit}"] = float(v * factor)
+        return GuidanceSummary(True, plans=1, planning_wall_s=ref.synthesis_s + ref.gains_s, fields=fields,
+                               details={"reference": ref})
+
+
+METHOD = AmpiMethod()

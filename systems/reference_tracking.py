@@ -1,0 +1,105 @@
+"""ReferenceTracker: makes a reference at the entry interface from the navigation estimate and
+tracks it with a time-varying LQR (paper 003's guidance for both AMPI and NTT; the
+reference maker is ``planning.ampi.reference.DatabaseReference``).
+
+At initialisation the tracker asks ``planner.reference(estimate)`` for a TrackedReference
+(the reference and its law u = u_ref - K (x - x_ref), planning.tracking). The law's state is
+the reference problem's: the six entry states, the bank and a clock ([h, lon, lat, V, gamma,
+psi, sigma, t], controls 'bank_rate'); the bank it feeds back is the tracker's own command,
+which the shared bank actuator follows. Every ``period`` T the command follows the reference
+bank and integrates only the feedback, sigma_c(t + T) = sigma_ref(t + T) + [sigma_c(t) -
+sigma_ref(t)] - K (x - x_ref) T (integrating u_ref as well would drift by up to |u| T per
+step), its change clipped to the rate limit times T and its value to the bank limit. A reference that
+cannot be made (e.g. an enclosing database case not verified) is recorded: the tracker then
+holds its initial bank and the flight is not a success.
+
+Ports:
+  - input  "estimated_state"  [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
+  - output "bank_command"     [1]  sigma_c [rad]
+  - output "reference_state"  [7]  the reference [h m, lon, lat rad, V m/s, gamma, psi, sigma rad] now
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from drake_entry.errors import DrakeEntryError, ScenarioError
+
+#: the reference problem's state layout the law is written in
+LAW_STATES = ("h", "lon", "lat", "V", "gamma", "psi", "sigma", "t")
+
+
+@dc.dataclass(frozen=True)
+class TrackerMemory:
+    """reference: the TrackedReference (None when it could not be made); message: why not."""
+
+    reference: object = None
+    message: str = ""
+
+
+class ReferenceTracker(LeafSystem):
+    def __init__(self, planner, *, bank_limit: float, rate_limit: float, period: float = 0.5,
+                 initial_bank: float = 0.0, lead: float = 0.0):
+        """Args: planner with reference(estimate) -> TrackedReference and ``problem.state_names``
+        == LAW_STATES; bank_limit [rad], rate_limit [rad/s] of the command; period [s];
+        initial_bank [rad] (held when no reference can be made); lead [s]: the feed-forward is
+        the reference bank this far ahead, the lag of the actuator loop the command drives."""
+        super().__init__()
+        if tuple(planner.problem.state_names) != LAW_STATES:
+            raise ScenarioError(f"ReferenceTracker needs a reference with states {LAW_STATES} (controls 'bank_rate'), "
+                                f"got {tuple(planner.problem.state_names)}")
+        for name, v in (("bank_limit", bank_limit), ("rate_limit", rate_limit), ("period", period)):
+            if not v > 0:
+                raise ScenarioError(f"ReferenceTracker.{name} = {v}: must be > 0")
+        if not 0.0 <= lead <= 10.0:
+            raise ScenarioError(f"ReferenceTracker.lead = {lead} s: allowed 0 to 10")
+        self.planner, self.bank_limit, self.rate_limit, self.period = planner, bank_limit, rate_limit, period
+        self.lead = float(lead)
+        self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
+        self._memory = self.DeclareAbstractState(AbstractValue.Make(TrackerMemory()))
+        self._bank = self.DeclareDiscreteState(BasicVector([float(initial_bank)]))
+        self.DeclareInitializationUnrestrictedUpdateEvent(self._start)
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+        self.DeclareStateOutputPort("bank_command", self._bank)
+        self.DeclareVectorOutputPort("reference_state", 7, self._reference_state,
+                                     prerequisites_of_calc={self.all_state_ticket(), self.time_ticket()})
+
+    def memory(self, context) -> TrackerMemory:
+        return context.get_abstract_state(int(self._memory)).get_value()
+
+    def _start(self, context, state):
+        estimate = np.asarray(self.est_port.Eval(context), float)
+        try:
+            ref = self.planner.reference(estimate)
+        except DrakeEntryError as e:  # recorded; the flight goes on without guidance
+            state.get_mutable_abstract_state(int(self._memory)).set_value(TrackerMemory(None, str(e)))
+            return
+        state.get_mutable_abstract_state(int(self._memory)).set_value(TrackerMemory(ref))
+        sigma0 = float(np.clip(ref.law.reference(context.get_time() + self.lead)[0][6], -self.bank_limit,
+                               self.bank_limit))
+        state.get_mutable_discrete_state(self._bank).SetFromVector([sigma0])
+
+    def _update(self, context, discrete_state):
+        ref = self.memory(context).reference
+        if ref is None:
+            return
+        t, T, lead = context.get_time(), self.period, self.lead
+        sigma = float(context.get_discrete_state(self._bank).GetAtIndex(0))
+        law = ref.law
+        ff_now, ff_next = law.reference(t + lead)[0][6], law.reference(t + T + lead)[0][6]
+        x_ref = law.reference(t)[0]
+        # the bank deviation is the command's from the feed-forward (the reference bank
+        # ``lead`` seconds ahead, which the lagging actuator delivers now)
+        x = np.concatenate([self.est_port.Eval(context), [x_ref[6] + sigma - ff_now, t]])
+        feedback = float(law.gain(t)[0] @ (x - x_ref))
+        target = ff_next + (sigma - ff_now) - feedback * T
+        step = float(np.clip(target - sigma, -self.rate_limit * T, self.rate_limit * T))
+        discrete_state.get_mutable_vector(self._bank).SetFromVector(
+            [float(np.clip(sigma + step, -self.bank_limit, self.bank_limit))])
+
+    def _reference_state(self, context, output):
+        ref = self.memory(context).reference
+        output.SetFromVector(np.full(7, np.nan) if ref is None else ref.law.reference(context.get_time())[0][:7])

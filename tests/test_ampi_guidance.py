@@ -1,0 +1,172 @@
+"""Paper 003's guidance on the packaged SHEFEX-3 database: the database itself (729 verified,
+consistent cases at 60 LD nodes, its provenance), the reference maker's eq. 6 offsets, AMPI
+against NTT references, the tracker system's errors and recorded failures, the spec's field
+errors, and closed-loop flights through the Drake Simulator."""
+import dataclasses as dc
+import math
+
+import numpy as np
+import pytest
+
+from drake_entry.errors import ScenarioError
+from drake_entry.planning.ampi.reference import DatabaseReference
+
+
+@pytest.fixture(scope="module")
+def planner():
+    return DatabaseReference.load("shefex3")
+
+
+def test_packaged_database_is_the_full_eq_5_grid_verified_consistent_and_reaches_the_target(planner):
+    db, problem = planner.database, planner.problem
+    assert planner.success, planner.message
+    assert db.grid.size == 729 and db.verified.all() and db.inconsistent(6) == {}
+    assert db.n_ld == 60 and db.storage_bytes / 1e6 == pytest.approx(3.155, abs=0.01)
+    assert db.provenance["study"]["problem"] == "shefex3"
+    # every case ends on the hard terminal point, in the speed and geodetic altitude windows
+    nx = len(db.state_names)
+    end = db.values[:, -1, :nx]
+    names = db.state_names
+    assert np.abs(end[:, names.index("lon")] - problem.final["lon"]).max() < 1e-6
+    assert np.abs(end[:, names.index("lat")] - problem.final["lat"]).max() < 1e-6
+    V = end[:, names.index("V")]
+    assert V.min() >= 570.0 - 1e-3 and V.max() <= 620.0 + 1e-3
+    h_geo = [problem.planet.atmospheric_altitude(x[0], x[2]) for x in end]
+    assert min(h_geo) >= 21e3 - 1.0 and max(h_geo) <= 26e3 + 1.0
+    # Table 2's bank limit holds at the NLP's knots but not between them: the first-order-held
+    # rate dips the bank up to 3 deg past 60 deg between DirectCollocation knots (case 591:
+    # -63.0 deg at 77.9 s), and the between-node verification does not check state bounds
+    # (docs/methods/ampi.md, known limitation); the tracker clips the command at 60 deg
+    assert 60.0 < np.degrees(np.abs(db.values[:, :, names.index("sigma")])).max() < 63.1
+
+
+def test_offsets_are_eq_6_with_a_geodetic_altitude(planner):
+    p = planner.problem
+    x0 = np.array([p.initial[n] for n in ("h", "lon", "lat", "V", "gamma", "psi")])
+    assert planner.offsets(x0) == pytest.approx(np.zeros(6), abs=1e-9)
+    x = x0.copy()
+    x[2] += math.radians(0.3)  # same state altitude at another latitude: a geodetic offset
+    x[3] += 20.0
+    d = planner.offsets(x)
+    dh = p.planet.atmospheric_altitude(x[0], x[2]) - p.planet.atmospheric_altitude(x0[0], x0[2])
+    assert abs(dh) > 10.0 and d == pytest.approx([dh, 0.0, math.radians(0.3), 20.0, 0.0, 0.0], abs=1e-9)
+
+
+def test_ampi_at_the_nominal_is_the_stored_entry_and_ntt_takes_the_nearest_case(planner):
+    db = planner.database
+    centre = db.grid.index(db.grid.centre)
+    x0 = np.array([planner.problem.initial[n] for n in ("h", "lon", "lat", "V", "gamma", "psi")])
+    syn, _ = planner.synthesis(x0)
+    assert np.array_equal(syn.states, db.entry(centre, planner.hd_points).states)
+    x = x0.copy()
+    x[3] += 50.0  # nearer V + 70 than V 0
+    ntt = dc.replace(planner, mode="ntt")
+    s_ntt, off = ntt.synthesis(x)
+    s_ampi, _ = planner.synthesis(x)
+    assert s_ntt.cases == [db.grid.index((1, 1, 1, 2, 1, 1))] and off[3] == pytest.approx(50.0)
+    # AMPI's t_f lies between the two stored cases', 50/70 of the way
+    t0, t1 = db.final_time[centre], db.final_time[s_ntt.cases[0]]
+    assert s_ampi.final_time == pytest.approx(t0 + 50.0 / 70.0 * (t1 - t0), rel=1e-12)
+
+
+def test_reference_comes_with_a_tvlqr_law(planner):
+    x0 = np.array([planner.problem.initial[n] for n in ("h", "lon", "lat", "V", "gamma", "psi")])
+    ref = planner.reference(x0)
+    law = ref.law
+    assert law.gains.shape == (planner.gain_samples, 1, 8) and np.isfinite(law.gains).all()
+    assert law.time[-1] == pytest.approx(ref.synthesis.final_time)
+    # the law flown on the problem's own dynamics from an entry 20 m/s fast ends nearer the
+    # reference's end point than the reference's rate flown open loop
+    from scipy.integrate import solve_ivp
+
+    from drake_entry.geodesy import central_angle
+
+    p = planner.problem
+    x0 = law.states[0].copy()
+    x0[3] += 20.0
+    ends = {}
+    for name, u in (("feedback", lambda t, x: law.command(t, x)), ("open", lambda t, x: law.reference(t)[1])):
+        sol = solve_ivp(lambda t, x: np.asarray(p.dynamics(x, np.clip(u(t, x), -np.radians(5), np.radians(5))), float),
+                        (0.0, law.time[-1]), x0, rtol=1e-7, atol=1e-6)
+        xf = sol.y[:, -1]
+        ends[name] = central_angle(xf[1], xf[2], law.states[-1, 1], law.states[-1, 2]) * p.planet.reference_radius
+    assert ends["feedback"] < 1e3 and ends["open"] > 10e3, ends  # measured 207 m, 30.6 km
+
+
+def test_tracker_records_a_reference_it_cannot_make_and_holds_its_bank(planner):
+    from pydrake.systems.analysis import Simulator
+
+    from drake_entry.systems.reference_tracking import ReferenceTracker
+
+    db = dc.replace(planner.database, verified=planner.database.verified.copy())
+    centre = db.grid.index(db.grid.centre)
+    db.verified[centre] = False
+    broken = dc.replace(planner, database=db)
+    tracker = ReferenceTracker(broken, bank_limit=math.radians(60), rate_limit=math.radians(5), initial_bank=0.3)
+    ctx = tracker.CreateDefaultContext()
+    x0 = [planner.problem.initial[n] for n in ("h", "lon", "lat", "V", "gamma", "psi")]
+    tracker.GetInputPort("estimated_state").FixValue(ctx, x0)
+    sim = Simulator(tracker, ctx)
+    sim.AdvanceTo(5.0)
+    mem = tracker.memory(sim.get_context())
+    assert mem.reference is None and f"database cases [{centre}" in mem.message and "not verified" in mem.message
+    assert tracker.GetOutputPort("bank_command").Eval(sim.get_context())[0] == 0.3
+    with pytest.raises(ScenarioError, match="ReferenceTracker.lead = -1.0 s: allowed 0 to 10"):
+        ReferenceTracker(planner, bank_limit=1.0, rate_limit=0.1, lead=-1.0)
+    with pytest.raises(ScenarioError, match="ReferenceTracker.rate_limit = 0: must be > 0"):
+        ReferenceTracker(planner, bank_limit=1.0, rate_limit=0)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("reference", "best", "guidance.reference = 'best'; allowed: ampi, ntt"),
+    ("database", "nowhere.npz", "guidance.database 'nowhere.npz' is neither a packaged database"),
+    ("tracking_scales", [1.0] * 6, "guidance.tracking_scales needs 7 values, got 6"),
+    ("bank_lead_s", 20.0, r"guidance.bank_lead_s = 20.0 is out of range; allowed \[0, 10\]"),
+    ("hd_points", 1, r"guidance.hd_points = 1 is out of range"),
+    ("terminal_velocity_m_s", 9000.0, r"guidance.terminal_velocity_m_s = 9000.0 is out of range"),
+])
+def test_spec_errors_name_the_field(field, value, message):
+    from drake_entry.scenario import load_scenario
+
+    s = load_scenario("shefex3_ampi")
+    bad = dc.replace(s, guidance=dc.replace(s.guidance, **{field: value}))
+    with pytest.raises(ScenarioError, match=message):
+        bad.guidance.validate(bad)
+
+
+def _fly(mode, dV=0.0, dgamma_deg=0.0):
+    from drake_entry.diagrams import closed_loop as cl
+    from drake_entry.scenario import load_scenario
+
+    s = load_scenario("shefex3_ampi")
+    s = dc.replace(s, guidance=dc.replace(s.guidance, reference=mode))
+    x0 = s.initial_state()
+    x0[3] += dV
+    x0[4] += math.radians(dgamma_deg)
+    return cl.fly(s, initial_state=x0)
+
+
+def test_nominal_flight_reaches_the_target_within_the_limits():
+    """The nominal entry through the Drake closed loop (navigation, actuator, tracker):
+    1.28 km from the target (the LD-60 reference alone drifts 5.7 km open loop), in the
+    altitude and speed windows, under Table 2's path limits."""
+    r = _fly("ampi")
+    assert r.success, r.message
+    assert r.errors["distance_m"] < 2.0e3
+    assert abs(r.errors["velocity_m_s"]) < 1.0
+    tr = r.trajectory
+    assert r.guidance.fields["reference_mode"] == "ampi" and r.guidance.fields["reference_extrapolated"] == 0
+    assert r.guidance.fields["synthesis_ms"] < 50.0  # loose: one cold call in a test process
+    peaks = {"dynamic_pressure": 50e3, "heat_flux": 6.5e6, "normal_load": 10.0}
+    for name, limit in peaks.items():
+        assert np.max(tr.column(name)) <= limit, name
+
+
+def test_ampi_beats_ntt_between_the_grid_levels():
+    """An entry 30 m/s fast and 0.2 deg steep (between the levels): NTT tracks the
+    nominal-speed case's reference and ends far from the target; AMPI's interpolated
+    reference lands within a few km."""
+    a, n = _fly("ampi", 30.0, 0.2), _fly("ntt", 30.0, 0.2)
+    assert a.success, a.message
+    assert a.errors["distance_m"] < 3.0e3
+    assert n.errors["distance_m"] > 3.0 * a.errors["distance_m"]

@@ -62,7 +62,7 @@ def run_cases(task: Task, cases: list, out_dir: str, manifest: dict, *, backend:
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=total, initial=total - len(todo), unit="case", desc=desc, smoothing=0.05)
+        bar = tqdm(total=total, initial=min(len(done), total), unit="case", desc=desc, smoothing=0.05)
     failed = 0
     with store:
         def record(row, traj):

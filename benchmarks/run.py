@@ -1,6 +1,6 @@
 """Benchmarks, each printing its figures and ratios measured side by side in one run.
 
-    python benchmarks/run.py [open-loop|socp|nlp|dymos|campaign|interface-cost|paper001|aborts|paper004|all] [options]
+    python benchmarks/run.py [open-loop|socp|nlp|dymos|campaign|interface-cost|paper001|aborts|paper003|paper004|all] [options]
 
 open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
 socp            both SOCP planners with Clarabel vs SCS: drag-energy SOCP by node count, SCvx
@@ -12,6 +12,8 @@ campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios
 interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline commit
 paper001        paper 001: SCvx nominal plan time and iterations by mesh vs the paper, flown by Drake
 aborts          paper 001: the 9 x 9 orbital-abort map through the campaign engine vs the 15-min goal
+paper003        paper 003: AMPI database storage, LD-HD reconstruction, synthesis vs OCP CPU time,
+                eq. 13 accuracy and open-loop miss of AMPI and NTT references (--cases)
 paper004        paper 004: Table 1 over seeds, scipy baselines, cases, two parameters, figures
 """
 import argparse
@@ -24,7 +26,7 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("which", nargs="?", default="all",
                         choices=("all", "open-loop", "socp", "nlp", "dymos", "campaign", "interface-cost", "paper001",
-                                 "aborts", "paper004"))
+                                 "aborts", "paper003", "paper004"))
     parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
     parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
     parser.add_argument("--nodes", type=int, default=40, help="nlp: nodes / samples")
@@ -35,6 +37,7 @@ if __name__ == "__main__":
     parser.add_argument("--grid", type=int, nargs=2, default=(9, 9), metavar=("ROWS", "COLUMNS"),
                         help="aborts: EIP grid size")
     parser.add_argument("--seeds", type=int, default=20, help="paper004: seeds per swarm method (Table 1)")
+    parser.add_argument("--cases", type=int, default=100, help="paper003: entries of the accuracy study")
     parser.add_argument("--out", default="out/paper004", help="paper004: figure directory")
     args = parser.parse_args()
     if args.which in ("all", "open-loop"):
@@ -71,6 +74,10 @@ if __name__ == "__main__":
         from aborts import aborts_benchmark
 
         aborts_benchmark(rows=args.grid[0], columns=args.grid[1])
+    if args.which in ("all", "paper003"):
+        from paper003 import paper003_benchmark
+
+        paper003_benchmark(cases=args.cases)
     if args.which in ("all", "paper004"):
         from paper004 import paper004_study
 

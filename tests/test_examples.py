@@ -128,3 +128,16 @@ def test_example_11(tmp_path):
     # eq. 1 reaches the target too, with another bank history: its minimisers are not unique
     assert r["eq1"].converged and r["eq1_miss_m"] < 1e3 and r["eq1_bank_gap_deg"] > 5.0
     assert os.path.exists(r["plot"])
+
+
+def test_example_12(tmp_path):
+    r = _run("12_ampi_guidance", tmp_path)
+    # between the grid levels AMPI's reference is nearer the entry's own optimum than NTT's,
+    # and only AMPI's closed loop reaches the target
+    assert r["optimum"].success
+    assert r["errors"]["ampi"]["h_m"] < r["errors"]["ntt"]["h_m"]
+    assert r["errors"]["ampi"]["V_m_s"] < r["errors"]["ntt"]["V_m_s"]
+    assert r["flights"]["ampi"].success and r["flights"]["ampi"].errors["distance_m"] < 3e3
+    assert r["flights"]["ntt"].errors["distance_m"] > 25e3
+    assert r["table"]["ampi"][25] == len(r["table"]["ampi"]["rows"]) == 6
+    assert os.path.exists(r["plot"])

@@ -52,8 +52,13 @@ class DatabaseReference(PlanResult):
     its neighbours (TrajectoryDatabase.inconsistent).
 
     Attributes:
-      database, problem (the OptimalControlProblem the database solved, its nominal initial
-      state the grid's centre), mode, hd_points (eq. 11's N_HD), weights, gain_samples.
+      database: the TrajectoryDatabase.
+      problem: the OptimalControlProblem the database solved (its initial state is the grid's
+        centre).
+      mode: 'ampi' or 'ntt'.
+      hd_points: eq. 11's N_HD + 1, the reference's equally spaced samples.
+      weights: the TVLQR's TrackingWeights (default TrackingWeights.entry()).
+      gain_samples: times the dynamics are linearised at for the gains.
     """
 
     database: TrajectoryDatabase

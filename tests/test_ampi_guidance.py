@@ -176,7 +176,8 @@ def test_ampi_beats_ntt_between_the_grid_levels():
 def test_reduced_campaign_ampi_against_ntt_table_3_form(tmp_path):
     """The first 40 samples of the 1000-run campaign (seed 0) of each mode, same controller:
     AMPI lands every one within 25 km under the path limits; NTT, flying the nearest entry's
-    reference, ends farther on average (the full campaigns: docs/methods/ampi.md)."""
+    reference, ends farther on average and passes the q limit (the full campaigns:
+    docs/methods/ampi.md)."""
     import pandas as pd
     from pydrake.common.yaml import yaml_dump_typed
 
@@ -191,8 +192,9 @@ def test_reduced_campaign_ampi_against_ntt_table_3_form(tmp_path):
         out = run_campaign(str(path), runs=40, seed=0, workers=2, out_dir=str(tmp_path / mode), progress=False)
         rows = pd.read_parquet(tmp_path / mode / "samples.parquet")
         assert len(rows) == 40 and rows["reached_terminal"].all(), out
-        for c in ("margin_heat_flux", "margin_dynamic_pressure", "margin_normal_load"):
-            assert rows[c].min() >= 0.0, (mode, c)
+        if mode == "ampi":  # NTT exceeds q on 230 of the full 1000 (up to 5.2 %), 8 of these 40
+            for c in ("margin_heat_flux", "margin_dynamic_pressure", "margin_normal_load"):
+                assert rows[c].min() >= 0.0, c
         dist[mode] = rows["err_distance_m"].to_numpy()
     assert (dist["ampi"] <= 25e3).all() and dist["ampi"].mean() < 3e3
     assert dist["ntt"].mean() > 2.0 * dist["ampi"].mean()

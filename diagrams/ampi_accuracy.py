@@ -97,15 +97,20 @@ def flown_controls(problem, syn, n_ld: int):
     return controls
 
 
+def _fly_ld(problem, syn, n_ld: int, x0, **propagation):
+    """diagrams.propagation.propagate of a Synthesis at the LD nodes (``flown_controls``)
+    from ``x0``: the PropagationCheck."""
+    flown = SimpleNamespace(time=syn.time, final_time=syn.final_time, transcription="lgl", controls=syn.controls,
+                            states=np.vstack([x0, syn.states[-1]]),
+                            control_function=lambda: flown_controls(problem, syn, n_ld))
+    return propagate(problem, flown, **propagation)
+
+
 def fly_reference(problem, syn, n_ld: int, x0) -> dict:
-    """Fly a Synthesis at the LD nodes open loop (its controls' LD polynomial) from the
-    entry state ``x0`` (the reference's own initial bank and clock): miss from the target
-    [m] and the final altitude and speed errors from the reference's."""
-    x0 = np.array(x0, float)
-    nominal = SimpleNamespace(time=syn.time, final_time=syn.final_time, transcription="lgl",
-                              controls=syn.controls, states=np.vstack([x0, syn.states[-1]]),
-                              control_function=lambda: flown_controls(problem, syn, n_ld))
-    check = propagate(problem, nominal, accuracy=1e-9, samples_per_interval=16, log_points=200)
+    """Fly a Synthesis at the LD nodes open loop (``flown_controls``) from the entry state
+    ``x0`` (the reference's own initial bank and clock): miss from the target [m] and the
+    final altitude and speed errors from the reference's."""
+    check = _fly_ld(problem, syn, n_ld, np.array(x0, float), accuracy=1e-9, samples_per_interval=16, log_points=200)
     if "failed" in check.terminal_error:
         return {"failed": check.terminal_error["failed"]}
     xf = check.states[-1]
@@ -125,15 +130,13 @@ def accuracy_case(state: dict, case: dict):
     refs = {}
     for mode in MODES:
         t0 = time.perf_counter()
-        if mode == "ampi":
-            syn = db.synthesise(offsets, state["hd_points"])
-        else:
-            syn = db.entry(db.nearest(offsets), state["hd_points"])
+        syn = db.reference(mode, offsets, state["hd_points"])
         row[f"{mode}_synthesis_s"] = time.perf_counter() - t0
         row[f"{mode}_extrapolated"] = int(syn.extrapolated.sum())
         refs[mode] = syn
+    at_ld = {mode: db.reference(mode, offsets) for mode in MODES}  # the same references at the LD nodes
     p = offset_problem(problem, dict(zip(db.grid.names, offsets)))
-    ld = db.synthesise(offsets)
+    ld = at_ld["ampi"]
     t0 = time.perf_counter()
     r = nlp.solve(p, transcription=s["transcription"], nodes=s["nodes"], tolerance=s["tolerance"],
                   max_iterations=s["max_iterations"], guess=(ld.time, ld.states, ld.controls),
@@ -153,8 +156,7 @@ def accuracy_case(state: dict, case: dict):
                 row[f"{mode}_{n}_rel_max"] = float(np.max(np.abs(err) / np.abs(truth[:, k])))
         row[f"{mode}_final_time_s"] = float(syn.final_time - r.final_time)
         x0 = [p.initial[n] for n in names[:6]] + [syn.states[0, 6], 0.0]
-        at_ld = db.synthesise(offsets) if mode == "ampi" else db.entry(db.nearest(offsets))
-        flown = fly_reference(p, at_ld, db.n_ld, x0)
+        flown = fly_reference(p, at_ld[mode], db.n_ld, x0)
         if "failed" in flown:
             row[f"{mode}_open_loop_failed"] = flown["failed"]
             row[f"{mode}_open_loop_miss_m"] = math.nan
@@ -237,11 +239,8 @@ def reconstruction_error(db: TrajectoryDatabase, index: int, problem, hd_points:
     rad) and the final position difference [m]."""
     ld = db.entry(index)
     hd = db.entry(index, hd_points)
-    control = flown_controls(problem, ld, db.n_ld)
-    nominal = SimpleNamespace(time=ld.time, final_time=ld.final_time, transcription="lgl", controls=ld.controls,
-                              states=ld.states, control_function=lambda: control)
-    check = propagate(problem, nominal, accuracy=1e-10, samples_per_interval=32,
-                      log_points=4 * (hd_points - 1))  # the log times include the HD times
+    check = _fly_ld(problem, ld, db.n_ld, ld.states[0], accuracy=1e-10, samples_per_interval=32,
+                    log_points=4 * (hd_points - 1))  # the log times include the HD times
     if "failed" in check.terminal_error:
         raise ScenarioError(f"case {index}: {check.terminal_error['failed']}")
     flown = np.array([np.interp(hd.time, check.time, c) for c in check.states.T]).T

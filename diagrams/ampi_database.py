@@ -177,10 +177,9 @@ def build_database(out_dir: str, study: DatabaseStudy | None = None, *, backend:
             run_cases(task, cases, out_dir, manifest, desc=f"database wave {k}", **campaign)
     rows, trajs = _read(out_dir)
     db = _assemble(grid, problem, state["ld_nodes"], rows, trajs, config)
-    bank = problem.state_names.index("sigma") if "sigma" in problem.state_names else None
     resolved = 0
     for r in range(1, resolve_rounds + 1):
-        bad = db.inconsistent(bank)
+        bad = db.inconsistent()
         if not bad:
             break
         sub = os.path.join(out_dir, f"resolve_{r}")
@@ -202,7 +201,7 @@ def build_database(out_dir: str, study: DatabaseStudy | None = None, *, backend:
                 resolved += 1
         db = _assemble(grid, problem, state["ld_nodes"], rows, trajs, config)
     db.save(os.path.join(out_dir, DATABASE_FILE))
-    left = db.inconsistent(bank)
+    left = db.inconsistent()
     report = {"cases": grid.size, "verified": int(db.verified.sum()), "re_solved": resolved,
               "inconsistent": {int(k): v for k, v in left.items()}, "storage_MB": db.storage_bytes / 1e6,
               "wall_s": time.perf_counter() - t0,

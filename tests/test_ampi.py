@@ -86,6 +86,10 @@ def test_database_synthesis_expands_stores_and_finds_the_nearest_entry(tmp_path)
     assert s.states[:, 1] == pytest.approx(hd ** 2 * (1.0 + x[0]), abs=1e-9)
     assert s.time[-1] == pytest.approx(s.final_time) and sorted(s.cases) == [3, 4, 6, 7]
     assert db.nearest([40.0, -0.004]) == grid.index((2, 1))
+    assert db.reference("ntt", [40.0, -0.004]).cases == [grid.index((2, 1))]
+    assert np.array_equal(db.reference("ampi", x, 41).states, s.states)
+    with pytest.raises(ScenarioError, match="mode = 'best'; allowed: ampi, ntt"):
+        db.reference("best", x)
     path = tmp_path / "db.npz"
     db.save(str(path))
     back = TrajectoryDatabase.load(str(path))

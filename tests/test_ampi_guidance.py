@@ -20,7 +20,7 @@ def planner():
 def test_packaged_database_is_the_full_eq_5_grid_verified_consistent_and_reaches_the_target(planner):
     db, problem = planner.database, planner.problem
     assert planner.success, planner.message
-    assert db.grid.size == 729 and db.verified.all() and db.inconsistent(6) == {}
+    assert db.grid.size == 729 and db.verified.all() and db.inconsistent() == {}
     assert db.n_ld == 60 and db.storage_bytes / 1e6 == pytest.approx(3.155, abs=0.01)
     assert db.provenance["study"]["problem"] == "shefex3"
     # every case ends on the hard terminal point, in the speed and geodetic altitude windows

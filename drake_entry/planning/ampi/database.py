@@ -22,7 +22,7 @@ import numpy as np
 from ...errors import ScenarioError
 from ...pseudospectral import interpolation_matrix, lgl_nodes
 from .grid import ParameterGrid
-from .synthesis import interpolate_corners, nearest_case, select_subspace
+from .synthesis import MODES, interpolate_corners, nearest_case, select_subspace
 
 #: consistency with the neighbours (``TrajectoryDatabase.inconsistent``): a case whose
 #: objective exceeds this factor times the median of its neighbours' (a worse local branch:
@@ -153,6 +153,15 @@ class TrajectoryDatabase:
         return self._expanded(self.values[index], float(self.final_time[index]), hd_points,
                               np.zeros(len(self.grid.names), bool), [int(index)])
 
+    def reference(self, mode: str, offsets, hd_points: int | None = None) -> Synthesis:
+        """The reference for entry ``offsets`` in ``mode`` (synthesis.MODES): 'ampi' is
+        ``synthesise``, 'ntt' the ``entry`` nearest to the offsets; expanded like both."""
+        if mode == "ampi":
+            return self.synthesise(offsets, hd_points)
+        if mode == "ntt":
+            return self.entry(self.nearest(offsets), hd_points)
+        raise ScenarioError(f"mode = '{mode}'; allowed: {', '.join(MODES)}")
+
     def _offsets(self, offsets) -> np.ndarray:
         x = np.asarray(offsets, float)
         if x.shape != (len(self.grid.names),):
@@ -191,9 +200,11 @@ class TrajectoryDatabase:
         return self.grid.index(nearest_case(self.grid.levels, self._offsets(offsets)))
 
     # -- consistency --------------------------------------------------------------------
-    def inconsistent(self, bank_column: int | None = None) -> dict:
+    def inconsistent(self) -> dict:
         """{case index: reason} for verified cases out of line with their verified neighbours
-        (module constants), and for every case not verified."""
+        (module constants; the bank check when the states include 'sigma'), and for every case
+        not verified."""
+        bank_column = self.state_names.index("sigma") if "sigma" in self.state_names else None
         out = {int(i): "not verified" for i in np.flatnonzero(~self.verified)}
         for i in np.flatnonzero(self.verified):
             nb = [j for j in self.grid.neighbours(int(i)) if self.verified[j]]

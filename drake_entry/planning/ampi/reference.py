@@ -88,7 +88,7 @@ class DatabaseReference(PlanResult):
             raise ScenarioError(f"database '{database}' does not record its problem (provenance.study.problem); "
                                 "rebuild it with diagrams.ampi_database.build_database")
         problem, _ = load_problem(study["problem"])
-        bad = db.inconsistent(problem.state_names.index("sigma") if "sigma" in problem.state_names else None)
+        bad = db.inconsistent()
         ok = not bad
         msg = (f"{int(db.verified.sum())}/{db.grid.size} cases verified and consistent" if ok else
                f"{len(bad)} of {db.grid.size} cases not verified or out of line, e.g. case {min(bad)}: {bad[min(bad)]}")
@@ -110,9 +110,7 @@ class DatabaseReference(PlanResult):
     def synthesis(self, entry_state) -> tuple[Synthesis, np.ndarray]:
         """(the mode's reference at the measured entry state, the offsets)."""
         x = self.offsets(entry_state)
-        if self.mode == "ampi":
-            return self.database.synthesise(x, self.hd_points), x
-        return self.database.entry(self.database.nearest(x), self.hd_points), x
+        return self.database.reference(self.mode, x, self.hd_points), x
 
     def reference(self, entry_state) -> TrackedReference:
         """The reference for a flight from ``entry_state`` and its TVLQR law."""

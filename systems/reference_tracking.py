@@ -7,9 +7,9 @@ At initialisation the tracker asks ``planner.reference(estimate)`` for a Tracked
 the reference problem's: the six entry states, the bank and a clock ([h, lon, lat, V, gamma,
 psi, sigma, t], controls 'bank_rate'); the bank it feeds back is the tracker's own command,
 which the shared bank actuator follows. Every ``period`` T the command follows the reference
-bank and integrates only the feedback, sigma_c(t + T) = sigma_ref(t + T) + [sigma_c(t) -
-sigma_ref(t)] - K (x - x_ref) T (integrating u_ref as well would drift by up to |u| T per
-step), its change clipped to the rate limit times T and its value to the bank limit. A reference that
+bank and integrates only the feedback, sigma_c(t + T) = sigma_ref(t + T + L) + [sigma_c(t) -
+sigma_ref(t + L)] - K (x - x_ref) T, with L the ``lead`` (integrating u_ref as well would drift
+by up to |u| T per step), its change clipped to the rate limit times T and its value to the bank limit. A reference that
 cannot be made (e.g. an enclosing database case not verified) is recorded: the tracker then
 holds its initial bank and the flight is not a success.
 

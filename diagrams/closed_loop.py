@@ -24,7 +24,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from drake_entry.aerodynamics import ScaledAero
 from drake_entry.atmosphere import Atmosphere, DispersedAtmosphere
-from drake_entry.diagrams.common import run
+from drake_entry.diagrams.common import add_step_loggers, run
 from drake_entry.dispersions import Draw
 from drake_entry.errors import ScenarioError
 from drake_entry.geodesy import range_and_crossrange
@@ -41,6 +41,7 @@ from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.systems.vehicle import EntryVehicle
 from drake_entry.trajectory import Trajectory
 from drake_entry.vehicles import Vehicle
+from drake_entry.verdict import Verdict, judge
 
 ALTITUDE_FLOOR_M = 5000.0
 
@@ -93,14 +94,16 @@ class ClosedLoopResult:
       errors: terminal errors (Table 3 form): altitude_m, longitude_deg, latitude_deg,
         velocity_m_s, range_to_go_m (along the heading, + short of the target),
         crossrange_m (+ target to the right), distance_m.
-      success: reached the terminal energy with the guidance active, finite terminal errors,
-        and inside every criterion of the mission's acceptance box.
-      message: human summary (the criteria missed, when outside the box).
+      success: the verdict (drake_entry.verdict): reached the terminal interface with the
+        guidance active and finite terminal errors, inside every criterion of the mission's
+        acceptance box, and every path limit held at every log sample and integrator step.
+      message: human summary (the criteria missed and the limits breached, when not a success).
       method: the guidance method's name.
       guidance: the method's GuidanceSummary (plans, planning time, its own fields and details).
       box: the acceptance box per criterion given (acceptance_box).
       reached: the flight stopped at the terminal interface (E_f, or h_f for a spec that
         stops at its altitude), inside the box or not.
+      verdict: the Verdict: inside_box, within_limits, each path limit's check (peak, margin).
     """
 
     trajectory: Trajectory
@@ -111,17 +114,20 @@ class ClosedLoopResult:
     guidance: GuidanceSummary
     box: dict = dc.field(default_factory=dict)
     reached: bool = False
+    verdict: Verdict | None = None
 
 
 @dc.dataclass
 class ClosedLoopDiagram:
     """A built closed loop: the diagram, its loggers by name, the (system, port) each logger
-    reads and the table columns of the extra signals (both for collect_trajectory)."""
+    reads and the table columns of the extra signals (both for collect_trajectory), and the
+    per-step loggers of the verdict's path limits."""
 
     diagram: object
     loggers: dict
     sources: dict
     columns: dict
+    step_loggers: dict
 
 
 def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=None, nav_noise=None,
@@ -191,11 +197,12 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
     signals.update({name: logged.port for name, logged in commands.logged.items()})
     period = scenario.simulation.log_period_s
     loggers = {name: LogVectorOutput(port, builder, period) for name, port in signals.items()}
+    step_loggers = add_step_loggers(builder, signals)
     sources = {name: (port.get_system().get_name(), port.get_name()) for name, port in signals.items()}
     columns = {"bank_command": ("bank_command_rad",), **{n: s.columns for n, s in commands.logged.items()}}
     diagram = builder.Build()
     diagram.set_name(f"closed_loop_{scenario.name}_{setup.method.name}")
-    return ClosedLoopDiagram(diagram, loggers, sources, columns)
+    return ClosedLoopDiagram(diagram, loggers, sources, columns, step_loggers)
 
 
 def terminal_errors(x, setup: ClosedLoopSetup) -> dict:
@@ -234,12 +241,12 @@ def fly(scenario: Scenario | ClosedLoopSetup, planner=None, *, initial_state=Non
     built = build_closed_loop(setup, nav_seed=nav_seed, nav_bias=nav_bias, nav_noise=nav_noise,
                               initial_state=initial_state, draw=draw)
     tr, simulator = run(built.diagram, built.loggers, setup.scenario, sources=built.sources, closed_loop=True,
-                        columns=built.columns)
+                        columns=built.columns, step_loggers=built.step_loggers)
     return summarise(setup, built.diagram, simulator.get_context(), tr)
 
 
 def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoopResult:
-    """ClosedLoopResult of a finished closed-loop simulation."""
+    """ClosedLoopResult of a finished closed-loop simulation, with its verdict."""
     guidance = setup.method.summarise(diagram, ctx, setup.planner)
     errors = terminal_errors(tr.state[-1], setup)
     box = acceptance_box(tr, setup, errors["distance_m"])
@@ -247,18 +254,22 @@ def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoo
     by_altitude = setup.scenario.guidance.stops_at_altitude
     name = "h_f" if by_altitude else "E_f"
     reached = ("altitude" if by_altitude else "energy") in tr.reason
+    finite = all(math.isfinite(v) for v in errors.values())
+    verdict = judge(tr, setup.scenario.path_limits(setup.vehicle), reached=reached and guidance.active and finite,
+                    inside_box=finite and not missed, tolerance=setup.scenario.terminal.path_limit_tolerance)
     if not reached:
-        ok, msg = False, f"stopped before {name}: {tr.reason}"
+        msg = f"stopped before {name}: {tr.reason}"
     elif not guidance.active:
-        ok, msg = False, guidance.message
-    elif not all(math.isfinite(v) for v in errors.values()):
-        ok, msg = False, f"reached {name} with non-finite terminal errors {errors}"
-    elif missed:
-        ok, msg = False, f"outside the acceptance box: {'; '.join(missed)} (reached {name} at t = {tr.time[-1]:.1f} s)"
+        msg = guidance.message
+    elif not finite:
+        msg = f"reached {name} with non-finite terminal errors {errors}"
     else:
-        ok = True
-        msg = f"reached {name} at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
-    return ClosedLoopResult(tr, errors, ok, msg, setup.method.name, guidance, box, reached)
+        parts = [f"outside the acceptance box: {'; '.join(missed)}"] if missed else []
+        if not verdict.within_limits:
+            parts.append(f"path limits breached: {verdict.violations_text()}")
+        where = f"reached {name} at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
+        msg = f"{' | '.join(parts)} ({where})" if parts else where
+    return ClosedLoopResult(tr, errors, verdict.success, msg, setup.method.name, guidance, box, reached, verdict)
 
 
 def _box_text(name: str, b: dict) -> str:

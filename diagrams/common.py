@@ -7,6 +7,7 @@ import time as _time
 
 import numpy as np
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
+from pydrake.systems.primitives import LogVectorOutput
 
 from drake_entry.errors import ModelRangeError, NonFiniteStateError
 from drake_entry.scenario import Scenario
@@ -30,7 +31,8 @@ def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loo
 
 
 def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason: str, wall_time: float,
-                       columns: dict | None = None, final_instant: bool = True) -> Trajectory:
+                       columns: dict | None = None, final_instant: bool = True,
+                       step_loggers: dict | None = None) -> Trajectory:
     """Trajectory from the loggers, with every logged signal's value at the final instant
     appended (the witness-located stop).
 
@@ -40,6 +42,8 @@ def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason
       columns: name -> table column names of the extra signals (Trajectory.extra_columns).
       final_instant: append the signals at the context's time (False after a run stopped
         inside a step, whose state is not a solution).
+      step_loggers: name -> per-step VectorLogSink of 'state', 'conditions', 'bank', 'alpha'
+        (``add_step_loggers``): they become ``Trajectory.steps``.
     """
     t_end = context.get_time()
     data = {}
@@ -55,9 +59,28 @@ def collect_trajectory(diagram, loggers: dict, context, *, sources: dict, reason
         data[name] = logged.T
     extra = {k: v for k, v in data.items() if k not in ("state", "conditions", "bank", "alpha")}
     time = np.append(times[keep], t_end) if final_instant else times[keep]
+    steps = None
+    if step_loggers:
+        logs = {name: logger.FindLog(context) for name, logger in step_loggers.items()}
+        t_steps = logs["state"].sample_times()
+        upto = t_steps <= t_end + 1e-9
+        steps = Trajectory(time=t_steps[upto], state=logs["state"].data()[:, upto].T,
+                           conditions=logs["conditions"].data()[:, upto].T, bank=logs["bank"].data()[0, upto],
+                           alpha=logs["alpha"].data()[0, upto], reason=reason, wall_time=wall_time)
     return Trajectory(time=time, state=data["state"], conditions=data["conditions"],
                       bank=data["bank"][:, 0], alpha=data["alpha"][:, 0], reason=reason, wall_time=wall_time,
-                      extra=extra, extra_columns={k: v for k, v in (columns or {}).items() if k in extra})
+                      extra=extra, extra_columns={k: v for k, v in (columns or {}).items() if k in extra},
+                      steps=steps)
+
+
+#: the signals logged at every integrator step for the verdict's path limits
+STEP_SIGNALS = ("state", "conditions", "bank", "alpha")
+
+
+def add_step_loggers(builder, signals: dict) -> dict:
+    """Per-step VectorLogSinks (Drake logs at every simulator step when the publish period is 0)
+    of ``signals[name]`` for each of STEP_SIGNALS: the flight at the integrator's own steps."""
+    return {name: LogVectorOutput(signals[name], builder, 0.0) for name in STEP_SIGNALS}
 
 
 def make_simulator(diagram, scenario: Scenario, *, initial_state=None, closed_loop: bool = False) -> Simulator:
@@ -76,7 +99,8 @@ def stop_reason(status) -> str:
 
 
 def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_state=None,
-        closed_loop: bool = False, columns: dict | None = None) -> tuple[Trajectory, Simulator]:
+        closed_loop: bool = False, columns: dict | None = None,
+        step_loggers: dict | None = None) -> tuple[Trajectory, Simulator]:
     """Simulate ``diagram`` to a terminal condition or max_time_s (see collect_trajectory)."""
     simulator = make_simulator(diagram, scenario, initial_state=initial_state, closed_loop=closed_loop)
     simulator.Initialize()
@@ -90,5 +114,5 @@ def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_st
         final = False
     wall = _time.perf_counter() - t0
     tr = collect_trajectory(diagram, loggers, simulator.get_context(), sources=sources, reason=reason,
-                            wall_time=wall, columns=columns, final_instant=final)
+                            wall_time=wall, columns=columns, final_instant=final, step_loggers=step_loggers)
     return tr, simulator

@@ -73,7 +73,8 @@ def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
         built, ctx = box["built"], box["context"]
         reason = built.diagram.GetSubsystemByName("termination").reason or "max_time"
         tr = collect_trajectory(built.diagram, built.loggers, ctx, sources=built.sources, reason=reason,
-                                wall_time=time.perf_counter() - t_wall, columns=built.columns)
+                                wall_time=time.perf_counter() - t_wall, columns=built.columns,
+                                step_loggers=built.step_loggers)
         res = summarise(setup, built.diagram, ctx, tr)
         row.update(box["draw"].columns())
         row.update(campaign_row(res, setup))
@@ -91,12 +92,15 @@ def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
 
 
 def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
-    """The row of one flight: outcome, the method's fields, final state, terminal errors,
-    peak path quantities and margins (drake_entry.trajectory.metrics)."""
+    """The row of one flight: the verdict (success = reached, inside_box and within_limits;
+    violations: each breached path limit with its peak, time and margin, '' when none), the
+    method's fields, final state, terminal errors, peak path quantities
+    (drake_entry.trajectory.metrics) and the margin of every path limit (drake_entry.verdict)."""
     tr, x = res.trajectory, res.trajectory.state[-1]
-    g = res.guidance
+    g, v = res.guidance, res.verdict
     return {
-        "success": bool(res.success), "message": res.message, "stop": tr.reason,
+        "success": bool(res.success), "inside_box": v.inside_box, "within_limits": v.within_limits,
+        "violations": v.violations_text(), "message": res.message, "stop": tr.reason,
         "reached_terminal": bool(res.reached), "method": res.method,
         "flight_time_s": float(tr.time[-1]), "plans": int(g.plans), "planning_wall_s": g.planning_wall_s, **g.fields,
         "final_altitude_m": float(x[0]), "final_velocity_m_s": float(x[3]),
@@ -105,7 +109,7 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
         "err_latitude_deg": res.errors["latitude_deg"], "err_velocity_m_s": res.errors["velocity_m_s"],
         "err_range_m": res.errors["range_to_go_m"], "err_crossrange_m": res.errors["crossrange_m"],
         "err_distance_m": res.errors["distance_m"],
-        **metrics(tr, setup.vehicle.limits),
+        **metrics(tr), **v.margins(),
         **{f"inside_{k}_box": b["inside"] for k, b in res.box.items()},
     }
 

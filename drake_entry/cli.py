@@ -128,7 +128,7 @@ def parse_overrides(items) -> dict:
 def _cmd_report(args) -> int:
     from .campaign_store import read_manifest
     from .errors import load_yaml_typed
-    from .report import errors_markdown, write_report
+    from .report import counts_sentence, errors_markdown, write_report
     from .scenario import Scenario
 
     manifest = read_manifest(args.dir) if os.path.isdir(args.dir) else None
@@ -143,8 +143,7 @@ def _cmd_report(args) -> int:
     for k, m in stats["margins"].items():
         print(f"worst {k}: {100 * m['worst']:.2f} % ({m['violations']} violations)")
     c = stats["coverage"]
-    print(f"{c['done']}/{c['requested']} samples done; {stats['successful']} inside the acceptance box, "
-          f"{stats['reached']} reached the terminal interface; report: {path}")
+    print(f"{c['done']}/{c['requested']} samples done: {counts_sentence(stats)}; report: {path}")
     return 0
 
 

@@ -26,6 +26,25 @@ ERROR_COLUMNS = tuple(zip(ERROR_COLUMN_NAMES,
 MARGIN_COLUMNS = ("margin_heat_flux", "margin_dynamic_pressure", "margin_normal_load", "margin_total_load")
 
 
+def _flags(rows: dict, col: str, n: int, default) -> np.ndarray:
+    """A boolean column (missing column or entry: ``default``, an array or a bool)."""
+    v = rows.get(col)
+    d = np.broadcast_to(np.asarray(default, bool), (n,))
+    return d.copy() if v is None else np.array([d[i] if x is None else bool(x) for i, x in enumerate(v)], bool)
+
+
+def failure_categories(row: dict) -> list[str]:
+    """Why a row is not a success: its stop message when it did not reach the terminal
+    interface; otherwise 'outside the acceptance box' and '<limit> limit breached' for each
+    breached path limit (the row's ``violations``)."""
+    reached, inside, within = row.get("reached"), row.get("inside_box"), row.get("within_limits")
+    if inside is None or within is None or not reached:
+        return [str(row.get("message") or "").split(":")[0][:80]]
+    out = [] if inside else ["outside the acceptance box"]
+    out += [f"{part.split()[0]} limit breached" for part in str(row.get("violations") or "").split("; ") if part]
+    return out or [str(row.get("message") or "").split(":")[0][:80]]
+
+
 def _finite(rows: dict, col: str, n: int) -> np.ndarray:
     """A column as floats (missing column or entry = nan)."""
     v = rows.get(col)
@@ -48,20 +67,27 @@ def reached_terminal(rows: dict) -> np.ndarray:
 def summary_statistics(rows: dict) -> dict:
     """Statistics of a campaign's rows (a column dict, e.g. from Parquet).
 
-    Counts: samples, successful (inside the acceptance box), reached (terminal interface
-    reached, inside the box or not), failed (not successful) with their reasons, and the
-    samples inside each box criterion. Terminal-error statistics over the reached samples;
-    path-constraint margins over every sample that flew (a finite margin).
+    Counts, each separately: samples, successful (the verdict: reached, inside the box and
+    within every path limit), reached (terminal interface reached), inside_acceptance_box and
+    within_limits (among the reached), failed (not successful) with their reasons
+    (``failure_categories``), and the samples inside each box criterion. Terminal-error
+    statistics over the reached samples; path-limit margins (every ``margin_*`` column) over
+    every sample that flew (a finite margin).
     """
     n = len(rows["index"])
     ok = np.array([bool(v) for v in rows["success"]])
     reached = reached_terminal(rows)
-    out = {"samples": n, "successful": int(ok.sum()), "reached": int(reached.sum()), "failed": int(n - ok.sum()),
-           "errors": {}, "margins": {}, "inside_box": {}}
+    inside = _flags(rows, "inside_box", n, ok) & reached  # rows before the verdict columns: success
+    within = _flags(rows, "within_limits", n, ok) & reached
+    out = {"samples": n, "successful": int(ok.sum()), "reached": int(reached.sum()),
+           "inside_acceptance_box": int(inside.sum()), "within_limits": int(within.sum()),
+           "failed": int(n - ok.sum()), "errors": {}, "margins": {}, "inside_box": {}}
     reasons = {}
-    for flag, msg in zip(ok, rows.get("message") or [""] * n):
-        if not flag:
-            key = str(msg).split(":")[0][:80]
+    keys = list(rows)
+    for i in np.flatnonzero(~ok):
+        row = {k: rows[k][i] for k in keys}
+        row["reached"] = bool(reached[i])
+        for key in failure_categories(row):
             reasons[key] = reasons.get(key, 0) + 1
     out["failure_reasons"] = reasons
     for col, _, _ in ERROR_COLUMNS:
@@ -76,7 +102,8 @@ def summary_statistics(rows: dict) -> dict:
         out["inside_km"] = {str(r): int((d <= r * 1e3).sum()) for r in (2, 25, 50, 75)}
     for col in [c for c in rows if c.startswith("inside_") and c.endswith("_box")]:
         out["inside_box"][col[len("inside_"):-len("_box")]] = int(sum(bool(v) for v in rows[col] if v is not None))
-    for col in MARGIN_COLUMNS:
+    for col in [c for c in MARGIN_COLUMNS if c in rows] + sorted(c for c in rows if c.startswith("margin_")
+                                                                  and c not in MARGIN_COLUMNS):
         m = _finite(rows, col, n)
         flew = np.isfinite(m)
         if flew.any():
@@ -92,6 +119,14 @@ def summary_statistics(rows: dict) -> dict:
                            "plans_per_sample": float(cost["plans"].mean()),
                            "derivative_evaluations_per_sample": float(cost["derivative_evaluations"].mean())}
     return out
+
+
+def counts_sentence(stats: dict) -> str:
+    """'N successful (reached, inside the box and within every path limit); ...' of a summary."""
+    return (f"{stats['successful']} successful (reached, inside the acceptance box and within every path limit); "
+            f"{stats['reached']} reached the terminal interface, {stats.get('inside_acceptance_box', '?')} of them "
+            f"inside the acceptance box and {stats.get('within_limits', '?')} within every path limit; "
+            f"{stats['failed']} not successful")
 
 
 def errors_markdown(stats: dict, reference=None) -> str:
@@ -152,6 +187,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
             for k, v in trajs[s].items():
                 traj.setdefault(k, []).extend(v)
     stats = summary_statistics(rows)
+    scenario = flown_scenario(meta)
     stats["coverage"] = {"requested": cov["requested"], "done": len(records), "cut_lines": cov["cut"],
                          "invalid_lines": cov["invalid"], "quarantined_lines": cov["quarantined"]}
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
@@ -170,8 +206,12 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
           f"Covers {c['done']} of {c['requested']} requested samples"
           + (f" (**incomplete**: {c['requested'] - c['done']} not run; re-run the campaign command to finish it)"
              if c["done"] < c["requested"] else "") + ": "
-          f"{stats['successful']} inside the acceptance box, {stats['reached']} reached the terminal interface, "
-          f"{stats['failed']} not successful."]
+          + counts_sentence(stats) + "."]
+    limits_text = _limits_text(scenario)
+    if limits_text:
+        md += ["", "Verdict: a sample succeeds when it reached the terminal interface, ended inside every "
+               "acceptance criterion and held every path limit at every log sample and integrator step. "
+               "Path limits: " + limits_text + "."]
     if stats["inside_box"]:
         md += ["", "Acceptance box (scenario `terminal` tolerances), samples inside each criterion: " + ", ".join(
             f"{k} {v}" for k, v in stats["inside_box"].items()) + "."]
@@ -183,7 +223,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     if stats["errors"]:
         md += ["## Terminal errors (samples that reached the terminal interface)", "",
                errors_markdown(stats, reference if reference is not None
-                               else getattr(flown_scenario(meta), "reference_results", None)), "",
+                               else getattr(scenario, "reference_results", None)), "",
                "ΔR is the range to go along the final heading (+ short of the target); the cross-range "
                "is reported separately.", ""]
     if stats.get("inside_km"):
@@ -211,6 +251,19 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     with open(path, "w") as f:
         f.write("\n".join(md) + "\n")
     return path
+
+
+def _limits_text(scenario) -> str:
+    """The path limits of the flown scenario and their tolerance ('' when the scenario or its
+    vehicle file cannot be read here)."""
+    if scenario is None:
+        return ""
+    try:
+        limits = scenario.path_limits()
+    except DrakeEntryError:
+        return ""
+    return (", ".join(f"{lim.name} {lim.bound_text()}" for lim in limits)
+            + f"; tolerance {100 * scenario.terminal.path_limit_tolerance:g} % of each limit")
 
 
 def _method(rows: dict) -> str:

@@ -20,6 +20,7 @@ from .guidance.drag_energy.spec import DragEnergy
 from .planet import Earth
 from .schedules import VARIABLES, Schedule
 from .vehicles import Vehicle, load_vehicle
+from .verdict import PathLimit, vehicle_path_limits
 
 
 @dc.dataclass
@@ -58,6 +59,9 @@ class TerminalSpec:
     altitude_tolerance_km: Optional[float] = None  # acceptance box: |h - altitude_km| <= this
     mach_tolerance: Optional[float] = None  # acceptance box: |M - mach| <= this
     distance_tolerance_km: Optional[float] = None  # acceptance box: distance to the target <= this
+    # relative tolerance on every path limit (vehicle and mission): a limit counts as held up to
+    # limit + this x |limit|, at every log sample and integrator step; 0: a limit is a limit
+    path_limit_tolerance: float = 0.0
 
 
 @dc.dataclass
@@ -172,6 +176,13 @@ class Scenario:
     def make_atmosphere(self) -> Atmosphere:
         return atmosphere_from_spec(self.atmosphere)
 
+    def path_limits(self, vehicle: Vehicle | None = None) -> list[PathLimit]:
+        """The path limits every flight must hold (drake_entry.verdict): the vehicle's heat
+        flux, dynamic pressure, loads and bank limit, then the guidance spec's mission limits.
+        ``vehicle``: the already built vehicle (default: ``make_vehicle()``)."""
+        v = self.make_vehicle() if vehicle is None else vehicle
+        return vehicle_path_limits(v.limits, v.bank_limit) + list(self.guidance.path_limits(self))
+
     def initial_state(self) -> np.ndarray:
         """Entry state x0 = [h, lon, lat, V, gamma, psi] in SI / rad (h: the state altitude,
         converted from the geodetic entry altitude with altitude_datum 'ellipsoid')."""
@@ -246,6 +257,7 @@ class Scenario:
         for name in ("altitude_tolerance_km", "mach_tolerance", "distance_tolerance_km"):
             if getattr(t, name) is not None:
                 check_range(f"terminal.{name}", getattr(t, name), 0.0, 1e5)
+        check_range("terminal.path_limit_tolerance", t.path_limit_tolerance, 0.0, 0.5)
         for col, v in self.reference_results.errors.items():
             if col not in ERROR_COLUMNS:
                 raise ScenarioError(f"reference_results.errors: '{col}' is not a terminal-error column; allowed: "

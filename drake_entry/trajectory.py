@@ -21,6 +21,9 @@ class Trajectory:
       reason: why the run stopped. wall_time: [s].
       extra: other logged signals by name, (n, k) arrays.
       extra_columns: table column names (units in them) of those signals, by name.
+      steps: the state, conditions, bank and alpha at every integrator step (a Trajectory
+        without extras), where the runner logged them: path limits and peaks are evaluated on
+        both (``flown``), so nothing between two log samples is missed.
     """
 
     time: np.ndarray
@@ -32,6 +35,16 @@ class Trajectory:
     wall_time: float
     extra: dict = dc.field(default_factory=dict)
     extra_columns: dict = dc.field(default_factory=dict)
+    steps: "Trajectory | None" = None
+
+    def flown_time(self) -> np.ndarray:
+        """The times [s] of every flown sample: the log samples, then the integrator steps."""
+        return self.time if self.steps is None else np.concatenate([self.time, self.steps.time])
+
+    def flown(self, name: str) -> np.ndarray:
+        """``column(name)`` at every flown sample (``flown_time``'s order)."""
+        return self.column(name) if self.steps is None else np.concatenate([self.column(name),
+                                                                             self.steps.column(name)])
 
     def column(self, name: str) -> np.ndarray:
         if name in STATE_NAMES:
@@ -59,7 +72,7 @@ class Trajectory:
 
 
 def metrics(tr: Trajectory, limits: PathLimits | None = None) -> dict:
-    """Peak path quantities and the heat load of a trajectory, with the relative margins
+    """Peak path quantities (over every flown sample, ``Trajectory.flown``) and the heat load of a trajectory, with the relative margins
     1 - peak/limit (negative = violated) when ``limits`` are given.
 
     Keys: peak_heat_flux_W_m2, peak_dynamic_pressure_Pa, peak_normal_load_g,
@@ -68,10 +81,10 @@ def metrics(tr: Trajectory, limits: PathLimits | None = None) -> dict:
     (for the finite limits only).
     """
     heat = tr.column("heat_flux")
-    out = {"peak_heat_flux_W_m2": float(heat.max()),
-           "peak_dynamic_pressure_Pa": float(tr.column("dynamic_pressure").max()),
-           "peak_normal_load_g": float(tr.column("normal_load").max()),
-           "peak_total_load_g": float(tr.column("total_load").max()),
+    out = {"peak_heat_flux_W_m2": float(tr.flown("heat_flux").max()),
+           "peak_dynamic_pressure_Pa": float(tr.flown("dynamic_pressure").max()),
+           "peak_normal_load_g": float(tr.flown("normal_load").max()),
+           "peak_total_load_g": float(tr.flown("total_load").max()),
            "heat_load_J_m2": float(np.sum(0.5 * (heat[1:] + heat[:-1]) * np.diff(tr.time)))}
     if limits is not None:
         m = limits.margins(heat_flux=out["peak_heat_flux_W_m2"], dynamic_pressure=out["peak_dynamic_pressure_Pa"],

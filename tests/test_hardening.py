@@ -124,7 +124,7 @@ def test_report_covers_partial_killed_and_all_failed_campaigns(tmp_path, capsys)
     path = _scenario_file(tmp_path, "pre_guidance_min_s: 100.0", "pre_guidance_min_s: 99999.0")
     out = _run(tmp_path, path, runs=2, out="failed")
     text = Path(write_report(out)).read_text()
-    assert "Covers 2 of 2 requested samples: 0 inside the acceptance box" in text
+    assert "Covers 2 of 2 requested samples: 0 successful" in text
     assert "guidance never engaged" in text
     # a killed extension: the report counts the rows on disk, not the old Parquet
     out = _run(tmp_path, runs=2, out="ext")

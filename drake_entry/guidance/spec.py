@@ -30,6 +30,11 @@ class GuidanceSpecBase:
         whose mission gives V_f rather than Mach overrides this)."""
         return self.terminal_mach * speed_of_sound
 
+    def path_limits(self, scenario) -> list:
+        """The mission's own path limits (drake_entry.verdict.PathLimit) that every flight must
+        hold besides the vehicle's; none by default."""
+        return []
+
     def validate(self, scenario) -> None:
         """Raise a one-line ScenarioError on a bad field (``scenario`` gives the context)."""
         check_range("guidance.period_s", self.period_s, 0.01, 60.0)

@@ -7,6 +7,7 @@ from ...errors import ScenarioError, check_range
 from ...planning.scvx.engine import ScvxSettings
 from ...planning.scvx.entry import EntryProblemSettings
 from ...planning.scvx.mission import ScvxMission
+from ...verdict import PathLimit
 from ..spec import GuidanceSpecBase
 
 #: spec fields passed to ScvxMission and EntryProblemSettings under the same names (max_iterations
@@ -77,6 +78,11 @@ class Scvx(GuidanceSpecBase):
     def planner_settings(self) -> tuple[EntryProblemSettings, ScvxSettings]:
         return (_named(lambda: EntryProblemSettings(**{k: getattr(self, k) for k in PROBLEM_FIELDS})),
                 _named(lambda: ScvxSettings.for_solver(self.solver, max_iterations=self.max_iterations)))
+
+    def path_limits(self, scenario) -> list:
+        """The flight-path-angle bounds of eq. 70 (flight_path_bounds_deg), held in flight."""
+        lo, hi = (math.radians(v) for v in self.flight_path_bounds_deg)
+        return [PathLimit("flight_path", "gamma", upper=hi, lower=lo, unit="deg", scale=180.0 / math.pi)]
 
     def validate(self, scenario) -> None:
         super().validate(scenario)

@@ -15,7 +15,8 @@ from ..spec import GuidanceSpecBase
 MISSION_FIELDS = ("site_radius_m", "final_altitude_m", "final_altitude_margin_m", "final_mach_max",
                   "final_vertical_speed_min_m_s", "flight_path_bounds_deg", "heading_bounds_deg", "bank_min_deg",
                   "alpha_deg", "alpha_speeds_m_s", "alpha_bounds_deg", "alpha_rate_limit_deg_s")
-PROBLEM_FIELDS = ("formulation", "objective", "segments", "nodes_per_segment")
+PROBLEM_FIELDS = ("formulation", "objective", "segments", "nodes_per_segment", "path_margin",
+                  "flight_path_margin_deg")
 
 
 @dc.dataclass
@@ -58,6 +59,11 @@ class Scvx(GuidanceSpecBase):
     objective: str = "heat_load"
     segments: int = 33
     nodes_per_segment: int = 4
+    # design margins of the plans flown (not the paper's): heat flux and load this fraction
+    # inside the vehicle's limits at the nodes, gamma this far [deg] under the upper flight-path
+    # bound, so that the closed loop, dispersed, holds the limits its verdict checks
+    path_margin: float = 0.02
+    flight_path_margin_deg: float = 0.1
     max_iterations: int = 100
     solver: str = "clarabel"
     # on-board re-planning from the navigation estimate every replan_period_s [s] (0 = fly the

@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from ...planning.result import PlanResult
-from ...planning.swarm.evaluator import HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
+from ...planning.swarm.evaluator import CONTROL_COLUMNS, HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
 from ...planning.swarm.search import SearchResult, problem_from_scenario, search
 from ...systems.swarm_bank_guidance import SwarmBankGuidance
 from ..interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
@@ -46,10 +46,15 @@ class SwarmPlan(PlanResult):
     violations: dict = dc.field(default_factory=dict)
 
     def evaluate(self, at) -> dict:
-        """The planned trajectory's HISTORY_COLUMNS interpolated at times ``at`` [s]."""
-        h = self.evaluation.history[0]
+        """The planned trajectory's HISTORY_COLUMNS at times ``at`` [s]: the states, commands and
+        flight conditions interpolated between the guidance steps, alpha and bank the actuators'
+        own path at every sub-step (what the plan flew: flown open loop these controls reproduce
+        the plan; the guidance-step samples interpolated linearly would not)."""
+        h, u = self.evaluation.history[0], self.evaluation.controls[0]
         t = np.atleast_1d(np.asarray(at, float))
-        return {name: np.interp(t, h[:, 0], h[:, i]) for i, name in enumerate(HISTORY_COLUMNS)}
+        out = {name: np.interp(t, h[:, 0], h[:, i]) for i, name in enumerate(HISTORY_COLUMNS)}
+        out.update({name: np.interp(t, u[:, 0], u[:, i]) for i, name in enumerate(CONTROL_COLUMNS) if i})
+        return out
 
 
 def verify(problem: SwarmProblem, ev: Evaluation) -> dict:

@@ -135,6 +135,9 @@ class EntryProblemSettings:
         whose relaxed u modulates the load sharply between nodes; 0 for a bank state, whose
         plans pass the check without it (with 0.02 the 9 x 9 abort map lost 5 of 51 feasible
         EIPs: the margin shrinks the reachable set).
+      flight_path_margin_deg: the nodes keep gamma this far [deg] below the mission's upper
+        flight-path bound (eq. 70's skip limit), so that the plan flown, and a dispersed closed
+        loop flying it, stays under the bound; 0: the paper's.
     """
 
     segments: int = 33
@@ -146,6 +149,7 @@ class EntryProblemSettings:
     max_lossless_gap: float = 0.01
     lossless_rate_limit: bool = True
     path_margin: float | None = None
+    flight_path_margin_deg: float = 0.0
 
     def __post_init__(self):
         if self.formulation not in FORMULATIONS:
@@ -170,6 +174,9 @@ class EntryProblemSettings:
             self.path_margin = DEFAULT_PATH_MARGIN[FORMULATIONS[self.formulation].bank]
         if not 0.0 <= self.path_margin <= 0.5:
             raise ScenarioError(f"EntryProblemSettings.path_margin = {self.path_margin} must be in [0, 0.5]")
+        if not 0.0 <= self.flight_path_margin_deg <= 5.0:
+            raise ScenarioError(f"EntryProblemSettings.flight_path_margin_deg = {self.flight_path_margin_deg} must be "
+                                f"in [0, 5] deg")
         if self.heading_sign not in (-1.0, 0.0, 1.0):
             raise ScenarioError(f"EntryProblemSettings.heading_sign = {self.heading_sign} must be -1, 0 or +1")
 
@@ -249,7 +256,8 @@ class EntryProblem(ConvexifiableProblem):
         sign = settings.heading_sign or heading_regulariser_sign(self.x0, self.site_lat)
         weight = settings.heading_weight if (f.bank == "lossless" and not self.n_bank_floor) else 0.0
         self.heading_lambda = sign * weight / final_time_guess  # per rad s, scaled objective
-        self._gamma_bounds = np.radians(mission.flight_path_bounds_deg)
+        self._gamma_bounds = np.radians(mission.flight_path_bounds_deg) - np.radians(
+            [0.0, settings.flight_path_margin_deg])
         self.rate_chords = f.bank == "lossless" and settings.lossless_rate_limit
         #: heat flux [W/m^2] and load [g] bounds at the nodes: the vehicle's less the path margin
         self.node_limits = ((1.0 - settings.path_margin) * limits.heat_flux_max,

@@ -125,6 +125,9 @@ class Evaluation:
       peak_total_load_g: largest total load factor.
       reversals: bank reversals flown. trajectories: members evaluated.
       history: per member, the recorded steps (HISTORY_COLUMNS), when asked.
+      controls: per member, the actuators' positions at every actuator sub-step, when asked:
+        (m, 3) [time s, alpha rad, bank rad], what the plant flew between the guidance steps
+        (CONTROL_COLUMNS).
     """
 
     J: np.ndarray
@@ -141,18 +144,22 @@ class Evaluation:
     reversals: np.ndarray
     trajectories: int
     history: list | None = None
+    controls: list | None = None
 
 
 #: columns of Evaluation.history tables
 HISTORY_COLUMNS = ("time_s", "altitude_m", "longitude_rad", "latitude_rad", "velocity_m_s", "flight_path_rad",
                    "heading_rad", "alpha_rad", "bank_rad", "bank_command_rad", "alpha_command_rad", "mach",
                    "dynamic_pressure_Pa", "heat_flux_W_m2", "total_load_g")
+#: columns of Evaluation.controls tables
+CONTROL_COLUMNS = ("time_s", "alpha_rad", "bank_rad")
 
 
 def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = False) -> Evaluation:
     """Fly every sigma0 [rad] of the population (array) and return its Evaluation; ``sigma_f``
     [rad]: per-member eq. 17 end banks (the two-parameter search; default the problem's); with
-    ``record`` each member's step-by-step history (HISTORY_COLUMNS) is kept for plots."""
+    ``record`` each member's step-by-step history (HISTORY_COLUMNS) and its actuators' path at
+    every sub-step (CONTROL_COLUMNS) are kept."""
     p, pl, veh = problem, problem.planet, problem.vehicle
     sigma0 = np.atleast_1d(np.asarray(sigma0, float))
     n = sigma0.size
@@ -175,6 +182,7 @@ def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = Fals
     dt = p.guidance_step_s
     steps = max(1, int(round(dt / p.actuator_substep_s)))
     history = [[] for _ in range(n)] if record else None
+    controls = [[] for _ in range(n)] if record else None
     t = 0.0
     while active.any() and t < p.max_time_s:
         idx = np.flatnonzero(active)
@@ -208,6 +216,10 @@ def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = Fals
         m = idx.size
         alpha[idx], bank[idx], alpha_rate[idx], bank_rate[idx] = pos[:m], pos[m:], rates[:m], rates[m:]
         a_path, b_path = path[:, :m], path[:, m:]
+        if record:
+            sub = t + dt * np.arange(steps) / steps  # each step's last point is the next step's first
+            for j, i in enumerate(idx):
+                controls[i].append(np.column_stack([sub, a_path[:-1, j], b_path[:-1, j]]))
         mid = steps // 2 if steps % 2 == 0 else None
         a_mid = a_path[mid] if mid is not None else 0.5 * (a_path[steps // 2] + a_path[steps // 2 + 1])
         b_mid = b_path[mid] if mid is not None else 0.5 * (b_path[steps // 2] + b_path[steps // 2 + 1])
@@ -238,8 +250,9 @@ def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = Fals
     J = np.where(reached, J, np.inf)
     if record:
         history = [np.array(h) for h in history]
+        controls = [np.vstack(c_i) for c_i in controls]
     return Evaluation(J, ds, c, dh, dV, final.T.copy(), t_end, reached, peaks[0], peaks[1], peaks[2], reversals, n,
-                      history)
+                      history, controls)
 
 
 def range_error(problem: SwarmProblem, lon, lat):

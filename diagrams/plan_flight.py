@@ -1,9 +1,9 @@
-"""Fly an SCvx plan's real bank with the Drake Simulator (paper 001 Table 3: the propagated
-miss) and compare the flown DRS point with the plan and the site.
+"""Fly an SCvx plan's real bank and alpha with the Drake Simulator through the closed loop's
+actuators (paper 001 Table 3: the propagated miss) and compare the flown DRS point with the
+plan and the site; the path limits are checked at every log sample and integrator step.
 
-    TrajectorySource(sigma(t)) --bank--> EntryVehicle --state--> VectorLogSink
-    ScheduleSource(alpha(V)) <--state-- EntryVehicle;  alpha --> EntryVehicle
-    (or TrajectorySource(alpha(t)) --alpha--> EntryVehicle where the plan planned alpha)
+    TrajectorySource(sigma(t + lead)) --> BankActuator (sampled every period) --bank--> EntryVehicle
+    TrajectorySource(alpha(t + lead)) or ScheduleSource(alpha(V)) --> AlphaActuator --alpha--> EntryVehicle
 
 The bank (atan2(u2, u1) of the lossless plan, the bank state of the direct ones) is the plan's
 segment polynomial sampled densely into a C2 spline; |u| < 1 in a relaxed plan means the flown
@@ -21,12 +21,15 @@ from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.atmosphere import Atmosphere
-from drake_entry.dynamics import flight_conditions
+from drake_entry.diagrams.common import add_step_loggers, collect_trajectory
 from drake_entry.planet import Earth
-from drake_entry.planning.scvx.planner import PROPAGATION_TOLERANCE_M, ScvxPlan, terminal_distance
+from drake_entry.planning.scvx.planner import (PROPAGATION_TOLERANCE_M, FlightCheck, ScvxPlan, plan_path_limits,
+                                               terminal_distance)
+from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.systems.vehicle import EntryVehicle
 from drake_entry.vehicles import Vehicle
+from drake_entry.verdict import check_limits
 
 #: acceptance of a flown plan (issue 13): DRS point within this of the plan and of the site [m]
 PLAN_TOLERANCE_M = PROPAGATION_TOLERANCE_M
@@ -43,8 +46,10 @@ class PlanFlight:
       from_site_m: flown DRS point to the site [m].
       drs: flown geodetic altitude [m], Mach and vertical speed [m/s] at t_f; drs_ok: all in the DRS box
         (altitude window, Mach, vertical speed; miss within SITE_TOLERANCE_M).
-      peaks: flown max heat flux [W/m^2] and total load [g].
-      ok: from_plan_m <= PLAN_TOLERANCE_M and the DRS box met.
+      peaks: flown max heat flux [W/m^2] and total load [g] (log samples and integrator steps).
+      ok: from_plan_m <= PLAN_TOLERANCE_M, the DRS box met and every path limit held.
+      checks: the path limits (vehicle q, n, bank; the mission's gamma bounds) on the flight.
+      trajectory: the flown Trajectory (with its integrator steps).
     """
 
     time: np.ndarray
@@ -55,32 +60,65 @@ class PlanFlight:
     drs_ok: bool
     peaks: dict
     ok: bool
+    checks: list = dc.field(default_factory=list)
+    trajectory: object = None
+
+    def violations_text(self) -> str:
+        return "; ".join(c.text() for c in self.checks if not c.held)
 
 
 def fly_plan(plan: ScvxPlan, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, *,
-             accuracy: float = 1e-9, samples_per_segment: int = 32, log_points: int = 2000) -> PlanFlight:
-    """Fly ``plan``'s bank from its entry state to its t_f with the Drake Simulator (RK5)."""
+             accuracy: float = 1e-9, samples_per_segment: int = 32, log_points: int = 2000,
+             flight: FlightCheck | None = None) -> PlanFlight:
+    """Fly ``plan``'s bank and alpha from its entry state to its t_f with the Drake Simulator
+    (RK5 at ``accuracy``) as the closed loop flies them (``flight``, default the plan's own
+    FlightCheck): the commands, read ``lead_s`` ahead on the plan, sampled every ``period_s``
+    (the guidance period) into the shared BankActuator (the vehicle's bank limits) and
+    AlphaActuator (the mission's alpha bounds and rate limit); ``period_s=None`` feeds the
+    plan's bank and alpha to the vehicle directly (no actuator)."""
     problem, tf = plan.problem, plan.final_time
     mission = problem.mission
+    flight = flight or plan.flight or FlightCheck()
+    period_s = flight.period_s
+    lead_s = flight.lead_s if period_s is not None else 0.0
     tt, bank, planned_alpha = plan.control_samples(samples_per_segment)
 
     def spline(values):
         return TrajectorySource(PiecewisePolynomial.CubicWithContinuousSecondDerivatives(
-            tt, np.reshape(values, (1, -1)), periodic_end_condition=False))
+            tt - lead_s, np.reshape(values, (1, -1)), periodic_end_condition=False))
 
     scheduled_alpha = planned_alpha is None
     builder = DiagramBuilder()
     plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, planet, atmosphere,
                                                            initial_state=plan.states[0, :6]))
-    source = builder.AddNamedSystem("bank", spline(bank))
-    builder.Connect(source.get_output_port(), plant.GetInputPort("bank"))
+    bank_source = builder.AddNamedSystem("bank_plan", spline(bank)).get_output_port()
     if scheduled_alpha:
-        alpha = builder.AddNamedSystem("alpha", ScheduleSource(problem.alpha, planet))
-        builder.Connect(plant.GetOutputPort("state"), alpha.GetInputPort("state"))
+        schedule = builder.AddNamedSystem("alpha_plan", ScheduleSource(problem.alpha, planet))
+        builder.Connect(plant.GetOutputPort("state"), schedule.GetInputPort("state"))
+        alpha_source = schedule.get_output_port()
     else:
-        alpha = builder.AddNamedSystem("alpha", spline(planned_alpha))
-    builder.Connect(alpha.get_output_port(), plant.GetInputPort("alpha"))
-    logger = LogVectorOutput(plant.GetOutputPort("state"), builder, tf / log_points)
+        alpha_source = builder.AddNamedSystem("alpha_plan", spline(planned_alpha)).get_output_port()
+    if period_s is None:
+        bank_out, alpha_out = bank_source, alpha_source
+    else:
+        lo, hi = np.radians(mission.alpha_bounds_deg)
+        bank_act = builder.AddNamedSystem("bank_actuator", BankActuator(
+            bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit, accel_limit=vehicle.bank_accel_limit,
+            initial_bank=float(plan.bank[0]), period=period_s))
+        alpha_act = builder.AddNamedSystem("alpha_actuator", AlphaActuator(
+            alpha_min=float(lo), alpha_max=float(hi), rate_limit=math.radians(mission.alpha_rate_limit_deg_s),
+            accel_limit=math.radians(flight.alpha_acceleration_deg_s2), initial_alpha=float(plan.alpha[0]),
+            period=period_s))
+        builder.Connect(bank_source, bank_act.get_input_port())
+        builder.Connect(alpha_source, alpha_act.get_input_port())
+        bank_out, alpha_out = bank_act.GetOutputPort("bank"), alpha_act.GetOutputPort("alpha")
+    builder.Connect(bank_out, plant.GetInputPort("bank"))
+    builder.Connect(alpha_out, plant.GetInputPort("alpha"))
+    signals = {"state": plant.GetOutputPort("state"), "conditions": plant.GetOutputPort("flight_conditions"),
+               "bank": bank_out, "alpha": alpha_out}
+    loggers = {name: LogVectorOutput(port, builder, tf / log_points) for name, port in signals.items()}
+    sources = {name: (port.get_system().get_name(), port.get_name()) for name, port in signals.items()}
+    step_loggers = add_step_loggers(builder, signals)
     diagram = builder.Build()
     simulator = Simulator(diagram)
     integrator = ResetIntegratorFromFlags(simulator, "runge_kutta5", 10.0)
@@ -88,24 +126,20 @@ def fly_plan(plan: ScvxPlan, vehicle: Vehicle, planet: Earth, atmosphere: Atmosp
     simulator.get_mutable_context().SetAccuracy(accuracy)
     simulator.Initialize()
     simulator.AdvanceTo(tf)
-    log = logger.FindLog(simulator.get_context())
-    T, X = log.sample_times(), log.data().T
-    xf = diagram.GetSubsystemByName("vehicle").GetOutputPort("state").Eval(
-        diagram.GetSubsystemContext(diagram.GetSubsystemByName("vehicle"), simulator.get_context()))
+    tr = collect_trajectory(diagram, loggers, simulator.get_context(), sources=sources, reason="t_f", wall_time=0.0,
+                            step_loggers=step_loggers)
+    xf = tr.state[-1]
     site = mission.site(planet)
     from_site = planet.great_circle_distance(xf[1], xf[2], *site)
-    alphas = ([float(problem.alpha(float(x[3]))) for x in X] if scheduled_alpha
-              else list(np.interp(T, tt, planned_alpha)))
-    a_f = float(problem.alpha(float(xf[3]))) if scheduled_alpha else float(planned_alpha[-1])
-    cf = flight_conditions(xf, 0.0, a_f, vehicle, planet, atmosphere)
     h_geo = float(planet.atmospheric_altitude(xf[0], xf[2]))
-    drs = {"altitude_m": h_geo, "mach": float(cf.mach), "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))}
+    mach = float(tr.column("mach")[-1])
+    drs = {"altitude_m": h_geo, "mach": mach, "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))}
     drs_ok = (mission.final_altitude_m[0] <= h_geo <= mission.final_altitude_m[1]
-              and cf.mach <= mission.final_mach_max and drs["vertical_speed_m_s"] >= mission.final_vertical_speed_min_m_s
+              and mach <= mission.final_mach_max and drs["vertical_speed_m_s"] >= mission.final_vertical_speed_min_m_s
               and from_site <= SITE_TOLERANCE_M)
-    conds = [flight_conditions(x, 0.0, a, vehicle, planet, atmosphere) for x, a in zip(X, alphas)]
-    peaks = {"heat_flux_W_m2": float(max(c.heat_flux for c in conds)),
-             "total_load_g": float(max(c.total_load for c in conds))}
+    checks = check_limits(tr.flown_time(), tr.flown, plan_path_limits(plan))
+    peaks = {"heat_flux_W_m2": float(tr.flown("heat_flux").max()), "total_load_g": float(tr.flown("total_load").max())}
     from_plan = terminal_distance(planet, xf, plan.states[-1])
-    return PlanFlight(T, X, from_plan, float(from_site), drs, bool(drs_ok), peaks,
-                      bool(from_plan <= PLAN_TOLERANCE_M and drs_ok))
+    within = all(c.held for c in checks)
+    return PlanFlight(tr.time, tr.state, from_plan, float(from_site), drs, bool(drs_ok), peaks,
+                      bool(from_plan <= PLAN_TOLERANCE_M and drs_ok and within), checks, tr)

@@ -8,6 +8,37 @@ import math
 import numpy as np
 
 
+#: the position loop's bandwidth omega [rad/s] of the closed loop's actuators (systems/actuators.py)
+BANDWIDTH_RAD_S = 2.0
+#: the sampled actuators' integration sub-step [s]
+SUBSTEP_S = 0.02
+
+
+def command_lag(period: float, bandwidth: float = BANDWIDTH_RAD_S) -> float:
+    """Low-frequency lag [s] of a command sampled and held every ``period`` [s] and tracked by
+    the linear law: period / 2 for the hold plus 1 / omega, the group delay of the critically
+    damped loop 4 omega^2 / (s + 2 omega)^2 (1.0 s at a 1-s period and omega = 2 rad/s)."""
+    return 0.5 * period + 1.0 / bandwidth
+
+
+def sampled_response(commands, period: float, x0: float, *, lower: float, upper: float, rate_limit: float,
+                     accel_limit: float, bandwidth: float = BANDWIDTH_RAD_S, substep: float = SUBSTEP_S):
+    """The sampled actuator (systems.actuators.LimitedActuator with a period) from x0 at rest
+    under ``commands[k]`` [rad] held over [k period, (k+1) period): (time [s], x [rad],
+    x_dot [rad/s]) at every sub-step, the samples the LeafSystem interpolates (C1 cubic
+    Hermite) between; the same ``integrate_actuator`` steps."""
+    steps = max(1, int(round(period / substep)))
+    h = period / steps
+    t, x, v = [0.0], [float(x0)], [0.0]
+    limits = dict(lower=lower, upper=upper, rate_limit=rate_limit, accel_limit=accel_limit, bandwidth=bandwidth)
+    for k, command in enumerate(commands):
+        s, r = integrate_actuator(x[-1], v[-1], float(command), h, steps, **limits)
+        t.extend(k * period + h * np.arange(1, steps + 1))
+        x.extend(s[1:])
+        v.extend(r[1:])
+    return np.array(t), np.array(x), np.array(v)
+
+
 def _clip(v: float, lower: float, upper: float) -> float:
     return lower if v < lower else (upper if v > upper else v)
 

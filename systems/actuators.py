@@ -23,13 +23,14 @@ from __future__ import annotations
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.actuator import actuator_rates, integrate_actuator
+from drake_entry.actuator import BANDWIDTH_RAD_S, SUBSTEP_S, actuator_rates, integrate_actuator
 from drake_entry.errors import ScenarioError
 
 
 class LimitedActuator(LeafSystem):
     def __init__(self, *, name: str, lower: float, upper: float, rate_limit: float, accel_limit: float,
-                 bandwidth: float = 2.0, initial: float = 0.0, period: float | None = None, substep: float = 0.02):
+                 bandwidth: float = BANDWIDTH_RAD_S, initial: float = 0.0, period: float | None = None,
+                 substep: float = SUBSTEP_S):
         """Args: name of the ports; lower, upper [rad] position limits; rate_limit [rad/s];
         accel_limit [rad/s^2]; bandwidth omega [rad/s] of the position loop (the rate loop
         runs at 4 omega); initial position [rad]; period [s] for the sampled realisation
@@ -87,8 +88,9 @@ class LimitedActuator(LeafSystem):
 class BankActuator(LimitedActuator):
     """Bank actuator: |sigma| <= bank_limit, ports "bank_command" -> "bank", "bank_rate"."""
 
-    def __init__(self, *, bank_limit: float, rate_limit: float, accel_limit: float, bandwidth: float = 2.0,
-                 initial_bank: float = 0.0, period: float | None = None, substep: float = 0.02):
+    def __init__(self, *, bank_limit: float, rate_limit: float, accel_limit: float,
+                 bandwidth: float = BANDWIDTH_RAD_S, initial_bank: float = 0.0, period: float | None = None,
+                 substep: float = SUBSTEP_S):
         """Args: bank_limit [rad] (> 0), the rest as LimitedActuator."""
         if not bank_limit > 0:
             raise ScenarioError(f"BankActuator.bank_limit must be > 0, got {bank_limit}")
@@ -102,8 +104,8 @@ class AlphaActuator(LimitedActuator):
     limits (papers 001 and 004 command alpha), ports "alpha_command" -> "alpha", "alpha_rate"."""
 
     def __init__(self, *, alpha_min: float, alpha_max: float, rate_limit: float, accel_limit: float,
-                 bandwidth: float = 2.0, initial_alpha: float = 0.0, period: float | None = None,
-                 substep: float = 0.02):
+                 bandwidth: float = BANDWIDTH_RAD_S, initial_alpha: float = 0.0, period: float | None = None,
+                 substep: float = SUBSTEP_S):
         """Args: alpha_min < alpha_max [rad], the rest as LimitedActuator."""
         super().__init__(name="alpha", lower=alpha_min, upper=alpha_max, rate_limit=rate_limit,
                          accel_limit=accel_limit, bandwidth=bandwidth, initial=initial_alpha, period=period,

@@ -43,9 +43,10 @@ class FlownPlan:
         t, bank, alpha = plan.control_samples()
         return FlownPlan(plan, start, t, bank, alpha)
 
-    def commands(self, t: float, speed: float) -> tuple[float, float]:
-        """(bank, alpha) [rad] at flight time t [s] and speed [m/s] (held after the plan's end)."""
-        s = t - self.start
+    def commands(self, t: float, speed: float, lead: float = 0.0) -> tuple[float, float]:
+        """(bank, alpha) [rad] at flight time t [s] and speed [m/s] (held after the plan's end),
+        read ``lead`` [s] ahead on the plan (the actuators' lag)."""
+        s = t + lead - self.start
         bank = float(np.interp(s, self.time, self.bank))
         alpha = (float(np.interp(s, self.time, self.alpha)) if self.alpha is not None
                  else float(self.plan.problem.alpha(speed)))
@@ -66,11 +67,13 @@ class ScvxMemory:
 
 class ScvxGuidance(LeafSystem):
     def __init__(self, plan: ScvxPlan, *, period: float = 1.0, replan_period: float = 0.0,
-                 min_time_to_go: float = 300.0, scvx_settings=None):
+                 min_time_to_go: float = 300.0, scvx_settings=None, lead: float = 0.0):
         """Args: plan (the pre-flight plan, flown from t = 0); period [s] of the re-plan check;
         replan_period [s] (0: no re-planning); min_time_to_go [s]: no re-plan with less left;
-        scvx_settings: ScvxSettings of the re-plans."""
+        scvx_settings: ScvxSettings of the re-plans; lead [s]: the commands are read this far
+        ahead on the plan (the actuators' lag; the plans are verified flown the same way)."""
         super().__init__()
+        self.lead = lead
         self.replan_period, self.min_time_to_go, self.scvx_settings = replan_period, min_time_to_go, scvx_settings
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         first = ScvxMemory(FlownPlan.of(plan, 0.0), replan_period if replan_period > 0 else np.inf)
@@ -89,7 +92,7 @@ class ScvxGuidance(LeafSystem):
 
     def _commands(self, context):
         x = self.est_port.Eval(context)
-        return self.memory(context).flown.commands(context.get_time(), float(x[3]))
+        return self.memory(context).flown.commands(context.get_time(), float(x[3]), self.lead)
 
     def _stats(self, context, output):
         mem = self.memory(context)

@@ -74,9 +74,10 @@ def test_guidance_system_serves_the_plan_bank_and_alpha(setup):
 
 def test_nominal_closed_loop_reaches_the_site_with_replanning(setup):
     """The nominal mission flown through the shared closed loop (navigation, bank and alpha
-    actuators): the pre-flight plan alone ends 21.5 km from the site (measured: the actuators' lag
-    accumulates, mostly cross-range), re-planned every 200 s from the estimate it ends at the
-    planned 10 km, inside the acceptance box (15 km, Mach <= 1), stopping at the DRS altitude."""
+    actuators): re-planned every 200 s from the estimate it ends at the planned 10 km, inside the
+    acceptance box (15 km, Mach <= 1), every path limit held, stopping at the DRS altitude. The
+    pre-flight plan alone lands inside the box too (9.6 km measured) because the guidance reads
+    the plan 1 s ahead (the actuators' lag); read without the lead it ends 21 km away."""
     from drake_entry.diagrams.closed_loop import fly
 
     assert setup.planner.success, setup.planner.message
@@ -91,9 +92,10 @@ def test_nominal_closed_loop_reaches_the_site_with_replanning(setup):
     open_loop = dc.replace(setup, scenario=dc.replace(
         setup.scenario, guidance=dc.replace(setup.scenario.guidance, replan_period_s=0.0)))
     plain = fly(open_loop)
-    assert plain.guidance.plans == 0
-    assert plain.errors["distance_m"] > flown.errors["distance_m"]
-    assert math.isfinite(plain.errors["distance_m"])
+    assert plain.guidance.plans == 0 and plain.success, plain.message
+    no_lead = fly(dc.replace(open_loop, scenario=dc.replace(
+        open_loop.scenario, guidance=dc.replace(open_loop.scenario.guidance, command_lead_s=0.0))))
+    assert no_lead.errors["distance_m"] > 15e3 and not no_lead.success and not no_lead.verdict.inside_box
     assert np.isfinite(flown.guidance.planning_wall_s) and flown.guidance.planning_wall_s > 0
 
 

@@ -19,9 +19,6 @@ from ...systems.scvx_guidance import ScvxGuidance
 from ..interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
 
 GUIDANCE_SYSTEM = "scvx_guidance"
-#: alpha actuator acceleration limit [deg/s^2] (not in paper 001; a labelled choice well above
-#: what a 1 deg/s planned alpha rate needs)
-ALPHA_ACCELERATION_DEG_S2 = 5.0
 
 
 class ScvxMethod(GuidanceMethod):
@@ -30,19 +27,20 @@ class ScvxMethod(GuidanceMethod):
     def make_planner(self, scenario) -> ScvxPlan:
         problem, scvx = scenario.guidance.planner_settings()
         return plan_entry(scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere(),
-                          scenario.guidance.mission(scenario), problem_settings=problem, settings=scvx)
+                          scenario.guidance.mission(scenario), problem_settings=problem, settings=scvx,
+                          flight=scenario.guidance.flight_check())
 
     def add_systems(self, builder, scenario, planner: ScvxPlan, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance
         guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, ScvxGuidance(
             planner, period=g.period_s, replan_period=g.replan_period_s, min_time_to_go=g.replan_min_time_to_go_s,
-            scvx_settings=g.planner_settings()[1]))
+            scvx_settings=g.planner_settings()[1], lead=g.command_lead_s))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         lo, hi = np.radians(g.alpha_bounds_deg)
         return GuidanceCommands(
             bank=guidance.GetOutputPort("bank_command"), alpha=guidance.GetOutputPort("alpha_command"),
             alpha_limits=ActuatorLimits(float(lo), float(hi), math.radians(g.alpha_rate_limit_deg_s),
-                                        math.radians(ALPHA_ACCELERATION_DEG_S2)),
+                                        math.radians(planner.flight.alpha_acceleration_deg_s2)),
             initial_bank=float(planner.bank[0]), initial_alpha=float(planner.alpha[0]),
             logged={"alpha_command": LoggedSignal(guidance.GetOutputPort("alpha_command"), ("alpha_command_rad",)),
                     "plan_stats": LoggedSignal(guidance.GetOutputPort("plan_stats"),

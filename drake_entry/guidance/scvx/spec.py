@@ -2,12 +2,13 @@
 
 import dataclasses as dc
 import math
+from typing import Optional
 
 from ...errors import ScenarioError, check_range
 from ...planning.scvx.engine import ScvxSettings
 from ...planning.scvx.entry import EntryProblemSettings
 from ...planning.scvx.mission import ScvxMission
-from ...verdict import PathLimit
+from ...planning.scvx.planner import FlightCheck
 from ..spec import GuidanceSpecBase
 
 #: spec fields passed to ScvxMission and EntryProblemSettings under the same names (max_iterations
@@ -16,7 +17,7 @@ MISSION_FIELDS = ("site_radius_m", "final_altitude_m", "final_altitude_margin_m"
                   "final_vertical_speed_min_m_s", "flight_path_bounds_deg", "heading_bounds_deg", "bank_min_deg",
                   "alpha_deg", "alpha_speeds_m_s", "alpha_bounds_deg", "alpha_rate_limit_deg_s")
 PROBLEM_FIELDS = ("formulation", "objective", "segments", "nodes_per_segment", "path_margin",
-                  "flight_path_margin_deg")
+                  "flight_path_margins_deg", "bank_margin_deg")
 
 
 @dc.dataclass
@@ -40,7 +41,8 @@ class Scvx(GuidanceSpecBase):
     # plan's design margin inside it [m], Mach (eq. 65), vertical speed [m/s] (eq. 66)
     site_radius_m: float = 10e3
     final_altitude_m: list[float] = dc.field(default_factory=lambda: [10e3, 13e3])
-    final_altitude_margin_m: float = 200.0
+    # (None: the formulation's default, 600 m for the lossless bank, 200 m for a bank state)
+    final_altitude_margin_m: Optional[float] = None
     final_mach_max: float = 1.0
     final_vertical_speed_min_m_s: float = -140.0
     # path bounds (eq. 70) and the smallest bank magnitude of the lossless bank (eq. 43) [deg]
@@ -60,10 +62,16 @@ class Scvx(GuidanceSpecBase):
     segments: int = 33
     nodes_per_segment: int = 4
     # design margins of the plans flown (not the paper's): heat flux and load this fraction
-    # inside the vehicle's limits at the nodes, gamma this far [deg] under the upper flight-path
-    # bound, so that the closed loop, dispersed, holds the limits its verdict checks
-    path_margin: float = 0.02
-    flight_path_margin_deg: float = 0.1
+    # inside the vehicle's limits at the nodes, gamma this far [deg] inside the flight-path
+    # bounds (above the lower, below the upper), |bank| this far [deg] inside the vehicle's
+    # limit, so that the closed loop, dispersed, holds the limits its verdict checks (None:
+    # EntryProblemSettings' defaults: 0.02, [1.0, 0.2] deg, 2 deg)
+    path_margin: Optional[float] = None
+    flight_path_margins_deg: Optional[list[float]] = None
+    bank_margin_deg: Optional[float] = None
+    # each command is read this far ahead on the plan [s]: the actuators' lag (half the guidance
+    # period for the hold, 1/bandwidth for the loop: 1.0 s at 1 s; drake_entry.actuator.command_lag)
+    command_lead_s: float = 1.0
     max_iterations: int = 100
     solver: str = "clarabel"
     # on-board re-planning from the navigation estimate every replan_period_s [s] (0 = fly the
@@ -75,20 +83,25 @@ class Scvx(GuidanceSpecBase):
         """The ScvxMission: entry state and target from the scenario (geocentric, converted to
         paper 001's geodetic form), the rest from this spec."""
         t = scenario.target
-        fields = {k: getattr(self, k) for k in MISSION_FIELDS}
+        fields = {k: getattr(self, k) for k in MISSION_FIELDS}  # final_altitude_margin_m may be None
         fields.update({k: tuple(v) for k, v in fields.items() if isinstance(v, list)})  # ScvxMission's pairs
         return _named(lambda: ScvxMission.from_geocentric(
             scenario.make_planet(), scenario.initial_state(), math.radians(t.longitude_deg),
             math.radians(t.latitude_deg), name=scenario.name, **fields))
 
+    def flight_check(self) -> FlightCheck:
+        """How the plans are verified: flown through the closed loop's actuators at the guidance
+        period with the guidance's command lead."""
+        return FlightCheck(period_s=self.period_s, lead_s=self.command_lead_s)
+
     def planner_settings(self) -> tuple[EntryProblemSettings, ScvxSettings]:
-        return (_named(lambda: EntryProblemSettings(**{k: getattr(self, k) for k in PROBLEM_FIELDS})),
+        given = {k: getattr(self, k) for k in PROBLEM_FIELDS if getattr(self, k) is not None}
+        return (_named(lambda: EntryProblemSettings(**given)),
                 _named(lambda: ScvxSettings.for_solver(self.solver, max_iterations=self.max_iterations)))
 
     def path_limits(self, scenario) -> list:
         """The flight-path-angle bounds of eq. 70 (flight_path_bounds_deg), held in flight."""
-        lo, hi = (math.radians(v) for v in self.flight_path_bounds_deg)
-        return [PathLimit("flight_path", "gamma", upper=hi, lower=lo, unit="deg", scale=180.0 / math.pi)]
+        return [self.mission(scenario).flight_path_limit()]
 
     def validate(self, scenario) -> None:
         super().validate(scenario)
@@ -99,6 +112,7 @@ class Scvx(GuidanceSpecBase):
             raise ScenarioError(f"guidance.replan_period_s = {self.replan_period_s} must be 0 or >= guidance.period_s "
                                 f"= {self.period_s}")
         check_range("guidance.replan_min_time_to_go_s", self.replan_min_time_to_go_s, 0.0, 1e4)
+        check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
         if self.terminal_mach > self.final_mach_max:
             raise ScenarioError(f"guidance.terminal_mach = {self.terminal_mach} exceeds guidance.final_mach_max = "
                                 f"{self.final_mach_max}")

@@ -41,8 +41,7 @@ def mission_problem(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mis
     cos_site = math.cos(site_lat)
     R = planet.reference_radius
     limits = vehicle.limits
-    h_lo = mission.final_altitude_m[0] + mission.final_altitude_margin_m
-    h_hi = mission.final_altitude_m[1] - mission.final_altitude_margin_m
+    h_lo, h_hi = mission.drs_altitude_window("rate")
 
     def geodetic_altitude(x, u, env):
         return planet.atmospheric_altitude(x[0], x[2])

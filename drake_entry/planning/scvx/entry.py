@@ -131,13 +131,14 @@ class EntryProblemSettings:
         (a design margin, not the paper's): the segment polynomials between the nodes peak
         above them (the nominal lossless plan's load by 3 % at its 22-s pull-up at 4.2 km/s),
         and the between-node check holds the plan to the vehicle's limits. 0: the paper's.
-        None (default): ``DEFAULT_PATH_MARGIN`` of the bank's form: 0.02 for the lossless bank,
-        whose relaxed u modulates the load sharply between nodes; 0 for a bank state, whose
-        plans pass the check without it (with 0.02 the 9 x 9 abort map lost 5 of 51 feasible
-        EIPs: the margin shrinks the reachable set).
-      flight_path_margin_deg: the nodes keep gamma this far [deg] below the mission's upper
-        flight-path bound (eq. 70's skip limit), so that the plan flown, and a dispersed closed
-        loop flying it, stays under the bound; 0: the paper's.
+        None (default): ``DEFAULT_PATH_MARGIN`` of the bank's form, 0.02 for both: the lossless
+        bank's relaxed u modulates the load sharply between nodes, and a bank state's plan
+        flown through the closed loop's actuators, dispersed, peaks up to 1 % above its nodes'
+        heat flux (the margin shrinks the reachable set: the 9 x 9 abort map loses EIPs whose
+        plans rode the limits).
+      flight_path_margin_deg: the nodes keep gamma this far [deg] inside the mission's
+        flight-path bounds (eq. 70: the skip limit above, the steepest dive below), so that the
+        plan flown, and a dispersed closed loop flying it, stays inside them; 0: the paper's.
     """
 
     segments: int = 33
@@ -149,7 +150,8 @@ class EntryProblemSettings:
     max_lossless_gap: float = 0.01
     lossless_rate_limit: bool = True
     path_margin: float | None = None
-    flight_path_margin_deg: float = 0.0
+    flight_path_margins_deg: tuple = (1.0, 0.2)
+    bank_margin_deg: float = 2.0
 
     def __post_init__(self):
         if self.formulation not in FORMULATIONS:
@@ -174,15 +176,19 @@ class EntryProblemSettings:
             self.path_margin = DEFAULT_PATH_MARGIN[FORMULATIONS[self.formulation].bank]
         if not 0.0 <= self.path_margin <= 0.5:
             raise ScenarioError(f"EntryProblemSettings.path_margin = {self.path_margin} must be in [0, 0.5]")
-        if not 0.0 <= self.flight_path_margin_deg <= 5.0:
-            raise ScenarioError(f"EntryProblemSettings.flight_path_margin_deg = {self.flight_path_margin_deg} must be "
-                                f"in [0, 5] deg")
+        margins = tuple(self.flight_path_margins_deg)
+        if len(margins) != 2 or not all(isinstance(v, (int, float)) and 0.0 <= v <= 5.0 for v in margins):
+            raise ScenarioError(f"EntryProblemSettings.flight_path_margins_deg = {margins} needs two margins in "
+                                f"[0, 5] deg (above the lower bound, below the upper)")
+        self.flight_path_margins_deg = tuple(float(v) for v in margins)
+        if not 0.0 <= self.bank_margin_deg <= 20.0:
+            raise ScenarioError(f"EntryProblemSettings.bank_margin_deg = {self.bank_margin_deg} must be in [0, 20] deg")
         if self.heading_sign not in (-1.0, 0.0, 1.0):
             raise ScenarioError(f"EntryProblemSettings.heading_sign = {self.heading_sign} must be -1, 0 or +1")
 
 
 #: EntryProblemSettings.path_margin by the bank's form (Formulation.bank) when not given
-DEFAULT_PATH_MARGIN = {"lossless": 0.02, "rate": 0.0}
+DEFAULT_PATH_MARGIN = {"lossless": 0.04, "rate": 0.02}
 
 #: EntryProblemSettings fields of the paper's lossless relaxation (Table 3 'Lossless Bank'):
 #: no floor on |u|, no bank-rate limit, no path margin, the heading regulariser closing the gap
@@ -256,8 +262,8 @@ class EntryProblem(ConvexifiableProblem):
         sign = settings.heading_sign or heading_regulariser_sign(self.x0, self.site_lat)
         weight = settings.heading_weight if (f.bank == "lossless" and not self.n_bank_floor) else 0.0
         self.heading_lambda = sign * weight / final_time_guess  # per rad s, scaled objective
-        self._gamma_bounds = np.radians(mission.flight_path_bounds_deg) - np.radians(
-            [0.0, settings.flight_path_margin_deg])
+        self._gamma_bounds = np.radians(mission.flight_path_bounds_deg) + np.radians(
+            settings.flight_path_margins_deg) * np.array([1.0, -1.0])
         self.rate_chords = f.bank == "lossless" and settings.lossless_rate_limit
         #: heat flux [W/m^2] and load [g] bounds at the nodes: the vehicle's less the path margin
         self.node_limits = ((1.0 - settings.path_margin) * limits.heat_flux_max,
@@ -267,15 +273,16 @@ class EntryProblem(ConvexifiableProblem):
     def _set_bounds(self, tf_guess):
         m, n, v = self.mission, self.n_nodes, self.vehicle
         deg = math.radians
+        bank_max = v.bank_limit - deg(self.settings.bank_margin_deg)
         x_lo = [-2e3, -4 * math.pi, -deg(89.0), 10.0, -deg(89.0), deg(m.heading_bounds_deg[0])]
         x_hi = [200e3, 4 * math.pi, deg(89.0), 12e3, deg(60.0), deg(m.heading_bounds_deg[1])]
         u_lo, u_hi = [], []
         if self.formulation.bank == "lossless":
-            u_lo += [math.cos(v.bank_limit), -math.sin(min(v.bank_limit, math.pi / 2))]
-            u_hi += [math.cos(deg(m.bank_min_deg)), math.sin(min(v.bank_limit, math.pi / 2))]
+            u_lo += [math.cos(bank_max), -math.sin(min(bank_max, math.pi / 2))]
+            u_hi += [math.cos(deg(m.bank_min_deg)), math.sin(min(bank_max, math.pi / 2))]
         else:
-            x_lo.append(-v.bank_limit)
-            x_hi.append(v.bank_limit)
+            x_lo.append(-bank_max)
+            x_hi.append(bank_max)
             u_lo.append(-v.bank_rate_limit)
             u_hi.append(v.bank_rate_limit)
         if self.formulation.alpha == "rate":
@@ -395,7 +402,7 @@ class EntryProblem(ConvexifiableProblem):
         else:
             epigraph = np.zeros(0)
         xf = X[-1]
-        h_lo, h_hi = m.final_altitude_m[0] + m.final_altitude_margin_m, m.final_altitude_m[1] - m.final_altitude_margin_m
+        h_lo, h_hi = m.drs_altitude_window(self.formulation.bank)
         events = np.array([(h_lo - hstar[-1]) / 1e3, (hstar[-1] - h_hi) / 1e3,
                            (xf[3] - m.final_mach_max * a[-1]) / 100.0,
                            (m.final_vertical_speed_min_m_s - xf[3] * math.sin(xf[4])) / 100.0])

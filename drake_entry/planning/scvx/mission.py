@@ -16,9 +16,14 @@ import numpy as np
 from ...errors import ScenarioError
 from ...planet import Earth
 from ...schedules import Schedule
+from ...verdict import PathLimit
 
 #: the largest site radius a mission accepts [m] (a minimum-miss abort opens its cone to it)
 SITE_RADIUS_MAX_M = 5e6
+#: ScvxMission.final_altitude_margin_m by the bank's form when not given [m]: the lossless bank's
+#: |u| < 1 at the final pull-up is lift the real bank cannot dump, so it flies its DRS point
+#: about 500 m above the plan's (measured on the nominal mission); a bank state flies within 20 m
+DEFAULT_DRS_ALTITUDE_MARGIN_M = {"lossless": 1200.0, "rate": 200.0}
 
 
 @dc.dataclass
@@ -35,7 +40,9 @@ class ScvxMission:
       final_altitude_m: geodetic DRS altitude window [m] (eq. 64).
       final_altitude_margin_m: the plan keeps its DRS altitude this far inside final_altitude_m [m],
         a design margin (not the paper's: it plans to the window's edges) so that the flown
-        point, within the plan's accuracy, stays inside the window; 0 plans to the edges.
+        point, within the plan's accuracy, stays inside the window; 0 plans to the edges; None
+        (default): DEFAULT_DRS_ALTITUDE_MARGIN_M of the formulation's bank form
+        (``drs_altitude_window``).
       final_mach_max: largest DRS Mach number (eq. 65: subsonic).
       final_vertical_speed_min_m_s: lowest V sin(gamma) at the DRS point [m/s] (eq. 66).
       flight_path_bounds_deg: path bounds on gamma [deg] (eq. 70), buffered.
@@ -59,7 +66,7 @@ class ScvxMission:
     site_latitude_deg: float = 36.974
     site_radius_m: float = 10e3
     final_altitude_m: tuple = (10e3, 13e3)
-    final_altitude_margin_m: float = 200.0
+    final_altitude_margin_m: float | None = None
     final_mach_max: float = 1.0
     final_vertical_speed_min_m_s: float = -140.0
     flight_path_bounds_deg: tuple = (-30.0, 0.5)
@@ -96,8 +103,9 @@ class ScvxMission:
             v = tuple(getattr(self, f))
             if len(v) != 2 or not lo <= v[0] < v[1] <= hi:
                 raise ScenarioError(f"ScvxMission.{f} = {v} needs two values {lo} <= low < high <= {hi}")
-        check("final_altitude_margin_m", self.final_altitude_margin_m, 0.0,
-              0.49 * (self.final_altitude_m[1] - self.final_altitude_m[0]), "m (under half the DRS window)")
+        if self.final_altitude_margin_m is not None:
+            check("final_altitude_margin_m", self.final_altitude_margin_m, 0.0,
+                  0.49 * (self.final_altitude_m[1] - self.final_altitude_m[0]), "m (under half the DRS window)")
         if self.entry_bank_deg is not None:
             check("entry_bank_deg", self.entry_bank_deg, -180.0, 180.0, "deg")
         if self.entry_alpha_deg is not None:
@@ -136,6 +144,20 @@ class ScvxMission:
     def site(self, planet: Earth) -> tuple[float, float]:
         """Site longitude and geocentric latitude [rad]."""
         return math.radians(self.site_longitude_deg), planet.from_geodetic(0.0, math.radians(self.site_latitude_deg))[1]
+
+    def drs_altitude_window(self, bank_form: str = "rate") -> tuple[float, float]:
+        """The geodetic DRS altitudes [m] a plan aims between: final_altitude_m less the margin
+        (``final_altitude_margin_m``, or the default of the bank form, 'lossless' or 'rate')."""
+        margin = self.final_altitude_margin_m
+        if margin is None:
+            margin = min(DEFAULT_DRS_ALTITUDE_MARGIN_M[bank_form], 0.49 * (self.final_altitude_m[1]
+                                                                          - self.final_altitude_m[0]))
+        return self.final_altitude_m[0] + margin, self.final_altitude_m[1] - margin
+
+    def flight_path_limit(self) -> PathLimit:
+        """The flight-path bounds (eq. 70) as a path limit a flight must hold."""
+        lo, hi = (math.radians(v) for v in self.flight_path_bounds_deg)
+        return PathLimit("flight_path", "gamma", upper=hi, lower=lo, unit="deg", scale=180.0 / math.pi)
 
     def alpha_schedule(self) -> Schedule:
         """alpha(V) [rad], velocity-scheduled and C2 (its derivative enters the Jacobians)."""

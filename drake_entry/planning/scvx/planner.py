@@ -8,13 +8,17 @@ import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.interpolate import CubicSpline
+from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
+from ...actuator import sampled_response
 from ...atmosphere import Atmosphere
 from ...constraints import dynamic_pressure
-from ...dynamics import STATE_NAMES, aero_accelerations, air_data, equations_of_motion, flight_conditions
+from ...dynamics import (FLIGHT_CONDITION_NAMES, STATE_NAMES, aero_accelerations, air_data, equations_of_motion,
+                         flight_conditions)
+from ...errors import ModelRangeError, NonFiniteStateError
 from ...planet import Earth
 from ...vehicles import Vehicle
+from ...verdict import PathLimit, check_limits, vehicle_path_limits
 from ..result import PlanResult
 from .engine import ScvxSettings, max_defect, max_violation, solve_scvx
 from .entry import EntryProblem, EntryProblemSettings
@@ -58,9 +62,11 @@ class ScvxPlan(PlanResult):
       miss_m: planned DRS point to the site [m]; drs: planned DRS altitude (geodetic) [m], Mach,
         vertical speed [m/s].
       metrics: the paper's Table 2, 3 and 6 quantities (``plan_metrics``).
-      propagated_error_m: the plan's real bank and alpha propagated from its entry state
-        (``propagate_plan``) end this far from its terminal point [m] (great circle and
-        altitude); ``success`` needs it <= PROPAGATION_TOLERANCE_M.
+      propagated_error_m: the plan's real bank and alpha flown from its entry state through the
+        closed loop's actuators (``propagate_plan``) end this far from its terminal point [m]
+        (great circle and altitude); ``success`` needs it <= PROPAGATION_TOLERANCE_M.
+      flight: the FlightCheck it was flown with; flown: ``flown_check``'s verdict (the flown DRS
+        point, inside_box, the path-limit checks, within_limits).
       guess: the glide guess it started from; history: the engine's IterationRecords.
     """
 
@@ -82,6 +88,8 @@ class ScvxPlan(PlanResult):
     metrics: dict
     propagated_error_m: float
     guess: GlideGuess | None = None
+    flight: FlightCheck | None = None
+    flown: dict = dc.field(default_factory=dict, repr=False)
     history: list = dc.field(default_factory=list, repr=False)
     problem: EntryProblem | None = dc.field(default=None, repr=False)
 
@@ -218,24 +226,143 @@ def plan_metrics(problem: EntryProblem, X, U, tf: float) -> dict:
             "miss_km": problem.site_miss(X[-1]) / 1e3}
 
 
-def propagate_plan(plan: ScvxPlan, *, samples_per_segment: int = 32, rtol: float = 1e-9):
-    """Fly the plan's real bank (and planned alpha, or the alpha(V) law at the flown speed) from
-    its entry state to its t_f with scipy's DOP853 on the project's equations of motion: the
-    model-layer check of ``plan_entry`` (``diagrams.plan_flight.fly_plan`` flies the same
-    controls with the Drake Simulator). Returns the solve_ivp solution."""
-    p = plan.problem
+@dc.dataclass(frozen=True)
+class FlightCheck:
+    """How a plan's controls are flown to verify it: as the closed loop flies them.
+
+    Attributes:
+      period_s: the guidance period [s]: the plan's bank and alpha are sampled and held this
+        long and tracked by the closed loop's actuator law (drake_entry.actuator); None flies
+        the plan's own bank and alpha directly (no actuator).
+      lead_s: each command is read this far ahead on the plan [s] (the actuators' lag,
+        ``actuator.command_lag``: 1.0 s at a 1-s period), as the SCvx guidance does.
+      alpha_acceleration_deg_s2: the alpha actuator's acceleration limit (not in paper 001: a
+        labelled choice well above what a 1 deg/s planned alpha rate needs).
+    """
+
+    period_s: float | None = 1.0
+    lead_s: float = 1.0
+    alpha_acceleration_deg_s2: float = 5.0
+
+
+def _actuated(plan: ScvxPlan, tt, samples, flight: FlightCheck, lower: float, upper: float, rate_limit: float,
+              accel_limit: float, x0: float):
+    """The command ``samples`` at times ``tt`` as the sampled actuator flies them: a C1 cubic
+    Hermite in time (``actuator.sampled_response``), read ``lead_s`` ahead."""
+    n = int(math.ceil(plan.final_time / flight.period_s)) + 1
+    commands = CubicSpline(tt, samples)(np.minimum(np.arange(n) * flight.period_s + flight.lead_s, tt[-1]))
+    t, x, v = sampled_response(commands, flight.period_s, x0, lower=lower, upper=upper, rate_limit=rate_limit,
+                               accel_limit=accel_limit)
+    return CubicHermiteSpline(t, x, v)
+
+
+@dc.dataclass
+class PlanPropagation:
+    """A plan's controls flown from its entry state (``propagate_plan``).
+
+    Attributes:
+      time [s] (n,), states (n, 6): the integrator's steps. bank, alpha: the flown controls as
+        functions of time [rad] (alpha None: the mission's alpha(V) law at the flown speed).
+      failure: why the flight stopped before t_f ('' when it reached it).
+    """
+
+    time: np.ndarray
+    states: np.ndarray
+    bank: object
+    alpha: object
+    failure: str = ""
+
+
+def propagate_plan(plan: ScvxPlan, *, flight: FlightCheck | None = FlightCheck(), samples_per_segment: int = 32,
+                   rtol: float = 1e-9, steps_per_period: int = 4) -> PlanPropagation:
+    """Fly the plan's bank and alpha (planned, or the alpha(V) law) from its entry state to its
+    t_f on the project's equations of motion, through the closed loop's actuators as ``flight``
+    says: the model-layer check of ``plan_entry``; ``diagrams.plan_flight.fly_plan`` flies the
+    same controls through the Drake actuator systems and a test holds the two together.
+
+    Through the actuators (whose path is C1 with a kink every 0.02-s sub-step) the flight is
+    fixed-step RK4 at ``steps_per_period`` steps per guidance period (2 m from a 1e-12
+    integration at t_f on the nominal mission, where DOP853 at rtol 1e-9 was 160 m off at twice
+    the cost); where alpha follows the alpha(V) law its sampled command is the law at the plan's
+    speed (the Drake flight: at the flown speed). ``flight=None`` flies the plan's own C2
+    controls with DOP853 at ``rtol``."""
+    p, v, m = plan.problem, plan.problem.vehicle, plan.problem.mission
     tt, bank_samples, alpha_samples = plan.control_samples(samples_per_segment)
-    bank = CubicSpline(tt, bank_samples)
-    alpha = CubicSpline(tt, alpha_samples) if alpha_samples is not None else None
+    actuated = flight is not None and flight.period_s is not None
+    if not actuated:
+        bank = CubicSpline(tt, bank_samples)
+        alpha = CubicSpline(tt, alpha_samples) if alpha_samples is not None else None
+    else:
+        if alpha_samples is None:
+            alpha_samples = np.array([float(p.alpha(V)) for V in plan.evaluate(tt)["V"]])
+        lo, hi = np.radians(m.alpha_bounds_deg)
+        bank = _actuated(plan, tt, bank_samples, flight, -v.bank_limit, v.bank_limit, v.bank_rate_limit,
+                         v.bank_accel_limit, float(plan.bank[0]))
+        alpha = _actuated(plan, tt, alpha_samples, flight, float(lo), float(hi), math.radians(m.alpha_rate_limit_deg_s),
+                          math.radians(flight.alpha_acceleration_deg_s2), float(plan.alpha[0]))
 
     def rhs(t, x):
         rho, a = air_data(x, p.planet, p.atmosphere)
         a_t = float(alpha(t)) if alpha is not None else float(p.alpha(float(x[3])))
         _, L, D = aero_accelerations(x, a_t, rho, a, p.vehicle)
-        return equations_of_motion(list(x), float(bank(t)), L, D, p.planet)
+        return np.asarray(equations_of_motion(list(x), float(bank(t)), L, D, p.planet))
 
-    atol = rtol * np.array([1e4, 1.0, 1.0, 1e3, 1.0, 1.0])
-    return solve_ivp(rhs, (0.0, plan.final_time), plan.states[0, :6], method="DOP853", rtol=rtol, atol=atol)
+    x0, tf = plan.states[0, :6].astype(float), plan.final_time
+    try:
+        if not actuated:
+            atol = rtol * np.array([1e4, 1.0, 1.0, 1e3, 1.0, 1.0])
+            sol = solve_ivp(rhs, (0.0, tf), x0, method="DOP853", rtol=rtol, atol=atol)
+            return PlanPropagation(sol.t, sol.y.T, bank, alpha, "" if sol.status == 0 else sol.message)
+        n = int(math.ceil(tf / flight.period_s * steps_per_period))
+        h = tf / n
+        T, X = [0.0], [x0]
+        x = x0
+        for k in range(n):
+            t = k * h
+            k1 = rhs(t, x)
+            k2 = rhs(t + 0.5 * h, x + 0.5 * h * k1)
+            k3 = rhs(t + 0.5 * h, x + 0.5 * h * k2)
+            k4 = rhs(t + h, x + h * k3)
+            x = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            if not np.all(np.isfinite(x)):
+                raise NonFiniteStateError(f"non-finite state at t = {t + h:.1f} s")
+            T.append(t + h)
+            X.append(x)
+        return PlanPropagation(np.array(T), np.array(X), bank, alpha)
+    except (ModelRangeError, NonFiniteStateError, OverflowError) as e:
+        return PlanPropagation(np.array([0.0]), x0[None, :], bank, alpha, f"{type(e).__name__}: {e}")
+
+
+def flown_check(plan: ScvxPlan, flown: PlanPropagation) -> dict:
+    """The verdict of a propagated plan: its terminal point to the plan's [m], the flown DRS point
+    (geodetic altitude [m], Mach, vertical speed [m/s], site miss [m]) and whether it is inside
+    the DRS box (eqs. 64-68: the altitude window, Mach, vertical speed, the site within
+    site_radius_m + PROPAGATION_TOLERANCE_M), and the path limits (``plan_path_limits``) at every
+    integrator step."""
+    p, m = plan.problem, plan.problem.mission
+    t, X = flown.time, flown.states
+    xf = X[-1]
+    alpha = (flown.alpha(t) if flown.alpha is not None else np.array([float(p.alpha(x[3])) for x in X]))
+    conds = np.array([flight_conditions(x, 0.0, a, p.vehicle, p.planet, p.atmosphere) for x, a in zip(X, alpha)])
+    columns = {name: conds[:, i] for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
+    columns.update({name: X[:, i] for i, name in enumerate(STATE_NAMES)})
+    columns.update(bank=flown.bank(t), alpha=alpha)
+    checks = check_limits(t, columns.__getitem__, plan_path_limits(plan))
+    h_geo = float(p.planet.atmospheric_altitude(xf[0], xf[2]))
+    drs = {"altitude_m": h_geo, "mach": float(columns["mach"][-1]), "vertical_speed_m_s": float(xf[3] * math.sin(xf[4])),
+           "site_miss_m": float(p.planet.great_circle_distance(xf[1], xf[2], *m.site(p.planet)))}
+    inside = (m.final_altitude_m[0] <= h_geo <= m.final_altitude_m[1] and drs["mach"] <= m.final_mach_max
+              and drs["vertical_speed_m_s"] >= m.final_vertical_speed_min_m_s
+              and drs["site_miss_m"] <= m.site_radius_m + PROPAGATION_TOLERANCE_M)
+    return {"from_plan_m": terminal_distance(p.planet, xf, plan.states[-1]), "drs": drs, "inside_box": bool(inside),
+            "checks": checks, "within_limits": all(c.held for c in checks)}
+
+
+def plan_path_limits(plan: ScvxPlan) -> list[PathLimit]:
+    """The path limits a flown plan must hold: the vehicle's heat flux, total load (and q where
+    finite) and bank limit, and the mission's flight-path bounds (eq. 70)."""
+    p = plan.problem
+    return vehicle_path_limits(p.vehicle.limits, p.vehicle.bank_limit) + [p.mission.flight_path_limit()]
 
 
 def terminal_distance(planet: Earth, x, x_plan) -> float:
@@ -245,14 +372,19 @@ def terminal_distance(planet: Earth, x, x_plan) -> float:
 
 def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission: ScvxMission, *,
                problem_settings: EntryProblemSettings | None = None, settings: ScvxSettings | None = None,
-               guess: GlideGuess | None = None, initial=None, progress=None) -> ScvxPlan:
-    """Plan the mission: the glide guess (unless given), SCvx, then the between-node check.
+               guess: GlideGuess | None = None, initial=None, progress=None,
+               flight: FlightCheck = FlightCheck()) -> ScvxPlan:
+    """Plan the mission: the glide guess (unless given), SCvx, the between-node check, then the
+    verdict of its controls flown (``flown_check``): ``success`` only when it converged, its
+    controls flown through the closed loop's actuators (``flight``) end within
+    PROPAGATION_TOLERANCE_M of its terminal point, inside the DRS box, and every path limit held.
 
     Args:
       initial: a previous ScvxPlan to start from instead of the guess (a warm start, or a
         polish in another formulation, e.g. a 'lossless' plan refined as 'direct'; its mesh may
         differ, it is interpolated).
       progress: ``progress(k, IterationRecord)`` after every iteration.
+      flight: how the controls are flown for the verdict (FlightCheck; re-plans keep it).
     """
     t0 = time.perf_counter()
     ps = problem_settings or EntryProblemSettings()
@@ -300,16 +432,33 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
         drs={"altitude_m": float(final[problem.out_h]), "mach": float(xf[3] / final[problem.out_a]),
              "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))},
         metrics=metrics, propagated_error_m=math.nan, guess=guess, history=outcome.history, problem=problem)
-    flown = propagate_plan(plan)
-    plan.propagated_error_m = (terminal_distance(planet, flown.y[:, -1], xf) if flown.status == 0 else math.inf)
-    accurate = plan.propagated_error_m <= PROPAGATION_TOLERANCE_M
-    if outcome.converged and not accurate:
-        plan.message += (f"; converged but inaccurate: its controls propagated end "
-                         f"{plan.propagated_error_m / 1e3:.1f} km from its terminal point "
-                         f"(> {PROPAGATION_TOLERANCE_M / 1e3:g} km; "
-                         + (f"lossless gap {gap:.2f}: polish it with the 'direct' formulation)" if gap > 1e-2
-                            else "refine the mesh)"))
-    plan.success = outcome.converged and checked and accurate
+    plan.flight = flight
+    propagated = propagate_plan(plan, flight=flight)
+    if propagated.failure:
+        plan.propagated_error_m = math.inf
+        plan.flown = {}
+        flown_ok, why = False, f"its controls flown stop before t_f: {propagated.failure}"
+    else:
+        plan.flown = flown = flown_check(plan, propagated)
+        plan.propagated_error_m = flown["from_plan_m"]
+        d = flown["drs"]
+        problems = []
+        if plan.propagated_error_m > PROPAGATION_TOLERANCE_M:
+            problems.append(f"end {plan.propagated_error_m / 1e3:.1f} km from its terminal point "
+                            f"(> {PROPAGATION_TOLERANCE_M / 1e3:g} km; "
+                            + (f"lossless gap {gap:.2f}: polish it with the 'direct' formulation)" if gap > 1e-2
+                               else "refine the mesh)"))
+        if not flown["inside_box"]:
+            problems.append(f"end outside the DRS box (geodetic altitude {d['altitude_m'] / 1e3:.2f} km of "
+                            f"{mission.final_altitude_m[0] / 1e3:g}-{mission.final_altitude_m[1] / 1e3:g} km, "
+                            f"Mach {d['mach']:.2f}, vertical speed {d['vertical_speed_m_s']:.1f} m/s, "
+                            f"{d['site_miss_m'] / 1e3:.1f} km from the site)")
+        if not flown["within_limits"]:
+            problems.append("breach " + "; ".join(c.text() for c in flown["checks"] if not c.held))
+        flown_ok, why = not problems, "its controls flown " + " and ".join(problems)
+    if outcome.converged and not flown_ok:
+        plan.message += f"; converged but {why}"
+    plan.success = outcome.converged and checked and flown_ok
     plan.solve_time = time.perf_counter() - t0 - build
     return plan
 
@@ -347,4 +496,4 @@ def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float
     if guess.final_time <= 0.0:
         raise ValueError(f"the previous plan has no time left at {elapsed:.1f} s (t_f {previous.final_time:.1f} s)")
     return plan_entry(p.vehicle, p.planet, p.atmosphere, mission, problem_settings=p.settings,
-                      settings=settings, guess=guess)
+                      settings=settings, guess=guess, flight=previous.flight or FlightCheck())

@@ -1,6 +1,6 @@
 """Benchmarks, each printing its figures and ratios measured side by side in one run.
 
-    python benchmarks/run.py [open-loop|socp|nlp|dymos|campaign|interface-cost|paper001|aborts|paper003|paper004|all] [options]
+    python benchmarks/run.py [open-loop|socp|nlp|dymos|campaign|interface-cost|paper001|aborts|paper003|paper004|examples|all] [options]
 
 open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
 socp            both SOCP planners with Clarabel vs SCS: drag-energy SOCP by node count, SCvx
@@ -15,6 +15,9 @@ aborts          paper 001: the 9 x 9 orbital-abort map through the campaign engi
 paper003        paper 003: AMPI database storage, LD-HD reconstruction, synthesis vs OCP CPU time,
                 eq. 13 accuracy and open-loop miss of AMPI and NTT references (--cases)
 paper004        paper 004: Table 1 over seeds, scipy baselines, cases, two parameters, figures
+examples        every example's wall time, exit status (its claims) and last line against the
+                time docs/examples.md gives (--mode quick|full|both, --only 05 07, --write;
+                not in "all")
 """
 import argparse
 import os
@@ -26,7 +29,7 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("which", nargs="?", default="all",
                         choices=("all", "open-loop", "socp", "nlp", "dymos", "campaign", "interface-cost", "paper001",
-                                 "aborts", "paper003", "paper004"))
+                                 "aborts", "paper003", "paper004", "examples"))
     parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
     parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
     parser.add_argument("--nodes", type=int, default=40, help="nlp: nodes / samples")
@@ -39,7 +42,14 @@ if __name__ == "__main__":
     parser.add_argument("--seeds", type=int, default=20, help="paper004: seeds per swarm method (Table 1)")
     parser.add_argument("--cases", type=int, default=100, help="paper003: entries of the accuracy study")
     parser.add_argument("--out", default="out/paper004", help="paper004: figure directory")
+    parser.add_argument("--mode", default="both", choices=("quick", "full", "both"), help="examples: which runs")
+    parser.add_argument("--only", nargs="*", default=None, help="examples: numbers or names to run")
+    parser.add_argument("--write", action="store_true", help="examples: write the measured times into the docs")
     args = parser.parse_args()
+    if args.which == "examples":  # minutes of wall time: on request only
+        from example_times import examples_benchmark
+
+        examples_benchmark(mode=args.mode, only=args.only, write=args.write)
     if args.which in ("all", "open-loop"):
         from open_loop import open_loop_benchmark
 

@@ -68,7 +68,7 @@ def propagate(problem, result, *, accuracy: float = 1e-11, samples_per_interval:
         simulator.AdvanceTo(tf)
     except (RuntimeError, ModelRangeError, NonFiniteStateError) as e:  # e.g. gamma reaching -90 deg, h below the
         # atmosphere model
-        failure = f"propagation stopped at t = {ctx.get_time():.2f} s of {tf:.2f} s: {str(e).splitlines()[0][:200]}"
+        failure = f"propagation stopped at t = {ctx.get_time():.2f} s of {tf:.2f} s: {first_sentence(str(e))}"
     log = logger.FindLog(ctx)
     t_end = ctx.get_time()
     x_end = plant.GetMyContextFromRoot(ctx).get_continuous_state_vector().CopyToVector()
@@ -77,6 +77,13 @@ def propagate(problem, result, *, accuracy: float = 1e-11, samples_per_interval:
     X = np.vstack([log.data()[:, keep].T, x_end])
     err = {"failed": failure} if failure else terminal_error(problem, result, x_end)
     return PropagationCheck(time=t, states=X, terminal_error=err)
+
+
+def first_sentence(text: str) -> str:
+    """The first sentence of a (Drake or model) error message, whole: never cut mid-word."""
+    line = text.strip().splitlines()[0] if text.strip() else ""
+    end = line.find(". ")
+    return line if end < 0 else line[:end + 1]
 
 
 def terminal_error(problem, result, x_end) -> dict:

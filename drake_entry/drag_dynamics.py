@@ -142,7 +142,12 @@ class DragTerms:
                                       + CDpp / CD - (CDp / CD) ** 2)  # eq. 41
 
         a_D = second(0.0)
-        b_D = second(1.0) - a_D
+        # b_D = dD''/du, the terms of eqs. 41-47 through gamma' only (u enters nowhere else);
+        # written out, not second(1) - second(0), which cancels to 0 where |a_D| >> |b_D|
+        hpp_u = -cg * b_gamma / D  # eq. 47
+        Vpp_u = g * cg * b_gamma / (D * V)  # eq. 47
+        Mpp_u = M_h * hpp_u + M_V * Vpp_u  # eq. 45
+        b_D = D * (self.rho_h * hpp_u / rho + 2.0 * Vpp_u / V + cd.d_mach * Mpp_u / CD)  # eq. 41
         return DragDynamics(D, Dp, a_D, b_D, self.a_Dgamma, self.b_Dgamma, self.lift_to_drag, self.M, rho)
 
 

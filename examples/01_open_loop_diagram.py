@@ -17,10 +17,12 @@ import argparse
 import os
 
 import matplotlib.pyplot as plt
+import numpy as np
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
+from drake_entry.claims import Claims
 from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.scenario import load_scenario
 from drake_entry.systems.actuators import BankActuator
@@ -91,11 +93,24 @@ def main(quick: bool = False, out_dir: str = "out/examples/01") -> dict:
     plt.close(fig)
     print(f"wrote {path}")
     return {"time_s": float(context.get_time()), "final_state": x[:, -1], "peak_heat_flux_W_m2": float(heat.max()),
+            "stop": status.message() or "time limit",
             "plot": path}
+
+def check(r: dict, quick: bool = False) -> Claims:
+    """What this example shows, checked."""
+    c = Claims("example 01: an open-loop diagram built by hand")
+    if quick:
+        c.check("the diagram flies the first 300 s", abs(r["time_s"] - 300.0) < 1e-6, f"{r['time_s']:.1f} s")
+    else:
+        c.check("the flight stops at its Mach 2.5 witness", "mach" in r["stop"].lower(), r["stop"])
+    c.check("the logged state stays finite", bool(np.all(np.isfinite(r["final_state"]))))
+    c.check("the plot is written", os.path.exists(r["plot"]), r["plot"])
+    return c
+
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="fly the first 300 s only")
     parser.add_argument("--out", default="out/examples/01", help="figure directory")
     args = parser.parse_args()
-    main(args.quick, args.out)
+    raise SystemExit(check(main(args.quick, args.out), args.quick).report())

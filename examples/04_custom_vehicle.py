@@ -16,6 +16,7 @@ import os
 
 import numpy as np
 
+from drake_entry.claims import Claims
 from drake_entry.atmosphere import US76Atmosphere
 from drake_entry.diagrams.closed_loop import fly
 from drake_entry.diagrams.open_loop import simulate
@@ -117,9 +118,24 @@ def main(quick: bool = False, out_dir: str = "out/examples/04") -> dict:
     return {"open_loop": tr, "reference": reference, "closed_loop": result}
 
 
+def check(r: dict, quick: bool = False) -> Claims:
+    """What this example shows, checked."""
+    c = Claims("example 04: your vehicle in your atmosphere")
+    ref = r["reference"]
+    c.check("the reference planned from 350 s is optimal and inside the corridor", ref.success and
+            ref.corridor_violation()["above_max"] < 0.02, ref.message)
+    if quick:
+        c.check("the open loop flies the first 400 s", abs(r["open_loop"].time[-1] - 400.0) < 1e-6)
+    else:
+        c.check("the open loop reaches Mach 2.5", "mach" in r["open_loop"].reason, r["open_loop"].reason)
+        cl = r["closed_loop"]
+        c.check("the closed loop lands inside the 2-km box within every path limit", cl.success, cl.message)
+    return c
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="400 s of open loop, no closed loop")
     parser.add_argument("--out", default="out/examples/04", help="output directory")
     args = parser.parse_args()
-    main(args.quick, args.out)
+    raise SystemExit(check(main(args.quick, args.out), args.quick).report())

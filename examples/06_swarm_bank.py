@@ -14,6 +14,7 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
+from drake_entry.claims import Claims
 from drake_entry.diagrams.closed_loop import fly
 from drake_entry.planning.swarm.evaluator import range_error
 from drake_entry.planning.swarm.search import problem_from_scenario, search
@@ -66,9 +67,26 @@ def main(quick: bool = False, out_dir: str = "out/examples/06") -> dict:
     return {"searches": found, "flight": result}
 
 
+def check(r: dict, quick: bool = False) -> Claims:
+    """What this example shows, checked."""
+    c = Claims("example 06: paper 004's bank profile")
+    flight = r["flight"]
+    plan = flight.guidance.details
+    c.check("the plan reaches the TAEM energy inside the path limits", plan.success, plan.message)
+    c.check("the Drake closed loop flies it to TAEM inside the box, every path limit held", flight.success,
+            flight.message)
+    x = flight.trajectory.state[-1]
+    dh = x[0] - plan.problem.h_f - plan.evaluation.altitude_error_m[0]
+    c.check("the Drake flight ends within 20 m of altitude of the planner's replica", abs(dh) < 20.0, f"{dh:+.2f} m")
+    for method, found in r["searches"].items():
+        c.check(f"{method} finds sigma_0 = 58.79 deg within 0.05 deg", abs(found.x[0] - 58.79) < 0.05,
+                f"{found.x[0]:.3f} deg")
+    return c
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="the bracketed search only (no PIO run)")
     parser.add_argument("--out", default="out/examples/06", help="figure directory")
     args = parser.parse_args()
-    main(args.quick, args.out)
+    raise SystemExit(check(main(args.quick, args.out), args.quick).report())

@@ -19,6 +19,7 @@ import argparse
 import os
 
 from drake_entry.campaign_store import read_rows
+from drake_entry.claims import Claims
 from drake_entry.diagrams.aborts import run_descent_aborts, run_orbital_aborts
 from drake_entry.planning.scvx.abort_report import write_abort_report
 from drake_entry.planning.scvx.aborts import FEASIBLE_RADII_M, feasible
@@ -39,9 +40,29 @@ def main(quick: bool = False, out_dir: str = "out/examples/08") -> dict:
     return out
 
 
+def check(r: dict, quick: bool = False) -> Claims:
+    """What this example shows, checked (an abort that cannot reach its site is a finding of the
+    map, not a failure of the example; a case that raised is)."""
+    c = Claims("example 08: paper 001's abort maps")
+    orbital, descent = r["orbital"], r["descent"]
+    for kind, x in (("orbital", orbital), ("descent", descent)):
+        raised = [row for row in x["rows"] if "traceback" in row or "iterations" not in row]
+        c.check(f"every {kind} case was planned and flown (none raised)", not raised,
+                "; ".join(f"case {row['index']}: {row.get('message', '')[:100]}" for row in raised[:3]))
+        c.check(f"the {kind} report is written", os.path.exists(x["report"]), x["report"])
+    centre = [row for row in orbital["rows"] if abs(row["entry_longitude_deg"] + 115.0) < 1e-9
+              and abs(row["entry_latitude_deg"] - 30.0) < 1e-9]
+    c.check("the nominal EIP's abort is feasible at 10 km", bool(centre) and feasible(centre[0], FEASIBLE_RADII_M[0]),
+            centre[0]["message"][:160] if centre else "missing")
+    c.check("no descent case is called feasible with a planned miss beyond 10 km",
+            all(not feasible(row, FEASIBLE_RADII_M[-1]) for row in descent["rows"]
+                if row.get("planned_miss_km", 0.0) > 10.0 + 1e-9))
+    return c
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--out", default="out/examples/08")
     args = parser.parse_args()
-    main(quick=args.quick, out_dir=args.out)
+    raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())

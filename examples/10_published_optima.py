@@ -19,6 +19,7 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
+from drake_entry.claims import Claims
 from drake_entry.planning import nlp
 from drake_entry.planning.nlp import catalogue
 
@@ -71,9 +72,25 @@ def main(quick: bool = False, out_dir: str = "out/examples/10") -> dict:
     return out
 
 
+def check(r: dict, quick: bool = False) -> Claims:
+    """What this example shows, checked."""
+    c = Claims("example 10: published optima")
+    for name in PROBLEMS:
+        x = r[name]
+        c.check(f"{name}: verified and within 1e-4 of the published optimum",
+                x["result"].success and x["relative"] <= 1e-4,
+                f"{x['result'].objective:.7g} vs {x['published']['objective']:.7g} ({x['relative']:.1e})")
+    for name in [k for k in r if k.endswith("_refined")]:
+        res = r[name]["result"]
+        steps = ", ".join(f"{m.nodes}: {m.error:.1e}" for m in res.mesh_history)
+        c.check(f"{name}: refinement ends verified with every mesh's error finite", res.success and all(
+            np.isfinite(m.error) for m in res.mesh_history), steps)
+    return c
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--out", default="out/examples/10")
     args = parser.parse_args()
-    main(quick=args.quick, out_dir=args.out)
+    raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())

@@ -23,6 +23,7 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
+from drake_entry.claims import Claims
 from drake_entry.diagrams.open_loop import simulate
 from drake_entry.planning import nlp
 from drake_entry.planning.ocp import ObjectiveTerm
@@ -84,9 +85,22 @@ def main(quick: bool = False, out_dir: str = "out/examples/11") -> dict:
             "plot": plot}
 
 
+def check(r: dict, quick: bool = False) -> Claims:
+    """What this example shows, checked."""
+    c = Claims("example 11: the SHEFEX-3 mission and problem")
+    c.check("bank 0 flies about 600 s (geodetic entry altitude)", 590.0 < r["open_loop"].time[-1] < 620.0,
+            f"{r['open_loop'].time[-1]:.0f} s")
+    c.check("the well-posed problem is solved and verified", r["result"].success, r["result"].message[:160])
+    c.check("eq. 1 converges and reaches the target within 1 km", r["eq1"].converged and r["eq1_miss_m"] < 1e3,
+            f"{r['eq1_miss_m']:.0f} m")
+    c.check("eq. 1's bank differs from the least bank by more than 5 deg (its minimisers are not unique)",
+            r["eq1_bank_gap_deg"] > 5.0, f"{r['eq1_bank_gap_deg']:.1f} deg")
+    return c
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="60 samples for the eq. 1 solve")
     parser.add_argument("--out", default="out/examples/11")
     args = parser.parse_args()
-    main(quick=args.quick, out_dir=args.out)
+    raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())

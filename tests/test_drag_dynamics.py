@@ -59,3 +59,30 @@ def test_earth_rate_correction_eq50_reduces_the_error_on_a_rotating_earth(horus,
                            heading=x[5], earth_rate=rate)
         errs.append(abs(dd.D_second(dd.lift_to_drag * np.cos(bank)) - fd2))
     assert errs[0] < 0.5 * errs[1]
+
+
+def test_b_D_is_the_slope_of_D_second_in_u_between_two_flown_banks(us76):
+    """b_D = dD''/du (eq. 62) against the finite-difference D'' of two trajectories flown from the
+    same state with banks 30 and 75 deg: (D''_1 - D''_2) / (u_1 - u_2) within 1e-3 (the two one-sided FD
+    second derivatives at the start carry their truncation). b_D is written out, not second(1) - second(0), so it is
+    not 0 where |a_D| >> |b_D| (high up, where D is small)."""
+    from drake_entry.vehicles import load_vehicle
+
+    v = load_vehicle("horus2b", aero="fit")
+    p = Earth.spherical(rotating=False)
+    alpha_of_E = lambda E: np.radians(40.0)  # noqa: E731
+    x0 = np.array([62e3, 0.0, 0.0, 6200.0, np.radians(-0.3), np.radians(70.0)])
+    E0 = specific_energy(x0, p)
+    dd = drag_dynamics(x0[0], x0[3], x0[4], AlphaProfile(np.radians(40.0)), v, p, us76)
+    fd2 = []
+    for bank in np.radians([30.0, 75.0]):
+        _, sol = _fly_in_energy(x0, bank, alpha_of_E, v, p, us76, 1e5)
+        # the FD stencil ends at E0: one-sided second difference from the start
+        step = 2e4
+        Ds = [drag_acceleration(sol.sol(E0 - k * step)[0], sol.sol(E0 - k * step)[3], np.radians(40.0), v, us76)
+              for k in range(4)]
+        fd2.append((2 * Ds[0] - 5 * Ds[1] + 4 * Ds[2] - Ds[3]) / step**2)
+    u = dd.lift_to_drag * np.cos(np.radians([30.0, 75.0]))
+    assert dd.b_D == pytest.approx((fd2[0] - fd2[1]) / (u[0] - u[1]), rel=1e-3)
+    high = drag_dynamics(115e3, 7400.0, np.radians(-1.4), AlphaProfile(np.radians(40.0)), v, p, us76)
+    assert high.b_D != 0.0 and np.isfinite(high.b_D) and high.D > 0.0

@@ -10,11 +10,20 @@ import pytest
 EXAMPLES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "examples")
 
 
-def _run(name: str, out_dir) -> object:
+def _module(name: str):
     spec = importlib.util.spec_from_file_location(name, os.path.join(EXAMPLES, f"{name}.py"))
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    return module.main(quick=True, out_dir=str(out_dir))
+    return module
+
+
+def _run(name: str, out_dir) -> object:
+    """The example's quick run; its own claims (``check``) must all hold."""
+    module = _module(name)
+    result = module.main(quick=True, out_dir=str(out_dir))
+    claims = module.check(result, quick=True)
+    assert claims.ok, [(c.text, c.measured) for c in claims.failed]
+    return result
 
 
 def test_every_example_is_tested():
@@ -30,12 +39,12 @@ def test_example_01(tmp_path):
 
 
 def test_example_02(tmp_path):
-    """The paper's controller lands inside the 2 km box; the example's PD controller reaches
-    the terminal energy through the same interface (with a larger miss: no feedforward)."""
+    """The paper's controller lands inside the 2 km box; the example's PID controller, flown
+    through the same interface, too (1.23 km measured), every path limit held."""
     r = _run("02_custom_controller", tmp_path)
     paper, ours = r.values()
     assert paper.success and paper.errors["distance_m"] < 2e3
-    assert ours.method == "drag_energy_pd" and "reached E_f" in ours.message and ours.errors["distance_m"] < 50e3
+    assert ours.method == "drag_energy_pid" and ours.success and ours.errors["distance_m"] < 2e3
     assert (tmp_path / "controllers.png").exists()
 
 
@@ -55,14 +64,13 @@ def test_example_04(tmp_path):
 
 
 def test_example_05(tmp_path):
+    """Refined from 30 nodes until verified (80 nodes: between-node error 3.2e-4, the flown
+    controls 19 m from the planned end); the example flies what solve() flew."""
     r = _run("05_optimal_control", tmp_path)
     res, flown = r["result"], r["flown"]
-    assert res.converged and res.costates is not None and np.all(np.isfinite(res.costates))
-    # 30 nodes (quick): converged, but the verification sees the between-node error and the miss
-    assert not res.success and res.message.startswith("converged but inaccurate")
-    assert res.verification.dynamics_error > 1e-3 and not res.verification.propagation_error <= 1e-4
-    assert res.states[-1, 0] == pytest.approx(0.0, abs=1.0) and math.degrees(res.states[-1, 4]) == pytest.approx(-89.0)
-    assert flown.time[-1] == pytest.approx(res.verification.flight.time[-1])  # the example flies what solve() flew
+    assert res.success and res.mesh_history[0].nodes == 30 and res.mesh_history[0].error > 1e-3
+    assert res.states[-1, 0] == pytest.approx(0.0, abs=1.0) and math.degrees(res.states[-1, 4]) == pytest.approx(-80.0)
+    assert flown.time[-1] == pytest.approx(res.verification.flight.time[-1])
 
 
 def test_example_06(tmp_path):
@@ -81,19 +89,18 @@ def test_example_07(tmp_path):
     assert plan.formulation == "direct"
     assert 460.0 < plan.objective < 500.0 and flight.from_plan_m < 5e3 and flight.from_site_m < 15e3 and flight.drs_ok
     assert os.path.exists(r["plot"])
-    # 70 samples (quick) converge; the verification finds the last interval's gamma off by 0.0015 > 1e-3
-    assert r["nlp"].converged and plan.objective == pytest.approx(r["nlp"].objective / 1e6, rel=0.01)  # 0.24 %
+    assert r["nlp"] is None  # the NLP cross-check runs in the full example and in the slow tests
 
 
 def test_example_09(tmp_path):
-    """The SCvx guidance in the closed loop: re-planned it ends within the 15 km box (10.02 km
-    measured), the pre-flight plan alone farther (21.5 km); the 2-sample campaign's report."""
+    """The SCvx guidance in the closed loop: re-planned it ends within the 15 km box (10.0 km
+    measured), the pre-flight plan alone too (9.7 km, read 1 s ahead), without the lead 21 km
+    away; the 2-sample campaign's report counts its successes."""
     r = _run("09_scvx_guidance", tmp_path)
-    replanned, alone = r["flights"]["re-planned every 200 s"], r["flights"]["pre-flight plan alone"]
-    assert r["plan"].success and replanned.success, replanned.message
-    assert r["distance_km"]["re-planned every 200 s"] < 15.0 < r["distance_km"]["pre-flight plan alone"]
-    assert alone.guidance.plans == 0 and replanned.guidance.plans >= 5
-    assert os.path.exists(r["plot"]) and "2 inside the acceptance box" in open(r["report"]).read()
+    alone = r["flights"]["pre-flight plan alone"]
+    assert r["distance_km"]["re-planned every 200 s"] < 15.0 and r["distance_km"]["pre-flight plan alone"] < 15.0
+    assert alone.guidance.plans == 0
+    assert os.path.exists(r["plot"]) and "2 successful" in open(r["report"]).read()
 
 
 def test_example_08(tmp_path):

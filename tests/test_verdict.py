@@ -1,0 +1,115 @@
+"""The one verdict of a flight (drake_entry.verdict): reached, inside the acceptance box and
+every path limit held at every flown sample, log and integrator steps alike."""
+import dataclasses as dc
+import math
+
+import numpy as np
+import pytest
+
+from drake_entry.constraints import PathLimits
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.trajectory import Trajectory, metrics
+from drake_entry.verdict import PathLimit, check_limits, judge, vehicle_path_limits
+
+Q = FLIGHT_CONDITION_NAMES.index("heat_flux")
+
+
+def _trajectory(time, heat_flux, gamma=None, bank=None) -> Trajectory:
+    n = len(time)
+    state = np.zeros((n, 6))
+    state[:, 4] = 0.0 if gamma is None else gamma
+    conditions = np.zeros((n, len(FLIGHT_CONDITION_NAMES)))
+    conditions[:, Q] = heat_flux
+    return Trajectory(time=np.asarray(time, float), state=state, conditions=conditions,
+                      bank=np.zeros(n) if bank is None else np.asarray(bank, float), alpha=np.zeros(n),
+                      reason="reached energy", wall_time=0.0)
+
+
+def test_a_peak_between_two_log_samples_is_caught_at_the_integrator_steps():
+    """A heat-flux pulse of peak 1.02 q_max at t = 10.5 s (sin^40 in time) logged every 1 s looks
+    held (the samples at 10 and 11 s are 0.90 q_max); the integrator's 0.25-s steps see the
+    breach with its peak, time and margin, and so does the peak column of the row."""
+    q_max = 500e3
+    pulse = lambda t: 1.02 * q_max * np.sin(np.clip(t - 0.5, 0, 20) / 20 * np.pi) ** 40  # noqa: E731
+    log_t = np.arange(0.0, 22.0, 1.0)
+    step_t = np.arange(0.0, 22.0, 0.25)
+    tr = _trajectory(log_t, pulse(log_t))
+    limits = vehicle_path_limits(PathLimits(heat_flux_max=q_max))
+    assert judge(tr, limits, reached=True, inside_box=True).within_limits  # the log alone misses it
+    tr.steps = _trajectory(step_t, pulse(step_t))
+    v = judge(tr, limits, reached=True, inside_box=True)
+    assert not v.within_limits and not v.success and v.inside_box and v.reached
+    (c,) = v.violations
+    assert c.limit.name == "heat_flux" and c.time == pytest.approx(10.5)
+    assert c.peak == pytest.approx(1.02 * q_max) and c.margin == pytest.approx(-0.02)
+    assert "heat_flux 510 kW/m^2 at t = 10.5 s (limit <= 500 kW/m^2, margin -2.00 %)" == c.text()
+    assert metrics(tr)["peak_heat_flux_W_m2"] == pytest.approx(1.02 * q_max)
+
+
+def test_tolerance_widens_every_bound_by_its_fraction():
+    """A 1 % breach fails at tolerance 0, holds at 0.011, fails at 0.009; a bound held exactly
+    (a clamp at the bank limit) holds at tolerance 0."""
+    tr = _trajectory([0.0, 1.0, 2.0], [0.0, 101.0, 0.0], bank=[0.0, math.radians(80.0), 0.0])
+    limits = [PathLimit("heat_flux", "heat_flux", upper=100.0), PathLimit("bank", "bank", upper=math.radians(80.0),
+                                                                         absolute=True)]
+    assert [c.held for c in check_limits(tr.time, tr.column, limits, 0.0)] == [False, True]
+    assert [c.held for c in check_limits(tr.time, tr.column, limits, 0.011)] == [True, True]
+    assert [c.held for c in check_limits(tr.time, tr.column, limits, 0.009)] == [False, True]
+    with pytest.raises(ValueError, match="tolerance must be >= 0"):
+        check_limits(tr.time, tr.column, limits, -0.1)
+
+
+def test_two_sided_limit_reports_the_binding_side():
+    """gamma in [-30, 0.5] deg: a flight from -31 to 0.2 deg breaches the lower bound by 1 deg
+    (margin -1/30); one from -20 to 0.6 deg the upper by 0.1 deg (margin -0.2)."""
+    lim = [PathLimit("flight_path", "gamma", upper=math.radians(0.5), lower=math.radians(-30.0))]
+    low = _trajectory([0, 1, 2], [0, 0, 0], gamma=np.radians([0.2, -10.0, -31.0]))
+    (c,) = check_limits(low.time, low.column, lim)
+    assert not c.held and c.peak == pytest.approx(math.radians(-31.0)) and c.margin == pytest.approx(-1 / 30)
+    high = _trajectory([0, 1, 2], [0, 0, 0], gamma=np.radians([0.6, -10.0, -20.0]))
+    (c,) = check_limits(high.time, high.column, lim)
+    assert not c.held and c.time == 0.0 and c.margin == pytest.approx(-0.2)
+
+
+def test_a_closed_loop_flight_that_breaks_a_limit_is_not_a_success():
+    """HORUS-2B nominal (peak heat flux 517 kW/m^2 measured) flown with a vehicle whose heat-flux
+    limit is 500 kW/m^2: it reaches E_f inside the acceptance box, but the verdict says breached,
+    with the peak and margin in the row and the message; with a 4 % tolerance in the scenario it
+    is a success again. (At 3dec588 the box alone made ``success``.)"""
+    from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
+    from drake_entry.diagrams.sample import campaign_row
+    from drake_entry.scenario import load_scenario
+
+    scenario = load_scenario("horus2b")
+    setup = ClosedLoopSetup.from_scenario(scenario)
+    setup = dc.replace(setup, vehicle=dc.replace(setup.vehicle, limits=dc.replace(setup.vehicle.limits,
+                                                                                  heat_flux_max=500e3)))
+    res = fly(setup)
+    assert res.reached and res.verdict.inside_box and not res.verdict.within_limits and not res.success
+    row = campaign_row(res, setup)
+    assert row["success"] is False and row["inside_box"] is True and row["within_limits"] is False
+    assert row["violations"].startswith("heat_flux 51") and "limit <= 500 kW/m^2" in row["violations"]
+    assert row["margin_heat_flux"] == pytest.approx(1.0 - row["peak_heat_flux_W_m2"] / 500e3)
+    assert "path limits breached: heat_flux" in res.message
+    tolerant = dc.replace(setup, scenario=dc.replace(scenario, terminal=dc.replace(scenario.terminal,
+                                                                                  path_limit_tolerance=0.04)))
+    assert fly(tolerant).success
+
+
+def test_the_report_counts_success_box_and_limits_separately():
+    """Rows: 2 successes, 1 inside the box breaching q, 1 outside the box within limits, 1 that
+    never reached: the counts and reasons say so."""
+    from drake_entry.report import summary_statistics
+
+    rows = {"index": [0, 1, 2, 3, 4], "success": [True, True, False, False, False],
+            "reached_terminal": [True, True, True, True, False], "inside_box": [True, True, True, False, False],
+            "within_limits": [True, True, False, True, True], "err_distance_m": [1.0, 2.0, 3.0, 9e4, math.nan],
+            "violations": ["", "", "heat_flux 540 kW/m^2 at t = 700.0 s (limit <= 530 kW/m^2, margin -1.89 %)",
+                           "", ""],
+            "message": ["ok", "ok", "path limits breached: ...", "outside the acceptance box: ...",
+                        "stopped before E_f: altitude floor"]}
+    st = summary_statistics(rows)
+    assert (st["successful"], st["reached"], st["inside_acceptance_box"], st["within_limits"], st["failed"]) == \
+        (2, 4, 3, 3, 3)
+    assert st["failure_reasons"] == {"heat_flux limit breached": 1, "outside the acceptance box": 1,
+                                     "stopped before E_f": 1}

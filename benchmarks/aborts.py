@@ -1,5 +1,5 @@
 """Benchmark: paper 001's orbital-abort map (Sec. VI.A) through the campaign engine, every
-case planned by SCvx and flown by the Drake Simulator, timed against the issue-13 goal
+case planned by SCvx and flown by the Drake Simulator, timed against the project's goal
 (the 9 x 9 map in <= 15 minutes on 2 cores) and the paper's per-plan figures (75.5 s, 21.8
 iterations, Table 7), with its Tables 4-7 form printed beside the paper's.
 

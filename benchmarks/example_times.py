@@ -88,7 +88,7 @@ def examples_benchmark(mode: str = "both", only=None, write: bool = False) -> li
         names = [n for n in names if n.split("_")[0] in only or n in only]
     docs = documented()
     modes = ("quick", "full") if mode == "both" else (mode,)
-    print(f"examples: wall time (fresh process, one at a time) against docs/examples.md; exit = the example's claims")
+    print("examples: wall time (fresh process, one at a time) against docs/examples.md; exit = the example's claims")
     print(f"{'example':24s} {'mode':5s} {'exit':>4s} {'wall':>9s} {'documented':>10s} {'ratio':>6s}  last line")
     measured = []
     with tempfile.TemporaryDirectory() as out_dir:

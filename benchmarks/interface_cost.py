@@ -17,7 +17,7 @@ import tarfile
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BASELINE = "0032fd2"  # main before the guidance-method interface (issue 10)
+BASELINE = "0032fd2"  # main before the guidance-method interface 
 TIMING = ("wall_time_s", "planning_wall_s")
 
 _SCRIPT = """

@@ -8,10 +8,10 @@ with the paper's figures, every plan flown by the Drake Simulator:
    load, t_f, max g-load, flown miss, iterations and verified success.
 3. Discretisation: the direct heat-load plan by mesh (trapezoid at 100 nodes = the paper's
    scheme, Lobatto 4-node segments), plan time and iterations against the paper's 75.5 s /
-   21.8 iterations (abort means) and the issue-13 goals (<= 5 s per plan at 100 nodes, <= 15 s
+   21.8 iterations (abort means) and the project's goals (<= 5 s per plan at 100 nodes, <= 15 s
    at the flyable accuracy, <= 5 km flown from the plan).
 4. NLP cross-check: the same direct minimum-heat-load problem through ``planning.nlp.solve``
-   (DirectCollocation and LGL with SNOPT) from the same glide guess (issue 13: within 1 %).
+   (DirectCollocation and LGL with SNOPT) from the same glide guess (the goal: within 1 %).
 
 The paper's numbers come from its own (non-public) SPHYNX aerodynamic table; ours use the
 labelled representative model (drake_entry/vehicles/sphynx.yaml), so values differ by the
@@ -60,7 +60,8 @@ def table2(case) -> list:
     from drake_entry.planning.scvx.entry import OBJECTIVES
 
     print("\nTable 2 form: objectives, direct bank and alpha, 33 x 4 Lobatto (100 nodes); "
-          "'ok' = converged, checked between the nodes and propagated within 5 km")
+          "'ok' = plan.success: converged, checked between the nodes, its controls flown through the "
+          "closed loop's actuators within 5 km of it, inside the DRS box and every path limit; 'flown': fly_plan (Drake)")
     print(f"{'objective':>21s} {'unit':>7s} {'ours':>9s} {'paper':>9s} {'t_f s':>6s} {'paper':>7s} {'plan s':>7s} "
           f"{'/paper':>7s} {'iters':>5s} {'paper':>5s} {'flown km':>8s} {'site km':>7s} {'ok':>5s}")
     rows = []

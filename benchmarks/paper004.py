@@ -25,7 +25,7 @@ def paper004_study(*, seeds: int = 20, out_dir: str = "out/paper004", scenario_n
     problem = problem_from_scenario(scenario)
     out: dict = {}
 
-    print("== Cost on this machine (goals of issue 12: one PIO run <= 15 s, a bracketed 1-D solve <= 5 s)")
+    print("== Cost on this machine (goals: one PIO run <= 15 s, a bracketed 1-D solve <= 5 s)")
     from drake_entry.planning.swarm.evaluator import evaluate
     for n in (1, 10, 100):
         sigma0 = np.radians(np.linspace(55.0, 62.0, n))

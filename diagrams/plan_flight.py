@@ -31,7 +31,7 @@ from drake_entry.systems.vehicle import EntryVehicle
 from drake_entry.vehicles import Vehicle
 from drake_entry.verdict import check_limits
 
-#: acceptance of a flown plan (issue 13): DRS point within this of the plan and of the site [m]
+#: acceptance of a flown plan: DRS point within this of the plan and of the site [m]
 PLAN_TOLERANCE_M = PROPAGATION_TOLERANCE_M
 SITE_TOLERANCE_M = 15e3
 

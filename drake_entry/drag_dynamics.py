@@ -8,7 +8,7 @@ aerodynamic alpha and Mach derivatives (eqs. 44, 60-61), the gravity derivative 
 (eq. 50). D'' is evaluated as a function of u by eqs. 41-47 and split into a_D, b_D
 (eqs. 62-63); the split is exact because u enters only through gamma' (eq. 48).
 
-Corrections to the paper (shared/notes/paper000-horus.md and our own derivation):
+Corrections to the paper (docs/methods/drag-energy.md and our own derivation):
   - eq. 59: M_hV = -(T_h / T) / (2 a), the paper drops the 1/a factor (a: speed of sound);
   - eq. 44: the mixed aerodynamic term appears once with factor 2 (C_D,aM = C_D,Ma).
 Derivatives ' are d/dE [per J/kg].

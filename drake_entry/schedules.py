@@ -3,7 +3,7 @@
 The HORUS-2B angle-of-attack law (paper 000 Sec. IV.A: 40 deg, then linear down to 15 deg
 between about 960 s and 1250 s, then held) is ``Schedule.ramp``; ``smooth=True`` replaces
 the corners by a quintic blend, which keeps gamma smooth under a smooth drag profile
-(shared/notes/paper000-horus.md).
+(docs/methods/drag-energy.md).
 """
 from __future__ import annotations
 

@@ -9,7 +9,7 @@
 A layer imports only the layers before it. Two deliberate exceptions:
 planning/nlp/dircol.py imports systems.ocp_plant (Drake's DirectCollocation takes a System), and
 planning/nlp/verify.py imports diagrams.propagation (an NLP's success is verified by flying its
-controls with the Drake Simulator, issue 14).
+controls with the Drake Simulator).
 No method's package imports another method's.
 """
 import ast

@@ -5,7 +5,7 @@ from pydrake.autodiffutils import AutoDiffXd
 from drake_entry.atmosphere import ExponentialAtmosphere
 from drake_entry.errors import ScenarioError
 
-# U.S. Standard Atmosphere 1976 reference densities (shared/data/README.md)
+# U.S. Standard Atmosphere 1976 reference densities (docs/models.md)
 US76_TABLE = [(0.0, 1.2250), (11019.0, 0.36392), (20063.0, 0.088035), (32162.0, 0.013225),
               (47350.0, 1.4275e-3), (51413.0, 8.6161e-4), (71802.0, 6.4211e-5), (86000.0, 6.958e-6)]
 

@@ -47,7 +47,7 @@ def test_corridor_upper_bound_equals_the_heat_flux_limit_where_heat_flux_binds(p
 
 
 def test_corridor_active_constraints_and_narrowest_point_match_the_feasibility_study(planner, scenario):
-    """shared/notes/paper000-horus.md: heat flux binds for e < 0.57, load factor to 0.85, then q;
+    """docs/methods/drag-energy.md: heat flux binds for e < 0.57, load factor to 0.85, then q;
     narrowest D_max/D_min about 1.17 near e = 0.93 (with its own alpha ramp)."""
     c = planner.corridor
     E0, Ef = scenario.entry_energy(), planner.E_final

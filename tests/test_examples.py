@@ -4,7 +4,6 @@ import importlib.util
 import math
 import os
 
-import numpy as np
 import pytest
 
 EXAMPLES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "examples")
@@ -24,6 +23,28 @@ def _run(name: str, out_dir) -> object:
     claims = module.check(result, quick=True)
     assert claims.ok, [(c.text, c.measured) for c in claims.failed]
     return result
+
+
+#: the examples whose full run takes under about a minute here (docs/examples.md)
+FULL_RUNS = ("01_open_loop_diagram", "02_custom_controller", "03_monte_carlo", "04_custom_vehicle",
+             "05_optimal_control", "06_swarm_bank", "11_shefex3_problem")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", FULL_RUNS)
+def test_full_example_exits_0_with_every_claim_and_no_warning(name, tmp_path):
+    """The full run as a user types it, in a fresh process: exit status 0 (its claims hold), its
+    last line the claims' count, and no warning, NaN or 'verified False' printed."""
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-W", "default", os.path.join(EXAMPLES, f"{name}.py"), "--out",
+                           str(tmp_path)], capture_output=True, text=True, timeout=600)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode == 0, out[-3000:]
+    assert out.strip().splitlines()[-1].endswith("claims hold"), out[-500:]
+    bad = [line for line in out.splitlines() if "Warning" in line or " nan" in line or "verified False" in line]
+    assert not bad, bad
 
 
 def test_every_example_is_tested():

@@ -221,7 +221,7 @@ def test_marv_60_nodes_reproduces_the_reported_solution():
     assert info["extremal_control_max_diff_deg_s"] < 1e-4
 
 
-# -- issue 14: scaling, free final time, verified success, statuses, options, guesses -------------------
+# -- scaling, free final time, verified success, statuses, options, guesses -------------------
 
 def test_objective_scale_is_chosen_from_the_gradient_reported_and_overridable():
     p, best = catalogue.brachistochrone()
@@ -260,7 +260,7 @@ def test_final_time_forms_are_checked():
 def test_under_resolved_solve_converges_but_is_not_called_success():
     """The false-success guard: 24 LGL nodes on MARV satisfy the NLP at the nodes (SNOPT
     info 1) but the dynamics between the nodes are off by ~4 % and the flown controls do
-    not follow; before issue 14 this was success=True."""
+    not follow; the solver's word alone called this a success."""
     p, _ = load_problem("marv")
     r = nlp.solve(p, nodes=24, solver="snopt", tolerance=1e-7)
     assert r.converged and not r.success
@@ -301,7 +301,7 @@ def test_entry_guess_respects_the_control_bounds_and_meets_the_final_conditions(
     assert X[0, :6] == pytest.approx(p.boundary_bounds("initial")[0][:6], rel=1e-12)
 
 
-# -- issue 14: published optima with the defaults, mesh refinement, heating with alpha ------------
+# -- published optima with the defaults, mesh refinement, heating with alpha ------------
 
 SUITE = {"brachistochrone": catalogue.brachistochrone, "goddard_rocket": catalogue.goddard_rocket,
          "shuttle_crossrange": catalogue.shuttle_crossrange,

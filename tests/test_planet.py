@@ -50,7 +50,7 @@ def test_bad_planet_parameters():
 def test_from_geodetic_inverts_geodetic_at_paper001_site():
     """The Azores site (paper 001: 36.974 deg N geodetic) lies 0.185 deg (20.5 km) further
     south in geocentric latitude; a point at 0 m geodetic is 7.7 km below the WGS-84 equatorial
-    sphere's surface there (shared/notes/paper001-sphynx.md)."""
+    sphere's surface there (docs/methods/scvx.md)."""
     p = Earth.oblate()
     h, lat = p.from_geodetic(0.0, np.radians(36.974))
     assert np.degrees(lat) == pytest.approx(36.7895, abs=1e-3)

@@ -2,7 +2,6 @@
 the mission it builds from the scenario, the guidance system against its plan, and the nominal
 closed-loop flight with and without on-board re-planning."""
 import dataclasses as dc
-import math
 
 import numpy as np
 import pytest

@@ -1,6 +1,6 @@
 """Paper 003 (SHEFEX-3) mission and optimal-control problem: geodetic altitudes, alpha
 scheduled in time with the bank as a state, eq. 1's objective and the packaged problem
-(shared/notes/paper003-shefex3.md gives the figures checked here)."""
+(docs/methods/ampi.md gives the figures checked here)."""
 import dataclasses as dc
 import math
 

@@ -7,7 +7,7 @@ from drake_entry.planning.swarm.optimizers import PSO_CONSTRICTION, pio, pso
 
 
 def v_shape(X):
-    """J(sigma0) of the CAV-H Case 1 shape (shared/notes: V-shaped, minimum 0.26 at 58.92 deg)."""
+    """J(sigma0) of the CAV-H Case 1 shape (the feasibility study, docs/methods/swarm-bank.md: V-shaped, minimum 0.26 at 58.92 deg)."""
     return 0.26 + 0.675 * np.abs(X[:, 0] - 58.92)
 
 

@@ -2,7 +2,7 @@
 (Algorithm 1), tensor-product interpolation (Algorithm 2), and the nearest database entry
 for neighbour-trajectory tracking (NTT, the paper's comparison).
 
-Algorithm 1 as printed has typos (shared/notes/paper003-shefex3.md): U_1 needs n_i entries
+Algorithm 1 as printed has typos (docs/methods/ampi.md): U_1 needs n_i entries
 (not d), its loops disagree, and a value on a grid point gives sign 0. Fixed here: in each
 dimension the enclosing interval is [j, j + 1] with j the last level <= x (the first
 interval for x below the grid, the last for x above it: then the interpolation

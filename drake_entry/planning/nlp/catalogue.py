@@ -1,5 +1,5 @@
 """Published optimal-control problems with known optima, posed as a user would pose them
-(issue 14's suite): each function returns (problem, published) where ``published`` holds the
+(the verification suite): each function returns (problem, published) where ``published`` holds the
 optimum and its source (tests/test_nlp.py, examples/10_published_optima.py, benchmarks/dymos_peer.py).
 """
 from __future__ import annotations

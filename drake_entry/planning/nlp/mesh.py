@@ -1,4 +1,4 @@
-"""Mesh refinement (issue 14): raise the node count until the between-node error meets the
+"""Mesh refinement: raise the node count until the between-node error meets the
 tolerance, each mesh warm-started from the previous solution.
 
 The error estimate of a mesh is verify.interval_errors: on every interval the integral of

@@ -1,6 +1,5 @@
-"""What the solver sees: states, controls, time and the objective divided by typical sizes
-(issue 14). Every factor is chosen automatically, reported in the result
-(``NlpResult.scaling``) and can be overridden (``solve(..., scaling={...})``).
+"""What the solver sees: states, controls, time and the objective divided by typical sizes.
+Every factor is chosen automatically, reported in the result (``NlpResult.scaling``) and can be overridden (``solve(..., scaling={...})``).
 
 - states, controls, time: the problem's own (entry problems: canonical units of paper 002,
   altitude in 10 km, controls by their bounds); for a ``CustomProblem`` without them, the

@@ -1,4 +1,4 @@
-"""Is an NLP solution right between its nodes? (issue 14: ``success`` means verified.)
+"""Is an NLP solution right between its nodes? (``success`` means verified.)
 
 Two independent checks, both in the relative form of GPOPS-II (Patterson & Rao 2014,
 eq. 39): an error in state i divided by 1 + max_k |x_i(t_k)|.
@@ -31,7 +31,7 @@ QUADRATURE_POINTS = 8
 #: mesh tolerance. The open-loop flight accumulates and amplifies those errors over the whole
 #: trajectory (entry dynamics are unstable in gamma on the final dive: 100 DirectCollocation
 #: samples of the SCvx cross-check meet 6e-4 between nodes and end 0.14 deg of gamma, 68 m,
-#: 0.08 m/s off, relative 0.0024), so its tolerance is 1e-2; issue 14's wrong answer (196 km,
+#: 0.08 m/s off, relative 0.0024), so its tolerance is 1e-2; the unverified wrong answer (196 km,
 #: 160 m/s) is 0.02-0.03.
 DYNAMICS_TOLERANCE = 1e-3
 PROPAGATION_TOLERANCE = 1e-2

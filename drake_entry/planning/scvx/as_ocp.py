@@ -1,7 +1,7 @@
 """Paper 001's direct problem posed for the NLP path: the same mission as an
 ``OptimalControlProblem`` (planning/ocp.py) that ``planning.nlp.solve`` transcribes with LGL or
 Drake's DirectCollocation and solves with Ipopt or SNOPT — the independent check of an SCvx
-plan's optimality (issue 13: the two heat loads within 1 %).
+plan's optimality (the two heat loads agree within 1 %: docs/methods/scvx.md).
 
 Same models and limits as the SCvx entry problem in its direct formulation (eqs. 34-36,
 54-55): states [h, lon, lat, V, gamma, psi, alpha, sigma], controls their rates within the

@@ -31,7 +31,7 @@ GAP_LIFT_FRACTION = 0.05
 BETWEEN_NODE_TOLERANCE = (0.02, 0.02, math.radians(0.2))
 #: evaluation points per mesh segment for the between-node check and the rate metrics
 POINTS_PER_SEGMENT = 8
-#: the plan's controls propagated must end within this of its terminal point [m] (issue 13)
+#: the plan's controls propagated must end within this of its terminal point [m]
 PROPAGATION_TOLERANCE_M = 5e3
 
 #: ``ScvxPlan.metrics`` keys of each objective (paper 001 Table 2)

@@ -40,7 +40,7 @@ def qeg_sin_flight_path(r, V, D, beta: float):
     d r_eq/dV = 2 / (beta V (1 - V^2)) from eq. 46 gives
     sin gamma = -2 D / (beta V^2 (1 - V^2) + 2 / r^2).
     The paper prints -D / (beta V^3 (1 - V^2) + 1/r^2), which is off by x0.56 to x1.25
-    (shared/notes/paper004-cavh.md); tests check this form against eq. 46's derivative."""
+    (docs/methods/swarm-bank.md); tests check this form against eq. 46's derivative."""
     r, V, D = (np.asarray(v, float) for v in (r, V, D))
     return -2.0 * D / (beta * V * V * (1.0 - V * V) + 2.0 / (r * r))
 

@@ -4,7 +4,7 @@ written and seeded, minimising a vectorised objective f(X) -> J over box bounds.
 PIO: the map-and-compass operator (eqs. 41-42) for iterations 1..k_c, then the landmark
 operator (eqs. 43-45): the population is halved each iteration (eq. 44 with ceil, at least
 one), keeping the fittest pigeons, which move toward their fitness-weighted centre. Eq. 43 is
-used corrected (shared/notes/paper004-cavh.md): weights 1/(J + eps) (J is minimised) and no
+used corrected (docs/methods/swarm-bank.md): weights 1/(J + eps) (J is minimised) and no
 N_p in the denominator (printed, the centre lands at X/N_p). Start velocities (not given in
 the paper) are zero.
 

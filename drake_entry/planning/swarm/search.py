@@ -4,7 +4,7 @@ the same counted, vectorised objective; and the on-board re-solution of sigma_0.
 
 Angles are in degrees here (the paper's and the user's unit); the evaluator works in rad.
 
-Baselines (shared/notes/paper004-cavh.md measured their trajectory counts):
+Baselines (docs/methods/swarm-bank.md measured their trajectory counts):
   grid            vectorised grid refinement on the signed range error (16 points, 4 rounds)
   brentq          one 16-point grid to bracket the signed range error, then scipy brentq
   secant          vectorised bracketing (16 points, then 2 rounds of 8 inside the bracket) and

@@ -126,18 +126,28 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
                for name, engine in engines.items()}
     history, build_time, solve_time, target = [], 0.0, 0.0, dynamics_tolerance
     calls, callback_time = 0, 0.0
+    first_guess = guess
     while True:
         mesh_time, failed = 0.0, []
-        for name, engine in engines.items():  # auto: SNOPT, then Ipopt from the same start if it fails
-            result, words, diagnosis = _solve_mesh(problem, transcription, name, engine, nodes, guess, scaling,
-                                                   options[name][0])
-            mesh_time, build_time = mesh_time + result.solve_time, build_time + result.build_time
-            calls, callback_time = calls + result.callback_calls, callback_time + result.callback_time
+        # auto: SNOPT, then Ipopt if it fails; a refined mesh whose warm start fails is tried
+        # again from the first guess (each solver in turn: SNOPT's second start before Ipopt's
+        # thousands of iterations)
+        starts = [("", guess)] + ([(" from the first guess", first_guess)] if guess is not first_guess else [])
+        for name, engine in engines.items():
+            for label, start in starts:
+                result, words, diagnosis = _solve_mesh(problem, transcription, name, engine, nodes, start, scaling,
+                                                       options[name][0])
+                mesh_time, build_time = mesh_time + result.solve_time, build_time + result.build_time
+                calls, callback_time = calls + result.callback_calls, callback_time + result.callback_time
+                words = words + label
+                if result.converged:
+                    break
+                failed.append(words)
             if result.converged:
                 break
-            failed.append(words)
-        if failed and len(engines) > 1:
-            words = f"{words} (auto solver after '{failed[0]}')" if result.converged else "; ".join(failed)
+        if failed:
+            after = "auto solver after" if name != next(iter(engines)) else "after"
+            words = f"{words} ({after} '{failed[0]}')" if result.converged else "; ".join(failed)
         solve_time += mesh_time
         result.solver, result.log_file, result.guess_time = name, options[name][1], guess_time
         result.build_time, result.solve_time, result.mesh_history = build_time, solve_time, history

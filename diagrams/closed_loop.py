@@ -41,7 +41,8 @@ from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.systems.vehicle import EntryVehicle
 from drake_entry.trajectory import Trajectory
 from drake_entry.vehicles import Vehicle
-from drake_entry.verdict import Verdict, judge
+from drake_entry.verdict import Verdict, box_text, judge
+from drake_entry.verdict import acceptance_box as box_at
 
 ALTITUDE_FLOOR_M = 5000.0
 
@@ -216,21 +217,12 @@ def terminal_errors(x, setup: ClosedLoopSetup) -> dict:
 
 
 def acceptance_box(tr: Trajectory, setup: ClosedLoopSetup, distance_m: float) -> dict:
-    """The mission's acceptance box (scenario.terminal tolerances, paper 000 Table 1) at the
-    final state: {criterion: {"error": e, "tolerance": tol, "inside": |e| <= tol}} for each
-    criterion whose tolerance is given: 'altitude' [m] about terminal.altitude_km (geodetic with
-    altitude_datum 'ellipsoid'), 'mach'
-    about terminal.mach, 'distance' [m] to the target (``distance_m``, terminal_errors')."""
-    t, x = setup.scenario.terminal, tr.state[-1]
-    box = {}
-    if t.altitude_km is not None and t.altitude_tolerance_km is not None:
-        h = setup.planet.atmospheric_altitude(x[0], x[2]) if setup.scenario.altitude_datum == "ellipsoid" else x[0]
-        box["altitude"] = (float(h - t.altitude_km * 1e3), t.altitude_tolerance_km * 1e3)
-    if t.mach is not None and t.mach_tolerance is not None:
-        box["mach"] = (float(tr.column("mach")[-1] - t.mach), t.mach_tolerance)
-    if t.distance_tolerance_km is not None:
-        box["distance"] = (float(distance_m), t.distance_tolerance_km * 1e3)
-    return {k: {"error": e, "tolerance": tol, "inside": bool(abs(e) <= tol)} for k, (e, tol) in box.items()}
+    """The mission's acceptance box (drake_entry.verdict.acceptance_box) at the final state:
+    the altitude geodetic with altitude_datum 'ellipsoid', the Mach number flown, the distance
+    to the target ``distance_m`` (terminal_errors')."""
+    x = tr.state[-1]
+    h = setup.planet.atmospheric_altitude(x[0], x[2]) if setup.scenario.altitude_datum == "ellipsoid" else x[0]
+    return box_at(setup.scenario.terminal, altitude_m=float(h), mach=float(tr.column("mach")[-1]), distance_m=distance_m)
 
 
 def fly(scenario: Scenario | ClosedLoopSetup, planner=None, *, initial_state=None, nav_seed: int = 0,
@@ -250,7 +242,7 @@ def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoo
     guidance = setup.method.summarise(diagram, ctx, setup.planner)
     errors = terminal_errors(tr.state[-1], setup)
     box = acceptance_box(tr, setup, errors["distance_m"])
-    missed = [f"{k} {_box_text(k, b)}" for k, b in box.items() if not b["inside"]]
+    missed = [f"{k} {box_text(k, b)}" for k, b in box.items() if not b["inside"]]
     by_altitude = setup.scenario.guidance.stops_at_altitude
     name = "h_f" if by_altitude else "E_f"
     reached = ("altitude" if by_altitude else "energy") in tr.reason
@@ -270,9 +262,3 @@ def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoo
         where = f"reached {name} at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
         msg = f"{' | '.join(parts)} ({where})" if parts else where
     return ClosedLoopResult(tr, errors, verdict.success, msg, setup.method.name, guidance, box, reached, verdict)
-
-
-def _box_text(name: str, b: dict) -> str:
-    if name == "mach":
-        return f"error {b['error']:+.3f} outside +-{b['tolerance']:g}"
-    return f"error {b['error'] / 1e3:+.3f} km outside +-{b['tolerance'] / 1e3:g} km"

@@ -34,15 +34,17 @@ def _flags(rows: dict, col: str, n: int, default) -> np.ndarray:
 
 
 def failure_categories(row: dict) -> list[str]:
-    """Why a row is not a success: its stop message when it did not reach the terminal
-    interface; otherwise 'outside the acceptance box' and '<limit> limit breached' for each
-    breached path limit (the row's ``violations``)."""
-    reached, inside, within = row.get("reached"), row.get("inside_box"), row.get("within_limits")
-    if inside is None or within is None or not reached:
-        return [str(row.get("message") or "").split(":")[0][:80]]
+    """Why a row is not a success: 'outside the acceptance box' and '<limit> limit breached'
+    for each breached path limit (the row's ``violations``) when that is why; otherwise the
+    first clause of its message (it did not reach, its guidance never engaged, it raised)."""
+    message = str(row.get("message") or "")
+    inside, within = row.get("inside_box"), row.get("within_limits")
+    if inside is None or within is None or not message.startswith(("outside the acceptance box",
+                                                                    "path limits breached")):
+        return [message.split(":")[0][:80]]  # it did not reach, or its guidance never engaged, ...
     out = [] if inside else ["outside the acceptance box"]
     out += [f"{part.split()[0]} limit breached" for part in str(row.get("violations") or "").split("; ") if part]
-    return out or [str(row.get("message") or "").split(":")[0][:80]]
+    return out or [message.split(":")[0][:80]]
 
 
 def _finite(rows: dict, col: str, n: int) -> np.ndarray:
@@ -86,7 +88,6 @@ def summary_statistics(rows: dict) -> dict:
     keys = list(rows)
     for i in np.flatnonzero(~ok):
         row = {k: rows[k][i] for k in keys}
-        row["reached"] = bool(reached[i])
         for key in failure_categories(row):
             reasons[key] = reasons.get(key, 0) + 1
     out["failure_reasons"] = reasons
@@ -100,7 +101,7 @@ def summary_statistics(rows: dict) -> dict:
     if reached.any():
         d = _finite(rows, "err_distance_m", n)[reached]
         out["inside_km"] = {str(r): int((d <= r * 1e3).sum()) for r in (2, 25, 50, 75)}
-    for col in [c for c in rows if c.startswith("inside_") and c.endswith("_box")]:
+    for col in [c for c in rows if c.startswith("inside_") and c.endswith("_box") and c != "inside_box"]:
         out["inside_box"][col[len("inside_"):-len("_box")]] = int(sum(bool(v) for v in rows[col] if v is not None))
     for col in [c for c in MARGIN_COLUMNS if c in rows] + sorted(c for c in rows if c.startswith("margin_")
                                                                   and c not in MARGIN_COLUMNS):

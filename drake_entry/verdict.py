@@ -131,6 +131,28 @@ def _scale(bound: float) -> float:
     return abs(bound) if bound != 0.0 else 1.0
 
 
+def acceptance_box(terminal, *, altitude_m: float, mach: float, distance_m: float) -> dict:
+    """The mission's acceptance box (a scenario's TerminalSpec, paper 000 Table 1) at a final
+    point: {criterion: {"error": e, "tolerance": tol, "inside": |e| <= tol}} for each criterion
+    whose tolerance is given: 'altitude' [m] about terminal.altitude_km (``altitude_m`` in the
+    scenario's datum), 'mach' about terminal.mach, 'distance' [m] to the target."""
+    t, box = terminal, {}
+    if t.altitude_km is not None and t.altitude_tolerance_km is not None:
+        box["altitude"] = (float(altitude_m - t.altitude_km * 1e3), t.altitude_tolerance_km * 1e3)
+    if t.mach is not None and t.mach_tolerance is not None:
+        box["mach"] = (float(mach - t.mach), t.mach_tolerance)
+    if t.distance_tolerance_km is not None:
+        box["distance"] = (float(distance_m), t.distance_tolerance_km * 1e3)
+    return {k: {"error": e, "tolerance": tol, "inside": bool(abs(e) <= tol)} for k, (e, tol) in box.items()}
+
+
+def box_text(name: str, b: dict) -> str:
+    """One acceptance criterion missed, in words."""
+    if name == "mach":
+        return f"error {b['error']:+.3f} outside +-{b['tolerance']:g}"
+    return f"error {b['error'] / 1e3:+.3f} km outside +-{b['tolerance'] / 1e3:g} km"
+
+
 @dc.dataclass(frozen=True)
 class Verdict:
     """The verdict of one flight.

@@ -113,3 +113,4 @@ def test_the_report_counts_success_box_and_limits_separately():
         (2, 4, 3, 3, 3)
     assert st["failure_reasons"] == {"heat_flux limit breached": 1, "outside the acceptance box": 1,
                                      "stopped before E_f": 1}
+    assert st["inside_box"] == {}  # per criterion (inside_<criterion>_box): none given here

@@ -18,14 +18,16 @@ import numpy as np
 from ...planning.result import PlanResult
 from ...planning.swarm.evaluator import CONTROL_COLUMNS, HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
 from ...planning.swarm.search import SearchResult, problem_from_scenario, search
+from ...verdict import acceptance_box, box_text, check_limits, vehicle_path_limits
 from ...systems.swarm_bank_guidance import SwarmBankGuidance
 from ..interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
 from ..reversal import add_bank_reversal, reversal_count
 
 GUIDANCE_SYSTEM = "swarm_bank_guidance"
-#: relative slack on the path limits when verifying a plan (the alpha law holds the load at
-#: its limit; the actuator's lag crosses it by a fraction of a percent)
-LIMIT_SLACK = 0.01
+#: the replica's recorded columns of the path limits it can check (the closed loop's verdict
+#: checks every limit at every integrator step)
+LIMIT_COLUMNS = {"heat_flux": "heat_flux_W_m2", "dynamic_pressure": "dynamic_pressure_Pa",
+                 "total_load": "total_load_g", "bank": "bank_rad"}
 
 
 @dc.dataclass
@@ -33,8 +35,11 @@ class SwarmPlan(PlanResult):
     """sigma_0 [deg] of paper 004 eq. 17 for a mission, with the search that found it and the
     evaluation of its trajectory (``evaluation``, one member with its recorded history).
 
-    success: the trajectory reaches the TAEM energy inside the path limits (heat rate, q, load
-    within LIMIT_SLACK); otherwise ``message`` names the violated limits with their values.
+    success: the trajectory reaches the TAEM energy inside the scenario's acceptance box and the
+    path limits (heat rate, q, load,
+    bank: the vehicle's, widened only by the scenario's ``terminal.path_limit_tolerance``, at
+    every guidance step of the closed-loop replica); otherwise ``message`` names the violated
+    limits with their peaks and margins.
     """
 
     variable = "time"
@@ -43,7 +48,7 @@ class SwarmPlan(PlanResult):
     sigma0_deg: float = math.nan
     search: SearchResult | None = None
     evaluation: Evaluation | None = None
-    violations: dict = dc.field(default_factory=dict)
+    violations: list = dc.field(default_factory=list)
 
     def evaluate(self, at) -> dict:
         """The planned trajectory's HISTORY_COLUMNS at times ``at`` [s]: the states, commands and
@@ -57,13 +62,27 @@ class SwarmPlan(PlanResult):
         return out
 
 
-def verify(problem: SwarmProblem, ev: Evaluation) -> dict:
-    """{limit: (peak, limit)} of the path limits the (single-member) evaluation violates."""
-    lim = problem.vehicle.limits
-    checks = {"heat_flux_W_m2": (ev.peak_heat_flux_W_m2[0], lim.heat_flux_max),
-              "dynamic_pressure_Pa": (ev.peak_dynamic_pressure_Pa[0], lim.dynamic_pressure_max),
-              "total_load_g": (ev.peak_total_load_g[0], lim.total_load_max)}
-    return {k: (float(v), float(m)) for k, (v, m) in checks.items() if v > m * (1.0 + LIMIT_SLACK)}
+def verify(problem: SwarmProblem, ev: Evaluation, tolerance: float = 0.0) -> list:
+    """The path limits the (single-member, recorded) evaluation breaches (drake_entry.verdict
+    LimitChecks, at every guidance step of the replica), ``tolerance`` relative."""
+    v = problem.vehicle
+    limits = [lim for lim in vehicle_path_limits(v.limits, v.bank_limit) if lim.name in LIMIT_COLUMNS]
+    h = ev.history[0]
+    column = {name: h[:, HISTORY_COLUMNS.index(LIMIT_COLUMNS[name])] for name in LIMIT_COLUMNS}
+    checks = check_limits(h[:, 0], lambda name: column[name], [dc.replace(lim, column=lim.name) for lim in limits],
+                          tolerance)
+    return [c for c in checks if not c.held]
+
+
+def terminal_box(scenario, problem: SwarmProblem, x) -> dict:
+    """The scenario's acceptance box (drake_entry.verdict.acceptance_box) at the replica's TAEM
+    state ``x`` [h, lon, lat, V, gamma, psi]: the state altitude (paper 004's sphere), the Mach
+    number there, the great-circle distance to the target."""
+    pl = problem.planet
+    h = float(pl.atmospheric_altitude(x[0], x[2])) if scenario.altitude_datum == "ellipsoid" else float(x[0])
+    a = float(problem.atmosphere.air_data(pl.atmospheric_altitude(x[0], x[2]))[1])
+    distance = float(pl.great_circle_distance(x[1], x[2], *problem.target))
+    return acceptance_box(scenario.terminal, altitude_m=h, mach=float(x[3]) / a, distance_m=distance)
 
 
 def plan(scenario, problem: SwarmProblem | None = None) -> SwarmPlan:
@@ -81,19 +100,23 @@ def plan(scenario, problem: SwarmProblem | None = None) -> SwarmPlan:
         sigma0 = float(g.bank_start_deg)
     build = time.perf_counter() - t0
     ev = evaluate(problem, np.radians([sigma0]), record=True)
-    violations = verify(problem, ev)
+    violations = verify(problem, ev, scenario.terminal.path_limit_tolerance)
     reached = bool(ev.reached[0])
+    box = terminal_box(scenario, problem, ev.final_state[0])
+    missed = [f"{k} {box_text(k, b)}" for k, b in box.items() if not b["inside"]]
     parts = [f"sigma_0 = {sigma0:.3f} deg" + (f" by {found.method} ({found.trajectories} trajectories)" if found
                                                  else " (given)"),
              f"J = {ev.J[0]:.4f}: range error {ev.range_error_m[0] / 1e3:+.2f} km, altitude {ev.altitude_error_m[0]:+.0f} m, "
              f"speed {ev.velocity_error_m_s[0]:+.1f} m/s, crossrange {ev.crossrange_m[0] / 1e3:+.2f} km"]
     if not reached:
         parts.append("the trajectory does not reach the TAEM energy")
+    if missed:
+        parts.append("ends outside the acceptance box: " + "; ".join(missed))
     if violations:
-        parts.append("violates " + ", ".join(f"{k} {v:.4g} > {m:.4g}" for k, (v, m) in violations.items()))
+        parts.append("breaches " + "; ".join(c.text() for c in violations))
     if found is not None and found.message:
         parts.append(found.message)
-    return SwarmPlan(success=reached and not violations, message="; ".join(parts),
+    return SwarmPlan(success=reached and not missed and not violations, message="; ".join(parts),
                      iterations=len(found.swarm.history) - 1 if found is not None and found.swarm else 0,
                      build_time=build, solve_time=time.perf_counter() - t0 - build, objective=float(ev.J[0]),
                      problem=problem, sigma0_deg=sigma0, search=found, evaluation=ev, violations=violations)

@@ -236,6 +236,9 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
         for col, m in stats["margins"].items():
             md.append(f"| {col.replace('margin_', '')} | {100 * m['worst']:.2f} % | {m['violations']} | "
                       f"{m['worst_sample']} |")
+        if stats["margins"].get("margin_bank", {}).get("worst") == 0.0:
+            md += ["", "A bank margin of 0 % means the bank actuator reached the vehicle's bank limit, where it "
+                   "clips: held, not breached."]
     if stats.get("cost"):
         c = stats["cost"]
         md += ["", f"Cost: {c['wall_s_per_sample']:.2f} s of one core per sample, {100 * c['planning_share']:.0f} % of "

@@ -102,7 +102,8 @@ def test_nominal_closed_loop_reaches_the_site_with_replanning(setup):
 def test_scvx_campaign_rows_and_report(tmp_path):
     """A reduced Monte-Carlo of the SCvx guidance through the shared campaign engine (2 samples of
     the scenario's labelled dispersions): every sample reaches the DRS altitude inside the
-    acceptance box, its rows carry the method's fields, and the report counts them."""
+    acceptance box with every path limit held (heat flux, load, bank, eq. 70's gamma bounds), its
+    rows carry the method's fields and the verdict, and the report counts them."""
     import pyarrow.parquet as pq
 
     from drake_entry.diagrams.montecarlo import run_campaign
@@ -113,7 +114,10 @@ def test_scvx_campaign_rows_and_report(tmp_path):
     assert rows["method"] == ["scvx", "scvx"]
     assert all(rows["reached_terminal"]) and all(p >= 3 for p in rows["plans"])
     st = summary_statistics(rows)
-    assert st["reached"] == 2 and st["successful"] == 2
+    assert st["reached"] == 2 and st["successful"] == 2 and st["within_limits"] == 2
+    assert all(rows["within_limits"]) and rows["violations"] == ["", ""]
+    assert min(rows["margin_heat_flux"]) > 0.0 and min(rows["margin_flight_path"]) > 0.0
     assert max(rows["err_distance_m"]) <= 15e3
     report = open(write_report(out)).read()
-    assert "2 inside the acceptance box" in report or "2/2" in report
+    assert "2 successful (reached, inside the acceptance box and within every path limit)" in report
+    assert "flight_path in [-30, 0.5] deg" in report

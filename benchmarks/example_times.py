@@ -59,10 +59,12 @@ def run_example(name: str, mode: str, out_dir: str) -> dict:
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
     wall = time.perf_counter() - t0
-    lines = [s for s in (proc.stdout + proc.stderr).splitlines() if s.strip()]
+    out = [s for s in proc.stdout.splitlines() if s.strip()]
+    lines = out + [s for s in proc.stderr.splitlines() if s.strip()]
     warnings = [s for s in lines if "Warning" in s or "nan" in s.split() or "verified False" in s]
-    return {"name": name, "mode": mode, "wall_s": wall, "exit": proc.returncode, "last": lines[-1] if lines else "",
-            "warnings": warnings}
+    failed = [s.strip() for s in out if "[FAILED]" in s]
+    return {"name": name, "mode": mode, "wall_s": wall, "exit": proc.returncode, "last": out[-1] if out else "",
+            "warnings": warnings + failed}
 
 
 def write_docs(measured: list) -> None:

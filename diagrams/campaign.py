@@ -70,9 +70,9 @@ def run_cases(task: Task, cases: list, out_dir: str, manifest: dict, *, backend:
             store.record(row, traj)
             if bar is not None:
                 bar.update(1)
-                if not row.get("success"):
+                if not row.get("success"):  # not a success: a verdict, not necessarily an error
                     failed += 1
-                    bar.set_postfix(failed=failed)
+                    bar.set_postfix(unsuccessful=failed)
 
         run_backend(backend, task, todo, record, workers=workers, scheduler=scheduler)
         store.finalise()

@@ -135,3 +135,21 @@ def test_one_orbital_abort_is_planned_flown_and_reported(tmp_path):
     report = open(write_abort_report(out)).read()
     assert "Feasible at 10 km" in report and "**Table 4 form**" in report
     assert (tmp_path / "reachability_map.png").exists() and (tmp_path / "attitude.png").exists()
+
+
+def test_descent_aborts_stop_where_the_planner_cannot_start():
+    """A flown descent slowing from 7000 m/s to 300 m/s at 1500 s: of the triggers every 100 s the
+    one at 1500 s (300 m/s, below the planner's 500 m/s) is not a case (the last three of the
+    nominal's 33 used to raise 'entry_speed_m_s out of range')."""
+    import numpy as np
+
+    from drake_entry.planet import Earth
+    from drake_entry.planning.scvx.aborts import descent_abort_cases
+
+    t = np.linspace(0.0, 1600.0, 161)
+    states = np.zeros((t.size, 6))
+    states[:, 0], states[:, 3] = 60e3, np.maximum(7000.0 - 6700.0 * t / 1500.0, 300.0)
+    cases = descent_abort_cases(t, states, np.zeros(t.size), np.radians(np.full(t.size, 30.0)), Earth.oblate(),
+                                site=(-7.95, 32.23), spacing_s=100.0)
+    speeds = [c["entry_speed_m_s"] for c in cases]
+    assert min(speeds) >= 500.0 and [c["abort_time_s"] for c in cases] == [100.0 * k for k in range(1, 15)]

@@ -28,7 +28,7 @@ import numpy as np
 from ... import geodesy
 from ...errors import ScenarioError
 from ...planet import Earth
-from .mission import SITE_RADIUS_MAX_M, ScvxMission
+from .mission import ENTRY_SPEED_RANGE_M_S, SITE_RADIUS_MAX_M, ScvxMission
 
 #: the paper's grid spacing [deg] and the smallest map the issue asks for
 GRID_SPACING_DEG = 5.0
@@ -126,13 +126,17 @@ def descent_abort_cases(time, states, bank, alpha, planet: Earth, *, site: tuple
     end) its state (time [s], states (n, 6) SI, bank and alpha [rad] at those times) becomes an
     abort's entry state and held attitude, with the alternative ``site`` (longitude, geodetic
     latitude) [deg]. Triggers where the flown gamma lies outside ``flight_path_bounds_deg`` are
-    moved to the bound (the planner's start must satisfy eq. 70)."""
+    moved to the bound (the planner's start must satisfy eq. 70); triggers where the flown speed
+    is below the planner's range (``ENTRY_SPEED_RANGE_M_S``: 500 m/s, the last minute before the
+    DRS point) are not cases."""
     if not 1.0 <= spacing_s <= 1e4:
         raise ScenarioError(f"descent abort spacing_s = {spacing_s} is out of range [1, 10000] s")
     time = np.asarray(time, float)
     cases = []
     for t_a in np.arange(spacing_s, time[-1], spacing_s):
         x = np.array([np.interp(t_a, time, states[:, k]) for k in range(6)])
+        if x[3] < ENTRY_SPEED_RANGE_M_S[0]:
+            break
         h_geo, lat_geo = planet.geodetic(planet.radius(x[0]), x[2])
         gamma = float(np.clip(math.degrees(x[4]), *flight_path_bounds_deg))
         cases.append({"index": len(cases), "abort_time_s": float(t_a), "entry_altitude_m": float(h_geo),

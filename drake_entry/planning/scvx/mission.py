@@ -20,6 +20,8 @@ from ...verdict import PathLimit
 
 #: the largest site radius a mission accepts [m] (a minimum-miss abort opens its cone to it)
 SITE_RADIUS_MAX_M = 5e6
+#: the entry speeds a mission accepts [m/s] (a plan from below 500 m/s has nowhere to glide)
+ENTRY_SPEED_RANGE_M_S = (500.0, 12e3)
 #: ScvxMission.final_altitude_margin_m by the bank's form when not given [m]: the lossless bank's
 #: |u| < 1 at the final pull-up is lift the real bank cannot dump, so it flies its DRS point
 #: about 500 m above the plan's (measured on the nominal mission); a bank state flies within 20 m
@@ -86,7 +88,7 @@ class ScvxMission:
                 raise ScenarioError(f"ScvxMission.{field} = {value!r} is out of range [{lo}, {hi}] {unit}")
 
         check("entry_altitude_m", self.entry_altitude_m, 0.0, 200e3, "m")
-        check("entry_speed_m_s", self.entry_speed_m_s, 500.0, 12e3, "m/s")
+        check("entry_speed_m_s", self.entry_speed_m_s, *ENTRY_SPEED_RANGE_M_S, "m/s")
         check("entry_flight_path_deg", self.entry_flight_path_deg, -45.0, 5.0, "deg")
         for f in ("entry_latitude_deg", "site_latitude_deg"):
             check(f, getattr(self, f), -89.0, 89.0, "deg")

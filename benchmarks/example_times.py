@@ -21,7 +21,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXAMPLES = os.path.join(ROOT, "examples")
 DOCS = os.path.join(ROOT, "docs", "examples.md")
 #: a docs row: | `NAME.py` | what | QUICK / FULL |
-ROW = re.compile(r"^(\| `(?P<name>\d\d_\w+)\.py` \|.*\| )(?P<quick>[^|/]+?) / (?P<full>[^|/]+?)( \|)$")
+ROW = re.compile(r"^(?P<head>\| `(?P<name>\d\d_\w+)\.py` \|.*\| )(?P<quick>[^|/]+?) / (?P<full>[^|/]+?)(?P<end> \|)$")
 
 
 def parse_time(text: str) -> float:
@@ -79,7 +79,7 @@ def write_docs(measured: list) -> None:
         full = by.get((m.group("name"), "full"))
         q = format_time(quick) if quick is not None else m.group("quick")
         f = format_time(full) if full is not None else m.group("full")
-        lines[i] = f"{m.group(1)}{q} / {f}{m.group(6)}"
+        lines[i] = f"{m.group('head')}{q} / {f}{m.group('end')}"
     with open(DOCS, "w") as fh:
         fh.write("\n".join(lines) + "\n")
 

@@ -72,8 +72,9 @@ class Trajectory:
 
 
 def metrics(tr: Trajectory, limits: PathLimits | None = None) -> dict:
-    """Peak path quantities (over every flown sample, ``Trajectory.flown``) and the heat load of a trajectory, with the relative margins
-    1 - peak/limit (negative = violated) when ``limits`` are given.
+    """Peak path quantities (over every flown sample, ``Trajectory.flown``) and the heat load of
+    a trajectory, with the relative margins 1 - peak/limit (negative = violated) when ``limits``
+    are given.
 
     Keys: peak_heat_flux_W_m2, peak_dynamic_pressure_Pa, peak_normal_load_g,
     peak_total_load_g, heat_load_J_m2 (trapezoidal integral of the heat flux over time),

@@ -41,7 +41,7 @@ class Scvx(GuidanceSpecBase):
     # plan's design margin inside it [m], Mach (eq. 65), vertical speed [m/s] (eq. 66)
     site_radius_m: float = 10e3
     final_altitude_m: list[float] = dc.field(default_factory=lambda: [10e3, 13e3])
-    # (None: the formulation's default, 600 m for the lossless bank, 200 m for a bank state)
+    # (None: the formulation's default, 1200 m for the lossless bank, 200 m for a bank state)
     final_altitude_margin_m: Optional[float] = None
     final_mach_max: float = 1.0
     final_vertical_speed_min_m_s: float = -140.0

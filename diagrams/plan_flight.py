@@ -23,13 +23,13 @@ from pydrake.trajectories import PiecewisePolynomial
 from drake_entry.atmosphere import Atmosphere
 from drake_entry.diagrams.common import add_step_loggers, collect_trajectory
 from drake_entry.planet import Earth
-from drake_entry.planning.scvx.planner import (PROPAGATION_TOLERANCE_M, FlightCheck, ScvxPlan, plan_path_limits,
-                                               terminal_distance)
+from drake_entry.planning.scvx.planner import (PROPAGATION_TOLERANCE_M, FlightCheck, ScvxPlan, drs_point,
+                                               plan_path_limits, terminal_distance)
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.systems.vehicle import EntryVehicle
 from drake_entry.vehicles import Vehicle
-from drake_entry.verdict import check_limits
+from drake_entry.verdict import breaches_text, check_limits
 
 #: acceptance of a flown plan: DRS point within this of the plan and of the site [m]
 PLAN_TOLERANCE_M = PROPAGATION_TOLERANCE_M
@@ -64,7 +64,7 @@ class PlanFlight:
     trajectory: object = None
 
     def violations_text(self) -> str:
-        return "; ".join(c.text() for c in self.checks if not c.held)
+        return breaches_text(self.checks)
 
 
 def fly_plan(plan: ScvxPlan, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, *,
@@ -129,14 +129,9 @@ def fly_plan(plan: ScvxPlan, vehicle: Vehicle, planet: Earth, atmosphere: Atmosp
     tr = collect_trajectory(diagram, loggers, simulator.get_context(), sources=sources, reason="t_f", wall_time=0.0,
                             step_loggers=step_loggers)
     xf = tr.state[-1]
-    site = mission.site(planet)
-    from_site = planet.great_circle_distance(xf[1], xf[2], *site)
-    h_geo = float(planet.atmospheric_altitude(xf[0], xf[2]))
-    mach = float(tr.column("mach")[-1])
-    drs = {"altitude_m": h_geo, "mach": mach, "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))}
-    drs_ok = (mission.final_altitude_m[0] <= h_geo <= mission.final_altitude_m[1]
-              and mach <= mission.final_mach_max and drs["vertical_speed_m_s"] >= mission.final_vertical_speed_min_m_s
-              and from_site <= SITE_TOLERANCE_M)
+    point, drs_ok = drs_point(mission, planet, xf, float(tr.column("mach")[-1]), SITE_TOLERANCE_M)
+    from_site = point.pop("site_miss_m")
+    drs = point
     checks = check_limits(tr.flown_time(), tr.flown, plan_path_limits(plan))
     peaks = {"heat_flux_W_m2": float(tr.flown("heat_flux").max()), "total_load_g": float(tr.flown("total_load").max())}
     from_plan = terminal_distance(planet, xf, plan.states[-1])

@@ -123,6 +123,12 @@ def check_limits(time, column, limits, tolerance: float = 0.0) -> list[LimitChec
     return out
 
 
+def breaches_text(checks) -> str:
+    """Each breached limit of ``checks`` (LimitChecks) with its peak, time and margin, '; '
+    apart ('' when every limit held)."""
+    return "; ".join(c.text() for c in checks if not c.held)
+
+
 #: relative slack for floating-point rounding at a bound a clamp holds exactly (the bank limit)
 ROUNDING = 1e-12
 
@@ -180,7 +186,7 @@ class Verdict:
 
     def violations_text(self) -> str:
         """Each breached limit with its peak, time and margin ('' when every limit held)."""
-        return "; ".join(c.text() for c in self.violations)
+        return breaches_text(self.checks)
 
     def margins(self) -> dict:
         """{'margin_<limit>': relative margin} of every checked limit."""

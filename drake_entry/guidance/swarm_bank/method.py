@@ -18,14 +18,14 @@ import numpy as np
 from ...planning.result import PlanResult
 from ...planning.swarm.evaluator import CONTROL_COLUMNS, HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
 from ...planning.swarm.search import SearchResult, problem_from_scenario, search
-from ...verdict import acceptance_box, box_text, check_limits, vehicle_path_limits
+from ...verdict import acceptance_box, box_text, breaches_text, check_limits, vehicle_path_limits
 from ...systems.swarm_bank_guidance import SwarmBankGuidance
 from ..interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
 from ..reversal import add_bank_reversal, reversal_count
 
 GUIDANCE_SYSTEM = "swarm_bank_guidance"
-#: the replica's recorded columns of the path limits it can check (the closed loop's verdict
-#: checks every limit at every integrator step)
+#: the replica's recorded column of each path-limit column it can check (the closed loop's
+#: verdict checks every limit at every integrator step)
 LIMIT_COLUMNS = {"heat_flux": "heat_flux_W_m2", "dynamic_pressure": "dynamic_pressure_Pa",
                  "total_load": "total_load_g", "bank": "bank_rad"}
 
@@ -66,10 +66,9 @@ def verify(problem: SwarmProblem, ev: Evaluation, tolerance: float = 0.0) -> lis
     """The path limits the (single-member, recorded) evaluation breaches (drake_entry.verdict
     LimitChecks, at every guidance step of the replica), ``tolerance`` relative."""
     v = problem.vehicle
-    limits = [lim for lim in vehicle_path_limits(v.limits, v.bank_limit) if lim.name in LIMIT_COLUMNS]
+    limits = [lim for lim in vehicle_path_limits(v.limits, v.bank_limit) if lim.column in LIMIT_COLUMNS]
     h = ev.history[0]
-    column = {name: h[:, HISTORY_COLUMNS.index(LIMIT_COLUMNS[name])] for name in LIMIT_COLUMNS}
-    checks = check_limits(h[:, 0], lambda name: column[name], [dc.replace(lim, column=lim.name) for lim in limits],
+    checks = check_limits(h[:, 0], lambda column: h[:, HISTORY_COLUMNS.index(LIMIT_COLUMNS[column])], limits,
                           tolerance)
     return [c for c in checks if not c.held]
 
@@ -79,8 +78,9 @@ def terminal_box(scenario, problem: SwarmProblem, x) -> dict:
     state ``x`` [h, lon, lat, V, gamma, psi]: the state altitude (paper 004's sphere), the Mach
     number there, the great-circle distance to the target."""
     pl = problem.planet
-    h = float(pl.atmospheric_altitude(x[0], x[2])) if scenario.altitude_datum == "ellipsoid" else float(x[0])
-    a = float(problem.atmosphere.air_data(pl.atmospheric_altitude(x[0], x[2]))[1])
+    geodetic = float(pl.atmospheric_altitude(x[0], x[2]))
+    h = geodetic if scenario.altitude_datum == "ellipsoid" else float(x[0])
+    a = float(problem.atmosphere.air_data(geodetic)[1])
     distance = float(pl.great_circle_distance(x[1], x[2], *problem.target))
     return acceptance_box(scenario.terminal, altitude_m=h, mach=float(x[3]) / a, distance_m=distance)
 
@@ -113,7 +113,7 @@ def plan(scenario, problem: SwarmProblem | None = None) -> SwarmPlan:
     if missed:
         parts.append("ends outside the acceptance box: " + "; ".join(missed))
     if violations:
-        parts.append("breaches " + "; ".join(c.text() for c in violations))
+        parts.append("breaches " + breaches_text(violations))
     if found is not None and found.message:
         parts.append(found.message)
     return SwarmPlan(success=reached and not missed and not violations, message="; ".join(parts),

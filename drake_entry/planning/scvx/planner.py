@@ -18,7 +18,7 @@ from ...dynamics import (FLIGHT_CONDITION_NAMES, STATE_NAMES, aero_accelerations
 from ...errors import ModelRangeError, NonFiniteStateError
 from ...planet import Earth
 from ...vehicles import Vehicle
-from ...verdict import PathLimit, check_limits, vehicle_path_limits
+from ...verdict import PathLimit, breaches_text, check_limits, vehicle_path_limits
 from ..result import PlanResult
 from .engine import ScvxSettings, max_defect, max_violation, solve_scvx
 from .entry import EntryProblem, EntryProblemSettings
@@ -348,14 +348,23 @@ def flown_check(plan: ScvxPlan, flown: PlanPropagation) -> dict:
     columns.update({name: X[:, i] for i, name in enumerate(STATE_NAMES)})
     columns.update(bank=flown.bank(t), alpha=alpha)
     checks = check_limits(t, columns.__getitem__, plan_path_limits(plan))
-    h_geo = float(p.planet.atmospheric_altitude(xf[0], xf[2]))
-    drs = {"altitude_m": h_geo, "mach": float(columns["mach"][-1]), "vertical_speed_m_s": float(xf[3] * math.sin(xf[4])),
-           "site_miss_m": float(p.planet.great_circle_distance(xf[1], xf[2], *m.site(p.planet)))}
-    inside = (m.final_altitude_m[0] <= h_geo <= m.final_altitude_m[1] and drs["mach"] <= m.final_mach_max
-              and drs["vertical_speed_m_s"] >= m.final_vertical_speed_min_m_s
-              and drs["site_miss_m"] <= m.site_radius_m + PROPAGATION_TOLERANCE_M)
-    return {"from_plan_m": terminal_distance(p.planet, xf, plan.states[-1]), "drs": drs, "inside_box": bool(inside),
+    drs, inside = drs_point(m, p.planet, xf, float(columns["mach"][-1]), m.site_radius_m + PROPAGATION_TOLERANCE_M)
+    return {"from_plan_m": terminal_distance(p.planet, xf, plan.states[-1]), "drs": drs, "inside_box": inside,
             "checks": checks, "within_limits": all(c.held for c in checks)}
+
+
+def drs_point(mission: ScvxMission, planet: Earth, xf, mach: float, site_tolerance_m: float) -> tuple[dict, bool]:
+    """The flown DRS point of a final state ``xf`` at Mach ``mach``: (geodetic altitude [m],
+    Mach, vertical speed [m/s], site miss [m]) and whether it is inside the DRS box (eqs. 64-68:
+    the altitude window, Mach, vertical speed, the site within ``site_tolerance_m``)."""
+    drs = {"altitude_m": float(planet.atmospheric_altitude(xf[0], xf[2])), "mach": float(mach),
+           "vertical_speed_m_s": float(xf[3] * math.sin(xf[4])),
+           "site_miss_m": float(planet.great_circle_distance(xf[1], xf[2], *mission.site(planet)))}
+    inside = (mission.final_altitude_m[0] <= drs["altitude_m"] <= mission.final_altitude_m[1]
+              and drs["mach"] <= mission.final_mach_max
+              and drs["vertical_speed_m_s"] >= mission.final_vertical_speed_min_m_s
+              and drs["site_miss_m"] <= site_tolerance_m)
+    return drs, bool(inside)
 
 
 def plan_path_limits(plan: ScvxPlan) -> list[PathLimit]:
@@ -454,7 +463,7 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
                             f"Mach {d['mach']:.2f}, vertical speed {d['vertical_speed_m_s']:.1f} m/s, "
                             f"{d['site_miss_m'] / 1e3:.1f} km from the site)")
         if not flown["within_limits"]:
-            problems.append("breach " + "; ".join(c.text() for c in flown["checks"] if not c.held))
+            problems.append("breach " + breaches_text(flown["checks"]))
         flown_ok, why = not problems, "its controls flown " + " and ".join(problems)
     if outcome.converged and not flown_ok:
         plan.message += f"; converged but {why}"

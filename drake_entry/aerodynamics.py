@@ -27,9 +27,9 @@ import numpy as np
 from pydrake.autodiffutils import AutoDiffXd
 from scipy.interpolate import CubicSpline
 
-from .errors import ScenarioError
-from .scalar import clamp, is_autodiff, lift, value_of
-from .tables import read_csv_rows
+from drake_entry.errors import ScenarioError
+from drake_entry.scalar import clamp, is_autodiff, lift, value_of
+from drake_entry.tables import read_csv_rows
 
 DEG = np.pi / 180.0
 

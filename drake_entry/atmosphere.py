@@ -27,9 +27,9 @@ from typing import NamedTuple
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from .errors import ModelRangeError, ScenarioError
-from .scalar import clamp, is_autodiff, is_symbolic, lift, value_of
-from .tables import read_csv_rows
+from drake_entry.errors import ModelRangeError, ScenarioError
+from drake_entry.scalar import clamp, is_autodiff, is_symbolic, lift, value_of
+from drake_entry.tables import read_csv_rows
 
 # U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
 G0_US76 = 9.80665  # m/s^2

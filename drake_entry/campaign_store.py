@@ -24,7 +24,7 @@ import hashlib
 import json
 import os
 
-from .errors import CampaignError
+from drake_entry.errors import CampaignError
 
 FORMAT = 2
 ROWS, TRAJECTORIES, QUARANTINE, MANIFEST, LOCK = ("samples.jsonl", "trajectories.jsonl", "quarantine.jsonl",

@@ -22,15 +22,15 @@ import sys
 
 import numpy as np
 
-from .errors import DrakeEntryError, ScenarioError
+from drake_entry.errors import DrakeEntryError, ScenarioError
 
 
 def _cmd_simulate(args) -> int:
-    from .diagrams.open_loop import simulate
-    from .plots import trajectory_plots
-    from .results import write_table
-    from .scenario import load_scenario
-    from .trajectory import metrics
+    from drake_entry.diagrams.open_loop import simulate
+    from drake_entry.plots import trajectory_plots
+    from drake_entry.results import write_table
+    from drake_entry.scenario import load_scenario
+    from drake_entry.trajectory import metrics
 
     scenario = load_scenario(args.scenario)
     tr = simulate(scenario)
@@ -58,11 +58,11 @@ def _cmd_simulate(args) -> int:
 
 
 def _cmd_fly(args) -> int:
-    from .diagrams.closed_loop import ClosedLoopSetup, fly
-    from .diagrams.sample import campaign_row
-    from .plots import trajectory_plots
-    from .results import write_table
-    from .scenario import load_scenario
+    from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
+    from drake_entry.diagrams.sample import campaign_row
+    from drake_entry.plots import trajectory_plots
+    from drake_entry.results import write_table
+    from drake_entry.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
     setup = ClosedLoopSetup.from_scenario(scenario)
@@ -86,8 +86,8 @@ def _cmd_fly(args) -> int:
 def _cmd_plan(args) -> int:
     import importlib
 
-    from .guidance import REGISTRY, method_for
-    from .scenario import load_scenario
+    from drake_entry.guidance import REGISTRY, method_for
+    from drake_entry.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
     package = REGISTRY[type(scenario.guidance)].rpartition(".")[0]
@@ -103,7 +103,7 @@ def _cmd_plan(args) -> int:
 
 
 def _cmd_campaign(args) -> int:
-    from .diagrams.montecarlo import run_campaign
+    from drake_entry.diagrams.montecarlo import run_campaign
 
     backend = "dask" if args.scheduler else args.backend
     out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
@@ -126,10 +126,10 @@ def parse_overrides(items) -> dict:
 
 
 def _cmd_report(args) -> int:
-    from .campaign_store import read_manifest
-    from .errors import load_yaml_typed
-    from .report import counts_sentence, errors_markdown, write_report
-    from .scenario import Scenario
+    from drake_entry.campaign_store import read_manifest
+    from drake_entry.errors import load_yaml_typed
+    from drake_entry.report import counts_sentence, errors_markdown, write_report
+    from drake_entry.scenario import Scenario
 
     manifest = read_manifest(args.dir) if os.path.isdir(args.dir) else None
     limits = reference = None
@@ -148,8 +148,8 @@ def _cmd_report(args) -> int:
 
 
 def _cmd_fit_horus(args) -> int:
-    from .aerodynamics import fit_horus_forms
-    from .vehicles import load_vehicle
+    from drake_entry.aerodynamics import fit_horus_forms
+    from drake_entry.vehicles import load_vehicle
 
     rep = fit_horus_forms(initial_aL=load_vehicle("horus2b").aero.aL)
     print("least-squares fit of paper 000 eqs. 32-33 to the clean, untrimmed M-692 cells")
@@ -161,10 +161,10 @@ def _cmd_fit_horus(args) -> int:
 
 
 def _cmd_optimize(args) -> int:
-    from .planning import nlp
-    from .planning.ocp_yaml import load_problem
-    from .plots import nlp_solution_plots
-    from .results import write_table
+    from drake_entry.planning import nlp
+    from drake_entry.planning.ocp_yaml import load_problem
+    from drake_entry.plots import nlp_solution_plots
+    from drake_entry.results import write_table
 
     problem, settings = load_problem(args.problem)
     nodes = settings.nodes if args.nodes is None else args.nodes

@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 # US customary units (exact SI conversions) for forms published in them
 FT = 0.3048  # m

@@ -16,11 +16,11 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import brentq
 
-from .atmosphere import Atmosphere
-from .constraints import PathLimits
-from .errors import ScenarioError
-from .planet import Earth
-from .vehicles import Vehicle
+from drake_entry.atmosphere import Atmosphere
+from drake_entry.constraints import PathLimits
+from drake_entry.errors import ScenarioError
+from drake_entry.planet import Earth
+from drake_entry.vehicles import Vehicle
 
 BOUND_NAMES = ("heat_flux", "normal_load", "dynamic_pressure", "total_load")
 

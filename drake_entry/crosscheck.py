@@ -10,10 +10,10 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .actuator import actuator_rates
-from .dynamics import specific_energy, state_derivatives
-from .errors import ScenarioError
-from .scenario import Scenario
+from drake_entry.actuator import actuator_rates
+from drake_entry.dynamics import specific_energy, state_derivatives
+from drake_entry.errors import ScenarioError
+from drake_entry.scenario import Scenario
 
 
 def solve_ivp_open_loop(scenario: Scenario, t_final: float, *, method: str = "DOP853", rtol: float = 1e-10,

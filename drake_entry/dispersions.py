@@ -27,7 +27,7 @@ import typing
 import numpy as np
 import pydrake.common.schema as schema
 
-from .errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
 Vector = typing.Union[schema.DeterministicVectorX, schema.GaussianVectorX, schema.UniformVectorX]

@@ -18,9 +18,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .atmosphere import Atmosphere
-from .planet import Earth
-from .vehicles import Vehicle
+from drake_entry.atmosphere import Atmosphere
+from drake_entry.planet import Earth
+from drake_entry.vehicles import Vehicle
 
 
 @dataclass(frozen=True)

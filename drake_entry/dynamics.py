@@ -19,12 +19,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .atmosphere import Atmosphere
-from .constraints import dynamic_pressure, normal_load_factor, total_load_factor
-from .errors import NonFiniteStateError
-from .planet import Earth
-from .scalar import promote
-from .vehicles import Vehicle
+from drake_entry.atmosphere import Atmosphere
+from drake_entry.constraints import dynamic_pressure, normal_load_factor, total_load_factor
+from drake_entry.errors import NonFiniteStateError
+from drake_entry.planet import Earth
+from drake_entry.scalar import promote
+from drake_entry.vehicles import Vehicle
 
 STATE_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
 STATE_UNITS = ("m", "rad", "rad", "m/s", "rad", "rad")

@@ -10,8 +10,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import geodesy
-from .errors import ScenarioError
+from drake_entry import geodesy
+from drake_entry.errors import ScenarioError
 
 # WGS-84 / EGM constants.
 MU_EARTH = 3.986004418e14  # m^3/s^2 (paper 000 eq. 28, corrected units)

@@ -194,7 +194,7 @@ def nlp_solution_plots(problem, result, out_dir: str, *, propagated=None, extrem
     its bounds, downtrack-crosstrack, speed, flight-path angle, alpha, bank, u_alpha and
     u_sigma against the extremal controls, and the Hamiltonian. NLP nodes as markers,
     the Drake propagation of the controls (``propagated``: PropagationCheck) as a line."""
-    from .geodesy import downtrack_crosstrack
+    from drake_entry.geodesy import downtrack_crosstrack
 
     os.makedirs(out_dir, exist_ok=True)
     paths = []

@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.polynomial import legendre
 
-from .errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 
 def lgl_nodes(n_nodes: int) -> np.ndarray:

@@ -12,12 +12,12 @@ import os
 
 import numpy as np
 
-from . import plots  # sets the Agg backend before pyplot is imported
-from .campaign_store import coverage, read_trajectories
-from .errors import CampaignError, DrakeEntryError, load_yaml_typed
-from .plots import plt
-from .scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
-from .scenario import Scenario
+from drake_entry import plots  # sets the Agg backend before pyplot is imported
+from drake_entry.campaign_store import coverage, read_trajectories
+from drake_entry.errors import CampaignError, DrakeEntryError, load_yaml_typed
+from drake_entry.plots import plt
+from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
+from drake_entry.scenario import Scenario
 
 # (row column, label, unit) of the terminal errors, in the scenario schema's order
 ERROR_COLUMNS = tuple(zip(ERROR_COLUMN_NAMES,

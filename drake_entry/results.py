@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 
-from .errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 
 def write_table(columns: dict, path: str) -> str:

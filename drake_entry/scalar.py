@@ -12,7 +12,7 @@ import numpy as np
 from pydrake.autodiffutils import AutoDiffXd
 from pydrake.symbolic import Expression, Variable
 
-from .errors import UnsupportedScalarError
+from drake_entry.errors import UnsupportedScalarError
 
 
 def is_autodiff(x) -> bool:

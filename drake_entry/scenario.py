@@ -12,15 +12,15 @@ from typing import Optional
 
 import numpy as np
 
-from . import dispersions as disp
-from .atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere, ExponentialAtmosphere, TableAtmosphere, US76Atmosphere
-from .errors import ScenarioError, check_range, load_yaml_typed
-from .guidance import GuidanceSpec, known_tags
-from .guidance.drag_energy.spec import DragEnergy
-from .planet import Earth
-from .schedules import VARIABLES, Schedule
-from .vehicles import Vehicle, load_vehicle
-from .verdict import PathLimit, vehicle_path_limits
+from drake_entry import dispersions as disp
+from drake_entry.atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere, ExponentialAtmosphere, TableAtmosphere, US76Atmosphere
+from drake_entry.errors import ScenarioError, check_range, load_yaml_typed
+from drake_entry.guidance import GuidanceSpec, known_tags
+from drake_entry.guidance.drag_energy.spec import DragEnergy
+from drake_entry.planet import Earth
+from drake_entry.schedules import VARIABLES, Schedule
+from drake_entry.vehicles import Vehicle, load_vehicle
+from drake_entry.verdict import PathLimit, vehicle_path_limits
 
 
 @dc.dataclass

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ScenarioError
-from .scalar import is_autodiff, lift, value_of
+from drake_entry.errors import ScenarioError
+from drake_entry.scalar import is_autodiff, lift, value_of
 
 VARIABLES = ("time", "energy", "mach", "velocity")
 

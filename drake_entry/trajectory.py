@@ -7,8 +7,8 @@ import dataclasses as dc
 
 import numpy as np
 
-from .constraints import PathLimits
-from .dynamics import FLIGHT_CONDITION_NAMES, STATE_NAMES
+from drake_entry.constraints import PathLimits
+from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, STATE_NAMES
 
 
 @dc.dataclass

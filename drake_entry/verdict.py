@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from .constraints import PathLimits
+from drake_entry.constraints import PathLimits
 
 
 @dc.dataclass(frozen=True)

@@ -11,12 +11,12 @@ from __future__ import annotations
 import importlib
 from typing import Union
 
-from ..errors import ScenarioError
-from .ampi.spec import Ampi
-from .bank_profile.spec import BankProfile
-from .drag_energy.spec import DragEnergy
-from .scvx.spec import Scvx
-from .swarm_bank.spec import SwarmBank
+from drake_entry.errors import ScenarioError
+from drake_entry.guidance.ampi.spec import Ampi
+from drake_entry.guidance.bank_profile.spec import BankProfile
+from drake_entry.guidance.drag_energy.spec import DragEnergy
+from drake_entry.guidance.scvx.spec import Scvx
+from drake_entry.guidance.swarm_bank.spec import SwarmBank
 
 REGISTRY = {
     DragEnergy: "drake_entry.guidance.drag_energy.method",

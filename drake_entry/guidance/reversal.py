@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 
-from ..systems.bank_reversal import BankReversalLogic
-from .interface import PlantPorts
+from drake_entry.systems.bank_reversal import BankReversalLogic
+from drake_entry.guidance.interface import PlantPorts
 
 REVERSAL_SYSTEM = "bank_reversal"
 

@@ -7,7 +7,7 @@ scenario's ``guidance:`` field selects it with the YAML tag ``!ClassName``.
 
 import dataclasses as dc
 
-from ..errors import ScenarioError, check_range
+from drake_entry.errors import ScenarioError, check_range
 
 
 @dc.dataclass

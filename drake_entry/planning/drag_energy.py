@@ -31,16 +31,16 @@ import numpy as np
 from pydrake.solvers import ClarabelSolver, MathematicalProgram, ScsSolver, SolverOptions
 from scipy.optimize import brentq
 
-from ..atmosphere import Atmosphere
-from ..corridor import Corridor, compute_corridor
-from ..drag_dynamics import AlphaProfile, DragDynamics, DragTerms, drag_acceleration, drag_dynamics
-from ..errors import ScenarioError
-from ..geodesy import bearing
-from ..planet import Earth
-from ..pseudospectral import LGL
-from ..schedules import Schedule
-from ..vehicles import Vehicle
-from .result import PlanResult
+from drake_entry.atmosphere import Atmosphere
+from drake_entry.corridor import Corridor, compute_corridor
+from drake_entry.drag_dynamics import AlphaProfile, DragDynamics, DragTerms, drag_acceleration, drag_dynamics
+from drake_entry.errors import ScenarioError
+from drake_entry.geodesy import bearing
+from drake_entry.planet import Earth
+from drake_entry.pseudospectral import LGL
+from drake_entry.schedules import Schedule
+from drake_entry.vehicles import Vehicle
+from drake_entry.planning.result import PlanResult
 
 SOLVERS = {"clarabel": ClarabelSolver, "scs": ScsSolver}
 

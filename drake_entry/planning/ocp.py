@@ -22,13 +22,13 @@ from typing import Callable
 
 import numpy as np
 
-from ..atmosphere import Atmosphere
-from ..dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_derivatives
-from ..errors import ScenarioError
-from ..geodesy import central_angle_smooth, crossrange_from_great_circle
-from ..planet import Earth
-from ..schedules import Schedule
-from ..vehicles import Vehicle
+from drake_entry.atmosphere import Atmosphere
+from drake_entry.dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_derivatives
+from drake_entry.errors import ScenarioError
+from drake_entry.geodesy import central_angle_smooth, crossrange_from_great_circle
+from drake_entry.planet import Earth
+from drake_entry.schedules import Schedule
+from drake_entry.vehicles import Vehicle
 
 PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
     "dynamic_pressure": ("dynamic_pressure", "Pa"), "heat_flux": ("heat_flux", "W/m^2"),

@@ -27,11 +27,11 @@ import os
 from importlib import resources
 from typing import Dict, List, Optional
 
-from ..errors import ScenarioError, load_yaml_typed
-from ..scenario import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
-from ..vehicles import load_vehicle
-from ..schedules import Schedule
-from .ocp import CONTROL_LAYOUTS, DEVIATION_STATES, ObjectiveTerm, OptimalControlProblem, PathConstraint
+from drake_entry.errors import ScenarioError, load_yaml_typed
+from drake_entry.scenario import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
+from drake_entry.vehicles import load_vehicle
+from drake_entry.schedules import Schedule
+from drake_entry.planning.ocp import CONTROL_LAYOUTS, DEVIATION_STATES, ObjectiveTerm, OptimalControlProblem, PathConstraint
 
 # YAML field -> (state or control name, factor to SI)
 STATE_FIELDS = {"altitude_km": ("h", 1e3), "longitude_deg": ("lon", math.pi / 180), "latitude_deg": ("lat", math.pi / 180),

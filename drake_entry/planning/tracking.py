@@ -31,7 +31,7 @@ from pydrake.systems.controllers import (FiniteHorizonLinearQuadraticRegulator,
 from pydrake.systems.primitives import TrajectoryLinearSystem
 from pydrake.trajectories import PiecewisePolynomial
 
-from ..errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 #: Riccati integration (Drake's RK3 with error control): 1e-3 changes K by < 1e-3 of its
 #: largest entry against 1e-4 on the SHEFEX-3 nominal, at 60 % of the cost

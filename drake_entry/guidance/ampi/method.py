@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import math
 
-from ...planning.ampi.reference import DatabaseReference
-from ...systems.reference_tracking import ReferenceTracker
-from ..interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
+from drake_entry.planning.ampi.reference import DatabaseReference
+from drake_entry.systems.reference_tracking import ReferenceTracker
+from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
 
 GUIDANCE_SYSTEM = "reference_tracker"
 

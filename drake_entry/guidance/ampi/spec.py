@@ -3,10 +3,10 @@
 import dataclasses as dc
 import math
 
-from ...errors import ScenarioError, check_range
-from ...planning.ampi.database import database_path
-from ...planning.ampi.synthesis import MODES
-from ..spec import GuidanceSpecBase
+from drake_entry.errors import ScenarioError, check_range
+from drake_entry.planning.ampi.database import database_path
+from drake_entry.planning.ampi.synthesis import MODES
+from drake_entry.guidance.spec import GuidanceSpecBase
 
 
 @dc.dataclass
@@ -49,7 +49,7 @@ class Ampi(GuidanceSpecBase):
 
     def weights(self):
         """The TVLQR weights (planning.tracking.TrackingWeights) of these fields."""
-        from ...planning.tracking import TrackingWeights
+        from drake_entry.planning.tracking import TrackingWeights
         d = math.radians
         h, lon, lat, V, gamma, psi, sigma = self.tracking_scales
         hf, lonf, latf, Vf = self.terminal_scales

@@ -3,8 +3,8 @@
 
 import dataclasses as dc
 
-from ...errors import ScenarioError, check_range
-from ..spec import ReversingBankSpec
+from drake_entry.errors import ScenarioError, check_range
+from drake_entry.guidance.spec import ReversingBankSpec
 
 
 @dc.dataclass

@@ -4,12 +4,12 @@ import dataclasses as dc
 import math
 from typing import Optional
 
-from ...errors import ScenarioError, check_range
-from ...planning.scvx.engine import ScvxSettings
-from ...planning.scvx.entry import EntryProblemSettings
-from ...planning.scvx.mission import ScvxMission
-from ...planning.scvx.planner import FlightCheck
-from ..spec import GuidanceSpecBase
+from drake_entry.errors import ScenarioError, check_range
+from drake_entry.planning.scvx.engine import ScvxSettings
+from drake_entry.planning.scvx.entry import EntryProblemSettings
+from drake_entry.planning.scvx.mission import ScvxMission
+from drake_entry.planning.scvx.planner import FlightCheck
+from drake_entry.guidance.spec import GuidanceSpecBase
 
 #: spec fields passed to ScvxMission and EntryProblemSettings under the same names (max_iterations
 #: and solver go to ScvxSettings.for_solver)

@@ -15,13 +15,13 @@ import time
 
 import numpy as np
 
-from ...planning.result import PlanResult
-from ...planning.swarm.evaluator import CONTROL_COLUMNS, HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
-from ...planning.swarm.search import SearchResult, problem_from_scenario, search
-from ...verdict import acceptance_box, box_text, breaches_text, check_limits, vehicle_path_limits
-from ...systems.swarm_bank_guidance import SwarmBankGuidance
-from ..interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
-from ..reversal import add_bank_reversal, reversal_count
+from drake_entry.planning.result import PlanResult
+from drake_entry.planning.swarm.evaluator import CONTROL_COLUMNS, HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
+from drake_entry.planning.swarm.search import SearchResult, problem_from_scenario, search
+from drake_entry.verdict import acceptance_box, box_text, breaches_text, check_limits, vehicle_path_limits
+from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
+from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
+from drake_entry.guidance.reversal import add_bank_reversal, reversal_count
 
 GUIDANCE_SYSTEM = "swarm_bank_guidance"
 #: the replica's recorded column of each path-limit column it can check (the closed loop's

@@ -4,8 +4,8 @@ import dataclasses as dc
 import math
 import typing
 
-from ...errors import ScenarioError, check_range
-from ..spec import ReversingBankSpec
+from drake_entry.errors import ScenarioError, check_range
+from drake_entry.guidance.spec import ReversingBankSpec
 
 #: sigma_0 searches: the paper's swarms and the scipy baselines (planning/swarm/search.py)
 OPTIMIZERS = ("pio", "pso", "pso_stable", "grid", "brentq", "secant", "bounded", "differential_evolution")

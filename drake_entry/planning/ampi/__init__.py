@@ -8,6 +8,6 @@ subspace selection, Algorithm 2 tensor-product interpolation, the nearest entry 
 The database is solved by the campaign engine (diagrams/ampi_database.py), which runs
 the NLP planner on every case.
 """
-from .database import Synthesis, TrajectoryDatabase, hd_matrix  # noqa: F401
-from .grid import PARAMETERS, ParameterGrid  # noqa: F401
-from .synthesis import interpolate, nearest_case, select_subspace  # noqa: F401
+from drake_entry.planning.ampi.database import Synthesis, TrajectoryDatabase, hd_matrix  # noqa: F401
+from drake_entry.planning.ampi.grid import PARAMETERS, ParameterGrid  # noqa: F401
+from drake_entry.planning.ampi.synthesis import interpolate, nearest_case, select_subspace  # noqa: F401

@@ -19,10 +19,10 @@ from importlib import resources
 
 import numpy as np
 
-from ...errors import ScenarioError
-from ...pseudospectral import interpolation_matrix, lgl_nodes
-from .grid import ParameterGrid
-from .synthesis import MODES, interpolate_corners, nearest_case, select_subspace
+from drake_entry.errors import ScenarioError
+from drake_entry.pseudospectral import interpolation_matrix, lgl_nodes
+from drake_entry.planning.ampi.grid import ParameterGrid
+from drake_entry.planning.ampi.synthesis import MODES, interpolate_corners, nearest_case, select_subspace
 
 #: consistency with the neighbours (``TrajectoryDatabase.inconsistent``): a case whose
 #: objective exceeds this factor times the median of its neighbours' (a worse local branch:

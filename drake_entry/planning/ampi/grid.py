@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from ...errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 #: the entry-state components a parameter may offset (the canonical state order)
 PARAMETERS = ("h", "lon", "lat", "V", "gamma", "psi")

@@ -18,12 +18,12 @@ import time
 
 import numpy as np
 
-from ...errors import ScenarioError
-from ..ocp_yaml import load_problem
-from ..result import PlanResult
-from ..tracking import TrackingLaw, TrackingWeights, tvlqr
-from .database import Synthesis, TrajectoryDatabase, database_path
-from .synthesis import MODES
+from drake_entry.errors import ScenarioError
+from drake_entry.planning.ocp_yaml import load_problem
+from drake_entry.planning.result import PlanResult
+from drake_entry.planning.tracking import TrackingLaw, TrackingWeights, tvlqr
+from drake_entry.planning.ampi.database import Synthesis, TrajectoryDatabase, database_path
+from drake_entry.planning.ampi.synthesis import MODES
 
 
 @dc.dataclass(frozen=True)

@@ -43,16 +43,16 @@ import time as _time
 import numpy as np
 from pydrake.solvers import IpoptSolver, SnoptSolver, SolverOptions
 
-from ...errors import ScenarioError
-from .dircol import _DircolTranscription
-from .guess import initial_guess
-from .lgl import _LglTranscription
-from .mesh import MAX_NODES, MeshStep, mesh_error, next_nodes  # noqa: F401 (API)
-from .result import NlpError, NlpResult, extremal_controls, summary  # noqa: F401 (API)
-from .scaling import Scaling, resolve as resolve_scaling  # noqa: F401 (API)
-from .status import restartable, verdict
-from .transcription import COSTATE_SIGN  # noqa: F401 (API)
-from .verify import DYNAMICS_TOLERANCE, PROPAGATION_TOLERANCE, Verification, verify as verify_solution  # noqa: F401
+from drake_entry.errors import ScenarioError
+from drake_entry.planning.nlp.dircol import _DircolTranscription
+from drake_entry.planning.nlp.guess import initial_guess
+from drake_entry.planning.nlp.lgl import _LglTranscription
+from drake_entry.planning.nlp.mesh import MAX_NODES, MeshStep, mesh_error, next_nodes  # noqa: F401 (API)
+from drake_entry.planning.nlp.result import NlpError, NlpResult, extremal_controls, summary  # noqa: F401 (API)
+from drake_entry.planning.nlp.scaling import Scaling, resolve as resolve_scaling  # noqa: F401 (API)
+from drake_entry.planning.nlp.status import restartable, verdict
+from drake_entry.planning.nlp.transcription import COSTATE_SIGN  # noqa: F401 (API)
+from drake_entry.planning.nlp.verify import DYNAMICS_TOLERANCE, PROPAGATION_TOLERANCE, Verification, verify as verify_solution  # noqa: F401
 
 TRANSCRIPTIONS = ("lgl", "dircol")
 #: a solver stopped near an optimum (status.restartable) at a point this feasible (largest

@@ -9,12 +9,12 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from ...aerodynamics import PolynomialAero
-from ...atmosphere import ExponentialAtmosphere
-from ...constraints import BTU_FT2_S, FT, SLUG, HeatFlux
-from ...planet import Earth
-from ...vehicles import Vehicle
-from ..ocp import CustomProblem, ObjectiveTerm, OptimalControlProblem, PathConstraint
+from drake_entry.aerodynamics import PolynomialAero
+from drake_entry.atmosphere import ExponentialAtmosphere
+from drake_entry.constraints import BTU_FT2_S, FT, SLUG, HeatFlux
+from drake_entry.planet import Earth
+from drake_entry.vehicles import Vehicle
+from drake_entry.planning.ocp import CustomProblem, ObjectiveTerm, OptimalControlProblem, PathConstraint
 
 G_BRACHISTOCHRONE = 9.81  # m/s^2
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .result import NlpResult
-from .transcription import _Transcription
+from drake_entry.planning.nlp.result import NlpResult
+from drake_entry.planning.nlp.transcription import _Transcription
 
 DIRCOL_COSTATE_FACTOR = 1.5
 

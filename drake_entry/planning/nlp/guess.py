@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from ...geodesy import bearing, central_angle_smooth, crossrange_from_great_circle
-from ..ocp import OptimalControlProblem
+from drake_entry.geodesy import bearing, central_angle_smooth, crossrange_from_great_circle
+from drake_entry.planning.ocp import OptimalControlProblem
 
 
 def initial_guess(problem, samples: int = 200):

@@ -5,10 +5,10 @@ import numpy as np
 from pydrake.autodiffutils import ExtractGradient, ExtractValue, InitializeAutoDiff
 from pydrake.solvers import MathematicalProgram
 
-from ...pseudospectral import LGL
-from .evaluator import _chain, _NodeEvaluator
-from .result import NlpResult
-from .transcription import _Transcription
+from drake_entry.pseudospectral import LGL
+from drake_entry.planning.nlp.evaluator import _chain, _NodeEvaluator
+from drake_entry.planning.nlp.result import NlpResult
+from drake_entry.planning.nlp.transcription import _Transcription
 
 
 class _LglTranscription(_Transcription):

@@ -23,8 +23,8 @@ import math
 
 import numpy as np
 
-from ...errors import DrakeEntryError
-from .verify import interval_errors
+from drake_entry.errors import DrakeEntryError
+from drake_entry.planning.nlp.verify import interval_errors
 
 #: default node caps: one LGL polynomial of 150 nodes already resolves minutes-long entry
 #: flights to 1e-4; Hermite-Simpson needs more samples for the same error

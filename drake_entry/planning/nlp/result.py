@@ -6,11 +6,11 @@ import dataclasses as dc
 
 import numpy as np
 
-from ...errors import DrakeEntryError, ScenarioError
-from ...pseudospectral import interpolation_matrix
-from ..ocp import OptimalControlProblem
-from ..result import PlanResult
-from .evaluator import model_values
+from drake_entry.errors import DrakeEntryError, ScenarioError
+from drake_entry.pseudospectral import interpolation_matrix
+from drake_entry.planning.ocp import OptimalControlProblem
+from drake_entry.planning.result import PlanResult
+from drake_entry.planning.nlp.evaluator import model_values
 
 
 @dc.dataclass

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ...errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 FIELDS = ("states", "controls", "time", "objective")
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .evaluator import CallbackTimer, model_values
-from .result import NlpResult
-from .scaling import objective_factor
+from drake_entry.planning.nlp.evaluator import CallbackTimer, model_values
+from drake_entry.planning.nlp.result import NlpResult
+from drake_entry.planning.nlp.scaling import objective_factor
 
 COSTATE_SIGN = 1.0  # Drake's multiplier sign convention, checked on analytic problems (tests)
 

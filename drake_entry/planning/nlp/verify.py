@@ -23,8 +23,8 @@ import dataclasses as dc
 
 import numpy as np
 
-from ...errors import DrakeEntryError
-from .evaluator import model_values
+from drake_entry.errors import DrakeEntryError
+from drake_entry.planning.nlp.evaluator import model_values
 
 QUADRATURE_POINTS = 8
 #: default tolerances (relative, GPOPS-II form). 1e-3 between nodes is GPOPS-II's default

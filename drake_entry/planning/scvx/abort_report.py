@@ -11,10 +11,10 @@ import textwrap
 
 import numpy as np
 
-from ...campaign_store import coverage, read_trajectories
-from ...planet import Earth
-from ...plots import _save, plt
-from .aborts import FEASIBLE_RADII_M, abort_statistics, feasible, statistics_markdown
+from drake_entry.campaign_store import coverage, read_trajectories
+from drake_entry.planet import Earth
+from drake_entry.plots import _save, plt
+from drake_entry.planning.scvx.aborts import FEASIBLE_RADII_M, abort_statistics, feasible, statistics_markdown
 
 
 def _geodetic_track(traj: dict, planet: Earth):

@@ -16,13 +16,13 @@ import math
 
 import numpy as np
 
-from ...atmosphere import Atmosphere
-from ...errors import ScenarioError
-from ...planet import Earth
-from ...vehicles import Vehicle
-from ..ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
-from .mission import ScvxMission
-from .planner import initial_decision
+from drake_entry.atmosphere import Atmosphere
+from drake_entry.errors import ScenarioError
+from drake_entry.planet import Earth
+from drake_entry.vehicles import Vehicle
+from drake_entry.planning.ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
+from drake_entry.planning.scvx.mission import ScvxMission
+from drake_entry.planning.scvx.planner import initial_decision
 
 #: OptimalControlProblem objective kind of each SCvx objective the NLP path can pose
 NLP_OBJECTIVES = {"heat_load": "heat_load", "time": "final_time"}

@@ -40,7 +40,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from pydrake.solvers import ClarabelSolver, LorentzConeConstraint, MathematicalProgram, ScsSolver, SolverOptions
 
-from ...errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0  # Phi of eq. 29
 #: a feasible point where the trust region reaches its floor is converged when the predicted

@@ -57,16 +57,16 @@ import numpy as np
 import scipy.sparse as sp
 from pydrake.autodiffutils import AutoDiffXd, ExtractGradient, ExtractValue, InitializeAutoDiff
 
-from ...atmosphere import Atmosphere
-from ...constraints import total_load_factor
-from ...dynamics import STATE_NAMES, air_data, aero_accelerations, equations_of_motion_lift_components
-from ...errors import ScenarioError
-from ...planet import Earth
-from ...pseudospectral import SegmentMesh
-from ...scalar import lift, value_of
-from ...vehicles import Vehicle
-from .engine import ConvexifiableProblem, Evaluation, Linearisation
-from .mission import ScvxMission
+from drake_entry.atmosphere import Atmosphere
+from drake_entry.constraints import total_load_factor
+from drake_entry.dynamics import STATE_NAMES, air_data, aero_accelerations, equations_of_motion_lift_components
+from drake_entry.errors import ScenarioError
+from drake_entry.planet import Earth
+from drake_entry.pseudospectral import SegmentMesh
+from drake_entry.scalar import lift, value_of
+from drake_entry.vehicles import Vehicle
+from drake_entry.planning.scvx.engine import ConvexifiableProblem, Evaluation, Linearisation
+from drake_entry.planning.scvx.mission import ScvxMission
 
 POSITION_SCALE = np.array([1e5, 1.0, 0.1, 7e3, 0.1, 0.5])  # m, rad, rad, m/s, rad, rad
 SIGMA_SCALE, ALPHA_SCALE = 1.0, 0.5  # rad

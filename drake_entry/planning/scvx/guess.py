@@ -22,13 +22,13 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
-from ... import geodesy
-from ...atmosphere import Atmosphere
-from ...dynamics import aero_accelerations, air_data, equations_of_motion
-from ...errors import ScenarioError
-from ...planet import Earth
-from ...vehicles import Vehicle
-from .mission import ScvxMission
+from drake_entry import geodesy
+from drake_entry.atmosphere import Atmosphere
+from drake_entry.dynamics import aero_accelerations, air_data, equations_of_motion
+from drake_entry.errors import ScenarioError
+from drake_entry.planet import Earth
+from drake_entry.vehicles import Vehicle
+from drake_entry.planning.scvx.mission import ScvxMission
 
 
 @dc.dataclass(frozen=True)

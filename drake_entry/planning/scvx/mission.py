@@ -13,10 +13,10 @@ import math
 
 import numpy as np
 
-from ...errors import ScenarioError
-from ...planet import Earth
-from ...schedules import Schedule
-from ...verdict import PathLimit
+from drake_entry.errors import ScenarioError
+from drake_entry.planet import Earth
+from drake_entry.schedules import Schedule
+from drake_entry.verdict import PathLimit
 
 #: the largest site radius a mission accepts [m] (a minimum-miss abort opens its cone to it)
 SITE_RADIUS_MAX_M = 5e6

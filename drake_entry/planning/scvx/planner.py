@@ -10,20 +10,20 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
-from ...actuator import sampled_response
-from ...atmosphere import Atmosphere
-from ...constraints import dynamic_pressure
-from ...dynamics import (FLIGHT_CONDITION_NAMES, STATE_NAMES, aero_accelerations, air_data, equations_of_motion,
+from drake_entry.actuator import sampled_response
+from drake_entry.atmosphere import Atmosphere
+from drake_entry.constraints import dynamic_pressure
+from drake_entry.dynamics import (FLIGHT_CONDITION_NAMES, STATE_NAMES, aero_accelerations, air_data, equations_of_motion,
                          flight_conditions)
-from ...errors import ModelRangeError, NonFiniteStateError
-from ...planet import Earth
-from ...vehicles import Vehicle
-from ...verdict import PathLimit, breaches_text, check_limits, vehicle_path_limits
-from ..result import PlanResult
-from .engine import ScvxSettings, max_defect, max_violation, solve_scvx
-from .entry import EntryProblem, EntryProblemSettings
-from .guess import GlideGuess, glide_guess
-from .mission import ScvxMission
+from drake_entry.errors import ModelRangeError, NonFiniteStateError
+from drake_entry.planet import Earth
+from drake_entry.vehicles import Vehicle
+from drake_entry.verdict import PathLimit, breaches_text, check_limits, vehicle_path_limits
+from drake_entry.planning.result import PlanResult
+from drake_entry.planning.scvx.engine import ScvxSettings, max_defect, max_violation, solve_scvx
+from drake_entry.planning.scvx.entry import EntryProblem, EntryProblemSettings
+from drake_entry.planning.scvx.guess import GlideGuess, glide_guess
+from drake_entry.planning.scvx.mission import ScvxMission
 
 #: the lossless gap is judged where the lift can act: L >= this fraction of g0
 GAP_LIFT_FRACTION = 0.05

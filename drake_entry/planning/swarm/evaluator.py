@@ -22,13 +22,13 @@ import math
 
 import numpy as np
 
-from ...actuator import integrate_actuators
-from ...constraints import dynamic_pressure
-from ...dynamics import aero_accelerations, equations_of_motion, state_derivatives
-from ...errors import ScenarioError
-from ...geodesy import bearings, downtrack_crosstrack
-from ...reversal import corridor_half_width, reversal_sign, wrap_angle
-from .guidance_law import LawMemory, LawSettings, law_commands
+from drake_entry.actuator import integrate_actuators
+from drake_entry.constraints import dynamic_pressure
+from drake_entry.dynamics import aero_accelerations, equations_of_motion, state_derivatives
+from drake_entry.errors import ScenarioError
+from drake_entry.geodesy import bearings, downtrack_crosstrack
+from drake_entry.reversal import corridor_half_width, reversal_sign, wrap_angle
+from drake_entry.planning.swarm.guidance_law import LawMemory, LawSettings, law_commands
 
 #: J of eq. 32: range error over 100 nmi, altitude error over 1 km, speed error over 100 m/s
 RANGE_UNIT_M, ALTITUDE_UNIT_M, SPEED_UNIT_M_S = 1.852e5, 1e3, 100.0

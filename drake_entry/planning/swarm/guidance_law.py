@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from ...errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 
 def linear_bank(e, e0: float, ef: float, sigma0, sigmaf):

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from ...errors import ScenarioError
+from drake_entry.errors import ScenarioError
 
 PSO_PAPER = dict(c1=1.4, c2=2.6, w_start=1.0, w_end=0.4)
 PSO_CONSTRICTION = dict(c1=1.494, c2=1.494, w_start=0.729, w_end=0.729)

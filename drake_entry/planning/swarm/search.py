@@ -23,10 +23,10 @@ import time
 import numpy as np
 from scipy import optimize
 
-from ...errors import ScenarioError
-from ...geodesy import destination
-from .evaluator import Evaluation, SwarmProblem, evaluate
-from .optimizers import PSO_CONSTRICTION, PSO_PAPER, SwarmResult, minimise, pio_search, pso_search
+from drake_entry.errors import ScenarioError
+from drake_entry.geodesy import destination
+from drake_entry.planning.swarm.evaluator import Evaluation, SwarmProblem, evaluate
+from drake_entry.planning.swarm.optimizers import PSO_CONSTRICTION, PSO_PAPER, SwarmResult, minimise, pio_search, pso_search
 
 SWARMS = ("pio", "pso", "pso_stable")
 BASELINES = ("grid", "brentq", "secant", "bounded", "differential_evolution")

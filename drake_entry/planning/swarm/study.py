@@ -11,9 +11,9 @@ import time
 
 import numpy as np
 
-from .evaluator import Evaluation, SwarmProblem, evaluate
-from .optimizers import minimise
-from .search import BASELINES, Objective, SearchResult, search, swarm_searches
+from drake_entry.planning.swarm.evaluator import Evaluation, SwarmProblem, evaluate
+from drake_entry.planning.swarm.optimizers import minimise
+from drake_entry.planning.swarm.search import BASELINES, Objective, SearchResult, search, swarm_searches
 
 #: paper 004's printed figures (Table 1: Case 1, 5 runs; Sec. 5 per case)
 PAPER = {

@@ -30,7 +30,7 @@ try:  # the guidance-method interface
     args = (ClosedLoopSetup.from_scenario(load_scenario("horus2b")),)
 except ImportError:  # before it
     from drake_entry.diagrams.montecarlo import run_sample
-    from drake_entry.planning.drag_energy import DragEnergyPlanner
+    from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
     s = load_scenario("horus2b")
     args = (s, DragEnergyPlanner.from_scenario(s))
 t0 = time.perf_counter()

@@ -39,7 +39,7 @@ def open_loop_benchmark(*, repeats: int = 3, scenario_name: str = "horus2b") -> 
 def _open_loop_benchmark(scenario, repeats: int) -> dict:
     from drake_entry.diagrams.open_loop import simulate
 
-    from drake_entry.crosscheck import solve_ivp_open_loop
+    from drake_entry.scipy_open_loop import solve_ivp_open_loop
 
     scenario.simulation.max_time_s = T_FINAL
     scenario.terminal.altitude_km, scenario.terminal.mach = 5.0, None  # fly the full T_FINAL

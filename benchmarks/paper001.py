@@ -32,11 +32,11 @@ PAPER_TABLE3 = {"direct": (540.382, 1711.45, 1.922, 10.41), "hybrid": (540.688, 
 
 
 def _setup():
-    from drake_entry.atmosphere import US76Atmosphere
-    from drake_entry.planet import Earth
-    from drake_entry.planning.scvx.guess import glide_guess
-    from drake_entry.planning.scvx.mission import ScvxMission
-    from drake_entry.vehicles import load_vehicle
+    from drake_entry.models.atmosphere import US76Atmosphere
+    from drake_entry.models.planet import Earth
+    from drake_entry.guidance.scvx.guess import glide_guess
+    from drake_entry.guidance.scvx.mission import ScvxMission
+    from drake_entry.models.vehicles import load_vehicle
 
     vehicle, planet, atmosphere, mission = load_vehicle("sphynx"), Earth.oblate(), US76Atmosphere(), ScvxMission()
     t0 = time.perf_counter()
@@ -46,8 +46,8 @@ def _setup():
 
 def _plan_and_fly(case, **settings):
     from drake_entry.diagrams.plan_flight import fly_plan
-    from drake_entry.planning.scvx.entry import EntryProblemSettings
-    from drake_entry.planning.scvx.planner import plan_entry
+    from drake_entry.guidance.scvx.entry import EntryProblemSettings
+    from drake_entry.guidance.scvx.planner import plan_entry
 
     vehicle, planet, atmosphere, mission, guess, guess_s = case
     t1 = time.perf_counter()
@@ -57,7 +57,7 @@ def _plan_and_fly(case, **settings):
 
 
 def table2(case) -> list:
-    from drake_entry.planning.scvx.entry import OBJECTIVES
+    from drake_entry.guidance.scvx.entry import OBJECTIVES
 
     print("\nTable 2 form: objectives, direct bank and alpha, 33 x 4 Lobatto (100 nodes); "
           "'ok' = plan.success: converged, checked between the nodes, its controls flown through the "
@@ -82,7 +82,7 @@ def table3(case) -> list:
     print(f"{'formulation':>14s} {'Q MJ/m2':>8s} {'paper':>8s} {'t_f s':>6s} {'paper':>7s} {'max g':>6s} {'paper':>6s} "
           f"{'plan DRS km':>11s} {'flown DRS km':>12s} {'flown-site km':>13s} {'paper':>6s} {'flown-plan km':>13s} "
           f"{'gap':>6s} {'iters':>5s} {'ok':>5s}  why not")
-    from drake_entry.planning.scvx.entry import PAPER_LOSSLESS
+    from drake_entry.guidance.scvx.entry import PAPER_LOSSLESS
 
     rows = []
     # the library's forms (lossless bank with the |u| floor, rate chords and 2 % path margin), and
@@ -127,10 +127,10 @@ def meshes(case, meshes=((99, 2), (33, 4), (50, 4), (66, 4))) -> list:
 
 def nlp_crosscheck(case, solves=(("dircol", "snopt", 100), ("lgl", "snopt", 60))) -> list:
     """The direct minimum-heat-load problem through the NLP path from the same glide guess
-    (``planning.scvx.as_ocp``), its controls flown by the Drake Simulator, beside the SCvx plan."""
+    (``guidance.scvx.as_ocp``), its controls flown by the Drake Simulator, beside the SCvx plan."""
     from drake_entry.diagrams.propagation import propagate
     from drake_entry.planning import nlp
-    from drake_entry.planning.scvx.as_ocp import nlp_form
+    from drake_entry.guidance.scvx.as_ocp import nlp_form
 
     plan, wall, _ = _plan_and_fly(case)
     problem, start = nlp_form(plan)

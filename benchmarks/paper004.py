@@ -13,11 +13,11 @@ import numpy as np
 
 
 def paper004_study(*, seeds: int = 20, out_dir: str = "out/paper004", scenario_name: str = "cav_h_paper004") -> dict:
-    from drake_entry.planning.swarm.evaluator import HISTORY_COLUMNS
-    from drake_entry.planning.swarm.search import problem_from_scenario, search
-    from drake_entry.planning.swarm.study import (PAPER, baselines, case_optima, case_problem, swarm_statistics,
+    from drake_entry.guidance.swarm_bank.evaluator import HISTORY_COLUMNS
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario, search
+    from drake_entry.guidance.swarm_bank.study import (PAPER, baselines, case_optima, case_problem, swarm_statistics,
                                                    two_parameter)
-    from drake_entry.plots import swarm_case_plots, swarm_convergence_plot
+    from drake_entry.guidance.swarm_bank.plots import swarm_case_plots, swarm_convergence_plot
     from drake_entry.scenario import load_scenario
 
     t_start = time.perf_counter()
@@ -26,7 +26,7 @@ def paper004_study(*, seeds: int = 20, out_dir: str = "out/paper004", scenario_n
     out: dict = {}
 
     print("== Cost on this machine (goals: one PIO run <= 15 s, a bracketed 1-D solve <= 5 s)")
-    from drake_entry.planning.swarm.evaluator import evaluate
+    from drake_entry.guidance.swarm_bank.evaluator import evaluate
     for n in (1, 10, 100):
         sigma0 = np.radians(np.linspace(55.0, 62.0, n))
         t0 = time.perf_counter()

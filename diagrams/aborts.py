@@ -1,13 +1,13 @@
 """Abort reachability campaigns of paper 001 Sec. VI through the campaign engine: every
-case is an SCvx plan (``planning.scvx.plan_entry``) flown by the Drake Simulator
+case is an SCvx plan (``guidance.scvx.plan_entry``) flown by the Drake Simulator
 (``plan_flight.fly_plan``), one row per case (``abort_row``), run on any backend
 (``campaign.run_cases``: serial, processes, Dask), resumable.
 
     run_orbital_aborts(out_dir)   the EIP grid (9 x 9 at 5 deg by default)
     run_descent_aborts(out_dir)   the nominal flown, re-planned to an alternative site every 50 s
 
-The cases and the Tables 4-7 statistics are ``planning.scvx.aborts``; the report and
-figures ``planning.scvx.abort_report``.
+The cases and the Tables 4-7 statistics are ``guidance.scvx.aborts``; the report and
+figures ``guidance.scvx.abort_report``.
 """
 from __future__ import annotations
 
@@ -17,20 +17,20 @@ import time
 
 import numpy as np
 
-from drake_entry.atmosphere import US76Atmosphere
+from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.diagrams.plan_flight import fly_plan
 from drake_entry.errors import ScenarioError
-from drake_entry.planet import Earth
-from drake_entry.planning.scvx.aborts import (ALTERNATIVE_SITES, DESCENT_ABORT_SPACING_S, FEASIBLE_RADII_M,
+from drake_entry.models.planet import Earth
+from drake_entry.guidance.scvx.aborts import (ALTERNATIVE_SITES, DESCENT_ABORT_SPACING_S, FEASIBLE_RADII_M,
                                               GRID_SHAPE, GRID_SPACING_DEG, OPEN_SITE_RADIUS_M, case_mission, descent_abort_cases,
                                               feasible, orbital_abort_cases)
-from drake_entry.planning.scvx.engine import ScvxSettings
-from drake_entry.planning.scvx.entry import EntryProblemSettings
-from drake_entry.planning.scvx.mission import ScvxMission
-from drake_entry.planning.scvx.planner import plan_entry
-from drake_entry.vehicles import load_vehicle
+from drake_entry.guidance.scvx.engine import ScvxSettings
+from drake_entry.guidance.scvx.entry import EntryProblemSettings
+from drake_entry.guidance.scvx.mission import ScvxMission
+from drake_entry.guidance.scvx.planner import plan_entry
+from drake_entry.models.vehicles import load_vehicle
 
 #: spacing [s] of the planned trajectory kept per case for the figures
 TRAJECTORY_STEP_S = 20.0
@@ -71,7 +71,7 @@ def setup_worker(config: dict) -> tuple:
 
 def abort_row(case: dict, plan, flight, wall_s: float) -> dict:
     """One case's row: the case, the plan's figures (Tables 4-7 quantities), the flown miss and
-    the feasibility at 10 and 40 km (``planning.scvx.aborts.feasible``)."""
+    the feasibility at 10 and 40 km (``guidance.scvx.aborts.feasible``)."""
     history = plan.history
     socp = [r.solver_iterations for r in history]
     row = {**case, "plan_success": bool(plan.success), "message": plan.message, "iterations": int(plan.iterations),

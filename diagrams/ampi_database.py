@@ -1,6 +1,6 @@
 """Paper 003's trajectory database solved through the campaign engine: every grid case is
 an NLP solve (planning.nlp, verified) of the problem with its entry state offset (eq. 6),
-stored at the LD nodes (planning.ampi.TrajectoryDatabase).
+stored at the LD nodes (guidance.ampi.TrajectoryDatabase).
 
 Continuation: the cases run in waves of growing grid distance from the nominal
 (ParameterGrid.waves), each wave on any backend (serial, processes, Dask) through
@@ -21,14 +21,15 @@ import time
 
 import numpy as np
 
-from drake_entry.campaign_store import read_rows, read_trajectories
+from drake_entry.campaign.store import read_rows, read_trajectories
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.errors import ScenarioError
 from drake_entry.planning import nlp
-from drake_entry.planning.ampi import ParameterGrid, TrajectoryDatabase
+from drake_entry.guidance.ampi.database import TrajectoryDatabase
+from drake_entry.guidance.ampi.grid import ParameterGrid
 from drake_entry.planning.ocp_yaml import load_problem
-from drake_entry.pseudospectral import lgl_nodes
+from drake_entry.planning.pseudospectral import lgl_nodes
 
 DATABASE_FILE = "database.npz"
 

@@ -16,7 +16,7 @@ import os
 import numpy as np
 
 import drake_entry
-from drake_entry.campaign_store import CampaignStore
+from drake_entry.campaign.store import CampaignStore
 from drake_entry.diagrams.backends import BACKENDS, Task, run_backend
 from drake_entry.errors import ScenarioError
 

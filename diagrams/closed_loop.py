@@ -22,27 +22,27 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from drake_entry.aerodynamics import ScaledAero
-from drake_entry.atmosphere import Atmosphere, DispersedAtmosphere
+from drake_entry.models.aerodynamics import ScaledAero
+from drake_entry.models.atmosphere import Atmosphere, DispersedAtmosphere
 from drake_entry.diagrams.common import add_step_loggers, run
-from drake_entry.dispersions import Draw
+from drake_entry.models.dispersions import Draw
 from drake_entry.errors import ScenarioError
-from drake_entry.geodesy import range_and_crossrange
+from drake_entry.models.geodesy import range_and_crossrange
 from drake_entry.guidance import method_for
 from drake_entry.guidance.interface import GuidanceMethod, GuidanceSummary, PlantPorts
-from drake_entry.planet import Earth
+from drake_entry.models.planet import Earth
 from drake_entry.scenario import Scenario
-from drake_entry.schedules import Schedule
+from drake_entry.models.schedules import Schedule
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.navigation import Navigation
 from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.systems.vehicle import EntryVehicle
-from drake_entry.trajectory import Trajectory
-from drake_entry.vehicles import Vehicle
-from drake_entry.verdict import Verdict, box_text, judge
-from drake_entry.verdict import acceptance_box as box_at
+from drake_entry.models.trajectory import Trajectory
+from drake_entry.models.vehicles import Vehicle
+from drake_entry.models.verdict import Verdict, box_text, judge
+from drake_entry.models.verdict import acceptance_box as box_at
 
 ALTITUDE_FLOOR_M = 5000.0
 
@@ -95,7 +95,7 @@ class ClosedLoopResult:
       errors: terminal errors (Table 3 form): altitude_m, longitude_deg, latitude_deg,
         velocity_m_s, range_to_go_m (along the heading, + short of the target),
         crossrange_m (+ target to the right), distance_m.
-      success: the verdict (drake_entry.verdict): reached the terminal interface with the
+      success: the verdict (drake_entry.models.verdict): reached the terminal interface with the
         guidance active and finite terminal errors, inside every criterion of the mission's
         acceptance box, and every path limit held at every log sample and integrator step.
       message: human summary (the criteria missed and the limits breached, when not a success).
@@ -217,7 +217,7 @@ def terminal_errors(x, setup: ClosedLoopSetup) -> dict:
 
 
 def acceptance_box(tr: Trajectory, setup: ClosedLoopSetup, distance_m: float) -> dict:
-    """The mission's acceptance box (drake_entry.verdict.acceptance_box) at the final state:
+    """The mission's acceptance box (drake_entry.models.verdict.acceptance_box) at the final state:
     the altitude geodetic with altitude_datum 'ellipsoid', the Mach number flown, the distance
     to the target ``distance_m`` (terminal_errors')."""
     x = tr.state[-1]

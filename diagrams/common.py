@@ -1,5 +1,5 @@
 """Pieces every diagram runner shares: integrator set-up, collecting the loggers into a
-``drake_entry.trajectory.Trajectory``, and a run loop that stops on the termination
+``drake_entry.models.trajectory.Trajectory``, and a run loop that stops on the termination
 monitor and appends the exact final instant."""
 from __future__ import annotations
 
@@ -11,11 +11,11 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from drake_entry.errors import ModelRangeError, NonFiniteStateError
 from drake_entry.scenario import Scenario
-from drake_entry.trajectory import Trajectory
+from drake_entry.models.trajectory import Trajectory
 
 
 def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loop: bool = False):
-    """Integrator, accuracy and maximum step from the scenario (RK5 by default; see DESIGN.md);
+    """Integrator, accuracy and maximum step from the scenario (RK5 by default; docs/architecture.md, "Integration");
     a closed loop takes fixed steps of ``simulation.closed_loop_step_s`` when that is > 0."""
     sim = scenario.simulation
     step = sim.closed_loop_step_s if closed_loop and sim.closed_loop_step_s > 0 else 0.0
@@ -25,7 +25,7 @@ def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loo
     else:
         integrator.set_target_accuracy(sim.accuracy)
         integrator.set_maximum_step_size(sim.max_step_s)
-    # witness functions need the context accuracy set explicitly (DESIGN.md)
+    # witness functions need the context accuracy set explicitly (docs/architecture.md, "Integration")
     simulator.get_mutable_context().SetAccuracy(sim.accuracy)
     return integrator
 

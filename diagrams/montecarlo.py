@@ -3,7 +3,7 @@
 ``run_campaign`` runs (or resumes) ``runs`` samples of a scenario's dispersions on a
 backend as a campaign of cases (diagrams.campaign: serial, local processes, Dask), each
 finished row streamed into the campaign directory (campaign_store); one sample is one
-Drake RandomSimulation (diagrams.sample). The report is drake_entry.report.
+Drake RandomSimulation (diagrams.sample). The report is drake_entry.campaign.report.
 """
 from __future__ import annotations
 
@@ -14,13 +14,13 @@ import os
 import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
 
-from drake_entry.campaign_store import done_indices, finalise  # noqa: F401 (API)
+from drake_entry.campaign.store import done_indices, finalise  # noqa: F401 (API)
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import check_backend, run_cases, versions
 from drake_entry.diagrams.sample import TIMING_COLUMNS, TRAJECTORY_STEP_S, campaign_row, run_sample, sample_seed  # noqa: F401 (API)
 from drake_entry.errors import ScenarioError
 from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
-from drake_entry.vehicles import PACKAGED_VEHICLES
+from drake_entry.models.vehicles import PACKAGED_VEHICLES
 
 
 def _absolute_and_hash(path: str) -> tuple[str, str]:

@@ -18,7 +18,7 @@ from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.schedule import make_schedule_source
 from drake_entry.systems.vehicle import EntryVehicle
-from drake_entry.trajectory import Trajectory
+from drake_entry.models.trajectory import Trajectory
 
 
 def build_open_loop(scenario: Scenario):

@@ -19,7 +19,7 @@ from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.errors import ModelRangeError, NonFiniteStateError
-from drake_entry.geodesy import downtrack_crosstrack
+from drake_entry.models.geodesy import downtrack_crosstrack
 from drake_entry.planning.ocp import OptimalControlProblem
 from drake_entry.systems.ocp_plant import OptimalControlPlant
 

@@ -4,7 +4,7 @@ Each sample is one ``pydrake.systems.analysis.RandomSimulation`` whose RandomGen
 seeded from (campaign seed, sample index) only, so any sample re-runs alone and
 reproduces its row. Inside ``make_simulator`` the sample's dispersions are drawn from that
 generator and built into the diagram's defaults (Drake's SetRandomContext then keeps
-them; DESIGN.md). A sample that raises returns a row with its reason instead.
+them; docs/architecture.md, "Integration"). A sample that raises returns a row with its reason instead.
 """
 from __future__ import annotations
 
@@ -18,10 +18,10 @@ from pydrake.systems.analysis import RandomSimulation
 
 from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, build_closed_loop, summarise
 from drake_entry.diagrams.common import collect_trajectory, make_simulator
-from drake_entry.dispersions import draw
+from drake_entry.models.dispersions import draw
 from drake_entry.errors import load_yaml_typed
 from drake_entry.scenario import Scenario
-from drake_entry.trajectory import metrics
+from drake_entry.models.trajectory import metrics
 
 TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
 # row columns that measure this machine's wall-clock time (excluded from reproducibility)
@@ -95,7 +95,7 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
     """The row of one flight: the verdict (success = reached, inside_box and within_limits;
     violations: each breached path limit with its peak, time and margin, '' when none), the
     method's fields, final state, terminal errors, peak path quantities
-    (drake_entry.trajectory.metrics) and the margin of every path limit (drake_entry.verdict)."""
+    (drake_entry.models.trajectory.metrics) and the margin of every path limit (drake_entry.models.verdict)."""
     tr, x = res.trajectory, res.trajectory.state[-1]
     g, v = res.guidance, res.verdict
     return {

@@ -27,10 +27,10 @@ from drake_entry.errors import DrakeEntryError, ScenarioError
 
 def _cmd_simulate(args) -> int:
     from drake_entry.diagrams.open_loop import simulate
-    from drake_entry.plots import trajectory_plots
-    from drake_entry.results import write_table
+    from drake_entry.campaign.plots import trajectory_plots
+    from drake_entry.campaign.tables import write_table
     from drake_entry.scenario import load_scenario
-    from drake_entry.trajectory import metrics
+    from drake_entry.models.trajectory import metrics
 
     scenario = load_scenario(args.scenario)
     tr = simulate(scenario)
@@ -60,8 +60,8 @@ def _cmd_simulate(args) -> int:
 def _cmd_fly(args) -> int:
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
     from drake_entry.diagrams.sample import campaign_row
-    from drake_entry.plots import trajectory_plots
-    from drake_entry.results import write_table
+    from drake_entry.campaign.plots import trajectory_plots
+    from drake_entry.campaign.tables import write_table
     from drake_entry.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
@@ -126,9 +126,9 @@ def parse_overrides(items) -> dict:
 
 
 def _cmd_report(args) -> int:
-    from drake_entry.campaign_store import read_manifest
+    from drake_entry.campaign.store import read_manifest
     from drake_entry.errors import load_yaml_typed
-    from drake_entry.report import counts_sentence, errors_markdown, write_report
+    from drake_entry.campaign.report import counts_sentence, errors_markdown, write_report
     from drake_entry.scenario import Scenario
 
     manifest = read_manifest(args.dir) if os.path.isdir(args.dir) else None
@@ -148,8 +148,8 @@ def _cmd_report(args) -> int:
 
 
 def _cmd_fit_horus(args) -> int:
-    from drake_entry.aerodynamics import fit_horus_forms
-    from drake_entry.vehicles import load_vehicle
+    from drake_entry.models.aerodynamics import fit_horus_forms
+    from drake_entry.models.vehicles import load_vehicle
 
     rep = fit_horus_forms(initial_aL=load_vehicle("horus2b").aero.aL)
     print("least-squares fit of paper 000 eqs. 32-33 to the clean, untrimmed M-692 cells")
@@ -163,8 +163,8 @@ def _cmd_fit_horus(args) -> int:
 def _cmd_optimize(args) -> int:
     from drake_entry.planning import nlp
     from drake_entry.planning.ocp_yaml import load_problem
-    from drake_entry.plots import nlp_solution_plots
-    from drake_entry.results import write_table
+    from drake_entry.planning.nlp.plots import nlp_solution_plots
+    from drake_entry.campaign.tables import write_table
 
     problem, settings = load_problem(args.problem)
     nodes = settings.nodes if args.nodes is None else args.nodes

@@ -12,15 +12,15 @@ from typing import Optional
 
 import numpy as np
 
-from drake_entry import dispersions as disp
-from drake_entry.atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere, ExponentialAtmosphere, TableAtmosphere, US76Atmosphere
+from drake_entry.models import dispersions as disp
+from drake_entry.models.atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere, ExponentialAtmosphere, TableAtmosphere, US76Atmosphere
 from drake_entry.errors import ScenarioError, check_range, load_yaml_typed
 from drake_entry.guidance import GuidanceSpec, known_tags
 from drake_entry.guidance.drag_energy.spec import DragEnergy
-from drake_entry.planet import Earth
-from drake_entry.schedules import VARIABLES, Schedule
-from drake_entry.vehicles import Vehicle, load_vehicle
-from drake_entry.verdict import PathLimit, vehicle_path_limits
+from drake_entry.models.planet import Earth
+from drake_entry.models.schedules import VARIABLES, Schedule
+from drake_entry.models.vehicles import Vehicle, load_vehicle
+from drake_entry.models.verdict import PathLimit, vehicle_path_limits
 
 
 @dc.dataclass
@@ -177,7 +177,7 @@ class Scenario:
         return atmosphere_from_spec(self.atmosphere)
 
     def path_limits(self, vehicle: Vehicle | None = None) -> list[PathLimit]:
-        """The path limits every flight must hold (drake_entry.verdict): the vehicle's heat
+        """The path limits every flight must hold (drake_entry.models.verdict): the vehicle's heat
         flux, dynamic pressure, loads and bank limit, then the guidance spec's mission limits.
         ``vehicle``: the already built vehicle (default: ``make_vehicle()``)."""
         v = self.make_vehicle() if vehicle is None else vehicle
@@ -350,7 +350,9 @@ def atmosphere_from_spec(a: AtmosphereSpec) -> Atmosphere:
     raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential, table")
 
 
-PACKAGED_SCENARIOS = ("horus2b", "shefex3", "shefex3_ampi", "cav_h", "cav_h_paper004", "marv", "sphynx_paper001")
+#: the scenarios shipped in drake_entry/scenarios (``<name>.yaml``), found in the package
+PACKAGED_SCENARIOS = tuple(sorted(p.name[:-5] for p in resources.files("drake_entry").joinpath("scenarios").iterdir()
+                                  if p.name.endswith(".yaml")))
 
 
 def load_scenario(name_or_path: str) -> Scenario:

@@ -23,7 +23,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from drake_entry.claims import Claims
-from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.scenario import load_scenario
 from drake_entry.systems.actuators import BankActuator
 from drake_entry.systems.atmosphere import AtmosphereSystem

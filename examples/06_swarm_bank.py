@@ -16,8 +16,8 @@ import numpy as np
 
 from drake_entry.claims import Claims
 from drake_entry.diagrams.closed_loop import fly
-from drake_entry.planning.swarm.evaluator import range_error
-from drake_entry.planning.swarm.search import problem_from_scenario, search
+from drake_entry.guidance.swarm_bank.evaluator import range_error
+from drake_entry.guidance.swarm_bank.search import problem_from_scenario, search
 from drake_entry.scenario import load_scenario
 
 

@@ -4,7 +4,7 @@ rates as controls, eqs. 54-55, the form of the paper's Tables 2 and 4-7; free fi
 fly the plan's bank and alpha with the Drake Simulator and compare with the plan and the site.
 ``--formulation lossless`` plans the lossless bank (eqs. 37-45) instead: its relaxed |u| < 1 shows
 up as a flown error, and the planner says so. The direct plan is then cross-checked: the same
-problem (``planning.scvx.as_ocp``) solved by the NLP path (Drake DirectCollocation + SNOPT) from
+problem (``guidance.scvx.as_ocp``) solved by the NLP path (Drake DirectCollocation + SNOPT) from
 the same glide guess, its controls flown by the Drake Simulator; the two heat loads agree
 within 1 % (0.24 % measured).
 
@@ -20,17 +20,17 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
-from drake_entry.atmosphere import US76Atmosphere
+from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.diagrams.plan_flight import fly_plan
 from drake_entry.claims import Claims
-from drake_entry.planet import Earth
+from drake_entry.models.planet import Earth
 from drake_entry.diagrams.propagation import propagate
 from drake_entry.planning import nlp
-from drake_entry.planning.scvx.as_ocp import nlp_form
-from drake_entry.planning.scvx.entry import FORMULATIONS, EntryProblemSettings
-from drake_entry.planning.scvx.mission import ScvxMission
-from drake_entry.planning.scvx.planner import plan_entry
-from drake_entry.vehicles import load_vehicle
+from drake_entry.guidance.scvx.as_ocp import nlp_form
+from drake_entry.guidance.scvx.entry import FORMULATIONS, EntryProblemSettings
+from drake_entry.guidance.scvx.mission import ScvxMission
+from drake_entry.guidance.scvx.planner import plan_entry
+from drake_entry.models.vehicles import load_vehicle
 
 
 def main(quick: bool = False, out_dir: str = "out/examples/07", formulation: str = "direct") -> dict:

@@ -8,7 +8,7 @@ engine (local processes; resumable: run it again and only missing cases run):
    attitude to Ben Guerir (minimum miss, as the paper), each flown.
 
 The EIP states of the grid and the alternative site's coordinates are labelled substitutes
-(drake_entry.planning.scvx.aborts); SPHYNX's aerodynamics are the representative model.
+(drake_entry.guidance.scvx.aborts); SPHYNX's aerodynamics are the representative model.
 
     python examples/08_abort_maps.py [--quick] [--out out/examples/08]
 
@@ -18,11 +18,11 @@ descent aborts.
 import argparse
 import os
 
-from drake_entry.campaign_store import read_rows
+from drake_entry.campaign.store import read_rows
 from drake_entry.claims import Claims
 from drake_entry.diagrams.aborts import run_descent_aborts, run_orbital_aborts
-from drake_entry.planning.scvx.abort_report import write_abort_report
-from drake_entry.planning.scvx.aborts import FEASIBLE_RADII_M, feasible
+from drake_entry.guidance.scvx.abort_report import write_abort_report
+from drake_entry.guidance.scvx.aborts import FEASIBLE_RADII_M, feasible
 
 
 def main(quick: bool = False, out_dir: str = "out/examples/08") -> dict:

@@ -11,7 +11,7 @@ trajectory database (Sagliano, Mooij & Theil 2017, Sec. II-III).
    are labelled substitutes (docs/methods/ampi.md).
 3. Paper 003 eq. 1 (soft terminal deviation) on the same problem, started from the well-posed
    solution: it weighs only where the flight ends, so any bank history that arrives is optimal
-   (the flat valley of the feasibility study) and its answer's bank is not the least one: the
+   (the flat valley a pre-implementation prototype found) and its answer's bank is not the least one: the
    database uses the well-posed form.
 
     python examples/11_shefex3_problem.py [--quick] [--out out/examples/11]

@@ -1,7 +1,7 @@
 """Second-order actuators with position, rate and acceleration limits: BankActuator and
 AlphaActuator (one LeafSystem, ``LimitedActuator``, named per use).
 
-The law is drake_entry.actuator.actuator_rates: the command is clipped to [lower, upper]
+The law is drake_entry.models.actuator.actuator_rates: the command is clipped to [lower, upper]
 and tracked with rate and acceleration limits, so a bank reversal (a sign flip of the
 command) rotates through wings-level at the rate limit. Two realisations:
 
@@ -23,7 +23,7 @@ from __future__ import annotations
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.actuator import BANDWIDTH_RAD_S, SUBSTEP_S, actuator_rates, integrate_actuator
+from drake_entry.models.actuator import BANDWIDTH_RAD_S, SUBSTEP_S, actuator_rates, integrate_actuator
 from drake_entry.errors import ScenarioError
 
 

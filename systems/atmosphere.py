@@ -4,7 +4,7 @@ Ports:
   - input  "state"     [6]  vehicle state [h m, lon, lat rad, V m/s, gamma, psi rad]
   - output "air_data"  [2]  density rho [kg/m^3], speed of sound a [m/s]
 
-A Monte-Carlo sample's density dispersion is a model, drake_entry.atmosphere.DispersedAtmosphere.
+A Monte-Carlo sample's density dispersion is a model, drake_entry.models.atmosphere.DispersedAtmosphere.
 """
 from __future__ import annotations
 
@@ -12,9 +12,9 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
-from drake_entry.atmosphere import Atmosphere
-from drake_entry.dynamics import air_data
-from drake_entry.planet import Earth
+from drake_entry.models.atmosphere import Atmosphere
+from drake_entry.models.dynamics import air_data
+from drake_entry.models.planet import Earth
 
 
 @TemplateSystem.define("AtmosphereSystem_")

@@ -1,6 +1,6 @@
 """ReferenceTracker: makes a reference at the entry interface from the navigation estimate and
 tracks it with a time-varying LQR (paper 003's guidance for both AMPI and NTT; the
-reference maker is ``planning.ampi.reference.DatabaseReference``).
+reference maker is ``guidance.ampi.reference.DatabaseReference``).
 
 At initialisation the tracker asks ``planner.reference(estimate)`` for a TrackedReference
 (the reference and its law u = u_ref - K (x - x_ref), planning.tracking). The law's state is

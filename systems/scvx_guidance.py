@@ -6,7 +6,7 @@ and read at the time since the plan began; alpha is the planned one where the fo
 it, else the mission's alpha(V) law at the estimated speed. With ``replan_period`` > 0, every
 period (while the plan in use has more than ``min_time_to_go`` seconds left) a new plan is
 made from the estimate, holding the bank and alpha being commanded
-(``planning.scvx.planner.replan_from``); a plan that is not a verified success is recorded and
+(``guidance.scvx.planner.replan_from``); a plan that is not a verified success is recorded and
 the previous one is kept.
 
 Ports:
@@ -24,7 +24,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
-from drake_entry.planning.scvx.planner import ScvxPlan, replan_from
+from drake_entry.guidance.scvx.planner import ScvxPlan, replan_from
 
 
 @dataclass(frozen=True)

@@ -1,10 +1,10 @@
-"""SwarmBankGuidance: paper 004's guidance law on board (drake_entry.planning.swarm).
+"""SwarmBankGuidance: paper 004's guidance law on board (drake_entry.guidance.swarm_bank).
 
 Every ``period`` seconds the law gives |sigma| (eq. 17 from sigma_0 with the QEG compensation,
 eqs. 46-48) and the alpha command (eq. 31, or eq. 21 until Mach_shift) from the navigation
 estimate and the sensed flight conditions; the shared reversal logic signs |sigma| and the
 shared actuators fly both. With ``resolve_period`` > 0, sigma_0 is re-solved on board from
-the estimate (planning.swarm.search.resolve_sigma0: predicted trajectories of the same law)
+the estimate (guidance.swarm_bank.search.resolve_sigma0: predicted trajectories of the same law)
 until the normalised energy ``resolve_until_e``. The predictions fly the nominal models with
 the lift and drag scaled by the ratios of the sensed to the modelled accelerations, low-passed
 over 30 s (``resolve_scaling``): a density or aerodynamic error the flight has shown is then
@@ -23,7 +23,7 @@ Ports:
 
 The commands are computed from the inputs and the law's memory (previous alpha command, Case 2
 switch) at each sample: the actuators sample them at the same instant, as the planner's
-evaluation assumes (planning/swarm/evaluator.py).
+evaluation assumes (guidance/swarm_bank/evaluator.py).
 """
 from __future__ import annotations
 
@@ -34,12 +34,12 @@ import time
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.aerodynamics import ScaledAero
-from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
+from drake_entry.models.aerodynamics import ScaledAero
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
 from drake_entry.errors import ScenarioError
-from drake_entry.planning.swarm.evaluator import SwarmProblem
-from drake_entry.planning.swarm.guidance_law import LawMemory, law_commands
-from drake_entry.planning.swarm.search import resolve_sigma0
+from drake_entry.guidance.swarm_bank.evaluator import SwarmProblem
+from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, law_commands
+from drake_entry.guidance.swarm_bank.search import resolve_sigma0
 
 _FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
 # discrete state: law memory (3), sigma_0, re-solutions, failed ones, wall time, next re-solution

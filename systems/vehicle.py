@@ -8,7 +8,7 @@ Ports:
                                    speed of sound [m/s] from an ``AtmosphereSystem``
   - output "state"              [6]  [h m, lon rad, lat rad, V m/s, gamma rad, psi rad]
   - output "flight_conditions"  [9]  rho kg/m^3, Mach, q Pa, heat flux W/m^2, n_z g, n g,
-                                   L m/s^2, D m/s^2, E J/kg (drake_entry.dynamics.FlightConditions)
+                                   L m/s^2, D m/s^2, E J/kg (drake_entry.models.dynamics.FlightConditions)
 """
 from __future__ import annotations
 
@@ -16,10 +16,10 @@ import numpy as np
 from pydrake.systems.framework import BasicVector_, ContinuousStateIndex, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
-from drake_entry import dynamics
-from drake_entry.atmosphere import Atmosphere
-from drake_entry.planet import Earth
-from drake_entry.vehicles import Vehicle
+from drake_entry.models import dynamics
+from drake_entry.models.atmosphere import Atmosphere
+from drake_entry.models.planet import Earth
+from drake_entry.models.vehicles import Vehicle
 
 N_STATE = 6
 N_CONDITIONS = len(dynamics.FLIGHT_CONDITION_NAMES)

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from drake_entry.atmosphere import US76Atmosphere
-from drake_entry.planet import Earth
-from drake_entry.vehicles import load_vehicle
+from drake_entry.models.atmosphere import US76Atmosphere
+from drake_entry.models.planet import Earth
+from drake_entry.models.vehicles import load_vehicle
 
 
 @pytest.fixture(scope="session")

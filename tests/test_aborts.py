@@ -7,14 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from drake_entry.campaign_store import read_rows
+from drake_entry.campaign.store import read_rows
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.errors import CampaignError, ScenarioError
-from drake_entry.planet import Earth
-from drake_entry.planning.scvx.aborts import (PAPER_TABLES, abort_statistics, case_mission, descent_abort_cases,
+from drake_entry.models.planet import Earth
+from drake_entry.guidance.scvx.aborts import (PAPER_TABLES, abort_statistics, case_mission, descent_abort_cases,
                                               feasible, heading_offset, orbital_abort_cases, statistics_markdown)
-from drake_entry.planning.scvx.mission import ScvxMission
+from drake_entry.guidance.scvx.mission import ScvxMission
 
 
 # ----- the generic campaign of cases ---------------------------------------------------------
@@ -122,7 +122,7 @@ def test_one_orbital_abort_is_planned_flown_and_reported(tmp_path):
     Drake flight ends inside the 10-km radius (measured 9.97 km flown, 476 MJ/m^2); the report
     carries the Tables 4-7 form and the maps."""
     from drake_entry.diagrams.aborts import run_orbital_aborts
-    from drake_entry.planning.scvx.abort_report import write_abort_report
+    from drake_entry.guidance.scvx.abort_report import write_abort_report
 
     out = run_orbital_aborts(str(tmp_path), shape=(1, 1), backend="serial", progress=False)
     rows, _ = read_rows(out)
@@ -143,8 +143,8 @@ def test_descent_aborts_stop_where_the_planner_cannot_start():
     nominal's 33 used to raise 'entry_speed_m_s out of range')."""
     import numpy as np
 
-    from drake_entry.planet import Earth
-    from drake_entry.planning.scvx.aborts import descent_abort_cases
+    from drake_entry.models.planet import Earth
+    from drake_entry.guidance.scvx.aborts import descent_abort_cases
 
     t = np.linspace(0.0, 1600.0, 161)
     states = np.zeros((t.size, 6))

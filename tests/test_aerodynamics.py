@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
 
-from drake_entry.aerodynamics import (CallableAero, CavHAero, DragPolarAero, fit_horus_forms, horus2b_table,
+from drake_entry.models.aerodynamics import (CallableAero, CavHAero, DragPolarAero, fit_horus_forms, horus2b_table,
                                       horus_cd_form, horus_cl_form, packaged_data)
-from drake_entry.tables import read_csv_rows
-from drake_entry.vehicles import load_vehicle
+from drake_entry.models.data_tables import read_csv_rows
+from drake_entry.models.vehicles import load_vehicle
 
 
 @pytest.fixture(scope="module")
@@ -80,7 +80,7 @@ def test_user_callables_give_exact_autodiff_derivatives():
 
 
 def test_analytic_horus_drag_partials_equal_autodiff_and_differences():
-    from drake_entry.aerodynamics import AeroModel
+    from drake_entry.models.aerodynamics import AeroModel
 
     fit = load_vehicle("horus2b").aero
     for alpha, mach in ((0.6, 7.0), (0.3, 2.4), (0.7, 15.0)):
@@ -95,7 +95,7 @@ def test_sphynx_representative_aero_has_paper001_lift_to_drag():
     """Paper 001 Sec. II.A quotes L/D about 1.2 supersonic and about 2 subsonic; the labelled
     representative model gives max L/D 1.17 at Mach 10, 1.74 at Mach 1.2, 2.05 at Mach 0.5, and
     its subsonic drag blend is C1 (finite-difference slope continuous across Mach 2)."""
-    from drake_entry.vehicles import load_vehicle
+    from drake_entry.models.vehicles import load_vehicle
 
     v = load_vehicle("sphynx")
     assert (v.mass, v.reference_area, v.nose_radius) == (550.0, 2.408, 0.5)

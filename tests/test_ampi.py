@@ -8,9 +8,11 @@ import pytest
 from scipy.interpolate import RegularGridInterpolator
 
 from drake_entry.errors import ScenarioError
-from drake_entry.planning.ampi import ParameterGrid, TrajectoryDatabase, hd_matrix, interpolate, select_subspace
-from drake_entry.planning.ampi.database import OBJECTIVE_FACTOR
-from drake_entry.pseudospectral import lgl_nodes
+from drake_entry.guidance.ampi.database import TrajectoryDatabase, hd_matrix
+from drake_entry.guidance.ampi.grid import ParameterGrid
+from drake_entry.guidance.ampi.synthesis import interpolate, select_subspace
+from drake_entry.guidance.ampi.database import OBJECTIVE_FACTOR
+from drake_entry.planning.pseudospectral import lgl_nodes
 
 
 def test_paper_grid_is_eq_5_and_continuation_reaches_every_case_from_the_nominal():
@@ -145,7 +147,7 @@ def test_database_build_by_continuation_is_verified_resumable_and_stored(tmp_pat
     assert report["storage_MB"] == pytest.approx(3 * 60 * 9 * 8 / 1e6 + 3 * 8 / 1e6)
     back = TrajectoryDatabase.load(str(tmp_path / DATABASE_FILE))
     assert np.array_equal(back.values, db.values)
-    from drake_entry.campaign_store import read_rows
+    from drake_entry.campaign.store import read_rows
 
     rows, _ = read_rows(str(tmp_path))
     assert rows[0]["guess_from"] == 1 and rows[2]["guess_from"] == 1 and rows[1]["guess_from"] == -1

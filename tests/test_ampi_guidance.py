@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from drake_entry.errors import ScenarioError
-from drake_entry.planning.ampi.reference import DatabaseReference
+from drake_entry.guidance.ampi.reference import DatabaseReference
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +79,7 @@ def test_reference_comes_with_a_tvlqr_law(planner):
     # reference's end point than the reference's rate flown open loop
     from scipy.integrate import solve_ivp
 
-    from drake_entry.geodesy import central_angle
+    from drake_entry.models.geodesy import central_angle
 
     p = planner.problem
     x0 = law.states[0].copy()

@@ -1,16 +1,20 @@
 """The layers of docs/architecture.md, read from the import statements of every module.
 
-  model     drake_entry/ (models, planning, scenario, guidance specs and registry, report)
-  systems   systems/           Drake LeafSystems
-  methods   drake_entry/guidance/<method>/method.py, guidance/reversal.py: a method's wiring
-  diagrams  diagrams/          builders, campaign runner
-  cli       drake_entry/cli.py, drake_entry/guidance/<method>/commands.py
+  models    drake_entry/errors.py, drake_entry/models/     physics; imports nothing else of the project
+  planning  drake_entry/ (all but the other rows)          shared planning, method planners and specs,
+                                                           scenario, campaign outputs
+  systems   systems/                                       Drake LeafSystems
+  methods   drake_entry/guidance/<method>/method.py,       a method's wiring
+            drake_entry/guidance/reversal_wiring.py
+  diagrams  diagrams/                                      builders, campaign runner
+  cli       drake_entry/cli.py, */commands.py              commands
 
 A layer imports only the layers before it. Two deliberate exceptions:
 planning/nlp/dircol.py imports systems.ocp_plant (Drake's DirectCollocation takes a System), and
 planning/nlp/verify.py imports diagrams.propagation (an NLP's success is verified by flying its
 controls with the Drake Simulator).
-No method's package imports another method's.
+No method's folder (drake_entry/guidance/<method>/) imports another method's, and the shared
+packages (models, planning, campaign) import no method's folder.
 """
 import ast
 from pathlib import Path
@@ -18,12 +22,10 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-ORDER = ("model", "systems", "methods", "diagrams", "cli")
+ORDER = ("models", "planning", "systems", "methods", "diagrams", "cli")
 EXCEPTIONS = {("drake_entry.planning.nlp.dircol", "drake_entry.systems.ocp_plant"),
               ("drake_entry.planning.nlp.verify", "drake_entry.diagrams.propagation")}
-METHOD_PLANNERS = ("drake_entry.planning.drag_energy", "drake_entry.planning.nlp", "drake_entry.planning.swarm",
-                   "drake_entry.planning.ampi",
-                   "drake_entry.planning.scvx")
+SHARED = ("drake_entry.models", "drake_entry.planning", "drake_entry.campaign", "drake_entry.errors")
 
 
 def module_name(path: Path) -> str:
@@ -38,16 +40,24 @@ def module_name(path: Path) -> str:
 
 def layer(module: str) -> str:
     parts = module.split(".")
+    if module == "drake_entry.errors" or parts[:2] == ["drake_entry", "models"]:
+        return "models"
     if parts[:2] == ["drake_entry", "systems"]:
         return "systems"
     if parts[:2] == ["drake_entry", "diagrams"]:
         return "diagrams"
-    if module == "drake_entry.cli" or (parts[:2] == ["drake_entry", "guidance"] and parts[-1] == "commands"):
+    if module == "drake_entry.cli" or parts[-1] == "commands":
         return "cli"
-    if module == "drake_entry.guidance.reversal" or (parts[:2] == ["drake_entry", "guidance"]
-                                                      and parts[-1] == "method"):
+    if module == "drake_entry.guidance.reversal_wiring" or (parts[:2] == ["drake_entry", "guidance"]
+                                                             and parts[-1] == "method"):
         return "methods"
-    return "model"
+    return "planning"
+
+
+def method_folder(module: str):
+    """The method a module belongs to (``drake_entry.guidance.<method>.*``), else None."""
+    parts = module.split(".")
+    return parts[2] if parts[:2] == ["drake_entry", "guidance"] and len(parts) > 3 else None
 
 
 def imports(source: str, module: str, is_package: bool) -> set:
@@ -80,13 +90,11 @@ def violations(module: str, imported: set, known: set) -> list:
             continue
         if ORDER.index(layer(target)) > ORDER.index(mine):
             found.append(f"{module} ({mine}) imports {target} ({layer(target)})")
-        mp, tp = module.split("."), target.split(".")
-        if mp[:2] == tp[:2] == ["drake_entry", "guidance"] and len(mp) > 3 and len(tp) > 3 and mp[2] != tp[2]:
-            found.append(f"{module} imports another method's package: {target}")
-        for a in METHOD_PLANNERS:
-            for b in METHOD_PLANNERS:
-                if a != b and module.startswith(a) and target.startswith(b):
-                    found.append(f"{module} imports another method's planner: {target}")
+        mine_m, theirs_m = method_folder(module), method_folder(target)
+        if theirs_m and mine_m and mine_m != theirs_m:
+            found.append(f"{module} imports another method's folder: {target}")
+        if theirs_m and module.startswith(SHARED):
+            found.append(f"{module} (shared) imports a method's folder: {target}")
     return found
 
 
@@ -106,21 +114,27 @@ def test_every_module_imports_only_the_layers_before_it():
 
 def test_the_layer_check_catches_violations():
     known = {"drake_entry.diagrams.closed_loop", "drake_entry.systems.vehicle", "drake_entry.planning.nlp",
-             "drake_entry.planning.drag_energy", "drake_entry.guidance.bank_profile.method",
-             "drake_entry.guidance.drag_energy.spec", "drake_entry.cli"}
+             "drake_entry.guidance.drag_energy.planner", "drake_entry.guidance.bank_profile.method",
+             "drake_entry.guidance.drag_energy.spec", "drake_entry.cli", "drake_entry.scenario",
+             "drake_entry.guidance.scvx.engine"}
     cases = {
-        ("drake_entry.scenario", "from .diagrams.closed_loop import fly"): "(model) imports",
+        ("drake_entry.scenario", "from .diagrams.closed_loop import fly"): "(planning) imports",
+        ("drake_entry.models.vehicles", "from drake_entry.scenario import Scenario"): "(models) imports",
         ("drake_entry.systems.vehicle", "from drake_entry.diagrams.closed_loop import fly"): "(systems) imports",
         ("drake_entry.guidance.drag_energy.method", "from drake_entry.cli import main"): "(methods) imports",
-        ("drake_entry.plots", "from systems.vehicle import EntryVehicle"): "use drake_entry.systems",
+        ("drake_entry.campaign.plots", "from systems.vehicle import EntryVehicle"): "use drake_entry.systems",
         ("drake_entry.guidance.drag_energy.method", "from ..bank_profile.method import METHOD"): "another method's",
-        ("drake_entry.planning.drag_energy", "from .nlp import solve"): "another method's planner",
+        ("drake_entry.guidance.drag_energy.planner", "from ..scvx.engine import X"): "another method's",
+        ("drake_entry.planning.tracking", "from drake_entry.guidance.scvx.engine import X"): "(shared) imports",
+        ("drake_entry.campaign.report", "from drake_entry.guidance.drag_energy import spec"): "(shared) imports",
     }
     for (module, source), message in cases.items():
         got = violations(module, imports(source, module, False), known)
         assert any(message in v for v in got), (module, source, got)
-    assert not violations("drake_entry.diagrams.sample", imports("from ..systems.vehicle import X",
-                                                                 "drake_entry.diagrams.sample", False), known)
+    for module, source in (("drake_entry.diagrams.sample", "from ..systems.vehicle import X"),
+                           ("drake_entry.guidance.drag_energy.planner", "from drake_entry.planning import nlp"),
+                           ("drake_entry.guidance.drag_energy.planner", "from .spec import DragEnergy")):
+        assert not violations(module, imports(source, module, False), known), (module, source)
 
 
 @pytest.mark.parametrize("name", ["benchmark", "benchmarks"])
@@ -138,3 +152,29 @@ def test_every_package_directory_is_installed():
     code = {module_name(p.parent / "__init__.py") for d in ("drake_entry", "systems", "diagrams")
             for p in (ROOT / d).rglob("__init__.py")}
     assert code <= listed, sorted(code - listed)
+
+
+def test_every_listed_package_exists():
+    """No stale entry in pyproject's package list (a moved package would install empty)."""
+    tomllib = pytest.importorskip("tomllib")
+
+    setuptools = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    mapping = setuptools["package-dir"]
+    for name in setuptools["packages"]:
+        directory = mapping.get(name, name.replace(".", "/"))
+        assert (ROOT / directory).is_dir(), f"pyproject lists {name}, but {directory}/ does not exist"
+
+
+def test_loading_a_scenario_loads_specs_only():
+    """Specs are pure data: reading any scenario imports no planner, no method wiring and no
+    Drake solver or systems module (they load when a method builds its planner)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from drake_entry.scenario import PACKAGED_SCENARIOS, load_scenario\n"
+            "for name in PACKAGED_SCENARIOS: load_scenario(name)\n"
+            "print(' '.join(sorted(n for n in sys.modules if n.startswith(('pydrake.solvers', 'pydrake.systems')) "
+            "or (n.startswith('drake_entry.guidance.') and n.rsplit('.', 1)[1] not in "
+            "('spec', 'settings', 'mission') and n.count('.') > 2))))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == [], out

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from pydrake.autodiffutils import AutoDiffXd
 
-from drake_entry.atmosphere import ExponentialAtmosphere
+from drake_entry.models.atmosphere import ExponentialAtmosphere
 from drake_entry.errors import ScenarioError
 
 # U.S. Standard Atmosphere 1976 reference densities (docs/models.md)
@@ -54,7 +54,7 @@ def test_autodiff_density_gradient_is_the_analytic_derivative(us76):
 def test_vectorised_equals_scalar(us76):
     """The array path (vectorised by layer) gives every altitude what the scalar path gives,
     all six quantities, across every layer boundary and the 86 km table join."""
-    from drake_entry.atmosphere import US76_LOWER_TOP, _us76_scalar
+    from drake_entry.models.atmosphere import US76_LOWER_TOP, _us76_scalar
 
     h = np.concatenate([np.linspace(-5e3, 1000e3, 4001), [0.0, 11e3, 20e3, 32e3, 47e3, 51e3, 71e3],
                         [US76_LOWER_TOP, np.nextafter(US76_LOWER_TOP, 1e9)]])
@@ -86,7 +86,7 @@ def test_bad_exponential_parameters_are_rejected():
 
 @pytest.mark.parametrize("h", [-4000.0, 0.0, 11000.0, 30500.0, 71000.0, 85999.0, 86001.0, 121500.0])
 def test_air_data_fast_path_equals_properties_to_the_last_bit(us76, h):
-    from drake_entry.atmosphere import DispersedAtmosphere
+    from drake_entry.models.atmosphere import DispersedAtmosphere
 
     for atm in (us76, ExponentialAtmosphere(), DispersedAtmosphere(us76, scale=1.07, amplitude=0.05,
                                                                      wavelength=9000.0, phase=0.3)):
@@ -110,7 +110,7 @@ def _us76_table_csv(path, us76, heights):
 def test_table_atmosphere_reproduces_its_table_and_interpolates_us76(tmp_path, us76):
     """Through its own rows exactly; between rows of a 2-km US76 sampling within 0.3 %
     (density) and 0.5 K (temperature): the splines are of ln rho and T."""
-    from drake_entry.atmosphere import TableAtmosphere
+    from drake_entry.models.atmosphere import TableAtmosphere
 
     heights = np.arange(20e3, 80001.0, 2e3)
     atm = TableAtmosphere.from_csv(str(_us76_table_csv(tmp_path / "a.csv", us76, heights)))
@@ -125,7 +125,7 @@ def test_table_atmosphere_reproduces_its_table_and_interpolates_us76(tmp_path, u
 
 @pytest.mark.parametrize("h", [25e3, 43.3e3, 61e3])
 def test_table_atmosphere_derivatives_equal_finite_differences(tmp_path, us76, h):
-    from drake_entry.atmosphere import TableAtmosphere
+    from drake_entry.models.atmosphere import TableAtmosphere
 
     atm = TableAtmosphere.from_csv(str(_us76_table_csv(tmp_path / "a.csv", us76, np.arange(20e3, 80001.0, 2e3))))
     d, t = atm.density_derivatives(h), atm.temperature_derivatives(h)
@@ -156,7 +156,7 @@ def test_bad_atmosphere_tables_are_one_line_errors(tmp_path, text, match):
 
 
 def test_table_atmosphere_outside_its_altitudes_names_the_range(tmp_path, us76):
-    from drake_entry.atmosphere import TableAtmosphere
+    from drake_entry.models.atmosphere import TableAtmosphere
     from drake_entry.errors import ModelRangeError
 
     atm = TableAtmosphere.from_csv(str(_us76_table_csv(tmp_path / "a.csv", us76, np.arange(20e3, 80001.0, 2e3))))

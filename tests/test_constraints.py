@@ -1,11 +1,11 @@
 import numpy as np
 import pytest
 
-from drake_entry.constraints import HeatFlux, PathLimits, make_heat_flux, normal_load_factor
+from drake_entry.models.constraints import HeatFlux, PathLimits, make_heat_flux, normal_load_factor
 
 
 def test_chapman_equals_paper001_normalised_form():
-    """data/README.md: C1 = 5.28137e-5 is paper 001 eq. 9 with c* = 1.1097e8, n = 0.5, m = 3.15."""
+    """docs/references.md: C1 = 5.28137e-5 is paper 001 eq. 9 with c* = 1.1097e8, n = 0.5, m = 3.15."""
     a, b = HeatFlux.chapman(0.8), HeatFlux.normalised(0.8)
     assert a(1e-4, 6000.0) == pytest.approx(b(1e-4, 6000.0), rel=1e-3)
 

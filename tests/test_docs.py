@@ -39,7 +39,7 @@ def _schemas(root):
     return seen
 
 
-@pytest.mark.parametrize("module, name", [("drake_entry.scenario", "Scenario"), ("drake_entry.vehicles", "VehicleSpec"),
+@pytest.mark.parametrize("module, name", [("drake_entry.scenario", "Scenario"), ("drake_entry.models.vehicles", "VehicleSpec"),
                                           ("drake_entry.planning.ocp_yaml", "ProblemSpec")])
 def test_yaml_reference_has_every_schema_field(module, name):
     import importlib

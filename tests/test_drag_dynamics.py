@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from drake_entry.drag_dynamics import AlphaProfile, drag_acceleration, drag_dynamics
-from drake_entry.dynamics import energy_domain_derivatives, specific_energy
-from drake_entry.planet import Earth
+from drake_entry.guidance.drag_energy.drag_dynamics import AlphaProfile, drag_acceleration, drag_dynamics
+from drake_entry.models.dynamics import energy_domain_derivatives, specific_energy
+from drake_entry.models.planet import Earth
 
 
 def _fly_in_energy(x0, bank, alpha_of_E, vehicle, planet, atm, dE):
@@ -23,7 +23,7 @@ def _fd_D(sol, E, step, alpha_of_E, vehicle, atm):
 
 @pytest.mark.parametrize("aero", ["fit", "table"])
 def test_D_second_equals_finite_difference_of_a_simulated_trajectory(aero, us76):
-    from drake_entry.vehicles import load_vehicle
+    from drake_entry.models.vehicles import load_vehicle
 
     v = load_vehicle("horus2b", aero=aero)
     p = Earth.spherical(rotating=False)
@@ -66,7 +66,7 @@ def test_b_D_is_the_slope_of_D_second_in_u_between_two_flown_banks(us76):
     same state with banks 30 and 75 deg: (D''_1 - D''_2) / (u_1 - u_2) within 1e-3 (the two one-sided FD
     second derivatives at the start carry their truncation). b_D is written out, not second(1) - second(0), so it is
     not 0 where |a_D| >> |b_D| (high up, where D is small)."""
-    from drake_entry.vehicles import load_vehicle
+    from drake_entry.models.vehicles import load_vehicle
 
     v = load_vehicle("horus2b", aero="fit")
     p = Earth.spherical(rotating=False)

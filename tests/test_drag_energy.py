@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from drake_entry.drag_dynamics import drag_acceleration
-from drake_entry.planning.drag_energy import DragEnergyPlanner, plan
+from drake_entry.guidance.drag_energy.drag_dynamics import drag_acceleration
+from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner, plan
 from drake_entry.scenario import load_scenario
 
 
@@ -31,7 +31,7 @@ def _state_on_bound(planner, i, name):
     """(h, V, alpha) where constraint ``name`` reaches its limit at corridor energy i."""
     c = planner.corridor
     E, alpha = c.energy[i], c.alpha[i]
-    from drake_entry.planning.drag_energy import altitude_speed_from_drag
+    from drake_entry.guidance.drag_energy.planner import altitude_speed_from_drag
 
     h, V = altitude_speed_from_drag(E, c.upper[name][i], alpha, planner.vehicle, planner.planet, planner.atmosphere)
     return h, V, alpha
@@ -46,7 +46,7 @@ def test_corridor_upper_bound_equals_the_heat_flux_limit_where_heat_flux_binds(p
     assert planner.vehicle.heat_flux(rho, V) == pytest.approx(530e3, rel=1e-4)
 
 
-def test_corridor_active_constraints_and_narrowest_point_match_the_feasibility_study(planner, scenario):
+def test_corridor_active_constraints_and_narrowest_point_match_the_prototype_study(planner, scenario):
     """docs/methods/drag-energy.md: heat flux binds for e < 0.57, load factor to 0.85, then q;
     narrowest D_max/D_min about 1.17 near e = 0.93 (with its own alpha ramp)."""
     c = planner.corridor
@@ -65,7 +65,7 @@ def test_corridor_active_constraints_and_narrowest_point_match_the_feasibility_s
 def test_equilibrium_glide_lower_bound_holds_lift_equal_to_gravity_minus_centrifugal(planner):
     c = planner.corridor
     i = len(c.energy) // 2
-    from drake_entry.planning.drag_energy import altitude_speed_from_drag
+    from drake_entry.guidance.drag_energy.planner import altitude_speed_from_drag
 
     h, V = altitude_speed_from_drag(c.energy[i], c.D_eq_glide[i], c.alpha[i], planner.vehicle, planner.planet,
                                     planner.atmosphere)
@@ -188,8 +188,8 @@ def test_drag_tracking_sign_convention_requires_negative_zeta(planner):
 
 def test_drag_inversion_from_a_neighbour_guess_equals_the_bracketed_root(planner):
     """Eq. 93 inverted by secant steps from a guess gives Brent's root (to 1e-3 m) and the drag."""
-    from drake_entry.drag_dynamics import drag_acceleration
-    from drake_entry.planning.drag_energy import altitude_speed_from_drag
+    from drake_entry.guidance.drag_energy.drag_dynamics import drag_acceleration
+    from drake_entry.guidance.drag_energy.planner import altitude_speed_from_drag
 
     c = planner.corridor
     for i in (10, 150, 280):

@@ -4,11 +4,11 @@ from pydrake.autodiffutils import ExtractGradient, InitializeAutoDiff
 from pydrake.symbolic import Expression, Variable
 from scipy.integrate import solve_ivp
 
-from drake_entry.aerodynamics import CallableAero
-from drake_entry.atmosphere import ExponentialAtmosphere
-from drake_entry.dynamics import energy_rate, flight_conditions, specific_energy, state_derivatives
-from drake_entry.planet import Earth
-from drake_entry.vehicles import Vehicle
+from drake_entry.models.aerodynamics import CallableAero
+from drake_entry.models.atmosphere import ExponentialAtmosphere
+from drake_entry.models.dynamics import energy_rate, flight_conditions, specific_energy, state_derivatives
+from drake_entry.models.planet import Earth
+from drake_entry.models.vehicles import Vehicle
 
 
 def test_autodiff_jacobian_equals_finite_differences(horus, us76, entry_state):
@@ -85,7 +85,7 @@ def test_paper000_eq102_terms_by_hand(horus, us76, entry_state):
 
 
 def test_symbolic_dynamics_evaluate_to_the_float_dynamics():
-    from drake_entry.vehicles import load_vehicle
+    from drake_entry.models.vehicles import load_vehicle
 
     x = [Variable(n) for n in ("h", "lon", "lat", "V", "gamma", "psi")]
     sigma, alpha = Variable("sigma"), Variable("alpha")
@@ -101,7 +101,7 @@ def test_symbolic_dynamics_evaluate_to_the_float_dynamics():
 
 
 def test_energy_domain_form_is_time_form_divided_by_energy_rate(horus, us76, entry_state):
-    from drake_entry.dynamics import energy_domain_derivatives
+    from drake_entry.models.dynamics import energy_domain_derivatives
 
     p = Earth.oblate()
     dx_dE = energy_domain_derivatives(entry_state, 0.3, 0.7, horus, p, us76)

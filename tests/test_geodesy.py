@@ -1,15 +1,15 @@
-"""Great-circle geometry (drake_entry.geodesy) and trajectory metrics (drake_entry.trajectory)."""
+"""Great-circle geometry (drake_entry.models.geodesy) and trajectory metrics (drake_entry.models.trajectory)."""
 import math
 
 import numpy as np
 import pytest
 from pydrake.autodiffutils import AutoDiffXd
 
-from drake_entry.constraints import PathLimits
-from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
-from drake_entry.geodesy import (bearing, central_angle, central_angle_smooth, crossrange_from_great_circle,
+from drake_entry.models.constraints import PathLimits
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.models.geodesy import (bearing, central_angle, central_angle_smooth, crossrange_from_great_circle,
                                  downtrack_crosstrack, range_and_crossrange)
-from drake_entry.trajectory import Trajectory, metrics
+from drake_entry.models.trajectory import Trajectory, metrics
 
 R = 6378137.0
 D = math.radians
@@ -78,7 +78,7 @@ def test_metrics_peaks_heat_load_and_margins_of_the_finite_limits():
 
 
 def test_destination_lies_on_the_great_circle_at_the_distance():
-    from drake_entry.geodesy import destination
+    from drake_entry.models.geodesy import destination
 
     lon, lat = destination(D(-72.3), D(39.2), D(38.6), 11250e3, R)
     assert R * central_angle(D(-72.3), D(39.2), lon, lat) == pytest.approx(11250e3, rel=1e-9)
@@ -87,7 +87,7 @@ def test_destination_lies_on_the_great_circle_at_the_distance():
 
 
 def test_array_bearings_equal_the_scalar_bearing():
-    from drake_entry.geodesy import bearings
+    from drake_entry.models.geodesy import bearings
 
     rng = np.random.default_rng(4)
     p = rng.uniform(-1.4, 1.4, (4, 30))
@@ -95,7 +95,7 @@ def test_array_bearings_equal_the_scalar_bearing():
 
 
 def test_reversal_sign_turns_back_at_the_corridor_edges():
-    from drake_entry.reversal import reversal_sign, wrap_angle
+    from drake_entry.models.bank_reversal import reversal_sign, wrap_angle
 
     assert [reversal_sign(e, 0.1, s) for e, s in ((0.2, 1.0), (-0.2, -1.0), (0.05, -1.0), (0.2, -1.0))] == \
         [-1.0, 1.0, -1.0, -1.0]

@@ -51,7 +51,7 @@ def test_a_nan_in_a_schedule_is_refused_and_a_nan_command_stops_the_run(tmp_path
         load_scenario(bad)
     # the guard behind the validation: NaN derivatives stop the integrator with a reason
     from drake_entry.diagrams.open_loop import simulate
-    from drake_entry.schedules import Schedule
+    from drake_entry.models.schedules import Schedule
 
     s = load_scenario("horus2b")
     s.schedule = lambda which: (Schedule((0.0, 100.0), (0.0, math.nan), "time") if which == "bank"
@@ -116,7 +116,7 @@ def test_a_campaign_refuses_other_settings_and_extends_with_more_runs(tmp_path):
 
 
 def test_report_covers_partial_killed_and_all_failed_campaigns(tmp_path, capsys):
-    from drake_entry.report import write_report
+    from drake_entry.campaign.report import write_report
 
     assert "is not a directory: no campaign" in _one_line_error(capsys, ["report", str(tmp_path / "missing")])
     assert "holds no campaign" in _one_line_error(capsys, ["report", str(tmp_path)])
@@ -152,7 +152,7 @@ def test_a_campaign_of_the_previous_format_is_reported_but_not_extended(tmp_path
 
 
 def test_lines_that_are_not_rows_are_quarantined_and_cut_rows_do_not_duplicate_trajectories(tmp_path):
-    from drake_entry.campaign_store import read_rows
+    from drake_entry.campaign.store import read_rows
 
     out = Path(_run(tmp_path, runs=2))
     rows = (out / "samples.jsonl").read_text().splitlines()
@@ -175,12 +175,12 @@ def test_lines_that_are_not_rows_are_quarantined_and_cut_rows_do_not_duplicate_t
 
 def test_a_second_writer_is_refused(tmp_path):
     out = tmp_path / "busy"
-    code = ("import sys, time; from drake_entry.campaign_store import CampaignStore; "
+    code = ("import sys, time; from drake_entry.campaign.store import CampaignStore; "
             f"s = CampaignStore({str(out)!r}, {{'runs': 1, 'seed': 0}}); print('locked', flush=True); time.sleep(60)")
     holder = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, cwd=ROOT)
     try:
         assert holder.stdout.readline().strip() == "locked"
-        from drake_entry.campaign_store import CampaignStore
+        from drake_entry.campaign.store import CampaignStore
 
         with pytest.raises(CampaignError, match="is being written by another campaign process"):
             CampaignStore(str(out), {"runs": 1, "seed": 0})
@@ -317,11 +317,11 @@ def test_bad_problem_files_are_one_line(tmp_path, capsys):
 
 
 def test_api_inputs_are_checked():
-    from drake_entry.aerodynamics import HorusFitAero
-    from drake_entry.atmosphere import ExponentialAtmosphere
-    from drake_entry.dynamics import state_derivatives
-    from drake_entry.planet import Earth
-    from drake_entry.vehicles import Vehicle, load_vehicle
+    from drake_entry.models.aerodynamics import HorusFitAero
+    from drake_entry.models.atmosphere import ExponentialAtmosphere
+    from drake_entry.models.dynamics import state_derivatives
+    from drake_entry.models.planet import Earth
+    from drake_entry.models.vehicles import Vehicle, load_vehicle
 
     v = load_vehicle("horus2b")
     x = np.array([70e3, 0.1, 0.2, 6500.0, -0.01, 1.0])

@@ -9,8 +9,8 @@ import pytest
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 from drake_entry.diagrams.montecarlo import TIMING_COLUMNS, done_indices, run_campaign, run_sample, sample_seed
 from drake_entry.errors import CampaignError
-from drake_entry.planning.drag_energy import DragEnergyPlanner
-from drake_entry.report import summary_statistics, write_report
+from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
+from drake_entry.campaign.report import summary_statistics, write_report
 from drake_entry.scenario import load_scenario
 
 
@@ -112,7 +112,7 @@ def test_dask_backend_gives_the_same_rows_as_local_processes(tmp_path):
 
 
 def test_error_table_shows_the_scenario_reference_only_when_it_gives_one():
-    from drake_entry.report import errors_markdown
+    from drake_entry.campaign.report import errors_markdown
     from drake_entry.scenario import ReferenceResultsSpec
 
     stats = {"errors": {"err_altitude_m": {"mean": 30.0, "std": 8.0}, "err_range_m": {"mean": -110.0, "std": 40.0}}}

@@ -409,7 +409,7 @@ def test_a_solver_stop_near_the_optimum_is_restartable():
 
 def test_betts_heating_form_equals_the_imperial_formula_and_needs_alpha():
     """q = q_a(alpha) q_r: Betts 2010 Sec. 6.1 in BTU/ft^2/s against constraints.HeatFlux (SI)."""
-    from drake_entry.constraints import HeatFlux, make_heat_flux
+    from drake_entry.models.constraints import HeatFlux, make_heat_flux
 
     ft, slug, btu = 0.3048, 14.593902937, 1055.05585262
     hf = HeatFlux.betts_shuttle()

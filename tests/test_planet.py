@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from drake_entry.planet import Earth
+from drake_entry.models.planet import Earth
 
 
 def test_gravity_is_minus_the_gradient_of_the_j2_potential():

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from numpy.polynomial import legendre
 
-from drake_entry.pseudospectral import LGL, lgl_nodes
+from drake_entry.planning.pseudospectral import LGL, lgl_nodes
 
 
 @pytest.mark.parametrize("n", [3, 10, 41, 161])
@@ -65,7 +65,7 @@ def test_lobatto_segment_mesh_integrates_polynomials_of_its_order_exactly(m):
     """Lobatto IIIA on a segment mesh: x_j - x_0 = integral of x' holds exactly for x of
     degree <= m (x' interpolated exactly on m nodes; m = 2: trapezoid, exact for parabolas);
     quadrature weights sum to 1."""
-    from drake_entry.pseudospectral import SegmentMesh
+    from drake_entry.planning.pseudospectral import SegmentMesh
 
     mesh = SegmentMesh(5, m)
     assert mesh.n_nodes == 5 * (m - 1) + 1 and mesh.weights.sum() == pytest.approx(1.0, abs=1e-14)
@@ -83,7 +83,7 @@ def test_lobatto_segment_mesh_integrates_polynomials_of_its_order_exactly(m):
 
 def test_segment_mesh_rejects_bad_sizes():
     from drake_entry.errors import ScenarioError
-    from drake_entry.pseudospectral import SegmentMesh
+    from drake_entry.planning.pseudospectral import SegmentMesh
 
     with pytest.raises(ScenarioError, match="n_segments"):
         SegmentMesh(0, 3)

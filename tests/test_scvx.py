@@ -7,17 +7,17 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from drake_entry.atmosphere import US76Atmosphere
+from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.errors import ScenarioError
-from drake_entry.planet import Earth
-from drake_entry.planning.scvx.engine import (ConvexifiableProblem, Evaluation, Linearisation, ScvxSettings,
+from drake_entry.models.planet import Earth
+from drake_entry.guidance.scvx.engine import (ConvexifiableProblem, Evaluation, Linearisation, ScvxSettings,
                                               defect_correction, golden_section, solve_scvx)
-from drake_entry.planning.scvx.entry import (PAPER_LOSSLESS, EntryProblem, EntryProblemSettings,
+from drake_entry.guidance.scvx.entry import (PAPER_LOSSLESS, EntryProblem, EntryProblemSettings,
                                              heading_regulariser_sign)
-from drake_entry.planning.scvx.guess import glide_guess
-from drake_entry.planning.scvx.mission import ScvxMission
-from drake_entry.planning.scvx.planner import initial_decision, plan_entry
-from drake_entry.vehicles import load_vehicle
+from drake_entry.guidance.scvx.guess import glide_guess
+from drake_entry.guidance.scvx.mission import ScvxMission
+from drake_entry.guidance.scvx.planner import initial_decision, plan_entry
+from drake_entry.models.vehicles import load_vehicle
 
 
 class Circle(ConvexifiableProblem):
@@ -320,7 +320,7 @@ def test_nominal_heat_load_matches_the_nlp_path(sphynx_case, nominal_plan):
     terminal point."""
     from drake_entry.diagrams.propagation import propagate
     from drake_entry.planning import nlp
-    from drake_entry.planning.scvx.as_ocp import nlp_form
+    from drake_entry.guidance.scvx.as_ocp import nlp_form
 
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     plan = nominal_plan

@@ -107,7 +107,7 @@ def test_scvx_campaign_rows_and_report(tmp_path):
     import pyarrow.parquet as pq
 
     from drake_entry.diagrams.montecarlo import run_campaign
-    from drake_entry.report import summary_statistics, write_report
+    from drake_entry.campaign.report import summary_statistics, write_report
 
     out = run_campaign("sphynx_paper001", runs=2, out_dir=str(tmp_path / "mc"), seed=1, workers=2, progress=False)
     rows = pq.read_table(f"{out}/samples.parquet").to_pydict()

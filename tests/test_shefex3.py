@@ -9,11 +9,11 @@ import pytest
 from pydrake.autodiffutils import AutoDiffXd
 
 from drake_entry.errors import ScenarioError
-from drake_entry.planet import Earth
+from drake_entry.models.planet import Earth
 from drake_entry.planning.ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
 from drake_entry.scenario import load_scenario
-from drake_entry.schedules import Schedule
+from drake_entry.models.schedules import Schedule
 
 ALPHA_LAW = Schedule.ramp(58.0, 88.0, math.radians(42.0), math.radians(17.5))  # paper 003 Table 2
 
@@ -30,7 +30,7 @@ def test_state_altitude_inverts_the_geodetic_altitude_of_the_atmosphere():
 
 def test_shefex3_entry_is_geodetic_and_bank_zero_flies_about_600_s_with_a_dip_below_40_km():
     """Paper 003 Sec. III: 'during the first 70 s the altitude decreases almost linearly to less
-    than 40 km', about 600 s per trajectory; the notes measured 604 s, first dip 37 km, q 43 kPa,
+    than 40 km', about 600 s per trajectory; a pre-implementation prototype measured 604 s, first dip 37 km, q 43 kPa,
     Q 5.9 MW/m^2, n_z 8.2 with bank 0 and the representative aerodynamics."""
     from drake_entry.diagrams.open_loop import simulate
 
@@ -174,7 +174,7 @@ def test_packaged_problem_solves_verified_within_the_limits():
 def test_table_1_target_lies_outside_the_representative_vehicles_footprint():
     """Why the packaged problem aims elsewhere (a labelled substitute): with the representative
     aerodynamics and the Table 1 windows hard, the least miss of the Table 1 target (66.40 N,
-    45.75 W) is 31 km (verified solve; the feasibility study's prototype found 54 km)."""
+    45.75 W) is 31 km (verified solve; a pre-implementation prototype found 54 km)."""
     from drake_entry.planning import nlp
 
     problem, settings = load_problem("shefex3")

@@ -30,7 +30,7 @@ def test_drake_closed_loop_flies_the_planned_trajectory(case1_flight):
     """The issue's check: the Drake closed loop at sigma0* ends within 2 km along-track and 20 m
     in altitude of the planner's trajectory (measured: 7 m and 0.2 m), and follows it within
     20 m of altitude all along (1 s samples)."""
-    from drake_entry.planning.swarm.evaluator import range_error
+    from drake_entry.guidance.swarm_bank.evaluator import range_error
 
     res = case1_flight
     plan = res.guidance.details
@@ -61,7 +61,7 @@ def test_the_flight_keeps_the_alpha_limits_and_the_load_limit(case1_flight):
 def test_bracketed_root_finding_finds_the_case1_sigma0(method, max_trajectories, max_populations):
     """Both bracketed solves on the signed range error land on the root (where the range
     error is under 1 km: 125 km/deg) within their trajectory and population budgets."""
-    from drake_entry.planning.swarm.search import problem_from_scenario, search
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario, search
 
     r = search(problem_from_scenario(_scenario()), method)
     assert r.x[0] == pytest.approx(SIGMA0_CASE1, abs=0.03) and not r.message
@@ -72,7 +72,7 @@ def test_bracketed_root_finding_finds_the_case1_sigma0(method, max_trajectories,
 def test_on_board_resolution_from_entry_recovers_the_planned_sigma0():
     """The re-solution (grid rounds and a secant on the signed range) from the entry state,
     started 4 deg off, lands on the planned root within 0.05 deg in at most 3 populations."""
-    from drake_entry.planning.swarm.search import problem_from_scenario, resolve_sigma0
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario, resolve_sigma0
 
     r = resolve_sigma0(problem_from_scenario(_scenario()), SIGMA0_CASE1 + 4.0)
     assert r.bracketed and r.sigma0_deg == pytest.approx(SIGMA0_CASE1, abs=0.05) and r.trajectories <= 24
@@ -107,8 +107,8 @@ def test_bad_spec_fields_are_one_line_errors(field, value, match):
 def test_case2_switch_is_latched_once_mach_has_fallen_below_the_shift():
     """Case 2 (eq. 21 until Mach_shift): the switch happens when Mach falls below the shift
     after exceeding it, and a later Mach above the shift does not switch back."""
-    from drake_entry.planning.swarm.guidance_law import LawMemory, law_commands
-    from drake_entry.planning.swarm.search import problem_from_scenario
+    from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, law_commands
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario
 
     p = dc.replace(problem_from_scenario(_scenario()), case="heat", mach_shift=16.0)
     law, veh = p.law(), p.vehicle
@@ -129,7 +129,7 @@ def test_campaign_rows_and_report_for_fixed_and_on_board_sigma0(tmp_path):
     import pyarrow.parquet as pq
 
     from drake_entry.diagrams.montecarlo import run_campaign
-    from drake_entry.report import write_report
+    from drake_entry.campaign.report import write_report
 
     rows = {}
     for name, period in (("fixed", 0.0), ("onboard", 400.0)):
@@ -165,8 +165,8 @@ def test_cli_plan_report_searches_flies_and_plots(tmp_path, capsys):
 def test_on_board_predictions_learn_the_lift_and_drag_the_flight_shows():
     """With sensed accelerations 4 % above (lift) and 3 % below (drag) the nominal models',
     the guidance's filtered ratios converge to 1.04 and 0.97 (30 s time constant)."""
-    from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
-    from drake_entry.planning.swarm.search import problem_from_scenario
+    from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario
     from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
     from pydrake.systems.analysis import Simulator
 

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from drake_entry.errors import ScenarioError
-from drake_entry.planning.swarm.guidance_law import (alpha_for_heat_rate, alpha_for_load_factor,
+from drake_entry.guidance.swarm_bank.guidance_law import (alpha_for_heat_rate, alpha_for_load_factor,
                                                      equilibrium_glide_radius, linear_bank, qeg_bank,
                                                      qeg_sin_flight_path)
-from drake_entry.vehicles import load_vehicle
+from drake_entry.models.vehicles import load_vehicle
 
 BETA = 920.0  # paper 004, below eq. 46
 D2R = math.radians
@@ -31,7 +31,7 @@ def test_eq47_corrected_follows_the_equilibrium_glide_radius_of_eq46(V, r, D):
     drdV_eq46 = (equilibrium_glide_radius(V + h, 5.0, BETA) - equilibrium_glide_radius(V - h, 5.0, BETA)) / (2 * h)
     assert drdV_dynamics == pytest.approx(drdV_eq46, rel=1e-7)
     printed = -D / (BETA * V**3 * (1 - V**2) + 1 / r**2)
-    assert not 0.9 < printed / s < 1.1  # the typo the feasibility study found (x0.56 to x1.25)
+    assert not 0.9 < printed / s < 1.1  # the typo a pre-implementation prototype found (x0.56 to x1.25)
 
 
 def test_eq48_lowers_vertical_lift_when_climbing_above_the_glide():
@@ -75,14 +75,14 @@ def test_eq21_alpha_is_a_fixed_point_on_the_heat_limit_and_raises_drag_above_it(
 
 def _case1_problem():
     """Paper 004 Case 1 on the packaged substitute mission (cav_h_paper004.yaml)."""
-    from drake_entry.planning.swarm.search import problem_from_scenario
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario
     from drake_entry.scenario import load_scenario
 
     return problem_from_scenario(load_scenario("cav_h_paper004"))
 
 
 def test_population_members_fly_independently():
-    from drake_entry.planning.swarm.evaluator import evaluate
+    from drake_entry.guidance.swarm_bank.evaluator import evaluate
 
     p = _case1_problem()
     both = evaluate(p, np.radians([57.0, 61.0]))
@@ -95,9 +95,9 @@ def test_population_members_fly_independently():
 def test_case1_optimum_is_where_the_substitute_target_puts_it():
     """Case 1 on the substitute mission (target placed for the paper's sigma_0 = 58.89 deg;
     the root of the signed range error lies between 58.7 and 58.9 deg here); the peak heat rate
-    is the feasibility study's 2.90 MW/m^2 (it does not depend on the target), the load stays
+    is the pre-implementation prototype's 2.90 MW/m^2 (it does not depend on the target), the load stays
     within its 2 g limit, and the TAEM speed is met within a few m/s (the energy fixes it)."""
-    from drake_entry.planning.swarm.evaluator import evaluate
+    from drake_entry.guidance.swarm_bank.evaluator import evaluate
 
     ev = evaluate(_case1_problem(), np.radians([58.7, 58.9]))
     assert ev.range_error_m[0] > 0 > ev.range_error_m[1]

@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 
 from drake_entry.errors import ScenarioError
-from drake_entry.planning.swarm.optimizers import PSO_CONSTRICTION, pio, pso
+from drake_entry.guidance.swarm_bank.optimizers import PSO_CONSTRICTION, pio, pso
 
 
 def v_shape(X):
-    """J(sigma0) of the CAV-H Case 1 shape (the feasibility study, docs/methods/swarm-bank.md: V-shaped, minimum 0.26 at 58.92 deg)."""
+    """J(sigma0) of the CAV-H Case 1 shape (a pre-implementation prototype, docs/methods/swarm-bank.md: V-shaped, minimum 0.26 at 58.92 deg)."""
     return 0.26 + 0.675 * np.abs(X[:, 0] - 58.92)
 
 
@@ -45,7 +45,7 @@ def test_bad_swarm_settings_are_one_line():
 
 
 @pytest.mark.slow
-def test_pio_on_cav_h_case1_finds_the_feasibility_study_optimum():
+def test_pio_on_cav_h_case1_finds_the_prototype_study_optimum():
     """Paper 004 settings (N 10, k_max 20, k_c 14, R 0.2), Case 1 on the substitute mission:
     sigma0* within 0.03 deg of the root of the signed range error (58.79 deg; paper 004: 58.89),
     J within 5e-3 of the grid refinement's 0.5727."""
@@ -55,7 +55,7 @@ def test_pio_on_cav_h_case1_finds_the_feasibility_study_optimum():
     sys.path.insert(0, str(Path(__file__).parent))
     from test_swarm_guidance_law import _case1_problem
 
-    from drake_entry.planning.swarm.evaluator import evaluate
+    from drake_entry.guidance.swarm_bank.evaluator import evaluate
 
     problem = _case1_problem()
     r = pio(lambda X: evaluate(problem, np.radians(X[:, 0])).J, [(0.0, 89.0)], seed=0)
@@ -65,7 +65,7 @@ def test_pio_on_cav_h_case1_finds_the_feasibility_study_optimum():
 def test_searches_in_lockstep_equal_the_same_searches_run_alone():
     """minimise() flies several seeds' populations in one objective call per round; each
     search's result is what it gives alone, and the calls are one per round of the longest."""
-    from drake_entry.planning.swarm.optimizers import minimise, pio_search, pso_search
+    from drake_entry.guidance.swarm_bank.optimizers import minimise, pio_search, pso_search
 
     calls = []
 

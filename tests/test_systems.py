@@ -7,9 +7,9 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from drake_entry.dynamics import FLIGHT_CONDITION_NAMES, flight_conditions, state_derivatives
-from drake_entry.planet import Earth
-from drake_entry.schedules import Schedule
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, flight_conditions, state_derivatives
+from drake_entry.models.planet import Earth
+from drake_entry.models.schedules import Schedule
 from drake_entry.systems.actuators import BankActuator
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.monitors import TerminationMonitor
@@ -24,7 +24,7 @@ def _fixed_inputs(system, context, **values):
 
 
 def test_entry_vehicle_ports():
-    from drake_entry.vehicles import load_vehicle
+    from drake_entry.models.vehicles import load_vehicle
 
     s = EntryVehicle(load_vehicle("horus2b"), Earth.spherical(), None, air_data_input=True)
     assert [s.get_input_port(i).get_name() for i in range(s.num_input_ports())] == ["bank", "alpha", "air_data"]
@@ -61,7 +61,7 @@ def test_entry_vehicle_converts_to_autodiff_for_trajectory_optimisation(horus, u
 
 
 def test_atmosphere_system_serves_a_dispersed_density(us76, entry_state, earth):
-    from drake_entry.atmosphere import DispersedAtmosphere
+    from drake_entry.models.atmosphere import DispersedAtmosphere
 
     s = AtmosphereSystem(DispersedAtmosphere(us76, scale=1.1), earth)
     ctx = s.CreateDefaultContext()
@@ -165,7 +165,7 @@ def test_sampled_actuator_reproduces_the_continuous_one():
 def test_segment_integrator_equals_midpoint_steps_of_the_actuator_law():
     """The sampled actuator's segment: RK2 on bank_actuator_rates through a limited reversal,
     and the exact critically damped solution where no limit is active (RK2 agrees to O(h^2))."""
-    from drake_entry.actuator import actuator_rates, integrate_actuator
+    from drake_entry.models.actuator import actuator_rates, integrate_actuator
 
     lim = dict(lower=-math.radians(80), upper=math.radians(80), rate_limit=math.radians(10), accel_limit=math.radians(5), bandwidth=2.0)
 
@@ -193,7 +193,7 @@ def test_population_actuator_equals_the_scalar_actuator_member_by_member():
     """integrate_actuators (a population, used by the paper-004 evaluator) gives every member
     what integrate_actuator gives it alone: limited reversals, settled members and linear
     tracking mixed in one call."""
-    from drake_entry.actuator import integrate_actuator, integrate_actuators
+    from drake_entry.models.actuator import integrate_actuator, integrate_actuators
 
     lim = dict(lower=math.radians(10), upper=math.radians(20), rate_limit=math.radians(4), accel_limit=math.radians(8),
                bandwidth=2.0)
@@ -212,7 +212,7 @@ def test_population_actuator_equals_the_scalar_actuator_member_by_member():
 def test_population_actuator_takes_per_member_limits():
     """Two actuators of different limits (alpha and bank, as the paper-004 evaluator stacks
     them) in one call give each member what the scalar actuator gives it with its own limits."""
-    from drake_entry.actuator import integrate_actuator, integrate_actuators
+    from drake_entry.models.actuator import integrate_actuator, integrate_actuators
 
     alpha = dict(lower=math.radians(10), upper=math.radians(20), rate_limit=math.radians(4),
                  accel_limit=math.radians(8), bandwidth=2.0)

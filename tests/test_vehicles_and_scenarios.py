@@ -3,7 +3,7 @@ import pytest
 
 from drake_entry.errors import ScenarioError
 from drake_entry.scenario import PACKAGED_SCENARIOS, load_scenario
-from drake_entry.vehicles import PACKAGED_VEHICLES, load_vehicle
+from drake_entry.models.vehicles import PACKAGED_VEHICLES, load_vehicle
 
 
 @pytest.mark.parametrize("name", PACKAGED_VEHICLES)
@@ -80,7 +80,7 @@ def test_missing_file():
 def test_paper000_table2_dispersion_is_reproducible_bounded_and_uniform():
     from pydrake.common import RandomGenerator
 
-    from drake_entry.dispersions import DispersionSpec, draw
+    from drake_entry.models.dispersions import DispersionSpec, draw
 
     spec = DispersionSpec.paper000_table2()
     half = np.array([250.0, np.radians(0.1), np.radians(0.1), 15.0, np.radians(0.01), np.radians(0.01)])

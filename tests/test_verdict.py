@@ -1,4 +1,4 @@
-"""The one verdict of a flight (drake_entry.verdict): reached, inside the acceptance box and
+"""The one verdict of a flight (drake_entry.models.verdict): reached, inside the acceptance box and
 every path limit held at every flown sample, log and integrator steps alike."""
 import dataclasses as dc
 import math
@@ -6,10 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from drake_entry.constraints import PathLimits
-from drake_entry.dynamics import FLIGHT_CONDITION_NAMES
-from drake_entry.trajectory import Trajectory, metrics
-from drake_entry.verdict import PathLimit, check_limits, judge, vehicle_path_limits
+from drake_entry.models.constraints import PathLimits
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.models.trajectory import Trajectory, metrics
+from drake_entry.models.verdict import PathLimit, check_limits, judge, vehicle_path_limits
 
 Q = FLIGHT_CONDITION_NAMES.index("heat_flux")
 
@@ -99,7 +99,7 @@ def test_a_closed_loop_flight_that_breaks_a_limit_is_not_a_success():
 def test_the_report_counts_success_box_and_limits_separately():
     """Rows: 2 successes, 1 inside the box breaching q, 1 outside the box within limits, 1 that
     never reached: the counts and reasons say so."""
-    from drake_entry.report import summary_statistics
+    from drake_entry.campaign.report import summary_statistics
 
     rows = {"index": [0, 1, 2, 3, 4], "success": [True, True, False, False, False],
             "reached_terminal": [True, True, True, True, False], "inside_box": [True, True, True, False, False],

@@ -29,7 +29,7 @@ class PlantPorts:
     Attributes:
       estimated_state: [6] navigation estimate [h m, lon rad, lat rad, V m/s, gamma rad, psi rad].
       flight_conditions: [9] sensed flight conditions of the true vehicle (the accelerometer's
-        drag and lift, loads, q, heat flux; drake_entry.dynamics.FLIGHT_CONDITION_NAMES).
+        drag and lift, loads, q, heat flux; drake_entry.models.dynamics.FLIGHT_CONDITION_NAMES).
     Time is the context's time; no port is needed for it.
     """
 

@@ -31,7 +31,7 @@ class GuidanceSpecBase:
         return self.terminal_mach * speed_of_sound
 
     def path_limits(self, scenario) -> list:
-        """The mission's own path limits (drake_entry.verdict.PathLimit) that every flight must
+        """The mission's own path limits (drake_entry.models.verdict.PathLimit) that every flight must
         hold besides the vehicle's; none by default."""
         return []
 

@@ -1,1 +1,1 @@
-"""Reference-trajectory planners, one module per method."""
+"""Planning machinery shared by several methods: the plan result type, the optimal-control problem description (and its YAML form), the LGL operators, the NLP transcriptions and solver, and time-varying LQR tracking."""

@@ -6,7 +6,7 @@ terms (paper 002 eqs. 1-11). Everything is SI and radians; users build it in Pyt
 read it from YAML (``load_problem``, fields with units in their names). Model functions
 and user callables are evaluated with floats and with Drake AutoDiffXd.
 
-State order: [h, lon, lat, V, gamma, psi] (the canonical order, DESIGN.md), then, with
+State order: [h, lon, lat, V, gamma, psi] (the canonical order, docs/architecture.md), then, with
 ``controls='rates'``, [alpha, sigma] driven by the controls [u_alpha, u_sigma]
 (paper 002 eq. 6); with ``controls='direct'`` the controls are [alpha, sigma]; with
 ``controls='bank_rate'`` alpha follows ``alpha_schedule`` in time (paper 003 Table 2) and
@@ -22,13 +22,13 @@ from typing import Callable
 
 import numpy as np
 
-from drake_entry.atmosphere import Atmosphere
-from drake_entry.dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_derivatives
+from drake_entry.models.atmosphere import Atmosphere
+from drake_entry.models.dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_derivatives
 from drake_entry.errors import ScenarioError
-from drake_entry.geodesy import central_angle_smooth, crossrange_from_great_circle
-from drake_entry.planet import Earth
-from drake_entry.schedules import Schedule
-from drake_entry.vehicles import Vehicle
+from drake_entry.models.geodesy import central_angle_smooth, crossrange_from_great_circle
+from drake_entry.models.planet import Earth
+from drake_entry.models.schedules import Schedule
+from drake_entry.models.vehicles import Vehicle
 
 PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
     "dynamic_pressure": ("dynamic_pressure", "Pa"), "heat_flux": ("heat_flux", "W/m^2"),

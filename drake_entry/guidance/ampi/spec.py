@@ -2,11 +2,30 @@
 
 import dataclasses as dc
 import math
+import os
+from importlib import resources
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.planning.ampi.database import database_path
-from drake_entry.planning.ampi.synthesis import MODES
 from drake_entry.guidance.spec import GuidanceSpecBase
+
+#: how the on-board reference is made: AMPI synthesis or the nearest entry (NTT)
+MODES = ("ampi", "ntt")
+
+
+def packaged_databases() -> tuple:
+    """Names of the trajectory databases shipped in drake_entry/data/ampi (``<name>.npz``)."""
+    folder = resources.files("drake_entry").joinpath("data/ampi")
+    return tuple(sorted(p.name[:-4] for p in folder.iterdir() if p.name.endswith(".npz")))
+
+
+def database_path(name_or_path: str) -> str:
+    """The file of a packaged database name or a path."""
+    if name_or_path in packaged_databases():
+        return str(resources.files("drake_entry").joinpath(f"data/ampi/{name_or_path}.npz"))
+    if os.path.exists(name_or_path):
+        return name_or_path
+    raise ScenarioError(f"database '{name_or_path}' is neither a packaged database "
+                        f"({', '.join(packaged_databases())}) nor a file")
 
 
 @dc.dataclass

@@ -10,8 +10,8 @@ import numpy as np
 
 from drake_entry.diagrams.closed_loop import fly
 from drake_entry.diagrams.open_loop import simulate
-from drake_entry.plots import corridor_plot, extraction_plot
-from drake_entry.trajectory import Trajectory
+from drake_entry.guidance.drag_energy.plots import corridor_plot, extraction_plot
+from drake_entry.models.trajectory import Trajectory
 
 
 def plan_report(scenario, out_dir: str) -> int:

@@ -12,11 +12,11 @@ import math
 
 import numpy as np
 
-from drake_entry.planning.drag_energy import DragEnergyPlanner
+from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
 from drake_entry.systems.drag_energy_guidance import DragEnergyGuidance
 from drake_entry.systems.drag_tracking import DragTrackingController
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
-from drake_entry.guidance.reversal import add_bank_reversal, reversal_count
+from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_count
 
 REFERENCE_COLUMNS = ("reference_drag_m_s2", "reference_drag_slope_1_m", "reference_drag_curvature_s2_m3",
                      "guidance_engaged")
@@ -71,7 +71,7 @@ class DragEnergyMethod(GuidanceMethod):
                                details=mem)
 
     def flight_plots(self, result, out_dir: str, *, title: str = "") -> list[str]:
-        from drake_entry.plots import tracking_plot
+        from drake_entry.guidance.drag_energy.plots import tracking_plot
 
         return tracking_plot(result.trajectory, out_dir, title=f"{title}: drag tracking")
 

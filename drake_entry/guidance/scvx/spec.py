@@ -5,10 +5,8 @@ import math
 from typing import Optional
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.planning.scvx.engine import ScvxSettings
-from drake_entry.planning.scvx.entry import EntryProblemSettings
-from drake_entry.planning.scvx.mission import ScvxMission
-from drake_entry.planning.scvx.planner import FlightCheck
+from drake_entry.guidance.scvx.mission import ScvxMission
+from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
 from drake_entry.guidance.spec import GuidanceSpecBase
 
 #: spec fields passed to ScvxMission and EntryProblemSettings under the same names (max_iterations
@@ -28,7 +26,7 @@ class Scvx(GuidanceSpecBase):
     entry point is the scenario's ``entry``, the site its ``target`` (both geocentric; the
     mission converts them to paper 001's geodetic form). The mission and planner fields carry
     the names and units of ScvxMission, EntryProblemSettings and ScvxSettings
-    (drake_entry/planning/scvx), which check them."""
+    (drake_entry/guidance/scvx), which check them."""
 
     stops_at_altitude = True
     # the closed loop stops on reaching this altitude (the DRS point): a state altitude (above
@@ -70,7 +68,7 @@ class Scvx(GuidanceSpecBase):
     flight_path_margins_deg: Optional[list[float]] = None
     bank_margin_deg: Optional[float] = None
     # each command is read this far ahead on the plan [s]: the actuators' lag (half the guidance
-    # period for the hold, 1/bandwidth for the loop: 1.0 s at 1 s; drake_entry.actuator.command_lag)
+    # period for the hold, 1/bandwidth for the loop: 1.0 s at 1 s; drake_entry.models.actuator.command_lag)
     command_lead_s: float = 1.0
     max_iterations: int = 100
     solver: str = "clarabel"

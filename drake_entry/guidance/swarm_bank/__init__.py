@@ -1,3 +1,9 @@
-"""Paper 004 guidance: |sigma| linear in energy from a sigma_0 chosen by pigeon-inspired
-optimisation (or PSO, or a scipy baseline) with the quasi-equilibrium-glide compensation, alpha
-from the path constraints, and the shared bank reversals; sigma_0 optionally re-solved on board."""
+"""Paper 004 (CAV-H): the bank profile by pigeon-inspired optimisation (and PSO).
+
+|sigma| linear in energy from a sigma_0 chosen by PIO (or PSO, or a scipy baseline) with the
+quasi-equilibrium-glide compensation, alpha from the path constraints and the shared bank
+reversals; sigma_0 optionally re-solved on board. ``guidance_law`` holds the per-step law
+(eqs. 17, 21, 31, 46-48), ``evaluator`` the closed-loop replica that scores a candidate,
+``optimizers`` PIO/PSO, ``search`` the searches, ``study`` the paper's study, ``plots`` its
+figures; ``spec``, ``method`` and ``commands`` plug it into scenarios, the closed loop and the CLI.
+"""

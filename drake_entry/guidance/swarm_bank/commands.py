@@ -6,8 +6,9 @@ from __future__ import annotations
 import sys
 
 from drake_entry.diagrams.closed_loop import fly
-from drake_entry.planning.swarm.evaluator import HISTORY_COLUMNS, range_error
-from drake_entry.plots import swarm_case_plots, trajectory_plots
+from drake_entry.guidance.swarm_bank.evaluator import HISTORY_COLUMNS, range_error
+from drake_entry.campaign.plots import trajectory_plots
+from drake_entry.guidance.swarm_bank.plots import swarm_case_plots
 
 
 def plan_report(scenario, out_dir: str) -> int:

@@ -3,7 +3,7 @@
   estimate, flight conditions --> SwarmBankGuidance --|sigma|--> BankReversalLogic --sigma_cmd-->
       (shared bank actuator);   SwarmBankGuidance --alpha_command--> (shared alpha actuator)
 
-The planner searches sigma_0 before flight (PIO by default, planning/swarm/search.py) on the
+The planner searches sigma_0 before flight (PIO by default, guidance/swarm_bank/search.py) on the
 evaluator that replicates this closed loop, and verifies the optimum's trajectory against the
 path limits (eqs. 13-15) before calling it a success.
 """
@@ -16,12 +16,12 @@ import time
 import numpy as np
 
 from drake_entry.planning.result import PlanResult
-from drake_entry.planning.swarm.evaluator import CONTROL_COLUMNS, HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
-from drake_entry.planning.swarm.search import SearchResult, problem_from_scenario, search
-from drake_entry.verdict import acceptance_box, box_text, breaches_text, check_limits, vehicle_path_limits
+from drake_entry.guidance.swarm_bank.evaluator import CONTROL_COLUMNS, HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
+from drake_entry.guidance.swarm_bank.search import SearchResult, problem_from_scenario, search
+from drake_entry.models.verdict import acceptance_box, box_text, breaches_text, check_limits, vehicle_path_limits
 from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
 from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
-from drake_entry.guidance.reversal import add_bank_reversal, reversal_count
+from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_count
 
 GUIDANCE_SYSTEM = "swarm_bank_guidance"
 #: the replica's recorded column of each path-limit column it can check (the closed loop's
@@ -63,7 +63,7 @@ class SwarmPlan(PlanResult):
 
 
 def verify(problem: SwarmProblem, ev: Evaluation, tolerance: float = 0.0) -> list:
-    """The path limits the (single-member, recorded) evaluation breaches (drake_entry.verdict
+    """The path limits the (single-member, recorded) evaluation breaches (drake_entry.models.verdict
     LimitChecks, at every guidance step of the replica), ``tolerance`` relative."""
     v = problem.vehicle
     limits = [lim for lim in vehicle_path_limits(v.limits, v.bank_limit) if lim.column in LIMIT_COLUMNS]
@@ -74,7 +74,7 @@ def verify(problem: SwarmProblem, ev: Evaluation, tolerance: float = 0.0) -> lis
 
 
 def terminal_box(scenario, problem: SwarmProblem, x) -> dict:
-    """The scenario's acceptance box (drake_entry.verdict.acceptance_box) at the replica's TAEM
+    """The scenario's acceptance box (drake_entry.models.verdict.acceptance_box) at the replica's TAEM
     state ``x`` [h, lon, lat, V, gamma, psi]: the state altitude (paper 004's sphere), the Mach
     number there, the great-circle distance to the target."""
     pl = problem.planet

@@ -7,7 +7,7 @@ import typing
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import ReversingBankSpec
 
-#: sigma_0 searches: the paper's swarms and the scipy baselines (planning/swarm/search.py)
+#: sigma_0 searches: the paper's swarms and the scipy baselines (guidance/swarm_bank/search.py)
 OPTIMIZERS = ("pio", "pso", "pso_stable", "grid", "brentq", "secant", "bounded", "differential_evolution")
 
 

@@ -9,11 +9,11 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from drake_entry.aerodynamics import PolynomialAero
-from drake_entry.atmosphere import ExponentialAtmosphere
-from drake_entry.constraints import BTU_FT2_S, FT, SLUG, HeatFlux
-from drake_entry.planet import Earth
-from drake_entry.vehicles import Vehicle
+from drake_entry.models.aerodynamics import PolynomialAero
+from drake_entry.models.atmosphere import ExponentialAtmosphere
+from drake_entry.models.constraints import BTU_FT2_S, FT, SLUG, HeatFlux
+from drake_entry.models.planet import Earth
+from drake_entry.models.vehicles import Vehicle
 from drake_entry.planning.ocp import CustomProblem, ObjectiveTerm, OptimalControlProblem, PathConstraint
 
 G_BRACHISTOCHRONE = 9.81  # m/s^2

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from drake_entry.geodesy import bearing, central_angle_smooth, crossrange_from_great_circle
+from drake_entry.models.geodesy import bearing, central_angle_smooth, crossrange_from_great_circle
 from drake_entry.planning.ocp import OptimalControlProblem
 
 

@@ -1,0 +1,2 @@
+"""Campaign outputs shared by every method: the durable campaign directory (``store``), the
+report (``report``), the standard figures (``plots``) and result tables (``tables``)."""

@@ -1,0 +1,561 @@
+"""Drag-energy entry guidance by pseudospectral convex optimisation (paper 000, Sec. VI).
+
+The reference drag profile D(E) is planned in the inverse variable I = 1/D on LGL nodes in
+energy (eq. 82). Then the range constraint is linear (eq. 83, with the ground-range
+correction below), the corridor is a box (eq. 86), the initial drag and slope are linear
+(eq. 84, corrected to I0' = -D0'/D0^2), and smoothness is two second-order cones:
+||D1 I|| <= s', ||D2 I|| <= s'', minimise s' + s'' (eqs. 90-92). One SOCP, no initial
+guess, solved with Clarabel (default) or SCS through Drake's MathematicalProgram.
+
+Derivatives in the cones are taken in the normalised LGL variable tau (so s' and s''
+are commensurate: in J/kg the I'' term would be about 1e7 times smaller than I'), and I
+is scaled by a reference drag for conditioning.
+
+Range: eq. 71 (R = -int dE / D) neglects cos(gamma) and R/r. We weight each node with
+kappa = R_E cos(gamma) / r from the extracted states and re-solve (``range_iterations``),
+so the ground range of the extracted trajectory equals the range to go.
+
+After the solve, states and bank are extracted node by node (eqs. 93-96): altitude and
+speed from (E, D), gamma from D' (eq. 94), u_FF (eq. 95) and sigma (eq. 96), with the
+bank saturated explicitly at [0, sigma_max] (flags returned).
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.solvers import ClarabelSolver, MathematicalProgram, ScsSolver, SolverOptions
+from scipy.optimize import brentq
+
+from drake_entry.models.atmosphere import Atmosphere
+from drake_entry.guidance.drag_energy.corridor import Corridor, compute_corridor
+from drake_entry.guidance.drag_energy.drag_dynamics import AlphaProfile, DragDynamics, DragTerms, drag_acceleration, drag_dynamics
+from drake_entry.errors import ScenarioError
+from drake_entry.models.geodesy import bearing
+from drake_entry.models.planet import Earth
+from drake_entry.planning.pseudospectral import LGL
+from drake_entry.models.schedules import Schedule
+from drake_entry.models.vehicles import Vehicle
+from drake_entry.planning.result import PlanResult
+
+SOLVERS = {"clarabel": ClarabelSolver, "scs": ScsSolver}
+
+
+@dataclass
+class DragEnergyProblem:
+    """One planning request.
+
+    Attributes:
+      vehicle, planet, atmosphere: models (the planner uses central gravity, eq. 37).
+      alpha: angle-of-attack schedule in energy [rad vs J/kg].
+      corridor: drag corridor covering [E_f, E_0] (drake_entry.guidance.drag_energy.corridor).
+      E0, Ef: initial and final energy [J/kg], E0 > Ef.
+      D0, D0_prime: drag [m/s^2] and dD/dE [1/m] at E0 (eqs. 72-74).
+      range_to_go: ground distance to fly [m].
+      Df, Df_prime: optional terminal drag and slope (eq. 85).
+      lat0, latf, heading0, headingf: [rad] linear profiles for the Earth-rate term (eq. 50).
+      n_nodes: LGL nodes. range_iterations: see module doc.
+      solver: 'clarabel' (default) or 'scs' (``SCS_OPTIONS``; ``python benchmarks/run.py socp``:
+        smooth to 0.7 % of Clarabel's eq. 92 at 20-40 nodes, 15x its time at 40; at 80 and 160
+        nodes feasible but rough, eq. 92 6x and 84x, as SCS's tolerance is reached first).
+      sigma_max: bank limit for extraction [rad].
+    """
+
+    vehicle: Vehicle
+    planet: Earth
+    atmosphere: Atmosphere
+    alpha: Schedule
+    corridor: Corridor
+    E0: float
+    Ef: float
+    D0: float
+    D0_prime: float
+    range_to_go: float
+    Df: float | None = None
+    Df_prime: float | None = None
+    lat0: float = 0.0
+    latf: float = 0.0
+    heading0: float = 0.0
+    headingf: float = 0.0
+    n_nodes: int = 40
+    solver: str = "clarabel"
+    range_iterations: int = 2
+    sigma_max: float = math.radians(89.0)
+    # a D0 outside the (margin-reduced) corridor by less than this fraction is projected onto it
+    initial_tolerance: float = 0.03
+    # first guess of the ground-range weight kappa(E) (e.g. from the previous plan), or None
+    kappa_guess: object = None
+
+    def validate(self):
+        if not self.E0 > self.Ef:
+            raise ScenarioError(f"DragEnergyProblem needs E0 > Ef, got E0={self.E0:.6g}, Ef={self.Ef:.6g} J/kg")
+        if not (self.corridor.energy[0] <= self.Ef and self.E0 <= self.corridor.energy[-1] + 1.0):
+            raise ScenarioError(f"corridor covers [{self.corridor.energy[0]:.6g}, {self.corridor.energy[-1]:.6g}] "
+                             f"J/kg, not [{self.Ef:.6g}, {self.E0:.6g}]")
+        if self.solver not in SOLVERS:
+            raise ScenarioError(f"solver '{self.solver}' is unknown; allowed: {', '.join(SOLVERS)}")
+        if not 5 <= self.n_nodes <= 400:
+            raise ScenarioError(f"n_nodes must be in [5, 400], got {self.n_nodes}")
+        if not self.D0 > 0 or not self.range_to_go > 0:
+            raise ScenarioError(f"D0 and range_to_go must be > 0 (got {self.D0}, {self.range_to_go})")
+
+
+@dataclass
+class Extraction:
+    """States and bank at the nodes (eqs. 93-96). Arrays over nodes, SI / rad."""
+
+    h: np.ndarray
+    V: np.ndarray
+    gamma: np.ndarray
+    u_ff: np.ndarray
+    sigma: np.ndarray
+    saturated: np.ndarray  # True where |u_FF| exceeded what the bank can give
+    lift_to_drag: np.ndarray
+
+
+@dataclass
+class DragEnergyReference(PlanResult):
+    """Result of ``plan``: the reference D(E) and everything needed to fly it. ``objective``
+    is s' + s'' of eq. 92 [s^2/m] (norms of the tau-derivatives of I); ``evaluate(E)``
+    gives D, D', D''."""
+
+    variable = "energy"
+
+    problem: DragEnergyProblem
+    lgl: LGL | None = None
+    I: np.ndarray | None = None  # 1/D at the nodes [s^2/m]
+    kappa: np.ndarray | None = None
+    extraction: Extraction | None = None
+    solver: str = ""
+    binding: list = field(default_factory=list)  # which bounds bind, where (diagnosis)
+    _nodal: np.ndarray | None = field(default=None, repr=False)
+
+    # -- the profile and its energy derivatives -----------------------------------------
+    @property
+    def energy(self) -> np.ndarray:
+        return self.lgl.x
+
+    @property
+    def D(self) -> np.ndarray:
+        return 1.0 / self.I
+
+    def profile(self, E):
+        """(D, D', D'') at energies E (eqs. 87-88 from the interpolated I(E); held at the ends).
+        Arrays of the shape of ``np.atleast_1d(E)``."""
+        if self._nodal is None:  # I, I', I'' at the nodes, once
+            self._nodal = np.vstack([self.I, self.lgl.D1 @ self.I, self.lgl.D2 @ self.I]).T
+        if np.ndim(E) == 0:  # the guidance's once-a-period call: one barycentric row (eq. 9)
+            op = self.lgl
+            E = min(max(float(E), self.problem.Ef), self.problem.E0)
+            d = (2.0 * E - (op.a + op.b)) / (op.b - op.a) - op.tau
+            if d.all():
+                w = op.bary / d
+                I, I1, I2 = ((w @ self._nodal) / w.sum()).tolist()
+            else:  # on a node
+                I, I1, I2 = self._nodal[int(np.argmin(np.abs(d)))].tolist()
+        else:
+            E = np.clip(np.atleast_1d(np.asarray(E, float)), self.problem.Ef, self.problem.E0)
+            I, I1, I2 = (self.lgl.interpolation(E) @ self._nodal).T
+        return (np.atleast_1d(1.0 / I), np.atleast_1d(-I1 / I**2),
+                np.atleast_1d(2.0 * I1**2 / I**3 - I2 / I**2))
+
+    def evaluate(self, at) -> dict:
+        """{'drag_m_s2', 'drag_slope_1_m' (dD/dE), 'drag_curvature_s2_m3' (d2D/dE2)} at energies [J/kg]."""
+        D, Dp, Dpp = self.profile(np.atleast_1d(np.asarray(at, float)))
+        return {"drag_m_s2": D, "drag_slope_1_m": Dp, "drag_curvature_s2_m3": Dpp}
+
+    def kappa_at(self, E) -> np.ndarray:
+        """Ground-range weight kappa = R cos(gamma)/r interpolated at energies E."""
+        return np.interp(E, self.energy[::-1], self.kappa[::-1])
+
+    def range_flown(self) -> float:
+        """Ground range of the profile [m] (eq. 83 with kappa)."""
+        return float(-self.lgl.weights @ (self.kappa * self.I))
+
+    def corridor_violation(self, n_dense: int = 2000) -> dict:
+        """Largest relative excursion outside the corridor on a dense energy grid (between
+        nodes too), and where (normalised energy e = (E0 - E)/(E0 - Ef))."""
+        p = self.problem
+        E = np.linspace(p.E0, p.Ef, n_dense)
+        D = self.profile(E)[0]
+        lo, hi = p.corridor.bounds(E)
+        over = D / hi - 1.0
+        under = 1.0 - D / lo
+        e = (p.E0 - E) / (p.E0 - p.Ef)
+        return {"above_max": float(max(over.max(), 0.0)), "above_max_at_e": float(e[over.argmax()]),
+                "below_min": float(max(under.max(), 0.0)), "below_min_at_e": float(e[under.argmax()])}
+
+
+def _alpha_profile(alpha: Schedule, E: float) -> AlphaProfile:
+    return AlphaProfile(*alpha.derivatives(E))
+
+
+def plan(problem: DragEnergyProblem) -> DragEnergyReference:
+    """Solve the drag-energy SOCP (eqs. 82-92) and extract states and bank (eqs. 93-96).
+
+    Never raises for an infeasible request: the result says which bound binds and where.
+    """
+    problem.validate()
+    p = problem
+    op = LGL(p.n_nodes, p.E0, p.Ef)
+    D_lo, D_hi = p.corridor.bounds(op.x)
+    note = ""
+    D0_in = min(max(p.D0, D_lo[0]), D_hi[0])
+    if D0_in != p.D0 and abs(D0_in / p.D0 - 1.0) <= p.initial_tolerance:
+        note = f" (initial drag {p.D0:.4g} projected onto the corridor bound {D0_in:.4g} m/s^2)"
+        p = dc.replace(p, D0=D0_in)
+    diag = _diagnose(p, op, D_lo, D_hi)
+    if diag:
+        return DragEnergyReference(success=False, message="; ".join(d["message"] for d in diag), problem=p, lgl=op,
+                                   binding=diag)
+    # ground-range weights: the guess, or eq. 71's kappa = 1 until the first extraction
+    kappa = np.ones(p.n_nodes) if p.kappa_guess is None else np.asarray(p.kappa_guess(op.x), float)
+    ref = None
+    total_build = total_solve = 0.0
+    total_iterations = 0
+    for _ in range(max(1, p.range_iterations)):
+        ref = solve_socp(p, op, D_lo, D_hi, kappa)
+        total_build += ref.build_time
+        total_solve += ref.solve_time
+        total_iterations += ref.iterations
+        if not ref.success:
+            break
+        ref.kappa = kappa  # the weights this solve satisfied exactly (eq. 83)
+        ref.extraction = extract(p, op, ref.I)
+        x = ref.extraction
+        kappa = p.planet.reference_radius * np.cos(x.gamma) / p.planet.radius(x.h)
+    ref.build_time, ref.solve_time, ref.iterations = total_build, total_solve, total_iterations
+    ref.message += note
+    if ref.success:
+        ref.binding = _binding(ref, D_lo, D_hi)
+    return ref
+
+
+#: SCS options of the drag-energy SOCP on its conditioned form (``solve_socp``): eps 1e-5 meets
+#: the planner's own check (``_check_solution``) with eq. 92 within 0.7 % of Clarabel's at
+#: 20-40 nodes in 800-4 925 iterations (3-48 ms); see docs/methods/drag-energy.md
+SCS_OPTIONS = {"eps_abs": 1e-5, "eps_rel": 1e-5, "max_iters": 100000}
+
+
+def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyReference:
+    """One SOCP of eqs. 82-92 on the LGL operator ``op`` with corridor bounds D_lo, D_hi [m/s^2]
+    at its nodes and fixed range weights kappa (``plan`` iterates it and extracts the states).
+
+    Conditioned for a first-order solver (SCS measures its residuals relative to the largest
+    row): the range row (eq. 83) is divided by the range to go [m], the initial-drag rows
+    (eq. 84-85) by their largest entry, and each cone of eq. 91 by its operator's 2-norm (|D2|
+    is 3e5 at 40 nodes), the cost weighted to stay eq. 92 divided by |D2|; unconditioned, SCS
+    needed 28 000 iterations at 40 nodes and did not converge at 80. Clarabel (interior point)
+    solves the plain form: conditioned, its optimum moved by up to 3e-4 (relative, within its
+    tolerance on this flat optimum) and the closed-loop campaign rows by up to 327 m."""
+    conditioned = p.solver == "scs"
+    t0 = time.perf_counter()
+    n = p.n_nodes
+    scale = p.D0  # I_hat = I * scale is O(1)
+    prog = MathematicalProgram()
+    I = prog.NewContinuousVariables(n, "I")
+    s = prog.NewContinuousVariables(2, "s")
+    prog.AddBoundingBoxConstraint(scale / D_hi, scale / D_lo, I)  # eq. 86
+    # eq. 83 with the ground-range weights kappa: R = -sum w_i kappa_i I_i (divided by R if conditioned)
+    R = p.range_to_go if conditioned else 1.0
+    prog.AddLinearEqualityConstraint((-op.weights * kappa / (scale * R))[None, :], [p.range_to_go / R], I)
+    # eq. 84 (corrected): I0 = 1/D0, dI/dtau(-1) = (dE/dtau) * (-D0'/D0^2)
+    half = (op.b - op.a) / 2.0
+    A0 = np.vstack([np.eye(n)[0], op.D1_tau[0]])
+    b0 = np.array([1.0, half * (-p.D0_prime / p.D0**2) * scale])
+    if p.Df is not None:  # eq. 85
+        A0 = np.vstack([A0, np.eye(n)[-1]])
+        b0 = np.append(b0, scale / p.Df)
+        if p.Df_prime is not None:
+            A0 = np.vstack([A0, op.D1_tau[-1]])
+            b0 = np.append(b0, half * (-p.Df_prime / p.Df**2) * scale)
+    row = np.abs(A0).max(axis=1) if conditioned else np.ones(len(A0))
+    prog.AddLinearEqualityConstraint(A0 / row[:, None], b0 / row, I)
+    # eq. 91: ||D1 I|| / |D1| <= s1, ||D2 I|| / |D2| <= s2 as Lorentz cones on [s_k, I] (norms 1 if plain)
+    norms = np.array([np.linalg.norm(Dk, 2) for Dk in (op.D1_tau, op.D2_tau)]) if conditioned else np.ones(2)
+    for k, Dk in enumerate((op.D1_tau, op.D2_tau)):
+        A = np.zeros((n + 1, n + 1))
+        A[0, 0] = 1.0
+        A[1:, 1:] = Dk / norms[k]
+        prog.AddLorentzConeConstraint(A, np.zeros(n + 1), np.concatenate([[s[k]], I]))
+    prog.AddLinearCost(norms / norms[1], 0.0, s)  # eq. 92 (divided by |D2| if conditioned)
+    t1 = time.perf_counter()
+    solver = SOLVERS[p.solver]()
+    options = SolverOptions()
+    if p.solver == "scs":
+        for k, v in SCS_OPTIONS.items():
+            options.SetOption(solver.solver_id(), k, v)
+    else:  # Clarabel's iterative refinement of each KKT solve took about 30 % of the solve time here
+        # and moved the 40-node solution by 5e-9 (relative); _check_solution verifies the result.
+        # Without it Clarabel stalled (InsufficientProgress) in about 1 of 170 re-plans: then
+        # the problem is solved again with Clarabel's defaults.
+        options.SetOption(solver.solver_id(), "iterative_refinement_enable", False)
+    if p.solver == "clarabel":
+        drake_log = logging.getLogger("drake")
+        level = drake_log.level
+        drake_log.setLevel(logging.WARNING)  # the fast attempt's rare stall is expected: no INFO line
+        try:
+            result = solver.Solve(prog, None, options)
+        finally:
+            drake_log.setLevel(level)
+        if not result.is_success():
+            result = solver.Solve(prog, None, SolverOptions())
+    else:
+        result = solver.Solve(prog, None, options)
+    t2 = time.perf_counter()
+    ok = result.is_success()
+    details = result.get_solver_details()
+    iters = int(getattr(details, "iterations", getattr(details, "iter", 0)) or 0)
+    msg = "optimal" if ok else f"{p.solver} returned {result.get_solution_result().name}"
+    I_sol = result.GetSolution(I) / scale if ok else None
+    if ok:  # check the answer ourselves: some solvers report "solved inaccurate" as success
+        problem_msg = _check_solution(p, op, I_sol, D_lo, D_hi, kappa)
+        if problem_msg:
+            ok, msg = False, f"{p.solver} returned an inaccurate solution: {problem_msg}"
+    return DragEnergyReference(success=ok, message=msg, problem=p, lgl=op, I=I_sol if ok else None, solver=p.solver,
+                               build_time=t1 - t0, solve_time=t2 - t1, iterations=iters,
+                               objective=_smoothness(op, I_sol) if ok else math.nan)
+
+
+def _smoothness(op: LGL, I) -> float:
+    """The objective of eq. 92 at I [s^2/m]: ||D1 I|| + ||D2 I|| (tau derivatives)."""
+    return float(np.linalg.norm(op.D1_tau @ I) + np.linalg.norm(op.D2_tau @ I))
+
+
+def _check_solution(p: DragEnergyProblem, op: LGL, I, D_lo, D_hi, kappa, tol: float = 1e-3,
+                    tol_range: float = 1e-5) -> str:
+    """'' if I satisfies the corridor (eq. 86) within ``tol`` (relative; the corridor already
+    carries its safety margin), the range (eq. 83) within ``tol_range`` and the initial
+    drag (eq. 84), else what fails where."""
+    D = 1.0 / I
+    e = (p.E0 - op.x) / (p.E0 - p.Ef)
+    over = D / D_hi - 1.0
+    under = 1.0 - D / D_lo
+    if over.max() > tol:
+        k = int(over.argmax())
+        return f"D_max exceeded by {100 * over[k]:.3g} % at e = {e[k]:.3f}"
+    if under.max() > tol:
+        k = int(under.argmax())
+        return f"D_min undercut by {100 * under[k]:.3g} % at e = {e[k]:.3f}"
+    rng = float(-op.weights @ (kappa * I))
+    if abs(rng / p.range_to_go - 1.0) > tol_range:
+        return f"range {rng / 1e3:.3f} km instead of {p.range_to_go / 1e3:.3f} km"
+    if abs(I[0] * p.D0 - 1.0) > tol_range:
+        return f"initial drag {1 / I[0]:.5g} instead of {p.D0:.5g} m/s^2"
+    return ""
+
+
+def _reachable_range(op: LGL, D) -> float:
+    """Range [m] flown on the profile D at the nodes (eq. 83 with kappa = 1)."""
+    return float(-op.weights @ (1.0 / D))
+
+
+def _diagnose(p: DragEnergyProblem, op: LGL, D_lo, D_hi) -> list:
+    """Name the bound that makes the request infeasible before calling the solver."""
+    out = []
+    e = (p.E0 - op.x) / (p.E0 - p.Ef)
+    empty = D_lo > D_hi
+    if empty.any():
+        out.append({"bound": "corridor", "where_e": float(e[empty][0]),
+                    "message": f"corridor empty (D_min > D_max) from e = {e[empty][0]:.3f} "
+                               f"to {e[empty][-1]:.3f}: reduce the margin or change alpha(E)"})
+        return out
+    if not D_lo[0] <= p.D0 <= D_hi[0]:
+        side = "above D_max" if p.D0 > D_hi[0] else "below D_min"
+        out.append({"bound": "initial_drag", "where_e": 0.0,
+                    "message": f"initial drag {p.D0:.4g} m/s^2 is {side} "
+                               f"[{D_lo[0]:.4g}, {D_hi[0]:.4g}] at E0"})
+    if p.Df is not None and not D_lo[-1] <= p.Df <= D_hi[-1]:
+        side = "above D_max" if p.Df > D_hi[-1] else "below D_min"
+        out.append({"bound": "terminal_drag", "where_e": 1.0,
+                    "message": f"terminal drag {p.Df:.4g} m/s^2 is {side} [{D_lo[-1]:.4g}, {D_hi[-1]:.4g}] "
+                               f"at Ef (e.g. the q limit at the nominal terminal point)"})
+    R_min = _reachable_range(op, D_hi)
+    R_max = _reachable_range(op, D_lo)
+    if p.range_to_go < R_min:
+        out.append({"bound": "D_max", "where_e": None,
+                    "message": f"range to go {p.range_to_go / 1e3:.1f} km is shorter than the corridor allows "
+                               f"({R_min / 1e3:.1f} km flying on D_max everywhere): the upper bound binds"})
+    elif p.range_to_go > R_max:
+        out.append({"bound": "D_min", "where_e": None,
+                    "message": f"range to go {p.range_to_go / 1e3:.1f} km is longer than the corridor allows "
+                               f"({R_max / 1e3:.1f} km flying on D_min everywhere): the lower bound binds"})
+    return out
+
+
+def _binding(ref: DragEnergyReference, D_lo, D_hi, tol: float = 1e-4) -> list:
+    """Where the solution rides a corridor bound (at nodes)."""
+    D = ref.D
+    e = (ref.problem.E0 - ref.energy) / (ref.problem.E0 - ref.problem.Ef)
+    out = []
+    for name, mask in (("D_max", D >= D_hi * (1 - tol)), ("D_min", D <= D_lo * (1 + tol))):
+        if mask.any():
+            out.append({"bound": name, "nodes": int(mask.sum()), "e": e[mask].round(4).tolist()})
+    return out
+
+
+def extract(p: DragEnergyProblem, op: LGL, I: np.ndarray) -> Extraction:
+    """States and bank at the nodes (eqs. 93-96)."""
+    n = op.n_nodes
+    D = 1.0 / I
+    I1 = op.D1 @ I
+    I2 = op.D2 @ I
+    Dp = -I1 / I**2
+    Dpp = 2.0 * I1**2 / I**3 - I2 / I**2
+    out = {k: np.zeros(n) for k in ("h", "V", "gamma", "u_ff", "sigma", "ld")}
+    sat = np.zeros(n, bool)
+    frac = (p.E0 - op.x) / (p.E0 - p.Ef)
+    h = slope = None
+    for i, E in enumerate(op.x):
+        alpha = _alpha_profile(p.alpha, E)
+        h, V, slope = _altitude_speed(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere, h_guess=h,
+                                      slope_guess=slope)
+        lat = p.lat0 + frac[i] * (p.latf - p.lat0)
+        heading = p.heading0 + frac[i] * (p.headingf - p.heading0)
+        terms = DragTerms(h, V, alpha, p.vehicle, p.planet, p.atmosphere)
+        gamma = math.asin(min(max((Dp[i] - terms.a_Dgamma) / terms.b_Dgamma, -1.0), 1.0))  # eq. 94
+        dd = terms.at(gamma, lat=lat, heading=heading)
+        u = dd.feedforward(Dpp[i])  # eq. 95
+        ratio = u / dd.lift_to_drag
+        lo = math.cos(p.sigma_max)
+        sat[i] = ratio > 1.0 or ratio < lo
+        sigma = math.acos(min(max(ratio, lo), 1.0))  # eq. 96, saturated
+        for k, v in (("h", h), ("V", V), ("gamma", gamma), ("u_ff", u), ("sigma", sigma), ("ld", dd.lift_to_drag)):
+            out[k][i] = v
+    return Extraction(out["h"], out["V"], out["gamma"], out["u_ff"], out["sigma"], sat, out["ld"])
+
+
+def altitude_speed_from_drag(E: float, D: float, alpha: float, vehicle: Vehicle, planet: Earth,
+                             atmosphere: Atmosphere, h_floor: float = 0.0, h_guess: float | None = None):
+    """(h, V) on energy level E where the drag equals D (eq. 93), to 1e-4 m.
+
+    With ``h_guess`` (the neighbouring node's altitude) a secant iteration on ln D, nearly
+    linear in h, converges in a few model evaluations; Brent's bracketed method is the
+    fallback and the default."""
+    return _altitude_speed(E, D, alpha, vehicle, planet, atmosphere, h_floor, h_guess)[:2]
+
+
+def _altitude_speed(E, D, alpha, vehicle, planet, atmosphere, h_floor=0.0, h_guess=None, slope_guess=None):
+    """altitude_speed_from_drag and the last secant slope d ln D / dh [1/m] (None after
+    Brent), which starts the next node's secant one model evaluation closer."""
+    h_top = min(planet.mu / (-E) - planet.reference_radius - 1.0, atmosphere.h_max)
+
+    def f(h):
+        V = math.sqrt(max(2.0 * (E + planet.mu / planet.radius(h)), 0.0))
+        return drag_acceleration(h, V, alpha, vehicle, atmosphere) - D
+
+    found = _secant_log_drag(f, D, h_guess, h_floor, h_top, slope_guess) if h_guess is not None else None
+    h, slope = found if found is not None else (brentq(f, h_floor, h_top, xtol=1e-4), None)
+    return h, math.sqrt(2.0 * (E + planet.mu / planet.radius(h))), slope
+
+
+def _secant_log_drag(f, D: float, h0: float, lo: float, hi: float, slope: float | None = None,
+                     tol: float = 1e-4, iterations: int = 12):
+    """(root of f(h) + D = D, last slope) by secant steps on ln(f(h) + D) - ln D, the first
+    step a Newton step with ``slope`` when given; None unless it converges in [lo, hi]."""
+    def g(h):
+        v = f(h) + D
+        return math.log(v / D) if v > 0.0 else None
+
+    a = min(max(h0, lo), hi)
+    ga = g(a)
+    if ga is None:
+        return None
+    if abs(ga) < 1e-12:
+        return a, slope
+    step = -ga / slope if slope is not None and slope < 0.0 else 200.0
+    b = min(max(a + step, lo), hi)
+    gb = g(b)
+    for _ in range(iterations):
+        if gb is None or gb == ga or a == b:
+            return None
+        s = (gb - ga) / (b - a)
+        c = b - gb / s
+        if not lo <= c <= hi:
+            return None
+        if abs(c - b) < tol:
+            return c, s
+        a, ga, b, gb = b, gb, c, g(c)
+    return None
+
+
+class DragEnergyPlanner:
+    """Plans drag-energy references from navigation states for one mission.
+
+    The corridor depends only on energy (alpha is scheduled in energy), so it is computed
+    once here and shared by every plan, every re-plan and every Monte-Carlo sample.
+    """
+
+    def __init__(self, *, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, alpha: Schedule,
+                 target_lon: float, target_lat: float, E_entry: float, E_final: float, n_nodes: int = 40,
+                 solver: str = "clarabel", margin: float = 0.03, corridor_points: int = 300,
+                 sigma_max: float | None = None, terminal_drag: float | None = None):
+        if alpha.variable != "energy":
+            raise ScenarioError(f"the drag-energy planner needs alpha scheduled in energy, got '{alpha.variable}'")
+        self.vehicle, self.atmosphere, self.alpha = vehicle, atmosphere, alpha
+        self.planet = planet.with_(j2=0.0)  # paper 000 eq. 37: central gravity in the planner
+        self.target = (target_lon, target_lat)
+        self.E_entry, self.E_final = E_entry, E_final
+        self.terminal_drag = terminal_drag  # D_f of eq. 85, or None (free)
+        self.n_nodes, self.solver = n_nodes, solver
+        self.sigma_max = vehicle.bank_limit if sigma_max is None else sigma_max
+        E = np.linspace(E_final, E_entry + 0.02 * (E_entry - E_final), corridor_points)
+        self.corridor = compute_corridor(E, alpha, vehicle, self.planet, atmosphere, margin=margin)
+
+    @staticmethod
+    def from_scenario(scenario) -> "DragEnergyPlanner":
+        g = scenario.guidance
+        vehicle = scenario.make_vehicle()
+        h_f, V_f, Ef = scenario.guidance_terminal_state()
+        alpha = scenario.schedule("alpha")
+        D_f = drag_acceleration(h_f, V_f, alpha(Ef), vehicle, scenario.make_atmosphere()) if g.terminal_drag else None
+        return DragEnergyPlanner(
+            vehicle=vehicle, planet=scenario.make_planet(), atmosphere=scenario.make_atmosphere(),
+            alpha=scenario.schedule("alpha"), target_lon=math.radians(scenario.target.longitude_deg),
+            target_lat=math.radians(scenario.target.latitude_deg), E_entry=scenario.entry_energy(), E_final=Ef,
+            n_nodes=g.n_nodes, solver=g.solver, margin=g.corridor_margin, corridor_points=g.corridor_points,
+            terminal_drag=D_f)
+
+    def energy(self, x) -> float:
+        return float(self.planet.specific_energy(x[0], x[3]))
+
+    def drag_state(self, x, sensed_drag: float | None = None) -> DragDynamics:
+        """D, D', a_D, b_D at state x for the scheduled alpha(E) (eqs. 40-63).
+
+        With ``sensed_drag`` (the accelerometer's drag acceleration [m/s^2]) the model's
+        drag dynamics are scaled by sensed/model: a density or drag-coefficient error scales
+        D, D' and D'' alike to first order, and the feedback then acts on the true drag.
+        """
+        E = self.energy(x)
+        d = drag_dynamics(x[0], x[3], x[4], _alpha_profile(self.alpha, E), self.vehicle, self.planet,
+                          self.atmosphere, lat=x[2], heading=x[5])
+        if sensed_drag is None or not sensed_drag > 0:
+            return d
+        k = sensed_drag / d.D
+        return dc.replace(d, D=sensed_drag, D_prime=k * d.D_prime, a_D=k * d.a_D, b_D=k * d.b_D,
+                          a_Dgamma=k * d.a_Dgamma, b_Dgamma=k * d.b_Dgamma)
+
+    def range_to_go(self, x) -> float:
+        return float(self.planet.great_circle_distance(x[1], x[2], *self.target))
+
+    def problem(self, x, sensed_drag: float | None = None, **overrides) -> DragEnergyProblem:
+        """The planning request from state x [h, lon, lat, V, gamma, psi] (and sensed drag)."""
+        d = self.drag_state(x, sensed_drag)
+        kw = dict(vehicle=self.vehicle, planet=self.planet, atmosphere=self.atmosphere, alpha=self.alpha,
+                  corridor=self.corridor, E0=self.energy(x), Ef=self.E_final, D0=d.D, D0_prime=d.D_prime,
+                  range_to_go=self.range_to_go(x), lat0=float(x[2]), latf=self.target[1],
+                  heading0=float(x[5]), headingf=bearing(x[1], x[2], *self.target), Df=self.terminal_drag,
+                  n_nodes=self.n_nodes, solver=self.solver, sigma_max=self.sigma_max)
+        kw.update(overrides)
+        return DragEnergyProblem(**kw)
+
+    def plan_from_state(self, x, previous: DragEnergyReference | None = None, sensed_drag: float | None = None,
+                        **overrides) -> DragEnergyReference:
+        """Plan from state x; a successful ``previous`` plan seeds kappa(E), so one SOCP suffices."""
+        if previous is not None and previous.success and previous.kappa is not None:
+            overrides = {"kappa_guess": previous.kappa_at, "range_iterations": 1, **overrides}
+        return plan(self.problem(x, sensed_drag, **overrides))

@@ -1,0 +1,490 @@
+"""Plan an entry with SCvx (paper 001): glide guess -> EntryProblem -> solve_scvx -> ScvxPlan,
+with the answer re-checked between the nodes before it is called a success."""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.interpolate import CubicHermiteSpline, CubicSpline
+
+from drake_entry.models.actuator import sampled_response
+from drake_entry.models.atmosphere import Atmosphere
+from drake_entry.models.constraints import dynamic_pressure
+from drake_entry.models.dynamics import (FLIGHT_CONDITION_NAMES, STATE_NAMES, aero_accelerations, air_data, equations_of_motion,
+                         flight_conditions)
+from drake_entry.errors import ModelRangeError, NonFiniteStateError
+from drake_entry.models.planet import Earth
+from drake_entry.models.vehicles import Vehicle
+from drake_entry.models.verdict import PathLimit, breaches_text, check_limits, vehicle_path_limits
+from drake_entry.planning.result import PlanResult
+from drake_entry.guidance.scvx.engine import ScvxSettings, max_defect, max_violation, solve_scvx
+from drake_entry.guidance.scvx.entry import EntryProblem, EntryProblemSettings
+from drake_entry.guidance.scvx.guess import GlideGuess, glide_guess
+from drake_entry.guidance.scvx.mission import ScvxMission
+from drake_entry.guidance.scvx.settings import FlightCheck
+
+#: the lossless gap is judged where the lift can act: L >= this fraction of g0
+GAP_LIFT_FRACTION = 0.05
+#: between-node re-check: relative tolerance on heat flux and load, absolute on gamma [rad]
+BETWEEN_NODE_TOLERANCE = (0.02, 0.02, math.radians(0.2))
+#: evaluation points per mesh segment for the between-node check and the rate metrics
+POINTS_PER_SEGMENT = 8
+#: the plan's controls propagated must end within this of its terminal point [m]
+PROPAGATION_TOLERANCE_M = 5e3
+
+#: ``ScvxPlan.metrics`` keys of each objective (paper 001 Table 2)
+OBJECTIVE_METRIC = {"heat_load": "heat_load_MJ_m2", "control_effort": "control_effort_deg",
+                    "max_control_rate": "max_control_rate_deg_s", "max_flight_path_rate": "max_flight_path_rate_deg_s",
+                    "max_heat_flux": "max_heat_flux_kW_m2", "max_load": "max_load_g", "time": "final_time_s",
+                    "miss": "miss_km"}
+
+
+@dc.dataclass(kw_only=True)
+class ScvxPlan(PlanResult):
+    """An SCvx entry plan (a PlanResult over time; ``objective`` in the unit of
+    ``entry.OBJECTIVES``: MJ/m^2, deg, deg/s, kW/m^2, g, s or km).
+
+    Attributes:
+      formulation: the EntryProblemSettings formulation ('lossless', 'hybrid', 'direct_bank', 'direct').
+      time: node times [s]; states: (n, n_x) SI, columns ``problem.state_names`` (h, lon, lat, V,
+        gamma, psi, then bank and alpha where they are states); controls: (n, n_u) at the nodes
+        ((u1, u2) of the lossless bank, then the rates [rad/s]); final_time: t_f [s].
+      bank, alpha: the bank and angle of attack [rad] at the nodes (atan2(u2, u1) and alpha(V)
+        where they are not states).
+      heat_load: integral of q dt [J/m^2] (without the regulariser).
+      lossless_gap: max(1 - |u|) over nodes where L >= 5 % g0; lossless_gap_all: over all nodes
+        (0 when the bank is a state: the flown bank is the planned one).
+      max_defect, max_violation: largest scaled dynamics defect and constraint violation.
+      between_nodes: worst relative excess of q and n and of gamma [rad] over their limits on
+        the segment polynomials between the nodes (8 points per segment).
+      miss_m: planned DRS point to the site [m]; drs: planned DRS altitude (geodetic) [m], Mach,
+        vertical speed [m/s].
+      metrics: the paper's Table 2, 3 and 6 quantities (``plan_metrics``).
+      propagated_error_m: the plan's real bank and alpha flown from its entry state through the
+        closed loop's actuators (``propagate_plan``) end this far from its terminal point [m]
+        (great circle and altitude); ``success`` needs it <= PROPAGATION_TOLERANCE_M.
+      flight: the FlightCheck it was flown with; flown: ``flown_check``'s verdict (the flown DRS
+        point, inside_box, the path-limit checks, within_limits).
+      guess: the glide guess it started from; history: the engine's IterationRecords.
+    """
+
+    formulation: str
+    time: np.ndarray
+    states: np.ndarray
+    controls: np.ndarray
+    final_time: float
+    bank: np.ndarray
+    alpha: np.ndarray
+    heat_load: float
+    lossless_gap: float
+    lossless_gap_all: float
+    max_defect: float
+    max_violation: float
+    between_nodes: dict
+    miss_m: float
+    drs: dict
+    metrics: dict
+    propagated_error_m: float
+    guess: GlideGuess | None = None
+    flight: FlightCheck | None = None
+    flown: dict = dc.field(default_factory=dict, repr=False)
+    history: list = dc.field(default_factory=list, repr=False)
+    problem: EntryProblem | None = dc.field(default=None, repr=False)
+
+    @property
+    def peaks(self) -> dict:
+        """Max heat flux [W/m^2] and total load [g] at the nodes."""
+        return {"heat_flux_W_m2": self.metrics["max_heat_flux_kW_m2"] * 1e3, "total_load_g": self.metrics["max_load_g"]}
+
+    def evaluate(self, at) -> dict:
+        """The plan at times ``at`` [s] on its own segment polynomials: the states by name
+        (h, lon, lat, V, gamma, psi), bank and alpha [rad], and the controls ('u1', 'u2' for the
+        lossless bank, 'bank_rate', 'alpha_rate' [rad/s] for the rate formulations)."""
+        t = np.clip(np.atleast_1d(np.asarray(at, float)), 0.0, self.final_time)
+        p = self.problem
+        P = p.mesh.interpolation(t / self.final_time)
+        X, U = P @ self.states, P @ self.controls
+        out = {name: X[:, i] for i, name in enumerate(p.state_names)}
+        bank_alpha = [p.bank_and_alpha(x, u) for x, u in zip(X, U)]
+        out["bank"] = np.array([math.atan2(s, c) for c, s, _ in bank_alpha])
+        out["alpha"] = np.array([float(a) for _, _, a in bank_alpha])
+        if p.formulation.bank == "lossless":
+            out.update(u1=U[:, 0], u2=U[:, 1])
+        names = {p.i_sigma: "bank_rate", p.i_alpha: "alpha_rate"}
+        for control, state in p.rate_controls:
+            out[names[state]] = U[:, control]
+        return out
+
+    def control_samples(self, samples_per_segment: int = 32):
+        """The controls to fly, sampled on the plan's polynomials: times [s] (``samples_per_segment``
+        per mesh segment), the bank unwrapped [rad], and the planned alpha [rad] (None where alpha
+        follows the mission's alpha(V) law, to be evaluated at the flown speed)."""
+        tt = np.linspace(0.0, self.final_time, samples_per_segment * self.problem.mesh.n_segments + 1)
+        ref = self.evaluate(tt)
+        return tt, np.unwrap(ref["bank"]), (ref["alpha"] if self.problem.i_alpha is not None else None)
+
+
+def _rate_limited(t, target, rate_limit, lower, upper):
+    """A path that follows ``target`` within bounds and at most ``rate_limit`` [1/s], and its rate."""
+    path = np.empty(len(t))
+    path[0] = np.clip(target[0], lower, upper)
+    for k in range(1, len(t)):
+        step = rate_limit * (t[k] - t[k - 1])
+        path[k] = np.clip(path[k - 1] + np.clip(target[k] - path[k - 1], -step, step), lower, upper)
+    return path, np.clip(np.gradient(path, t), -rate_limit, rate_limit)
+
+
+def decision_from_trajectory(problem: EntryProblem, states, bank, alpha, tf: float, lossless_controls=None):
+    """Scaled z from a trajectory at the mesh nodes: states (n, 6), bank and alpha [rad] (n,),
+    t_f [s]. Where bank or alpha are states they follow the given ones within their bounds and
+    rate limits (their rates are the controls), starting from the mission's held entry bank and
+    alpha where it holds them; the lossless bank takes ``lossless_controls``
+    (n, 2) if given, else (cos, sin) of the bank."""
+    t = problem.mesh.s * tf
+    X, U = [np.asarray(states, float)], []
+    f, m, v = problem.formulation, problem.mission, problem.vehicle
+    held = (lambda path, value: np.concatenate([[math.radians(value)], path[1:]]) if value is not None else path)
+    if f.bank == "lossless":
+        if lossless_controls is None and problem.rate_chords:
+            bank, _ = _rate_limited(t, np.unwrap(bank), v.bank_rate_limit, -math.inf, math.inf)
+        U.append(lossless_controls if lossless_controls is not None else np.stack([np.cos(bank), np.sin(bank)], axis=1))
+    else:
+        sigma, rate = _rate_limited(t, held(np.unwrap(bank), m.entry_bank_deg), v.bank_rate_limit, -v.bank_limit,
+                                    v.bank_limit)
+        X.append(sigma[:, None])
+        U.append(rate[:, None])
+    if f.alpha == "rate":
+        lo, hi = np.radians(m.alpha_bounds_deg)
+        a, rate = _rate_limited(t, held(np.asarray(alpha, float), m.entry_alpha_deg),
+                                math.radians(m.alpha_rate_limit_deg_s), lo, hi)
+        X.append(a[:, None])
+        U.append(rate[:, None])
+    return problem.pack(np.concatenate(X, axis=1), np.concatenate(U, axis=1), tf)
+
+
+def initial_decision(problem: EntryProblem, guess: GlideGuess) -> np.ndarray:
+    """z from a glide guess: states by cubic spline at the mesh times, its bank and alpha(V)."""
+    t = problem.mesh.s * guess.final_time
+    T, idx = np.unique(guess.time, return_index=True)
+    X = CubicSpline(T, guess.states[idx])(t)
+    bank = np.interp(t, T, guess.bank[idx])
+    alpha = np.array([problem.alpha(float(V)) for V in X[:, 3]])
+    return decision_from_trajectory(problem, X, bank, alpha, guess.final_time)
+
+
+def _dense(problem: EntryProblem, X, U):
+    """Points between the nodes (POINTS_PER_SEGMENT per segment, and the ends): s, states, controls."""
+    mesh = problem.mesh
+    inner = (np.arange(mesh.n_segments)[:, None] + (np.arange(POINTS_PER_SEGMENT)[None, :] + 0.5)
+             / POINTS_PER_SEGMENT).ravel() / mesh.n_segments
+    s = np.concatenate([[0.0], inner, [1.0]])
+    P = mesh.interpolation(s)
+    return s, P @ X, P @ U
+
+
+def _between_nodes(problem: EntryProblem, X, U) -> dict:
+    """Worst excess of q, n (relative) and gamma (rad) over their limits between the nodes."""
+    _, Xd, Ud = _dense(problem, X, U)
+    outputs = np.array([problem.node_outputs(x, u) for x, u in zip(Xd, Ud)])
+    lim = problem.vehicle.limits
+    g_lo, g_hi = np.radians(problem.mission.flight_path_bounds_deg)
+    return {"heat_flux": float(max(outputs[:, problem.out_q].max() / lim.heat_flux_max - 1.0, 0.0)),
+            "total_load": float(max(outputs[:, problem.out_n].max() / lim.total_load_max - 1.0, 0.0)),
+            "flight_path_rad": float(max((g_lo - Xd[:, 4]).max(), (Xd[:, 4] - g_hi).max(), 0.0))}
+
+
+def plan_metrics(problem: EntryProblem, X, U, tf: float) -> dict:
+    """Paper 001's Table 2/3/6 quantities of a plan: heat load [MJ/m^2] (node quadrature),
+    final time [s], max heat flux [kW/m^2], max total load [g], max |gamma_dot| [deg/s] and max
+    dynamic pressure [kPa] at the nodes; integrated and max |sigma_dot|, |alpha_dot| and |(sigma_dot, alpha_dot)| [deg, deg/s]
+    on the segment polynomials (the bank and alpha histories differentiated, whatever the
+    formulation); the planned miss [km]."""
+    nodes, _ = problem._nodes(X, U, gradients=False)
+    s, Xd, Ud = _dense(problem, X, U)
+    t = s * tf
+    bank_alpha = [problem.bank_and_alpha(x, u) for x, u in zip(Xd, Ud)]
+    sigma = np.unwrap([math.atan2(sn, c) for c, sn, _ in bank_alpha])
+    alpha = np.array([float(a) for _, _, a in bank_alpha])
+    sigma_dot, alpha_dot = np.gradient(sigma, t), np.gradient(alpha, t)
+    norm = np.hypot(sigma_dot, alpha_dot)
+    deg = math.degrees
+    return {"heat_load_MJ_m2": float(tf * (problem.mesh.weights @ nodes[:, problem.out_q]) / 1e6),
+            "final_time_s": tf,
+            "max_heat_flux_kW_m2": float(nodes[:, problem.out_q].max() / 1e3),
+            "max_load_g": float(nodes[:, problem.out_n].max()),
+            "max_flight_path_rate_deg_s": deg(float(np.abs(nodes[:, 4]).max())),
+            "max_dynamic_pressure_kPa": max(dynamic_pressure(air_data(x, problem.planet, problem.atmosphere)[0], x[3])
+                                            for x in X) / 1e3,
+            "bank_effort_deg": deg(float(np.trapezoid(np.abs(sigma_dot), t))),
+            "max_bank_rate_deg_s": deg(float(np.abs(sigma_dot).max())),
+            "alpha_effort_deg": deg(float(np.trapezoid(np.abs(alpha_dot), t))),
+            "max_alpha_rate_deg_s": deg(float(np.abs(alpha_dot).max())),
+            "control_effort_deg": deg(float(np.trapezoid(norm, t))),
+            "max_control_rate_deg_s": deg(float(norm.max())),
+            "miss_km": problem.site_miss(X[-1]) / 1e3}
+
+
+def _actuated(plan: ScvxPlan, tt, samples, flight: FlightCheck, lower: float, upper: float, rate_limit: float,
+              accel_limit: float, x0: float):
+    """The command ``samples`` at times ``tt`` as the sampled actuator flies them: a C1 cubic
+    Hermite in time (``actuator.sampled_response``), read ``lead_s`` ahead."""
+    n = int(math.ceil(plan.final_time / flight.period_s)) + 1
+    commands = CubicSpline(tt, samples)(np.minimum(np.arange(n) * flight.period_s + flight.lead_s, tt[-1]))
+    t, x, v = sampled_response(commands, flight.period_s, x0, lower=lower, upper=upper, rate_limit=rate_limit,
+                               accel_limit=accel_limit)
+    return CubicHermiteSpline(t, x, v)
+
+
+@dc.dataclass
+class PlanPropagation:
+    """A plan's controls flown from its entry state (``propagate_plan``).
+
+    Attributes:
+      time [s] (n,), states (n, 6): the integrator's steps. bank, alpha: the flown controls as
+        functions of time [rad] (alpha None: the mission's alpha(V) law at the flown speed).
+      failure: why the flight stopped before t_f ('' when it reached it).
+    """
+
+    time: np.ndarray
+    states: np.ndarray
+    bank: object
+    alpha: object
+    failure: str = ""
+
+
+def propagate_plan(plan: ScvxPlan, *, flight: FlightCheck | None = FlightCheck(), samples_per_segment: int = 32,
+                   rtol: float = 1e-9, steps_per_period: int = 4) -> PlanPropagation:
+    """Fly the plan's bank and alpha (planned, or the alpha(V) law) from its entry state to its
+    t_f on the project's equations of motion, through the closed loop's actuators as ``flight``
+    says: the model-layer check of ``plan_entry``; ``diagrams.plan_flight.fly_plan`` flies the
+    same controls through the Drake actuator systems and a test holds the two together.
+
+    Through the actuators (whose path is C1 with a kink every 0.02-s sub-step) the flight is
+    fixed-step RK4 at ``steps_per_period`` steps per guidance period (2 m from a 1e-12
+    integration at t_f on the nominal mission, where DOP853 at rtol 1e-9 was 160 m off at twice
+    the cost); where alpha follows the alpha(V) law its sampled command is the law at the plan's
+    speed (the Drake flight: at the flown speed). ``flight=None`` flies the plan's own C2
+    controls with DOP853 at ``rtol``."""
+    p, v, m = plan.problem, plan.problem.vehicle, plan.problem.mission
+    tt, bank_samples, alpha_samples = plan.control_samples(samples_per_segment)
+    actuated = flight is not None and flight.period_s is not None
+    if not actuated:
+        bank = CubicSpline(tt, bank_samples)
+        alpha = CubicSpline(tt, alpha_samples) if alpha_samples is not None else None
+    else:
+        if alpha_samples is None:
+            alpha_samples = np.array([float(p.alpha(V)) for V in plan.evaluate(tt)["V"]])
+        lo, hi = np.radians(m.alpha_bounds_deg)
+        bank = _actuated(plan, tt, bank_samples, flight, -v.bank_limit, v.bank_limit, v.bank_rate_limit,
+                         v.bank_accel_limit, float(plan.bank[0]))
+        alpha = _actuated(plan, tt, alpha_samples, flight, float(lo), float(hi), math.radians(m.alpha_rate_limit_deg_s),
+                          math.radians(flight.alpha_acceleration_deg_s2), float(plan.alpha[0]))
+
+    def rhs(t, x):
+        rho, a = air_data(x, p.planet, p.atmosphere)
+        a_t = float(alpha(t)) if alpha is not None else float(p.alpha(float(x[3])))
+        _, L, D = aero_accelerations(x, a_t, rho, a, p.vehicle)
+        return np.asarray(equations_of_motion(list(x), float(bank(t)), L, D, p.planet))
+
+    x0, tf = plan.states[0, :6].astype(float), plan.final_time
+    try:
+        if not actuated:
+            atol = rtol * np.array([1e4, 1.0, 1.0, 1e3, 1.0, 1.0])
+            sol = solve_ivp(rhs, (0.0, tf), x0, method="DOP853", rtol=rtol, atol=atol)
+            return PlanPropagation(sol.t, sol.y.T, bank, alpha, "" if sol.status == 0 else sol.message)
+        n = int(math.ceil(tf / flight.period_s * steps_per_period))
+        h = tf / n
+        T, X = [0.0], [x0]
+        x = x0
+        for k in range(n):
+            t = k * h
+            k1 = rhs(t, x)
+            k2 = rhs(t + 0.5 * h, x + 0.5 * h * k1)
+            k3 = rhs(t + 0.5 * h, x + 0.5 * h * k2)
+            k4 = rhs(t + h, x + h * k3)
+            x = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            if not np.all(np.isfinite(x)):
+                raise NonFiniteStateError(f"non-finite state at t = {t + h:.1f} s")
+            T.append(t + h)
+            X.append(x)
+        return PlanPropagation(np.array(T), np.array(X), bank, alpha)
+    except (ModelRangeError, NonFiniteStateError, OverflowError) as e:
+        return PlanPropagation(np.array([0.0]), x0[None, :], bank, alpha, f"{type(e).__name__}: {e}")
+
+
+def flown_check(plan: ScvxPlan, flown: PlanPropagation) -> dict:
+    """The verdict of a propagated plan: its terminal point to the plan's [m], the flown DRS point
+    (geodetic altitude [m], Mach, vertical speed [m/s], site miss [m]) and whether it is inside
+    the DRS box (eqs. 64-68: the altitude window, Mach, vertical speed, the site within
+    site_radius_m + PROPAGATION_TOLERANCE_M), and the path limits (``plan_path_limits``) at every
+    integrator step."""
+    p, m = plan.problem, plan.problem.mission
+    t, X = flown.time, flown.states
+    xf = X[-1]
+    alpha = (flown.alpha(t) if flown.alpha is not None else np.array([float(p.alpha(x[3])) for x in X]))
+    conds = np.array([flight_conditions(x, 0.0, a, p.vehicle, p.planet, p.atmosphere) for x, a in zip(X, alpha)])
+    columns = {name: conds[:, i] for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
+    columns.update({name: X[:, i] for i, name in enumerate(STATE_NAMES)})
+    columns.update(bank=flown.bank(t), alpha=alpha)
+    checks = check_limits(t, columns.__getitem__, plan_path_limits(plan))
+    drs, inside = drs_point(m, p.planet, xf, float(columns["mach"][-1]), m.site_radius_m + PROPAGATION_TOLERANCE_M)
+    return {"from_plan_m": terminal_distance(p.planet, xf, plan.states[-1]), "drs": drs, "inside_box": inside,
+            "checks": checks, "within_limits": all(c.held for c in checks)}
+
+
+def drs_point(mission: ScvxMission, planet: Earth, xf, mach: float, site_tolerance_m: float) -> tuple[dict, bool]:
+    """The flown DRS point of a final state ``xf`` at Mach ``mach``: (geodetic altitude [m],
+    Mach, vertical speed [m/s], site miss [m]) and whether it is inside the DRS box (eqs. 64-68:
+    the altitude window, Mach, vertical speed, the site within ``site_tolerance_m``)."""
+    drs = {"altitude_m": float(planet.atmospheric_altitude(xf[0], xf[2])), "mach": float(mach),
+           "vertical_speed_m_s": float(xf[3] * math.sin(xf[4])),
+           "site_miss_m": float(planet.great_circle_distance(xf[1], xf[2], *mission.site(planet)))}
+    inside = (mission.final_altitude_m[0] <= drs["altitude_m"] <= mission.final_altitude_m[1]
+              and drs["mach"] <= mission.final_mach_max
+              and drs["vertical_speed_m_s"] >= mission.final_vertical_speed_min_m_s
+              and drs["site_miss_m"] <= site_tolerance_m)
+    return drs, bool(inside)
+
+
+def plan_path_limits(plan: ScvxPlan) -> list[PathLimit]:
+    """The path limits a flown plan must hold: the vehicle's heat flux, total load (and q where
+    finite) and bank limit, and the mission's flight-path bounds (eq. 70)."""
+    p = plan.problem
+    return vehicle_path_limits(p.vehicle.limits, p.vehicle.bank_limit) + [p.mission.flight_path_limit()]
+
+
+def terminal_distance(planet: Earth, x, x_plan) -> float:
+    """Distance [m] between two terminal points: great circle and altitude, root sum square."""
+    return float(math.hypot(planet.great_circle_distance(x[1], x[2], x_plan[1], x_plan[2]), x[0] - x_plan[0]))
+
+
+def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission: ScvxMission, *,
+               problem_settings: EntryProblemSettings | None = None, settings: ScvxSettings | None = None,
+               guess: GlideGuess | None = None, initial=None, progress=None,
+               flight: FlightCheck = FlightCheck()) -> ScvxPlan:
+    """Plan the mission: the glide guess (unless given), SCvx, the between-node check, then the
+    verdict of its controls flown (``flown_check``): ``success`` only when it converged, its
+    controls flown through the closed loop's actuators (``flight``) end within
+    PROPAGATION_TOLERANCE_M of its terminal point, inside the DRS box, and every path limit held.
+
+    Args:
+      initial: a previous ScvxPlan to start from instead of the guess (a warm start, or a
+        polish in another formulation, e.g. a 'lossless' plan refined as 'direct'; its mesh may
+        differ, it is interpolated).
+      progress: ``progress(k, IterationRecord)`` after every iteration.
+      flight: how the controls are flown for the verdict (FlightCheck; re-plans keep it).
+    """
+    t0 = time.perf_counter()
+    ps = problem_settings or EntryProblemSettings()
+    if initial is None and guess is None:
+        guess = glide_guess(vehicle, planet, atmosphere, mission)
+    tf0 = initial.final_time if initial is not None else guess.final_time
+    problem = EntryProblem(vehicle, planet, atmosphere, mission, ps, tf0)
+    if initial is not None:
+        ref = initial.evaluate(problem.mesh.s * tf0)
+        lossless = np.stack([ref["u1"], ref["u2"]], axis=1) if "u1" in ref else None
+        z0 = decision_from_trajectory(problem, np.stack([ref[k] for k in STATE_NAMES], axis=1), ref["bank"],
+                                      ref["alpha"], tf0, lossless)
+    else:
+        z0 = initial_decision(problem, guess)
+    build = time.perf_counter() - t0
+    outcome = solve_scvx(problem, z0, settings, progress=progress)
+    X, U, tf = problem.unpack(outcome.z)
+    bank_alpha = [problem.bank_and_alpha(x, u) for x, u in zip(X, U)]
+    bank = np.array([math.atan2(s, c) for c, s, _ in bank_alpha])
+    alpha = np.array([float(a) for _, _, a in bank_alpha])
+    norm_u = np.array([math.hypot(c, s) for c, s, _ in bank_alpha])
+    lift = np.array([flight_conditions(x[:6], 0.0, a, vehicle, planet, atmosphere).lift for x, a in zip(X, alpha)])
+    acting = lift >= GAP_LIFT_FRACTION * planet.g0
+    gap = float(np.max(1.0 - norm_u[acting], initial=0.0))
+    metrics = plan_metrics(problem, X, U, tf)
+    between = _between_nodes(problem, X, U)
+    xf = X[-1]
+    final = problem.node_outputs(xf, U[-1])
+    ev = outcome.evaluation
+    tol_q, tol_n, tol_g = BETWEEN_NODE_TOLERANCE
+    checked = (between["heat_flux"] <= tol_q and between["total_load"] <= tol_n
+               and between["flight_path_rad"] <= tol_g)
+    message = outcome.message
+    if outcome.converged and not checked:
+        message += (f"; converged but violated between the nodes (heat flux +{between['heat_flux']:.1%}, "
+                    f"load +{between['total_load']:.1%}, gamma {math.degrees(between['flight_path_rad']):.2f} deg): "
+                    f"refine the mesh")
+    plan = ScvxPlan(
+        success=False, message=message, iterations=outcome.iterations, build_time=build,
+        objective=metrics[OBJECTIVE_METRIC[ps.objective]], formulation=ps.formulation,
+        time=problem.mesh.s * tf, states=X, controls=U, final_time=tf, bank=bank, alpha=alpha,
+        heat_load=metrics["heat_load_MJ_m2"] * 1e6, lossless_gap=gap,
+        lossless_gap_all=float(np.max(1.0 - norm_u)), max_defect=max_defect(ev),
+        max_violation=max_violation(ev), between_nodes=between, miss_m=problem.site_miss(xf),
+        drs={"altitude_m": float(final[problem.out_h]), "mach": float(xf[3] / final[problem.out_a]),
+             "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))},
+        metrics=metrics, propagated_error_m=math.nan, guess=guess, history=outcome.history, problem=problem)
+    plan.flight = flight
+    propagated = propagate_plan(plan, flight=flight)
+    if propagated.failure:
+        plan.propagated_error_m = math.inf
+        plan.flown = {}
+        flown_ok, why = False, f"its controls flown stop before t_f: {propagated.failure}"
+    else:
+        plan.flown = flown = flown_check(plan, propagated)
+        plan.propagated_error_m = flown["from_plan_m"]
+        d = flown["drs"]
+        problems = []
+        if plan.propagated_error_m > PROPAGATION_TOLERANCE_M:
+            problems.append(f"end {plan.propagated_error_m / 1e3:.1f} km from its terminal point "
+                            f"(> {PROPAGATION_TOLERANCE_M / 1e3:g} km; "
+                            + (f"lossless gap {gap:.2f}: polish it with the 'direct' formulation)" if gap > 1e-2
+                               else "refine the mesh)"))
+        if not flown["inside_box"]:
+            problems.append(f"end outside the DRS box (geodetic altitude {d['altitude_m'] / 1e3:.2f} km of "
+                            f"{mission.final_altitude_m[0] / 1e3:g}-{mission.final_altitude_m[1] / 1e3:g} km, "
+                            f"Mach {d['mach']:.2f}, vertical speed {d['vertical_speed_m_s']:.1f} m/s, "
+                            f"{d['site_miss_m'] / 1e3:.1f} km from the site)")
+        if not flown["within_limits"]:
+            problems.append("breach " + breaches_text(flown["checks"]))
+        flown_ok, why = not problems, "its controls flown " + " and ".join(problems)
+    if outcome.converged and not flown_ok:
+        plan.message += f"; converged but {why}"
+    plan.success = outcome.converged and checked and flown_ok
+    plan.solve_time = time.perf_counter() - t0 - build
+    return plan
+
+
+#: ScvxMission fields a re-plan takes from the state flown (the rest stay the mission's)
+_ENTRY_FIELDS = ("entry_altitude_m", "entry_longitude_deg", "entry_latitude_deg", "entry_speed_m_s",
+                 "entry_flight_path_deg", "entry_heading_deg", "site_longitude_deg", "site_latitude_deg",
+                 "entry_bank_deg", "entry_alpha_deg")
+
+
+def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float, *,
+                settings: ScvxSettings | None = None) -> ScvxPlan:
+    """Re-plan ``previous``'s mission from state ``x`` [h, lon, lat, V, gamma, psi] reached
+    ``elapsed`` [s] into it, holding the bank and alpha being flown [rad] where they are
+    states (the rate formulations): the same site, DRS box, limits, formulation and mesh,
+    warm-started from the rest of the previous plan (its states and bank from ``elapsed`` to
+    its t_f, the state at ``elapsed`` replaced by ``x``; the remaining time its t_f guess). A state outside the mission's bounds (e.g. gamma above
+    0.5 deg in a dispersed skip) is clipped into them for the new entry point."""
+    p = previous.problem
+    m = p.mission
+    x = np.array(x, float)
+    x[4] = np.clip(x[4], *np.radians(m.flight_path_bounds_deg))
+    fields = {k: v for k, v in dc.asdict(m).items() if k not in _ENTRY_FIELDS}
+    f = p.formulation
+    if f.bank == "rate":
+        fields["entry_bank_deg"] = float(np.clip(math.degrees(bank), -180.0, 180.0))
+    if f.alpha == "rate":
+        fields["entry_alpha_deg"] = float(np.clip(math.degrees(alpha), *m.alpha_bounds_deg))
+    mission = ScvxMission.from_geocentric(p.planet, x, p.site_lon, p.site_lat, **fields)
+    rest = np.linspace(min(elapsed, previous.final_time), previous.final_time, 200)
+    ref = previous.evaluate(rest)
+    states = np.stack([ref[k] for k in STATE_NAMES], axis=1)
+    states[0] = x
+    guess = GlideGuess(rest - rest[0], states, ref["bank"], math.nan, math.nan, True)
+    if guess.final_time <= 0.0:
+        raise ValueError(f"the previous plan has no time left at {elapsed:.1f} s (t_f {previous.final_time:.1f} s)")
+    return plan_entry(p.vehicle, p.planet, p.atmosphere, mission, problem_settings=p.settings,
+                      settings=settings, guess=guess, flight=previous.flight or FlightCheck())

@@ -1,0 +1,266 @@
+"""Paper 004 trajectories for a whole population at once: every member flies the guidance law
+of ``guidance_law`` with its own sigma_0 (eq. 17), from the start state to the TAEM energy,
+and gets the objective of eq. 32.
+
+The evaluation is a discrete-time replica of the Drake closed loop the method flies
+(diagrams/closed_loop.py with guidance/swarm_bank), so a planned optimum is what the
+Simulator then flies. Per guidance step (``guidance_step_s``, the step the eq. 21 recursion
+depends on): air data and aerodynamic accelerations at the actuators' positions; the law's
+|sigma| and alpha commands (``law_commands``); the bank command is |sigma| times the sign
+chosen at the previous step (the shared reversal logic's sign is a discrete state, so the
+actuator samples it one step late), then the sign is updated from the heading-error
+corridor (paper 000 Sec. VI.D); both actuators are integrated over the step in
+``actuator_substep_s`` steps (drake_entry.models.actuator, the Drake actuators' law); then one RK4
+step of drake_entry.models.dynamics (the same equations as the Drake plant) with the actuators'
+positions at the stage times. A member stops at the TAEM energy (its final state
+interpolated in energy), below the altitude floor or at ``max_time_s``.
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+
+import numpy as np
+
+from drake_entry.models.actuator import integrate_actuators
+from drake_entry.models.constraints import dynamic_pressure
+from drake_entry.models.dynamics import aero_accelerations, equations_of_motion, state_derivatives
+from drake_entry.errors import ScenarioError
+from drake_entry.models.geodesy import bearings, downtrack_crosstrack
+from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle
+from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, LawSettings, law_commands
+
+#: J of eq. 32: range error over 100 nmi, altitude error over 1 km, speed error over 100 m/s
+RANGE_UNIT_M, ALTITUDE_UNIT_M, SPEED_UNIT_M_S = 1.852e5, 1e3, 100.0
+
+
+@dc.dataclass
+class SwarmProblem:
+    """A paper-004 design problem (SI, rad).
+
+    Attributes:
+      vehicle, planet, atmosphere: models (a rotating sphere, central gravity: paper 004 eq. 12).
+      x0: start state [h, lon, lat, V, gamma, psi]. target: (lon, lat) of the TAEM point.
+      origin: (lon, lat) the along-track range is measured from (None: x0's position).
+      h_f, V_f: TAEM altitude [m] and speed [m/s] (r*, V* of eq. 32).
+      sigma_f: terminal bank of eq. 17 (paper: 60 deg). e0: eq. 17's start energy [J/kg]
+        (None: x0's; an on-board re-solution keeps the entry's).
+      alpha_min, alpha_max, alpha_rate, alpha_accel: alpha bounds and actuator limits.
+      load_max [g], heat_max [W/m^2]: the path limits of eqs. 13-14.
+      case: 'load' (Case 1, eq. 31) or 'heat' (Case 2, eq. 21 until mach_shift, then eq. 31).
+      k2, beta: eq. 48 gain and eq. 46 nondimensional scale height (paper: 10, 920).
+      reversal_heading, reversal_velocity: heading-error corridor [rad] linear in speed [m/s].
+      initial_alpha, initial_bank, initial_sign, memory: the actuators, the reversal sign and
+        the alpha law's memory at x0 (entry: alpha_max, 0, +1, nothing latched).
+    """
+
+    vehicle: object
+    planet: object
+    atmosphere: object
+    x0: np.ndarray
+    target: tuple
+    h_f: float
+    V_f: float
+    origin: tuple | None = None
+    sigma_f: float = math.radians(60.0)
+    e0: float | None = None
+    alpha_min: float = math.radians(10.0)
+    alpha_max: float = math.radians(20.0)
+    alpha_rate: float = math.radians(4.0)
+    alpha_accel: float = math.radians(8.0)
+    load_max: float = 2.0
+    heat_max: float = 6e6
+    case: str = "load"
+    mach_shift: float = 20.0
+    k2: float = 10.0
+    beta: float = 920.0
+    reversal_heading: tuple = (math.radians(5.0), math.radians(15.0))
+    reversal_velocity: tuple = (1000.0, 6000.0)
+    guidance_step_s: float = 1.0
+    actuator_substep_s: float = 0.02
+    altitude_floor_m: float = 5000.0
+    max_time_s: float = 5000.0
+    initial_alpha: float | None = None
+    initial_bank: float = 0.0
+    initial_sign: float = 1.0
+    memory: tuple = (False, False)  # (Mach was above Mach_shift, switched to Case 1)
+
+    def __post_init__(self):
+        if self.case not in ("load", "heat"):
+            raise ScenarioError(f"paper-004 alpha law case = {self.case!r}; allowed: 'load', 'heat'")
+
+    @property
+    def start_energy(self) -> float:
+        """eq. 17's e0 [J/kg] (e = mu/r - V^2/2, eq. 10, SI)."""
+        return self.energy(self.x0[0], self.x0[3]) if self.e0 is None else self.e0
+
+    @property
+    def ef(self) -> float:
+        return self.energy(self.h_f, self.V_f)
+
+    def energy(self, h, V):
+        return self.planet.mu / self.planet.radius(h) - 0.5 * np.asarray(V) ** 2
+
+    def law(self) -> LawSettings:
+        pl = self.planet
+        return LawSettings(self.sigma_f, self.start_energy, self.ef, self.vehicle.bank_limit, self.alpha_min,
+                           self.alpha_max, self.load_max, self.heat_max, self.case, self.mach_shift, self.k2,
+                           self.beta, pl.reference_radius, pl.g0, pl.mu)
+
+
+@dc.dataclass
+class Evaluation:
+    """Per member (arrays): objective J (eq. 32), its parts, the final state and peaks.
+
+    Attributes:
+      J: objective of eq. 32 (inf where the TAEM energy was not reached).
+      range_error_m: signed along-track distance at TAEM [m], + beyond the target.
+      crossrange_m: cross-track distance from the entry-to-target great circle [m].
+      altitude_error_m: h - h_f at the TAEM energy [m].
+      velocity_error_m_s: V - V_f at the TAEM energy [m/s].
+      final_state: (n, 6) state at the TAEM energy (or where the member stopped).
+      time_s: time of the TAEM energy [s]. reached: the TAEM energy was reached.
+      peak_heat_flux_W_m2: largest heat rate along the trajectory.
+      peak_dynamic_pressure_Pa: largest dynamic pressure.
+      peak_total_load_g: largest total load factor.
+      reversals: bank reversals flown. trajectories: members evaluated.
+      history: per member, the recorded steps (HISTORY_COLUMNS), when asked.
+      controls: per member, the actuators' positions at every actuator sub-step, when asked:
+        (m, 3) [time s, alpha rad, bank rad], what the plant flew between the guidance steps
+        (CONTROL_COLUMNS).
+    """
+
+    J: np.ndarray
+    range_error_m: np.ndarray
+    crossrange_m: np.ndarray
+    altitude_error_m: np.ndarray
+    velocity_error_m_s: np.ndarray
+    final_state: np.ndarray
+    time_s: np.ndarray
+    reached: np.ndarray
+    peak_heat_flux_W_m2: np.ndarray
+    peak_dynamic_pressure_Pa: np.ndarray
+    peak_total_load_g: np.ndarray
+    reversals: np.ndarray
+    trajectories: int
+    history: list | None = None
+    controls: list | None = None
+
+
+#: columns of Evaluation.history tables
+HISTORY_COLUMNS = ("time_s", "altitude_m", "longitude_rad", "latitude_rad", "velocity_m_s", "flight_path_rad",
+                   "heading_rad", "alpha_rad", "bank_rad", "bank_command_rad", "alpha_command_rad", "mach",
+                   "dynamic_pressure_Pa", "heat_flux_W_m2", "total_load_g")
+#: columns of Evaluation.controls tables
+CONTROL_COLUMNS = ("time_s", "alpha_rad", "bank_rad")
+
+
+def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = False) -> Evaluation:
+    """Fly every sigma0 [rad] of the population (array) and return its Evaluation; ``sigma_f``
+    [rad]: per-member eq. 17 end banks (the two-parameter search; default the problem's); with
+    ``record`` each member's step-by-step history (HISTORY_COLUMNS) and its actuators' path at
+    every sub-step (CONTROL_COLUMNS) are kept."""
+    p, pl, veh = problem, problem.planet, problem.vehicle
+    sigma0 = np.atleast_1d(np.asarray(sigma0, float))
+    n = sigma0.size
+    sigma_f = None if sigma_f is None else np.broadcast_to(np.asarray(sigma_f, float), (n,))
+    law = p.law()
+    x = np.tile(np.asarray(p.x0, float)[:, None], (1, n))
+    alpha0 = p.alpha_max if p.initial_alpha is None else p.initial_alpha
+    alpha, alpha_rate = np.full(n, alpha0), np.zeros(n)
+    bank, bank_rate = np.full(n, p.initial_bank), np.zeros(n)
+    sign = np.full(n, 1.0 if p.initial_sign >= 0 else -1.0)
+    memory = LawMemory.start(alpha0, n, was_above=p.memory[0], switched=p.memory[1])
+    reversals = np.zeros(n, int)
+    active, reached = np.ones(n, bool), np.zeros(n, bool)
+    final, t_end, peaks = x.copy(), np.zeros(n), np.zeros((3, n))
+    ef = p.ef
+    # alpha (first n) and bank (last n) actuators integrate in one call with per-member limits
+    limits = {k: np.repeat([a, b], n) for k, a, b in (
+        ("lower", p.alpha_min, -veh.bank_limit), ("upper", p.alpha_max, veh.bank_limit),
+        ("rate_limit", p.alpha_rate, veh.bank_rate_limit), ("accel_limit", p.alpha_accel, veh.bank_accel_limit))}
+    dt = p.guidance_step_s
+    steps = max(1, int(round(dt / p.actuator_substep_s)))
+    history = [[] for _ in range(n)] if record else None
+    controls = [[] for _ in range(n)] if record else None
+    t = 0.0
+    while active.any() and t < p.max_time_s:
+        idx = np.flatnonzero(active)
+        xa = x[:, idx]
+        V = xa[3]
+        rho, a = p.atmosphere.air_data(pl.atmospheric_altitude(xa[0], xa[2]))
+        mach, L, D = aero_accelerations(xa, alpha[idx], rho, a, veh)
+        q, heat = dynamic_pressure(rho, V), veh.heat_flux(rho, V)
+        load = np.hypot(L, D) / pl.g0
+        peaks[:, idx] = np.maximum(peaks[:, idx], [heat, q, load])
+        mem = LawMemory(memory.alpha_command[idx], memory.mach_was_above[idx], memory.switched[idx])
+        magnitude, alpha_cmd, mem = law_commands(law, sigma0[idx], xa, pl.radius(xa[0]), rho, mach, L, D, heat, q,
+                                                 veh.aero, veh.area_over_mass, mem,
+                                                 None if sigma_f is None else sigma_f[idx])
+        memory.alpha_command[idx], memory.mach_was_above[idx], memory.switched[idx] = (
+            mem.alpha_command, mem.mach_was_above, mem.switched)
+        bank_cmd = sign[idx] * magnitude  # the sign of the previous step (see module doc)
+        err = wrap_angle(xa[5] - bearings(xa[1], xa[2], *p.target))
+        new_sign = reversal_sign(err, corridor_half_width(V, p.reversal_heading, p.reversal_velocity), sign[idx])
+        reversals[idx] += new_sign != sign[idx]
+        sign[idx] = new_sign
+        if record:
+            for j, i in enumerate(idx):
+                history[i].append((t, *xa[:, j], alpha[i], bank[i], bank_cmd[j], alpha_cmd[j], mach[j], q[j],
+                                   heat[j], load[j]))
+        both = np.concatenate([idx, idx + n])
+        pos, rates, path = integrate_actuators(np.concatenate([alpha[idx], bank[idx]]),
+                                               np.concatenate([alpha_rate[idx], bank_rate[idx]]),
+                                               np.concatenate([alpha_cmd, bank_cmd]), dt / steps, steps,
+                                               bandwidth=2.0, **{k: v[both] for k, v in limits.items()})
+        m = idx.size
+        alpha[idx], bank[idx], alpha_rate[idx], bank_rate[idx] = pos[:m], pos[m:], rates[:m], rates[m:]
+        a_path, b_path = path[:, :m], path[:, m:]
+        if record:
+            sub = t + dt * np.arange(steps) / steps  # each step's last point is the next step's first
+            for j, i in enumerate(idx):
+                controls[i].append(np.column_stack([sub, a_path[:-1, j], b_path[:-1, j]]))
+        mid = steps // 2 if steps % 2 == 0 else None
+        a_mid = a_path[mid] if mid is not None else 0.5 * (a_path[steps // 2] + a_path[steps // 2 + 1])
+        b_mid = b_path[mid] if mid is not None else 0.5 * (b_path[steps // 2] + b_path[steps // 2 + 1])
+        # one RK4 step of the plant's equations (the first stage's air data are those above)
+        k1 = equations_of_motion(xa, b_path[0], L, D, pl)
+        k2 = np.asarray(state_derivatives(list(xa + 0.5 * dt * k1), b_mid, a_mid, veh, pl, p.atmosphere))
+        k3 = np.asarray(state_derivatives(list(xa + 0.5 * dt * k2), b_mid, a_mid, veh, pl, p.atmosphere))
+        k4 = np.asarray(state_derivatives(list(xa + dt * k3), b_path[-1], a_path[-1], veh, pl, p.atmosphere))
+        xn = xa + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        t += dt
+        e, e_new = p.energy(xa[0], V), p.energy(xn[0], xn[3])
+        done = e_new >= ef
+        if done.any():  # the TAEM energy was crossed inside this step: interpolate in energy
+            w = np.clip((ef - e[done]) / (e_new[done] - e[done]), 0.0, 1.0)
+            final[:, idx[done]] = xa[:, done] + w * (xn[:, done] - xa[:, done])
+            t_end[idx[done]] = t - dt + w * dt
+            reached[idx[done]] = True
+        low = ~done & (xn[0] < p.altitude_floor_m)
+        final[:, idx[low]] = xn[:, low]
+        t_end[idx[low]] = t
+        x[:, idx] = xn
+        active[idx[done | low]] = False
+    final[:, active] = x[:, active]
+    t_end[active] = t
+    ds, c = range_error(p, final[1], final[2])
+    dh, dV = final[0] - p.h_f, final[3] - p.V_f
+    J = np.abs(ds) / RANGE_UNIT_M + np.abs(dh) / ALTITUDE_UNIT_M + np.abs(dV) / SPEED_UNIT_M_S  # eq. 32
+    J = np.where(reached, J, np.inf)
+    if record:
+        history = [np.array(h) for h in history]
+        controls = [np.vstack(c_i) for c_i in controls]
+    return Evaluation(J, ds, c, dh, dV, final.T.copy(), t_end, reached, peaks[0], peaks[1], peaks[2], reversals, n,
+                      history, controls)
+
+
+def range_error(problem: SwarmProblem, lon, lat):
+    """(signed along-track distance beyond the target [m], cross-track [m]) of positions
+    [rad], along the great circle from ``origin`` (x0's position by default) to the target."""
+    R = problem.planet.reference_radius
+    lon0, lat0 = problem.origin if problem.origin is not None else (problem.x0[1], problem.x0[2])
+    tlon, tlat = problem.target
+    d, c = downtrack_crosstrack(np.atleast_1d(lon), np.atleast_1d(lat), lon0, lat0, tlon, tlat, R)
+    d_target, _ = downtrack_crosstrack(np.array([tlon]), np.array([tlat]), lon0, lat0, tlon, tlat, R)
+    return d - d_target[0], c

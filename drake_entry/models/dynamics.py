@@ -1,0 +1,172 @@
+"""The 3-DOF point-mass entry equations, written once for float, AutoDiffXd and Expression.
+
+State x = [h, lon, lat, V, gamma, psi]: altitude above the reference sphere [m],
+longitude and geocentric latitude [rad], Earth-relative speed [m/s], flight-path angle
+[rad], heading [rad] from north, clockwise. Controls: bank sigma and angle of attack
+alpha [rad].
+
+With a spherical planet and J2 off this is paper 000 eq. 102. With J2 the radial and
+meridional (north) gravity components of paper 001 eq. 7 enter; their projections are
+derived from the potential here (paper 001 eqs. 4-6 mix heading conventions): the north
+component g_n adds g_n cos(gamma) cos(psi) to V', -g_n sin(gamma) cos(psi) / V to gamma'
+and -g_n sin(psi) / (V cos gamma) to psi'. On an oblate planet the atmosphere is
+evaluated at the geodetic altitude (paper 001 Sec. II.A).
+"""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from drake_entry.models.atmosphere import Atmosphere
+from drake_entry.models.constraints import dynamic_pressure, normal_load_factor, total_load_factor
+from drake_entry.errors import NonFiniteStateError
+from drake_entry.models.planet import Earth
+from drake_entry.models.scalar import promote
+from drake_entry.models.vehicles import Vehicle
+
+STATE_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
+STATE_UNITS = ("m", "rad", "rad", "m/s", "rad", "rad")
+
+
+class FlightConditions(NamedTuple):
+    """Quantities along a trajectory, SI units."""
+
+    rho: object  # density [kg/m^3]
+    mach: object  # Mach number [-]
+    dynamic_pressure: object  # q [Pa]
+    heat_flux: object  # stagnation heat flux [W/m^2]
+    normal_load: object  # n_z [g]
+    total_load: object  # n [g]
+    lift: object  # L, lift acceleration [m/s^2]
+    drag: object  # D, drag acceleration [m/s^2]
+    energy: object  # specific mechanical energy E = V^2/2 + potential [J/kg]
+
+
+FLIGHT_CONDITION_NAMES = FlightConditions._fields
+
+
+def air_data(x, planet: Earth, atmosphere: Atmosphere):
+    """Density [kg/m^3] and speed of sound [m/s] at state x."""
+    return atmosphere.air_data(planet.atmospheric_altitude(x[0], x[2]))
+
+
+def aero_accelerations(x, alpha, rho, speed_of_sound, vehicle: Vehicle):
+    """Mach, lift and drag accelerations L, D [m/s^2] (paper 001 eq. 8 divided by m)."""
+    V = x[3]
+    mach = V / speed_of_sound
+    cl, cd = vehicle.aero.coefficients(alpha, mach)
+    qS_m = 0.5 * rho * V * V * vehicle.area_over_mass
+    return mach, qS_m * cl, qS_m * cd
+
+
+def state_derivatives(x, bank, alpha, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere):
+    """xdot for x = [h, lon, lat, V, gamma, psi] (paper 000 eq. 102; J2 per paper 001 eq. 7).
+
+    Args:
+      x: state (sequence of 6 scalars of one type).
+      bank: sigma [rad]. alpha: angle of attack [rad].
+    Returns:
+      numpy array (dtype float or object) of the six time derivatives, SI.
+    """
+    x = [promote(v) for v in x]
+    bank, alpha = promote(bank), promote(alpha)
+    rho, a = air_data(x, planet, atmosphere)
+    _, L, D = aero_accelerations(x, alpha, rho, a, vehicle)
+    return equations_of_motion(x, bank, L, D, planet)
+
+
+def equations_of_motion(x, bank, L, D, planet: Earth):
+    """xdot given the lift and drag accelerations L, D [m/s^2] (paper 000 eq. 102)."""
+    fn = math if isinstance(x[4], float) and isinstance(bank, float) else np  # float fast path
+    return equations_of_motion_lift_components(x, L * fn.cos(bank), L * fn.sin(bank), D, planet)
+
+
+def equations_of_motion_lift_components(x, L_vertical, L_horizontal, D, planet: Earth):
+    """xdot given the lift components L cos(sigma), L sin(sigma) and the drag D [m/s^2].
+
+    The form the lossless bank relaxation needs (paper 001 eqs. 40-41: L u1, L u2 with
+    u1 = cos sigma, u2 = sin sigma); ``equations_of_motion`` calls it with the real bank."""
+    h, lon, lat, V, gamma, psi = x
+    r = planet.radius(h)
+    g_r, g_n = planet.gravity(r, lat)
+    w = planet.omega
+    fn = math if isinstance(gamma, float) and isinstance(L_vertical, float) else np  # float fast path
+    sg, cg = fn.sin(gamma), fn.cos(gamma)
+    sp, cp = fn.sin(psi), fn.cos(psi)
+    sl, cl = fn.sin(lat), fn.cos(lat)
+    tan_g = sg / cg
+    h_dot = V * sg
+    lon_dot = V * cg * sp / (r * cl)
+    lat_dot = V * cg * cp / r
+    V_dot = -D - g_r * sg + g_n * cg * cp + w * w * r * cl * (sg * cl - cg * sl * cp)
+    gamma_dot = (
+        L_vertical / V
+        + (V / r - g_r / V) * cg
+        - g_n * sg * cp / V
+        + 2.0 * w * cl * sp
+        + w * w * r / V * cl * (cg * cl + sg * sl * cp)
+    )
+    psi_dot = (
+        L_horizontal / (V * cg)
+        + V / r * cg * sp * sl / cl
+        - g_n * sp / (V * cg)
+        + 2.0 * w * (sl - cl * tan_g * cp)
+        + w * w * r / (V * cg) * sl * cl * sp
+    )
+    if fn is math:  # float path: stop on NaN/inf here (an error-controlled integrator would
+        total = h_dot + lon_dot + lat_dot + V_dot + gamma_dot + psi_dot  # shrink its step for ever)
+        if total - total != 0.0:
+            raise NonFiniteStateError(f"non-finite state derivative at h = {h:.6g} m, V = {V:.6g} m/s, "
+                                      f"gamma = {gamma:.6g} rad, L cos(bank) = {L_vertical:.6g}, "
+                                      f"L sin(bank) = {L_horizontal:.6g}, D = {D:.6g}")
+    return np.array([h_dot, lon_dot, lat_dot, V_dot, gamma_dot, psi_dot])
+
+
+def flight_conditions(x, bank, alpha, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere) -> FlightConditions:
+    """Density, Mach, q, heat flux, load factors, L, D and energy at state x."""
+    rho, a = air_data(x, planet, atmosphere)
+    mach, L, D = aero_accelerations(x, alpha, rho, a, vehicle)
+    return conditions_from(x, alpha, rho, mach, L, D, vehicle, planet)
+
+
+def conditions_from(x, alpha, rho, mach, L, D, vehicle: Vehicle, planet: Earth) -> FlightConditions:
+    """FlightConditions from already computed air data and aerodynamic accelerations."""
+    V = x[3]
+    return FlightConditions(
+        rho=rho,
+        mach=mach,
+        dynamic_pressure=dynamic_pressure(rho, V),
+        heat_flux=vehicle.heat_flux(rho, V, alpha),
+        normal_load=normal_load_factor(L, D, alpha, planet.g0),
+        total_load=total_load_factor(L, D, planet.g0),
+        lift=L,
+        drag=D,
+        energy=specific_energy(x, planet),
+    )
+
+
+def specific_energy(x, planet: Earth):
+    """E = V^2/2 + potential(r, lat) [J/kg] (paper 000 Sec. V.A: V^2/2 - mu/r without J2)."""
+    return 0.5 * x[3] * x[3] + planet.potential(planet.radius(x[0]), x[2])
+
+
+def energy_rate(x, xdot, planet: Earth):
+    """dE/dt [W/kg] along xdot, by the chain rule (equals -D V without rotation and J2,
+    paper 000 eq. 39)."""
+    h, lat, V = x[0], x[2], x[3]
+    r = planet.radius(h)
+    g_r, g_n = planet.gravity(r, lat)
+    # potential partials: dPhi/dr = g_r, dPhi/dlat = -r g_n
+    return V * xdot[3] + g_r * xdot[0] - r * g_n * xdot[2]
+
+
+def energy_domain_derivatives(x, bank, alpha, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere):
+    """dx/dE = xdot / Edot, energy as the independent variable (paper 000 eq. 37 generalised).
+
+    Also returns dt/dE as a seventh entry so time can be recovered.
+    """
+    xdot = state_derivatives(x, bank, alpha, vehicle, planet, atmosphere)
+    edot = energy_rate(x, xdot, planet)
+    return np.append(xdot / edot, 1.0 / edot)

@@ -1,0 +1,202 @@
+"""The one verdict of a flight: it succeeds only if it reached its terminal interface, ended
+inside every criterion of the acceptance box, and held every path limit.
+
+Path limits are the vehicle's (heat flux, dynamic pressure, normal and total load, bank
+limit) and the mission's own (e.g. paper 001's flight-path-angle bounds, eq. 70), given as
+``PathLimit``s. They are checked on every sample of the flown trajectory: the log samples and,
+where the runner logged them (``Trajectory.steps``), the integrator's own steps
+(``Trajectory.flown``), so a peak
+between two log samples is not missed.
+
+A limit holds when ``lower - tol |lower| <= value <= upper + tol |upper|`` at every sample, with
+``tol`` the scenario's ``terminal.path_limit_tolerance`` (relative; default 0: a limit is a
+limit). The margin of a limit is its worst relative distance to the bound,
+``(upper - peak) / |upper|`` (``1 - peak/limit`` for a positive upper limit; negative =
+breached), the smaller of the two sides for a two-sided limit.
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+
+import numpy as np
+
+from drake_entry.models.constraints import PathLimits
+
+
+@dc.dataclass(frozen=True)
+class PathLimit:
+    """A bound on one flown quantity.
+
+    Attributes:
+      name: what the row and report call it ('heat_flux', 'flight_path', ...).
+      column: the Trajectory column it reads (a state name, a flight condition, 'bank', 'alpha').
+      upper, lower: bounds in SI (rad for angles); +-inf when one-sided.
+      absolute: bound |value| instead of value (the bank limit).
+      unit, scale: the display unit and the factor from SI to it (e.g. 'kW/m^2', 1e-3).
+    """
+
+    name: str
+    column: str
+    upper: float = math.inf
+    lower: float = -math.inf
+    absolute: bool = False
+    unit: str = ""
+    scale: float = 1.0
+
+    def bound_text(self) -> str:
+        """The limit as printed in reports, e.g. '<= 530 kW/m^2', 'in [-30, 0.5] deg'."""
+        s = self.scale
+        if math.isfinite(self.lower) and math.isfinite(self.upper):
+            return f"in [{self.lower * s:.4g}, {self.upper * s:.4g}] {self.unit}".rstrip()
+        if math.isfinite(self.upper):
+            return f"{'|.| ' if self.absolute else ''}<= {self.upper * s:.4g} {self.unit}".rstrip()
+        return f">= {self.lower * s:.4g} {self.unit}".rstrip()
+
+
+def vehicle_path_limits(limits: PathLimits, bank_limit: float | None = None) -> list[PathLimit]:
+    """The vehicle's finite path limits (and |bank| <= ``bank_limit`` [rad] when given)."""
+    out = []
+    for name, column, unit, scale in (("heat_flux", "heat_flux", "kW/m^2", 1e-3),
+                                      ("dynamic_pressure", "dynamic_pressure", "kPa", 1e-3),
+                                      ("normal_load", "normal_load", "g", 1.0),
+                                      ("total_load", "total_load", "g", 1.0)):
+        value = getattr(limits, f"{name}_max")
+        if math.isfinite(value):
+            out.append(PathLimit(name, column, upper=float(value), unit=unit, scale=scale))
+    if bank_limit is not None:
+        out.append(PathLimit("bank", "bank", upper=float(bank_limit), absolute=True, unit="deg",
+                             scale=180.0 / math.pi))
+    return out
+
+
+@dc.dataclass(frozen=True)
+class LimitCheck:
+    """One path limit evaluated on a flight.
+
+    Attributes:
+      limit: the PathLimit. peak: the flown value nearest to (or furthest past) the binding
+        bound [SI]. time: when [s]. margin: relative margin (negative = breached).
+      held: within the bound widened by the tolerance.
+    """
+
+    limit: PathLimit
+    peak: float
+    time: float
+    margin: float
+    held: bool
+
+    def text(self) -> str:
+        s = self.limit.scale
+        return (f"{self.limit.name} {self.peak * s:.4g} {self.limit.unit} at t = {self.time:.1f} s "
+                f"(limit {self.limit.bound_text()}, margin {100 * self.margin:+.2f} %)")
+
+
+def check_limits(time, column, limits, tolerance: float = 0.0) -> list[LimitCheck]:
+    """Evaluate each PathLimit on the samples ``column(name)`` at ``time`` [s] (NaN samples are
+    ignored; a limit with no finite sample does not hold). ``tolerance``: relative widening of
+    every bound (>= 0)."""
+    if not tolerance >= 0.0:
+        raise ValueError(f"path-limit tolerance must be >= 0, got {tolerance}")
+    t = np.asarray(time, float)
+    out = []
+    for lim in limits:
+        v = np.asarray(column(lim.column), float)
+        v = np.abs(v) if lim.absolute else v
+        ok = np.isfinite(v)
+        if not ok.any():
+            out.append(LimitCheck(lim, math.nan, math.nan, math.nan, False))
+            continue
+        tv, vv = t[ok], v[ok]
+        candidates = []
+        if math.isfinite(lim.upper):
+            i = int(np.argmax(vv))
+            candidates.append(((lim.upper - vv[i]) / _scale(lim.upper), vv[i], tv[i],
+                               vv[i] <= lim.upper + (tolerance + ROUNDING) * abs(lim.upper)))
+        if math.isfinite(lim.lower):
+            i = int(np.argmin(vv))
+            candidates.append(((vv[i] - lim.lower) / _scale(lim.lower), vv[i], tv[i],
+                               vv[i] >= lim.lower - (tolerance + ROUNDING) * abs(lim.lower)))
+        margin, peak, when, held = min(candidates, key=lambda c: c[0])
+        out.append(LimitCheck(lim, float(peak), float(when), float(margin),
+                              bool(all(c[3] for c in candidates))))
+    return out
+
+
+def breaches_text(checks) -> str:
+    """Each breached limit of ``checks`` (LimitChecks) with its peak, time and margin, '; '
+    apart ('' when every limit held)."""
+    return "; ".join(c.text() for c in checks if not c.held)
+
+
+#: relative slack for floating-point rounding at a bound a clamp holds exactly (the bank limit)
+ROUNDING = 1e-12
+
+
+def _scale(bound: float) -> float:
+    return abs(bound) if bound != 0.0 else 1.0
+
+
+def acceptance_box(terminal, *, altitude_m: float, mach: float, distance_m: float) -> dict:
+    """The mission's acceptance box (a scenario's TerminalSpec, paper 000 Table 1) at a final
+    point: {criterion: {"error": e, "tolerance": tol, "inside": |e| <= tol}} for each criterion
+    whose tolerance is given: 'altitude' [m] about terminal.altitude_km (``altitude_m`` in the
+    scenario's datum), 'mach' about terminal.mach, 'distance' [m] to the target."""
+    t, box = terminal, {}
+    if t.altitude_km is not None and t.altitude_tolerance_km is not None:
+        box["altitude"] = (float(altitude_m - t.altitude_km * 1e3), t.altitude_tolerance_km * 1e3)
+    if t.mach is not None and t.mach_tolerance is not None:
+        box["mach"] = (float(mach - t.mach), t.mach_tolerance)
+    if t.distance_tolerance_km is not None:
+        box["distance"] = (float(distance_m), t.distance_tolerance_km * 1e3)
+    return {k: {"error": e, "tolerance": tol, "inside": bool(abs(e) <= tol)} for k, (e, tol) in box.items()}
+
+
+def box_text(name: str, b: dict) -> str:
+    """One acceptance criterion missed, in words."""
+    if name == "mach":
+        return f"error {b['error']:+.3f} outside +-{b['tolerance']:g}"
+    return f"error {b['error'] / 1e3:+.3f} km outside +-{b['tolerance'] / 1e3:g} km"
+
+
+@dc.dataclass(frozen=True)
+class Verdict:
+    """The verdict of one flight.
+
+    Attributes:
+      success: reached and inside_box and within_limits (and, for a closed loop, the guidance
+        was active with finite terminal errors: the caller folds those into ``reached``).
+      reached: the flight stopped at its terminal interface.
+      inside_box: the final state is inside every acceptance criterion.
+      within_limits: every path limit held on every flown sample.
+      checks: one LimitCheck per path limit.
+      tolerance: the relative path-limit tolerance used.
+    """
+
+    success: bool
+    reached: bool
+    inside_box: bool
+    within_limits: bool
+    checks: tuple
+    tolerance: float
+
+    @property
+    def violations(self) -> list[LimitCheck]:
+        return [c for c in self.checks if not c.held]
+
+    def violations_text(self) -> str:
+        """Each breached limit with its peak, time and margin ('' when every limit held)."""
+        return breaches_text(self.checks)
+
+    def margins(self) -> dict:
+        """{'margin_<limit>': relative margin} of every checked limit."""
+        return {f"margin_{c.limit.name}": c.margin for c in self.checks}
+
+
+def judge(tr, limits, *, reached: bool, inside_box: bool, tolerance: float = 0.0) -> Verdict:
+    """The verdict of flight ``tr`` (a Trajectory): ``limits`` checked on every flown sample
+    (log and integrator steps); ``reached`` and ``inside_box`` as the caller measured them."""
+    checks = tuple(check_limits(tr.flown_time(), tr.flown, limits, tolerance))
+    within = all(c.held for c in checks)
+    return Verdict(bool(reached and inside_box and within), bool(reached), bool(inside_box), bool(within), checks,
+                   float(tolerance))

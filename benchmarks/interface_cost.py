@@ -28,9 +28,9 @@ try:  # the guidance-method interface
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup
     from drake_entry.diagrams.sample import run_sample
     args = (ClosedLoopSetup.from_scenario(load_scenario("horus2b")),)
-except ImportError:  # before it
+except ImportError:  # before it (the planner's module path of that time)
     from drake_entry.diagrams.montecarlo import run_sample
-    from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
+    from drake_entry.planning.drag_energy import DragEnergyPlanner
     s = load_scenario("horus2b")
     args = (s, DragEnergyPlanner.from_scenario(s))
 t0 = time.perf_counter()
@@ -49,9 +49,25 @@ def _checkout(revision: str, into: str) -> str:
     return tree
 
 
-def _run(tree: str, samples: int, seed: int) -> dict:
-    env = dict(os.environ, PYTHONPATH=tree)
-    out = subprocess.run([sys.executable, "-c", _SCRIPT, str(samples), str(seed)], cwd=tree, env=env,
+def _installed_layout(tree: str, into: str) -> str:
+    """A directory importable as the tree installs: drake_entry/ with systems/ and diagrams/
+    inside it (pyproject's package-dir), made of symbolic links in ``into``."""
+    site = os.path.join(into, os.path.basename(tree) + "_site")
+    package = os.path.join(site, "drake_entry")
+    if not os.path.isdir(package):
+        os.makedirs(package)
+        for entry in os.listdir(os.path.join(tree, "drake_entry")):
+            os.symlink(os.path.join(tree, "drake_entry", entry), os.path.join(package, entry))
+        for name in ("systems", "diagrams"):
+            if not os.path.exists(os.path.join(package, name)):
+                os.symlink(os.path.join(tree, name), os.path.join(package, name))
+    return site
+
+
+def _run(site: str, samples: int, seed: int) -> dict:
+    """The samples run by the tree laid out in ``site`` (its working directory and import path)."""
+    env = dict(os.environ, PYTHONPATH=site)
+    out = subprocess.run([sys.executable, "-c", _SCRIPT, str(samples), str(seed)], cwd=site, env=env,
                          capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -60,7 +76,8 @@ def interface_cost_benchmark(*, baseline: str | None = None, rounds: int = 3, sa
                              seed: int = 7) -> dict:
     baseline = baseline or BASELINE
     with tempfile.TemporaryDirectory() as tmp:
-        trees = {f"baseline {baseline}": _checkout(baseline, tmp), "this checkout": ROOT}
+        trees = {f"baseline {baseline}": _installed_layout(_checkout(baseline, tmp), tmp),
+                 "this checkout": _installed_layout(ROOT, tmp)}
         walls = {k: [] for k in trees}
         rows = {}
         print(f"paper-000 campaign cost per sample: {samples} samples (seed {seed}) serially per side, "

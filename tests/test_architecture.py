@@ -28,11 +28,24 @@ EXCEPTIONS = {("drake_entry.planning.nlp.dircol", "drake_entry.systems.ocp_plant
 SHARED = ("drake_entry.models", "drake_entry.planning", "drake_entry.campaign", "drake_entry.errors")
 
 
+def setuptools_config() -> dict:
+    """pyproject's [tool.setuptools]: the package list and the ``package-dir`` mapping."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+    return tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+
+
+#: {repository directory: installed package} from ``package-dir`` (systems -> drake_entry.systems)
+INSTALLED_AS = {directory: name for name, directory in setuptools_config()["package-dir"].items() if name}
+
+
 def module_name(path: Path) -> str:
-    rel = path.relative_to(ROOT).with_suffix("")
-    parts = list(rel.parts)
-    if parts[0] in ("systems", "diagrams"):  # installed inside the drake_entry namespace
-        parts = ["drake_entry"] + parts
+    """A source file's module name as installed."""
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[0] in INSTALLED_AS:
+        parts = INSTALLED_AS[parts[0]].split(".") + parts[1:]
     if parts[-1] == "__init__":
         parts = parts[:-1]
     return ".".join(parts)
@@ -99,7 +112,7 @@ def violations(module: str, imported: set, known: set) -> list:
 
 
 def project_modules() -> dict:
-    files = [p for d in ("drake_entry", "systems", "diagrams") for p in (ROOT / d).rglob("*.py")]
+    files = [p for d in ["drake_entry", *INSTALLED_AS] for p in (ROOT / d).rglob("*.py")]
     return {module_name(p): p for p in files}
 
 
@@ -144,25 +157,35 @@ def test_benchmarks_live_outside_the_library(name):
 
 
 def test_every_package_directory_is_installed():
-    """pyproject lists its packages explicitly (package-dir maps systems/ and diagrams/):
-    a new package directory missing from the list would be absent from the wheel."""
-    tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
-
-    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
-    code = {module_name(p.parent / "__init__.py") for d in ("drake_entry", "systems", "diagrams")
+    """pyproject lists its packages explicitly (package-dir maps systems/ and diagrams/): a new
+    package directory missing from the list would be absent from the wheel, a stale entry would
+    install nothing."""
+    setuptools = setuptools_config()
+    listed = set(setuptools["packages"])
+    code = {module_name(p.parent / "__init__.py") for d in ["drake_entry", *INSTALLED_AS]
             for p in (ROOT / d).rglob("__init__.py")}
     assert code <= listed, sorted(code - listed)
-
-
-def test_every_listed_package_exists():
-    """No stale entry in pyproject's package list (a moved package would install empty)."""
-    tomllib = pytest.importorskip("tomllib")
-
-    setuptools = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
-    mapping = setuptools["package-dir"]
-    for name in setuptools["packages"]:
-        directory = mapping.get(name, name.replace(".", "/"))
+    for name in listed:
+        directory = setuptools["package-dir"].get(name, name.replace(".", "/"))
         assert (ROOT / directory).is_dir(), f"pyproject lists {name}, but {directory}/ does not exist"
+
+
+def test_the_tests_run_against_the_installed_package():
+    """The README's test command imports the installed package, not the working tree: a wheel
+    install is tested as users get it (an editable install maps to this tree by design)."""
+    import importlib.metadata
+    import json
+
+    import drake_entry
+    import drake_entry.systems
+
+    installs = [json.loads(d.read_text("direct_url.json") or "{}")
+                for d in importlib.metadata.distributions(name="drake_entry")]  # a stray egg-info has none
+    editable = any(i.get("dir_info", {}).get("editable", False) for i in installs)
+    inside = Path(drake_entry.__file__).resolve().is_relative_to(ROOT)
+    assert inside == editable, (drake_entry.__file__, "editable" if editable else "wheel")
+    systems_dir = Path(drake_entry.systems.__file__).resolve().parent
+    assert systems_dir == (ROOT / "systems" if editable else Path(drake_entry.__file__).resolve().parent / "systems")
 
 
 def test_loading_a_scenario_loads_specs_only():

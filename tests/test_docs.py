@@ -76,6 +76,8 @@ def test_every_page_in_the_navigation_exists():
 
     config = yaml.safe_load(_read("mkdocs.yml").replace("!!python", "#"))
     generated = {"reference/scenario.md", "reference/vehicle.md", "reference/problem.md"}
+    generated |= set(re.findall(r'\("(api/\w+\.md)"', _read("docs/hooks/reference.py")))  # the API pages
+    assert {"api/models.md", "api/guidance.md"} <= generated
 
     def pages(nav):
         for item in nav:

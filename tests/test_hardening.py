@@ -177,7 +177,7 @@ def test_a_second_writer_is_refused(tmp_path):
     out = tmp_path / "busy"
     code = ("import sys, time; from drake_entry.campaign.store import CampaignStore; "
             f"s = CampaignStore({str(out)!r}, {{'runs': 1, 'seed': 0}}); print('locked', flush=True); time.sleep(60)")
-    holder = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, cwd=ROOT)
+    holder = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
         assert holder.stdout.readline().strip() == "locked"
         from drake_entry.campaign.store import CampaignStore
@@ -195,11 +195,11 @@ def test_repeated_kills_lose_and_repeat_no_sample(tmp_path):
     code = ("from drake_entry.diagrams.montecarlo import run_campaign; "
             f"run_campaign('horus2b', runs=6, out_dir={str(out)!r}, seed=5, workers=1, progress=False)")
     for delay in (4.0, 2.5, 3.0):
-        p = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT)
+        p = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path)
         time.sleep(delay)
         p.send_signal(signal.SIGKILL)
         p.wait()
-    subprocess.run([sys.executable, "-c", code], cwd=ROOT, check=True, timeout=300)
+    subprocess.run([sys.executable, "-c", code], cwd=tmp_path, check=True, timeout=300)
     rows = [json.loads(line) for line in (out / "samples.jsonl").read_text().splitlines()]
     assert sorted(r["index"] for r in rows) == list(range(6))
     import pyarrow.parquet as pq

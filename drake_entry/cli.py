@@ -7,8 +7,8 @@ Commands:
   plan SCENARIO       the guidance method's reference plan with its figures (drag-energy:
                       corridor, reference at engagement, extraction vs propagation, paper 000 Figs. 3-5)
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
-  optimize PROBLEM    optimal reference by the NLP path (LGL pseudospectral or DirectCollocation,
-                      Ipopt or SNOPT), propagated with Drake, plots like paper 002 Figs. 1-10
+and the commands the methods and shared packages contribute (their commands.py modules), e.g.
+  optimize PROBLEM    optimal reference by the NLP path (paper 002), verified and flown by Drake
   fit-horus           refit the HORUS-2B aero forms (paper 000 eqs. 32-33); print residuals
 
 Benchmarks are scripts, not commands: python benchmarks/run.py (see README).
@@ -19,6 +19,7 @@ import argparse
 import json
 import os
 import sys
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -147,72 +148,29 @@ def _cmd_report(args) -> int:
     return 0
 
 
-def _cmd_fit_horus(args) -> int:
-    from drake_entry.models.aerodynamics import fit_horus_forms
-    from drake_entry.models.vehicles import load_vehicle
+class Command(NamedTuple):
+    """A subcommand contributed by a package: ``COMMANDS`` in a method folder's ``commands.py``
+    (found by itself) or in a shared package's (``SHARED_COMMAND_MODULES``)."""
 
-    rep = fit_horus_forms(initial_aL=load_vehicle("horus2b").aero.aL)
-    print("least-squares fit of paper 000 eqs. 32-33 to the clean, untrimmed M-692 cells")
-    print(f"C_D: {rep.cells_CD} cells, RMS {rep.rms_CD:.4f}, max |residual| {rep.max_CD:.4f}")
-    print(f"C_L: {rep.cells_CL} cells, RMS {rep.rms_CL:.4f}, max |residual| {rep.max_CL:.4f}")
-    print("aD =", [float(f"{v:.10g}") for v in rep.aD])
-    print("aL =", [float(f"{v:.10g}") for v in rep.aL])
-    return 0
+    name: str
+    help: str
+    add_arguments: Callable  # (argparse.ArgumentParser) -> None
+    run: Callable  # (argparse.Namespace) -> exit code
 
 
-def _cmd_optimize(args) -> int:
-    from drake_entry.planning import nlp
-    from drake_entry.planning.ocp_yaml import load_problem
-    from drake_entry.planning.nlp.plots import nlp_solution_plots
-    from drake_entry.campaign.tables import write_table
+#: the shared packages that contribute commands (a method folder's commands.py is found by itself)
+SHARED_COMMAND_MODULES = ("drake_entry.planning.nlp.commands",)
 
-    problem, settings = load_problem(args.problem)
-    nodes = settings.nodes if args.nodes is None else args.nodes
-    transcription = args.transcription or settings.transcription
-    solver = args.solver or settings.solver
-    tol = settings.tolerance if args.tolerance is None else args.tolerance
-    max_iterations = settings.max_iterations if args.max_iterations is None else args.max_iterations
-    guess = None
-    coarse_nodes = settings.coarse_nodes if args.coarse is None else args.coarse
-    if coarse_nodes and coarse_nodes < nodes:
-        print(f"coarse solve: {transcription}, {coarse_nodes} nodes, {solver} ...", flush=True)
-        coarse = nlp.solve(problem, transcription=transcription, solver=solver, nodes=coarse_nodes,
-                           tolerance=max(tol, 1e-6), max_iterations=max_iterations)
-        print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
-        guess = coarse if coarse.converged else None
-    refine = args.refine or settings.refine
-    max_nodes = (args.max_nodes or settings.max_nodes or None) if refine else None
-    how = f"mesh refinement from {nodes} nodes" if refine else f"{nodes} nodes"
-    print(f"solve: {problem.name}, {transcription}, {how}, {solver} ...", flush=True)
-    result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
-                       max_iterations=max_iterations, guess=guess, verify=not args.no_propagate,
-                       refine=refine, max_nodes=max_nodes, dynamics_tolerance=settings.dynamics_tolerance,
-                       propagation_tolerance=settings.propagation_tolerance)
-    check = result.verification.flight if result.verification is not None else None
-    info = nlp.summary(problem, result, check)
-    os.makedirs(args.out, exist_ok=True)
-    cols = {"time_s": result.time}
-    for i, name in enumerate(problem.state_names):
-        cols[name] = result.states[:, i]
-    for j, name in enumerate(problem.control_names):
-        cols[name] = result.controls[:, j]
-    if result.costates is not None and len(result.costate_time) == len(result.time):
-        for i, name in enumerate(problem.state_names):
-            cols[f"lambda_{name}"] = result.costates[:, i]
-        cols["hamiltonian"] = result.hamiltonian
-    write_table(cols, os.path.join(args.out, f"solution.{args.format}"))
-    with open(os.path.join(args.out, "summary.json"), "w") as f:
-        json.dump(info, f, indent=2, default=float)
-    ext = None
-    try:
-        ext = nlp.extremal_controls(problem, result)
-    except ValueError:
-        pass
-    pngs = nlp_solution_plots(problem, result, args.out, propagated=check, extremal=ext,
-                              title=f"{problem.name}: {transcription.upper()} {result.nodes} nodes, {result.solver}")
-    print(json.dumps(info, indent=2, default=float))
-    print(f"wrote solution, summary.json and {len(pngs)} plots to {args.out}")
-    return 0 if result.success else 1
+
+def contributed_commands() -> list:
+    """Every ``Command`` of the shared packages and of the method folders, in that order."""
+    import importlib
+    from importlib import resources
+
+    folder = resources.files("drake_entry.guidance")
+    methods = sorted(p.name for p in folder.iterdir() if p.is_dir() and p.joinpath("commands.py").is_file())
+    modules = list(SHARED_COMMAND_MODULES) + [f"drake_entry.guidance.{m}.commands" for m in methods]
+    return [c for name in modules for c in getattr(importlib.import_module(name), "COMMANDS", ())]
 
 
 def main(argv=None) -> int:
@@ -253,30 +211,10 @@ def main(argv=None) -> int:
     p.add_argument("--out", default="out/simulate", help="output directory")
     p.add_argument("--format", choices=("parquet", "csv"), default="parquet")
     p.set_defaults(func=_cmd_simulate)
-    o = sub.add_parser("optimize", help="optimal reference by the NLP path (paper 002)")
-    o.add_argument("problem", help="packaged problem (marv) or a problem YAML path")
-    o.add_argument("--nodes", type=int, default=None, help="LGL nodes / collocation samples (default: the YAML)")
-    o.add_argument("--transcription", choices=("lgl", "dircol"), default=None)
-    o.add_argument("--solver", choices=("auto", "ipopt", "snopt"), default=None)
-    o.add_argument("--tolerance", type=float, default=None)
-    o.add_argument("--coarse", type=int, default=None, metavar="N",
-                   help="first solve with N nodes and start the full solve from it (0 = the propagated "
-                        "guess; default: the YAML's coarse_nodes)")
-    o.add_argument("--max-iterations", type=int, default=None, metavar="N",
-                   help="solver iteration limit (default: the YAML's solve.max_iterations)")
-    o.add_argument("--refine", action="store_true",
-                   help="mesh refinement: raise the node count until the between-node error meets the "
-                        "verification tolerance (default: the YAML's solve.refine)")
-    o.add_argument("--max-nodes", type=int, default=None, metavar="N",
-                   help="mesh refinement's node cap (default: the YAML's solve.max_nodes, else 150 LGL / "
-                        "400 dircol)")
-    o.add_argument("--no-propagate", action="store_true",
-                   help="skip the verification (between-node dynamics and the Drake propagation)")
-    o.add_argument("--out", default="out/optimize")
-    o.add_argument("--format", choices=("parquet", "csv"), default="csv")
-    o.set_defaults(func=_cmd_optimize)
-    f = sub.add_parser("fit-horus", help="refit paper 000 eqs. 32-33 to the M-692 table; print residuals")
-    f.set_defaults(func=_cmd_fit_horus)
+    for command in contributed_commands():
+        parser_ = sub.add_parser(command.name, help=command.help)
+        command.add_arguments(parser_)
+        parser_.set_defaults(func=command.run)
     args = parser.parse_args(argv)
     try:
         out = getattr(args, "out", None)

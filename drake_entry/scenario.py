@@ -13,10 +13,12 @@ from typing import Optional
 import numpy as np
 
 from drake_entry.models import dispersions as disp
-from drake_entry.models.atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere, ExponentialAtmosphere, TableAtmosphere, US76Atmosphere
+from drake_entry.models.atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere
 from drake_entry.errors import ScenarioError, check_range, load_yaml_typed
 from drake_entry.guidance import GuidanceSpec, known_tags
 from drake_entry.guidance.drag_energy.spec import DragEnergy
+from drake_entry.models.environment import (AtmosphereSpec, PlanetSpec, atmosphere_from_spec,  # noqa: F401
+                                           planet_from_spec)
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import VARIABLES, Schedule
 from drake_entry.models.vehicles import Vehicle, load_vehicle
@@ -62,28 +64,6 @@ class TerminalSpec:
     # relative tolerance on every path limit (vehicle and mission): a limit counts as held up to
     # limit + this x |limit|, at every log sample and integrator step; 0: a limit is a limit
     path_limit_tolerance: float = 0.0
-
-
-@dc.dataclass
-class PlanetSpec:
-    # spherical | oblate
-    model: str = "spherical"
-    rotating: bool = True  # Earth rotation on (Coriolis and centrifugal terms)
-    j2: bool = False  # J2 gravity term on
-    # sphere / ellipsoid radius override [m] (paper 002: R_e = 6378145 m); None = WGS-84
-    radius_m: Optional[float] = None
-
-
-@dc.dataclass
-class AtmosphereSpec:
-    # us76 | exponential | table
-    model: str = "us76"
-    # exponential model only (paper 000 eq. 29)
-    rho0_kg_m3: float = 1.2256
-    scale_height_m: float = 7200.0  # exponential model only
-    # table model only: CSV path with columns altitude_m, density_kg_m3, temperature_K
-    # (relative paths are read from the working directory)
-    table_csv: str = ""
 
 
 @dc.dataclass
@@ -315,39 +295,6 @@ INTEGRATORS = ("runge_kutta5", "runge_kutta3", "radau3")
 SCHEDULE_VALUES_DEG = {"alpha": (-90.0, 90.0), "bank": (-360.0, 360.0)}
 SCHEDULE_BREAKPOINTS = {"time": (-1e5, 1e5), "normalized_energy": (-1.0, 2.0), "mach": (0.0, 100.0),
                         "velocity": (0.0, 3e4), "energy": (-1e8, 0.0)}
-
-
-def planet_from_spec(p: PlanetSpec) -> Earth:
-    """Earth model of a PlanetSpec (one-line ScenarioError on a bad field)."""
-    kw = {}
-    if p.radius_m is not None:
-        if not p.radius_m > 0:
-            raise ScenarioError(f"planet.radius_m = {p.radius_m}; allowed > 0")
-        kw = dict(reference_radius=p.radius_m, equatorial_radius=p.radius_m)
-    if p.model == "spherical":
-        return Earth.spherical(rotating=p.rotating, j2=p.j2, **kw)
-    if p.model == "oblate":
-        return Earth.oblate(omega=Earth().omega if p.rotating else 0.0, j2=Earth().j2 if p.j2 else 0.0, **kw)
-    raise ScenarioError(f"planet.model '{p.model}' is unknown; allowed: spherical, oblate")
-
-
-def atmosphere_from_spec(a: AtmosphereSpec) -> Atmosphere:
-    """Atmosphere model of an AtmosphereSpec (one-line ScenarioError on a bad field)."""
-    if a.model == "us76":
-        return US76Atmosphere()
-    if a.model == "exponential":
-        try:
-            return ExponentialAtmosphere(a.rho0_kg_m3, a.scale_height_m)
-        except ValueError as e:
-            raise ScenarioError(f"atmosphere: {e}") from None
-    if a.model == "table":
-        if not a.table_csv:
-            raise ScenarioError("atmosphere.table_csv is required for model 'table' (a CSV with the columns "
-                                "altitude_m, density_kg_m3, temperature_K)")
-        if not os.path.isfile(a.table_csv):
-            raise ScenarioError(f"atmosphere.table_csv = '{a.table_csv}' is not a file")
-        return TableAtmosphere.from_csv(a.table_csv)
-    raise ScenarioError(f"atmosphere.model '{a.model}' is unknown; allowed: us76, exponential, table")
 
 
 #: the scenarios shipped in drake_entry/scenarios (``<name>.yaml``), found in the package

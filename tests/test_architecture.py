@@ -201,3 +201,17 @@ def test_loading_a_scenario_loads_specs_only():
             "('spec', 'settings', 'mission') and n.count('.') > 2))))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert out == [], out
+
+
+def test_the_cli_knows_no_method_and_finds_every_command():
+    """drake_entry/cli.py imports no method's folder; the commands a method folder contributes
+    (COMMANDS in its commands.py) are found without a list kept by hand."""
+    from drake_entry.cli import contributed_commands
+
+    module = "drake_entry.cli"
+    imported = imports((ROOT / "drake_entry" / "cli.py").read_text(), module, False)
+    assert not [name for name in imported if method_folder(name)], imported
+    names = {c.name for c in contributed_commands()}
+    assert {"optimize", "fit-horus"} <= names
+    folders = [p.parent.name for p in (ROOT / "drake_entry" / "guidance").glob("*/commands.py")]
+    assert "drag_energy" in folders

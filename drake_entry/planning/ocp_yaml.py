@@ -28,7 +28,7 @@ from importlib import resources
 from typing import Dict, List, Optional
 
 from drake_entry.errors import ScenarioError, load_yaml_typed
-from drake_entry.scenario import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
+from drake_entry.models.environment import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
 from drake_entry.models.vehicles import load_vehicle
 from drake_entry.models.schedules import Schedule
 from drake_entry.planning.ocp import CONTROL_LAYOUTS, DEVIATION_STATES, ObjectiveTerm, OptimalControlProblem, PathConstraint

@@ -1,6 +1,7 @@
-"""``drake-entry plan`` for the drag-energy method: the corridor and the reference planned at
-engagement, with its extracted states against an open-loop propagation of the extracted
-bank (paper 000 Figs. 3-5). This module is at the CLI layer (it flies diagrams)."""
+"""The drag-energy method's commands: ``drake-entry plan`` (the corridor and the reference planned
+at engagement, with its extracted states against an open-loop propagation of the extracted bank,
+paper 000 Figs. 3-5) and ``drake-entry fit-horus`` (the HORUS-2B aerodynamic fit of paper 000
+eqs. 32-33). This module is at the CLI layer (it flies diagrams)."""
 from __future__ import annotations
 
 import dataclasses as dc
@@ -8,14 +9,14 @@ import sys
 
 import numpy as np
 
-from drake_entry.diagrams.closed_loop import fly
-from drake_entry.diagrams.open_loop import simulate
-from drake_entry.guidance.drag_energy.plots import corridor_plot, extraction_plot
-from drake_entry.models.trajectory import Trajectory
+from drake_entry.cli import Command
 
 
 def plan_report(scenario, out_dir: str) -> int:
     """Fly to engagement (plan once), plot and print the plan; exit code."""
+    from drake_entry.diagrams.closed_loop import fly
+    from drake_entry.guidance.drag_energy.plots import corridor_plot, extraction_plot
+
     scenario.guidance.replan_period_s = 0.0
     res = fly(scenario)
     mem = res.guidance.details
@@ -43,9 +44,11 @@ def plan_report(scenario, out_dir: str) -> int:
     return 0
 
 
-def propagate_extracted_bank(scenario, reference, x0) -> Trajectory:
+def propagate_extracted_bank(scenario, reference, x0):
     """Open-loop flight from x0 with the extracted bank magnitude sigma(E) and alpha(E)
-    (paper 000 Fig. 5: extracted states against open-loop propagation)."""
+    (paper 000 Fig. 5: extracted states against open-loop propagation); a ``Trajectory``."""
+    from drake_entry.diagrams.open_loop import simulate
+
     sc = dc.replace(scenario)
     x = reference.extraction
     E = reference.energy[::-1]  # increasing
@@ -58,3 +61,21 @@ def propagate_extracted_bank(scenario, reference, x0) -> Trajectory:
                              energy_MJ_kg=reference.problem.Ef / 1e6)
     sc.simulation = dc.replace(scenario.simulation, integrator="runge_kutta5", accuracy=1e-8)
     return simulate(sc, initial_state=x0)
+
+
+def fit_horus(args) -> int:
+    """Refit paper 000 eqs. 32-33 to the clean M-692 cells and print the residuals; exit 0."""
+    from drake_entry.models.aerodynamics import fit_horus_forms
+    from drake_entry.models.vehicles import load_vehicle
+
+    rep = fit_horus_forms(initial_aL=load_vehicle("horus2b").aero.aL)
+    print("least-squares fit of paper 000 eqs. 32-33 to the clean, untrimmed M-692 cells")
+    print(f"C_D: {rep.cells_CD} cells, RMS {rep.rms_CD:.4f}, max |residual| {rep.max_CD:.4f}")
+    print(f"C_L: {rep.cells_CL} cells, RMS {rep.rms_CL:.4f}, max |residual| {rep.max_CL:.4f}")
+    print("aD =", [float(f"{v:.10g}") for v in rep.aD])
+    print("aL =", [float(f"{v:.10g}") for v in rep.aL])
+    return 0
+
+
+COMMANDS = (Command("fit-horus", "refit paper 000 eqs. 32-33 to the M-692 table; print residuals",
+                    lambda parser: None, fit_horus),)

@@ -1,0 +1,92 @@
+"""``drake-entry optimize``: an optimal reference by the NLP path (paper 002: LGL pseudospectral
+or DirectCollocation, SNOPT or Ipopt), verified between the nodes and flown by the Drake
+Simulator, with figures in the form of paper 002 Figs. 1-10. CLI layer."""
+from __future__ import annotations
+
+import json
+import os
+
+from drake_entry.cli import Command
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("problem", help="packaged problem (marv, shefex3) or a problem YAML path")
+    parser.add_argument("--nodes", type=int, default=None, help="LGL nodes / collocation samples (default: the YAML)")
+    parser.add_argument("--transcription", choices=("lgl", "dircol"), default=None)
+    parser.add_argument("--solver", choices=("auto", "ipopt", "snopt"), default=None)
+    parser.add_argument("--tolerance", type=float, default=None)
+    parser.add_argument("--coarse", type=int, default=None, metavar="N",
+                        help="first solve with N nodes and start the full solve from it (0 = the propagated "
+                             "guess; default: the YAML's coarse_nodes)")
+    parser.add_argument("--max-iterations", type=int, default=None, metavar="N",
+                        help="solver iteration limit (default: the YAML's solve.max_iterations)")
+    parser.add_argument("--refine", action="store_true",
+                        help="mesh refinement: raise the node count until the between-node error meets the "
+                             "verification tolerance (default: the YAML's solve.refine)")
+    parser.add_argument("--max-nodes", type=int, default=None, metavar="N",
+                        help="mesh refinement's node cap (default: the YAML's solve.max_nodes, else 150 LGL / "
+                             "400 dircol)")
+    parser.add_argument("--no-propagate", action="store_true",
+                        help="skip the verification (between-node dynamics and the Drake propagation)")
+    parser.add_argument("--out", default="out/optimize")
+    parser.add_argument("--format", choices=("parquet", "csv"), default="csv")
+
+
+def run(args) -> int:
+    """Solve, verify, write the solution table, summary.json and figures; exit 0 when verified."""
+    from drake_entry.campaign.tables import write_table
+    from drake_entry.planning import nlp
+    from drake_entry.planning.nlp.plots import nlp_solution_plots
+    from drake_entry.planning.ocp_yaml import load_problem
+
+    problem, settings = load_problem(args.problem)
+    nodes = settings.nodes if args.nodes is None else args.nodes
+    transcription = args.transcription or settings.transcription
+    solver = args.solver or settings.solver
+    tol = settings.tolerance if args.tolerance is None else args.tolerance
+    max_iterations = settings.max_iterations if args.max_iterations is None else args.max_iterations
+    guess = None
+    coarse_nodes = settings.coarse_nodes if args.coarse is None else args.coarse
+    if coarse_nodes and coarse_nodes < nodes:
+        print(f"coarse solve: {transcription}, {coarse_nodes} nodes, {solver} ...", flush=True)
+        coarse = nlp.solve(problem, transcription=transcription, solver=solver, nodes=coarse_nodes,
+                           tolerance=max(tol, 1e-6), max_iterations=max_iterations)
+        print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
+        guess = coarse if coarse.converged else None
+    refine = args.refine or settings.refine
+    max_nodes = (args.max_nodes or settings.max_nodes or None) if refine else None
+    how = f"mesh refinement from {nodes} nodes" if refine else f"{nodes} nodes"
+    print(f"solve: {problem.name}, {transcription}, {how}, {solver} ...", flush=True)
+    result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
+                       max_iterations=max_iterations, guess=guess, verify=not args.no_propagate,
+                       refine=refine, max_nodes=max_nodes, dynamics_tolerance=settings.dynamics_tolerance,
+                       propagation_tolerance=settings.propagation_tolerance)
+    check = result.verification.flight if result.verification is not None else None
+    info = nlp.summary(problem, result, check)
+    os.makedirs(args.out, exist_ok=True)
+    cols = {"time_s": result.time}
+    for i, name in enumerate(problem.state_names):
+        cols[name] = result.states[:, i]
+    for j, name in enumerate(problem.control_names):
+        cols[name] = result.controls[:, j]
+    if result.costates is not None and len(result.costate_time) == len(result.time):
+        for i, name in enumerate(problem.state_names):
+            cols[f"lambda_{name}"] = result.costates[:, i]
+        cols["hamiltonian"] = result.hamiltonian
+    write_table(cols, os.path.join(args.out, f"solution.{args.format}"))
+    with open(os.path.join(args.out, "summary.json"), "w") as f:
+        json.dump(info, f, indent=2, default=float)
+    ext = None
+    try:
+        ext = nlp.extremal_controls(problem, result)
+    except ValueError:
+        pass
+    pngs = nlp_solution_plots(problem, result, args.out, propagated=check, extremal=ext,
+                              title=f"{problem.name}: {transcription.upper()} {result.nodes} nodes, {result.solver}")
+    print(json.dumps(info, indent=2, default=float))
+    print(f"wrote solution, summary.json and {len(pngs)} plots to {args.out}")
+    return 0 if result.success else 1
+
+
+COMMANDS = (Command("optimize", "optimal reference by the NLP path (paper 002), verified and flown by Drake",
+                    add_arguments, run),)

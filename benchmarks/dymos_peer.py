@@ -113,10 +113,10 @@ def _run_dymos(build, nodes):
 
 def dymos_benchmark(*, nodes: int = 31) -> dict:
     """Both problems, dymos and ours, printed side by side with wall-time ratios."""
+    import dataclasses as dc
+
     from drake_entry.planning import nlp
     from drake_entry.planning.nlp import catalogue
-
-    import dataclasses as dc
 
     brachistochrone, cycloid = catalogue.brachistochrone()
     # the same problem on both sides: t_f in [0.1, 5] s as dymos' example poses it (from the

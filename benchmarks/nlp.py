@@ -10,7 +10,6 @@ def nlp_benchmark(*, problem_name: str = "marv", nodes: int = 40, tolerance: flo
     split into our Python callbacks (models, Jacobians, AutoDiff packing) and the solver's
     own share (with Drake's conversions)."""
     from drake_entry.diagrams.propagation import propagate
-
     from drake_entry.planning import nlp
     from drake_entry.planning.ocp_yaml import load_problem
 

@@ -7,7 +7,6 @@ cheapest setting of each that meets it is reported, and the ratio Drake / scipy.
 """
 from __future__ import annotations
 
-
 T_FINAL = 1500.0
 
 
@@ -38,7 +37,6 @@ def open_loop_benchmark(*, repeats: int = 3, scenario_name: str = "horus2b") -> 
 
 def _open_loop_benchmark(scenario, repeats: int) -> dict:
     from drake_entry.diagrams.open_loop import simulate
-
     from drake_entry.scipy_open_loop import solve_ivp_open_loop
 
     scenario.simulation.max_time_s = T_FINAL

@@ -32,10 +32,10 @@ PAPER_TABLE3 = {"direct": (540.382, 1711.45, 1.922, 10.41), "hybrid": (540.688, 
 
 
 def _setup():
-    from drake_entry.models.atmosphere import US76Atmosphere
-    from drake_entry.models.planet import Earth
     from drake_entry.guidance.scvx.guess import glide_guess
     from drake_entry.guidance.scvx.mission import ScvxMission
+    from drake_entry.models.atmosphere import US76Atmosphere
+    from drake_entry.models.planet import Earth
     from drake_entry.models.vehicles import load_vehicle
 
     vehicle, planet, atmosphere, mission = load_vehicle("sphynx"), Earth.oblate(), US76Atmosphere(), ScvxMission()
@@ -129,8 +129,8 @@ def nlp_crosscheck(case, solves=(("dircol", "snopt", 100), ("lgl", "snopt", 60))
     """The direct minimum-heat-load problem through the NLP path from the same glide guess
     (``guidance.scvx.as_ocp``), its controls flown by the Drake Simulator, beside the SCvx plan."""
     from drake_entry.diagrams.propagation import propagate
-    from drake_entry.planning import nlp
     from drake_entry.guidance.scvx.as_ocp import nlp_form
+    from drake_entry.planning import nlp
 
     plan, wall, _ = _plan_and_fly(case)
     problem, start = nlp_form(plan)

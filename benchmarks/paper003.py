@@ -34,11 +34,19 @@ def _timed(f, repeats):
 
 
 def paper003_benchmark(cases: int = 100, out_dir: str | None = None, workers: int | None = None) -> dict:
-    from drake_entry.diagrams.ampi_accuracy import (COMPARED, UNITS, AccuracyStudy, accuracy_study, entry_offsets,
-                                                    format_summary, reconstruction_error, summarise)
+    from drake_entry.diagrams.ampi_accuracy import (
+        COMPARED,
+        UNITS,
+        AccuracyStudy,
+        accuracy_study,
+        entry_offsets,
+        format_summary,
+        reconstruction_error,
+        summarise,
+    )
     from drake_entry.diagrams.ampi_database import offset_problem
-    from drake_entry.planning import nlp
     from drake_entry.guidance.ampi.reference import DatabaseReference
+    from drake_entry.planning import nlp
     from drake_entry.planning.tracking import tvlqr
 
     planner = DatabaseReference.load("shefex3")

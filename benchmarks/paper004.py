@@ -14,10 +14,16 @@ import numpy as np
 
 def paper004_study(*, seeds: int = 20, out_dir: str = "out/paper004", scenario_name: str = "cav_h_paper004") -> dict:
     from drake_entry.guidance.swarm_bank.evaluator import HISTORY_COLUMNS
-    from drake_entry.guidance.swarm_bank.search import problem_from_scenario, search
-    from drake_entry.guidance.swarm_bank.study import (PAPER, baselines, case_optima, case_problem, swarm_statistics,
-                                                   two_parameter)
     from drake_entry.guidance.swarm_bank.plots import swarm_case_plots, swarm_convergence_plot
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario, search
+    from drake_entry.guidance.swarm_bank.study import (
+        PAPER,
+        baselines,
+        case_optima,
+        case_problem,
+        swarm_statistics,
+        two_parameter,
+    )
     from drake_entry.scenario import load_scenario
 
     t_start = time.perf_counter()

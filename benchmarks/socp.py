@@ -18,13 +18,12 @@ def socp_benchmark(*, repeats: int = 5, nodes=(20, 40, 80, 160), scenario_name: 
     (the pure convex problem), and the corridor excursion of the Clarabel profile on a
     dense energy grid (between nodes)."""
     import dataclasses as dc
+    import logging
     import math
 
-    from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner, solve_socp, plan
+    from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner, plan, solve_socp
     from drake_entry.planning.pseudospectral import LGL
     from drake_entry.scenario import load_scenario
-
-    import logging
 
     logging.getLogger("drake").setLevel(logging.WARNING)  # SCS's per-solve INFO lines
     scenario = load_scenario(scenario_name)
@@ -72,12 +71,12 @@ def scvx_solver_benchmark() -> dict:
     import logging
     import time
 
-    from drake_entry.models.atmosphere import US76Atmosphere
     from drake_entry.diagrams.plan_flight import fly_plan
-    from drake_entry.models.planet import Earth
     from drake_entry.guidance.scvx.engine import ScvxSettings
     from drake_entry.guidance.scvx.mission import ScvxMission
     from drake_entry.guidance.scvx.planner import plan_entry
+    from drake_entry.models.atmosphere import US76Atmosphere
+    from drake_entry.models.planet import Earth
     from drake_entry.models.vehicles import load_vehicle
 
     logging.getLogger("drake").setLevel(logging.WARNING)
@@ -109,9 +108,9 @@ def campaign_solver_benchmark(*, runs: int = 20, seed: int = 2018) -> dict:
     import tempfile
     import time
 
+    from drake_entry.campaign.report import _columns, summary_statistics
     from drake_entry.campaign.store import read_rows
     from drake_entry.diagrams.montecarlo import run_campaign
-    from drake_entry.campaign.report import _columns, summary_statistics
 
     print(f"\nclosed-loop horus2b campaign, the same {runs} samples (seed {seed}), one worker, "
           f"re-planning with each solver")

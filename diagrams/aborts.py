@@ -17,19 +17,28 @@ import time
 
 import numpy as np
 
-from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.diagrams.plan_flight import fly_plan
 from drake_entry.errors import ScenarioError
-from drake_entry.models.planet import Earth
-from drake_entry.guidance.scvx.aborts import (ALTERNATIVE_SITES, DESCENT_ABORT_SPACING_S, FEASIBLE_RADII_M,
-                                              GRID_SHAPE, GRID_SPACING_DEG, OPEN_SITE_RADIUS_M, case_mission, descent_abort_cases,
-                                              feasible, orbital_abort_cases)
+from drake_entry.guidance.scvx.aborts import (
+    ALTERNATIVE_SITES,
+    DESCENT_ABORT_SPACING_S,
+    FEASIBLE_RADII_M,
+    GRID_SHAPE,
+    GRID_SPACING_DEG,
+    OPEN_SITE_RADIUS_M,
+    case_mission,
+    descent_abort_cases,
+    feasible,
+    orbital_abort_cases,
+)
 from drake_entry.guidance.scvx.engine import ScvxSettings
 from drake_entry.guidance.scvx.entry import EntryProblemSettings
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.planner import plan_entry
+from drake_entry.models.atmosphere import US76Atmosphere
+from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import load_vehicle
 
 #: spacing [s] of the planned trajectory kept per case for the figures

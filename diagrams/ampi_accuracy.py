@@ -31,15 +31,16 @@ from types import SimpleNamespace
 import numpy as np
 
 from drake_entry.campaign.store import read_rows
-from drake_entry.diagrams.ampi_database import offset_problem, setup_worker as database_worker
+from drake_entry.diagrams.ampi_database import offset_problem
+from drake_entry.diagrams.ampi_database import setup_worker as database_worker
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.diagrams.propagation import propagate
 from drake_entry.errors import ScenarioError
-from drake_entry.models.geodesy import central_angle
-from drake_entry.planning import nlp
 from drake_entry.guidance.ampi.database import TrajectoryDatabase, database_path
 from drake_entry.guidance.ampi.spec import MODES
+from drake_entry.models.geodesy import central_angle
+from drake_entry.planning import nlp
 from drake_entry.planning.pseudospectral import LGL
 
 #: the states compared (eq. 13 shows h, lon, lat, V and t_f; gamma, psi and the bank too)

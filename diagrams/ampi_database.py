@@ -25,9 +25,9 @@ from drake_entry.campaign.store import read_rows, read_trajectories
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.errors import ScenarioError
-from drake_entry.planning import nlp
 from drake_entry.guidance.ampi.database import TrajectoryDatabase
 from drake_entry.guidance.ampi.grid import ParameterGrid
+from drake_entry.planning import nlp
 from drake_entry.planning.ocp_yaml import load_problem
 from drake_entry.planning.pseudospectral import lgl_nodes
 

@@ -22,27 +22,27 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from drake_entry.models.aerodynamics import ScaledAero
-from drake_entry.models.atmosphere import Atmosphere, DispersedAtmosphere
 from drake_entry.diagrams.common import add_step_loggers, run
-from drake_entry.models.dispersions import Draw
 from drake_entry.errors import ScenarioError
-from drake_entry.models.geodesy import range_and_crossrange
 from drake_entry.guidance import method_for
 from drake_entry.guidance.interface import GuidanceMethod, GuidanceSummary, PlantPorts
+from drake_entry.models.aerodynamics import ScaledAero
+from drake_entry.models.atmosphere import Atmosphere, DispersedAtmosphere
+from drake_entry.models.dispersions import Draw
+from drake_entry.models.geodesy import range_and_crossrange
 from drake_entry.models.planet import Earth
-from drake_entry.scenario import Scenario
 from drake_entry.models.schedules import Schedule
+from drake_entry.models.trajectory import Trajectory
+from drake_entry.models.vehicles import Vehicle
+from drake_entry.models.verdict import Verdict, box_text, judge
+from drake_entry.models.verdict import acceptance_box as box_at
+from drake_entry.scenario import Scenario
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.navigation import Navigation
 from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.systems.vehicle import EntryVehicle
-from drake_entry.models.trajectory import Trajectory
-from drake_entry.models.vehicles import Vehicle
-from drake_entry.models.verdict import Verdict, box_text, judge
-from drake_entry.models.verdict import acceptance_box as box_at
 
 ALTITUDE_FLOOR_M = 5000.0
 

@@ -10,8 +10,8 @@ from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.primitives import LogVectorOutput
 
 from drake_entry.errors import ModelRangeError, NonFiniteStateError
-from drake_entry.scenario import Scenario
 from drake_entry.models.trajectory import Trajectory
+from drake_entry.scenario import Scenario
 
 
 def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loop: bool = False):

@@ -19,8 +19,8 @@ from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import check_backend, run_cases, versions
 from drake_entry.diagrams.sample import TIMING_COLUMNS, TRAJECTORY_STEP_S, campaign_row, run_sample, sample_seed  # noqa: F401 (API)
 from drake_entry.errors import ScenarioError
-from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
 from drake_entry.models.vehicles import PACKAGED_VEHICLES
+from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
 
 
 def _absolute_and_hash(path: str) -> tuple[str, str]:

@@ -12,13 +12,13 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from drake_entry.diagrams.common import run
+from drake_entry.models.trajectory import Trajectory
 from drake_entry.scenario import Scenario
 from drake_entry.systems.actuators import BankActuator
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.schedule import make_schedule_source
 from drake_entry.systems.vehicle import EntryVehicle
-from drake_entry.models.trajectory import Trajectory
 
 
 def build_open_loop(scenario: Scenario):

@@ -20,16 +20,22 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.diagrams.common import add_step_loggers, collect_trajectory
+from drake_entry.guidance.scvx.planner import (
+    PROPAGATION_TOLERANCE_M,
+    FlightCheck,
+    ScvxPlan,
+    drs_point,
+    plan_path_limits,
+    terminal_distance,
+)
+from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
-from drake_entry.guidance.scvx.planner import (PROPAGATION_TOLERANCE_M, FlightCheck, ScvxPlan, drs_point,
-                                               plan_path_limits, terminal_distance)
+from drake_entry.models.vehicles import Vehicle
+from drake_entry.models.verdict import breaches_text, check_limits
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.systems.vehicle import EntryVehicle
-from drake_entry.models.vehicles import Vehicle
-from drake_entry.models.verdict import breaches_text, check_limits
 
 #: acceptance of a flown plan: DRS point within this of the plan and of the site [m]
 PLAN_TOLERANCE_M = PROPAGATION_TOLERANCE_M

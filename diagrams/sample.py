@@ -18,10 +18,10 @@ from pydrake.systems.analysis import RandomSimulation
 
 from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, build_closed_loop, summarise
 from drake_entry.diagrams.common import collect_trajectory, make_simulator
-from drake_entry.models.dispersions import draw
 from drake_entry.errors import load_yaml_typed
-from drake_entry.scenario import Scenario
+from drake_entry.models.dispersions import draw
 from drake_entry.models.trajectory import metrics
+from drake_entry.scenario import Scenario
 
 TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
 # row columns that measure this machine's wall-clock time (excluded from reproducibility)

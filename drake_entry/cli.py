@@ -27,11 +27,11 @@ from drake_entry.errors import DrakeEntryError, ScenarioError
 
 
 def _cmd_simulate(args) -> int:
-    from drake_entry.diagrams.open_loop import simulate
     from drake_entry.campaign.plots import trajectory_plots
     from drake_entry.campaign.tables import write_table
-    from drake_entry.scenario import load_scenario
+    from drake_entry.diagrams.open_loop import simulate
     from drake_entry.models.trajectory import metrics
+    from drake_entry.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
     tr = simulate(scenario)
@@ -59,10 +59,10 @@ def _cmd_simulate(args) -> int:
 
 
 def _cmd_fly(args) -> int:
-    from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
-    from drake_entry.diagrams.sample import campaign_row
     from drake_entry.campaign.plots import trajectory_plots
     from drake_entry.campaign.tables import write_table
+    from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
+    from drake_entry.diagrams.sample import campaign_row
     from drake_entry.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
@@ -127,9 +127,9 @@ def parse_overrides(items) -> dict:
 
 
 def _cmd_report(args) -> int:
+    from drake_entry.campaign.report import counts_sentence, errors_markdown, write_report
     from drake_entry.campaign.store import read_manifest
     from drake_entry.errors import load_yaml_typed
-    from drake_entry.campaign.report import counts_sentence, errors_markdown, write_report
     from drake_entry.scenario import Scenario
 
     manifest = read_manifest(args.dir) if os.path.isdir(args.dir) else None

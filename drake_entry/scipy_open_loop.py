@@ -10,9 +10,9 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from drake_entry.errors import ScenarioError
 from drake_entry.models.actuator import actuator_rates
 from drake_entry.models.dynamics import specific_energy, state_derivatives
-from drake_entry.errors import ScenarioError
 from drake_entry.scenario import Scenario
 
 

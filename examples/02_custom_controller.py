@@ -31,8 +31,8 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.claims import Claims
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
-from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.guidance.drag_energy.method import DragEnergyMethod
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.scenario import load_scenario
 
 DRAG = FLIGHT_CONDITION_NAMES.index("drag")

@@ -17,13 +17,13 @@ import os
 import numpy as np
 
 from drake_entry.claims import Claims
-from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.diagrams.closed_loop import fly
 from drake_entry.diagrams.open_loop import simulate
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
 from drake_entry.guidance.drag_energy.plots import corridor_plot
-from drake_entry.scenario import load_scenario
+from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.models.vehicles import load_vehicle
+from drake_entry.scenario import load_scenario
 
 VEHICLE_YAML = """\
 name: my_glider

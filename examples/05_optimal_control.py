@@ -22,13 +22,13 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
-from drake_entry.models.atmosphere import ExponentialAtmosphere
 from drake_entry.claims import Claims
 from drake_entry.diagrams.propagation import propagate
+from drake_entry.models.atmosphere import ExponentialAtmosphere
 from drake_entry.models.planet import Earth
+from drake_entry.models.vehicles import load_vehicle
 from drake_entry.planning.nlp import solve
 from drake_entry.planning.ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
-from drake_entry.models.vehicles import load_vehicle
 
 deg = math.radians
 

@@ -20,10 +20,10 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
+from drake_entry.campaign.report import write_report
 from drake_entry.claims import Claims
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
 from drake_entry.diagrams.montecarlo import run_campaign
-from drake_entry.campaign.report import write_report
 from drake_entry.scenario import load_scenario
 
 

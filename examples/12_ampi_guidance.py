@@ -28,8 +28,8 @@ from drake_entry.claims import Claims
 from drake_entry.diagrams import closed_loop as cl
 from drake_entry.diagrams.ampi_database import offset_problem
 from drake_entry.diagrams.montecarlo import run_campaign
-from drake_entry.planning import nlp
 from drake_entry.guidance.ampi.reference import DatabaseReference
+from drake_entry.planning import nlp
 from drake_entry.scenario import Scenario, load_scenario
 
 #: an entry between the grid levels: 110 m low, 40 m/s fast, 0.3 deg steep, 0.2 deg north

@@ -23,8 +23,8 @@ from __future__ import annotations
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.models.actuator import BANDWIDTH_RAD_S, SUBSTEP_S, actuator_rates, integrate_actuator
 from drake_entry.errors import ScenarioError
+from drake_entry.models.actuator import BANDWIDTH_RAD_S, SUBSTEP_S, actuator_rates, integrate_actuator
 
 
 class LimitedActuator(LeafSystem):

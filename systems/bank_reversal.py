@@ -18,8 +18,8 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import ScenarioError
-from drake_entry.models.geodesy import bearing
 from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle
+from drake_entry.models.geodesy import bearing
 
 
 class BankReversalLogic(LeafSystem):

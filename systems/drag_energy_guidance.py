@@ -24,8 +24,8 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
-from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner, DragEnergyReference
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 
 _DRAG = FLIGHT_CONDITION_NAMES.index("drag")
 

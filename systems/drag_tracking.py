@@ -24,9 +24,9 @@ import math
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.systems.drag_energy_guidance import sensed_drag
 
 

@@ -19,9 +19,9 @@ from __future__ import annotations
 
 from pydrake.systems.framework import EventStatus, LeafSystem, PublishEvent, WitnessFunctionDirection
 
+from drake_entry.errors import ScenarioError
 from drake_entry.models.atmosphere import US76_H_MAX
 from drake_entry.models.dynamics import specific_energy
-from drake_entry.errors import ScenarioError
 from drake_entry.models.planet import Earth
 
 #: default ceiling [m]: 100 km under the top of the US76 model (1000 km), so that an

@@ -12,8 +12,8 @@ from pydrake.systems.framework import LeafSystem
 from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, specific_energy
 from drake_entry.errors import ScenarioError
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, specific_energy
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
 

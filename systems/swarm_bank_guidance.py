@@ -34,12 +34,12 @@ import time
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.models.aerodynamics import ScaledAero
-from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.swarm_bank.evaluator import SwarmProblem
 from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, law_commands
 from drake_entry.guidance.swarm_bank.search import resolve_sigma0
+from drake_entry.models.aerodynamics import ScaledAero
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
 
 _FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
 # discrete state: law memory (3), sigma_0, re-solutions, failed ones, wall time, next re-solution

@@ -11,10 +11,18 @@ from drake_entry.campaign.store import read_rows
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.errors import CampaignError, ScenarioError
-from drake_entry.models.planet import Earth
-from drake_entry.guidance.scvx.aborts import (PAPER_TABLES, abort_statistics, case_mission, descent_abort_cases,
-                                              feasible, heading_offset, orbital_abort_cases, statistics_markdown)
+from drake_entry.guidance.scvx.aborts import (
+    PAPER_TABLES,
+    abort_statistics,
+    case_mission,
+    descent_abort_cases,
+    feasible,
+    heading_offset,
+    orbital_abort_cases,
+    statistics_markdown,
+)
 from drake_entry.guidance.scvx.mission import ScvxMission
+from drake_entry.models.planet import Earth
 
 
 # ----- the generic campaign of cases ---------------------------------------------------------
@@ -143,8 +151,8 @@ def test_descent_aborts_stop_where_the_planner_cannot_start():
     nominal's 33 used to raise 'entry_speed_m_s out of range')."""
     import numpy as np
 
-    from drake_entry.models.planet import Earth
     from drake_entry.guidance.scvx.aborts import descent_abort_cases
+    from drake_entry.models.planet import Earth
 
     t = np.linspace(0.0, 1600.0, 161)
     states = np.zeros((t.size, 6))

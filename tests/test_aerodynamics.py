@@ -1,8 +1,16 @@
 import numpy as np
 import pytest
 
-from drake_entry.models.aerodynamics import (CallableAero, CavHAero, DragPolarAero, fit_horus_forms, horus2b_table,
-                                      horus_cd_form, horus_cl_form, packaged_data)
+from drake_entry.models.aerodynamics import (
+    CallableAero,
+    CavHAero,
+    DragPolarAero,
+    fit_horus_forms,
+    horus2b_table,
+    horus_cd_form,
+    horus_cl_form,
+    packaged_data,
+)
 from drake_entry.models.data_tables import read_csv_rows
 from drake_entry.models.vehicles import load_vehicle
 

@@ -8,10 +8,9 @@ import pytest
 from scipy.interpolate import RegularGridInterpolator
 
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.ampi.database import TrajectoryDatabase, hd_matrix
+from drake_entry.guidance.ampi.database import OBJECTIVE_FACTOR, TrajectoryDatabase, hd_matrix
 from drake_entry.guidance.ampi.grid import ParameterGrid
 from drake_entry.guidance.ampi.synthesis import interpolate, select_subspace
-from drake_entry.guidance.ampi.database import OBJECTIVE_FACTOR
 from drake_entry.planning.pseudospectral import lgl_nodes
 
 

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 from pydrake.autodiffutils import AutoDiffXd
 
-from drake_entry.models.atmosphere import ExponentialAtmosphere
 from drake_entry.errors import ScenarioError
+from drake_entry.models.atmosphere import ExponentialAtmosphere
 
 # U.S. Standard Atmosphere 1976 reference densities (docs/models.md)
 US76_TABLE = [(0.0, 1.2250), (11019.0, 0.36392), (20063.0, 0.088035), (32162.0, 0.013225),
@@ -156,8 +156,8 @@ def test_bad_atmosphere_tables_are_one_line_errors(tmp_path, text, match):
 
 
 def test_table_atmosphere_outside_its_altitudes_names_the_range(tmp_path, us76):
-    from drake_entry.models.atmosphere import TableAtmosphere
     from drake_entry.errors import ModelRangeError
+    from drake_entry.models.atmosphere import TableAtmosphere
 
     atm = TableAtmosphere.from_csv(str(_us76_table_csv(tmp_path / "a.csv", us76, np.arange(20e3, 80001.0, 2e3))))
     with pytest.raises(ModelRangeError, match=r"outside the TableAtmosphere range \[20000, 80000\]"):

@@ -2,10 +2,10 @@ import numpy as np
 import pytest
 from pydrake.common import RandomGenerator
 
+from drake_entry.errors import ScenarioError
 from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.atmosphere import DispersedAtmosphere
 from drake_entry.models.dispersions import DispersionSpec, draw
-from drake_entry.errors import ScenarioError
 from drake_entry.scenario import load_scenario
 
 

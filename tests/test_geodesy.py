@@ -7,8 +7,14 @@ from pydrake.autodiffutils import AutoDiffXd
 
 from drake_entry.models.constraints import PathLimits
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
-from drake_entry.models.geodesy import (bearing, central_angle, central_angle_smooth, crossrange_from_great_circle,
-                                 downtrack_crosstrack, range_and_crossrange)
+from drake_entry.models.geodesy import (
+    bearing,
+    central_angle,
+    central_angle_smooth,
+    crossrange_from_great_circle,
+    downtrack_crosstrack,
+    range_and_crossrange,
+)
 from drake_entry.models.trajectory import Trajectory, metrics
 
 R = 6378137.0

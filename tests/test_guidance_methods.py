@@ -10,6 +10,7 @@ import pyarrow.parquet as pq
 import pytest
 from pydrake.common.yaml import yaml_dump_typed
 
+from drake_entry.campaign.report import summary_statistics, write_report
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
 from drake_entry.diagrams.montecarlo import TIMING_COLUMNS, run_campaign
 from drake_entry.errors import ScenarioError
@@ -18,7 +19,6 @@ from drake_entry.guidance.bank_profile.spec import BankProfile
 from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary
 from drake_entry.guidance.spec import GuidanceSpecBase
 from drake_entry.planning.result import PlanResult
-from drake_entry.campaign.report import summary_statistics, write_report
 from drake_entry.scenario import Scenario, load_scenario
 
 DATA = Path(__file__).parent / "data"
@@ -129,8 +129,8 @@ def test_every_registered_method_provides_the_interface():
 
 def test_planner_results_share_one_shape():
     """success, message, iterations, build_time, solve_time, objective and evaluate()."""
-    from drake_entry.planning import nlp
     from drake_entry.guidance.drag_energy.planner import DragEnergyReference
+    from drake_entry.planning import nlp
 
     for cls in (DragEnergyReference, nlp.NlpResult):
         assert issubclass(cls, PlanResult)

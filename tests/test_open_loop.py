@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from drake_entry.diagrams.open_loop import simulate
-from drake_entry.scipy_open_loop import solve_ivp_open_loop
 from drake_entry.scenario import load_scenario
+from drake_entry.scipy_open_loop import solve_ivp_open_loop
 
 
 @pytest.fixture(scope="module")
@@ -37,8 +37,8 @@ def test_run_stops_exactly_on_the_terminal_interface():
 
 
 def test_cli_simulate_writes_table_summary_and_plots(tmp_path):
-    from drake_entry.cli import main
     from drake_entry.campaign.tables import read_table
+    from drake_entry.cli import main
 
     assert main(["simulate", "horus2b", "--out", str(tmp_path), "--format", "csv"]) == 0
     t = read_table(str(tmp_path / "trajectory.csv"))

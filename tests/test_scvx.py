@@ -7,16 +7,22 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.errors import ScenarioError
-from drake_entry.models.planet import Earth
-from drake_entry.guidance.scvx.engine import (ConvexifiableProblem, Evaluation, Linearisation, ScvxSettings,
-                                              defect_correction, golden_section, solve_scvx)
-from drake_entry.guidance.scvx.entry import (PAPER_LOSSLESS, EntryProblem, EntryProblemSettings,
-                                             heading_regulariser_sign)
+from drake_entry.guidance.scvx.engine import (
+    ConvexifiableProblem,
+    Evaluation,
+    Linearisation,
+    ScvxSettings,
+    defect_correction,
+    golden_section,
+    solve_scvx,
+)
+from drake_entry.guidance.scvx.entry import PAPER_LOSSLESS, EntryProblem, EntryProblemSettings, heading_regulariser_sign
 from drake_entry.guidance.scvx.guess import glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.planner import initial_decision, plan_entry
+from drake_entry.models.atmosphere import US76Atmosphere
+from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import load_vehicle
 
 
@@ -319,8 +325,8 @@ def test_nominal_heat_load_matches_the_nlp_path(sphynx_case, nominal_plan):
     node, heat flux within the limit, its controls flown by the Drake Simulator 0.07 km from its
     terminal point."""
     from drake_entry.diagrams.propagation import propagate
-    from drake_entry.planning import nlp
     from drake_entry.guidance.scvx.as_ocp import nlp_form
+    from drake_entry.planning import nlp
 
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     plan = nominal_plan

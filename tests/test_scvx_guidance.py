@@ -106,8 +106,8 @@ def test_scvx_campaign_rows_and_report(tmp_path):
     rows carry the method's fields and the verdict, and the report counts them."""
     import pyarrow.parquet as pq
 
-    from drake_entry.diagrams.montecarlo import run_campaign
     from drake_entry.campaign.report import summary_statistics, write_report
+    from drake_entry.diagrams.montecarlo import run_campaign
 
     out = run_campaign("sphynx_paper001", runs=2, out_dir=str(tmp_path / "mc"), seed=1, workers=2, progress=False)
     rows = pq.read_table(f"{out}/samples.parquet").to_pydict()

@@ -10,10 +10,10 @@ from pydrake.autodiffutils import AutoDiffXd
 
 from drake_entry.errors import ScenarioError
 from drake_entry.models.planet import Earth
+from drake_entry.models.schedules import Schedule
 from drake_entry.planning.ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
 from drake_entry.scenario import load_scenario
-from drake_entry.models.schedules import Schedule
 
 ALPHA_LAW = Schedule.ramp(58.0, 88.0, math.radians(42.0), math.radians(17.5))  # paper 003 Table 2
 

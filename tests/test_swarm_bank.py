@@ -128,8 +128,8 @@ def test_campaign_rows_and_report_for_fixed_and_on_board_sigma0(tmp_path):
     and, on the same draws, misses by less (seed 3, fixed: 105 and 832 km)."""
     import pyarrow.parquet as pq
 
-    from drake_entry.diagrams.montecarlo import run_campaign
     from drake_entry.campaign.report import write_report
+    from drake_entry.diagrams.montecarlo import run_campaign
 
     rows = {}
     for name, period in (("fixed", 0.0), ("onboard", 400.0)):
@@ -165,10 +165,11 @@ def test_cli_plan_report_searches_flies_and_plots(tmp_path, capsys):
 def test_on_board_predictions_learn_the_lift_and_drag_the_flight_shows():
     """With sensed accelerations 4 % above (lift) and 3 % below (drag) the nominal models',
     the guidance's filtered ratios converge to 1.04 and 0.97 (30 s time constant)."""
-    from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
-    from drake_entry.guidance.swarm_bank.search import problem_from_scenario
-    from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
     from pydrake.systems.analysis import Simulator
+
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario
+    from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
+    from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
 
     p = problem_from_scenario(_scenario())
     system = SwarmBankGuidance(p, math.radians(SIGMA0_CASE1), resolve_period=1e4)  # no re-solution within 300 s

@@ -6,9 +6,14 @@ import numpy as np
 import pytest
 
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.swarm_bank.guidance_law import (alpha_for_heat_rate, alpha_for_load_factor,
-                                                     equilibrium_glide_radius, linear_bank, qeg_bank,
-                                                     qeg_sin_flight_path)
+from drake_entry.guidance.swarm_bank.guidance_law import (
+    alpha_for_heat_rate,
+    alpha_for_load_factor,
+    equilibrium_glide_radius,
+    linear_bank,
+    qeg_bank,
+    qeg_sin_flight_path,
+)
 from drake_entry.models.vehicles import load_vehicle
 
 BETA = 920.0  # paper 004, below eq. 46

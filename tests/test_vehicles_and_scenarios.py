@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from drake_entry.errors import ScenarioError
-from drake_entry.scenario import PACKAGED_SCENARIOS, load_scenario
 from drake_entry.models.vehicles import PACKAGED_VEHICLES, load_vehicle
+from drake_entry.scenario import PACKAGED_SCENARIOS, load_scenario
 
 
 @pytest.mark.parametrize("name", PACKAGED_VEHICLES)

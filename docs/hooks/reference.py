@@ -7,8 +7,8 @@ import atexit
 import os
 import shutil
 import tempfile
-import tomllib
 
+import tomllib
 from mkdocs.plugins import event_priority
 from mkdocs.structure.files import File
 

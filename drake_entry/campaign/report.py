@@ -13,9 +13,9 @@ import os
 import numpy as np
 
 from drake_entry.campaign import plots  # sets the Agg backend before pyplot is imported
+from drake_entry.campaign.plots import plt
 from drake_entry.campaign.store import coverage, read_trajectories
 from drake_entry.errors import CampaignError, DrakeEntryError, load_yaml_typed
-from drake_entry.campaign.plots import plt
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 
-from drake_entry.systems.bank_reversal import BankReversalLogic
 from drake_entry.guidance.interface import PlantPorts
+from drake_entry.systems.bank_reversal import BankReversalLogic
 
 REVERSAL_SYSTEM = "bank_reversal"
 

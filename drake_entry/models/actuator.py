@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 
-
 #: the position loop's bandwidth omega [rad/s] of the closed loop's actuators (systems/actuators.py)
 BANDWIDTH_RAD_S = 2.0
 #: the sampled actuators' integration sub-step [s]

@@ -28,8 +28,8 @@ from pydrake.autodiffutils import AutoDiffXd
 from scipy.interpolate import CubicSpline
 
 from drake_entry.errors import ScenarioError
-from drake_entry.models.scalar import clamp, is_autodiff, lift, value_of
 from drake_entry.models.data_tables import read_csv_rows
+from drake_entry.models.scalar import clamp, is_autodiff, lift, value_of
 
 DEG = np.pi / 180.0
 

@@ -28,8 +28,8 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from drake_entry.errors import ModelRangeError, ScenarioError
-from drake_entry.models.scalar import clamp, is_autodiff, is_symbolic, lift, value_of
 from drake_entry.models.data_tables import read_csv_rows
+from drake_entry.models.scalar import clamp, is_autodiff, is_symbolic, lift, value_of
 
 # U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
 G0_US76 = 9.80665  # m/s^2

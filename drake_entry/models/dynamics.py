@@ -19,9 +19,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from drake_entry.errors import NonFiniteStateError
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.constraints import dynamic_pressure, normal_load_factor, total_load_factor
-from drake_entry.errors import NonFiniteStateError
 from drake_entry.models.planet import Earth
 from drake_entry.models.scalar import promote
 from drake_entry.models.vehicles import Vehicle

@@ -10,8 +10,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from drake_entry.models import geodesy
 from drake_entry.errors import ScenarioError
+from drake_entry.models import geodesy
 
 # WGS-84 / EGM constants.
 MU_EARTH = 3.986004418e14  # m^3/s^2 (paper 000 eq. 28, corrected units)

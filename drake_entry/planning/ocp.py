@@ -22,9 +22,9 @@ from typing import Callable
 
 import numpy as np
 
+from drake_entry.errors import ScenarioError
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_derivatives
-from drake_entry.errors import ScenarioError
 from drake_entry.models.geodesy import central_angle_smooth, crossrange_from_great_circle
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule

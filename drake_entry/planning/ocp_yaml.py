@@ -29,9 +29,15 @@ from typing import Dict, List, Optional
 
 from drake_entry.errors import ScenarioError, load_yaml_typed
 from drake_entry.models.environment import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
-from drake_entry.models.vehicles import load_vehicle
 from drake_entry.models.schedules import Schedule
-from drake_entry.planning.ocp import CONTROL_LAYOUTS, DEVIATION_STATES, ObjectiveTerm, OptimalControlProblem, PathConstraint
+from drake_entry.models.vehicles import load_vehicle
+from drake_entry.planning.ocp import (
+    CONTROL_LAYOUTS,
+    DEVIATION_STATES,
+    ObjectiveTerm,
+    OptimalControlProblem,
+    PathConstraint,
+)
 
 # YAML field -> (state or control name, factor to SI)
 STATE_FIELDS = {"altitude_km": ("h", 1e3), "longitude_deg": ("lon", math.pi / 180), "latitude_deg": ("lat", math.pi / 180),

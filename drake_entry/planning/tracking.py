@@ -26,8 +26,10 @@ import time
 import numpy as np
 from pydrake.autodiffutils import ExtractGradient, InitializeAutoDiff
 from pydrake.systems.analysis import SimulatorConfig
-from pydrake.systems.controllers import (FiniteHorizonLinearQuadraticRegulator,
-                                         FiniteHorizonLinearQuadraticRegulatorOptions)
+from pydrake.systems.controllers import (
+    FiniteHorizonLinearQuadraticRegulator,
+    FiniteHorizonLinearQuadraticRegulatorOptions,
+)
 from pydrake.systems.primitives import TrajectoryLinearSystem
 from pydrake.trajectories import PiecewisePolynomial
 

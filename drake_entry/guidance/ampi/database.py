@@ -18,10 +18,10 @@ from functools import lru_cache
 import numpy as np
 
 from drake_entry.errors import ScenarioError
-from drake_entry.planning.pseudospectral import interpolation_matrix, lgl_nodes
 from drake_entry.guidance.ampi.grid import ParameterGrid
 from drake_entry.guidance.ampi.spec import MODES, database_path  # noqa: F401 (database_path: public here too)
 from drake_entry.guidance.ampi.synthesis import interpolate_corners, nearest_case, select_subspace
+from drake_entry.planning.pseudospectral import interpolation_matrix, lgl_nodes
 
 #: consistency with the neighbours (``TrajectoryDatabase.inconsistent``): a case whose
 #: objective exceeds this factor times the median of its neighbours' (a worse local branch:

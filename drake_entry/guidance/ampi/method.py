@@ -13,8 +13,8 @@ from __future__ import annotations
 import math
 
 from drake_entry.guidance.ampi.reference import DatabaseReference
-from drake_entry.systems.reference_tracking import ReferenceTracker
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
+from drake_entry.systems.reference_tracking import ReferenceTracker
 
 GUIDANCE_SYSTEM = "reference_tracker"
 

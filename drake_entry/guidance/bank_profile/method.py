@@ -13,11 +13,11 @@ import time
 
 import numpy as np
 
-from drake_entry.planning.result import PlanResult
-from drake_entry.models.schedules import Schedule
-from drake_entry.systems.schedule import ScheduleSource
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, PlantPorts
 from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_count
+from drake_entry.models.schedules import Schedule
+from drake_entry.planning.result import PlanResult
+from drake_entry.systems.schedule import ScheduleSource
 
 
 @dc.dataclass

@@ -16,9 +16,9 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import brentq
 
+from drake_entry.errors import ScenarioError
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.constraints import PathLimits
-from drake_entry.errors import ScenarioError
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 

@@ -31,15 +31,21 @@ import numpy as np
 from pydrake.solvers import ClarabelSolver, MathematicalProgram, ScsSolver, SolverOptions
 from scipy.optimize import brentq
 
-from drake_entry.models.atmosphere import Atmosphere
-from drake_entry.guidance.drag_energy.corridor import Corridor, compute_corridor
-from drake_entry.guidance.drag_energy.drag_dynamics import AlphaProfile, DragDynamics, DragTerms, drag_acceleration, drag_dynamics
 from drake_entry.errors import ScenarioError
+from drake_entry.guidance.drag_energy.corridor import Corridor, compute_corridor
+from drake_entry.guidance.drag_energy.drag_dynamics import (
+    AlphaProfile,
+    DragDynamics,
+    DragTerms,
+    drag_acceleration,
+    drag_dynamics,
+)
+from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.geodesy import bearing
 from drake_entry.models.planet import Earth
-from drake_entry.planning.pseudospectral import LGL
 from drake_entry.models.schedules import Schedule
 from drake_entry.models.vehicles import Vehicle
+from drake_entry.planning.pseudospectral import LGL
 from drake_entry.planning.result import PlanResult
 
 SOLVERS = {"clarabel": ClarabelSolver, "scs": ScsSolver}

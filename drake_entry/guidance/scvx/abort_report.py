@@ -11,10 +11,10 @@ import textwrap
 
 import numpy as np
 
-from drake_entry.campaign.store import coverage, read_trajectories
-from drake_entry.models.planet import Earth
 from drake_entry.campaign.plots import plt, save_figure
+from drake_entry.campaign.store import coverage, read_trajectories
 from drake_entry.guidance.scvx.aborts import FEASIBLE_RADII_M, abort_statistics, feasible, statistics_markdown
+from drake_entry.models.planet import Earth
 
 
 def _geodetic_track(traj: dict, planet: Earth):

@@ -25,10 +25,10 @@ import math
 
 import numpy as np
 
-from drake_entry.models import geodesy
 from drake_entry.errors import ScenarioError
-from drake_entry.models.planet import Earth
 from drake_entry.guidance.scvx.mission import ENTRY_SPEED_RANGE_M_S, SITE_RADIUS_MAX_M, ScvxMission
+from drake_entry.models import geodesy
+from drake_entry.models.planet import Earth
 
 #: the paper's grid spacing [deg] and the smallest map the issue asks for
 GRID_SPACING_DEG = 5.0

@@ -16,13 +16,13 @@ import math
 
 import numpy as np
 
-from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.errors import ScenarioError
+from drake_entry.guidance.scvx.mission import ScvxMission
+from drake_entry.guidance.scvx.planner import initial_decision
+from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.planning.ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
-from drake_entry.guidance.scvx.mission import ScvxMission
-from drake_entry.guidance.scvx.planner import initial_decision
 
 #: OptimalControlProblem objective kind of each SCvx objective the NLP path can pose
 NLP_OBJECTIVES = {"heat_load": "heat_load", "time": "final_time"}

@@ -56,19 +56,25 @@ import numpy as np
 import scipy.sparse as sp
 from pydrake.autodiffutils import AutoDiffXd, ExtractGradient, ExtractValue, InitializeAutoDiff
 
-from drake_entry.models.atmosphere import Atmosphere
-from drake_entry.models.constraints import total_load_factor
-from drake_entry.models.dynamics import STATE_NAMES, air_data, aero_accelerations, equations_of_motion_lift_components
 from drake_entry.errors import ScenarioError
-from drake_entry.models.planet import Earth
-from drake_entry.planning.pseudospectral import SegmentMesh
-from drake_entry.models.scalar import lift, value_of
-from drake_entry.models.vehicles import Vehicle
 from drake_entry.guidance.scvx.engine import ConvexifiableProblem, Evaluation, Linearisation
 from drake_entry.guidance.scvx.mission import ScvxMission
-from drake_entry.guidance.scvx.settings import (DEFAULT_PATH_MARGIN, FORMULATIONS, OBJECTIVES,  # noqa: F401
-                                               PAPER_LOSSLESS, RATE_OBJECTIVES, EntryProblemSettings,
-                                               Formulation)
+from drake_entry.guidance.scvx.settings import (  # noqa: F401
+    DEFAULT_PATH_MARGIN,
+    FORMULATIONS,
+    OBJECTIVES,
+    PAPER_LOSSLESS,
+    RATE_OBJECTIVES,
+    EntryProblemSettings,
+    Formulation,
+)
+from drake_entry.models.atmosphere import Atmosphere
+from drake_entry.models.constraints import total_load_factor
+from drake_entry.models.dynamics import STATE_NAMES, aero_accelerations, air_data, equations_of_motion_lift_components
+from drake_entry.models.planet import Earth
+from drake_entry.models.scalar import lift, value_of
+from drake_entry.models.vehicles import Vehicle
+from drake_entry.planning.pseudospectral import SegmentMesh
 
 POSITION_SCALE = np.array([1e5, 1.0, 0.1, 7e3, 0.1, 0.5])  # m, rad, rad, m/s, rad, rad
 SIGMA_SCALE, ALPHA_SCALE = 1.0, 0.5  # rad

@@ -22,13 +22,13 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
+from drake_entry.errors import ScenarioError
+from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.models import geodesy
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.dynamics import aero_accelerations, air_data, equations_of_motion
-from drake_entry.errors import ScenarioError
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
-from drake_entry.guidance.scvx.mission import ScvxMission
 
 
 @dc.dataclass(frozen=True)

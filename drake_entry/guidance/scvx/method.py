@@ -14,9 +14,16 @@ import math
 
 import numpy as np
 
+from drake_entry.guidance.interface import (
+    ActuatorLimits,
+    GuidanceCommands,
+    GuidanceMethod,
+    GuidanceSummary,
+    LoggedSignal,
+    PlantPorts,
+)
 from drake_entry.guidance.scvx.planner import ScvxPlan, plan_entry
 from drake_entry.systems.scvx_guidance import ScvxGuidance
-from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
 
 GUIDANCE_SYSTEM = "scvx_guidance"
 

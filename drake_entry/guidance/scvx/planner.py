@@ -10,21 +10,27 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
-from drake_entry.models.actuator import sampled_response
-from drake_entry.models.atmosphere import Atmosphere
-from drake_entry.models.constraints import dynamic_pressure
-from drake_entry.models.dynamics import (FLIGHT_CONDITION_NAMES, STATE_NAMES, aero_accelerations, air_data, equations_of_motion,
-                         flight_conditions)
 from drake_entry.errors import ModelRangeError, NonFiniteStateError
-from drake_entry.models.planet import Earth
-from drake_entry.models.vehicles import Vehicle
-from drake_entry.models.verdict import PathLimit, breaches_text, check_limits, vehicle_path_limits
-from drake_entry.planning.result import PlanResult
 from drake_entry.guidance.scvx.engine import ScvxSettings, max_defect, max_violation, solve_scvx
 from drake_entry.guidance.scvx.entry import EntryProblem, EntryProblemSettings
 from drake_entry.guidance.scvx.guess import GlideGuess, glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import FlightCheck
+from drake_entry.models.actuator import sampled_response
+from drake_entry.models.atmosphere import Atmosphere
+from drake_entry.models.constraints import dynamic_pressure
+from drake_entry.models.dynamics import (
+    FLIGHT_CONDITION_NAMES,
+    STATE_NAMES,
+    aero_accelerations,
+    air_data,
+    equations_of_motion,
+    flight_conditions,
+)
+from drake_entry.models.planet import Earth
+from drake_entry.models.vehicles import Vehicle
+from drake_entry.models.verdict import PathLimit, breaches_text, check_limits, vehicle_path_limits
+from drake_entry.planning.result import PlanResult
 
 #: the lossless gap is judged where the lift can act: L >= this fraction of g0
 GAP_LIFT_FRACTION = 0.05

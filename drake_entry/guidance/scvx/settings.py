@@ -9,7 +9,6 @@ import math
 
 from drake_entry.errors import ScenarioError
 
-
 #: convergence tolerances by solver where they differ from ScvxSettings' (``for_solver``)
 SOLVER_TOLERANCES = {"scs": {"defect_tolerance": 1e-5, "constraint_tolerance": 1e-5, "decrease_tolerance": 1e-3}}
 

@@ -6,7 +6,6 @@ from __future__ import annotations
 import sys
 
 
-
 def plan_report(scenario, out_dir: str) -> int:
     """Plan, fly once (nominal), print the comparison and write the figures; exit code 0 when
     the plan is verified and the flight agrees with it (2 km along-track, 20 m altitude)."""

@@ -22,13 +22,13 @@ import math
 
 import numpy as np
 
+from drake_entry.errors import ScenarioError
+from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, LawSettings, law_commands
 from drake_entry.models.actuator import integrate_actuators
+from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle
 from drake_entry.models.constraints import dynamic_pressure
 from drake_entry.models.dynamics import aero_accelerations, equations_of_motion, state_derivatives
-from drake_entry.errors import ScenarioError
 from drake_entry.models.geodesy import bearings, downtrack_crosstrack
-from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle
-from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, LawSettings, law_commands
 
 #: J of eq. 32: range error over 100 nmi, altitude error over 1 km, speed error over 100 m/s
 RANGE_UNIT_M, ALTITUDE_UNIT_M, SPEED_UNIT_M_S = 1.852e5, 1e3, 100.0

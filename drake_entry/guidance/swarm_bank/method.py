@@ -15,13 +15,26 @@ import time
 
 import numpy as np
 
-from drake_entry.planning.result import PlanResult
-from drake_entry.guidance.swarm_bank.evaluator import CONTROL_COLUMNS, HISTORY_COLUMNS, Evaluation, SwarmProblem, evaluate
+from drake_entry.guidance.interface import (
+    ActuatorLimits,
+    GuidanceCommands,
+    GuidanceMethod,
+    GuidanceSummary,
+    LoggedSignal,
+    PlantPorts,
+)
+from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_count
+from drake_entry.guidance.swarm_bank.evaluator import (
+    CONTROL_COLUMNS,
+    HISTORY_COLUMNS,
+    Evaluation,
+    SwarmProblem,
+    evaluate,
+)
 from drake_entry.guidance.swarm_bank.search import SearchResult, problem_from_scenario, search
 from drake_entry.models.verdict import acceptance_box, box_text, breaches_text, check_limits, vehicle_path_limits
+from drake_entry.planning.result import PlanResult
 from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
-from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
-from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_count
 
 GUIDANCE_SYSTEM = "swarm_bank_guidance"
 #: the replica's recorded column of each path-limit column it can check (the closed loop's

@@ -24,9 +24,16 @@ import numpy as np
 from scipy import optimize
 
 from drake_entry.errors import ScenarioError
-from drake_entry.models.geodesy import destination
 from drake_entry.guidance.swarm_bank.evaluator import Evaluation, SwarmProblem, evaluate
-from drake_entry.guidance.swarm_bank.optimizers import PSO_CONSTRICTION, PSO_PAPER, SwarmResult, minimise, pio_search, pso_search
+from drake_entry.guidance.swarm_bank.optimizers import (
+    PSO_CONSTRICTION,
+    PSO_PAPER,
+    SwarmResult,
+    minimise,
+    pio_search,
+    pso_search,
+)
+from drake_entry.models.geodesy import destination
 
 SWARMS = ("pio", "pso", "pso_stable")
 BASELINES = ("grid", "brentq", "secant", "bounded", "differential_evolution")

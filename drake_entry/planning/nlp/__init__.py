@@ -49,10 +49,12 @@ from drake_entry.planning.nlp.guess import initial_guess
 from drake_entry.planning.nlp.lgl import _LglTranscription
 from drake_entry.planning.nlp.mesh import MAX_NODES, MeshStep, mesh_error, next_nodes  # noqa: F401 (API)
 from drake_entry.planning.nlp.result import NlpError, NlpResult, extremal_controls, summary  # noqa: F401 (API)
-from drake_entry.planning.nlp.scaling import Scaling, resolve as resolve_scaling  # noqa: F401 (API)
+from drake_entry.planning.nlp.scaling import Scaling  # noqa: F401 (API)
+from drake_entry.planning.nlp.scaling import resolve as resolve_scaling
 from drake_entry.planning.nlp.status import restartable, verdict
 from drake_entry.planning.nlp.transcription import COSTATE_SIGN  # noqa: F401 (API)
-from drake_entry.planning.nlp.verify import DYNAMICS_TOLERANCE, PROPAGATION_TOLERANCE, Verification, verify as verify_solution  # noqa: F401
+from drake_entry.planning.nlp.verify import DYNAMICS_TOLERANCE, PROPAGATION_TOLERANCE, Verification  # noqa: F401
+from drake_entry.planning.nlp.verify import verify as verify_solution
 
 TRANSCRIPTIONS = ("lgl", "dircol")
 #: a solver stopped near an optimum (status.restartable) at a point this feasible (largest

@@ -5,10 +5,10 @@ import numpy as np
 from pydrake.autodiffutils import ExtractGradient, ExtractValue, InitializeAutoDiff
 from pydrake.solvers import MathematicalProgram
 
-from drake_entry.planning.pseudospectral import LGL
 from drake_entry.planning.nlp.evaluator import _chain, _NodeEvaluator
 from drake_entry.planning.nlp.result import NlpResult
 from drake_entry.planning.nlp.transcription import _Transcription
+from drake_entry.planning.pseudospectral import LGL
 
 
 class _LglTranscription(_Transcription):

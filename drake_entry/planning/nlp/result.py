@@ -7,10 +7,10 @@ import dataclasses as dc
 import numpy as np
 
 from drake_entry.errors import DrakeEntryError, ScenarioError
-from drake_entry.planning.pseudospectral import interpolation_matrix
-from drake_entry.planning.ocp import OptimalControlProblem
-from drake_entry.planning.result import PlanResult
 from drake_entry.planning.nlp.evaluator import model_values
+from drake_entry.planning.ocp import OptimalControlProblem
+from drake_entry.planning.pseudospectral import interpolation_matrix
+from drake_entry.planning.result import PlanResult
 
 
 @dc.dataclass

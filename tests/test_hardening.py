@@ -1,4 +1,4 @@
-"""Issue 11: no hang, no traceback, no false success, no silently mixed campaign. Each test
+"""Hardening: no hang, no traceback, no false success, no silently mixed campaign. Each test
 reproduces one finding from the packaged horus2b scenario or the API."""
 import json
 import math

@@ -318,7 +318,7 @@ def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, no
 
 @pytest.mark.slow
 def test_nominal_heat_load_matches_the_nlp_path(sphynx_case, nominal_plan):
-    """Issue 13's evidence: the same direct minimum-heat-load problem (``as_ocp.mission_problem``:
+    """Paper 001 Table 3 against the NLP path: the same direct minimum-heat-load problem (``as_ocp.mission_problem``:
     same models, limits and DRS box) through ``nlp.solve`` with DirectCollocation + SNOPT at 100
     samples from the same glide guess: the SCvx heat load within 1 % of it (measured 476.15 vs
     475.02 MJ/m^2, +0.24 %). The NLP answer is checked as an answer: its DRS box met at the final
@@ -345,7 +345,7 @@ def test_nominal_heat_load_matches_the_nlp_path(sphynx_case, nominal_plan):
 
 
 def test_nominal_lossless_plan_converges_in_35_iterations_and_its_real_bank_flies(sphynx_case, lossless_plan):
-    """Issue 13's evidence: the nominal lossless heat-load plan (u = (cos, sin) of the bank, eqs.
+    """Paper 001 Table 3, lossless bank: the nominal lossless heat-load plan (u = (cos, sin) of the bank, eqs.
     37-45, with the floor |u| >= 0.99 and the bank-rate chords) converges from the glide guess
     in <= 35 iterations (measured 27: the projection of nearly feasible points and the
     convergence test at feasible points cut the tail of 37) with defects <= 1e-6,

@@ -17,6 +17,20 @@ class ScenarioError(DrakeEntryError, ValueError):
     field, the value and the allowed range."""
 
 
+class FieldError(ScenarioError):
+    """A ScenarioError about one field of a settings object: ``<owner>.<field> <complaint>``.
+    A spec that passes its own fields on to a settings object re-raises it under its own name
+    (``under("guidance")``), so the message names the field the user wrote."""
+
+    def __init__(self, owner: str, field: str, complaint: str):
+        super().__init__(f"{owner}.{field} {complaint}")
+        self.owner, self.field, self.complaint = owner, field, complaint
+
+    def under(self, owner: str) -> "FieldError":
+        """The same complaint about the same field, owned by ``owner``."""
+        return FieldError(owner, self.field, self.complaint)
+
+
 class NonFiniteStateError(DrakeEntryError, FloatingPointError):
     """The equations of motion produced NaN or infinity (a NaN command, model or state):
     a simulation stops there with this as its reason instead of integrating garbage."""

@@ -168,6 +168,12 @@ def test_every_package_directory_is_installed():
     for name in listed:
         directory = setuptools["package-dir"].get(name, name.replace(".", "/"))
         assert (ROOT / directory).is_dir(), f"pyproject lists {name}, but {directory}/ does not exist"
+    for name, patterns in setuptools["package-data"].items():  # every data file ships
+        assert name in listed, f"package-data names {name}, which is not a listed package"
+        assert any(any((ROOT / name.replace(".", "/")).glob(p)) for p in patterns), (name, patterns)
+    data_dirs = {p.parent.relative_to(ROOT).as_posix().replace("/", ".") for p in (ROOT / "drake_entry").rglob("*")
+                 if p.suffix in (".yaml", ".csv", ".npz")}
+    assert data_dirs <= set(setuptools["package-data"]), sorted(data_dirs - set(setuptools["package-data"]))
 
 
 def test_the_tests_run_against_the_installed_package():

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from drake_entry.errors import ScenarioError
+from drake_entry.errors import FieldError
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
 from drake_entry.models.verdict import PathLimit
@@ -85,7 +85,7 @@ class ScvxMission:
     def __post_init__(self):
         def check(field, value, lo, hi, unit):
             if not (isinstance(value, (int, float)) and lo <= value <= hi):
-                raise ScenarioError(f"ScvxMission.{field} = {value!r} is out of range [{lo}, {hi}] {unit}")
+                raise FieldError("ScvxMission", field, f"= {value!r} is out of range [{lo}, {hi}] {unit}")
 
         check("entry_altitude_m", self.entry_altitude_m, 0.0, 200e3, "m")
         check("entry_speed_m_s", self.entry_speed_m_s, *ENTRY_SPEED_RANGE_M_S, "m/s")
@@ -104,7 +104,7 @@ class ScvxMission:
                           ("alpha_bounds_deg", 0.0, 60.0)):
             v = tuple(getattr(self, f))
             if len(v) != 2 or not lo <= v[0] < v[1] <= hi:
-                raise ScenarioError(f"ScvxMission.{f} = {v} needs two values {lo} <= low < high <= {hi}")
+                raise FieldError("ScvxMission", f, f"= {v} needs two values {lo} <= low < high <= {hi}")
         if self.final_altitude_margin_m is not None:
             check("final_altitude_margin_m", self.final_altitude_margin_m, 0.0,
                   0.49 * (self.final_altitude_m[1] - self.final_altitude_m[0]), "m (under half the DRS window)")
@@ -113,13 +113,13 @@ class ScvxMission:
         if self.entry_alpha_deg is not None:
             check("entry_alpha_deg", self.entry_alpha_deg, *self.alpha_bounds_deg, "deg (alpha_bounds_deg)")
         if len(self.alpha_deg) != 2 or not all(0.0 <= a <= 60.0 for a in self.alpha_deg):
-            raise ScenarioError(f"ScvxMission.alpha_deg = {tuple(self.alpha_deg)} needs two angles in [0, 60] deg "
+            raise FieldError("ScvxMission", "alpha_deg", f"= {tuple(self.alpha_deg)} needs two angles in [0, 60] deg "
                                 f"(high speed, low speed)")
         if not self.flight_path_bounds_deg[0] <= self.entry_flight_path_deg <= self.flight_path_bounds_deg[1] + 1e-9:
-            raise ScenarioError(f"ScvxMission.entry_flight_path_deg = {self.entry_flight_path_deg} lies outside "
+            raise FieldError("ScvxMission", "entry_flight_path_deg", f"= {self.entry_flight_path_deg} lies outside "
                                 f"flight_path_bounds_deg = {tuple(self.flight_path_bounds_deg)}")
         if not self.heading_bounds_deg[0] <= self.entry_heading_deg <= self.heading_bounds_deg[1]:
-            raise ScenarioError(f"ScvxMission.entry_heading_deg = {self.entry_heading_deg} lies outside "
+            raise FieldError("ScvxMission", "entry_heading_deg", f"= {self.entry_heading_deg} lies outside "
                                 f"heading_bounds_deg = {tuple(self.heading_bounds_deg)}")
 
     @staticmethod

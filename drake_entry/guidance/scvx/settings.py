@@ -7,7 +7,7 @@ from __future__ import annotations
 import dataclasses as dc
 import math
 
-from drake_entry.errors import ScenarioError
+from drake_entry.errors import FieldError, ScenarioError
 
 #: convergence tolerances by solver where they differ from ScvxSettings' (``for_solver``)
 SOLVER_TOLERANCES = {"scs": {"defect_tolerance": 1e-5, "constraint_tolerance": 1e-5, "decrease_tolerance": 1e-3}}
@@ -76,19 +76,19 @@ class ScvxSettings:
             raise ScenarioError(f"ScvxSettings rho0 <= rho1 <= rho2 must lie in [0, 1], got "
                                 f"{self.rho0}, {self.rho1}, {self.rho2}")
         if not self.trust_factor > 1.0:
-            raise ScenarioError(f"ScvxSettings.trust_factor = {self.trust_factor} must be > 1")
+            raise FieldError("ScvxSettings", "trust_factor", f"= {self.trust_factor} must be > 1")
         if not 0.0 < self.trust_radius_min <= self.trust_radius <= self.trust_radius_max:
             raise ScenarioError("ScvxSettings needs 0 < trust_radius_min <= trust_radius <= trust_radius_max")
         if not (isinstance(self.max_iterations, int) and self.max_iterations >= 1):
-            raise ScenarioError(f"ScvxSettings.max_iterations = {self.max_iterations} must be an integer >= 1")
+            raise FieldError("ScvxSettings", "max_iterations", f"= {self.max_iterations} must be an integer >= 1")
         if not (isinstance(self.line_search_steps, int) and 0 <= self.line_search_steps <= 30):
-            raise ScenarioError(f"ScvxSettings.line_search_steps = {self.line_search_steps} must be in [0, 30]")
+            raise FieldError("ScvxSettings", "line_search_steps", f"= {self.line_search_steps} must be in [0, 30]")
         for name in ("virtual_control_weight", "buffer_weight", "defect_tolerance", "constraint_tolerance",
                      "decrease_tolerance", "projection_defect_limit"):
             if not getattr(self, name) > 0.0:
-                raise ScenarioError(f"ScvxSettings.{name} = {getattr(self, name)} must be > 0")
+                raise FieldError("ScvxSettings", name, f"= {getattr(self, name)} must be > 0")
         if self.solver not in ("clarabel", "scs"):
-            raise ScenarioError(f"ScvxSettings.solver = '{self.solver}'; allowed: clarabel, scs")
+            raise FieldError("ScvxSettings", "solver", f"= '{self.solver}'; allowed: clarabel, scs")
 
 
 @dc.dataclass(frozen=True)
@@ -164,36 +164,36 @@ class EntryProblemSettings:
 
     def __post_init__(self):
         if self.formulation not in FORMULATIONS:
-            raise ScenarioError(f"EntryProblemSettings.formulation = '{self.formulation}'; allowed: "
+            raise FieldError("EntryProblemSettings", "formulation", f"= '{self.formulation}'; allowed: "
                                 f"{', '.join(FORMULATIONS)}")
         if self.objective not in OBJECTIVES:
-            raise ScenarioError(f"EntryProblemSettings.objective = '{self.objective}'; allowed: {', '.join(OBJECTIVES)}")
+            raise FieldError("EntryProblemSettings", "objective", f"= '{self.objective}'; allowed: {', '.join(OBJECTIVES)}")
         if self.objective in RATE_OBJECTIVES and self.formulation == "lossless":
-            raise ScenarioError(f"EntryProblemSettings.objective = '{self.objective}' needs a formulation with rate "
+            raise FieldError("EntryProblemSettings", "objective", f"= '{self.objective}' needs a formulation with rate "
                                 f"controls (hybrid, direct_bank, direct), not 'lossless'")
         if not (isinstance(self.segments, int) and 1 <= self.segments <= 2000):
-            raise ScenarioError(f"EntryProblemSettings.segments = {self.segments} must be an integer in [1, 2000]")
+            raise FieldError("EntryProblemSettings", "segments", f"= {self.segments} must be an integer in [1, 2000]")
         if not (isinstance(self.nodes_per_segment, int) and 2 <= self.nodes_per_segment <= 12):
-            raise ScenarioError(f"EntryProblemSettings.nodes_per_segment = {self.nodes_per_segment} must be an "
+            raise FieldError("EntryProblemSettings", "nodes_per_segment", f"= {self.nodes_per_segment} must be an "
                                 f"integer in [2, 12]")
         if not 0.0 <= self.heading_weight <= 10.0:
-            raise ScenarioError(f"EntryProblemSettings.heading_weight = {self.heading_weight} must be in [0, 10]")
+            raise FieldError("EntryProblemSettings", "heading_weight", f"= {self.heading_weight} must be in [0, 10]")
         if not 1e-4 <= self.max_lossless_gap <= 1.0:
-            raise ScenarioError(f"EntryProblemSettings.max_lossless_gap = {self.max_lossless_gap} must be in "
+            raise FieldError("EntryProblemSettings", "max_lossless_gap", f"= {self.max_lossless_gap} must be in "
                                 f"[1e-4, 1] (1: the paper's relaxation, no floor on |u|)")
         if self.path_margin is None:
             self.path_margin = DEFAULT_PATH_MARGIN[FORMULATIONS[self.formulation].bank]
         if not 0.0 <= self.path_margin <= 0.5:
-            raise ScenarioError(f"EntryProblemSettings.path_margin = {self.path_margin} must be in [0, 0.5]")
+            raise FieldError("EntryProblemSettings", "path_margin", f"= {self.path_margin} must be in [0, 0.5]")
         margins = tuple(self.flight_path_margins_deg)
         if len(margins) != 2 or not all(isinstance(v, (int, float)) and 0.0 <= v <= 5.0 for v in margins):
-            raise ScenarioError(f"EntryProblemSettings.flight_path_margins_deg = {margins} needs two margins in "
+            raise FieldError("EntryProblemSettings", "flight_path_margins_deg", f"= {margins} needs two margins in "
                                 f"[0, 5] deg (above the lower bound, below the upper)")
         self.flight_path_margins_deg = tuple(float(v) for v in margins)
         if not 0.0 <= self.bank_margin_deg <= 20.0:
-            raise ScenarioError(f"EntryProblemSettings.bank_margin_deg = {self.bank_margin_deg} must be in [0, 20] deg")
+            raise FieldError("EntryProblemSettings", "bank_margin_deg", f"= {self.bank_margin_deg} must be in [0, 20] deg")
         if self.heading_sign not in (-1.0, 0.0, 1.0):
-            raise ScenarioError(f"EntryProblemSettings.heading_sign = {self.heading_sign} must be -1, 0 or +1")
+            raise FieldError("EntryProblemSettings", "heading_sign", f"= {self.heading_sign} must be -1, 0 or +1")
 
 
 #: EntryProblemSettings.path_margin by the bank's form (Formulation.bank) when not given

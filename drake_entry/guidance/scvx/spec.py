@@ -4,19 +4,10 @@ import dataclasses as dc
 import math
 from typing import Optional
 
-from drake_entry.errors import ScenarioError, check_range
+from drake_entry.errors import FieldError, ScenarioError, check_range
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
 from drake_entry.guidance.spec import GuidanceSpecBase
-
-#: spec fields passed to ScvxMission and EntryProblemSettings under the same names (max_iterations
-#: and solver go to ScvxSettings.for_solver)
-MISSION_FIELDS = ("site_radius_m", "final_altitude_m", "final_altitude_margin_m", "final_mach_max",
-                  "final_vertical_speed_min_m_s", "flight_path_bounds_deg", "heading_bounds_deg", "bank_min_deg",
-                  "alpha_deg", "alpha_speeds_m_s", "alpha_bounds_deg", "alpha_rate_limit_deg_s")
-PROBLEM_FIELDS = ("formulation", "objective", "segments", "nodes_per_segment", "path_margin",
-                  "flight_path_margins_deg", "bank_margin_deg")
-
 
 @dc.dataclass
 class Scvx(GuidanceSpecBase):
@@ -81,7 +72,7 @@ class Scvx(GuidanceSpecBase):
         """The ScvxMission: entry state and target from the scenario (geocentric, converted to
         paper 001's geodetic form), the rest from this spec."""
         t = scenario.target
-        fields = {k: getattr(self, k) for k in MISSION_FIELDS}  # final_altitude_margin_m may be None
+        fields = {k: getattr(self, k) for k in shared_fields(self, ScvxMission)}  # a margin may be None
         fields.update({k: tuple(v) for k, v in fields.items() if isinstance(v, list)})  # ScvxMission's pairs
         return _named(lambda: ScvxMission.from_geocentric(
             scenario.make_planet(), scenario.initial_state(), math.radians(t.longitude_deg),
@@ -93,7 +84,7 @@ class Scvx(GuidanceSpecBase):
         return FlightCheck(period_s=self.period_s, lead_s=self.command_lead_s)
 
     def planner_settings(self) -> tuple[EntryProblemSettings, ScvxSettings]:
-        given = {k: getattr(self, k) for k in PROBLEM_FIELDS if getattr(self, k) is not None}
+        given = {k: getattr(self, k) for k in shared_fields(self, EntryProblemSettings) if getattr(self, k) is not None}
         return (_named(lambda: EntryProblemSettings(**given)),
                 _named(lambda: ScvxSettings.for_solver(self.solver, max_iterations=self.max_iterations)))
 
@@ -116,12 +107,17 @@ class Scvx(GuidanceSpecBase):
                                 f"{self.final_mach_max}")
 
 
+def shared_fields(spec, settings_class) -> list[str]:
+    """The spec's fields that ``settings_class`` has under the same name (the spec passes them on;
+    max_iterations and solver go to ScvxSettings.for_solver)."""
+    theirs = {f.name for f in dc.fields(settings_class)}
+    return [f.name for f in dc.fields(spec) if f.name in theirs and f.name not in ("max_iterations", "solver")]
+
+
 def _named(build):
-    """build(), its ScenarioError naming the spec's field ('guidance.x') instead of the class's."""
+    """build(), a FieldError of the settings it builds re-raised naming the spec's field
+    ('guidance.x'), the field the user wrote."""
     try:
         return build()
-    except ScenarioError as e:
-        message = str(e)
-        for owner in ("ScvxMission.", "EntryProblemSettings.", "ScvxSettings."):
-            message = message.replace(owner, "guidance.")
-        raise ScenarioError(message) from None
+    except FieldError as e:
+        raise e.under("guidance") from None

@@ -188,8 +188,8 @@ def test_the_tests_run_against_the_installed_package():
     installs = [json.loads(d.read_text("direct_url.json") or "{}")
                 for d in importlib.metadata.distributions(name="drake_entry")]  # a stray egg-info has none
     editable = any(i.get("dir_info", {}).get("editable", False) for i in installs)
-    inside = Path(drake_entry.__file__).resolve().is_relative_to(ROOT)
-    assert inside == editable, (drake_entry.__file__, "editable" if editable else "wheel")
+    from_tree = Path(drake_entry.__file__).resolve().parent == ROOT / "drake_entry"
+    assert from_tree == editable, (drake_entry.__file__, "editable" if editable else "wheel")
     systems_dir = Path(drake_entry.systems.__file__).resolve().parent
     assert systems_dir == (ROOT / "systems" if editable else Path(drake_entry.__file__).resolve().parent / "systems")
 

@@ -180,7 +180,7 @@ def test_drag_tracking_recovers_from_a_perturbed_entry(scenario, planner):
 
 
 def test_drag_tracking_sign_convention_requires_negative_zeta(planner):
-    from drake_entry.systems.drag_tracking import DragTrackingController
+    from drake_entry.systems.drag_energy_tracking import DragTrackingController
 
     with pytest.raises(ValueError, match="zeta must be < 0"):
         DragTrackingController(planner, zeta=0.7, omega=1e-6)

@@ -16,7 +16,7 @@ from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
 from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_count
 from drake_entry.systems.drag_energy_guidance import DragEnergyGuidance
-from drake_entry.systems.drag_tracking import DragTrackingController
+from drake_entry.systems.drag_energy_tracking import DragTrackingController
 
 REFERENCE_COLUMNS = ("reference_drag_m_s2", "reference_drag_slope_1_m", "reference_drag_curvature_s2_m3",
                      "guidance_engaged")

@@ -9,6 +9,7 @@ from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
 from drake_entry.guidance.spec import GuidanceSpecBase
 
+
 @dc.dataclass
 class Scvx(GuidanceSpecBase):
     """An SCvx plan (paper 001) from the entry state to the target's DRS box (eqs. 64-70),

@@ -46,8 +46,8 @@ def _setup():
 
 def _plan_and_fly(case, **settings):
     from drake_entry.diagrams.plan_flight import fly_plan
-    from drake_entry.guidance.scvx.entry import EntryProblemSettings
     from drake_entry.guidance.scvx.planner import plan_entry
+    from drake_entry.guidance.scvx.settings import EntryProblemSettings
 
     vehicle, planet, atmosphere, mission, guess, guess_s = case
     t1 = time.perf_counter()
@@ -57,7 +57,7 @@ def _plan_and_fly(case, **settings):
 
 
 def table2(case) -> list:
-    from drake_entry.guidance.scvx.entry import OBJECTIVES
+    from drake_entry.guidance.scvx.settings import OBJECTIVES
 
     print("\nTable 2 form: objectives, direct bank and alpha, 33 x 4 Lobatto (100 nodes); "
           "'ok' = plan.success: converged, checked between the nodes, its controls flown through the "
@@ -82,7 +82,7 @@ def table3(case) -> list:
     print(f"{'formulation':>14s} {'Q MJ/m2':>8s} {'paper':>8s} {'t_f s':>6s} {'paper':>7s} {'max g':>6s} {'paper':>6s} "
           f"{'plan DRS km':>11s} {'flown DRS km':>12s} {'flown-site km':>13s} {'paper':>6s} {'flown-plan km':>13s} "
           f"{'gap':>6s} {'iters':>5s} {'ok':>5s}  why not")
-    from drake_entry.guidance.scvx.entry import PAPER_LOSSLESS
+    from drake_entry.guidance.scvx.settings import PAPER_LOSSLESS
 
     rows = []
     # the library's forms (lossless bank with the |u| floor, rate chords and 2 % path margin), and

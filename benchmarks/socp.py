@@ -72,9 +72,9 @@ def scvx_solver_benchmark() -> dict:
     import time
 
     from drake_entry.diagrams.plan_flight import fly_plan
-    from drake_entry.guidance.scvx.engine import ScvxSettings
     from drake_entry.guidance.scvx.mission import ScvxMission
     from drake_entry.guidance.scvx.planner import plan_entry
+    from drake_entry.guidance.scvx.settings import ScvxSettings
     from drake_entry.models.atmosphere import US76Atmosphere
     from drake_entry.models.planet import Earth
     from drake_entry.models.vehicles import load_vehicle

@@ -33,10 +33,9 @@ from drake_entry.guidance.scvx.aborts import (
     feasible,
     orbital_abort_cases,
 )
-from drake_entry.guidance.scvx.engine import ScvxSettings
-from drake_entry.guidance.scvx.entry import EntryProblemSettings
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.planner import plan_entry
+from drake_entry.guidance.scvx.settings import EntryProblemSettings, ScvxSettings
 from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import load_vehicle

@@ -37,8 +37,8 @@ from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.diagrams.propagation import propagate
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.ampi.database import TrajectoryDatabase, database_path
-from drake_entry.guidance.ampi.spec import MODES
+from drake_entry.guidance.ampi.database import TrajectoryDatabase
+from drake_entry.guidance.ampi.spec import MODES, database_path
 from drake_entry.models.geodesy import central_angle
 from drake_entry.planning import nlp
 from drake_entry.planning.pseudospectral import LGL

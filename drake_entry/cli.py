@@ -211,10 +211,13 @@ def main(argv=None) -> int:
     p.add_argument("--out", default="out/simulate", help="output directory")
     p.add_argument("--format", choices=("parquet", "csv"), default="parquet")
     p.set_defaults(func=_cmd_simulate)
-    for command in contributed_commands():
-        parser_ = sub.add_parser(command.name, help=command.help)
-        command.add_arguments(parser_)
-        parser_.set_defaults(func=command.run)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    asked = next((a for a in argv if not a.startswith("-")), None)
+    if asked not in sub.choices:  # a contributed command, the command list or a typo: load them all
+        for command in contributed_commands():  # (importing the NLP package costs about 0.4 s)
+            parser_ = sub.add_parser(command.name, help=command.help)
+            command.add_arguments(parser_)
+            parser_.set_defaults(func=command.run)
     args = parser.parse_args(argv)
     try:
         out = getattr(args, "out", None)

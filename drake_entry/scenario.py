@@ -17,7 +17,7 @@ from drake_entry.guidance import GuidanceSpec, known_tags
 from drake_entry.guidance.drag_energy.spec import DragEnergy
 from drake_entry.models import dispersions as disp
 from drake_entry.models.atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere
-from drake_entry.models.environment import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec  # noqa: F401
+from drake_entry.models.environment import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import VARIABLES, Schedule
 from drake_entry.models.vehicles import Vehicle, load_vehicle

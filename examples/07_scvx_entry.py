@@ -24,9 +24,9 @@ from drake_entry.claims import Claims
 from drake_entry.diagrams.plan_flight import fly_plan
 from drake_entry.diagrams.propagation import propagate
 from drake_entry.guidance.scvx.as_ocp import nlp_form
-from drake_entry.guidance.scvx.entry import FORMULATIONS, EntryProblemSettings
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.planner import plan_entry
+from drake_entry.guidance.scvx.settings import FORMULATIONS, EntryProblemSettings
 from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import load_vehicle

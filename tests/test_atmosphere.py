@@ -147,7 +147,7 @@ def test_table_atmosphere_derivatives_equal_finite_differences(tmp_path, us76, h
 ])
 def test_bad_atmosphere_tables_are_one_line_errors(tmp_path, text, match):
     from drake_entry.errors import ScenarioError
-    from drake_entry.scenario import AtmosphereSpec, atmosphere_from_spec
+    from drake_entry.models.environment import AtmosphereSpec, atmosphere_from_spec
 
     path = tmp_path / "bad.csv"
     path.write_text(text)
@@ -163,5 +163,5 @@ def test_table_atmosphere_outside_its_altitudes_names_the_range(tmp_path, us76):
     with pytest.raises(ModelRangeError, match=r"outside the TableAtmosphere range \[20000, 80000\]"):
         atm.density(90e3)
     with pytest.raises(ScenarioError, match="is not a file"):
-        from drake_entry.scenario import AtmosphereSpec, atmosphere_from_spec
+        from drake_entry.models.environment import AtmosphereSpec, atmosphere_from_spec
         atmosphere_from_spec(AtmosphereSpec(model="table", table_csv=str(tmp_path / "missing.csv")))

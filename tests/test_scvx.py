@@ -17,10 +17,11 @@ from drake_entry.guidance.scvx.engine import (
     golden_section,
     solve_scvx,
 )
-from drake_entry.guidance.scvx.entry import PAPER_LOSSLESS, EntryProblem, EntryProblemSettings, heading_regulariser_sign
+from drake_entry.guidance.scvx.entry import EntryProblem, heading_regulariser_sign
 from drake_entry.guidance.scvx.guess import glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.planner import initial_decision, plan_entry
+from drake_entry.guidance.scvx.settings import PAPER_LOSSLESS, EntryProblemSettings
 from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import load_vehicle

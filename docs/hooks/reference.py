@@ -4,6 +4,7 @@ source tree, so neither can drift from the code; and the source tree the API ref
 with ``systems/`` and ``diagrams/`` placed inside ``drake_entry/`` as pyproject's
 ``package-dir`` installs them (the repository keeps them at its top level)."""
 import atexit
+import functools
 import os
 import shutil
 import tempfile
@@ -15,6 +16,7 @@ from mkdocs.structure.files import File
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
+@functools.cache
 def installed_subpackages() -> dict:
     """{name inside drake_entry: repository directory}, read from pyproject's ``package-dir``."""
     with open(os.path.join(ROOT, "pyproject.toml"), "rb") as f:

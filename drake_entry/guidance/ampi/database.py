@@ -19,7 +19,7 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.ampi.grid import ParameterGrid
-from drake_entry.guidance.ampi.spec import MODES, database_path  # noqa: F401 (database_path: public here too)
+from drake_entry.guidance.ampi.spec import MODES
 from drake_entry.guidance.ampi.synthesis import interpolate_corners, nearest_case, select_subspace
 from drake_entry.planning.pseudospectral import interpolation_matrix, lgl_nodes
 
@@ -31,7 +31,8 @@ from drake_entry.planning.pseudospectral import interpolation_matrix, lgl_nodes
 OBJECTIVE_FACTOR = 1.5
 FINAL_TIME_JUMP_S = 30.0
 BANK_JUMP_DEG = 15.0
-#: packaged databases: drake_entry/data/ampi/<name>.npz (built by diagrams/ampi_database.py)
+
+
 @dc.dataclass
 class Synthesis:
     """An interpolated trajectory (paper 003 Algorithms 1-2 and eq. 11).
@@ -140,7 +141,7 @@ class TrajectoryDatabase:
                               np.zeros(len(self.grid.names), bool), [int(index)])
 
     def reference(self, mode: str, offsets, hd_points: int | None = None) -> Synthesis:
-        """The reference for entry ``offsets`` in ``mode`` (synthesis.MODES): 'ampi' is
+        """The reference for entry ``offsets`` in ``mode`` (spec.MODES): 'ampi' is
         ``synthesise``, 'ntt' the ``entry`` nearest to the offsets; expanded like both."""
         if mode == "ampi":
             return self.synthesise(offsets, hd_points)

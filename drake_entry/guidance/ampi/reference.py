@@ -19,8 +19,8 @@ import time
 import numpy as np
 
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.ampi.database import Synthesis, TrajectoryDatabase, database_path
-from drake_entry.guidance.ampi.spec import MODES
+from drake_entry.guidance.ampi.database import Synthesis, TrajectoryDatabase
+from drake_entry.guidance.ampi.spec import MODES, database_path
 from drake_entry.planning.ocp_yaml import load_problem
 from drake_entry.planning.result import PlanResult
 from drake_entry.planning.tracking import TrackingLaw, TrackingWeights, tvlqr

@@ -13,7 +13,8 @@ MODES = ("ampi", "ntt")
 
 
 def packaged_databases() -> tuple:
-    """Names of the trajectory databases shipped in drake_entry/data/ampi (``<name>.npz``)."""
+    """Names of the trajectory databases shipped in drake_entry/data/ampi (``<name>.npz``, built by
+    diagrams/ampi_database.py)."""
     folder = resources.files("drake_entry").joinpath("data/ampi")
     return tuple(sorted(p.name[:-4] for p in folder.iterdir() if p.name.endswith(".npz")))
 

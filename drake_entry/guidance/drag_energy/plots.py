@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 
-from drake_entry.campaign.plots import limit_line, plt, save_figure  # noqa: F401 (Agg backend first)
+from drake_entry.campaign.plots import plt, save_figure  # the Agg backend is set there
 
 
 def corridor_plot(corridor, E0: float, Ef: float, out_dir: str, *, reference=None, title: str = "") -> list[str]:

@@ -40,7 +40,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from pydrake.solvers import ClarabelSolver, LorentzConeConstraint, MathematicalProgram, ScsSolver, SolverOptions
 
-from drake_entry.guidance.scvx.settings import SOLVER_TOLERANCES, ScvxSettings  # noqa: F401 (public here too)
+from drake_entry.guidance.scvx.settings import ScvxSettings
 
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0  # Phi of eq. 29
 #: a feasible point where the trust region reaches its floor is converged when the predicted

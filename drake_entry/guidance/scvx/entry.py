@@ -59,14 +59,10 @@ from pydrake.autodiffutils import AutoDiffXd, ExtractGradient, ExtractValue, Ini
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.scvx.engine import ConvexifiableProblem, Evaluation, Linearisation
 from drake_entry.guidance.scvx.mission import ScvxMission
-from drake_entry.guidance.scvx.settings import (  # noqa: F401
-    DEFAULT_PATH_MARGIN,
+from drake_entry.guidance.scvx.settings import (
     FORMULATIONS,
-    OBJECTIVES,
-    PAPER_LOSSLESS,
     RATE_OBJECTIVES,
     EntryProblemSettings,
-    Formulation,
 )
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.constraints import total_load_factor

@@ -11,11 +11,11 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
 from drake_entry.errors import ModelRangeError, NonFiniteStateError
-from drake_entry.guidance.scvx.engine import ScvxSettings, max_defect, max_violation, solve_scvx
-from drake_entry.guidance.scvx.entry import EntryProblem, EntryProblemSettings
+from drake_entry.guidance.scvx.engine import max_defect, max_violation, solve_scvx
+from drake_entry.guidance.scvx.entry import EntryProblem
 from drake_entry.guidance.scvx.guess import GlideGuess, glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
-from drake_entry.guidance.scvx.settings import FlightCheck
+from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
 from drake_entry.models.actuator import sampled_response
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.constraints import dynamic_pressure
@@ -51,7 +51,7 @@ OBJECTIVE_METRIC = {"heat_load": "heat_load_MJ_m2", "control_effort": "control_e
 @dc.dataclass(kw_only=True)
 class ScvxPlan(PlanResult):
     """An SCvx entry plan (a PlanResult over time; ``objective`` in the unit of
-    ``entry.OBJECTIVES``: MJ/m^2, deg, deg/s, kW/m^2, g, s or km).
+    ``settings.OBJECTIVES``: MJ/m^2, deg, deg/s, kW/m^2, g, s or km).
 
     Attributes:
       formulation: the EntryProblemSettings formulation ('lossless', 'hybrid', 'direct_bank', 'direct').

@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 
-from drake_entry.campaign.plots import limit_line, plt, save_figure  # noqa: F401 (Agg backend first)
+from drake_entry.campaign.plots import limit_line, plt, save_figure  # the Agg backend is set there
 
 
 def swarm_case_plots(histories: dict, columns, out_dir: str, *, limits=None, flown=None, title: str = "") -> list[str]:

@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 
-from drake_entry.campaign.plots import limit_line, plt, save_figure  # noqa: F401 (Agg backend first)
+from drake_entry.campaign.plots import plt, save_figure  # the Agg backend is set there
 
 
 def nlp_solution_plots(problem, result, out_dir: str, *, propagated=None, extremal=None, title: str = "") -> list[str]:

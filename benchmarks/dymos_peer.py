@@ -115,6 +115,7 @@ def dymos_benchmark(*, nodes: int = 31) -> dict:
     """Both problems, dymos and ours, printed side by side with wall-time ratios."""
     import dataclasses as dc
 
+    from drake_entry.diagrams.verification import fly_controls
     from drake_entry.planning import nlp
     from drake_entry.planning.nlp import catalogue
 
@@ -135,7 +136,7 @@ def dymos_benchmark(*, nodes: int = 31) -> dict:
             peer = {"ok": False, "objective": float("nan"), "wall_s": float("nan"), "error": str(e)[:120]}
         rows = {"dymos (SLSQP)": peer}
         for tx in ("lgl", "dircol"):
-            r = nlp.solve(problem, transcription=tx, nodes=nodes)
+            r = nlp.solve(problem, transcription=tx, nodes=nodes, verifier=fly_controls)
             rows[f"drake_entry {tx} ({r.solver})"] = {"ok": r.success, "objective": r.objective,
                                                       "wall_s": r.total_time}
         for who, row in rows.items():

@@ -9,13 +9,14 @@ def nlp_benchmark(*, problem_name: str = "marv", nodes: int = 40, tolerance: flo
     the Drake-propagated terminal position error, side by side in one run; the solve time
     split into our Python callbacks (models, Jacobians, AutoDiff packing) and the solver's
     own share (with Drake's conversions)."""
-    from drake_entry.diagrams.propagation import propagate
+    from drake_entry.diagrams.verification import fly_controls
     from drake_entry.planning import nlp
     from drake_entry.planning.ocp_yaml import load_problem
 
     problem, _ = load_problem(problem_name)
     starts = {"propagated guess": nlp.initial_guess(problem)}
-    seed = nlp.solve(problem, transcription="lgl", solver="snopt", nodes=30, tolerance=tolerance)
+    seed = nlp.solve(problem, transcription="lgl", solver="snopt", nodes=30, tolerance=tolerance,
+                     verifier=fly_controls)
     if seed.success:
         starts["30-node LGL/SNOPT solution"] = seed
     out = {}
@@ -27,11 +28,11 @@ def nlp_benchmark(*, problem_name: str = "marv", nodes: int = 40, tolerance: flo
             for solver in nlp.SOLVERS:
                 try:
                     r = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, guess=guess,
-                                  tolerance=tolerance)
+                                  tolerance=tolerance, verifier=fly_controls)
                 except Exception as e:  # noqa: BLE001 - one failing combination is reported, not fatal
                     print(f"{transcription:14s} {solver:7s} error: {type(e).__name__}: {str(e).splitlines()[0][:80]}")
                     continue
-                check = propagate(problem, r) if r.success else None
+                check = r.verification.flight if r.success else None
                 miss = check.terminal_error.get("position_m", float("nan")) if check else float("nan")
                 out[(start, transcription, solver)] = dict(success=r.success, solve_time=r.solve_time,
                                                            callback_time=r.callback_time, objective=r.objective,

@@ -45,15 +45,16 @@ def _setup():
 
 
 def _plan_and_fly(case, **settings):
-    from drake_entry.diagrams.plan_flight import fly_plan
+    from drake_entry.diagrams.verification import fly_controls
     from drake_entry.guidance.scvx.planner import plan_entry
     from drake_entry.guidance.scvx.settings import EntryProblemSettings
 
     vehicle, planet, atmosphere, mission, guess, guess_s = case
     t1 = time.perf_counter()
-    plan = plan_entry(vehicle, planet, atmosphere, mission, guess=guess, problem_settings=EntryProblemSettings(**settings))
-    wall = time.perf_counter() - t1 + guess_s
-    return plan, wall, fly_plan(plan, vehicle, planet, atmosphere)
+    plan = plan_entry(vehicle, planet, atmosphere, mission, guess=guess, problem_settings=EntryProblemSettings(**settings),
+                      verifier=fly_controls)
+    wall = time.perf_counter() - t1 + guess_s  # with the Drake flight of its controls (its verdict)
+    return plan, wall, plan.flown
 
 
 def table2(case) -> list:
@@ -61,7 +62,7 @@ def table2(case) -> list:
 
     print("\nTable 2 form: objectives, direct bank and alpha, 33 x 4 Lobatto (100 nodes); "
           "'ok' = plan.success: converged, checked between the nodes, its controls flown through the "
-          "closed loop's actuators within 5 km of it, inside the DRS box and every path limit; 'flown': fly_plan (Drake)")
+          "closed loop's actuators within 5 km of it, inside the DRS box and every path limit; 'flown': the verdict's Drake flight (plan.flown)")
     print(f"{'objective':>21s} {'unit':>7s} {'ours':>9s} {'paper':>9s} {'t_f s':>6s} {'paper':>7s} {'plan s':>7s} "
           f"{'/paper':>7s} {'iters':>5s} {'paper':>5s} {'flown km':>8s} {'site km':>7s} {'ok':>5s}")
     rows = []
@@ -128,7 +129,7 @@ def meshes(case, meshes=((99, 2), (33, 4), (50, 4), (66, 4))) -> list:
 def nlp_crosscheck(case, solves=(("dircol", "snopt", 100), ("lgl", "snopt", 60))) -> list:
     """The direct minimum-heat-load problem through the NLP path from the same glide guess
     (``guidance.scvx.as_ocp``), its controls flown by the Drake Simulator, beside the SCvx plan."""
-    from drake_entry.diagrams.propagation import propagate
+    from drake_entry.diagrams.verification import fly_controls
     from drake_entry.guidance.scvx.as_ocp import nlp_form
     from drake_entry.planning import nlp
 
@@ -142,8 +143,8 @@ def nlp_crosscheck(case, solves=(("dircol", "snopt", 100), ("lgl", "snopt", 60))
     rows = [{"method": "scvx", "heat_load_MJ_m2": plan.objective, "solve_s": wall, "success": plan.success}]
     for transcription, solver, nodes in solves:
         result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, guess=start,
-                           tolerance=1e-6)
-        error = propagate(problem, result).terminal_error
+                           tolerance=1e-6, verifier=fly_controls)
+        error = nlp.propagate(problem, result, fly_controls).terminal_error
         flown = error.get("position_m", float("nan")) / 1e3
         label = f"{transcription} {nodes} {solver}"
         q = result.objective / 1e6

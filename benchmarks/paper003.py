@@ -45,6 +45,7 @@ def paper003_benchmark(cases: int = 100, out_dir: str | None = None, workers: in
         summarise,
     )
     from drake_entry.diagrams.ampi_database import offset_problem
+    from drake_entry.diagrams.verification import fly_controls
     from drake_entry.guidance.ampi.reference import DatabaseReference
     from drake_entry.planning import nlp
     from drake_entry.planning.tracking import tvlqr
@@ -73,7 +74,7 @@ def paper003_benchmark(cases: int = 100, out_dir: str | None = None, workers: in
                                  planner.gain_samples), 3)
     p = offset_problem(problem, dict(zip(db.grid.names, offsets[0])))
     ld = db.synthesise(offsets[0])
-    s = {"transcription": "dircol", "nodes": 100, "tolerance": 1e-6}
+    s = {"transcription": "dircol", "nodes": 100, "tolerance": 1e-6, "verifier": fly_controls}
     t0 = time.perf_counter()
     cold = nlp.solve(p, **s)
     cold_s = time.perf_counter() - t0

@@ -1,7 +1,8 @@
 """Abort reachability campaigns of paper 001 Sec. VI through the campaign engine: every
-case is an SCvx plan (``guidance.scvx.plan_entry``) flown by the Drake Simulator
-(``plan_flight.fly_plan``), one row per case (``abort_row``), run on any backend
-(``campaign.run_cases``: serial, processes, Dask), resumable.
+case is an SCvx plan (``guidance.scvx.plan_entry``) whose verdict is its controls flown by
+the Drake Simulator through the closed loop's actuators (``verification.fly_controls``), one
+row per case (``abort_row``), run on any backend (``campaign.run_cases``: serial, processes,
+Dask), resumable.
 
     run_orbital_aborts(out_dir)   the EIP grid (9 x 9 at 5 deg by default)
     run_descent_aborts(out_dir)   the nominal flown, re-planned to an alternative site every 50 s
@@ -19,7 +20,7 @@ import numpy as np
 
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
-from drake_entry.diagrams.plan_flight import fly_plan
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.scvx.aborts import (
     ALTERNATIVE_SITES,
@@ -77,9 +78,12 @@ def setup_worker(config: dict) -> tuple:
     return AbortStudy(**config).models()
 
 
-def abort_row(case: dict, plan, flight, wall_s: float) -> dict:
-    """One case's row: the case, the plan's figures (Tables 4-7 quantities), the flown miss and
-    the feasibility at 10 and 40 km (``guidance.scvx.aborts.feasible``)."""
+def abort_row(case: dict, plan, wall_s: float) -> dict:
+    """One case's row: the case, the plan's figures (Tables 4-7 quantities), its flown miss
+    (``plan.flown``: the Drake flight of its controls; inf when it stopped early; flown_drs_ok:
+    inside the case's DRS box) and the feasibility at 10 and 40 km
+    (``guidance.scvx.aborts.feasible``)."""
+    flight = plan.flown
     history = plan.history
     socp = [r.solver_iterations for r in history]
     row = {**case, "plan_success": bool(plan.success), "message": plan.message, "iterations": int(plan.iterations),
@@ -111,9 +115,9 @@ def run_case(models: tuple, case: dict):
     vehicle, planet, atmosphere, mission, problem, scvx = models
     t0 = time.perf_counter()
     plan = plan_entry(vehicle, planet, atmosphere, case_mission(mission, case), problem_settings=problem,
-                      settings=scvx)
+                      settings=scvx, verifier=fly_controls)
     wall = time.perf_counter() - t0
-    return abort_row(case, plan, fly_plan(plan, vehicle, planet, atmosphere), wall), plan_trajectory(plan, case["index"])
+    return abort_row(case, plan, wall), plan_trajectory(plan, case["index"])
 
 
 def _run(study: AbortStudy, cases: list, out_dir: str, kind: str, extra: dict, **campaign) -> str:
@@ -140,10 +144,11 @@ def run_orbital_aborts(out_dir: str, *, study: AbortStudy | None = None, shape: 
 def fly_nominal(study: AbortStudy):
     """The nominal plan and its Drake flight (the trajectory the descent aborts leave)."""
     vehicle, planet, atmosphere, mission, problem, scvx = study.models()
-    plan = plan_entry(vehicle, planet, atmosphere, mission, problem_settings=problem, settings=scvx)
+    plan = plan_entry(vehicle, planet, atmosphere, mission, problem_settings=problem, settings=scvx,
+                      verifier=fly_controls)
     if not plan.success:
         raise ScenarioError(f"the nominal plan of the descent aborts failed: {plan.message}")
-    return plan, fly_plan(plan, vehicle, planet, atmosphere)
+    return plan, plan.flown
 
 
 def run_descent_aborts(out_dir: str, *, study: AbortStudy | None = None, site: str = "ben_guerir",
@@ -173,7 +178,7 @@ def run_descent_aborts(out_dir: str, *, study: AbortStudy | None = None, site: s
     abort_study = dc.replace(study, problem={**study.problem, "objective": objective})
     extra = {"site": list(ALTERNATIVE_SITES[site]), "site_name": site, "spacing_s": spacing_s,
              "nominal": {"final_time_s": plan.final_time, "heat_load_MJ_m2": plan.metrics["heat_load_MJ_m2"],
-                         "flown_lon_deg": np.degrees(flight.states[:, 1]).tolist()[::20],
-                         "flown_lat_deg": np.degrees(flight.states[:, 2]).tolist()[::20]}}
+                         "flown_lon_deg": np.degrees(flown.state[:, 1]).tolist()[::20],
+                         "flown_lat_deg": np.degrees(flown.state[:, 2]).tolist()[::20]}}
     return _run(abort_study, cases, out_dir, "descent_aborts", extra, backend=backend, workers=workers,
                 scheduler=scheduler, progress=progress)

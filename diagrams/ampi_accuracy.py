@@ -24,6 +24,7 @@ flight of its own controls.
 from __future__ import annotations
 
 import dataclasses as dc
+import functools
 import math
 import time
 from types import SimpleNamespace
@@ -35,7 +36,7 @@ from drake_entry.diagrams.ampi_database import offset_problem
 from drake_entry.diagrams.ampi_database import setup_worker as database_worker
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
-from drake_entry.diagrams.propagation import propagate
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.ampi.database import TrajectoryDatabase
 from drake_entry.guidance.ampi.spec import MODES, database_path
@@ -98,13 +99,14 @@ def flown_controls(problem, syn, n_ld: int):
     return controls
 
 
-def _fly_ld(problem, syn, n_ld: int, x0, **propagation):
-    """diagrams.propagation.propagate of a Synthesis at the LD nodes (``flown_controls``)
-    from ``x0``: the PropagationCheck."""
+def _fly_ld(problem, syn, n_ld: int, x0, *, accuracy: float, samples_per_interval: int, log_points: int):
+    """nlp.propagate of a Synthesis at the LD nodes (``flown_controls``) from ``x0`` by the
+    Drake verifier at ``accuracy`` with ``log_points`` logged: the PropagationCheck."""
     flown = SimpleNamespace(time=syn.time, final_time=syn.final_time, transcription="lgl", controls=syn.controls,
                             states=np.vstack([x0, syn.states[-1]]),
                             control_function=lambda: flown_controls(problem, syn, n_ld))
-    return propagate(problem, flown, **propagation)
+    return nlp.propagate(problem, flown, functools.partial(fly_controls, accuracy=accuracy, log_points=log_points),
+                         samples_per_interval=samples_per_interval)
 
 
 def fly_reference(problem, syn, n_ld: int, x0) -> dict:
@@ -141,7 +143,8 @@ def accuracy_case(state: dict, case: dict):
     t0 = time.perf_counter()
     r = nlp.solve(p, transcription=s["transcription"], nodes=s["nodes"], tolerance=s["tolerance"],
                   max_iterations=s["max_iterations"], guess=(ld.time, ld.states, ld.controls),
-                  dynamics_tolerance=s["dynamics_tolerance"], propagation_tolerance=s["propagation_tolerance"])
+                  dynamics_tolerance=s["dynamics_tolerance"], propagation_tolerance=s["propagation_tolerance"],
+                  verifier=fly_controls)
     row.update(ocp_s=time.perf_counter() - t0, ocp_objective=float(r.objective), ocp_final_time_s=float(r.final_time),
                message=r.message[:300])
     if not r.success:

@@ -24,6 +24,7 @@ import numpy as np
 from drake_entry.campaign.store import read_rows, read_trajectories
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import run_cases, task_manifest
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.ampi.database import TrajectoryDatabase
 from drake_entry.guidance.ampi.grid import ParameterGrid
@@ -111,7 +112,7 @@ def solve_case(state: dict, case: dict):
     r = nlp.solve(case_problem(problem, grid, index), transcription=s["transcription"], nodes=s["nodes"],
                   tolerance=s["tolerance"], max_iterations=s["max_iterations"], guess=guess,
                   dynamics_tolerance=s["dynamics_tolerance"],
-                  propagation_tolerance=s["propagation_tolerance"])
+                  propagation_tolerance=s["propagation_tolerance"], verifier=fly_controls)
     wall = time.perf_counter() - t0
     t = 0.5 * (lgl_nodes(state["ld_nodes"]) + 1.0) * r.final_time  # the LD times
     X, U = r.state_function()(t), r.control_function()(t)

@@ -23,6 +23,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from drake_entry.diagrams.common import add_step_loggers, run
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance import method_for
 from drake_entry.guidance.interface import GuidanceMethod, GuidanceSummary, PlantPorts
@@ -52,7 +53,8 @@ class ClosedLoopSetup:
     """What every flight of one mission shares (built once per campaign worker).
 
     Attributes:
-      scenario; method: its GuidanceMethod; planner: what ``method.make_planner`` built.
+      scenario; method: its GuidanceMethod; planner: what ``method.make_planner`` built (given
+        the Drake plan verifier, diagrams.verification.fly_controls).
       vehicle, planet, atmosphere: the nominal models (a Monte-Carlo draw disperses copies).
       alpha: the scenario's alpha schedule [rad]. entry_energy, terminal: E_0 [J/kg] and
         (h_f [m], V_f [m/s], E_f [J/kg]) of the guidance terminal interface (central gravity).
@@ -75,7 +77,7 @@ class ClosedLoopSetup:
         scenario's ``guidance:`` spec (which it may read; examples/02_custom_controller.py)."""
         method = method_for(scenario.guidance) if method is None else method
         return ClosedLoopSetup(
-            scenario=scenario, method=method, planner=method.make_planner(scenario) if planner is None else planner,
+            scenario=scenario, method=method, planner=method.make_planner(scenario, fly_controls) if planner is None else planner,
             vehicle=scenario.make_vehicle(), planet=scenario.make_planet(), atmosphere=scenario.make_atmosphere(),
             alpha=scenario.schedule("alpha"), entry_energy=scenario.entry_energy(),
             terminal=scenario.guidance_terminal_state())

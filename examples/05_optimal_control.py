@@ -23,11 +23,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.claims import Claims
-from drake_entry.diagrams.propagation import propagate
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.models.atmosphere import ExponentialAtmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import load_vehicle
-from drake_entry.planning.nlp import solve
+from drake_entry.planning.nlp import propagate, solve
 from drake_entry.planning.ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
 
 deg = math.radians
@@ -55,14 +55,14 @@ def marv_problem() -> OptimalControlProblem:
 def main(quick: bool = False, out_dir: str = "out/examples/05") -> dict:
     problem = marv_problem()
     # from the built-in propagated guess on 30 nodes, refined until verified
-    result = solve(problem, solver="snopt", nodes=30, tolerance=1e-6, refine=True, max_nodes=80)
+    result = solve(problem, solver="snopt", nodes=30, tolerance=1e-6, refine=True, max_nodes=80, verifier=fly_controls)
     for step in result.mesh_history:
         print(f"{step.nodes:4d} nodes: between-node error {step.error:.2g}")
     print(f"{result.nodes} nodes: {result.message}; J = {result.objective:.3f}, t_f = {result.final_time:.1f} s, "
           f"{result.total_time:.1f} s")
 
     # fly the controls open loop with the Drake Simulator (OptimalControlPlant, RK5), as solve() did
-    flown = propagate(problem, result)
+    flown = propagate(problem, result, fly_controls)
     t_end = flown.time[-1]
     planned = result.evaluate(t_end)
     print(f"flown minus planned at t = {t_end:.2f} s (t_f = {result.final_time:.2f} s): "

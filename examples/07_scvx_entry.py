@@ -21,8 +21,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.claims import Claims
-from drake_entry.diagrams.plan_flight import fly_plan
-from drake_entry.diagrams.propagation import propagate
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.guidance.scvx.as_ocp import nlp_form
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.planner import plan_entry
@@ -43,24 +42,26 @@ def main(quick: bool = False, out_dir: str = "out/examples/07", formulation: str
         print(f"  iteration {k + 1:2d}: merit {rec.merit:9.4g}  trust radius {rec.trust_radius:8.2g}  "
               f"{'accepted' if rec.accepted else 'rejected'}  max defect {rec.max_defect:.1e}")
 
+    # the plan's verdict flies its controls with the Drake Simulator through the closed loop's actuators
     plan = plan_entry(vehicle, planet, atmosphere, mission, problem_settings=settings,
-                      progress=None if quick else progress)
+                      progress=None if quick else progress, verifier=fly_controls)
     print(f"plan: {plan.message}; heat load {plan.objective:.1f} MJ/m^2, t_f {plan.final_time:.0f} s, "
           f"{plan.iterations} iterations, {plan.build_time + plan.solve_time:.1f} s; lossless gap "
-          f"{plan.lossless_gap:.3f}; planned miss {plan.miss_m / 1e3:.1f} km; its controls propagated end "
+          f"{plan.lossless_gap:.3f}; planned miss {plan.miss_m / 1e3:.1f} km; its controls flown end "
           f"{plan.propagated_error_m / 1e3:.2f} km from it")
     m = plan.metrics
     print(f"paper 001 Table 6 form: integrated |bank rate| {m['bank_effort_deg']:.0f} deg, max {m['max_bank_rate_deg_s']:.2f} "
           f"deg/s; integrated |alpha rate| {m['alpha_effort_deg']:.1f} deg, max {m['max_alpha_rate_deg_s']:.3f} deg/s")
-    flight = fly_plan(plan, vehicle, planet, atmosphere)
+    flight = plan.flown
     print(f"flown by Drake: {flight.from_plan_m / 1e3:.2f} km from the plan, {flight.from_site_m / 1e3:.2f} km "
           f"from the site; DRS altitude {flight.drs['altitude_m'] / 1e3:.2f} km, Mach {flight.drs['mach']:.2f}, "
           f"vertical speed {flight.drs['vertical_speed_m_s']:.1f} m/s; DRS box met: {flight.drs_ok}")
     crosscheck = None
     if formulation == "direct" and not quick:  # the same problem by the NLP path, from the same glide guess
         problem, start = nlp_form(plan)
-        crosscheck = nlp.solve(problem, transcription="dircol", solver="snopt", nodes=100, guess=start, tolerance=1e-6)
-        flown = propagate(problem, crosscheck).terminal_error.get("position_m", math.nan)
+        crosscheck = nlp.solve(problem, transcription="dircol", solver="snopt", nodes=100, guess=start, tolerance=1e-6,
+                               verifier=fly_controls)
+        flown = nlp.propagate(problem, crosscheck, fly_controls).terminal_error.get("position_m", math.nan)
         print(f"NLP path (DirectCollocation + SNOPT, {crosscheck.nodes} samples): {crosscheck.message}; heat load "
               f"{crosscheck.objective / 1e6:.2f} MJ/m^2 (SCvx {plan.objective / (crosscheck.objective / 1e6) - 1:+.2%}), "
               f"t_f {crosscheck.final_time:.0f} s, {crosscheck.solve_time:.1f} s; flown {flown / 1e3:.2f} km from it")

@@ -3,8 +3,8 @@ defaults, then with mesh refinement, each against its published optimum.
 
 The problems are posed as a user would pose them: the Brachistochrone (the cycloid), the
 Goddard rocket (COPS 3.0), Betts' Space Shuttle maximum crossrange with and without the wing
-heating limit q = q_a(alpha) q_r (Betts 2010, Sec. 6.1). Each is solved by ``nlp.solve(problem)``
-(40 LGL nodes, solver 'auto': SNOPT, then Ipopt if SNOPT fails), verified between the nodes
+heating limit q = q_a(alpha) q_r (Betts 2010, Sec. 6.1). Each is solved by
+``nlp.solve(problem, verifier=fly_controls)`` (40 LGL nodes, solver 'auto': SNOPT, then Ipopt if SNOPT fails), verified between the nodes
 and by the Drake Simulator, and compared with the published figure; then the Brachistochrone
 and the shuttle are solved from a coarse mesh with ``refine=True``, which raises the node
 count until the between-node error meets the tolerance. Plots: the shuttle ground tracks and
@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.claims import Claims
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.planning import nlp
 from drake_entry.planning.nlp import catalogue
 
@@ -37,7 +38,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/10") -> dict:
           f"{'wall [s]':>8s}")
     for name, make in PROBLEMS.items():
         problem, published = make()
-        r = nlp.solve(problem)
+        r = nlp.solve(problem, verifier=fly_controls)
         rel = abs(r.objective - published["objective"]) / abs(published["objective"])
         out[name] = {"result": r, "published": published, "relative": rel}
         print(f"{name:28s} {r.solver:6s} {str(r.success):8s} {r.objective:12.7g} {published['objective']:12.7g} "
@@ -45,7 +46,8 @@ def main(quick: bool = False, out_dir: str = "out/examples/10") -> dict:
     refine = ["brachistochrone"] if quick else ["brachistochrone", "shuttle_crossrange"]
     for name in refine:
         problem, published = PROBLEMS[name]()
-        r = nlp.solve(problem, nodes=5 if name == "brachistochrone" else 20, refine=True, dynamics_tolerance=1e-4)
+        r = nlp.solve(problem, nodes=5 if name == "brachistochrone" else 20, refine=True, dynamics_tolerance=1e-4,
+                      verifier=fly_controls)
         steps = ", ".join(f"{m.nodes} nodes: {m.error:.1e}" for m in r.mesh_history)
         print(f"refined {name}: {steps}; verified {r.success}, objective {r.objective:.7g}")
         out[f"{name}_refined"] = {"result": r, "published": published}

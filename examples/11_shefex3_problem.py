@@ -25,6 +25,7 @@ import numpy as np
 
 from drake_entry.claims import Claims
 from drake_entry.diagrams.open_loop import simulate
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.planning import nlp
 from drake_entry.planning.ocp import ObjectiveTerm
 from drake_entry.planning.ocp_yaml import load_problem
@@ -42,7 +43,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/11") -> dict:
 
     problem, settings = load_problem("shefex3")
     result = nlp.solve(problem, transcription=settings.transcription, nodes=settings.nodes,
-                       tolerance=settings.tolerance)
+                       tolerance=settings.tolerance, verifier=fly_controls)
     print(f"well-posed problem ({settings.transcription}, {settings.nodes} samples): {result.message}")
     print(f"  J = {result.objective:.4f}, t_f = {result.final_time:.1f} s, {result.total_time:.1f} s wall")
 
@@ -52,7 +53,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/11") -> dict:
     eq1 = ObjectiveTerm("terminal_deviation", reference=xf_ref, weights={"lon": 1.0, "lat": 1.0, "V": 1e-4})
     soft = dc.replace(problem, objective=[eq1], final={k: v for k, v in problem.final.items() if k not in ("lon", "lat")})
     eq1_result = nlp.solve(soft, transcription=settings.transcription, nodes=60 if quick else settings.nodes,
-                           tolerance=settings.tolerance, guess=result)
+                           tolerance=settings.tolerance, guess=result, verifier=fly_controls)
     miss = planet.great_circle_distance(eq1_result.states[-1, 1], eq1_result.states[-1, 2], xf_ref["lon"],
                                         xf_ref["lat"])
     bank_gap = float(np.degrees(np.abs(eq1_result.evaluate(result.time)["sigma"] - result.states[:, 6]).max()))

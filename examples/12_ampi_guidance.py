@@ -28,6 +28,7 @@ from drake_entry.claims import Claims
 from drake_entry.diagrams import closed_loop as cl
 from drake_entry.diagrams.ampi_database import offset_problem
 from drake_entry.diagrams.montecarlo import run_campaign
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.guidance.ampi.reference import DatabaseReference
 from drake_entry.planning import nlp
 from drake_entry.scenario import Scenario, load_scenario
@@ -48,7 +49,8 @@ def main(quick: bool = False, out_dir: str = "out/examples/12") -> dict:
     x0 = np.array([p.initial[n] for n in ("h", "lon", "lat", "V", "gamma", "psi")])
     refs = {mode: dc.replace(planner, mode=mode).synthesis(x0)[0] for mode in ("ampi", "ntt")}
     ld = db.synthesise(planner.offsets(x0))
-    optimum = nlp.solve(p, transcription="dircol", nodes=100, tolerance=1e-6, guess=(ld.time, ld.states, ld.controls))
+    optimum = nlp.solve(p, transcription="dircol", nodes=100, tolerance=1e-6, guess=(ld.time, ld.states, ld.controls),
+                        verifier=fly_controls)
     print(f"the entry's own optimum: {optimum.message[:60]}..., t_f {optimum.final_time:.1f} s")
     errors = {}
     for mode, syn in refs.items():

@@ -135,7 +135,7 @@ def test_planner_results_share_one_shape():
     for cls in (DragEnergyReference, nlp.NlpResult):
         assert issubclass(cls, PlanResult)
     s = _bank_profile_scenario()
-    plan = method_for(s.guidance).make_planner(s)
+    plan = method_for(s.guidance).make_planner(s, verifier=None)  # a bank profile flies no plan controls
     assert isinstance(plan, PlanResult) and plan.success and plan.variable == "energy"
     E0, Ef = s.entry_energy(), s.guidance_terminal_state()[2]
     got = plan.evaluate([E0, 0.5 * (E0 + Ef), Ef])["bank_magnitude_rad"]
@@ -147,7 +147,7 @@ class _ConstantAlphaMethod(GuidanceMethod):
 
     name = "constant_alpha"
 
-    def make_planner(self, scenario):
+    def make_planner(self, scenario, verifier):
         return None
 
     def add_systems(self, builder, scenario, planner, plant):

@@ -6,11 +6,17 @@ import math
 import numpy as np
 import pytest
 
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.planning import nlp
 from drake_entry.planning.nlp import catalogue
 from drake_entry.planning.ocp import CustomProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
+
+
+def solve(problem, **options):
+    """nlp.solve verified by the Drake flight of its controls (the verifier every caller passes)."""
+    return nlp.solve(problem, verifier=fly_controls, **options)
 
 
 def double_integrator(**kw):
@@ -35,7 +41,7 @@ def cycloid_time(xf, yf):
 
 @pytest.mark.parametrize("solver", ["ipopt", "snopt"])
 def test_lgl_double_integrator_control_objective_and_costates_are_exact(solver):
-    r = nlp.solve(double_integrator(), transcription="lgl", solver=solver, nodes=12)
+    r = solve(double_integrator(), transcription="lgl", solver=solver, nodes=12)
     assert r.success, r.message
     t = r.time
     assert r.objective == pytest.approx(6.0, abs=1e-7)
@@ -51,12 +57,12 @@ def test_terminal_constraint_binds_on_the_final_node_only(transcription, nodes, 
     """x(1) free but x(1) + v(1) >= 1 at the final node with v(1) = 0: the rest-to-rest optimum
     (J = 6) with the constraint active; the same row on the path would forbid the start."""
     reach = PathConstraint(lambda x, u, env: x[0] + x[1], min=1.0, name="reach")
-    r = nlp.solve(double_integrator(final={"v": 0.0}, terminal=[reach]), transcription=transcription, nodes=nodes)
+    r = solve(double_integrator(final={"v": 0.0}, terminal=[reach]), transcription=transcription, nodes=nodes)
     assert r.success, r.message
     assert r.states[-1, 0] == pytest.approx(1.0, abs=1e-7)
     assert r.objective == pytest.approx(6.0, rel=tol)
     loose = PathConstraint(lambda x, u, env: x[0] + x[1], min=0.5, name="reach")
-    r = nlp.solve(double_integrator(final={"v": 0.0}, terminal=[loose]), transcription=transcription, nodes=nodes)
+    r = solve(double_integrator(final={"v": 0.0}, terminal=[loose]), transcription=transcription, nodes=nodes)
     assert r.states[-1, 0] == pytest.approx(0.5, abs=1e-7)  # still active, at its own bound
     assert r.objective == pytest.approx(6.0 * 0.25, rel=tol)  # J scales with the distance squared
 
@@ -64,7 +70,7 @@ def test_terminal_constraint_binds_on_the_final_node_only(transcription, nodes, 
 def test_dircol_double_integrator_converges_at_second_order():
     errs = []
     for n in (12, 24, 48):
-        r = nlp.solve(double_integrator(), transcription="dircol", nodes=n)
+        r = solve(double_integrator(), transcription="dircol", nodes=n)
         assert r.success, r.message
         errs.append(abs(r.objective - 6.0))
         tm = r.costate_time
@@ -75,7 +81,7 @@ def test_dircol_double_integrator_converges_at_second_order():
 @pytest.mark.parametrize("transcription,nodes,tol", [("lgl", 20, 2e-5), ("dircol", 40, 2e-3)])
 def test_brachistochrone_minimum_time_equals_the_cycloid(transcription, nodes, tol):
     # Ipopt: SNOPT (auto's first try) runs into its iteration limit on dircol here (48 s)
-    r = nlp.solve(brachistochrone(), transcription=transcription, nodes=nodes, solver="ipopt")
+    r = solve(brachistochrone(), transcription=transcription, nodes=nodes, solver="ipopt")
     assert r.success, r.message
     T = cycloid_time(2.0, 1.0)
     assert r.final_time == pytest.approx(T, rel=tol)
@@ -85,18 +91,16 @@ def test_brachistochrone_minimum_time_equals_the_cycloid(transcription, nodes, t
 
 
 def test_propagated_controls_reach_the_nlp_final_state():
-    from drake_entry.diagrams.propagation import propagate
-
     p = brachistochrone()
-    r = nlp.solve(p, nodes=20)
-    check = propagate(p, r)
+    r = solve(p, nodes=20)
+    check = nlp.propagate(p, r, fly_controls)
     assert check.terminal_error["state_max"] < 1e-4
     assert check.states[-1, 0] == pytest.approx(2.0, abs=1e-4)
 
 
 def test_infeasible_problem_is_diagnosed_not_raised():
     """|u| <= 1 cannot move 1 m and stop in 1 s (needs |u| = 4 at bang-bang)."""
-    r = nlp.solve(double_integrator(control_bounds={"u": (-1.0, 1.0)}), nodes=10, max_iterations=200)
+    r = solve(double_integrator(control_bounds={"u": (-1.0, 1.0)}), nodes=10, max_iterations=200)
     assert not r.success
     assert "largest violation" in r.message and "defects" in r.message
 
@@ -104,11 +108,11 @@ def test_infeasible_problem_is_diagnosed_not_raised():
 def test_bad_options_and_problems_are_rejected_with_the_allowed_values():
     p = double_integrator()
     with pytest.raises(ValueError, match="allowed: lgl, dircol"):
-        nlp.solve(p, transcription="hermite")
+        solve(p, transcription="hermite")
     with pytest.raises(ValueError, match="allowed: auto, ipopt, snopt"):
-        nlp.solve(p, solver="knitro")
+        solve(p, solver="knitro")
     with pytest.raises(ValueError, match="nodes must be an integer >= 3"):
-        nlp.solve(p, nodes=2)
+        solve(p, nodes=2)
     with pytest.raises(ValueError, match="unknown state 'z'"):
         double_integrator(final={"z": 1.0})
     with pytest.raises(ValueError, match="min <= max"):
@@ -130,8 +134,8 @@ def test_marv_solution_satisfies_paper_002_constraints_and_extremal_controls():
     """Paper 002 eqs. 16-18 hold at the nodes; eq. 23 (with the u_max^2 the Hamiltonian
     gives) reproduces the NLP controls from the costates."""
     p, _ = load_problem("marv")
-    r = nlp.solve(p, nodes=24, solver="snopt", tolerance=1e-7, verify=False)  # the nodes only: 24 is coarse
-    assert r.converged and r.success and "not verified" in r.message, r.message
+    r = nlp.solve(p, nodes=24, solver="snopt", tolerance=1e-7)  # the nodes only: 24 is coarse
+    assert r.converged and not r.success and "not verified" in r.message, r.message
     X, U = r.states, r.controls
     assert X[0, 0] == pytest.approx(37000.0) and X[-1, 0] == pytest.approx(0.0, abs=1e-3)
     assert math.degrees(X[-1, 1]) == pytest.approx(25.15, abs=1e-8)
@@ -150,7 +154,7 @@ def test_user_path_callable_binds_on_both_transcriptions(transcription):
     """v <= 1.2 (the free optimum peaks at 1.5) as a user callable: active, met at the nodes,
     and the cost rises above the free optimum (DirectCollocation evaluates it in AutoDiff)."""
     p = double_integrator(path=[PathConstraint(lambda x, u, env: x[1], max=1.2, name="speed")])
-    r = nlp.solve(p, transcription=transcription, nodes=21)
+    r = solve(p, transcription=transcription, nodes=21)
     assert r.success, r.message
     assert r.states[:, 1].max() == pytest.approx(1.2, abs=1e-6)
     assert r.objective > 6.0 * 1.05
@@ -160,9 +164,9 @@ def test_user_dynamic_pressure_callable_equals_the_builtin_constraint():
     """A user's q(x, u) callable as a path constraint gives the built-in constraint's optimum (24
     LGL nodes; at 16 SNOPT stops infeasible, info 13, with numpy 2.4 / drake 1.51)."""
     p, _ = load_problem("marv")
-    builtin = nlp.solve(p, nodes=24, solver="snopt", tolerance=1e-7, verify=False)
+    builtin = nlp.solve(p, nodes=24, solver="snopt", tolerance=1e-7)
     user = [PathConstraint(lambda x, u, env: env.dynamic_pressure, min=12000.0, name="q_user")] + p.path[1:]
-    mine = nlp.solve(p.with_(path=user), nodes=24, solver="snopt", tolerance=1e-7, guess=builtin, verify=False)
+    mine = nlp.solve(p.with_(path=user), nodes=24, solver="snopt", tolerance=1e-7, guess=builtin)
     assert builtin.converged and mine.converged
     assert mine.objective == pytest.approx(builtin.objective, rel=1e-6)
 
@@ -177,7 +181,7 @@ def test_optimize_command_writes_solution_summary_and_the_ten_figures(tmp_path):
                "--out", str(out), "--no-propagate"])
     assert rc == 0
     info = json.load(open(out / "summary.json"))
-    assert info["success"] and info["converged"] and info["verification"] is None
+    assert not info["success"] and info["converged"] and info["verification"] is None  # converged, not verified
     assert info["nodes"] == 24 and info["final_time_s"] > 0 and info["scaling"]["time_s"] > 0
     assert info["extremal_control_max_diff_deg_s"] < 1e-3
     assert len(list(out.glob("fig*.png"))) == 10 and (out / "solution.csv").exists()
@@ -211,7 +215,7 @@ def test_marv_60_nodes_reproduces_the_reported_solution():
     """Reduced size of docs/results/paper002_marv (README): J, t_f, the altitude maxima on
     the q = 12 kPa bound, the bank near 180 deg at t_f and the extremal controls."""
     p, _ = load_problem("marv")
-    r = nlp.solve(p, nodes=60, solver="snopt", tolerance=1e-7)
+    r = solve(p, nodes=60, solver="snopt", tolerance=1e-7)
     # converged; 60 nodes are not verified (between-node gamma error 0.0012 > 1e-3, the flown
     # controls reach gamma = -90 deg 0.6 s before t_f): the reported solution has 125 nodes
     assert r.converged and not r.success and r.verification.dynamics_error < 2e-3, r.message
@@ -227,19 +231,19 @@ def test_marv_60_nodes_reproduces_the_reported_solution():
 
 def test_objective_scale_is_chosen_from_the_gradient_reported_and_overridable():
     p, best = catalogue.brachistochrone()
-    r = nlp.solve(p, nodes=20)
+    r = solve(p, nodes=20)
     assert r.success, r.message
     assert r.scaling.source["objective"] == "gradient" and r.scaling.source["time"] == "guess final time"
     assert r.objective == pytest.approx(best["objective"], rel=2e-5)
-    mine = nlp.solve(p, nodes=20, scaling={"objective": 2.0, "time": 1.0})
+    mine = solve(p, nodes=20, scaling={"objective": 2.0, "time": 1.0})
     assert mine.scaling.objective == 2.0 and mine.scaling.source["objective"] == "user"
     assert mine.objective == pytest.approx(best["objective"], rel=2e-5)
     with pytest.raises(ScenarioError, match=r"scaling.speed: unknown field; allowed: states, controls, time, objective"):
-        nlp.solve(p, nodes=20, scaling={"speed": 1.0})
+        solve(p, nodes=20, scaling={"speed": 1.0})
     with pytest.raises(ScenarioError, match=r"scaling.states: needs 3 values"):
-        nlp.solve(p, nodes=20, scaling={"states": [1.0, 2.0]})
+        solve(p, nodes=20, scaling={"states": [1.0, 2.0]})
     with pytest.raises(ScenarioError, match=r"scaling.time = -1.0: allowed finite values > 0"):
-        nlp.solve(p, nodes=20, scaling={"time": -1.0})
+        solve(p, nodes=20, scaling={"time": -1.0})
 
 
 @pytest.mark.parametrize("final_time", [None, (None, 5.0), (0.5, None)])
@@ -248,7 +252,7 @@ def test_free_final_time_as_none_or_an_open_interval(final_time, transcription, 
     p = brachistochrone()
     p = dc.replace(p, final_time=final_time)
     assert p.final_time_bounds[1] == (5.0 if final_time == (None, 5.0) else math.inf)
-    r = nlp.solve(p, transcription=transcription, nodes=nodes)
+    r = solve(p, transcription=transcription, nodes=nodes)
     assert r.converged, r.message
     assert r.final_time == pytest.approx(cycloid_time(2.0, 1.0), rel=tol)
 
@@ -264,7 +268,7 @@ def test_under_resolved_solve_converges_but_is_not_called_success():
     info 1) but the dynamics between the nodes are off by ~4 % and the flown controls do
     not follow; the solver's word alone called this a success."""
     p, _ = load_problem("marv")
-    r = nlp.solve(p, nodes=24, solver="snopt", tolerance=1e-7)
+    r = solve(p, nodes=24, solver="snopt", tolerance=1e-7)
     assert r.converged and not r.success
     assert r.message.startswith("converged but inaccurate: SNOPT: optimality conditions satisfied (info 1)")
     v = r.verification
@@ -273,15 +277,15 @@ def test_under_resolved_solve_converges_but_is_not_called_success():
 
 
 def test_solver_statuses_are_in_words_and_options_pass_through(tmp_path):
-    r = nlp.solve(double_integrator(), nodes=12, solver="ipopt", solver_options={"max_iter": 1})
+    r = solve(double_integrator(), nodes=12, solver="ipopt", solver_options={"max_iter": 1})
     assert not r.success and not r.converged
     assert r.message.startswith("not solved: Ipopt: Max iteration exceeded (status 1)"), r.message
-    r = nlp.solve(double_integrator(), nodes=12, solver="snopt", solver_options={"Major iterations limit": 1})
+    r = solve(double_integrator(), nodes=12, solver="snopt", solver_options={"Major iterations limit": 1})
     assert not r.success and "SNOPT: major iteration limit reached (info 32)" in r.message, r.message
     with pytest.raises(ScenarioError, match=r"solver_options\['tol'\] = \[1\]: allowed an int, float or str"):
-        nlp.solve(double_integrator(), nodes=12, solver="ipopt", solver_options={"tol": [1]})
+        solve(double_integrator(), nodes=12, solver="ipopt", solver_options={"tol": [1]})
     log = tmp_path / "snopt.out"
-    r = nlp.solve(double_integrator(), nodes=12, solver="snopt", log_file=str(log))
+    r = solve(double_integrator(), nodes=12, solver="snopt", log_file=str(log))
     assert r.success and r.log_file == str(log) and log.exists()
 
 
@@ -312,12 +316,12 @@ SUITE = {"brachistochrone": catalogue.brachistochrone, "goddard_rocket": catalog
 
 @pytest.mark.parametrize("name", SUITE)
 def test_published_optimum_is_reached_with_the_library_defaults(name):
-    """Each catalogue problem as a user poses it, solved by ``nlp.solve(problem)`` with no
+    """Each catalogue problem as a user poses it, solved by ``solve(problem)`` with no
     option: verified, and its objective within 1e-4 (relative) of the published optimum
     (brachistochrone: the cycloid, exact; Goddard: COPS 3.0; shuttle with and without the
     heating limit: Betts 2010, Sec. 6.1)."""
     problem, published = SUITE[name]()
-    r = nlp.solve(problem)
+    r = solve(problem)
     assert r.success, r.message
     assert r.solver in nlp.auto_solvers()
     assert abs(r.objective - published["objective"]) <= 1e-4 * abs(published["objective"]), (r.objective, published)
@@ -332,14 +336,14 @@ def test_auto_solver_tries_snopt_then_ipopt():
     assert nlp.auto_solvers()[-1] == "ipopt"
     # auto falls back on Ipopt from the same start: SNOPT stops (info 3 or 13) on the
     # brachistochrone's singular start (v = 0) at 40 LGL nodes and tolerance 1e-8, Ipopt converges
-    r = nlp.solve(catalogue.brachistochrone()[0], nodes=40)
+    r = solve(catalogue.brachistochrone()[0], nodes=40)
     if nlp.default_solver() == "snopt":
         assert r.solver == "ipopt" and "(auto solver after 'SNOPT: " in r.message, r.message
     assert r.success
     with pytest.raises(ScenarioError, match="solver_options are by the solver's own names"):
-        nlp.solve(double_integrator(), solver_options={"tol": 1e-6})
+        solve(double_integrator(), solver_options={"tol": 1e-6})
     with pytest.raises(ScenarioError, match="solver 'knitro' is unknown; allowed: auto, ipopt, snopt"):
-        nlp.solve(double_integrator(), solver="knitro")
+        solve(double_integrator(), solver="knitro")
 
 
 @pytest.mark.parametrize("transcription,start", [("lgl", 5), ("dircol", 6)])
@@ -347,7 +351,7 @@ def test_mesh_refinement_raises_the_nodes_until_the_between_node_error_meets_the
     """From a mesh too coarse for the tolerance, each mesh warm-started from the last: the
     errors in mesh_history fall to the tolerance, the last mesh is the result's and verified."""
     problem, published = catalogue.brachistochrone()
-    r = nlp.solve(problem, transcription=transcription, nodes=start, refine=True, dynamics_tolerance=1e-6)
+    r = solve(problem, transcription=transcription, nodes=start, refine=True, dynamics_tolerance=1e-6)
     steps = r.mesh_history
     assert r.success, r.message
     assert len(steps) >= 2 and steps[0].nodes == start and steps[0].error > 1e-6
@@ -361,12 +365,12 @@ def test_mesh_refinement_raises_the_nodes_until_the_between_node_error_meets_the
 
 def test_mesh_refinement_stops_at_max_nodes_and_says_so():
     problem, _ = catalogue.brachistochrone()
-    r = nlp.solve(problem, nodes=5, refine=True, max_nodes=6, dynamics_tolerance=1e-9)
+    r = solve(problem, nodes=5, refine=True, max_nodes=6, dynamics_tolerance=1e-9)
     assert not r.success and r.converged and r.nodes == 6
     assert [m.nodes for m in r.mesh_history] == [5, 6]
     assert "stopped at max_nodes = 6 above the tolerance 1e-09" in r.message
     with pytest.raises(ScenarioError, match=r"max_nodes = 3 is out of range; allowed: an integer >= nodes \(4\)"):
-        nlp.solve(problem, nodes=4, refine=True, max_nodes=3)
+        solve(problem, nodes=4, refine=True, max_nodes=3)
 
 
 def test_next_mesh_size_follows_each_transcriptions_convergence_rate():
@@ -434,7 +438,7 @@ def test_heating_limit_holds_at_the_nodes_of_the_constrained_shuttle():
     """Betts' heating-limited shuttle at 40 LGL nodes: the limit binds (70 BTU/ft^2/s at the
     nodes), so the crossrange is below the unconstrained 34.1412 deg."""
     problem, published = catalogue.shuttle_crossrange(heating_limit=True)
-    r = nlp.solve(problem, verify=False)
+    r = nlp.solve(problem)
     q = np.array([float(problem.conditions(x, u).heat_flux) for x, u in zip(r.states, r.controls)])
     limit = 70.0 * catalogue.BTU_FT2_S
     assert q.max() <= limit * (1 + 1e-6) and q.max() >= limit * (1 - 1e-6)
@@ -448,7 +452,7 @@ def test_plant_reports_undefined_models_as_nan_to_the_solver_and_raises_for_the_
     from pydrake.autodiffutils import AutoDiffXd
 
     from drake_entry.errors import ModelRangeError
-    from drake_entry.systems.ocp_plant import OptimalControlPlant
+    from drake_entry.planning.ocp_system import OptimalControlPlant
 
     problem, _ = catalogue.shuttle_crossrange()
     below = np.array([-20e3, 0.0, 0.0, 7000.0, -0.1, 1.5])
@@ -482,7 +486,7 @@ def test_solve_time_is_split_into_our_callbacks_and_the_solver(transcription):
         return base.dynamics_function(x, u)
 
     problem = dc.replace(base, dynamics_function=dynamics)
-    r = nlp.solve(problem, transcription=transcription, solver="ipopt", nodes=12, verify=False)
+    r = nlp.solve(problem, transcription=transcription, solver="ipopt", nodes=12)
     assert r.converged
     assert 0.0 < r.callback_time < r.solve_time
     if transcription == "lgl":

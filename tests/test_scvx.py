@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.scvx.engine import (
     ConvexifiableProblem,
@@ -20,7 +21,7 @@ from drake_entry.guidance.scvx.engine import (
 from drake_entry.guidance.scvx.entry import EntryProblem, heading_regulariser_sign
 from drake_entry.guidance.scvx.guess import glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
-from drake_entry.guidance.scvx.planner import initial_decision, plan_entry
+from drake_entry.guidance.scvx.planner import initial_decision, plan_controls, plan_entry
 from drake_entry.guidance.scvx.settings import PAPER_LOSSLESS, EntryProblemSettings
 from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.models.planet import Earth
@@ -260,7 +261,7 @@ def test_glide_guess_reaches_the_drs_altitude_near_the_site(sphynx_case):
 @pytest.fixture(scope="module")
 def nominal_plan(sphynx_case):
     vehicle, planet, atmosphere, mission, guess = sphynx_case
-    return plan_entry(vehicle, planet, atmosphere, mission, guess=guess)
+    return plan_entry(vehicle, planet, atmosphere, mission, guess=guess, verifier=fly_controls)
 
 
 @pytest.fixture(scope="module")
@@ -269,14 +270,14 @@ def lossless_plan(sphynx_case):
     (flown through the actuators it ends about 950 m above the plan's)."""
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     return plan_entry(vehicle, planet, atmosphere, mission, guess=guess,
-                      problem_settings=EntryProblemSettings(formulation="lossless"))
+                      problem_settings=EntryProblemSettings(formulation="lossless"), verifier=fly_controls)
 
 
 @pytest.fixture(scope="module")
 def paper_lossless_plan(sphynx_case):
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     return plan_entry(vehicle, planet, atmosphere, mission, guess=guess,
-                      problem_settings=EntryProblemSettings(**PAPER_LOSSLESS))
+                      problem_settings=EntryProblemSettings(**PAPER_LOSSLESS), verifier=fly_controls)
 
 
 def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, nominal_plan):
@@ -287,8 +288,6 @@ def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, no
     limit held; the planner's own model-layer flight (the same actuator law) agrees within 100 m.
     Heat load 477 MJ/m^2 measured (the paper's 540.4 with its own aero table, Table 3; both about
     8 % below their lossless plans)."""
-    from drake_entry.diagrams.plan_flight import fly_plan
-
     vehicle, planet, atmosphere, mission, _ = sphynx_case
     plan = nominal_plan
     assert plan.success, plan.message
@@ -304,9 +303,10 @@ def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, no
     assert np.all(np.radians(mission.alpha_bounds_deg[0]) - 1e-9 <= plan.alpha)
     assert plan.miss_m <= 10e3 + 1.0
     assert plan.propagated_error_m < 5e3
-    flight = fly_plan(plan, vehicle, planet, atmosphere)
+    flight = plan.flown
     assert flight.ok, (flight.from_plan_m, flight.drs, flight.violations_text())
-    assert flight.from_plan_m == pytest.approx(plan.propagated_error_m, abs=100.0)  # Drake and scipy agree
+    assert flight.from_plan_m == plan.propagated_error_m and not flight.failure
+    assert flight.trajectory.time[-1] == pytest.approx(plan.final_time, abs=1e-9)
     assert flight.from_site_m < 15e3
     assert all(c.held and c.margin >= 0.0 for c in flight.checks)
     names = {c.limit.name for c in flight.checks}
@@ -317,6 +317,19 @@ def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, no
     assert mid["bank"][0] == pytest.approx(plan.bank[len(plan.time) // 2], abs=1e-12)
 
 
+def test_the_verifiers_fixed_steps_fly_the_plan_as_a_tight_error_controlled_flight(nominal_plan):
+    """The plan verifier flies through the sampled actuators with fixed RK5 steps of half the
+    guidance period; the same diagram with error-controlled RK5 at accuracy 1e-10 ends within
+    5 m of it (0.3 m measured against 1e-9), and both end where the verdict says."""
+    plan = nominal_plan
+    tight = fly_controls(plan_controls(plan, plan.flight), accuracy=1e-10)
+    assert not tight.failure and tight.time[-1] == pytest.approx(plan.final_time, abs=1e-9)
+    xf, xg = tight.states[-1], plan.flown.states[-1]
+    gap = math.hypot(plan.problem.planet.great_circle_distance(xf[1], xf[2], xg[1], xg[2]), xf[0] - xg[0])
+    assert gap < 5.0, gap
+    assert abs(xf[3] - xg[3]) < 0.05  # m/s
+
+
 @pytest.mark.slow
 def test_nominal_heat_load_matches_the_nlp_path(sphynx_case, nominal_plan):
     """Paper 001 Table 3 against the NLP path: the same direct minimum-heat-load problem (``as_ocp.mission_problem``:
@@ -325,7 +338,6 @@ def test_nominal_heat_load_matches_the_nlp_path(sphynx_case, nominal_plan):
     475.02 MJ/m^2, +0.24 %). The NLP answer is checked as an answer: its DRS box met at the final
     node, heat flux within the limit, its controls flown by the Drake Simulator 0.07 km from its
     terminal point."""
-    from drake_entry.diagrams.propagation import propagate
     from drake_entry.guidance.scvx.as_ocp import nlp_form
     from drake_entry.planning import nlp
 
@@ -335,14 +347,15 @@ def test_nominal_heat_load_matches_the_nlp_path(sphynx_case, nominal_plan):
     assert plan.guess is guess and problem.final_time_bounds == pytest.approx(
         (0.3 * guess.final_time, 3.0 * guess.final_time), rel=1e-12)  # the SCvx problem's bounds
     assert start[1][0, :6] == pytest.approx(mission.entry_state(planet), rel=1e-12)  # the OCP's layout
-    result = nlp.solve(problem, transcription="dircol", solver="snopt", nodes=100, guess=start, tolerance=1e-6)
+    result = nlp.solve(problem, transcription="dircol", solver="snopt", nodes=100, guess=start, tolerance=1e-6,
+                       verifier=fly_controls)
     assert result.success, result.message
     assert plan.objective == pytest.approx(result.objective / 1e6, rel=0.01)
     for c, value in zip(problem.terminal, problem.terminal_values(result.states[-1], result.controls[-1])):
         assert c.min - 1e-6 * c.scale <= value <= c.max + 1e-6 * c.scale, c.name
     q = [problem.conditions(x, u).heat_flux for x, u in zip(result.states, result.controls)]
     assert max(q) <= vehicle.limits.heat_flux_max * (1 + 1e-6)
-    assert propagate(problem, result).terminal_error["position_m"] < 1e3
+    assert nlp.propagate(problem, result, fly_controls).terminal_error["position_m"] < 1e3
 
 
 def test_nominal_lossless_plan_converges_in_35_iterations_and_its_real_bank_flies(sphynx_case, lossless_plan):
@@ -354,8 +367,6 @@ def test_nominal_lossless_plan_converges_in_35_iterations_and_its_real_bank_flie
     bank atan2(u2, u1) flown by the Drake Simulator through the closed loop's actuators ends <= 5 km
     from the plan (measured 1.9 km), <= 15 km from the site, inside the DRS box (its default
     1200 m altitude margin: planned 11.80 km, flown 12.75 km), every path limit held."""
-    from drake_entry.diagrams.plan_flight import fly_plan
-
     vehicle, planet, atmosphere, mission, _ = sphynx_case
     plan = lossless_plan
     assert plan.success, plan.message
@@ -365,7 +376,7 @@ def test_nominal_lossless_plan_converges_in_35_iterations_and_its_real_bank_flie
     assert 500.0 < plan.objective < 540.0
     turns = plan.problem.bank_turns(plan.controls)
     assert np.all(turns <= plan.problem.bank_turn_limits(plan.final_time) * (1 + 1e-6) + 1e-6)
-    flight = fly_plan(plan, vehicle, planet, atmosphere)
+    flight = plan.flown
     assert flight.ok and flight.drs_ok, (flight.from_plan_m, flight.drs, flight.violations_text())
     assert flight.from_plan_m <= 5e3 and flight.from_site_m <= 15e3
     assert 10e3 <= flight.drs["altitude_m"] <= 13e3
@@ -378,15 +389,13 @@ def test_paper_lossless_plan_reports_its_gap_and_is_refused_when_its_bank_does_n
     the skip and the final dive; its real bank flown by the Drake Simulator through the closed
     loop's actuators misses: more than 5 km from the plan (16.5 km measured) and above the DRS
     window, so the plan is refused, its message says why and points to the direct polish."""
-    from drake_entry.diagrams.plan_flight import fly_plan
-
     vehicle, planet, atmosphere, _, _ = sphynx_case
     plan = paper_lossless_plan
     assert plan.message.startswith("converged in")
     assert plan.max_defect <= 1e-6 and plan.max_violation <= 1e-6
     assert 500.0 < plan.objective < 540.0
     assert 0.01 < plan.lossless_gap < 0.5  # 0.1-0.3 measured, by trust-region path
-    flight = fly_plan(plan, vehicle, planet, atmosphere)
+    flight = plan.flown
     assert flight.from_plan_m > 5e3 and not flight.ok
     assert not plan.success
     assert "converged but its controls flown end" in plan.message and "'direct'" in plan.message
@@ -397,9 +406,9 @@ def test_default_lossless_margin_is_what_flies_it_into_the_drs_window(sphynx_cas
     above the 10-13 km window (eq. 64) through the actuators: refused, naming the flown altitude."""
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     plan = plan_entry(vehicle, planet, atmosphere, dc.replace(mission, final_altitude_margin_m=200.0), guess=guess,
-                      problem_settings=EntryProblemSettings(formulation="lossless"))
+                      problem_settings=EntryProblemSettings(formulation="lossless"), verifier=fly_controls)
     assert plan.drs["altitude_m"] == pytest.approx(12.8e3, abs=1.0)
-    assert plan.flown["drs"]["altitude_m"] > 13e3 and not plan.flown["inside_box"]
+    assert plan.flown.drs["altitude_m"] > 13e3 and not plan.flown.drs_ok
     assert not plan.success and "outside the DRS box (geodetic altitude 1" in plan.message
 
 
@@ -409,7 +418,7 @@ def test_direct_polish_of_the_lossless_plan_flies(sphynx_case, paper_lossless_pl
     and lowers the heat load (alpha planned)."""
     vehicle, planet, atmosphere, mission, _ = sphynx_case
     polished = plan_entry(vehicle, planet, atmosphere, mission, initial=paper_lossless_plan,
-                          problem_settings=EntryProblemSettings(formulation="direct"))
+                          problem_settings=EntryProblemSettings(formulation="direct"), verifier=fly_controls)
     assert polished.success, polished.message
     assert polished.guess is None
     assert polished.propagated_error_m < 5e3
@@ -422,13 +431,13 @@ def test_warm_start_from_a_plan_on_a_finer_mesh_keeps_its_heat_load(sphynx_case,
     actuators still meet the DRS box and the limits."""
     vehicle, planet, atmosphere, mission, _ = sphynx_case
     warm = plan_entry(vehicle, planet, atmosphere, mission, initial=nominal_plan,
-                      problem_settings=EntryProblemSettings(segments=40, nodes_per_segment=4))
+                      problem_settings=EntryProblemSettings(segments=40, nodes_per_segment=4), verifier=fly_controls)
     assert warm.message.startswith("converged"), warm.message
     assert warm.guess is None and warm.problem.n_nodes == 121
     assert warm.max_defect <= 1e-6 and warm.max_violation <= 1e-6
     assert warm.objective == pytest.approx(nominal_plan.objective, rel=0.01)
     assert warm.success, warm.message
-    assert warm.flown["inside_box"] and warm.flown["within_limits"] and warm.propagated_error_m <= 5e3
+    assert warm.flown.drs_ok and warm.flown.within_limits and warm.propagated_error_m <= 5e3
 
 
 def test_min_max_load_objective_is_the_epigraph_of_the_peak_load(sphynx_case, lossless_plan):
@@ -440,7 +449,7 @@ def test_min_max_load_objective_is_the_epigraph_of_the_peak_load(sphynx_case, lo
     window, so the plan is refused and points to the direct polish."""
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     plan = plan_entry(vehicle, planet, atmosphere, mission, guess=guess,
-                      problem_settings=EntryProblemSettings(objective="max_load", **PAPER_LOSSLESS))
+                      problem_settings=EntryProblemSettings(objective="max_load", **PAPER_LOSSLESS), verifier=fly_controls)
     assert plan.message.startswith("converged in"), plan.message
     assert plan.lossless_gap > 0.1 and plan.propagated_error_m > 5e3
     assert not plan.success and "polish it with the 'direct' formulation" in plan.message

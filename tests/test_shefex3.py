@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from pydrake.autodiffutils import AutoDiffXd
 
+from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
@@ -158,7 +159,7 @@ def test_packaged_problem_solves_verified_within_the_limits():
 
     problem, settings = load_problem("shefex3")
     r = nlp.solve(problem, transcription=settings.transcription, nodes=settings.nodes,
-                  tolerance=settings.tolerance)
+                  tolerance=settings.tolerance, verifier=fly_controls)
     assert r.success, r.message
     assert 550.0 < r.final_time < 630.0 and 0.0 < r.objective < 100.0
     x = r.states[-1]
@@ -181,7 +182,8 @@ def test_table_1_target_lies_outside_the_representative_vehicles_footprint():
     target = (math.radians(-45.75), math.radians(66.40))
     nearest = dc.replace(problem, objective=[ObjectiveTerm("miss_distance", target=target, scale=1e8)],
                          final={k: v for k, v in problem.final.items() if k not in ("lon", "lat")})
-    r = nlp.solve(nearest, transcription=settings.transcription, nodes=settings.nodes, tolerance=settings.tolerance)
+    r = nlp.solve(nearest, transcription=settings.transcription, nodes=settings.nodes, tolerance=settings.tolerance,
+                  verifier=fly_controls)
     assert r.success, r.message
     miss = problem.planet.great_circle_distance(r.states[-1, 1], r.states[-1, 2], *target)
     assert 20e3 < miss < 60e3

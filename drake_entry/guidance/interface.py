@@ -108,9 +108,11 @@ class GuidanceMethod:
     #: name used in rows, reports and messages (snake_case)
     name: str = ""
 
-    def make_planner(self, scenario):
+    def make_planner(self, scenario, verifier):
         """What the method builds once per mission and reuses for every flight and sample
-        (e.g. a planner with its corridor). Runs in each campaign worker."""
+        (e.g. a planner with its corridor). Runs in each campaign worker. ``verifier`` flies a
+        plan's controls with the Drake Simulator (drake_entry.planning.verification): a planner
+        whose plan is a set of controls calls its plans a success only when they fly."""
         raise NotImplementedError
 
     def add_systems(self, builder, scenario, planner, plant: PlantPorts) -> GuidanceCommands:

@@ -20,24 +20,6 @@ def command_lag(period: float, bandwidth: float = BANDWIDTH_RAD_S) -> float:
     return 0.5 * period + 1.0 / bandwidth
 
 
-def sampled_response(commands, period: float, x0: float, *, lower: float, upper: float, rate_limit: float,
-                     accel_limit: float, bandwidth: float = BANDWIDTH_RAD_S, substep: float = SUBSTEP_S):
-    """The sampled actuator (systems.actuators.LimitedActuator with a period) from x0 at rest
-    under ``commands[k]`` [rad] held over [k period, (k+1) period): (time [s], x [rad],
-    x_dot [rad/s]) at every sub-step, the samples the LeafSystem interpolates (C1 cubic
-    Hermite) between; the same ``integrate_actuator`` steps."""
-    steps = max(1, int(round(period / substep)))
-    h = period / steps
-    t, x, v = [0.0], [float(x0)], [0.0]
-    limits = dict(lower=lower, upper=upper, rate_limit=rate_limit, accel_limit=accel_limit, bandwidth=bandwidth)
-    for k, command in enumerate(commands):
-        s, r = integrate_actuator(x[-1], v[-1], float(command), h, steps, **limits)
-        t.extend(k * period + h * np.arange(1, steps + 1))
-        x.extend(s[1:])
-        v.extend(r[1:])
-    return np.array(t), np.array(x), np.array(v)
-
-
 def _clip(v: float, lower: float, upper: float) -> float:
     return lower if v < lower else (upper if v > upper else v)
 

@@ -22,7 +22,7 @@ GUIDANCE_SYSTEM = "reference_tracker"
 class AmpiMethod(GuidanceMethod):
     name = "ampi"
 
-    def make_planner(self, scenario) -> DatabaseReference:
+    def make_planner(self, scenario, verifier) -> DatabaseReference:
         g = scenario.guidance
         return DatabaseReference.load(g.database, g.reference, hd_points=g.hd_points, weights=g.weights(),
                                       gain_samples=g.gain_samples)

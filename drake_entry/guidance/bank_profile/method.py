@@ -37,7 +37,7 @@ class BankProfilePlan(PlanResult):
 class BankProfileMethod(GuidanceMethod):
     name = "bank_profile"
 
-    def make_planner(self, scenario) -> BankProfilePlan:
+    def make_planner(self, scenario, verifier) -> BankProfilePlan:
         t0 = time.perf_counter()
         g = scenario.guidance
         E0, Ef = scenario.entry_energy(), scenario.guidance_terminal_state()[2]

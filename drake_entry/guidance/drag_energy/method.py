@@ -25,7 +25,7 @@ REFERENCE_COLUMNS = ("reference_drag_m_s2", "reference_drag_slope_1_m", "referen
 class DragEnergyMethod(GuidanceMethod):
     name = "drag_energy"
 
-    def make_planner(self, scenario) -> DragEnergyPlanner:
+    def make_planner(self, scenario, verifier) -> DragEnergyPlanner:
         return DragEnergyPlanner.from_scenario(scenario)
 
     def add_systems(self, builder, scenario, planner, plant: PlantPorts) -> GuidanceCommands:

@@ -31,11 +31,11 @@ GUIDANCE_SYSTEM = "scvx_guidance"
 class ScvxMethod(GuidanceMethod):
     name = "scvx"
 
-    def make_planner(self, scenario) -> ScvxPlan:
+    def make_planner(self, scenario, verifier) -> ScvxPlan:
         problem, scvx = scenario.guidance.planner_settings()
         return plan_entry(scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere(),
                           scenario.guidance.mission(scenario), problem_settings=problem, settings=scvx,
-                          flight=scenario.guidance.flight_check())
+                          flight=scenario.guidance.flight_check(), verifier=verifier)
 
     def add_systems(self, builder, scenario, planner: ScvxPlan, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance

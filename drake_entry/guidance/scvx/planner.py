@@ -7,30 +7,25 @@ import math
 import time
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.interpolate import CubicHermiteSpline, CubicSpline
+from scipy.interpolate import CubicSpline
 
-from drake_entry.errors import ModelRangeError, NonFiniteStateError
 from drake_entry.guidance.scvx.engine import max_defect, max_violation, solve_scvx
 from drake_entry.guidance.scvx.entry import EntryProblem
 from drake_entry.guidance.scvx.guess import GlideGuess, glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
-from drake_entry.models.actuator import sampled_response
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.constraints import dynamic_pressure
 from drake_entry.models.dynamics import (
-    FLIGHT_CONDITION_NAMES,
     STATE_NAMES,
-    aero_accelerations,
     air_data,
-    equations_of_motion,
     flight_conditions,
 )
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.models.verdict import PathLimit, breaches_text, check_limits, vehicle_path_limits
 from drake_entry.planning.result import PlanResult
+from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, Verifier, require_verifier
 
 #: the lossless gap is judged where the lift can act: L >= this fraction of g0
 GAP_LIFT_FRACTION = 0.05
@@ -38,7 +33,7 @@ GAP_LIFT_FRACTION = 0.05
 BETWEEN_NODE_TOLERANCE = (0.02, 0.02, math.radians(0.2))
 #: evaluation points per mesh segment for the between-node check and the rate metrics
 POINTS_PER_SEGMENT = 8
-#: the plan's controls propagated must end within this of its terminal point [m]
+#: the plan's controls flown must end within this of its terminal point [m]
 PROPAGATION_TOLERANCE_M = 5e3
 
 #: ``ScvxPlan.metrics`` keys of each objective (paper 001 Table 2)
@@ -69,11 +64,13 @@ class ScvxPlan(PlanResult):
       miss_m: planned DRS point to the site [m]; drs: planned DRS altitude (geodetic) [m], Mach,
         vertical speed [m/s].
       metrics: the paper's Table 2, 3 and 6 quantities (``plan_metrics``).
-      propagated_error_m: the plan's real bank and alpha flown from its entry state through the
-        closed loop's actuators (``propagate_plan``) end this far from its terminal point [m]
-        (great circle and altitude); ``success`` needs it <= PROPAGATION_TOLERANCE_M.
-      flight: the FlightCheck it was flown with; flown: ``flown_check``'s verdict (the flown DRS
-        point, inside_box, the path-limit checks, within_limits).
+      propagated_error_m: the plan's real bank and alpha flown by the verifier (the Drake
+        Simulator) from its entry state through the closed loop's actuators (``plan_controls``)
+        end this far from its terminal point [m] (great circle and altitude); ``success`` needs
+        it <= PROPAGATION_TOLERANCE_M.
+      flight: the FlightCheck it was flown with; flown: the PlanFlight (``flown_check``: the
+        flown DRS point and box, the path-limit checks); verifier: what flew it (re-plans
+        use the same).
       guess: the glide guess it started from; history: the engine's IterationRecords.
     """
 
@@ -96,7 +93,8 @@ class ScvxPlan(PlanResult):
     propagated_error_m: float
     guess: GlideGuess | None = None
     flight: FlightCheck | None = None
-    flown: dict = dc.field(default_factory=dict, repr=False)
+    flown: PlanFlight | None = dc.field(default=None, repr=False)
+    verifier: Verifier | None = dc.field(default=None, repr=False)
     history: list = dc.field(default_factory=list, repr=False)
     problem: EntryProblem | None = dc.field(default=None, repr=False)
 
@@ -233,112 +231,85 @@ def plan_metrics(problem: EntryProblem, X, U, tf: float) -> dict:
             "miss_km": problem.site_miss(X[-1]) / 1e3}
 
 
-def _actuated(plan: ScvxPlan, tt, samples, flight: FlightCheck, lower: float, upper: float, rate_limit: float,
-              accel_limit: float, x0: float):
-    """The command ``samples`` at times ``tt`` as the sampled actuator flies them: a C1 cubic
-    Hermite in time (``actuator.sampled_response``), read ``lead_s`` ahead."""
-    n = int(math.ceil(plan.final_time / flight.period_s)) + 1
-    commands = CubicSpline(tt, samples)(np.minimum(np.arange(n) * flight.period_s + flight.lead_s, tt[-1]))
-    t, x, v = sampled_response(commands, flight.period_s, x0, lower=lower, upper=upper, rate_limit=rate_limit,
-                               accel_limit=accel_limit)
-    return CubicHermiteSpline(t, x, v)
+def plan_controls(plan: ScvxPlan, flight: FlightCheck | None, samples_per_segment: int = 32) -> EntryControls:
+    """The plan's bank and alpha (planned, or the mission's alpha(V) law at the flown speed) as
+    the verifier flies them: from its entry state to its t_f, through the closed loop's bank and
+    alpha actuators as ``flight`` says (the vehicle's bank limits, the mission's alpha bounds and
+    rate limit), or directly when ``flight`` is None or has no period."""
+    p, v, m = plan.problem, plan.problem.vehicle, plan.problem.mission
+    tt, bank, alpha = plan.control_samples(samples_per_segment)
+    actuation = None
+    if flight is not None and flight.period_s is not None:
+        lo, hi = np.radians(m.alpha_bounds_deg)
+        actuation = Actuation(period_s=flight.period_s, lead_s=flight.lead_s, bank_limit=v.bank_limit,
+                              bank_rate_limit=v.bank_rate_limit, bank_accel_limit=v.bank_accel_limit,
+                              alpha_bounds=(float(lo), float(hi)), alpha_rate_limit=math.radians(m.alpha_rate_limit_deg_s),
+                              alpha_accel_limit=math.radians(flight.alpha_acceleration_deg_s2),
+                              initial_bank=float(plan.bank[0]), initial_alpha=float(plan.alpha[0]))
+    return EntryControls(p.vehicle, p.planet, p.atmosphere, plan.states[0, :6].astype(float), plan.final_time,
+                         tt, bank, alpha, p.alpha, actuation)
 
 
 @dc.dataclass
-class PlanPropagation:
-    """A plan's controls flown from its entry state (``propagate_plan``).
+class PlanFlight:
+    """A plan's controls flown by the verifier, and the verdict on that flight.
 
     Attributes:
-      time [s] (n,), states (n, 6): the integrator's steps. bank, alpha: the flown controls as
-        functions of time [rad] (alpha None: the mission's alpha(V) law at the flown speed).
+      from_plan_m: flown minus planned position at t_f [m] (great circle and altitude, root
+        sum square); inf when the flight stopped early.
+      from_site_m: flown DRS point to the site [m].
+      drs: flown geodetic altitude [m], Mach and vertical speed [m/s] at t_f; drs_ok: inside the
+        DRS box (eqs. 64-68: the altitude window, Mach, vertical speed, the site within
+        site_radius_m + PROPAGATION_TOLERANCE_M).
+      peaks: flown max heat flux [W/m^2] and total load [g] (log samples and integrator steps).
+      checks: the path limits (``plan_path_limits``) on the flight; within_limits: all held.
       failure: why the flight stopped before t_f ('' when it reached it).
+      trajectory: the flown drake_entry.models.trajectory.Trajectory (with its integrator steps).
     """
 
-    time: np.ndarray
-    states: np.ndarray
-    bank: object
-    alpha: object
+    from_plan_m: float
+    from_site_m: float
+    drs: dict
+    drs_ok: bool
+    peaks: dict
+    checks: list
+    within_limits: bool
     failure: str = ""
+    trajectory: object = dc.field(default=None, repr=False)
+
+    @property
+    def ok(self) -> bool:
+        """Reached t_f within PROPAGATION_TOLERANCE_M of the plan, inside the DRS box, every path limit held."""
+        return (not self.failure and self.from_plan_m <= PROPAGATION_TOLERANCE_M and self.drs_ok
+                and self.within_limits)
+
+    @property
+    def time(self) -> np.ndarray:
+        """Logged times of the flight [s]."""
+        return self.trajectory.time
+
+    @property
+    def states(self) -> np.ndarray:
+        """Logged states (n, 6) of the flight [h, lon, lat, V, gamma, psi] (SI, rad)."""
+        return self.trajectory.state
+
+    def violations_text(self) -> str:
+        return breaches_text(self.checks)
 
 
-def propagate_plan(plan: ScvxPlan, *, flight: FlightCheck | None = FlightCheck(), samples_per_segment: int = 32,
-                   rtol: float = 1e-9, steps_per_period: int = 4) -> PlanPropagation:
-    """Fly the plan's bank and alpha (planned, or the alpha(V) law) from its entry state to its
-    t_f on the project's equations of motion, through the closed loop's actuators as ``flight``
-    says: the model-layer check of ``plan_entry``; ``diagrams.plan_flight.fly_plan`` flies the
-    same controls through the Drake actuator systems and a test holds the two together.
-
-    Through the actuators (whose path is C1 with a kink every 0.02-s sub-step) the flight is
-    fixed-step RK4 at ``steps_per_period`` steps per guidance period (2 m from a 1e-12
-    integration at t_f on the nominal mission, where DOP853 at rtol 1e-9 was 160 m off at twice
-    the cost); where alpha follows the alpha(V) law its sampled command is the law at the plan's
-    speed (the Drake flight: at the flown speed). ``flight=None`` flies the plan's own C2
-    controls with DOP853 at ``rtol``."""
-    p, v, m = plan.problem, plan.problem.vehicle, plan.problem.mission
-    tt, bank_samples, alpha_samples = plan.control_samples(samples_per_segment)
-    actuated = flight is not None and flight.period_s is not None
-    if not actuated:
-        bank = CubicSpline(tt, bank_samples)
-        alpha = CubicSpline(tt, alpha_samples) if alpha_samples is not None else None
-    else:
-        if alpha_samples is None:
-            alpha_samples = np.array([float(p.alpha(V)) for V in plan.evaluate(tt)["V"]])
-        lo, hi = np.radians(m.alpha_bounds_deg)
-        bank = _actuated(plan, tt, bank_samples, flight, -v.bank_limit, v.bank_limit, v.bank_rate_limit,
-                         v.bank_accel_limit, float(plan.bank[0]))
-        alpha = _actuated(plan, tt, alpha_samples, flight, float(lo), float(hi), math.radians(m.alpha_rate_limit_deg_s),
-                          math.radians(flight.alpha_acceleration_deg_s2), float(plan.alpha[0]))
-
-    def rhs(t, x):
-        rho, a = air_data(x, p.planet, p.atmosphere)
-        a_t = float(alpha(t)) if alpha is not None else float(p.alpha(float(x[3])))
-        _, L, D = aero_accelerations(x, a_t, rho, a, p.vehicle)
-        return np.asarray(equations_of_motion(list(x), float(bank(t)), L, D, p.planet))
-
-    x0, tf = plan.states[0, :6].astype(float), plan.final_time
-    try:
-        if not actuated:
-            atol = rtol * np.array([1e4, 1.0, 1.0, 1e3, 1.0, 1.0])
-            sol = solve_ivp(rhs, (0.0, tf), x0, method="DOP853", rtol=rtol, atol=atol)
-            return PlanPropagation(sol.t, sol.y.T, bank, alpha, "" if sol.status == 0 else sol.message)
-        n = int(math.ceil(tf / flight.period_s * steps_per_period))
-        h = tf / n
-        T, X = [0.0], [x0]
-        x = x0
-        for k in range(n):
-            t = k * h
-            k1 = rhs(t, x)
-            k2 = rhs(t + 0.5 * h, x + 0.5 * h * k1)
-            k3 = rhs(t + 0.5 * h, x + 0.5 * h * k2)
-            k4 = rhs(t + h, x + h * k3)
-            x = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-            if not np.all(np.isfinite(x)):
-                raise NonFiniteStateError(f"non-finite state at t = {t + h:.1f} s")
-            T.append(t + h)
-            X.append(x)
-        return PlanPropagation(np.array(T), np.array(X), bank, alpha)
-    except (ModelRangeError, NonFiniteStateError, OverflowError) as e:
-        return PlanPropagation(np.array([0.0]), x0[None, :], bank, alpha, f"{type(e).__name__}: {e}")
-
-
-def flown_check(plan: ScvxPlan, flown: PlanPropagation) -> dict:
-    """The verdict of a propagated plan: its terminal point to the plan's [m], the flown DRS point
-    (geodetic altitude [m], Mach, vertical speed [m/s], site miss [m]) and whether it is inside
-    the DRS box (eqs. 64-68: the altitude window, Mach, vertical speed, the site within
-    site_radius_m + PROPAGATION_TOLERANCE_M), and the path limits (``plan_path_limits``) at every
-    integrator step."""
+def flown_check(plan: ScvxPlan, flown: FlownControls) -> PlanFlight:
+    """The verdict on a flight of the plan's controls: its terminal point to the plan's, the
+    flown DRS point and box, and the path limits at every log sample and integrator step."""
     p, m = plan.problem, plan.problem.mission
-    t, X = flown.time, flown.states
-    xf = X[-1]
-    alpha = (flown.alpha(t) if flown.alpha is not None else np.array([float(p.alpha(x[3])) for x in X]))
-    conds = np.array([flight_conditions(x, 0.0, a, p.vehicle, p.planet, p.atmosphere) for x, a in zip(X, alpha)])
-    columns = {name: conds[:, i] for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
-    columns.update({name: X[:, i] for i, name in enumerate(STATE_NAMES)})
-    columns.update(bank=flown.bank(t), alpha=alpha)
-    checks = check_limits(t, columns.__getitem__, plan_path_limits(plan))
-    drs, inside = drs_point(m, p.planet, xf, float(columns["mach"][-1]), m.site_radius_m + PROPAGATION_TOLERANCE_M)
-    return {"from_plan_m": terminal_distance(p.planet, xf, plan.states[-1]), "drs": drs, "inside_box": inside,
-            "checks": checks, "within_limits": all(c.held for c in checks)}
+    tr = flown.trajectory
+    checks = check_limits(tr.flown_time(), tr.flown, plan_path_limits(plan))
+    peaks = {"heat_flux_W_m2": float(tr.flown("heat_flux").max()), "total_load_g": float(tr.flown("total_load").max())}
+    xf = tr.state[-1]
+    drs, inside = drs_point(m, p.planet, xf, float(tr.column("mach")[-1]), m.site_radius_m + PROPAGATION_TOLERANCE_M)
+    from_site = drs.pop("site_miss_m")
+    from_plan = math.inf if flown.failure else terminal_distance(p.planet, xf, plan.states[-1])
+    return PlanFlight(from_plan, float(from_site), drs, bool(inside and not flown.failure), peaks, checks,
+                      all(c.held for c in checks), flown.failure, tr)
 
 
 def drs_point(mission: ScvxMission, planet: Earth, xf, mach: float, site_tolerance_m: float) -> tuple[dict, bool]:
@@ -370,10 +341,11 @@ def terminal_distance(planet: Earth, x, x_plan) -> float:
 def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission: ScvxMission, *,
                problem_settings: EntryProblemSettings | None = None, settings: ScvxSettings | None = None,
                guess: GlideGuess | None = None, initial=None, progress=None,
-               flight: FlightCheck = FlightCheck()) -> ScvxPlan:
+               flight: FlightCheck = FlightCheck(), verifier: Verifier | None = None) -> ScvxPlan:
     """Plan the mission: the glide guess (unless given), SCvx, the between-node check, then the
-    verdict of its controls flown (``flown_check``): ``success`` only when it converged, its
-    controls flown through the closed loop's actuators (``flight``) end within
+    verdict of its controls flown by ``verifier`` (the Drake Simulator,
+    drake_entry.diagrams.verification.fly_controls; ``flown_check``): ``success`` only when it
+    converged, its controls flown through the closed loop's actuators (``flight``) end within
     PROPAGATION_TOLERANCE_M of its terminal point, inside the DRS box, and every path limit held.
 
     Args:
@@ -382,7 +354,9 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
         differ, it is interpolated).
       progress: ``progress(k, IterationRecord)`` after every iteration.
       flight: how the controls are flown for the verdict (FlightCheck; re-plans keep it).
+      verifier: flies the controls (drake_entry.planning.verification; re-plans keep it).
     """
+    fly = require_verifier(verifier, "plan_entry")
     t0 = time.perf_counter()
     ps = problem_settings or EntryProblemSettings()
     if initial is None and guess is None:
@@ -429,29 +403,26 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
         drs={"altitude_m": float(final[problem.out_h]), "mach": float(xf[3] / final[problem.out_a]),
              "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))},
         metrics=metrics, propagated_error_m=math.nan, guess=guess, history=outcome.history, problem=problem)
-    plan.flight = flight
-    propagated = propagate_plan(plan, flight=flight)
-    if propagated.failure:
-        plan.propagated_error_m = math.inf
-        plan.flown = {}
-        flown_ok, why = False, f"its controls flown stop before t_f: {propagated.failure}"
+    plan.flight, plan.verifier = flight, fly
+    plan.flown = flown = flown_check(plan, fly(plan_controls(plan, flight)))
+    plan.propagated_error_m = flown.from_plan_m
+    if flown.failure:
+        flown_ok, why = False, f"its controls flown stop before t_f: {flown.failure}"
     else:
-        plan.flown = flown = flown_check(plan, propagated)
-        plan.propagated_error_m = flown["from_plan_m"]
-        d = flown["drs"]
+        d = dict(flown.drs, site_miss_m=flown.from_site_m)
         problems = []
         if plan.propagated_error_m > PROPAGATION_TOLERANCE_M:
             problems.append(f"end {plan.propagated_error_m / 1e3:.1f} km from its terminal point "
                             f"(> {PROPAGATION_TOLERANCE_M / 1e3:g} km; "
                             + (f"lossless gap {gap:.2f}: polish it with the 'direct' formulation)" if gap > 1e-2
                                else "refine the mesh)"))
-        if not flown["inside_box"]:
+        if not flown.drs_ok:
             problems.append(f"end outside the DRS box (geodetic altitude {d['altitude_m'] / 1e3:.2f} km of "
                             f"{mission.final_altitude_m[0] / 1e3:g}-{mission.final_altitude_m[1] / 1e3:g} km, "
                             f"Mach {d['mach']:.2f}, vertical speed {d['vertical_speed_m_s']:.1f} m/s, "
                             f"{d['site_miss_m'] / 1e3:.1f} km from the site)")
-        if not flown["within_limits"]:
-            problems.append("breach " + breaches_text(flown["checks"]))
+        if not flown.within_limits:
+            problems.append("breach " + flown.violations_text())
         flown_ok, why = not problems, "its controls flown " + " and ".join(problems)
     if outcome.converged and not flown_ok:
         plan.message += f"; converged but {why}"
@@ -493,4 +464,5 @@ def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float
     if guess.final_time <= 0.0:
         raise ValueError(f"the previous plan has no time left at {elapsed:.1f} s (t_f {previous.final_time:.1f} s)")
     return plan_entry(p.vehicle, p.planet, p.atmosphere, mission, problem_settings=p.settings,
-                      settings=settings, guess=guess, flight=previous.flight or FlightCheck())
+                      settings=settings, guess=guess, flight=previous.flight or FlightCheck(),
+                      verifier=previous.verifier)

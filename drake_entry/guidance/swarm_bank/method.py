@@ -138,7 +138,7 @@ def plan(scenario, problem: SwarmProblem | None = None) -> SwarmPlan:
 class SwarmBankMethod(GuidanceMethod):
     name = "swarm_bank"
 
-    def make_planner(self, scenario) -> SwarmPlan:
+    def make_planner(self, scenario, verifier) -> SwarmPlan:
         return plan(scenario)
 
     def add_systems(self, builder, scenario, planner: SwarmPlan, plant: PlantPorts) -> GuidanceCommands:

@@ -14,17 +14,20 @@ D X - (t_f / 2) f(X, U) = 0 and the path rows, evaluated by one vectorised model
 its exact sparse Jacobian (lgl, evaluator). Costates come from the defects' KKT multipliers
 (eq. 15): lambda(t_k) = nu_k / w_k, converted back to SI.
 
-DirectCollocation: Drake's Hermite-Simpson transcription of systems.ocp_plant (the same
+DirectCollocation: Drake's Hermite-Simpson transcription of planning.ocp_system (the same
 scaled dynamics as a Drake System) with N samples; the running cost is the trapezoid rule
 over the samples; costates are estimated at the segment midpoints from the collocation
 multipliers, lambda(t_k+1/2) = 3 nu_k / (2 h_k).
 
 The result reports the Hamiltonian H = L + lambda' f along the solution (zero on an
-extremal with free final time, paper 002 Fig. 10) and ``propagate`` (diagrams.propagation)
-flies the controls with the Drake Simulator to check the terminal state.
+extremal with free final time, paper 002 Fig. 10) and ``verify.propagate`` flies the controls
+with the verifier it is given (the Drake Simulator: drake_entry.diagrams.verification) to
+check the terminal state.
 
 ``success`` means verified (verify: dynamics between the nodes and the controls flown by the
-Drake Simulator); a converged answer that fails the check says "converged but inaccurate".
+``verifier``); a converged answer that fails the check says "converged but inaccurate", and
+one solved without a verifier says "not verified" and is not a success (``converged`` keeps
+the solver's word).
 
 ``refine=True`` raises the node count until the between-node error meets the tolerance
 (mesh); ``solver='auto'`` (default) tries SNOPT, then Ipopt from the same start.
@@ -53,7 +56,13 @@ from drake_entry.planning.nlp.scaling import Scaling  # noqa: F401 (API)
 from drake_entry.planning.nlp.scaling import resolve as resolve_scaling
 from drake_entry.planning.nlp.status import restartable, verdict
 from drake_entry.planning.nlp.transcription import COSTATE_SIGN  # noqa: F401 (API)
-from drake_entry.planning.nlp.verify import DYNAMICS_TOLERANCE, PROPAGATION_TOLERANCE, Verification  # noqa: F401
+from drake_entry.planning.nlp.verify import (  # noqa: F401 (API)
+    DYNAMICS_TOLERANCE,
+    PROPAGATION_TOLERANCE,
+    PropagationCheck,
+    Verification,
+    propagate,
+)
 from drake_entry.planning.nlp.verify import verify as verify_solution
 
 TRANSCRIPTIONS = ("lgl", "dircol")
@@ -65,7 +74,7 @@ SOLVERS = ("ipopt", "snopt")
 
 def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: int = 40, guess=None,
           tolerance: float = 1e-8, max_iterations: int = 3000, verbose: bool = False, scaling=None,
-          solver_options: dict | None = None, log_file: str | None = None, verify: bool = True,
+          solver_options: dict | None = None, log_file: str | None = None, verifier=None,
           dynamics_tolerance: float = DYNAMICS_TOLERANCE,
           propagation_tolerance: float = PROPAGATION_TOLERANCE, refine: bool = False,
           max_nodes: int | None = None) -> NlpResult:
@@ -87,8 +96,10 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
       solver_options: further options by the solver's own names, set last (e.g.
         {"linear_solver": "mumps"} for Ipopt, {"Hessian full memory": 1} for SNOPT).
       log_file: where the solver writes its log.
-      verify: check the solution between the nodes and by flying its controls
-        (nlp.verify); without it ``success`` is the solver's word only.
+      verifier: flies the controls for the verification (drake_entry.planning.verification;
+        the Drake one is drake_entry.diagrams.verification.fly_controls); with it the solution
+        is checked between the nodes and by its flown controls (nlp.verify); without it the
+        answer is not verified and ``success`` is False (``converged``: the solver's word).
       dynamics_tolerance: the verification's between-node tolerance (relative).
       propagation_tolerance: the verification's tolerance on the flown controls (relative).
       refine: mesh refinement (nlp.mesh): start on ``nodes`` and raise the node count,
@@ -161,20 +172,20 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
             mesh = f" on mesh {len(history)} ({nodes} nodes)" if refine else ""
             result.success, result.message = False, f"not solved{mesh}: {words}; {diagnosis}"
             return result
-        if not verify and not refine:
-            result.success, result.message = True, f"solved (not verified): {words}"
+        if verifier is None and not refine:
+            result.success, result.message = False, f"solved, not verified (no verifier given): {words}"
             return result
         if refine and history[-1].error > target and nodes < cap:
             nodes, guess = next_nodes(transcription, history, target, cap), (result.time, result.states,
                                                                              result.controls)
             continue
-        if not verify:
-            result.success = history[-1].error <= target
-            result.message = (f"solved (propagation not verified): {words}; " if result.success else
-                              f"converged but inaccurate: {words}; ") + _mesh_words(history, target, cap)
+        if verifier is None:
+            result.success = False
+            result.message = (f"solved, not verified (no verifier given): {words}; " if history[-1].error <= target
+                              else f"converged but inaccurate: {words}; ") + _mesh_words(history, target, cap)
             return result
         t_verify = _time.perf_counter()
-        check = verify_solution(problem, result, dynamics_tolerance=dynamics_tolerance,
+        check = verify_solution(problem, result, verifier=verifier, dynamics_tolerance=dynamics_tolerance,
                                 propagation_tolerance=propagation_tolerance)
         result.verify_time = _time.perf_counter() - t_verify
         result.verification = check

@@ -1,6 +1,5 @@
-"""Drake DirectCollocation (Hermite-Simpson) transcription. It needs the problem as a Drake
-System, so it imports systems.ocp_plant: the one deliberate exception to the layer rule
-(docs/architecture.md)."""
+"""Drake DirectCollocation (Hermite-Simpson) transcription of the problem as a Drake System
+(planning.ocp_system)."""
 from __future__ import annotations
 
 import numpy as np
@@ -18,7 +17,7 @@ class _DircolTranscription(_Transcription):
         super().__init__(problem, nodes, scaling)
         from pydrake.planning import DirectCollocation
 
-        from drake_entry.systems.ocp_plant import OptimalControlPlant  # the transcription needs a Drake System
+        from drake_entry.planning.ocp_system import OptimalControlPlant
 
         self.plant = OptimalControlPlant(problem, self.sx, self.su, self.ts, undefined_as_nan=True,
                                          timer=self.timer)

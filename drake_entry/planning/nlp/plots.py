@@ -12,7 +12,7 @@ def nlp_solution_plots(problem, result, out_dir: str, *, propagated=None, extrem
     """Paper 002 Figs. 1-10 for an entry NLP solution: altitude, dynamic pressure against
     its bounds, downtrack-crosstrack, speed, flight-path angle, alpha, bank, u_alpha and
     u_sigma against the extremal controls, and the Hamiltonian. NLP nodes as markers,
-    the Drake propagation of the controls (``propagated``: PropagationCheck) as a line."""
+    the Drake propagation of the controls (``propagated``: nlp.verify.PropagationCheck) as a line."""
     from drake_entry.models.geodesy import downtrack_crosstrack
 
     os.makedirs(out_dir, exist_ok=True)

@@ -31,7 +31,7 @@ class NlpResult(PlanResult):
       costate_time: times of the costate rows [s].
       hamiltonian: H = L + lambda' f at costate_time [cost units / s].
       converged: the solver's own verdict (SNOPT info 1, Ipopt status 0).
-      verification: nlp.verify.Verification (None when solve(verify=False)).
+      verification: nlp.verify.Verification (None when solved without a verifier).
       scaling: nlp.scaling.Scaling, the factors the solver saw.
       guess_time, build_time, solve_time, verify_time: wall time [s] of the initial guess,
         the transcription, the solver and the verification; ``total_time`` their sum.
@@ -149,7 +149,7 @@ def summary(problem, result: NlpResult, check=None) -> dict:
     """Figures of merit of a solution (paper 002 'Results' for entry problems): objective,
     final time, solve time, the local altitude maxima and the dynamic pressure there,
     final bank, largest |H| at interior nodes, extremal-control match and, with ``check``
-    (a diagrams.propagation.PropagationCheck), the propagated terminal errors."""
+    (an nlp.verify.PropagationCheck), the propagated terminal errors."""
     out = {"success": result.success, "converged": result.converged, "message": result.message,
            "transcription": result.transcription, "solver": result.solver, "nodes": result.nodes,
            "objective": result.objective, "final_time_s": result.final_time, "solve_time_s": result.solve_time,

@@ -11,7 +11,8 @@ sigma = the grid step / 3: eq. 5's ranges as 3 sigma), one case
 3. compares each reference with the OCP at the same normalised times (eq. 13's max_k over
    N_HD + 1 equally spaced points): max |error| per state and the t_f error;
 4. flies each reference's bank open loop from the true entry state with the Drake
-   Simulator (diagrams.propagation) and measures the miss from the target.
+   Simulator (nlp.propagate with the plan verifier, diagrams.verification) and measures the
+   miss from the target.
 
 ``summarise`` gives eq. 13's mean and standard deviation of the per-case maximum errors
 (absolute, and relative for h and V as in Fig. 5), the open-loop misses and the CPU times

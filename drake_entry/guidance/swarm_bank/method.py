@@ -4,8 +4,9 @@
       (shared bank actuator);   SwarmBankGuidance --alpha_command--> (shared alpha actuator)
 
 The planner searches sigma_0 before flight (PIO by default, guidance/swarm_bank/search.py) on the
-evaluator that replicates this closed loop, and verifies the optimum's trajectory against the
-path limits (eqs. 13-15) before calling it a success.
+evaluator that replicates this closed loop, and calls the optimum a success only when its
+commands, flown by the plan verifier (the Drake Simulator through the closed loop's actuators),
+end near the replica's TAEM point, inside the acceptance box and the path limits (eqs. 13-15).
 """
 from __future__ import annotations
 
@@ -34,25 +35,26 @@ from drake_entry.guidance.swarm_bank.evaluator import (
 from drake_entry.guidance.swarm_bank.search import SearchResult, problem_from_scenario, search
 from drake_entry.models.verdict import acceptance_box, box_text, breaches_text, check_limits, vehicle_path_limits
 from drake_entry.planning.result import PlanResult
+from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, require_verifier
 from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
 
 GUIDANCE_SYSTEM = "swarm_bank_guidance"
-#: the replica's recorded column of each path-limit column it can check (the closed loop's
-#: verdict checks every limit at every integrator step)
-LIMIT_COLUMNS = {"heat_flux": "heat_flux_W_m2", "dynamic_pressure": "dynamic_pressure_Pa",
-                 "total_load": "total_load_g", "bank": "bank_rad"}
-
+#: the plan's commands flown by Drake must end this close to the replica's TAEM point [m]
+#: (great circle and altitude; measured on paper 004's Case 1 optimum: see docs/methods/swarm-bank.md)
+FLOWN_TOLERANCE_M = 2000.0
 
 @dc.dataclass
 class SwarmPlan(PlanResult):
     """sigma_0 [deg] of paper 004 eq. 17 for a mission, with the search that found it and the
     evaluation of its trajectory (``evaluation``, one member with its recorded history).
 
-    success: the trajectory reaches the TAEM energy inside the scenario's acceptance box and the
-    path limits (heat rate, q, load,
-    bank: the vehicle's, widened only by the scenario's ``terminal.path_limit_tolerance``, at
-    every guidance step of the closed-loop replica); otherwise ``message`` names the violated
-    limits with their peaks and margins.
+    success: the replica reaches the TAEM energy, and its commands flown by the Drake Simulator
+    through the closed loop's actuators (``flown``, ``plan_controls``) end within
+    FLOWN_TOLERANCE_M of the replica's TAEM point (``from_replica_m``), inside the scenario's
+    acceptance box and within the path limits (heat rate, q, load, bank: the vehicle's, widened
+    only by the scenario's ``terminal.path_limit_tolerance``, at every log sample and
+    integrator step); otherwise ``message`` names what failed, the violated limits with their
+    peaks and margins (``violations``).
     """
 
     variable = "time"
@@ -62,6 +64,8 @@ class SwarmPlan(PlanResult):
     search: SearchResult | None = None
     evaluation: Evaluation | None = None
     violations: list = dc.field(default_factory=list)
+    flown: FlownControls | None = dc.field(default=None, repr=False)
+    from_replica_m: float = math.nan
 
     def evaluate(self, at) -> dict:
         """The planned trajectory's HISTORY_COLUMNS at times ``at`` [s]: the states, commands and
@@ -75,14 +79,33 @@ class SwarmPlan(PlanResult):
         return out
 
 
-def verify(problem: SwarmProblem, ev: Evaluation, tolerance: float = 0.0) -> list:
-    """The path limits the (single-member, recorded) evaluation breaches (drake_entry.models.verdict
-    LimitChecks, at every guidance step of the replica), ``tolerance`` relative."""
-    v = problem.vehicle
-    limits = [lim for lim in vehicle_path_limits(v.limits, v.bank_limit) if lim.column in LIMIT_COLUMNS]
+def plan_controls(problem: SwarmProblem, ev: Evaluation) -> EntryControls:
+    """The replica's bank and alpha commands (``ev``'s recorded member, one per guidance step)
+    as the closed loop flies them: sampled every guidance step, no lead, into the shared bank
+    and alpha actuators (the vehicle's bank limits, the problem's alpha bounds and limits), from
+    the start state to the replica's TAEM time."""
     h = ev.history[0]
-    checks = check_limits(h[:, 0], lambda column: h[:, HISTORY_COLUMNS.index(LIMIT_COLUMNS[column])], limits,
-                          tolerance)
+    t = h[:, 0]
+    bank, alpha = h[:, HISTORY_COLUMNS.index("bank_command_rad")], h[:, HISTORY_COLUMNS.index("alpha_command_rad")]
+    tf = float(ev.time_s[0])
+    if tf > t[-1] + 1e-9:  # the TAEM energy is crossed inside the last step: its commands hold
+        t, bank, alpha = np.append(t, tf), np.append(bank, bank[-1]), np.append(alpha, alpha[-1])
+    v, p = problem.vehicle, problem
+    actuation = Actuation(period_s=p.guidance_step_s, lead_s=0.0, bank_limit=v.bank_limit,
+                          bank_rate_limit=v.bank_rate_limit, bank_accel_limit=v.bank_accel_limit,
+                          alpha_bounds=(p.alpha_min, p.alpha_max), alpha_rate_limit=p.alpha_rate,
+                          alpha_accel_limit=p.alpha_accel, initial_bank=p.initial_bank,
+                          initial_alpha=p.alpha_max if p.initial_alpha is None else p.initial_alpha)
+    return EntryControls(v, p.planet, p.atmosphere, np.asarray(p.x0, float), tf, t, bank, alpha, None, actuation)
+
+
+def verify(problem: SwarmProblem, flown: FlownControls, tolerance: float = 0.0) -> list:
+    """The path limits (heat rate, q, load, bank: drake_entry.models.verdict, ``tolerance``
+    relative) the Drake flight of the plan's commands breaches, at every log sample and
+    integrator step."""
+    v = problem.vehicle
+    tr = flown.trajectory
+    checks = check_limits(tr.flown_time(), tr.flown, vehicle_path_limits(v.limits, v.bank_limit), tolerance)
     return [c for c in checks if not c.held]
 
 
@@ -98,9 +121,12 @@ def terminal_box(scenario, problem: SwarmProblem, x) -> dict:
     return acceptance_box(scenario.terminal, altitude_m=h, mach=float(x[3]) / a, distance_m=distance)
 
 
-def plan(scenario, problem: SwarmProblem | None = None) -> SwarmPlan:
-    """Search sigma_0 (unless the spec gives it), fly the answer once more with its history and
-    verify it."""
+def plan(scenario, verifier, problem: SwarmProblem | None = None) -> SwarmPlan:
+    """Search sigma_0 (unless the spec gives it) on the replica, record the answer's flight,
+    and verify it: its commands flown by ``verifier`` (the Drake Simulator through the closed
+    loop's actuators, ``plan_controls``) must end inside the acceptance box, within every path
+    limit and within FLOWN_TOLERANCE_M of the replica's TAEM point."""
+    fly = require_verifier(verifier, "the swarm-bank planner")
     t0 = time.perf_counter()
     g = scenario.guidance
     problem = problem_from_scenario(scenario) if problem is None else problem
@@ -113,33 +139,43 @@ def plan(scenario, problem: SwarmProblem | None = None) -> SwarmPlan:
         sigma0 = float(g.bank_start_deg)
     build = time.perf_counter() - t0
     ev = evaluate(problem, np.radians([sigma0]), record=True)
-    violations = verify(problem, ev, scenario.terminal.path_limit_tolerance)
     reached = bool(ev.reached[0])
-    box = terminal_box(scenario, problem, ev.final_state[0])
+    flown = fly(plan_controls(problem, ev))
+    x = flown.states[-1]
+    violations = verify(problem, flown, scenario.terminal.path_limit_tolerance)
+    box = terminal_box(scenario, problem, x)
     missed = [f"{k} {box_text(k, b)}" for k, b in box.items() if not b["inside"]]
+    xf = ev.final_state[0]
+    from_replica = math.hypot(problem.planet.great_circle_distance(x[1], x[2], xf[1], xf[2]), x[0] - xf[0])
     parts = [f"sigma_0 = {sigma0:.3f} deg" + (f" by {found.method} ({found.trajectories} trajectories)" if found
                                                  else " (given)"),
              f"J = {ev.J[0]:.4f}: range error {ev.range_error_m[0] / 1e3:+.2f} km, altitude {ev.altitude_error_m[0]:+.0f} m, "
              f"speed {ev.velocity_error_m_s[0]:+.1f} m/s, crossrange {ev.crossrange_m[0] / 1e3:+.2f} km"]
     if not reached:
         parts.append("the trajectory does not reach the TAEM energy")
+    parts.append(f"flown by Drake through the actuators: {from_replica:.0f} m from the replica's TAEM point"
+                 + (f", stopped early: {flown.failure}" if flown.failure else ""))
+    departs = flown.failure or not from_replica <= FLOWN_TOLERANCE_M
+    if departs and not flown.failure:
+        parts.append(f"the Drake flight departs from the replica (> {FLOWN_TOLERANCE_M:.0f} m)")
     if missed:
-        parts.append("ends outside the acceptance box: " + "; ".join(missed))
+        parts.append("the flight ends outside the acceptance box: " + "; ".join(missed))
     if violations:
-        parts.append("breaches " + breaches_text(violations))
+        parts.append("the flight breaches " + breaches_text(violations))
     if found is not None and found.message:
         parts.append(found.message)
-    return SwarmPlan(success=reached and not missed and not violations, message="; ".join(parts),
+    return SwarmPlan(success=reached and not departs and not missed and not violations, message="; ".join(parts),
                      iterations=len(found.swarm.history) - 1 if found is not None and found.swarm else 0,
                      build_time=build, solve_time=time.perf_counter() - t0 - build, objective=float(ev.J[0]),
-                     problem=problem, sigma0_deg=sigma0, search=found, evaluation=ev, violations=violations)
+                     problem=problem, sigma0_deg=sigma0, search=found, evaluation=ev, violations=violations,
+                     flown=flown, from_replica_m=from_replica)
 
 
 class SwarmBankMethod(GuidanceMethod):
     name = "swarm_bank"
 
     def make_planner(self, scenario, verifier) -> SwarmPlan:
-        return plan(scenario)
+        return plan(scenario, verifier)
 
     def add_systems(self, builder, scenario, planner: SwarmPlan, plant: PlantPorts) -> GuidanceCommands:
         g, p = scenario.guidance, planner.problem

@@ -8,10 +8,14 @@ this kind; a case that fails is a row with its reason and never stops the others
 """
 from __future__ import annotations
 
+import datetime
 import hashlib
 import importlib.metadata
 import json
 import os
+import platform
+import subprocess
+import sys
 
 import numpy as np
 
@@ -26,12 +30,47 @@ def versions() -> dict:
     return {"drake_entry": drake_entry.__version__, "drake": importlib.metadata.version("drake")}
 
 
+def session() -> dict:
+    """Where and how this run of a campaign was made (not part of its identity; a resumed
+    campaign keeps one record per run, ``manifest['sessions']``): the UTC date, the command,
+    Python, NumPy and SciPy, the platform, drake_entry and Drake (whose build carries the
+    solvers: Clarabel, SCS, Ipopt, SNOPT), and the git commit of the drake_entry source when it
+    is a checkout (None for an installed wheel)."""
+    def version(name):
+        try:
+            return importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:
+            return None
+
+    return {"date_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+            "command": " ".join([os.path.basename(sys.argv[0]), *sys.argv[1:]]) if sys.argv and sys.argv[0] else "",
+            "python": platform.python_version(), "numpy": np.__version__, "scipy": version("scipy"),
+            "platform": platform.platform(terse=True), "git_commit": source_commit(), **versions()}
+
+
+def source_commit() -> str | None:
+    """The git commit of the drake_entry source tree (with '+changes' when it has uncommitted
+    ones), or None when the package is not a git checkout."""
+    here = os.path.dirname(os.path.abspath(drake_entry.__file__))
+    try:
+        top = subprocess.run(["git", "-C", here, "rev-parse", "--show-toplevel"], capture_output=True, text=True,
+                             timeout=10)
+        if top.returncode != 0 or not os.path.samefile(top.stdout.strip(), os.path.dirname(here)):
+            return None
+        head = subprocess.run(["git", "-C", here, "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
+        dirty = subprocess.run(["git", "-C", here, "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return head.stdout.strip() + ("+changes" if dirty.stdout.strip() else "") if head.returncode == 0 else None
+
+
 def task_manifest(task: Task, cases: list, **extra) -> dict:
     """The manifest of a campaign of ``cases`` (dicts with an integer 'index') of ``task``:
     the task, the case list's sha256 and the versions identify it."""
     digest = hashlib.sha256(json.dumps(cases, sort_keys=True, default=float).encode()).hexdigest()
     return {"task": {"setup": task.setup, "run": task.run, "config": task.config}, "cases_sha256": digest,
-            "versions": versions(), "runs": len(cases), **extra}
+            "versions": versions(), "runs": len(cases), "sessions": [session()], **extra}
 
 
 def check_backend(backend: str, workers) -> None:

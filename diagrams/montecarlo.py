@@ -16,7 +16,7 @@ from pydrake.common.yaml import yaml_dump_typed
 
 from drake_entry.campaign.store import done_indices, finalise  # noqa: F401 (API)
 from drake_entry.diagrams.backends import Task
-from drake_entry.diagrams.campaign import check_backend, run_cases, versions
+from drake_entry.diagrams.campaign import check_backend, run_cases, session, versions
 from drake_entry.diagrams.sample import TIMING_COLUMNS, TRAJECTORY_STEP_S, campaign_row, run_sample, sample_seed  # noqa: F401 (API)
 from drake_entry.errors import ScenarioError
 from drake_entry.models.vehicles import PACKAGED_VEHICLES
@@ -45,7 +45,7 @@ def campaign_manifest(scenario_path: str, *, seed: int, trajectory_step_s: float
     return {"scenario": name, "scenario_yaml": yaml_dump_typed(scenario), "vehicle_file_sha256": vehicle_sha,
             "atmosphere_file_sha256": atmosphere_sha,
             "seed": int(seed), "trajectory_step_s": float(trajectory_step_s), "overrides": overrides or {},
-            "versions": versions(),
+            "versions": versions(), "sessions": [session()],
             "runs": int(runs), "dispersion": "scenario dispersions"}
 
 

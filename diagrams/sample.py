@@ -20,10 +20,13 @@ from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, 
 from drake_entry.diagrams.common import collect_trajectory, make_simulator
 from drake_entry.errors import load_yaml_typed
 from drake_entry.models.dispersions import draw
-from drake_entry.models.trajectory import metrics
+from drake_entry.models.trajectory import control_activity, metrics
 from drake_entry.scenario import Scenario
 
 TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
+#: the first samples are stored at this finer step [s] (the report's bank histories), when the
+#: campaign keeps trajectories at all
+DETAILED_SAMPLES, DETAILED_STEP_S = 5, 1.0
 # row columns that measure this machine's wall-clock time (excluded from reproducibility)
 TIMING_COLUMNS = ("wall_time_s", "planning_wall_s")
 
@@ -50,7 +53,8 @@ def run_case(state: dict, case: dict):
 def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
                trajectory_step_s: float = TRAJECTORY_STEP_S) -> tuple[dict, dict | None]:
     """One Monte-Carlo sample of ``setup.scenario.dispersions``: (row, trajectory columns every
-    ``trajectory_step_s`` seconds plus the final instant, or None when it is 0)."""
+    ``trajectory_step_s`` seconds (the first DETAILED_SAMPLES samples every DETAILED_STEP_S)
+    plus the final instant, or None when it is 0)."""
     scenario = setup.scenario
     seed = sample_seed(campaign_seed, index)
     t_wall = time.perf_counter()
@@ -81,7 +85,8 @@ def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
         integrator = box["simulator"].get_integrator()
         row.update({"integration_steps": integrator.get_num_steps_taken(),
                     "derivative_evaluations": integrator.get_num_derivative_evaluations()})
-        traj = _downsample(tr, index, trajectory_step_s) if trajectory_step_s > 0 else None
+        step = min(trajectory_step_s, DETAILED_STEP_S) if index < DETAILED_SAMPLES else trajectory_step_s
+        traj = _downsample(tr, index, step) if trajectory_step_s > 0 else None
     except Exception as e:  # one failed sample never stops the campaign
         row.update(box["draw"].columns() if "draw" in box else {})
         row.update({"success": False, "message": f"{type(e).__name__}: {e}".splitlines()[0][:500],
@@ -95,7 +100,9 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
     """The row of one flight: the verdict (success = reached, inside_box and within_limits;
     violations: each breached path limit with its peak, time and margin, '' when none), the
     method's fields, final state, terminal errors, peak path quantities
-    (drake_entry.models.trajectory.metrics) and the margin of every path limit (drake_entry.models.verdict)."""
+    (drake_entry.models.trajectory.metrics), the bank's activity (``control_activity``), the
+    margin of every path limit (drake_entry.models.verdict), and each acceptance criterion's
+    inside flag and error (``box_<criterion>_error``: m, or Mach)."""
     tr, x = res.trajectory, res.trajectory.state[-1]
     g, v = res.guidance, res.verdict
     return {
@@ -110,7 +117,9 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
         "err_range_m": res.errors["range_to_go_m"], "err_crossrange_m": res.errors["crossrange_m"],
         "err_distance_m": res.errors["distance_m"],
         **metrics(tr), **v.margins(),
+        **control_activity(tr, setup.vehicle.bank_limit, setup.vehicle.bank_rate_limit),
         **{f"inside_{k}_box": b["inside"] for k, b in res.box.items()},
+        **{f"box_{k}_error": b["error"] for k, b in res.box.items()},
     }
 
 

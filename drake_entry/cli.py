@@ -1,8 +1,10 @@
 """drake-entry: plan, fly and analyse atmospheric-entry trajectories on Drake.
 
 Commands:
+  scenarios [NAME]    the packaged scenarios (name, guidance method, vehicle, description), or one
+                      scenario's YAML file with its comments
   campaign SCENARIO   closed-loop Monte-Carlo campaign (Drake RandomSimulation) with a report
-  report DIR          (re)write the report of a campaign directory
+  report DIR          (re)write the report (report.md, report.html) of a campaign directory
   fly SCENARIO        one closed-loop guided flight with plots
   plan SCENARIO       the guidance method's reference plan with its figures (drag-energy:
                       corridor, reference at engagement, extraction vs propagation, paper 000 Figs. 3-5)
@@ -103,6 +105,54 @@ def _cmd_plan(args) -> int:
     return commands.plan_report(scenario, args.out)
 
 
+def packaged_scenarios() -> list[str]:
+    """The packaged scenario names (the YAML files of drake_entry/scenarios, read without
+    importing the scenario schema)."""
+    from importlib import resources
+
+    return sorted(p.name[:-5] for p in resources.files("drake_entry").joinpath("scenarios").iterdir()
+                  if p.name.endswith(".yaml"))
+
+
+def _cmd_scenarios(args) -> int:
+    from importlib import resources
+
+    from drake_entry.scenario import load_scenario
+
+    names = packaged_scenarios()
+    if args.name is not None:
+        if args.name not in names:
+            raise ScenarioError(f"scenario '{args.name}' is not packaged; packaged: {', '.join(names)}")
+        print(resources.files("drake_entry").joinpath(f"scenarios/{args.name}.yaml").read_text(), end="")
+        return 0
+    rows = []
+    for name in names:
+        text = resources.files("drake_entry").joinpath(f"scenarios/{name}.yaml").read_text()
+        scenario = load_scenario(name)
+        closed = any(line.startswith("guidance:") for line in text.splitlines())
+        method = f"!{type(scenario.guidance).__name__}" if closed else "open loop (simulate)"
+        rows.append((name, method, scenario.vehicle, scenario.description))
+    widths = [max(len(r[i]) for r in rows + [("name", "guidance", "vehicle", "")]) for i in range(3)]
+    print(f"{'name':{widths[0]}}  {'guidance':{widths[1]}}  {'vehicle':{widths[2]}}  description")
+    for r in rows:
+        print(f"{r[0]:{widths[0]}}  {r[1]:{widths[1]}}  {r[2]:{widths[2]}}  {r[3]}")
+    print("\n`drake-entry scenarios NAME` prints one with its comments; a scenario YAML file of your own works "
+          "wherever a name does.")
+    return 0
+
+
+def _version() -> str:
+    import importlib.metadata
+
+    import drake_entry
+
+    try:
+        drake = importlib.metadata.version("drake")
+    except importlib.metadata.PackageNotFoundError:
+        drake = "not installed"
+    return f"drake-entry {drake_entry.__version__} (Drake {drake}, Python {sys.version.split()[0]})"
+
+
 def _cmd_campaign(args) -> int:
     from drake_entry.diagrams.montecarlo import run_campaign
 
@@ -173,13 +223,31 @@ def contributed_commands() -> list:
     return [c for name in modules for c in getattr(importlib.import_module(name), "COMMANDS", ())]
 
 
+class _HelpWithDefaults(argparse.ArgumentDefaultsHelpFormatter):
+    """Help that shows each argument's default, unless there is none or the help states it."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "default" in text or action.default in (None, argparse.SUPPRESS, []) or isinstance(action.default, bool):
+            return text
+        return super()._get_help_string(action)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="drake-entry", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", required=True)
-    c = sub.add_parser("campaign", help="closed-loop Monte-Carlo campaign with a report")
-    c.add_argument("scenario", help="packaged scenario name or YAML path")
-    c.add_argument("--runs", type=int, default=100)
+    scenarios = ", ".join(packaged_scenarios())
+    scenario_help = f"packaged scenario name ({scenarios}; see `drake-entry scenarios`) or a YAML path"
+    defaults = _HelpWithDefaults
+    sc = sub.add_parser("scenarios", help="list the packaged scenarios, or print one with its comments",
+                        formatter_class=defaults)
+    sc.add_argument("name", nargs="?", default=None, help="a packaged scenario to print")
+    sc.set_defaults(func=_cmd_scenarios)
+    c = sub.add_parser("campaign", help="closed-loop Monte-Carlo campaign with a report", formatter_class=defaults)
+    c.add_argument("scenario", help=scenario_help)
+    c.add_argument("--runs", type=int, default=100, help="samples (a larger value extends a finished campaign)")
     c.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
     c.add_argument("--seed", type=int, default=0, help="campaign seed; sample i is reproducible from (seed, i)")
     c.add_argument("--out", default="out/campaign", help="campaign directory (re-running resumes it)")
@@ -188,28 +256,32 @@ def main(argv=None) -> int:
     c.add_argument("--scheduler", default=None,
                    help="Dask scheduler address (implies --backend dask); a LocalCluster when omitted")
     c.add_argument("--trajectory-step", type=float, default=10.0, metavar="SECONDS",
-                   help="keep each sample's trajectory every SECONDS (default 10; 0 = none, rows only)")
+                   help="keep each sample's trajectory every SECONDS (0 = none, rows only; the first 5 samples "
+                        "every 1 s for the report's bank histories)")
     c.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE", dest="overrides",
                    help="override a scenario field, e.g. --set guidance.resolve_period_s=100 (repeatable; "
                         "the value is read as YAML)")
     c.set_defaults(func=_cmd_campaign)
-    r = sub.add_parser("report", help="write the report of a campaign directory")
-    r.add_argument("dir")
+    r = sub.add_parser("report", help="write the report (report.md, report.html) of a campaign directory",
+                       formatter_class=defaults)
+    r.add_argument("dir", help="a campaign directory (finished, running, killed or partial)")
     r.set_defaults(func=_cmd_report)
-    fl = sub.add_parser("fly", help="one closed-loop guided flight")
-    fl.add_argument("scenario")
-    fl.add_argument("--out", default="out/fly")
-    fl.add_argument("--format", choices=("parquet", "csv"), default="parquet")
+    fl = sub.add_parser("fly", help="one closed-loop guided flight (exit 1 when it is not a success)",
+                        formatter_class=defaults)
+    fl.add_argument("scenario", help=scenario_help)
+    fl.add_argument("--out", default="out/fly", help="output directory: trajectory table, summary.json, figures")
+    fl.add_argument("--format", choices=("parquet", "csv"), default="parquet", help="trajectory table format")
     fl.set_defaults(func=_cmd_fly)
     pl = sub.add_parser("plan", help="the guidance method's plan report (drag-energy: corridor, reference and "
-                        "extraction, paper 000 Figs. 3-5; swarm bank: sigma_0 search, Drake check, paper 004 figures)")
-    pl.add_argument("scenario")
-    pl.add_argument("--out", default="out/plan")
+                        "extraction, paper 000 Figs. 3-5; swarm bank: sigma_0 search, Drake check, paper 004 figures)",
+                        formatter_class=defaults)
+    pl.add_argument("scenario", help=scenario_help)
+    pl.add_argument("--out", default="out/plan", help="output directory: figures and tables of the plan")
     pl.set_defaults(func=_cmd_plan)
-    p = sub.add_parser("simulate", help="fly the open-loop diagram of a scenario")
-    p.add_argument("scenario", help="packaged scenario name (horus2b, shefex3, cav_h, cav_h_paper004, marv) or a YAML path")
+    p = sub.add_parser("simulate", help="fly the open-loop diagram of a scenario", formatter_class=defaults)
+    p.add_argument("scenario", help=scenario_help)
     p.add_argument("--out", default="out/simulate", help="output directory")
-    p.add_argument("--format", choices=("parquet", "csv"), default="parquet")
+    p.add_argument("--format", choices=("parquet", "csv"), default="parquet", help="trajectory table format")
     p.set_defaults(func=_cmd_simulate)
     argv = sys.argv[1:] if argv is None else list(argv)
     asked = next((a for a in argv if not a.startswith("-")), None)

@@ -5,6 +5,7 @@ import dataclasses as dc
 import os
 import re
 import typing
+from pathlib import Path
 
 import pytest
 
@@ -88,3 +89,15 @@ def test_every_page_in_the_navigation_exists():
     assert len(found) >= 15
     for page in found:
         assert page in generated or os.path.isfile(os.path.join(ROOT, "docs", page)), page
+
+
+def test_readme_and_getting_started_name_every_example_and_scenario():
+    """The lists a newcomer reads are complete: every example in README.md, every packaged
+    scenario in getting-started.md (drake-entry scenarios lists them from the files)."""
+    root = Path(ROOT)
+    readme = (root / "README.md").read_text()
+    missing = [p.name for p in sorted((root / "examples").glob("[0-9]*.py")) if p.name not in readme]
+    assert not missing, f"README.md does not name {missing}"
+    start = (root / "docs" / "getting-started.md").read_text()
+    names = [p.stem for p in sorted((root / "drake_entry" / "scenarios").glob("*.yaml"))]
+    assert not [n for n in names if f"`{n}`" not in start], names

@@ -9,6 +9,7 @@ import pytest
 from drake_entry.campaign.report import summary_statistics, write_report
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 from drake_entry.diagrams.montecarlo import TIMING_COLUMNS, done_indices, run_campaign, run_sample, sample_seed
+from drake_entry.diagrams.sample import DETAILED_SAMPLES, DETAILED_STEP_S
 from drake_entry.errors import CampaignError
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
 from drake_entry.scenario import load_scenario
@@ -27,6 +28,9 @@ def test_a_sample_rerun_alone_reproduces_its_row_bit_for_bit(horus):
         if k not in TIMING_COLUMNS:
             assert a[k] == b[k], k
     assert sample_seed(11, 5) != sample_seed(11, 6) != sample_seed(12, 5)
+    _, traj = run_sample(horus, 11, DETAILED_SAMPLES, trajectory_step_s=10.0)
+    t = np.asarray(traj["time_s"])
+    assert np.allclose(np.diff(t)[:-1], 10.0) and t[-1] > 1000.0  # every 10 s, then the final instant
 
 
 def test_a_failing_sample_is_recorded_with_its_reason(horus):
@@ -64,7 +68,38 @@ def test_campaign_resumes_without_losing_or_repeating_samples(tmp_path):
     assert "of one core per sample" in text and "re-planning" in text
     traj = pq.read_table(f"{out}/trajectories.parquet").to_pydict()
     t0 = np.array(traj["time_s"])[np.array(traj["sample"]) == 0]
-    assert np.allclose(np.diff(t0)[:-1], 10.0) and t0[-1] > 1000.0  # every 10 s, then the final instant
+    assert np.allclose(np.diff(t0)[:-1], DETAILED_STEP_S) and t0[-1] > 1000.0  # the first samples: detailed
+    assert not os.path.exists(f"{out}/campaign.lock")  # removed by the writer that held it
+
+
+def test_report_is_self_contained_with_provenance_requirements_and_bounds(tmp_path):
+    """Two sessions of a 2-sample campaign: the report states who ran it with what, the
+    dispersions with their source, every requirement with its threshold, value, margin and
+    verdict, the Clopper-Pearson bound (2 of 2: 0.1^(1/2) = 31.62 % at 90 %), statistics with
+    the unresolved percentiles blank, and an HTML copy with every figure inline."""
+    out = str(tmp_path / "c")
+    run_campaign("horus2b", runs=1, out_dir=out, seed=4, workers=1, progress=False)
+    run_campaign("horus2b", runs=2, out_dir=out, seed=4, workers=1, progress=False)
+    manifest = json.load(open(f"{out}/campaign.json"))
+    assert len(manifest["sessions"]) == 2 and manifest["sessions"][0]["numpy"] == np.__version__
+    text = open(write_report(out)).read()
+    assert "**2 of 2 samples successful; the success probability is at least 31.62 % at 90 % confidence" in text
+    assert "22.36 % at 95 % confidence" in text  # 0.05 ** 0.5
+    assert "| seeds | master seed 4; sample i draws" in text and "sha256" in text
+    assert "`drake-entry campaign horus2b --runs 2 --seed 4 --trajectory-step 10.0 --out DIR`" in text
+    assert "Source: paper 000 Table 2 (entry interface only, uniform)" in text
+    assert "| entry altitude (deviation) | 122000 m | uniform | [-250, 250] | m |" in text
+    assert "| terminal altitude about 25 km | ≤ 2 km | largest absolute error of 2 |" in text
+    assert "| heat_flux | <= 530 kW/m^2 | worst flown sample of 2 |" in text and "PASS (2 of 2 held)" in text
+    assert "| peak heat flux | kW/m^2 | 2 |" in text and "— (needs 230 runs)" in text
+    assert "| bank reversals | - | 2 |" in text
+    figures = [line for line in text.splitlines() if line.startswith("*Figure ")]
+    assert len(figures) == 8 and all(len(f) > 120 for f in figures)  # each with its caption
+    html_text = open(f"{out}/report.html").read()
+    assert html_text.count("data:image/png;base64,") == 8 and "<table>" in html_text
+    summary = json.load(open(f"{out}/summary.json"))
+    assert summary["success_lower_bound"]["0.9"] == pytest.approx(0.1 ** 0.5)
+    assert summary["distributions"]["err_distance_m"]["n"] == 2
 
 
 def test_campaign_without_trajectories_keeps_rows_only(tmp_path):

@@ -8,7 +8,7 @@ import pytest
 
 from drake_entry.models.constraints import PathLimits
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
-from drake_entry.models.trajectory import Trajectory, metrics
+from drake_entry.models.trajectory import Trajectory, control_activity, metrics
 from drake_entry.models.verdict import PathLimit, check_limits, judge, vehicle_path_limits
 
 Q = FLIGHT_CONDITION_NAMES.index("heat_flux")
@@ -114,3 +114,24 @@ def test_the_report_counts_success_box_and_limits_separately():
     assert st["failure_reasons"] == {"heat_flux limit breached": 1, "outside the acceptance box": 1,
                                      "stopped before E_f": 1}
     assert st["inside_box"] == {}  # per criterion (inside_<criterion>_box): none given here
+
+
+def test_control_activity_counts_reversals_travel_rate_and_time_at_the_limits():
+    """A bank held at +60 deg, reversed to -60 deg at 10 deg/s (12 s), held at the -60 deg limit
+    for 50 s, reversed back: 2 reversals, 240 deg of travel, a 10 deg/s peak rate with 24 s at
+    it (the rate limit), 100 s at the bank limit; the log samples alone (every 5 s) would
+    miss where the ramps start and end, so the integrator steps (0.1 s) are used."""
+    def bank(t):
+        up = np.clip(60.0 - 10.0 * (t - 20.0), -60.0, 60.0)
+        back = np.clip(-60.0 + 10.0 * (t - 82.0), -60.0, 60.0)
+        return np.radians(np.where(t < 82.0, up, back))
+    steps = np.arange(0.0, 150.0 + 1e-9, 0.1)
+    logs = np.arange(0.0, 150.0 + 1e-9, 5.0)
+    tr = _trajectory(logs, np.zeros(logs.size), bank=bank(logs))
+    tr.steps = _trajectory(steps, np.zeros(steps.size), bank=bank(steps))
+    a = control_activity(tr, bank_limit=math.radians(60.0), bank_rate_limit=math.radians(10.0))
+    assert a["bank_reversals"] == 2
+    assert a["bank_travel_deg"] == pytest.approx(240.0, rel=1e-9)
+    assert a["peak_bank_rate_deg_s"] == pytest.approx(10.0, rel=1e-6)
+    assert a["time_at_bank_rate_limit_s"] == pytest.approx(24.0, abs=0.11)
+    assert a["time_at_bank_limit_s"] == pytest.approx(150.0 - 24.0, abs=0.11)  # +60 and -60 are both the limit

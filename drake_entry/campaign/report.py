@@ -1,19 +1,38 @@
-"""Campaign reports: Table-3-style statistics, margins and plots, written as Markdown + PNG.
+"""The campaign report: one document for every method and campaign, Markdown and a
+self-contained HTML file, in the form of NASA entry Monte-Carlo practice (Hanson & Beard 2010,
+NASA/TP-2010-216447; docs/references.md).
 
-``summary_statistics(rows)`` gives mean, 1-sigma and percentiles of the terminal errors
-(paper 000 Table 3; paper 003 Table 3 counts inside 25/50/75 km) and the worst
-path-constraint margins. ``write_report(out_dir)`` reads a campaign directory's streams
-(drake_entry.campaign.store) and writes report.md with its figures and what it covers.
+``summary_statistics(rows)`` counts the verdicts and gives the terminal errors' mean, 1-sigma
+and percentiles (paper 000 Table 3; paper 003 Table 3 counts inside 25/50/75 km) and the worst
+path-limit margins. ``write_report(out_dir)`` reads a campaign directory's streams
+(drake_entry.campaign.store) and writes report.md and report.html: verdict, provenance,
+dispersions, requirements, outcome, statistics (drake_entry.campaign.statistics), contributors
+to the miss, cost and captioned figures (drake_entry.campaign.report_figures).
 """
 from __future__ import annotations
 
+import base64
+import datetime
+import hashlib
+import html
 import json
+import math
 import os
+import re
 
 import numpy as np
+from scipy import stats as sps
 
-from drake_entry.campaign import plots  # sets the Agg backend before pyplot is imported
-from drake_entry.campaign.plots import plt
+from drake_entry.campaign import report_figures as figures
+from drake_entry.campaign.statistics import (
+    CONFIDENCE,
+    COVERAGE,
+    SUCCESS_LEVELS,
+    describe,
+    order_statistic_bound,
+    runs_for_bound,
+    success_lower_bound,
+)
 from drake_entry.campaign.store import coverage, read_trajectories
 from drake_entry.errors import CampaignError, DrakeEntryError, load_yaml_typed
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
@@ -166,14 +185,18 @@ def _columns(records: list) -> dict:
 
 
 def write_report(out_dir: str, *, title: str | None = None, limits=None, reference=None) -> str:
-    """Write report.md, summary.json and PNG figures for the campaign in out_dir.
+    """Write report.md, report.html (self-contained: figures inline), summary.json and the PNG
+    figures for the campaign in out_dir; return the path of report.md.
 
     Reads the campaign's streams (samples.jsonl, trajectories.jsonl: the truth, also for a
-    killed or running campaign) and says what the report covers: samples requested and
-    done, lines cut or quarantined. ``limits``: the vehicle's path limits drawn on the figures;
-    ``reference``: the scenario's reference_results put beside the terminal errors (default:
-    the flown scenario's, from the manifest). Raises CampaignError when out_dir holds no
-    campaign."""
+    killed or running campaign) and the scenario as flown (its manifest). The report: the
+    verdict with Clopper-Pearson bounds, provenance, the dispersion table, the requirements
+    table, the outcome and the failed samples, statistics of every terminal error, peak, heat
+    load, flight time and control-activity figure, the largest contributors to the miss, and
+    captioned figures. ``limits``: the vehicle's path limits drawn on the figures (default: the
+    flown scenario's vehicle); ``reference``: published results put beside the terminal errors
+    (default: the flown scenario's ``reference_results``). Raises CampaignError when out_dir
+    holds no campaign."""
     cov = coverage(out_dir)
     meta = cov["manifest"]
     records = [cov["rows"][k] for k in sorted(cov["rows"])]
@@ -189,71 +212,30 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
                 traj.setdefault(k, []).extend(v)
     stats = summary_statistics(rows)
     scenario = flown_scenario(meta)
+    if limits is None and scenario is not None:
+        limits = _vehicle_limits(scenario)
+    if reference is None:
+        reference = getattr(scenario, "reference_results", None)
     stats["coverage"] = {"requested": cov["requested"], "done": len(records), "cut_lines": cov["cut"],
                          "invalid_lines": cov["invalid"], "quarantined_lines": cov["quarantined"]}
+    stats["success_lower_bound"] = {f"{level:g}": success_lower_bound(stats["successful"], stats["samples"], level)
+                                    for level in SUCCESS_LEVELS}
+    reached = reached_terminal(rows)
+    stats["distributions"] = {key: describe(values) for key, (_, _, values) in _quantities(rows, reached).items()}
+    stats["contributors"] = miss_contributors(rows, reached)
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
         json.dump(stats, f, indent=2)
-    figs = []
-    reached = reached_terminal(rows)
-    if reached.any():
-        figs += _terminal_figures(rows, reached, out_dir)
-    if traj is not None:
-        figs += _trajectory_figures(traj, out_dir, limits)
-
-    c = stats["coverage"]
-    md = [f"# {title or 'Monte-Carlo campaign'}", "",
-          f"Scenario `{meta.get('scenario', '?')}` (method `{_method(rows)}`), seed {meta.get('seed', '?')}, "
-          f"dispersion {meta.get('dispersion', '?')}, overrides {meta.get('overrides', {})}.", "",
-          f"Covers {c['done']} of {c['requested']} requested samples"
-          + (f" (**incomplete**: {c['requested'] - c['done']} not run; re-run the campaign command to finish it)"
-             if c["done"] < c["requested"] else "") + ": "
-          + counts_sentence(stats) + "."]
-    limits_text = _limits_text(scenario)
-    if limits_text:
-        md += ["", "Verdict: a sample succeeds when it reached the terminal interface, ended inside every "
-               "acceptance criterion and held every path limit at every log sample and integrator step. "
-               "Path limits: " + limits_text + "."]
-    if stats["inside_box"]:
-        md += ["", "Acceptance box (scenario `terminal` tolerances), samples inside each criterion: " + ", ".join(
-            f"{k} {v}" for k, v in stats["inside_box"].items()) + "."]
-    damaged = c["cut_lines"] + c["invalid_lines"] + c["quarantined_lines"]
-    if damaged:
-        md += ["", f"Stream damage: {c['cut_lines']} cut last line(s) and {c['invalid_lines']} invalid line(s) "
-               f"not counted, {c['quarantined_lines']} line(s) in quarantine.jsonl (their samples ran again)."]
-    md += [""]
-    if stats["errors"]:
-        md += ["## Terminal errors (samples that reached the terminal interface)", "",
-               errors_markdown(stats, reference if reference is not None
-                               else getattr(scenario, "reference_results", None)), "",
-               "ΔR is the range to go along the final heading (+ short of the target); the cross-range "
-               "is reported separately.", ""]
-    if stats.get("inside_km"):
-        md += ["Samples within a distance of the target: " + ", ".join(
-            f"{k} km: {v}" for k, v in stats["inside_km"].items()), ""]
-    if stats["margins"]:
-        md += ["## Path-constraint margins (worst over all runs; negative = violated)", "",
-               "| constraint | worst margin | violations | worst sample |", "|---|---|---|---|"]
-        for col, m in stats["margins"].items():
-            md.append(f"| {col.replace('margin_', '')} | {100 * m['worst']:.2f} % | {m['violations']} | "
-                      f"{m['worst_sample']} |")
-        if stats["margins"].get("margin_bank", {}).get("worst") == 0.0:
-            md += ["", "A bank margin of 0 % means the bank actuator reached the vehicle's bank limit, where it "
-                   "clips: held, not breached."]
-    if stats.get("cost"):
-        c = stats["cost"]
-        md += ["", f"Cost: {c['wall_s_per_sample']:.2f} s of one core per sample, {100 * c['planning_share']:.0f} % of "
-               f"it re-planning ({c['plans_per_sample']:.1f} plans), {c['derivative_evaluations_per_sample']:.0f} "
-               "plant derivative evaluations."]
-    if stats["failure_reasons"]:
-        md += ["", "## Samples not successful, by reason", ""] + [
-            f"- {k}: {v}" for k, v in stats["failure_reasons"].items()]
-    if traj is None:
-        md += ["", "Trajectories were not kept (`--trajectory-step 0`) or none finished: the state envelopes, "
-               "constraint histories, drag profiles and groundtracks are omitted."]
-    md += ["", "## Figures", ""] + [f"![{os.path.basename(p)}]({os.path.basename(p)})" for p in figs]
+    name = title or _name(meta)
+    figs = _figures(rows, reached, traj, out_dir, scenario, limits, name)
+    sections = [_header(meta, stats, title, rows), _provenance(meta, stats), _dispersions(scenario),
+                _requirements(rows, reached, stats, scenario), _outcome(rows, stats, traj),
+                _distributions(rows, reached, stats, reference), _contributors(stats), _cost(stats),
+                _figure_list(figs)]
+    md = "\n\n".join(section for section in sections if section) + "\n"
     path = os.path.join(out_dir, "report.md")
     with open(path, "w") as f:
-        f.write("\n".join(md) + "\n")
+        f.write(md)
+    write_html(md, out_dir, title=name)
     return path
 
 
@@ -275,104 +257,437 @@ def _method(rows: dict) -> str:
     return ", ".join(names) or "?"
 
 
-def _terminal_figures(rows: dict, reached, out_dir: str) -> list:
-    figs = []
+#: (row column, label, unit, scale from the row's SI) of the non-error quantities of the statistics tables
+PEAK_QUANTITIES = (("peak_heat_flux_W_m2", "peak heat flux", "kW/m^2", 1e-3, "heat_flux_max"),
+                   ("peak_dynamic_pressure_Pa", "peak dynamic pressure", "kPa", 1e-3, "dynamic_pressure_max"),
+                   ("peak_normal_load_g", "peak normal load", "g", 1.0, "normal_load_max"),
+                   ("peak_total_load_g", "peak total load", "g", 1.0, "total_load_max"))
+OTHER_QUANTITIES = (("heat_load_J_m2", "heat load", "MJ/m^2", 1e-6), ("flight_time_s", "flight time", "s", 1.0))
+CONTROL_QUANTITIES = (("bank_reversals", "bank reversals", "-", 1.0), ("bank_travel_deg", "bank travel", "deg", 1.0),
+                      ("peak_bank_rate_deg_s", "peak bank rate", "deg/s", 1.0),
+                      ("time_at_bank_limit_s", "time at the bank limit", "s", 1.0),
+                      ("time_at_bank_rate_limit_s", "time at the bank-rate limit", "s", 1.0))
+#: dispersion rows: (spec path, label, unit)
+DISPERSION_FIELDS = (("entry.altitude_m", "entry altitude", "m"), ("entry.longitude_deg", "entry longitude", "deg"),
+                     ("entry.latitude_deg", "entry latitude", "deg"), ("entry.velocity_m_s", "entry speed", "m/s"),
+                     ("entry.flight_path_deg", "entry flight-path angle", "deg"),
+                     ("entry.heading_deg", "entry heading", "deg"),
+                     ("density_scale", "density factor", "-"),
+                     ("density_wave_amplitude", "density wave amplitude (fraction)", "-"),
+                     ("lift_scale", "lift-coefficient factor", "-"), ("drag_scale", "drag-coefficient factor", "-"),
+                     ("mass_scale", "mass factor", "-"))
+NAV_UNITS = ("m", "rad", "rad", "m/s", "rad", "rad")
+#: row columns of the drawn dispersions (drake_entry.models.dispersions.Draw.columns) in words
+DISPERSION_LABELS = {"disp_dh_m": "entry altitude deviation [m]", "disp_dlon_deg": "entry longitude deviation [deg]",
+                     "disp_dlat_deg": "entry latitude deviation [deg]", "disp_dV_m_s": "entry speed deviation [m/s]",
+                     "disp_dgamma_deg": "entry flight-path deviation [deg]",
+                     "disp_dpsi_deg": "entry heading deviation [deg]", "disp_density_scale": "density factor",
+                     "disp_density_wave": "density wave amplitude", "disp_lift_scale": "lift-coefficient factor",
+                     "disp_drag_scale": "drag-coefficient factor", "disp_mass_scale": "mass factor",
+                     **{f"disp_nav_bias_{k}": f"navigation bias, {k}" for k in ("h", "lon", "lat", "V", "gamma", "psi")}}
+NAV_NAMES = ("altitude", "longitude", "latitude", "speed", "flight-path angle", "heading")
+
+
+def _name(meta: dict) -> str:
+    return f"{os.path.basename(str(meta.get('scenario', '?'))).removesuffix('.yaml')} Monte-Carlo campaign"
+
+
+def _vehicle_limits(scenario):
+    try:
+        return scenario.make_vehicle().limits
+    except DrakeEntryError:
+        return None
+
+
+def _quantities(rows: dict, reached) -> dict:
+    """{key: (label, unit, values)} of every quantity of the statistics tables: terminal errors
+    over the reached samples, the rest over every sample that flew (finite)."""
     n = len(rows["index"])
-    # histograms of the terminal errors
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
-    for ax, (col, label, unit) in zip(axes, (ERROR_COLUMNS[0], ERROR_COLUMNS[3], ERROR_COLUMNS[4])):
-        v = _finite(rows, col, n)[reached]
-        ax.hist(v[np.isfinite(v)], bins=40, color="C0")
-        ax.set_xlabel(f"{label} [{unit}]")
-        ax.grid(True)
-    axes[0].set_ylabel("samples")
-    figs.append(_save(fig, out_dir, "error_histograms.png"))
-
-    # terminal footprint: range-to-go vs cross-range with a 2-sigma ellipse
-    fig, ax = plt.subplots(figsize=(5.5, 5))
-    x = _finite(rows, "err_crossrange_m", n)[reached] / 1e3
-    y = _finite(rows, "err_range_m", n)[reached] / 1e3
-    both = np.isfinite(x) & np.isfinite(y)
-    x, y = x[both], y[both]
-    ax.plot(x, y, ".", ms=3)
-    if x.size > 2:
-        cov = np.cov(np.vstack([x, y]))
-        vals, vecs = np.linalg.eigh(cov)
-        t = np.linspace(0, 2 * np.pi, 200)
-        ell = vecs @ (2 * np.sqrt(np.maximum(vals, 0))[:, None] * np.vstack([np.cos(t), np.sin(t)]))
-        ax.plot(x.mean() + ell[0], y.mean() + ell[1], "r-", label="2σ ellipse")
-        ax.legend(fontsize=8)
-    ax.set_xlabel("cross-range [km]")
-    ax.set_ylabel("range to go [km]")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.grid(True)
-    figs.append(_save(fig, out_dir, "footprint.png"))
-    return figs
+    out = {}
+    for col, label, unit in ERROR_COLUMNS:
+        if col in rows:
+            out[col] = (label, unit, _finite(rows, col, n)[reached])
+    for col, label, unit, scale, *_ in PEAK_QUANTITIES + OTHER_QUANTITIES + CONTROL_QUANTITIES:
+        if col in rows:
+            out[col] = (label, unit, _finite(rows, col, n) * scale)
+    return out
 
 
-def _trajectory_figures(traj: dict, out_dir: str, limits) -> list:
+def _cell(text) -> str:
+    """A Markdown table cell: a '|' in the text is escaped."""
+    return str(text).replace("|", "\\|")
+
+
+def _fmt(x, digits: int = 4) -> str:
+    if x is None:
+        return "—"
+    if isinstance(x, float) and not math.isfinite(x):
+        return "—"
+    return f"{x:.{digits}g}"
+
+
+def _header(meta: dict, stats: dict, title: str | None, rows: dict) -> str:
+    c = stats["coverage"]
+    n, k = stats["samples"], stats["successful"]
+    lb = stats["success_lower_bound"]
+    lines = [f"# {title or _name(meta)}", ""]
+    lines.append(f"**{k} of {n} samples successful; the success probability is at least "
+                 f"{100 * lb['0.9']:.2f} % at 90 % confidence and {100 * lb['0.95']:.2f} % at 95 % confidence** "
+                 "(one-sided Clopper-Pearson bounds on these samples).")
+    lines += ["", f"Scenario `{meta.get('scenario', '?')}` (guidance method `{_method(rows)}`), seed "
+              f"{meta.get('seed', '?')}. "
+              f"Covers {c['done']} of {c['requested']} requested samples"
+              + (f" (**incomplete**: {c['requested'] - c['done']} not run; re-run the campaign command to finish it)"
+                 if c["done"] < c["requested"] else "") + ": " + counts_sentence(stats) + "."]
+    damaged = c["cut_lines"] + c["invalid_lines"] + c["quarantined_lines"]
+    if damaged:
+        lines += ["", f"Stream damage: {c['cut_lines']} cut last line(s) and {c['invalid_lines']} invalid line(s) "
+                  f"not counted, {c['quarantined_lines']} line(s) in quarantine.jsonl (their samples ran again)."]
+    return "\n".join(lines)
+
+
+def _provenance(meta: dict, stats: dict) -> str:
+    v = meta.get("versions", {})
+    sessions = meta.get("sessions") or []
+    last = sessions[-1] if sessions else {}
+    digest = hashlib.sha256(str(meta.get("scenario_yaml", "")).encode()).hexdigest()
+    overrides = meta.get("overrides") or {}
+    command = (f"drake-entry campaign {meta.get('scenario', '?')} --runs {meta.get('runs', '?')} "
+               f"--seed {meta.get('seed', '?')} --trajectory-step {meta.get('trajectory_step_s', '?')}"
+               + "".join(f" --set {k}={json.dumps(val)}" for k, val in overrides.items()) + " --out DIR")
+    commit = last.get("git_commit") or "not recorded (an installed package, not a git checkout)"
+    rows = [("drake_entry", f"{v.get('drake_entry', '?')}, commit {commit}"),
+            ("Drake", f"{v.get('drake', '?')} (its build carries the solvers: Clarabel, SCS, Ipopt, SNOPT)"),
+            ("Python, NumPy, SciPy", ", ".join(str(last.get(k, "not recorded")) for k in ("python", "numpy", "scipy"))),
+            ("platform", str(last.get("platform", "not recorded"))),
+            ("runs of the campaign", "; ".join(f"{s.get('date_utc', '?')}: `{s.get('command', '')}`" for s in sessions)
+             or "not recorded (a campaign written before the provenance record)"),
+            ("scenario", f"`{meta.get('scenario', '?')}`, as flown (overrides applied) sha256 {digest[:16]}…"),
+            ("overrides", ", ".join(f"{k} = {val}" for k, val in overrides.items()) or "none"),
+            ("seeds", f"master seed {meta.get('seed', '?')}; sample i draws from Drake's RandomGenerator seeded with "
+                      f"numpy SeedSequence([{meta.get('seed', '?')}, i]) (each sample re-runs alone)"),
+            ("samples", f"{stats['coverage']['done']} done of {stats['coverage']['requested']} requested"),
+            ("campaign fingerprint", f"{str(meta.get('fingerprint', '?'))[:16]}…"),
+            ("reproduce", f"`{command}`"),
+            ("report written", f"{datetime.datetime.now(datetime.timezone.utc).isoformat(timespec='seconds')} by "
+                               f"drake_entry {drake_entry_version()}")]
+    return "## Provenance\n\n| item | value |\n|---|---|\n" + "\n".join(f"| {a} | {b} |" for a, b in rows)
+
+
+def drake_entry_version() -> str:
+    import drake_entry
+
+    return drake_entry.__version__
+
+
+def _distribution_text(d) -> tuple[str, str]:
+    """(distribution, bounds or sigma) of a schema scalar or a plain number."""
+    name = type(d).__name__
+    if isinstance(d, (int, float)):
+        return "fixed", f"{d:g}"
+    if name == "Uniform":
+        return "uniform", f"[{d.min:g}, {d.max:g}]"
+    if name == "Gaussian":
+        return "Gaussian", f"mean {d.mean:g}, 1σ {d.stddev:g} (3σ {3 * d.stddev:.4g}: 99.73 %)"
+    if name == "Deterministic":
+        return "fixed", f"{d.value:g}"
+    return name, str(d)
+
+
+def _dispersions(scenario) -> str:
+    if scenario is None:
+        return ("## Dispersions\n\nThe flown scenario could not be read from the manifest (a campaign of another "
+                "version): see campaign.json.")
+    spec, entry = scenario.dispersions, scenario.entry
+    nominal = {"entry.altitude_m": f"{entry.altitude_km * 1e3:g} m", "entry.longitude_deg": f"{entry.longitude_deg:g} deg",
+               "entry.latitude_deg": f"{entry.latitude_deg:g} deg", "entry.velocity_m_s": f"{entry.velocity_m_s:g} m/s",
+               "entry.flight_path_deg": f"{entry.flight_path_deg:g} deg", "entry.heading_deg": f"{entry.heading_deg:g} deg"}
+    lines = []
+    for path, label, unit in DISPERSION_FIELDS:
+        holder = spec.entry if path.startswith("entry.") else spec
+        value = getattr(holder, path.split(".")[-1])
+        kind, spread = _distribution_text(value)
+        if kind == "fixed" and float(spread) in (0.0, 1.0) and path != "density_wave_amplitude":
+            continue  # not dispersed: the nominal model
+        if kind == "fixed" and path == "density_wave_amplitude" and float(spread) == 0.0:
+            continue
+        where = nominal.get(path, "1 (the nominal model)" if unit == "-" else "")
+        delta = " (deviation)" if path.startswith("entry.") else ""
+        lines.append(f"| {label}{delta} | {where} | {kind} | {spread} | {unit} |")
+    if any(lines) and spec.density_wave_amplitude not in (0.0,):
+        lines.append(f"| density wave length | — | fixed | {spec.density_wave_length_km:g} | km |")
+    bias = spec.nav_bias
+    name = type(bias).__name__
+    if name == "GaussianVectorX":
+        for i, (m, s) in enumerate(zip(bias.mean, bias.stddev)):
+            if s:
+                lines.append(f"| navigation bias, {NAV_NAMES[i]} | 0 | Gaussian | mean {m:g}, 1σ {s:g} | {NAV_UNITS[i]} |")
+    elif name == "UniformVectorX":
+        for i, (lo, hi) in enumerate(zip(bias.min, bias.max)):
+            if lo or hi:
+                lines.append(f"| navigation bias, {NAV_NAMES[i]} | 0 | uniform | [{lo:g}, {hi:g}] | {NAV_UNITS[i]} |")
+    for i, s in enumerate(spec.nav_noise_sigma):
+        if s:
+            lines.append(f"| navigation white noise, {NAV_NAMES[i]} | 0 | Gaussian per step | 1σ {s:g} | "
+                         f"{NAV_UNITS[i]} |")
+    head = "## Dispersions\n\n"
+    source = f"Source: {spec.source}." if spec.source else "Source: not stated in the scenario (`dispersions.source`)."
+    if not lines:
+        return head + "Nothing is dispersed: every sample flies the nominal scenario. " + source
+    return (head + source + " Entry values are deviations added to the nominal entry state.\n\n"
+            "| parameter | nominal | distribution | bounds or σ | unit |\n|---|---|---|---|---|\n" + "\n".join(lines))
+
+
+def _requirements(rows: dict, reached, stats: dict, scenario) -> str:
+    n = len(rows["index"])
+    nr = int(reached.sum())
+    lines = []
+    term = scenario.terminal if scenario is not None else None
+    lines.append(f"| reach the terminal interface | every sample | count | {nr} of {n} | — | "
+                 f"{'PASS' if nr == n else 'FAIL'} |")
+    box = (("altitude", "terminal altitude", "altitude_tolerance_km", 1e3, "km", "km"),
+           ("mach", "terminal Mach", "mach_tolerance", 1.0, "", "-"),
+           ("distance", "distance to the target", "distance_tolerance_km", 1e3, "km", "km"))
+    for key, label, field, scale, unit, show in box:
+        col = f"box_{key}_error"
+        flag = f"inside_{key}_box"
+        if term is None or getattr(term, field, None) is None or flag not in rows:
+            continue
+        tol = getattr(term, field)
+        inside = int(sum(bool(v) for v, r in zip(rows[flag], reached) if r and v is not None))
+        e = _finite(rows, col, n)[reached] / scale if col in rows else np.array([])
+        e = e[np.isfinite(e)]
+        worst = float(np.abs(e).max()) if e.size else math.nan
+        centre = ""
+        if key == "altitude" and term.altitude_km is not None:
+            centre = f" about {term.altitude_km:g} km"
+        elif key == "mach" and term.mach is not None:
+            centre = f" about {term.mach:g}"
+        lines.append(f"| {label}{centre} | ≤ {tol:g} {unit} | largest absolute error of {nr} | "
+                     f"{_fmt(worst)} {unit} | {_fmt(tol - worst)} {unit} | "
+                     f"{'PASS' if inside == nr == n else 'FAIL'} ({inside} of {n} inside) |")
+    limits = []
+    if scenario is not None:
+        try:
+            limits = scenario.path_limits()
+        except DrakeEntryError:
+            limits = []
+    peaks = {"heat_flux": "peak_heat_flux_W_m2", "dynamic_pressure": "peak_dynamic_pressure_Pa",
+             "normal_load": "peak_normal_load_g", "total_load": "peak_total_load_g"}
+    tolerance = scenario.terminal.path_limit_tolerance if scenario is not None else 0.0
+    for lim in limits:
+        m = stats["margins"].get(f"margin_{lim.name}")
+        if m is None:
+            continue
+        flew = int(np.isfinite(_finite(rows, f"margin_{lim.name}", n)).sum())
+        peak = ""
+        if lim.name in peaks and peaks[lim.name] in rows:
+            worst = float(np.nanmax(_finite(rows, peaks[lim.name], n))) * lim.scale
+            peak = f"{worst:.4g} {lim.unit}"
+        else:
+            peak = "—"
+        ok = m["violations"] == 0
+        lines.append(f"| {lim.name} | {_cell(lim.bound_text())} | worst flown sample of {flew} | {peak} | "
+                     f"{100 * m['worst']:.2f} % (sample {m['worst_sample']}) | "
+                     f"{'PASS' if ok else 'FAIL'} ({flew - m['violations']} of {flew} held) |")
+    note = (f"A limit counts as held up to its value plus {100 * tolerance:g} % of it (the scenario's "
+            "`terminal.path_limit_tolerance`), at every log sample and integrator step. PASS means every sample met "
+            "the requirement; the statistic and the margin are those of the worst sample (margins relative to the "
+            "limit). A bank margin of 0 % means the bank actuator reached the vehicle's bank limit, where it clips: "
+            "held, not breached.")
+    verdict = ("A sample succeeds when it reached the terminal interface, ended inside every acceptance criterion "
+               "and held every path limit at every log sample and integrator step.")
+    limits_text = _limits_text(scenario)
+    if limits_text:
+        verdict += " Path limits: " + limits_text + "."
+    return ("## Requirements\n\n" + verdict + "\n\n| requirement | threshold | statistic | campaign value | margin | "
+            "verdict |\n|---|---|---|---|---|---|\n" + "\n".join(lines) + "\n\n" + note)
+
+
+def _outcome(rows: dict, stats: dict, traj) -> str:
+    lb = stats["success_lower_bound"]
+    out = ["## Outcome", "", counts_sentence(stats) + ".", "",
+           "| confidence | lower bound on the success probability (one-sided Clopper-Pearson) |", "|---|---|"]
+    out += [f"| {100 * float(level):g} % | {100 * value:.2f} % |" for level, value in lb.items()]
+    runs_needed = runs_for_bound()
+    out += ["", f"With every sample successful, {runs_needed} runs would show 99 % success at 90 % confidence."]
+    if stats["failure_reasons"]:
+        out += ["", "Samples not successful, by reason:", ""] + [f"- {k}: {v}" for k, v in stats["failure_reasons"].items()]
+        failed = [i for i, ok in enumerate(rows["success"]) if not ok]
+        out += ["", "| sample | seed | reason |", "|---|---|---|"]
+        for i in failed[:MAX_FAILED_LISTED]:
+            reason = str(rows.get("message", [""] * len(rows["index"]))[i] or "").replace("|", "/")[:200]
+            out.append(f"| {rows['index'][i]} | {rows.get('seed', ['?'] * len(rows['index']))[i]} | {reason} |")
+        if len(failed) > MAX_FAILED_LISTED:
+            out.append(f"| … | | {len(failed) - MAX_FAILED_LISTED} more in samples.parquet |")
+        out += ["", "Re-run one sample alone with `drake-entry fly` on the same scenario and its seed "
+                "(diagrams.sample.run_sample reproduces a row from the master seed and the index)."]
+    if stats.get("inside_km"):
+        out += ["", "Samples within a distance of the target: " + ", ".join(
+            f"{k} km: {v}" for k, v in stats["inside_km"].items())]
+    if traj is None:
+        out += ["", "Trajectories were not kept (`--trajectory-step 0`) or none finished: the state envelopes, "
+                "constraint histories, drag profiles and groundtracks are omitted."]
+    return "\n".join(out)
+
+
+MAX_FAILED_LISTED = 50
+
+
+def _distributions(rows: dict, reached, stats: dict, reference) -> str:
+    n_reached = int(reached.sum())
+    quantities = _quantities(rows, reached)
+    head = ("| quantity | unit | N | min | P0.13 | P1 | P50 | mean | σ | P99 | P99.87 | max | "
+            f"Wilks {100 * COVERAGE:g} %/{100 * CONFIDENCE:g} % |")
+    sep = "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+
+    def table(keys):
+        lines = [head, sep]
+        for key in keys:
+            if key not in quantities:
+                continue
+            label, unit, values = quantities[key]
+            d = stats["distributions"][key]
+            if d.get("n", 0) == 0:
+                continue
+            signed = key.startswith("err_") and key != "err_distance_m"
+            bound = order_statistic_bound(np.abs(values) if signed else values)
+            cells = [label + (" (bound on the absolute value)" if signed else ""), unit, str(d["n"])]
+            cells += [_fmt(d.get(k)) for k in ("min", "p0.13", "p1", "p50", "mean", "sigma", "p99", "p99.87", "max")]
+            cells.append(_fmt(bound) if bound is not None else f"— (needs {runs_for_bound()} runs)")
+            lines.append("| " + " | ".join(cells) + " |")
+        return "\n".join(lines)
+
+    out = ["## Statistics", "",
+           "Percentiles are empirical (linear interpolation between order statistics); P0.13 and P99.87 (the 3σ levels "
+           "of a normal distribution, 99.73 % two-sided) are given only when the sample holds a point beyond them "
+           "(770 runs or more). σ is the sample standard deviation; mean ± 3σ covers 99.73 % only of a normal "
+           f"distribution. The Wilks column is a distribution-free bound: with {runs_for_bound()} runs or more, the "
+           f"largest value (or a lower order statistic) exceeds the {100 * COVERAGE:g} % quantile with "
+           f"{100 * CONFIDENCE:g} % confidence.", "",
+           f"### Terminal errors ({n_reached} samples that reached the terminal interface)", "",
+           table([c for c, _, _ in ERROR_COLUMNS])]
+    if stats["errors"]:
+        out += ["", errors_markdown(stats, reference), "",
+                "ΔR is the range to go along the final heading (+ short of the target); the cross-range is reported "
+                "separately."]
+    out += ["", "### Peak path quantities, heat load and flight time (every sample that flew)", "",
+            table([c for c, *_ in PEAK_QUANTITIES + OTHER_QUANTITIES])]
+    if any(c in rows for c, *_ in CONTROL_QUANTITIES):
+        out += ["", "### Control activity (the bank actuator's position, every sample that flew)", "",
+                table([c for c, *_ in CONTROL_QUANTITIES]), "",
+                "Reversals are sign changes of the flown bank between excursions beyond 1 deg; travel is the total "
+                "angle turned; the rate is the actuator's (finite differences over the integrator steps); time at a "
+                "limit counts intervals whose two ends are at it (rate: within 1 % of the vehicle's bank-rate limit)."]
+    return "\n".join(out)
+
+
+def miss_contributors(rows: dict, reached, top: int = 5) -> list:
+    """The dispersed inputs (``disp_*`` columns that vary) ranked by |Spearman rank correlation|
+    with the miss distance over the reached samples: [{input, rho, p_value}] (empty below 8
+    samples)."""
+    n = len(rows["index"])
+    miss = _finite(rows, "err_distance_m", n)[reached]
+    if miss.size < 8 or not np.isfinite(miss).all():
+        return []
+    out = []
+    for col in sorted(c for c in rows if c.startswith("disp_")):
+        x = _finite(rows, col, n)[reached]
+        if not np.isfinite(x).all() or np.ptp(x) == 0.0:
+            continue
+        rho, p = sps.spearmanr(x, miss)
+        out.append({"input": col, "rho": float(rho), "p_value": float(p)})
+    return sorted(out, key=lambda c: -abs(c["rho"]))[:top]
+
+
+def _contributors(stats_: dict) -> str:
+    c = stats_.get("contributors") or []
+    if not c:
+        return ""
+    lines = ["## Largest contributors to the miss", "",
+             "Dispersed inputs ranked by the magnitude of their Spearman rank correlation with the distance to the "
+             "target over the samples that reached the terminal interface (a monotonic association, not a causal "
+             "share; |ρ| below about 0.2 explains little, and a p-value above 0.05 is indistinguishable from none).", "",
+             "| input | Spearman ρ | p-value |", "|---|---|---|"]
+    lines += [f"| {DISPERSION_LABELS.get(x['input'], x['input'].removeprefix('disp_'))} | {x['rho']:+.3f} | "
+              f"{x['p_value']:.2g} |" for x in c]
+    return "\n".join(lines)
+
+
+def _cost(stats_: dict) -> str:
+    if not stats_.get("cost"):
+        return ""
+    c = stats_["cost"]
+    return (f"## Cost\n\n{c['wall_s_per_sample']:.2f} s of one core per sample, {100 * c['planning_share']:.0f} % of "
+            f"it re-planning ({c['plans_per_sample']:.1f} plans), {c['derivative_evaluations_per_sample']:.0f} plant "
+            "derivative evaluations.")
+
+
+def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: str) -> list:
+    """[(path, caption)] of every figure the campaign supports."""
+    n = len(rows["index"])
     figs = []
-    sample = np.asarray(traj["sample"])
-    E = np.asarray(traj["energy_J_kg"], float)
-    E0, Ef = E.max(), E.min()
-    e = (E0 - E) / (E0 - Ef)
-    groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
-    for ax, (col, scale, label) in zip(axes.ravel(), (("altitude_m", 1e-3, "altitude [km]"),
-                                                       ("velocity_m_s", 1e-3, "speed [km/s]"),
-                                                       ("flight_path_deg", 1.0, "flight-path angle [deg]"),
-                                                       ("bank_deg", 1.0, "bank [deg]"))):
-        v = np.asarray(traj[col], float) * scale
-        for g in groups:
-            ax.plot(e[g], v[g], lw=0.4, alpha=0.5)
-        ax.set_ylabel(label)
-        ax.grid(True)
-    for ax in axes[1]:
-        ax.set_xlabel("normalised energy e")
-    figs.append(_save(fig, out_dir, "states_vs_energy.png"))  # paper 000 Fig. 6
-
-    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
-    for ax, (col, scale, label, lim) in zip(axes, (
-            ("dynamic_pressure_Pa", 1e-3, "dynamic pressure [kPa]", "dynamic_pressure_max"),
-            ("heat_flux_W_m2", 1e-3, "heat flux [kW/m^2]", "heat_flux_max"),
-            ("normal_load_g", 1.0, "normal load [g]", "normal_load_max"))):
-        v = np.asarray(traj[col], float) * scale
-        for g in groups:
-            ax.plot(e[g], v[g], lw=0.4, alpha=0.5)
-        if limits is not None and np.isfinite(getattr(limits, lim)):
-            ax.axhline(getattr(limits, lim) * scale, color="r", ls="--", lw=1)
-        ax.set_xlabel("normalised energy e")
-        ax.set_ylabel(label)
-        ax.grid(True)
-    figs.append(_save(fig, out_dir, "constraints_vs_energy.png"))  # paper 000 Fig. 7
-
-    if "reference_drag_m_s2" in traj:
-        fig, ax = plt.subplots(figsize=(6.5, 4.5))
-        ref = np.asarray(traj["reference_drag_m_s2"], float)
-        D = np.asarray(traj["drag_m_s2"], float)
-        for g in groups:
-            m = ref[g] > 0
-            ax.plot(e[g][m], ref[g][m], lw=0.4, alpha=0.5)
-        ax.plot([], [], label="references (one per sample)")
-        ax.plot(e, D, ",", color="k", alpha=0.3, label="flown")
-        ax.set_xlabel("normalised energy e")
-        ax.set_ylabel("drag [m/s^2]")
-        ax.legend(fontsize=8)
-        ax.grid(True)
-        figs.append(_save(fig, out_dir, "drag_profiles.png"))  # paper 000 Fig. 8
-
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    lon, lat = np.asarray(traj["longitude_deg"]), np.asarray(traj["latitude_deg"])
-    for g in groups:
-        ax.plot(lon[g], lat[g], lw=0.4, alpha=0.5)
-    ax.set_xlabel("longitude [deg]")
-    ax.set_ylabel("latitude [deg]")
-    ax.grid(True)
-    figs.append(_save(fig, out_dir, "groundtracks.png"))  # paper 000 Fig. 9
-    return figs
+    if reached.any():
+        errors = {f"{label} [{unit}]": _finite(rows, col, n)[reached] for col, label, unit in ERROR_COLUMNS if col in rows}
+        figs.append(figures.error_histograms(errors, out_dir, title))
+        radius = getattr(getattr(scenario, "terminal", None), "distance_tolerance_km", None)
+        figs.append(figures.footprint(_finite(rows, "err_crossrange_m", n)[reached] / 1e3,
+                                      _finite(rows, "err_range_m", n)[reached] / 1e3, out_dir, title, radius_km=radius))
+    peaks = {f"{label} [{unit}]": (_finite(rows, col, n) * scale,
+                                   getattr(limits, lim) * scale if limits is not None else None)
+             for col, label, unit, scale, lim in PEAK_QUANTITIES if col in rows}
+    figs.append(figures.peak_histograms(peaks, out_dir, title))
+    if traj is not None:
+        figs.append(figures.envelopes(traj, out_dir, title))
+        figs.append(figures.path_quantities(traj, out_dir, title, limits))
+        figs.append(figures.drag_profiles(traj, out_dir, title))
+        target = ((scenario.target.longitude_deg, scenario.target.latitude_deg) if scenario is not None else None)
+        figs.append(figures.ground_tracks(traj, out_dir, title, target=target))
+        figs.append(figures.bank_histories(traj, out_dir, title, detailed=_detailed_samples(traj)))
+    return [f for f in figs if f is not None]
 
 
-def _save(fig, out_dir, name) -> str:
-    paths = []
-    plots.save_figure(fig, out_dir, name, paths)
-    return paths[0]
+def _detailed_samples(traj: dict) -> list:
+    """Samples stored at a step of 1 s or finer (the first few of a campaign: diagrams.sample)."""
+    sample, t = np.asarray(traj["sample"]), np.asarray(traj["time_s"], float)
+    out = []
+    for s in np.unique(sample):
+        ts = t[sample == s]
+        if ts.size > 3 and np.median(np.diff(ts)) <= 1.0 + 1e-9:
+            out.append(int(s))
+    return out[:5]
+
+
+def _figure_list(figs: list) -> str:
+    out = ["## Figures"]
+    for k, (path, caption) in enumerate(figs, 1):
+        name = os.path.basename(path)
+        out += ["", f"![Figure {k}: {name}]({name})", "", f"*Figure {k}. {caption}*"]
+    return "\n".join(out)
+
+
+def write_html(markdown_text: str, out_dir: str, *, title: str) -> str:
+    """report.html: the Markdown rendered (tables), every figure inline as a data URI."""
+    import markdown
+
+    body = markdown.markdown(markdown_text, extensions=["tables"])
+
+    def inline(match):
+        src = match.group(1)
+        path = os.path.join(out_dir, src)
+        if not os.path.isfile(path):
+            return match.group(0)
+        with open(path, "rb") as f:
+            data = base64.b64encode(f.read()).decode()
+        return f'src="data:image/png;base64,{data}"'
+
+    body = re.sub(r'src="([^"]+\.png)"', inline, body)
+    css = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto;line-height:1.4}"
+           "table{border-collapse:collapse;margin:1em 0;font-size:0.9em}td,th{border:1px solid #bbb;padding:3px 6px}"
+           "th{background:#eee}img{max-width:100%}em{color:#333}")
+    html_text = (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{html.escape(title)}</title>"
+                 f"<style>{css}</style></head><body>\n{body}\n</body></html>\n")
+    path = os.path.join(out_dir, "report.html")
+    with open(path, "w") as f:
+        f.write(html_text)
+    return path

@@ -3,8 +3,10 @@ trajectories streamed as samples finish.
 
   campaign.json          manifest: the scenario as flown (canonical YAML, overrides applied),
                          seed, trajectory step, versions, the fingerprint of all of these,
-                         and the number of samples requested so far
-  campaign.lock          held (flock) by the one process writing the directory
+                         the number of samples requested so far, and one ``sessions`` record
+                         per run (date, command, library versions, commit: not identity)
+  campaign.lock          held (flock) by the one process writing the directory, removed when it
+                         closes
   samples.jsonl          one row per finished sample, appended and flushed at once
   trajectories.jsonl     its down-sampled trajectory, appended just before its row
   quarantine.jsonl       lines that were not rows or trajectories, moved aside on resume
@@ -56,15 +58,7 @@ class CampaignStore:
             raise CampaignError(f"--out {out_dir} is a file, not a campaign directory")
         self.out_dir = out_dir
         os.makedirs(out_dir, exist_ok=True)
-        self._lock = os.open(self.path(LOCK), os.O_RDWR | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as e:
-            os.close(self._lock)
-            if e.errno in (errno.EWOULDBLOCK, errno.EACCES):
-                raise CampaignError(f"{out_dir} is being written by another campaign process; wait for it to "
-                                    f"finish or use another --out") from None
-            raise
+        self._lock = self._acquire_lock()
         os.ftruncate(self._lock, 0)
         os.write(self._lock, str(os.getpid()).encode())
         try:
@@ -74,6 +68,30 @@ class CampaignStore:
             self.close()
             raise
         self._rows = self._traj = None
+
+    def _acquire_lock(self) -> int:
+        """The exclusive flock on campaign.lock (created if absent). The writer removes the file
+        when it closes, so a lock taken on a file that was removed meanwhile is retaken on the
+        new one (the inode must be the path's)."""
+        path = self.path(LOCK)
+        for _ in range(100):
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as e:
+                os.close(fd)
+                if e.errno in (errno.EWOULDBLOCK, errno.EACCES):
+                    raise CampaignError(f"{self.out_dir} is being written by another campaign process; wait for it "
+                                        f"to finish or use another --out") from None
+                raise
+            try:
+                same = os.fstat(fd).st_ino == os.stat(path).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                return fd
+            os.close(fd)  # the previous writer removed it between our open and our lock: again
+        raise CampaignError(f"{self.out_dir}: could not take the campaign lock (it kept being replaced)")
 
     def _check_manifest(self, manifest: dict) -> dict:
         manifest = dict(manifest, format=FORMAT)
@@ -90,6 +108,7 @@ class CampaignStore:
                     f"{self.out_dir} holds a campaign with another {', '.join(differs) or 'format'}; extend it "
                     f"with the same settings and a larger --runs, or start afresh with another --out")
             manifest["runs"] = max(int(old.get("runs", 0)), int(manifest["runs"]))
+            manifest["sessions"] = list(old.get("sessions", [])) + list(manifest.get("sessions", []))
         _write_atomic(self.path(MANIFEST), json.dumps(manifest, indent=2).encode())
         return manifest
 
@@ -113,7 +132,13 @@ class CampaignStore:
         self.close()
 
     def close(self):
+        """Release the lock and remove campaign.lock (removed while still held, so no other
+        writer can hold a lock on a file that is gone: see ``_acquire_lock``)."""
         if self._lock is not None:
+            try:
+                os.unlink(self.path(LOCK))
+            except FileNotFoundError:
+                pass
             os.close(self._lock)  # releases the flock
             self._lock = None
 

@@ -49,6 +49,9 @@ class EntryDispersionSpec:
 class DispersionSpec:
     """Everything a Monte-Carlo sample may disperse (defaults: nothing)."""
 
+    # where these dispersions come from (a paper's table, or a labelled choice): the report's
+    # dispersion table cites it
+    source: str = ""
     entry: EntryDispersionSpec = dc.field(default_factory=EntryDispersionSpec)
     # true density = nominal * density_scale * (1 + amplitude sin(2 pi h / wavelength + phase))
     density_scale: Scalar = 1.0

@@ -1,6 +1,7 @@
 """A simulated trajectory (the record every diagram runner returns) and its metrics: the
-one place where peak heat flux, dynamic pressure, loads and heat load are computed (for the
-CLI summaries, campaign rows and plots)."""
+one place where peak heat flux, dynamic pressure, loads and heat load (``metrics``) and the
+bank's activity (``control_activity``) are computed (for the CLI summaries, campaign rows and
+plots)."""
 from __future__ import annotations
 
 import dataclasses as dc
@@ -92,3 +93,31 @@ def metrics(tr: Trajectory, limits: PathLimits | None = None) -> dict:
                            normal_load=out["peak_normal_load_g"], total_load=out["peak_total_load_g"])
         out.update({f"margin_{k}": float(v) for k, v in m.items() if np.isfinite(getattr(limits, f"{k}_max"))})
     return out
+
+
+#: a bank reversal is a sign change of the flown bank between excursions beyond this [rad]
+REVERSAL_THRESHOLD = np.radians(1.0)
+
+
+def control_activity(tr: Trajectory, bank_limit: float, bank_rate_limit: float) -> dict:
+    """The bank's activity over every flown sample in time order (log samples and integrator
+    steps): ``bank_reversals`` (sign changes between excursions beyond REVERSAL_THRESHOLD),
+    ``bank_travel_deg`` (the total angle turned), ``peak_bank_rate_deg_s`` (largest |rate| by
+    finite differences of the C1 actuator path), ``time_at_bank_limit_s`` (|bank| within 1e-6
+    rad of ``bank_limit`` [rad] at both ends of an interval) and ``time_at_bank_rate_limit_s``
+    (|rate| >= 99 % of ``bank_rate_limit`` [rad/s])."""
+    t, idx = np.unique(tr.flown_time(), return_index=True)
+    bank = tr.flown("bank")[idx]
+    if t.size < 2:
+        return {"bank_reversals": 0, "bank_travel_deg": 0.0, "peak_bank_rate_deg_s": 0.0,
+                "time_at_bank_limit_s": 0.0, "time_at_bank_rate_limit_s": 0.0}
+    dt, step = np.diff(t), np.diff(bank)
+    rate = step / dt
+    signs = np.sign(bank[np.abs(bank) > REVERSAL_THRESHOLD])
+    held = np.abs(bank) >= bank_limit - 1e-6
+    at_limit = held[:-1] & held[1:]
+    at_rate = np.abs(rate) >= 0.99 * bank_rate_limit
+    return {"bank_reversals": int(np.count_nonzero(np.diff(signs))),
+            "bank_travel_deg": float(np.degrees(np.abs(step).sum())),
+            "peak_bank_rate_deg_s": float(np.degrees(np.abs(rate).max())),
+            "time_at_bank_limit_s": float(dt[at_limit].sum()), "time_at_bank_rate_limit_s": float(dt[at_rate].sum())}

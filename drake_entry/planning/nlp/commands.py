@@ -12,9 +12,12 @@ from drake_entry.cli import Command
 def add_arguments(parser) -> None:
     parser.add_argument("problem", help="packaged problem (marv, shefex3) or a problem YAML path")
     parser.add_argument("--nodes", type=int, default=None, help="LGL nodes / collocation samples (default: the YAML)")
-    parser.add_argument("--transcription", choices=("lgl", "dircol"), default=None)
-    parser.add_argument("--solver", choices=("auto", "ipopt", "snopt"), default=None)
-    parser.add_argument("--tolerance", type=float, default=None)
+    parser.add_argument("--transcription", choices=("lgl", "dircol"), default=None,
+                        help="Legendre pseudospectral (paper 002) or Drake's DirectCollocation (default: the YAML)")
+    parser.add_argument("--solver", choices=("auto", "ipopt", "snopt"), default=None,
+                        help="NLP solver; auto tries SNOPT, then Ipopt (default: the YAML)")
+    parser.add_argument("--tolerance", type=float, default=None,
+                        help="solver optimality and feasibility tolerance, scaled units (default: the YAML)")
     parser.add_argument("--coarse", type=int, default=None, metavar="N",
                         help="first solve with N nodes and start the full solve from it (0 = the propagated "
                              "guess; default: the YAML's coarse_nodes)")
@@ -30,8 +33,10 @@ def add_arguments(parser) -> None:
                         help="skip the verification (between-node dynamics and the Drake flight of the "
                              "controls): the answer is reported converged, not verified (success false), "
                              "and the exit code is 0 when it converged")
-    parser.add_argument("--out", default="out/optimize")
-    parser.add_argument("--format", choices=("parquet", "csv"), default="csv")
+    parser.add_argument("--out", default="out/optimize",
+                        help="output directory: solution table, summary.json, figures (default: out/optimize)")
+    parser.add_argument("--format", choices=("parquet", "csv"), default="csv",
+                        help="solution table format (default: csv)")
 
 
 def run(args) -> int:

@@ -1,0 +1,297 @@
+"""The figures of a campaign report, each returned with its caption (what it shows, N, the
+statistic, the units, what to look at). Headless (Agg).
+
+    terminal_figures(rows, reached, ...)   error histograms, footprint, peak histograms
+    trajectory_figures(traj, ...)          envelopes against energy, path quantities, drag
+                                           profiles, ground tracks, bank histories
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import stats
+
+from drake_entry.campaign import plots  # sets the Agg backend before pyplot is imported
+from drake_entry.campaign.plots import plt
+
+#: k of the 99 % probability ellipse of a 2-D normal: sqrt(chi2.ppf(0.99, 2)) = 3.035
+ELLIPSE_99_K = math.sqrt(stats.chi2.ppf(0.99, 2))
+#: the half-width of the ground tracks' zoom about the target [deg of latitude]
+ZOOM_DEG = 0.5
+#: envelope percentiles across samples [%]
+ENVELOPE = (1.0, 50.0, 99.0)
+#: the normalised energy on the x axes, defined once for every caption
+ENERGY_AXIS = "normalised energy e = (E0 - E) / (E0 - Ef)"
+ENERGY_DEFINITION = ("e = (E0 - E) / (E0 - Ef) is the normalised energy (E = V^2/2 - mu/r, E0 the highest and Ef the "
+                     "lowest energy flown in the campaign): 0 at entry, 1 at the terminal interface")
+
+
+def fd_bins(values) -> np.ndarray | int:
+    """Freedman-Diaconis bin edges (numpy's 'fd'; 10 bins where the interquartile range is 0)."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    if v.size < 4 or np.subtract(*np.percentile(v, [75, 25])) == 0.0:
+        return 10
+    return np.histogram_bin_edges(v, bins="fd")
+
+
+def _save(fig, out_dir: str, name: str, title: str) -> str:
+    paths = []
+    plots.save_figure(fig, out_dir, name, paths, title)
+    return paths[0]
+
+
+def error_histograms(errors: dict, out_dir: str, title: str) -> tuple[str, str]:
+    """``errors``: {label [unit]: values} of the reached samples."""
+    n_panels = len(errors)
+    cols = 4
+    rows = math.ceil(n_panels / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(14, 3.3 * rows), squeeze=False)
+    n = 0
+    for ax, (label, v) in zip(axes.ravel(), errors.items()):
+        v = np.asarray(v, float)
+        v = v[np.isfinite(v)]
+        n = max(n, v.size)
+        ax.hist(v, bins=fd_bins(v), color="C0", alpha=0.8)
+        if v.size > 1:
+            m, s = v.mean(), v.std(ddof=1)
+            ax.axvline(m, color="k", lw=1.2, label="mean")
+            for k in (-3, 3):
+                ax.axvline(m + k * s, color="k", ls="--", lw=0.9, label="mean ± 3σ" if k > 0 else None)
+        ax.set_xlabel(label)
+        ax.locator_params(axis="x", nbins=5)
+        ax.grid(True, alpha=0.4)
+    for ax in axes.ravel()[n_panels:]:
+        ax.set_visible(False)
+    axes[0, 0].set_ylabel("samples")
+    if axes[0, 0].get_legend_handles_labels()[0]:
+        axes[0, 0].legend(fontsize=7)
+    path = _save(fig, out_dir, "error_histograms.png", title)
+    return path, (f"Terminal errors of the {n} samples that reached the terminal interface (final minus target "
+                  "values). Bins by the Freedman-Diaconis rule; solid line the mean, dashed lines mean ± 3σ (99.73 % "
+                  "of a normal distribution). Look for skew and outliers beyond the dashed lines.")
+
+
+def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float | None) -> tuple[str, str]:
+    """Cross-range against range to go [km] of the reached samples, centred on the target."""
+    x, y = np.asarray(cross_km, float), np.asarray(range_km, float)
+    ok = np.isfinite(x) & np.isfinite(y)
+    x, y = x[ok], y[ok]
+    fig, ax = plt.subplots(figsize=(6.4, 6.0))
+    ax.plot(x, y, ".", ms=4, color="C0", label=f"samples (N = {x.size})")
+    ax.plot(0.0, 0.0, "r*", ms=14, label="target")
+    t = np.linspace(0.0, 2.0 * np.pi, 300)
+    circle = np.vstack([np.cos(t), np.sin(t)])
+    extent = [np.abs(x).max(initial=0.0), np.abs(y).max(initial=0.0)]
+    miss = np.hypot(x, y)
+    if x.size > 2:
+        vals, vecs = np.linalg.eigh(np.cov(np.vstack([x, y])))
+        ell = vecs @ (ELLIPSE_99_K * np.sqrt(np.maximum(vals, 0.0))[:, None] * circle)
+        ax.plot(x.mean() + ell[0], y.mean() + ell[1], "C1-", lw=1.5,
+                label=f"99 % ellipse (k = {ELLIPSE_99_K:.3f}σ, normal)")
+        p99 = float(np.percentile(miss, 99))
+        ax.plot(p99 * circle[0], p99 * circle[1], "C2:", lw=1.5, label=f"P99 miss radius {p99:.3g} km")
+        extent += [np.abs(x.mean() + ell[0]).max(), np.abs(y.mean() + ell[1]).max(), p99]
+    if radius_km is not None:
+        ax.plot(radius_km * circle[0], radius_km * circle[1], "r--", lw=1.2,
+                label=f"acceptance region ({radius_km:g} km)")
+        if radius_km <= 4.0 * max(extent):
+            extent.append(radius_km)
+    half = 1.1 * max(max(extent), 1e-3)
+    ax.set_xlim(-half, half)
+    ax.set_ylim(-half, half)
+    ax.set_aspect("equal")
+    ax.set_xlabel("cross-range [km] (+ right of the final heading)")
+    ax.set_ylabel("range to go [km] (+ short of the target)")
+    ax.legend(fontsize=8, loc="upper right")
+    ax.grid(True, alpha=0.4)
+    path = _save(fig, out_dir, "footprint.png", title)
+    caption = (f"Terminal footprint of the {x.size} samples that reached the terminal interface, centred on the "
+               "target, equal axes. The ellipse holds 99 % of a normal distribution with the sample's mean and "
+               "covariance (k = 3.035σ in 2-D); the dotted circle is the 99th percentile of the miss distance")
+    caption += (f"; the dashed circle is the acceptance region ({radius_km:g} km)" if radius_km is not None else "")
+    if radius_km is not None and radius_km > 4.0 * max(extent[:2] + [1e-9]):
+        caption += " (drawn only when near the samples: here far outside the axes)"
+    return path, caption + "."
+
+
+def peak_histograms(peaks: dict, out_dir: str, title: str) -> tuple[str, str] | None:
+    """``peaks``: {label [unit]: (values, limit or None)} over every sample that flew."""
+    panels = [(k, np.asarray(v, float), lim) for k, (v, lim) in peaks.items()
+              if np.isfinite(np.asarray(v, float)).any()]
+    if not panels:
+        return None
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.6), squeeze=False)
+    n = 0
+    for ax, (label, v, lim) in zip(axes[0], panels):
+        v = v[np.isfinite(v)]
+        n = max(n, v.size)
+        ax.hist(v, bins=fd_bins(v), color="C0", alpha=0.8)
+        if lim is not None and np.isfinite(lim):
+            ax.axvline(lim, color="r", ls="--", lw=1.4, label=f"limit {lim:g}")
+            ax.legend(fontsize=8)
+        ax.set_xlabel(label)
+        ax.grid(True, alpha=0.4)
+    axes[0, 0].set_ylabel("samples")
+    path = _save(fig, out_dir, "peak_histograms.png", title)
+    return path, (f"Peak path quantities of the {n} samples that flew (the largest value over every log sample and "
+                  "integrator step of each flight), Freedman-Diaconis bins, the vehicle's limits dashed. The gap "
+                  "between the rightmost bar and the limit line is the campaign's worst margin.")
+
+
+def _on_energy_grid(e, v, groups, grid):
+    """Each sample's values interpolated on ``grid`` of normalised energy (nan outside its range)."""
+    out = np.full((len(groups), grid.size), np.nan)
+    for i, g in enumerate(groups):
+        order = np.argsort(e[g])
+        eg, vg = e[g][order], v[g][order]
+        inside = (grid >= eg[0]) & (grid <= eg[-1])
+        out[i, inside] = np.interp(grid[inside], eg, vg)
+    return out
+
+
+def envelopes(traj: dict, out_dir: str, title: str) -> tuple[str, str]:
+    """Altitude, speed, flight-path angle and bank against normalised energy as P1/P50/P99 envelopes."""
+    sample = np.asarray(traj["sample"])
+    e = normalised_energy(traj)
+    groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
+    grid = np.linspace(0.0, 1.0, 201)
+    fig, axes = plt.subplots(2, 2, figsize=(12, 7.5), sharex=True)
+    for ax, (col, scale, label) in zip(axes.ravel(), (("altitude_m", 1e-3, "altitude [km]"),
+                                                       ("velocity_m_s", 1e-3, "speed [km/s]"),
+                                                       ("flight_path_deg", 1.0, "flight-path angle [deg]"),
+                                                       ("bank_deg", 1.0, "bank [deg]"))):
+        values = _on_energy_grid(e, np.asarray(traj[col], float) * scale, groups, grid)
+        with np.errstate(all="ignore"):
+            count = np.isfinite(values).sum(axis=0)
+            lo, mid, hi = (np.nanpercentile(values, p, axis=0) if values.size else grid * np.nan for p in ENVELOPE)
+        keep = count >= max(3, len(groups) // 2)
+        for m in (lo, mid, hi):
+            m[~keep] = np.nan
+        ax.fill_between(grid, lo, hi, color="C0", alpha=0.25, label="P1 - P99 across samples")
+        ax.plot(grid, mid, "C0-", lw=1.5, label="P50 (median)")
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.4)
+    for ax in axes[1]:
+        ax.set_xlabel(ENERGY_AXIS)
+    axes[0, 0].legend(fontsize=8)
+    path = _save(fig, out_dir, "state_envelopes.png", title)
+    return path, (f"State envelopes of the {len(groups)} stored trajectories against normalised energy: the band holds "
+                  f"the 1st to 99th percentile across samples at each energy, the line their median. {ENERGY_DEFINITION}. "
+                  "The bank panel shows magnitudes and signs mixed: see the bank histories for single flights.")
+
+
+def path_quantities(traj: dict, out_dir: str, title: str, limits) -> tuple[str, str]:
+    """Dynamic pressure, heat flux and normal load against normalised energy, every sample, limits labelled."""
+    sample = np.asarray(traj["sample"])
+    e = normalised_energy(traj)
+    groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.0))
+    for ax, (col, scale, label, lim, unit) in zip(axes, (
+            ("dynamic_pressure_Pa", 1e-3, "dynamic pressure [kPa]", "dynamic_pressure_max", "kPa"),
+            ("heat_flux_W_m2", 1e-3, "heat flux [kW/m^2]", "heat_flux_max", "kW/m^2"),
+            ("normal_load_g", 1.0, "normal load [g]", "normal_load_max", "g"))):
+        v = np.asarray(traj[col], float) * scale
+        for g in groups:
+            ax.plot(e[g], v[g], lw=0.4, alpha=0.4, color="C0")
+        value = getattr(limits, lim, None) if limits is not None else None
+        if value is not None and np.isfinite(value):
+            ax.axhline(value * scale, color="r", ls="--", lw=1.2, label=f"limit {value * scale:g} {unit}")
+            ax.legend(fontsize=8)
+        ax.set_xlabel(ENERGY_AXIS)
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.4)
+    path = _save(fig, out_dir, "path_quantities.png", title)
+    return path, (f"Path quantities of the {len(groups)} stored trajectories against normalised energy (one line per "
+                  "sample, at the storage step: the peaks between stored points are in the peak histograms), the "
+                  f"vehicle's limits dashed. {ENERGY_DEFINITION}.")
+
+
+def drag_profiles(traj: dict, out_dir: str, title: str) -> tuple[str, str] | None:
+    """Flown drag (light) under the guidance's references (dark) against normalised energy."""
+    if "reference_drag_m_s2" not in traj:
+        return None
+    sample = np.asarray(traj["sample"])
+    e = normalised_energy(traj)
+    groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
+    ref = np.asarray(traj["reference_drag_m_s2"], float)
+    D = np.asarray(traj["drag_m_s2"], float)
+    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    for i, g in enumerate(groups):
+        ax.plot(e[g], D[g], lw=2.0, alpha=0.25, color="C1", label="flown drag" if i == 0 else None)
+    for i, g in enumerate(groups):
+        m = ref[g] > 0
+        ax.plot(e[g][m], ref[g][m], lw=0.6, color="k", alpha=0.6, label="reference (re-planned)" if i == 0 else None)
+    ax.set_xlabel(ENERGY_AXIS)
+    ax.set_ylabel("drag acceleration [m/s^2]")
+    ax.legend(fontsize=8)
+    ax.grid(True, alpha=0.4)
+    path = _save(fig, out_dir, "drag_profiles.png", title)
+    return path, (f"Drag tracking of the {len(groups)} stored trajectories: the flown drag (wide light lines) under "
+                  "the drag reference the guidance was tracking at each stored point (thin dark lines; it changes "
+                  f"at every re-plan). {ENERGY_DEFINITION}.")
+
+
+def ground_tracks(traj: dict, out_dir: str, title: str, *, target=None) -> tuple[str, str]:
+    """Every stored ground track with the entry points and the target (left), and the last
+    ZOOM_DEG around the target, where the dispersed tracks part (right); true-length axes."""
+    sample = np.asarray(traj["sample"])
+    lon, lat = np.asarray(traj["longitude_deg"], float), np.asarray(traj["latitude_deg"], float)
+    groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
+    ends = np.array([[lon[g][-1], lat[g][-1]] for g in groups])
+    centre = np.asarray(target, float) if target is not None else ends.mean(axis=0)
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.5))
+    aspect = 1.0 / max(math.cos(math.radians(float(np.nanmean(lat)))), 0.1)
+    for ax, zoom in zip(axes, (False, True)):
+        for g in groups:
+            ax.plot(lon[g], lat[g], lw=0.6 if zoom else 0.5, alpha=0.5, color="C0")
+        if not zoom:
+            starts = np.array([[lon[g][0], lat[g][0]] for g in groups])
+            ax.plot(starts[:, 0], starts[:, 1], "g^", ms=5, label="entry interface")
+        else:
+            ax.plot(ends[:, 0], ends[:, 1], "k.", ms=4, label="terminal points")
+            half = max(ZOOM_DEG, 1.2 * float(np.abs(ends - centre).max()))
+            ax.set_xlim(centre[0] - half * aspect, centre[0] + half * aspect)
+            ax.set_ylim(centre[1] - half, centre[1] + half)
+        if target is not None:
+            ax.plot(*target, "r*", ms=14, label="target")
+        ax.set_aspect(aspect)
+        ax.set_xlabel("longitude [deg]")
+        ax.set_ylabel("latitude [deg]")
+        ax.legend(fontsize=8)
+        ax.grid(True, alpha=0.4)
+    axes[1].set_title("near the target", fontsize=9)
+    path = _save(fig, out_dir, "groundtracks.png", title)
+    return path, (f"Ground tracks of the {len(groups)} stored trajectories from their (dispersed) entry interfaces"
+                  + (" to the target" if target is not None else "") + " (left) and the end of each near "
+                  + ("the target" if target is not None else "the mean terminal point")
+                  + " (right), where the dispersed tracks part; both axes scaled so a degree of longitude and of "
+                  "latitude have their true lengths at the mean latitude.")
+
+
+def bank_histories(traj: dict, out_dir: str, title: str, *, detailed: list) -> tuple[str, str] | None:
+    """Bank against time of the samples stored at the detailed step."""
+    if not detailed:
+        return None
+    sample = np.asarray(traj["sample"])
+    t, bank = np.asarray(traj["time_s"], float), np.asarray(traj["bank_deg"], float)
+    fig, ax = plt.subplots(figsize=(9, 4.2))
+    for s in detailed:
+        g = np.flatnonzero(sample == s)
+        ax.plot(t[g], bank[g], lw=1.0, label=f"sample {s}")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("bank [deg] (actuator position)")
+    ax.legend(fontsize=8, ncol=min(len(detailed), 5))
+    ax.grid(True, alpha=0.4)
+    path = _save(fig, out_dir, "bank_histories.png", title)
+    return path, (f"Bank angle flown by samples {', '.join(str(s) for s in detailed)} (stored at the detailed "
+                  "step, not the campaign's storage step), the bank actuator's position: reversals cross wings-level "
+                  "at the bank-rate limit.")
+
+
+def normalised_energy(traj: dict) -> np.ndarray:
+    """e of ENERGY_DEFINITION for every stored point."""
+    E = np.asarray(traj["energy_J_kg"], float)
+    E0, Ef = np.nanmax(E), np.nanmin(E)
+    return (E0 - E) / (E0 - Ef) if E0 > Ef else np.zeros_like(E)

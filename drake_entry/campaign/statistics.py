@@ -1,0 +1,107 @@
+"""Monte-Carlo statistics of a signable report, in the form of NASA entry, descent and landing
+Monte-Carlo practice (Hanson & Beard 2010, NASA/TP-2010-216447; docs/references.md):
+
+- ``success_lower_bound``: the one-sided Clopper-Pearson lower confidence bound on the success
+  probability (scipy.stats.binomtest; for n successes in n runs it is (1 - level)^(1/n):
+  0.9772 at 90 % for 100 of 100);
+- ``order_statistic_bound``: the distribution-free (Wilks) bound: the r-th largest of n
+  samples exceeds the ``coverage`` quantile with probability ``confidence`` when
+  P(Binomial(n, 1 - coverage) >= r) >= confidence (scipy.stats.binom); with the maximum
+  (r = 1) 99 % coverage at 90 % confidence needs 230 runs, 95 %/95 % needs 59;
+- ``describe``: min, P0.13, P1, P50, mean, sigma, P99, P99.87, max of one quantity. P0.13 and
+  P99.87 are the 3-sigma levels of a normal distribution (99.73 % two-sided); an empirical
+  percentile is reported only where the sample holds at least one point beyond it
+  (n >= 1 / min(p, 1 - p)), else it is None and the report says why.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import stats
+
+from drake_entry.errors import ScenarioError
+
+#: the percentiles of the report [%] (P0.13 and P99.87: the normal distribution's 3-sigma levels)
+PERCENTILES = (0.13, 1.0, 50.0, 99.0, 99.87)
+#: the default coverage and confidence of the order-statistic bound
+COVERAGE, CONFIDENCE = 0.99, 0.90
+#: the confidence levels of the success-probability bound
+SUCCESS_LEVELS = (0.90, 0.95)
+
+
+def success_lower_bound(successes: int, runs: int, level: float) -> float:
+    """One-sided lower ``level`` confidence bound on the success probability (Clopper-Pearson,
+    exact): the lower end of the equal-tailed two-sided interval at 2 level - 1."""
+    if not (isinstance(runs, (int, np.integer)) and runs >= 1):
+        raise ScenarioError(f"runs must be an integer >= 1, got {runs}")
+    if not (isinstance(successes, (int, np.integer)) and 0 <= successes <= runs):
+        raise ScenarioError(f"successes must be an integer in [0, runs = {runs}], got {successes}")
+    if not 0.5 < level < 1.0:
+        raise ScenarioError(f"level must be in (0.5, 1), got {level}")
+    if successes == 0:
+        return 0.0
+    return float(stats.binomtest(int(successes), int(runs)).proportion_ci(confidence_level=2.0 * level - 1.0,
+                                                                          method="exact").low)
+
+
+def runs_for_bound(coverage: float = COVERAGE, confidence: float = CONFIDENCE) -> int:
+    """Fewest runs whose maximum bounds the ``coverage`` quantile at ``confidence`` (Wilks,
+    first order): the least n with 1 - coverage^n >= confidence."""
+    _check_fraction("coverage", coverage)
+    _check_fraction("confidence", confidence)
+    n = math.ceil(math.log(1.0 - confidence) / math.log(coverage))
+    while stats.binom.sf(0, n, 1.0 - coverage) < confidence:  # guard the rounding of the logarithms
+        n += 1
+    return int(n)
+
+
+def order_statistic_rank(runs: int, coverage: float = COVERAGE, confidence: float = CONFIDENCE) -> int:
+    """The largest r such that the r-th largest of ``runs`` samples bounds the ``coverage``
+    quantile from above with probability >= ``confidence`` (0 when even the maximum does not)."""
+    _check_fraction("coverage", coverage)
+    _check_fraction("confidence", confidence)
+    p_exceed = 1.0 - coverage
+    r = 0
+    while r < runs and stats.binom.sf(r, runs, p_exceed) >= confidence:  # P(X >= r + 1)
+        r += 1
+    return r
+
+
+def order_statistic_bound(values, coverage: float = COVERAGE, confidence: float = CONFIDENCE,
+                          upper: bool = True) -> float | None:
+    """The distribution-free bound on the ``coverage`` quantile (``upper``) or the 1 - coverage
+    quantile (lower) at ``confidence``: the r-th largest (smallest) sample, r from
+    ``order_statistic_rank``; None when the sample is too small (``runs_for_bound``)."""
+    v = np.sort(np.asarray(values, float)[np.isfinite(values)])
+    r = order_statistic_rank(v.size, coverage, confidence)
+    if r == 0:
+        return None
+    return float(v[-r] if upper else v[r - 1])
+
+
+def describe(values) -> dict:
+    """min, P0.13, P1, P50, mean, sigma (n - 1), P99, P99.87, max and n of the finite values
+    (percentiles the sample cannot resolve are None, see the module docstring)."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    n = int(v.size)
+    if n == 0:
+        return {"n": 0}
+    out = {"n": n, "min": float(v.min()), "mean": float(v.mean()), "sigma": float(v.std(ddof=1)) if n > 1 else 0.0,
+           "max": float(v.max())}
+    for p in PERCENTILES:
+        tail = min(p, 100.0 - p) / 100.0
+        resolved = tail == 0.5 or n * tail >= 1.0
+        out[percentile_key(p)] = float(np.percentile(v, p, method="linear")) if resolved else None
+    return out
+
+
+def percentile_key(p: float) -> str:
+    """'p0.13', 'p1', 'p50', ... (the keys of ``describe``)."""
+    return f"p{p:g}"
+
+
+def _check_fraction(name: str, value: float) -> None:
+    if not 0.0 < value < 1.0:
+        raise ScenarioError(f"{name} must be in (0, 1), got {value}")

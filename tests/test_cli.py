@@ -1,0 +1,63 @@
+"""The command line shows what the package holds: scenarios, version, help on every argument."""
+import argparse
+import importlib.metadata
+from importlib import resources
+
+import pytest
+
+from drake_entry.cli import main
+
+
+def _packaged_files() -> set:
+    return {p.name[:-5] for p in resources.files("drake_entry").joinpath("scenarios").iterdir()
+            if p.name.endswith(".yaml")}
+
+
+def test_scenarios_lists_every_packaged_file_with_its_method_and_vehicle(capsys):
+    assert main(["scenarios"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    listed = {line.split()[0] for line in out[1:] if line and not line.startswith("`")}
+    assert listed == _packaged_files() and len(listed) >= 7
+    rows = {line.split()[0]: line for line in out[1:] if line.strip()}
+    assert "!DragEnergy" in rows["horus2b"] and "horus2b" in rows["horus2b"].split()[2]
+    assert "!Scvx" in rows["sphynx_paper001"] and "!Ampi" in rows["shefex3_ampi"]
+    assert "open loop" in rows["marv"]
+
+
+def test_scenarios_name_prints_the_file_with_its_comments(capsys):
+    assert main(["scenarios", "horus2b"]) == 0
+    text = capsys.readouterr().out
+    assert text == resources.files("drake_entry").joinpath("scenarios/horus2b.yaml").read_text()
+    assert "#" in text and "paper 000 Table 2" in text
+    assert main(["scenarios", "no_such"]) == 2
+    assert "is not packaged; packaged: cav_h" in capsys.readouterr().err
+
+
+def test_version_names_the_package_and_drake(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--version"])
+    assert e.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"drake-entry {importlib.metadata.version('drake_entry')} ")
+    assert f"Drake {importlib.metadata.version('drake')}" in out
+
+
+@pytest.mark.parametrize("command", ["scenarios", "campaign", "report", "fly", "plan", "simulate", "optimize",
+                                     "fit-horus"])
+def test_every_argument_has_help(command, capsys, monkeypatch):
+    """Each subcommand's every argument carries a help text (the parsers are built by main)."""
+    seen = {}
+    original = argparse.ArgumentParser.parse_args
+
+    def capture(self, args=None, namespace=None):
+        seen["parser"] = self
+        raise SystemExit(0)
+
+    monkeypatch.setattr(argparse.ArgumentParser, "parse_args", capture)
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    monkeypatch.setattr(argparse.ArgumentParser, "parse_args", original)
+    sub = next(a for a in seen["parser"]._actions if isinstance(a, argparse._SubParsersAction))
+    parser = sub.choices[command]
+    missing = [a.dest for a in parser._actions if not isinstance(a, argparse._HelpAction) and not a.help]
+    assert not missing, f"{command}: arguments without help: {missing}"

@@ -3,7 +3,8 @@
 Commands:
   scenarios [NAME]    the packaged scenarios (name, guidance method, vehicle, description), or one
                       scenario's YAML file with its comments
-  campaign SCENARIO   closed-loop Monte-Carlo campaign (Drake RandomSimulation) with a report
+  campaign SCENARIO   closed-loop Monte-Carlo campaign (Drake RandomSimulation) with a report;
+                      exit 1 when a sample is not successful
   report DIR          (re)write the report (report.md, report.html) of a campaign directory
   fly SCENARIO        one closed-loop guided flight with plots
   plan SCENARIO       the guidance method's reference plan with its figures (drag-energy:
@@ -11,6 +12,7 @@ Commands:
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
 and the commands the methods and shared packages contribute (their commands.py modules), e.g.
   optimize PROBLEM    optimal reference by the NLP path (paper 002), verified and flown by Drake
+  results             every packaged closed-loop scenario as a campaign with its report
   fit-horus           refit the HORUS-2B aero forms (paper 000 eqs. 32-33); print residuals
 
 Benchmarks are scripts, not commands: python benchmarks/run.py (see README).
@@ -160,7 +162,14 @@ def _cmd_campaign(args) -> int:
     out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
                        overrides=parse_overrides(args.overrides), backend=backend, scheduler=args.scheduler,
                        trajectory_step_s=args.trajectory_step)
-    return _cmd_report(argparse.Namespace(dir=out))
+    _cmd_report(argparse.Namespace(dir=out))
+    with open(os.path.join(out, "summary.json")) as f:
+        stats = json.load(f)
+    if stats["successful"] < stats["samples"]:  # a campaign that shows a failure exits non-zero
+        print(f"drake-entry: {stats['samples'] - stats['successful']} of {stats['samples']} samples are not "
+              f"successful (see {os.path.join(out, 'report.md')})", file=sys.stderr)
+        return 1
+    return 0
 
 
 def parse_overrides(items) -> dict:
@@ -209,7 +218,7 @@ class Command(NamedTuple):
 
 
 #: the shared packages that contribute commands (a method folder's commands.py is found by itself)
-SHARED_COMMAND_MODULES = ("drake_entry.planning.nlp.commands",)
+SHARED_COMMAND_MODULES = ("drake_entry.planning.nlp.commands", "drake_entry.campaign.commands")
 
 
 def contributed_commands() -> list:

@@ -61,3 +61,34 @@ def test_every_argument_has_help(command, capsys, monkeypatch):
     parser = sub.choices[command]
     missing = [a.dest for a in parser._actions if not isinstance(a, argparse._HelpAction) and not a.help]
     assert not missing, f"{command}: arguments without help: {missing}"
+
+
+def test_results_runs_the_chosen_scenarios_into_one_index(tmp_path, capsys):
+    """`drake-entry results --only horus2b --runs 2`: the campaign, its report and an index line
+    with the count and the 90 % bound (2 of 2: 31.62 %); exit 0 when every sample succeeded."""
+    out = tmp_path / "results"
+    assert main(["results", "--only", "horus2b", "--runs", "2", "--workers", "1", "--out", str(out)]) == 0
+    index = (out / "index.md").read_text()
+    assert "| `horus2b` | 2 of 2 | 31.62 % | [report](horus2b/report.md) |" in index
+    assert (out / "horus2b" / "report.html").exists()
+    assert main(["results", "--only", "marv", "--out", str(out)]) == 2  # open loop: not a closed-loop scenario
+    assert "not a packaged closed-loop scenario" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_results_of_every_closed_loop_scenario_in_reduced_size(tmp_path):
+    """CI's reduced run of the command that makes docs/results/campaigns: every packaged
+    closed-loop scenario, 2 samples each, a report each; the packaged paper 004 scenario flies
+    its pre-flight sigma_0 without on-board re-solution and misses the 50-km box under
+    dispersions, so the command exits 1 and says so."""
+    from drake_entry.campaign.commands import closed_loop_scenarios
+
+    out = tmp_path / "results"
+    code = main(["results", "--runs", "2", "--out", str(out)])
+    names = closed_loop_scenarios()
+    assert set(names) >= {"horus2b", "sphynx_paper001", "shefex3_ampi", "cav_h_paper004"}
+    for name in names:
+        assert (out / name / "report.md").exists() and (out / name / "report.html").exists(), name
+    index = (out / "index.md").read_text()
+    assert all(f"`{name}`" in index for name in names)
+    assert code == (0 if all(" 2 of 2 " in line for line in index.splitlines() if line.startswith("| `")) else 1)

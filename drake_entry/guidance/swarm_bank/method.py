@@ -200,7 +200,8 @@ class SwarmBankMethod(GuidanceMethod):
         mine = system.GetMyContextFromRoot(context)
         plans, failed, wall = system.GetOutputPort("plan_stats").Eval(mine)
         sigma0 = math.degrees(system.GetOutputPort("sigma0").Eval(mine)[0])
-        return GuidanceSummary(True, plans=int(plans), planning_wall_s=float(wall),
+        unverified = "" if planner.success else f"the pre-flight plan is not verified: {planner.message}"
+        return GuidanceSummary(planner.success, unverified, plans=int(plans), planning_wall_s=float(wall),
                                fields={"reversals": reversal_count(diagram, context),
                                        "sigma0_planned_deg": planner.sigma0_deg, "sigma0_final_deg": sigma0,
                                        "resolutions_unbracketed": int(failed)},

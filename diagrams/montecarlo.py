@@ -14,10 +14,18 @@ import os
 import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
 
-from drake_entry.campaign.store import done_indices, finalise  # noqa: F401 (API)
+from drake_entry.campaign.store import done_indices, finalise, read_nominal, write_nominal  # noqa: F401 (API)
 from drake_entry.diagrams.backends import Task
 from drake_entry.diagrams.campaign import check_backend, run_cases, session, versions
-from drake_entry.diagrams.sample import TIMING_COLUMNS, TRAJECTORY_STEP_S, campaign_row, run_sample, sample_seed  # noqa: F401 (API)
+from drake_entry.diagrams.sample import (  # noqa: F401 (API)
+    DETAILED_STEP_S,
+    TIMING_COLUMNS,
+    TRAJECTORY_STEP_S,
+    campaign_row,
+    downsample,
+    run_sample,
+    sample_seed,
+)
 from drake_entry.errors import ScenarioError
 from drake_entry.models.vehicles import PACKAGED_VEHICLES
 from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
@@ -79,5 +87,25 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
                 {"scenario_yaml": manifest["scenario_yaml"], "seed": int(seed),
                  "trajectory_step_s": float(trajectory_step_s)})
     cases = [{"index": i, "seed": sample_seed(seed, i)} for i in range(int(runs))]
-    return run_cases(task, cases, out_dir, manifest, backend=backend, workers=workers, scheduler=scheduler,
-                     progress=progress, desc="campaign")
+    run_cases(task, cases, out_dir, manifest, backend=backend, workers=workers, scheduler=scheduler,
+              progress=progress, desc="campaign")
+    if trajectory_step_s > 0 and read_nominal(out_dir) is None:
+        fly_nominal(out_dir, manifest["scenario_yaml"])
+    return out_dir
+
+
+def fly_nominal(out_dir: str, scenario_yaml: str) -> None:
+    """Fly the campaign's scenario once without dispersions and keep its trajectory every
+    DETAILED_STEP_S (``nominal.json``: the report overlays it on the campaign's envelopes).
+    A flight that raises is not kept: the report then shows the campaign alone."""
+    from drake_entry.diagrams.closed_loop import fly
+    from drake_entry.errors import DrakeEntryError, load_yaml_typed
+    from drake_entry.scenario import Scenario
+
+    try:
+        scenario = load_yaml_typed(Scenario, text=scenario_yaml, where="campaign scenario").validate()
+        tr = fly(scenario).trajectory
+    except (DrakeEntryError, RuntimeError) as e:
+        print(f"drake-entry: the nominal flight of the campaign failed ({e}); the report shows the campaign alone")
+        return
+    write_nominal(out_dir, downsample(tr, -1, DETAILED_STEP_S))

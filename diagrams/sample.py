@@ -86,7 +86,7 @@ def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
         row.update({"integration_steps": integrator.get_num_steps_taken(),
                     "derivative_evaluations": integrator.get_num_derivative_evaluations()})
         step = min(trajectory_step_s, DETAILED_STEP_S) if index < DETAILED_SAMPLES else trajectory_step_s
-        traj = _downsample(tr, index, step) if trajectory_step_s > 0 else None
+        traj = downsample(tr, index, step) if trajectory_step_s > 0 else None
     except Exception as e:  # one failed sample never stops the campaign
         row.update(box["draw"].columns() if "draw" in box else {})
         row.update({"success": False, "message": f"{type(e).__name__}: {e}".splitlines()[0][:500],
@@ -123,7 +123,8 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
     }
 
 
-def _downsample(tr, index: int, step_s: float) -> dict:
+def downsample(tr, index: int, step_s: float) -> dict:
+    """Trajectory columns of ``tr`` every ``step_s`` [s] and at its final instant, tagged ``sample`` = index."""
     t = tr.time
     keep = np.unique(np.append(np.searchsorted(t, np.arange(0.0, t[-1], step_s)), len(t) - 1))
     out = {"sample": np.full(keep.size, index), **{k: np.asarray(v)[keep] for k, v in tr.table().items()}}

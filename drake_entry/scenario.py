@@ -105,6 +105,8 @@ class ReferenceResultsSpec:
     # row column (err_altitude_m, err_longitude_deg, err_latitude_deg, err_velocity_m_s,
     # err_range_m, err_crossrange_m, err_distance_m) -> [mean, 1-sigma] in its unit
     errors: dict[str, list[float]] = dc.field(default_factory=dict)
+    # why the campaign's figures may differ from the published ones (printed under the comparison)
+    note: str = ""
 
 
 #: the terminal-error columns of a campaign row (reference results may give them; the report's order)

@@ -93,6 +93,9 @@ def test_report_is_self_contained_with_provenance_requirements_and_bounds(tmp_pa
     assert "| heat_flux | <= 530 kW/m^2 | worst flown sample of 2 |" in text and "PASS (2 of 2 held)" in text
     assert "| peak heat flux | kW/m^2 | 2 |" in text and "— (needs 230 runs)" in text
     assert "| bank reversals | - | 2 |" in text
+    assert "Why the figures differ from paper 000 Table 3: This guidance re-plans the drag profile every 20 s" in text
+    assert os.path.exists(f"{out}/nominal.json")  # the undispersed flight, overlaid on the envelopes
+    assert "the dashed line the nominal flight (the scenario without dispersions)" in text
     figures = [line for line in text.splitlines() if line.startswith("*Figure ")]
     assert len(figures) == 8 and all(len(f) > 120 for f in figures)  # each with its caption
     html_text = open(f"{out}/report.html").read()

@@ -33,7 +33,7 @@ from drake_entry.campaign.statistics import (
     runs_for_bound,
     success_lower_bound,
 )
-from drake_entry.campaign.store import coverage, read_trajectories
+from drake_entry.campaign.store import coverage, read_nominal, read_trajectories
 from drake_entry.errors import CampaignError, DrakeEntryError, load_yaml_typed
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario
@@ -226,7 +226,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
         json.dump(stats, f, indent=2)
     name = title or _name(meta)
-    figs = _figures(rows, reached, traj, out_dir, scenario, limits, name)
+    figs = _figures(rows, reached, traj, out_dir, scenario, limits, name, meta)
     sections = [_header(meta, stats, title, rows), _provenance(meta, stats), _dispersions(scenario),
                 _requirements(rows, reached, stats, scenario), _outcome(rows, stats, traj),
                 _distributions(rows, reached, stats, reference), _contributors(stats), _cost(stats),
@@ -520,8 +520,8 @@ def _outcome(rows: dict, stats: dict, traj) -> str:
             out.append(f"| {rows['index'][i]} | {rows.get('seed', ['?'] * len(rows['index']))[i]} | {reason} |")
         if len(failed) > MAX_FAILED_LISTED:
             out.append(f"| … | | {len(failed) - MAX_FAILED_LISTED} more in samples.parquet |")
-        out += ["", "Re-run one sample alone with `drake-entry fly` on the same scenario and its seed "
-                "(diagrams.sample.run_sample reproduces a row from the master seed and the index)."]
+        out += ["", "Each sample re-runs alone and reproduces its row: `drake_entry.diagrams.sample.run_sample("
+                "ClosedLoopSetup.from_scenario(scenario), master_seed, index)`."]
     if stats.get("inside_km"):
         out += ["", "Samples within a distance of the target: " + ", ".join(
             f"{k} km: {v}" for k, v in stats["inside_km"].items())]
@@ -571,6 +571,9 @@ def _distributions(rows: dict, reached, stats: dict, reference) -> str:
         out += ["", errors_markdown(stats, reference), "",
                 "ΔR is the range to go along the final heading (+ short of the target); the cross-range is reported "
                 "separately."]
+        note = getattr(reference, "note", "") if reference is not None and reference.source else ""
+        if note:
+            out += ["", f"Why the figures differ from {reference.source}: {note}"]
     out += ["", "### Peak path quantities, heat load and flight time (every sample that flew)", "",
             table([c for c, *_ in PEAK_QUANTITIES + OTHER_QUANTITIES])]
     if any(c in rows for c, *_ in CONTROL_QUANTITIES):
@@ -623,7 +626,7 @@ def _cost(stats_: dict) -> str:
             "derivative evaluations.")
 
 
-def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: str) -> list:
+def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: str, meta: dict | None = None) -> list:
     """[(path, caption)] of every figure the campaign supports."""
     n = len(rows["index"])
     figs = []
@@ -638,22 +641,24 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
              for col, label, unit, scale, lim in PEAK_QUANTITIES if col in rows}
     figs.append(figures.peak_histograms(peaks, out_dir, title))
     if traj is not None:
-        figs.append(figures.envelopes(traj, out_dir, title))
+        figs.append(figures.envelopes(traj, out_dir, title, nominal=read_nominal(out_dir)))
         figs.append(figures.path_quantities(traj, out_dir, title, limits))
         figs.append(figures.drag_profiles(traj, out_dir, title))
         target = ((scenario.target.longitude_deg, scenario.target.latitude_deg) if scenario is not None else None)
         figs.append(figures.ground_tracks(traj, out_dir, title, target=target))
-        figs.append(figures.bank_histories(traj, out_dir, title, detailed=_detailed_samples(traj)))
+        step = float((meta or {}).get("trajectory_step_s") or 10.0)
+        figs.append(figures.bank_histories(traj, out_dir, title, detailed=_detailed_samples(traj, step)))
     return [f for f in figs if f is not None]
 
 
-def _detailed_samples(traj: dict) -> list:
-    """Samples stored at a step of 1 s or finer (the first few of a campaign: diagrams.sample)."""
+def _detailed_samples(traj: dict, step_s: float) -> list:
+    """Samples stored finer than half the campaign's storage step ``step_s`` [s] (the first few
+    of a campaign, at the detailed step or the scenario's log period: diagrams.sample)."""
     sample, t = np.asarray(traj["sample"]), np.asarray(traj["time_s"], float)
     out = []
     for s in np.unique(sample):
         ts = t[sample == s]
-        if ts.size > 3 and np.median(np.diff(ts)) <= 1.0 + 1e-9:
+        if ts.size > 3 and np.median(np.diff(ts)) < 0.5 * step_s:
             out.append(int(s))
     return out[:5]
 

@@ -151,10 +151,16 @@ def _on_energy_grid(e, v, groups, grid):
     return out
 
 
-def envelopes(traj: dict, out_dir: str, title: str) -> tuple[str, str]:
-    """Altitude, speed, flight-path angle and bank against normalised energy as P1/P50/P99 envelopes."""
+def envelopes(traj: dict, out_dir: str, title: str, *, nominal: dict | None = None) -> tuple[str, str]:
+    """Altitude, speed, flight-path angle and bank against normalised energy as P1/P50/P99
+    envelopes, with the nominal (undispersed) flight overlaid when given."""
     sample = np.asarray(traj["sample"])
     e = normalised_energy(traj)
+    E0, Ef = energy_range(traj)
+    e_nominal = None
+    if nominal is not None:
+        En = np.asarray(nominal["energy_J_kg"], float)
+        e_nominal = (E0 - En) / (E0 - Ef) if E0 > Ef else np.zeros_like(En)
     groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
     grid = np.linspace(0.0, 1.0, 201)
     fig, axes = plt.subplots(2, 2, figsize=(12, 7.5), sharex=True)
@@ -171,6 +177,8 @@ def envelopes(traj: dict, out_dir: str, title: str) -> tuple[str, str]:
             m[~keep] = np.nan
         ax.fill_between(grid, lo, hi, color="C0", alpha=0.25, label="P1 - P99 across samples")
         ax.plot(grid, mid, "C0-", lw=1.5, label="P50 (median)")
+        if e_nominal is not None:
+            ax.plot(e_nominal, np.asarray(nominal[col], float) * scale, "k--", lw=1.0, label="nominal (no dispersion)")
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.4)
     for ax in axes[1]:
@@ -178,7 +186,9 @@ def envelopes(traj: dict, out_dir: str, title: str) -> tuple[str, str]:
     axes[0, 0].legend(fontsize=8)
     path = _save(fig, out_dir, "state_envelopes.png", title)
     return path, (f"State envelopes of the {len(groups)} stored trajectories against normalised energy: the band holds "
-                  f"the 1st to 99th percentile across samples at each energy, the line their median. {ENERGY_DEFINITION}. "
+                  f"the 1st to 99th percentile across samples at each energy, the solid line their median"
+                  + (", the dashed line the nominal flight (the scenario without dispersions)" if nominal is not None
+                     else "") + f". {ENERGY_DEFINITION}. "
                   "The bank panel shows magnitudes and signs mixed: see the bank histories for single flights.")
 
 
@@ -285,13 +295,19 @@ def bank_histories(traj: dict, out_dir: str, title: str, *, detailed: list) -> t
     ax.legend(fontsize=8, ncol=min(len(detailed), 5))
     ax.grid(True, alpha=0.4)
     path = _save(fig, out_dir, "bank_histories.png", title)
-    return path, (f"Bank angle flown by samples {', '.join(str(s) for s in detailed)} (stored at the detailed "
-                  "step, not the campaign's storage step), the bank actuator's position: reversals cross wings-level "
-                  "at the bank-rate limit.")
+    return path, (f"Bank angle flown by samples {', '.join(str(s) for s in detailed)} (stored every 1 s or at the "
+                  "scenario's log period when longer, not at the campaign's storage step), the bank actuator's "
+                  "position: reversals cross wings-level at the bank-rate limit.")
+
+
+def energy_range(traj: dict) -> tuple[float, float]:
+    """(E0, Ef) of ENERGY_DEFINITION: the highest and lowest energy stored [J/kg]."""
+    E = np.asarray(traj["energy_J_kg"], float)
+    return float(np.nanmax(E)), float(np.nanmin(E))
 
 
 def normalised_energy(traj: dict) -> np.ndarray:
     """e of ENERGY_DEFINITION for every stored point."""
     E = np.asarray(traj["energy_J_kg"], float)
-    E0, Ef = np.nanmax(E), np.nanmin(E)
+    E0, Ef = energy_range(traj)
     return (E0 - E) / (E0 - Ef) if E0 > Ef else np.zeros_like(E)

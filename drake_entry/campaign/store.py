@@ -10,6 +10,7 @@ trajectories streamed as samples finish.
   samples.jsonl          one row per finished sample, appended and flushed at once
   trajectories.jsonl     its down-sampled trajectory, appended just before its row
   quarantine.jsonl       lines that were not rows or trajectories, moved aside on resume
+  nominal.json           the undispersed flight of the scenario (not a sample), for the report
   samples.parquet, trajectories.parquet   written by ``finalise`` (sorted by sample index)
 
 A sample counts as done when its row line is complete. An interrupted campaign resumes
@@ -31,6 +32,8 @@ from drake_entry.errors import CampaignError
 FORMAT = 2
 ROWS, TRAJECTORIES, QUARANTINE, MANIFEST, LOCK = ("samples.jsonl", "trajectories.jsonl", "quarantine.jsonl",
                                                   "campaign.json", "campaign.lock")
+#: the undispersed flight of the campaign's scenario (trajectory columns), not a sample
+NOMINAL = "nominal.json"
 # what the fingerprint covers, and how a mismatch is named
 IDENTITY = {"scenario_yaml": "scenario content", "vehicle_file_sha256": "vehicle file content",
             "seed": "seed", "trajectory_step_s": "trajectory step", "versions": "drake_entry/drake version",
@@ -231,6 +234,20 @@ def read_rows(out_dir: str) -> tuple[dict, dict]:
         else:
             out[r["index"]] = r
     return out, {"cut": int(cut), "invalid": len(bad), "duplicates": dup}
+
+
+def write_nominal(out_dir: str, columns: dict) -> None:
+    """Keep the campaign's nominal flight (trajectory columns; atomically)."""
+    _write_atomic(os.path.join(out_dir, NOMINAL), json.dumps(columns).encode())
+
+
+def read_nominal(out_dir: str) -> dict | None:
+    """The campaign's nominal flight, or None when it was not flown (or not readable)."""
+    try:
+        with open(os.path.join(out_dir, NOMINAL)) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
 
 
 def read_trajectories(out_dir: str, done: set) -> dict:

@@ -1,6 +1,6 @@
 """Benchmarks, each printing its figures and ratios measured side by side in one run.
 
-    python benchmarks/run.py [open-loop|socp|nlp|dymos|campaign|interface-cost|paper001|aborts|paper003|paper004|examples|all] [options]
+    python benchmarks/run.py [open-loop|socp|nlp|dymos|campaign|interface-cost|method-cost|paper001|aborts|paper003|paper004|examples|all] [options]
 
 open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
 socp            both SOCP planners with Clarabel vs SCS: drag-energy SOCP by node count, SCvx
@@ -10,6 +10,9 @@ dymos           NLP path vs dymos (pip extra "bench"; not in "all") on the Brach
                 Betts' shuttle, same problem and nodes (default 31)
 campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios)
 interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline commit
+method-cost     every packaged guidance scenario: core seconds per sample split into plant,
+                planning, guidance, actuators and the rest, vs a baseline commit (--baseline,
+                default the previous commit; --only scenario names)
 paper001        paper 001: SCvx nominal plan time and iterations by mesh vs the paper, flown by Drake
 aborts          paper 001: the 9 x 9 orbital-abort map through the campaign engine vs the 15-min goal
 paper003        paper 003: AMPI database storage, LD-HD reconstruction, synthesis vs OCP CPU time,
@@ -28,8 +31,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("which", nargs="?", default="all",
-                        choices=("all", "open-loop", "socp", "nlp", "dymos", "campaign", "interface-cost", "paper001",
-                                 "aborts", "paper003", "paper004", "examples"))
+                        choices=("all", "open-loop", "socp", "nlp", "dymos", "campaign", "interface-cost", "method-cost",
+                                 "paper001", "aborts", "paper003", "paper004", "examples"))
     parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
     parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
     parser.add_argument("--nodes", type=int, default=40, help="nlp: nodes / samples")
@@ -45,6 +48,7 @@ if __name__ == "__main__":
     parser.add_argument("--mode", default="both", choices=("quick", "full", "both"), help="examples: which runs")
     parser.add_argument("--only", nargs="*", default=None, help="examples: numbers or names to run")
     parser.add_argument("--write", action="store_true", help="examples: write the measured times into the docs")
+    parser.add_argument("--scenarios", nargs="*", default=None, help="method-cost: packaged scenarios to cost")
     args = parser.parse_args()
     if args.which == "examples":  # minutes of wall time: on request only
         from example_times import examples_benchmark
@@ -76,6 +80,10 @@ if __name__ == "__main__":
         from interface_cost import interface_cost_benchmark
 
         interface_cost_benchmark(baseline=args.baseline, rounds=args.rounds)
+    if args.which in ("all", "method-cost"):
+        from method_cost import method_cost_benchmark
+
+        method_cost_benchmark(baseline=args.baseline or "HEAD~1", rounds=args.rounds, only=args.scenarios)
     if args.which in ("all", "paper001"):
         from paper001 import paper001_benchmark
 

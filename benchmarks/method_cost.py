@@ -1,0 +1,133 @@
+"""Benchmark: every packaged guidance scenario costed, this checkout against a baseline commit
+(default: the previous one), measured side by side in one run.
+
+For each packaged closed-loop scenario and each side, in a fresh process: the pre-flight
+set-up (models and the method's planner, once per campaign worker), then ``samples`` campaign
+samples (seed 7), core time per sample (process time, the best of ``rounds`` rounds), split:
+
+  plant      the plant's derivative evaluations of the sample (the integrator's count, in the
+             row) times the cost of one evaluation measured alone (vehicle and atmosphere
+             systems, the sample's nominal models, at the entry state)
+  planning   the method's own clock of on-board planning (the row's planning_wall_s)
+  rest       everything else: guidance and controller updates, flight conditions, actuators,
+             navigation, monitors, loggers and the simulator itself
+
+The rows of both sides are compared: speed is never bought with accuracy (the verdicts and the
+largest difference of the terminal distance are printed). Targets (this 2-core machine):
+drag-energy and AMPI >= 3 runs/s/core, SCvx and PIO with on-board re-solution <= 6 s per sample.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+from interface_cost import _checkout, _installed_layout
+
+#: the targets of the speed work [s of one core per sample] by scenario
+TARGET_S = {"horus2b": 1 / 3, "shefex3_ampi": 1 / 3, "sphynx_paper001": 6.0, "cav_h_paper004": 6.0}
+CATEGORIES = ("plant", "planning", "rest")
+
+_SCRIPT = r"""
+import json, sys, time
+import numpy as np
+from drake_entry.scenario import load_scenario
+from drake_entry.diagrams.closed_loop import ClosedLoopSetup
+from drake_entry.diagrams.sample import run_sample
+from drake_entry.systems.atmosphere import AtmosphereSystem
+from drake_entry.systems.vehicle import EntryVehicle
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource
+
+name, n, seed, rounds = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+t0 = time.process_time()
+setup = ClosedLoopSetup.from_scenario(load_scenario(name))
+setup_s = time.process_time() - t0
+run_sample(setup, seed, 10_000, trajectory_step_s=10.0)  # warm caches and imports
+walls = []
+for _ in range(rounds):
+    t0 = time.process_time()
+    rows = [run_sample(setup, seed, i, trajectory_step_s=10.0)[0] for i in range(n)]
+    walls.append((time.process_time() - t0) / n)
+# one plant derivative evaluation alone: the vehicle fed by the atmosphere system, as in the loop
+builder = DiagramBuilder()
+plant = builder.AddSystem(EntryVehicle(setup.vehicle, setup.planet, setup.atmosphere, air_data_input=True))
+air = builder.AddSystem(AtmosphereSystem(setup.atmosphere, setup.planet))
+builder.Connect(plant.GetOutputPort("state"), air.get_input_port())
+builder.Connect(air.get_output_port(), plant.GetInputPort("air_data"))
+for port, value in (("bank", 0.5), ("alpha", 0.3)):
+    src = builder.AddSystem(ConstantVectorSource([value]))
+    builder.Connect(src.get_output_port(), plant.GetInputPort(port))
+diagram = builder.Build()
+context = diagram.CreateDefaultContext()
+sub = plant.GetMyMutableContextFromRoot(context)
+x0 = np.array(setup.scenario.initial_state(), float)
+x0[0] = min(x0[0], 60e3)  # inside the sensible atmosphere, as most of the flight is
+sub.SetContinuousState(x0)
+calls = 2000
+states = [x0 * (1.0 + 1e-6 * k) for k in range(calls)]  # a new state each call: nothing cached is reused
+t0 = time.process_time()
+for x in states:
+    sub.SetContinuousState(x)
+    diagram.EvalTimeDerivatives(context)
+per_eval = (time.process_time() - t0) / calls
+evaluations = float(np.mean([r.get("derivative_evaluations", 0) for r in rows]))
+planning = float(np.mean([r.get("planning_wall_s", 0.0) or 0.0 for r in rows]))
+print(json.dumps({"setup_s": setup_s, "sample_s": min(walls), "per_eval_s": per_eval, "evaluations": evaluations,
+                  "planning_s": planning, "rows": rows}, default=float))
+"""
+
+
+def _run(site: str, scenario: str, samples: int, seed: int, rounds: int) -> dict:
+    env = dict(os.environ, PYTHONPATH=site)
+    out = subprocess.run([sys.executable, "-c", _SCRIPT, scenario, str(samples), str(seed), str(rounds)], cwd=site,
+                         env=env, capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _closed_loop_scenarios(root: str) -> list[str]:
+    folder = os.path.join(root, "drake_entry", "scenarios")
+    names = sorted(f[:-5] for f in os.listdir(folder) if f.endswith(".yaml"))
+    return [n for n in names if any(line.startswith("guidance:") for line in open(os.path.join(folder, f"{n}.yaml")))]
+
+
+def method_cost_benchmark(*, baseline: str = "HEAD~1", samples: dict | None = None, rounds: int = 2,
+                          seed: int = 7, only: list | None = None) -> dict:
+    """Print and return {scenario: {side: {setup_s, sample_s, shares}}, ...}; ``samples`` per
+    scenario (default: 10 for the fast methods, 2 for SCvx and PIO)."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    names = only or _closed_loop_scenarios(root)
+    counts = {"horus2b": 10, "shefex3_ampi": 10, "sphynx_paper001": 2, "cav_h_paper004": 4, **(samples or {})}
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        sides = {f"baseline {baseline}": _installed_layout(_checkout(baseline, tmp), tmp),
+                 "this checkout": _installed_layout(root, tmp)}
+        print(f"core seconds per campaign sample, {baseline} against this checkout (seed {seed}, best of {rounds} "
+              "rounds, process time); plant = derivative evaluations x one evaluation's cost measured alone; "
+              "planning = the method's own clock; rest = the remainder")
+        head = f"{'scenario':16s} {'side':22s} {'setup s':>8s} {'s/sample':>9s} {'runs/s':>7s} " + " ".join(
+            f"{c:>9s}" for c in CATEGORIES) + f" {'target':>7s}"
+        print(head)
+        for name in names:
+            n = counts.get(name, 2)
+            res = {label: _run(site, name, n, seed, rounds) for label, site in sides.items()}
+            for label, r in res.items():
+                plant = r["evaluations"] * r["per_eval_s"]
+                parts = {"plant": plant, "planning": r["planning_s"],
+                         "rest": max(r["sample_s"] - plant - r["planning_s"], 0.0)}
+                r["split_s"] = parts
+                split = " ".join(f"{parts[c]:9.3f}" for c in CATEGORIES)
+                target = TARGET_S.get(name)
+                print(f"{name:16s} {label:22s} {r['setup_s']:8.2f} {r['sample_s']:9.3f} {1 / r['sample_s']:7.2f} "
+                      f"{split} {target if target is None else f'{target:7.2f}'}")
+            (_, a), (_, b) = res.items()
+            ratio = b["sample_s"] / a["sample_s"]
+            diffs = [abs(x.get("err_distance_m", 0.0) - y.get("err_distance_m", 0.0))
+                     for x, y in zip(a["rows"], b["rows"])]
+            same = [x.get("success") == y.get("success") for x, y in zip(a["rows"], b["rows"])]
+            print(f"{'':16s} ratio this/baseline {ratio:.3f}; verdicts equal: {all(same)}; largest terminal-distance "
+                  f"difference {max(diffs, default=0.0):.3g} m over {n} samples")
+            out[name] = {**res, "ratio": ratio, "max_distance_difference_m": max(diffs, default=0.0)}
+    return out

@@ -64,10 +64,6 @@ class ScvxPlan(PlanResult):
       miss_m: planned DRS point to the site [m]; drs: planned DRS altitude (geodetic) [m], Mach,
         vertical speed [m/s].
       metrics: the paper's Table 2, 3 and 6 quantities (``plan_metrics``).
-      propagated_error_m: the plan's real bank and alpha flown by the verifier (the Drake
-        Simulator) from its entry state through the closed loop's actuators (``plan_controls``)
-        end this far from its terminal point [m] (great circle and altitude); ``success`` needs
-        it <= PROPAGATION_TOLERANCE_M.
       flight: the FlightCheck it was flown with; flown: the PlanFlight (``flown_check``: the
         flown DRS point and box, the path-limit checks); verifier: what flew it (re-plans
         use the same).
@@ -90,13 +86,20 @@ class ScvxPlan(PlanResult):
     miss_m: float
     drs: dict
     metrics: dict
-    propagated_error_m: float
     guess: GlideGuess | None = None
     flight: FlightCheck | None = None
     flown: PlanFlight | None = dc.field(default=None, repr=False)
     verifier: Verifier | None = dc.field(default=None, repr=False)
     history: list = dc.field(default_factory=list, repr=False)
     problem: EntryProblem | None = dc.field(default=None, repr=False)
+
+    @property
+    def propagated_error_m(self) -> float:
+        """The plan's real bank and alpha flown by the verifier (the Drake Simulator) from its
+        entry state through the closed loop's actuators (``plan_controls``) end this far from its
+        terminal point [m] (great circle and altitude; inf when the flight stopped early, nan
+        before it flew); ``success`` needs it <= PROPAGATION_TOLERANCE_M."""
+        return self.flown.from_plan_m if self.flown is not None else math.nan
 
     @property
     def peaks(self) -> dict:
@@ -402,14 +405,13 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
         max_violation=max_violation(ev), between_nodes=between, miss_m=problem.site_miss(xf),
         drs={"altitude_m": float(final[problem.out_h]), "mach": float(xf[3] / final[problem.out_a]),
              "vertical_speed_m_s": float(xf[3] * math.sin(xf[4]))},
-        metrics=metrics, propagated_error_m=math.nan, guess=guess, history=outcome.history, problem=problem)
+        metrics=metrics, guess=guess, history=outcome.history, problem=problem)
     plan.flight, plan.verifier = flight, fly
     plan.flown = flown = flown_check(plan, fly(plan_controls(plan, flight)))
-    plan.propagated_error_m = flown.from_plan_m
     if flown.failure:
-        flown_ok, why = False, f"its controls flown stop before t_f: {flown.failure}"
+        why = f"its controls flown stop before t_f: {flown.failure}"
     else:
-        d = dict(flown.drs, site_miss_m=flown.from_site_m)
+        d = flown.drs
         problems = []
         if plan.propagated_error_m > PROPAGATION_TOLERANCE_M:
             problems.append(f"end {plan.propagated_error_m / 1e3:.1f} km from its terminal point "
@@ -420,13 +422,13 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
             problems.append(f"end outside the DRS box (geodetic altitude {d['altitude_m'] / 1e3:.2f} km of "
                             f"{mission.final_altitude_m[0] / 1e3:g}-{mission.final_altitude_m[1] / 1e3:g} km, "
                             f"Mach {d['mach']:.2f}, vertical speed {d['vertical_speed_m_s']:.1f} m/s, "
-                            f"{d['site_miss_m'] / 1e3:.1f} km from the site)")
+                            f"{flown.from_site_m / 1e3:.1f} km from the site)")
         if not flown.within_limits:
             problems.append("breach " + flown.violations_text())
-        flown_ok, why = not problems, "its controls flown " + " and ".join(problems)
-    if outcome.converged and not flown_ok:
+        why = "its controls flown " + " and ".join(problems)
+    if outcome.converged and not flown.ok:
         plan.message += f"; converged but {why}"
-    plan.success = outcome.converged and checked and flown_ok
+    plan.success = outcome.converged and checked and flown.ok
     plan.solve_time = time.perf_counter() - t0 - build
     return plan
 

@@ -155,7 +155,7 @@ def plan(scenario, verifier, problem: SwarmProblem | None = None) -> SwarmPlan:
         parts.append("the trajectory does not reach the TAEM energy")
     parts.append(f"flown by Drake through the actuators: {from_replica:.0f} m from the replica's TAEM point"
                  + (f", stopped early: {flown.failure}" if flown.failure else ""))
-    departs = flown.failure or not from_replica <= FLOWN_TOLERANCE_M
+    departs = bool(flown.failure) or not from_replica <= FLOWN_TOLERANCE_M
     if departs and not flown.failure:
         parts.append(f"the Drake flight departs from the replica (> {FLOWN_TOLERANCE_M:.0f} m)")
     if missed:

@@ -26,6 +26,8 @@ import tempfile
 
 from interface_cost import _checkout, _installed_layout
 
+from drake_entry.cli import closed_loop_scenarios
+
 #: the targets of the speed work [s of one core per sample] by scenario
 TARGET_S = {"horus2b": 1 / 3, "shefex3_ampi": 1 / 3, "sphynx_paper001": 6.0, "cav_h_paper004": 6.0}
 CATEGORIES = ("plant", "planning", "rest")
@@ -87,18 +89,12 @@ def _run(site: str, scenario: str, samples: int, seed: int, rounds: int) -> dict
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _closed_loop_scenarios(root: str) -> list[str]:
-    folder = os.path.join(root, "drake_entry", "scenarios")
-    names = sorted(f[:-5] for f in os.listdir(folder) if f.endswith(".yaml"))
-    return [n for n in names if any(line.startswith("guidance:") for line in open(os.path.join(folder, f"{n}.yaml")))]
-
-
 def method_cost_benchmark(*, baseline: str = "HEAD~1", samples: dict | None = None, rounds: int = 2,
                           seed: int = 7, only: list | None = None) -> dict:
     """Print and return {scenario: {side: {setup_s, sample_s, shares}}, ...}; ``samples`` per
     scenario (default: 10 for the fast methods, 2 for SCvx and PIO)."""
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    names = only or _closed_loop_scenarios(root)
+    names = only or closed_loop_scenarios()
     counts = {"horus2b": 10, "shefex3_ampi": 10, "sphynx_paper001": 2, "cav_h_paper004": 4, **(samples or {})}
     out = {}
     with tempfile.TemporaryDirectory() as tmp:

@@ -116,6 +116,16 @@ def packaged_scenarios() -> list[str]:
                   if p.name.endswith(".yaml"))
 
 
+def closed_loop_scenarios() -> list[str]:
+    """The packaged scenarios that declare a guidance method (a ``guidance:`` block): those a
+    campaign can fly."""
+    from importlib import resources
+
+    folder = resources.files("drake_entry").joinpath("scenarios")
+    return [n for n in packaged_scenarios() if any(line.startswith("guidance:")
+                                                   for line in folder.joinpath(f"{n}.yaml").read_text().splitlines())]
+
+
 def _cmd_scenarios(args) -> int:
     from importlib import resources
 
@@ -128,11 +138,10 @@ def _cmd_scenarios(args) -> int:
         print(resources.files("drake_entry").joinpath(f"scenarios/{args.name}.yaml").read_text(), end="")
         return 0
     rows = []
+    closed = closed_loop_scenarios()
     for name in names:
-        text = resources.files("drake_entry").joinpath(f"scenarios/{name}.yaml").read_text()
         scenario = load_scenario(name)
-        closed = any(line.startswith("guidance:") for line in text.splitlines())
-        method = f"!{type(scenario.guidance).__name__}" if closed else "open loop (simulate)"
+        method = f"!{type(scenario.guidance).__name__}" if name in closed else "open loop (simulate)"
         rows.append((name, method, scenario.vehicle, scenario.description))
     widths = [max(len(r[i]) for r in rows + [("name", "guidance", "vehicle", "")]) for i in range(3)]
     print(f"{'name':{widths[0]}}  {'guidance':{widths[1]}}  {'vehicle':{widths[2]}}  description")
@@ -162,9 +171,7 @@ def _cmd_campaign(args) -> int:
     out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
                        overrides=parse_overrides(args.overrides), backend=backend, scheduler=args.scheduler,
                        trajectory_step_s=args.trajectory_step)
-    _cmd_report(argparse.Namespace(dir=out))
-    with open(os.path.join(out, "summary.json")) as f:
-        stats = json.load(f)
+    stats = _write_and_print_report(out)
     if stats["successful"] < stats["samples"]:  # a campaign that shows a failure exits non-zero
         print(f"drake-entry: {stats['samples'] - stats['successful']} of {stats['samples']} samples are not "
               f"successful (see {os.path.join(out, 'report.md')})", file=sys.stderr)
@@ -186,25 +193,26 @@ def parse_overrides(items) -> dict:
 
 
 def _cmd_report(args) -> int:
-    from drake_entry.campaign.report import counts_sentence, errors_markdown, write_report
-    from drake_entry.campaign.store import read_manifest
-    from drake_entry.errors import load_yaml_typed
-    from drake_entry.scenario import Scenario
+    _write_and_print_report(args.dir)
+    return 0
 
-    manifest = read_manifest(args.dir) if os.path.isdir(args.dir) else None
-    limits = reference = None
-    if manifest and manifest.get("scenario_yaml"):  # the scenario as flown, wherever the report runs
-        scenario = load_yaml_typed(Scenario, text=manifest["scenario_yaml"], where="campaign scenario")
-        limits, reference = scenario.make_vehicle().limits, scenario.reference_results
-    path = write_report(args.dir, limits=limits, reference=reference)
-    with open(os.path.join(args.dir, "summary.json")) as f:
+
+def _write_and_print_report(out_dir: str) -> dict:
+    """Write the report of ``out_dir`` (its scenario as flown, from the manifest), print its
+    terminal errors, margins and counts, and return its statistics (summary.json)."""
+    from drake_entry.campaign.report import counts_sentence, errors_markdown, flown_scenario, write_report
+    from drake_entry.campaign.store import read_manifest
+
+    path = write_report(out_dir)
+    with open(os.path.join(out_dir, "summary.json")) as f:
         stats = json.load(f)
-    print(errors_markdown(stats, reference))
+    scenario = flown_scenario(read_manifest(out_dir))
+    print(errors_markdown(stats, getattr(scenario, "reference_results", None)))
     for k, m in stats["margins"].items():
         print(f"worst {k}: {100 * m['worst']:.2f} % ({m['violations']} violations)")
     c = stats["coverage"]
     print(f"{c['done']}/{c['requested']} samples done: {counts_sentence(stats)}; report: {path}")
-    return 0
+    return stats
 
 
 class Command(NamedTuple):

@@ -47,7 +47,6 @@ def test_version_names_the_package_and_drake(capsys):
 def test_every_argument_has_help(command, capsys, monkeypatch):
     """Each subcommand's every argument carries a help text (the parsers are built by main)."""
     seen = {}
-    original = argparse.ArgumentParser.parse_args
 
     def capture(self, args=None, namespace=None):
         seen["parser"] = self
@@ -56,7 +55,6 @@ def test_every_argument_has_help(command, capsys, monkeypatch):
     monkeypatch.setattr(argparse.ArgumentParser, "parse_args", capture)
     with pytest.raises(SystemExit):
         main([command, "--help"])
-    monkeypatch.setattr(argparse.ArgumentParser, "parse_args", original)
     sub = next(a for a in seen["parser"]._actions if isinstance(a, argparse._SubParsersAction))
     parser = sub.choices[command]
     missing = [a.dest for a in parser._actions if not isinstance(a, argparse._HelpAction) and not a.help]
@@ -81,7 +79,7 @@ def test_results_of_every_closed_loop_scenario_in_reduced_size(tmp_path):
     closed-loop scenario, 2 samples each, a report each; the packaged paper 004 scenario flies
     its pre-flight sigma_0 without on-board re-solution and misses the 50-km box under
     dispersions, so the command exits 1 and says so."""
-    from drake_entry.campaign.commands import closed_loop_scenarios
+    from drake_entry.cli import closed_loop_scenarios
 
     out = tmp_path / "results"
     code = main(["results", "--runs", "2", "--out", str(out)])

@@ -3,20 +3,11 @@ with its report, into one directory (the documentation's docs/results/ is made b
 layer (it runs diagrams)."""
 from __future__ import annotations
 
+import json
 import os
 import sys
 
-from drake_entry.cli import Command
-
-
-def closed_loop_scenarios() -> list[str]:
-    """The packaged scenarios that declare a guidance method (a ``guidance:`` block)."""
-    from importlib import resources
-
-    folder = resources.files("drake_entry").joinpath("scenarios")
-    names = sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".yaml"))
-    return [n for n in names if any(line.startswith("guidance:")
-                                    for line in folder.joinpath(f"{n}.yaml").read_text().splitlines())]
+from drake_entry.cli import Command, closed_loop_scenarios
 
 
 def add_arguments(parser) -> None:
@@ -54,8 +45,6 @@ def run(args) -> int:
         out = run_campaign(name, runs=args.runs, out_dir=os.path.join(args.out, name), seed=args.seed,
                            workers=args.workers, trajectory_step_s=args.trajectory_step)
         path = write_report(out)
-        import json
-
         with open(os.path.join(out, "summary.json")) as f:
             stats = json.load(f)
         ok, n = stats["successful"], stats["samples"]

@@ -221,7 +221,8 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     stats["success_lower_bound"] = {f"{level:g}": success_lower_bound(stats["successful"], stats["samples"], level)
                                     for level in SUCCESS_LEVELS}
     reached = reached_terminal(rows)
-    stats["distributions"] = {key: describe(values) for key, (_, _, values) in _quantities(rows, reached).items()}
+    quantities = _quantities(rows, reached)
+    stats["distributions"] = {key: describe(values) for key, (_, _, values) in quantities.items()}
     stats["contributors"] = miss_contributors(rows, reached)
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
         json.dump(stats, f, indent=2)
@@ -229,7 +230,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     figs = _figures(rows, reached, traj, out_dir, scenario, limits, name, meta)
     sections = [_header(meta, stats, title, rows), _provenance(meta, stats), _dispersions(scenario),
                 _requirements(rows, reached, stats, scenario), _outcome(rows, stats, traj),
-                _distributions(rows, reached, stats, reference), _contributors(stats), _cost(stats),
+                _distributions(rows, quantities, reached, stats, reference), _contributors(stats), _cost(stats),
                 _figure_list(figs)]
     md = "\n\n".join(section for section in sections if section) + "\n"
     path = os.path.join(out_dir, "report.md")
@@ -268,14 +269,18 @@ CONTROL_QUANTITIES = (("bank_reversals", "bank reversals", "-", 1.0), ("bank_tra
                       ("time_at_bank_limit_s", "time at the bank limit", "s", 1.0),
                       ("time_at_bank_rate_limit_s", "time at the bank-rate limit", "s", 1.0))
 #: dispersion rows: (spec path, label, unit)
-DISPERSION_FIELDS = (("entry.altitude_m", "entry altitude", "m"), ("entry.longitude_deg", "entry longitude", "deg"),
-                     ("entry.latitude_deg", "entry latitude", "deg"), ("entry.velocity_m_s", "entry speed", "m/s"),
-                     ("entry.flight_path_deg", "entry flight-path angle", "deg"),
-                     ("entry.heading_deg", "entry heading", "deg"),
-                     ("density_scale", "density factor", "-"),
-                     ("density_wave_amplitude", "density wave amplitude (fraction)", "-"),
-                     ("lift_scale", "lift-coefficient factor", "-"), ("drag_scale", "drag-coefficient factor", "-"),
-                     ("mass_scale", "mass factor", "-"))
+#: dispersion rows: (spec path, label, unit, the value that disperses nothing)
+DISPERSION_FIELDS = (("entry.altitude_m", "entry altitude", "m", 0.0),
+                     ("entry.longitude_deg", "entry longitude", "deg", 0.0),
+                     ("entry.latitude_deg", "entry latitude", "deg", 0.0),
+                     ("entry.velocity_m_s", "entry speed", "m/s", 0.0),
+                     ("entry.flight_path_deg", "entry flight-path angle", "deg", 0.0),
+                     ("entry.heading_deg", "entry heading", "deg", 0.0),
+                     ("density_scale", "density factor", "-", 1.0),
+                     ("density_wave_amplitude", "density wave amplitude (fraction)", "-", 0.0),
+                     ("lift_scale", "lift-coefficient factor", "-", 1.0),
+                     ("drag_scale", "drag-coefficient factor", "-", 1.0),
+                     ("mass_scale", "mass factor", "-", 1.0))
 NAV_UNITS = ("m", "rad", "rad", "m/s", "rad", "rad")
 #: row columns of the drawn dispersions (drake_entry.models.dispersions.Draw.columns) in words
 DISPERSION_LABELS = {"disp_dh_m": "entry altitude deviation [m]", "disp_dlon_deg": "entry longitude deviation [deg]",
@@ -380,17 +385,22 @@ def drake_entry_version() -> str:
     return drake_entry.__version__
 
 
+def _fixed_value(d) -> float | None:
+    """The value of a plain number or a schema Deterministic; None for a distribution."""
+    if isinstance(d, (int, float)):
+        return float(d)
+    return float(d.value) if type(d).__name__ == "Deterministic" else None
+
+
 def _distribution_text(d) -> tuple[str, str]:
     """(distribution, bounds or sigma) of a schema scalar or a plain number."""
     name = type(d).__name__
-    if isinstance(d, (int, float)):
-        return "fixed", f"{d:g}"
+    if _fixed_value(d) is not None:
+        return "fixed", f"{_fixed_value(d):g}"
     if name == "Uniform":
         return "uniform", f"[{d.min:g}, {d.max:g}]"
     if name == "Gaussian":
         return "Gaussian", f"mean {d.mean:g}, 1σ {d.stddev:g} (3σ {3 * d.stddev:.4g}: 99.73 %)"
-    if name == "Deterministic":
-        return "fixed", f"{d.value:g}"
     return name, str(d)
 
 
@@ -403,19 +413,17 @@ def _dispersions(scenario) -> str:
                "entry.latitude_deg": f"{entry.latitude_deg:g} deg", "entry.velocity_m_s": f"{entry.velocity_m_s:g} m/s",
                "entry.flight_path_deg": f"{entry.flight_path_deg:g} deg", "entry.heading_deg": f"{entry.heading_deg:g} deg"}
     lines = []
-    for path, label, unit in DISPERSION_FIELDS:
+    for path, label, unit, undispersed in DISPERSION_FIELDS:
         holder = spec.entry if path.startswith("entry.") else spec
         value = getattr(holder, path.split(".")[-1])
-        kind, spread = _distribution_text(value)
-        if kind == "fixed" and float(spread) in (0.0, 1.0) and path != "density_wave_amplitude":
+        if _fixed_value(value) == undispersed:
             continue  # not dispersed: the nominal model
-        if kind == "fixed" and path == "density_wave_amplitude" and float(spread) == 0.0:
-            continue
-        where = nominal.get(path, "1 (the nominal model)" if unit == "-" else "")
+        kind, spread = _distribution_text(value)
+        where = nominal.get(path, "1 (the nominal model)" if undispersed == 1.0 else "0")
         delta = " (deviation)" if path.startswith("entry.") else ""
         lines.append(f"| {label}{delta} | {where} | {kind} | {spread} | {unit} |")
-    if any(lines) and spec.density_wave_amplitude not in (0.0,):
-        lines.append(f"| density wave length | — | fixed | {spec.density_wave_length_km:g} | km |")
+        if path == "density_wave_amplitude":
+            lines.append(f"| density wave length | — | fixed | {spec.density_wave_length_km:g} | km |")
     bias = spec.nav_bias
     name = type(bias).__name__
     if name == "GaussianVectorX":
@@ -534,9 +542,8 @@ def _outcome(rows: dict, stats: dict, traj) -> str:
 MAX_FAILED_LISTED = 50
 
 
-def _distributions(rows: dict, reached, stats: dict, reference) -> str:
+def _distributions(rows: dict, quantities: dict, reached, stats: dict, reference) -> str:
     n_reached = int(reached.sum())
-    quantities = _quantities(rows, reached)
     head = ("| quantity | unit | N | min | P0.13 | P1 | P50 | mean | σ | P99 | P99.87 | max | "
             f"Wilks {100 * COVERAGE:g} %/{100 * CONFIDENCE:g} % |")
     sep = "|---|---|---|---|---|---|---|---|---|---|---|---|---|"

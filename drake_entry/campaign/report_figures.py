@@ -93,10 +93,11 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
         p99 = float(np.percentile(miss, 99))
         ax.plot(p99 * circle[0], p99 * circle[1], "C2:", lw=1.5, label=f"P99 miss radius {p99:.3g} km")
         extent += [np.abs(x.mean() + ell[0]).max(), np.abs(y.mean() + ell[1]).max(), p99]
+    in_view = radius_km is not None and radius_km <= 4.0 * max(extent)  # else the samples would be a dot
     if radius_km is not None:
         ax.plot(radius_km * circle[0], radius_km * circle[1], "r--", lw=1.2,
                 label=f"acceptance region ({radius_km:g} km)")
-        if radius_km <= 4.0 * max(extent):
+        if in_view:
             extent.append(radius_km)
     half = 1.1 * max(max(extent), 1e-3)
     ax.set_xlim(-half, half)
@@ -111,7 +112,7 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
                "target, equal axes. The ellipse holds 99 % of a normal distribution with the sample's mean and "
                "covariance (k = 3.035σ in 2-D); the dotted circle is the 99th percentile of the miss distance")
     caption += (f"; the dashed circle is the acceptance region ({radius_km:g} km)" if radius_km is not None else "")
-    if radius_km is not None and radius_km > 4.0 * max(extent[:2] + [1e-9]):
+    if radius_km is not None and not in_view:
         caption += " (drawn only when near the samples: here far outside the axes)"
     return path, caption + "."
 

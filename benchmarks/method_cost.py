@@ -6,8 +6,9 @@ set-up (models and the method's planner, once per campaign worker), then ``sampl
 samples (seed 7), core time per sample (process time, the best of ``rounds`` rounds), split:
 
   plant      the plant's derivative evaluations of the sample (the integrator's count, in the
-             row) times the cost of one evaluation measured alone (vehicle and atmosphere
-             systems, the sample's nominal models, at the entry state)
+             row) times the cost of one evaluation measured alone (the scenario's vehicle and
+             atmosphere systems, native or Python, flown by the simulator for 200 s at constant
+             controls from the entry state lowered to 60 km)
   planning   the method's own clock of on-board planning (the row's planning_wall_s)
   rest       everything else: guidance and controller updates, flight conditions, actuators,
              navigation, monitors, loggers and the simulator itself
@@ -40,6 +41,7 @@ from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 from drake_entry.diagrams.sample import run_sample
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.vehicle import EntryVehicle
+from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
@@ -54,27 +56,33 @@ for _ in range(rounds):
     rows = [run_sample(setup, seed, i, trajectory_step_s=10.0)[0] for i in range(n)]
     walls.append((time.process_time() - t0) / n)
 # one plant derivative evaluation alone: the vehicle fed by the atmosphere system, as in the loop
+# (the scenario's plant where the checkout has the native one, else the Python systems)
 builder = DiagramBuilder()
-plant = builder.AddSystem(EntryVehicle(setup.vehicle, setup.planet, setup.atmosphere, air_data_input=True))
-air = builder.AddSystem(AtmosphereSystem(setup.atmosphere, setup.planet))
-builder.Connect(plant.GetOutputPort("state"), air.get_input_port())
-builder.Connect(air.get_output_port(), plant.GetInputPort("air_data"))
+try:
+    from drake_entry.systems.native_plant import add_plant
+    plant, air, _ = add_plant(builder, setup.vehicle, setup.planet, setup.atmosphere, initial_state=None,
+                           plant=setup.scenario.simulation.plant)
+except ImportError:
+    plant = builder.AddSystem(EntryVehicle(setup.vehicle, setup.planet, setup.atmosphere, air_data_input=True))
+    air = builder.AddSystem(AtmosphereSystem(setup.atmosphere, setup.planet))
+    builder.Connect(plant.GetOutputPort("state"), air.get_input_port())
+    builder.Connect(air.get_output_port(), plant.GetInputPort("air_data"))
 for port, value in (("bank", 0.5), ("alpha", 0.3)):
     src = builder.AddSystem(ConstantVectorSource([value]))
     builder.Connect(src.get_output_port(), plant.GetInputPort(port))
 diagram = builder.Build()
-context = diagram.CreateDefaultContext()
-sub = plant.GetMyMutableContextFromRoot(context)
+# flown by the simulator (its own calls, as in the loop; no Python-side call overhead): 200 s of
+# fixed 0.1-s RK3 steps from the entry state lowered to 60 km, inside the sensible atmosphere
 x0 = np.array(setup.scenario.initial_state(), float)
-x0[0] = min(x0[0], 60e3)  # inside the sensible atmosphere, as most of the flight is
-sub.SetContinuousState(x0)
-calls = 2000
-states = [x0 * (1.0 + 1e-6 * k) for k in range(calls)]  # a new state each call: nothing cached is reused
+x0[0] = min(x0[0], 60e3)
+simulator = Simulator(diagram)
+plant.set_initial_state(plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()), x0)
+integrator = ResetIntegratorFromFlags(simulator, "runge_kutta3", 0.1)
+integrator.set_fixed_step_mode(True)
+simulator.Initialize()
 t0 = time.process_time()
-for x in states:
-    sub.SetContinuousState(x)
-    diagram.EvalTimeDerivatives(context)
-per_eval = (time.process_time() - t0) / calls
+simulator.AdvanceTo(200.0)
+per_eval = (time.process_time() - t0) / integrator.get_num_derivative_evaluations()
 evaluations = float(np.mean([r.get("derivative_evaluations", 0) for r in rows]))
 planning = float(np.mean([r.get("planning_wall_s", 0.0) or 0.0 for r in rows]))
 print(json.dumps({"setup_s": setup_s, "sample_s": min(walls), "per_eval_s": per_eval, "evaluations": evaluations,

@@ -5,6 +5,8 @@
   alpha: the scenario's alpha schedule (sampled at the guidance period), or the method's
       alpha_command through the rate- and acceleration-limited AlphaActuator
   AtmosphereSystem(state) --air_data--> EntryVehicle, TerminationMonitor
+  (vehicle and atmosphere: the native SymbolicVectorSystems or the Python reference systems,
+  by the scenario's simulation.plant; systems/native_plant.py)
 
 This module builds the shared parts (vehicle, atmosphere, navigation, actuators,
 termination monitor, loggers) and asks the scenario's guidance method
@@ -39,11 +41,10 @@ from drake_entry.models.verdict import Verdict, box_text, judge
 from drake_entry.models.verdict import acceptance_box as box_at
 from drake_entry.scenario import Scenario
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
-from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.monitors import TerminationMonitor
+from drake_entry.systems.native_plant import add_plant
 from drake_entry.systems.navigation import Navigation
 from drake_entry.systems.schedule import ScheduleSource
-from drake_entry.systems.vehicle import EntryVehicle
 
 ALTITUDE_FLOOR_M = 5000.0
 
@@ -123,14 +124,15 @@ class ClosedLoopResult:
 @dc.dataclass
 class ClosedLoopDiagram:
     """A built closed loop: the diagram, its loggers by name, the (system, port) each logger
-    reads and the table columns of the extra signals (both for collect_trajectory), and the
-    per-step loggers of the verdict's path limits."""
+    reads and the table columns of the extra signals (both for collect_trajectory), the
+    per-step loggers of the verdict's path limits, and the plant flown ("native" or "python")."""
 
     diagram: object
     loggers: dict
     sources: dict
     columns: dict
     step_loggers: dict
+    plant: str = "python"
 
 
 def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=None, nav_noise=None,
@@ -152,14 +154,11 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
         nav_bias, nav_noise, nav_seed = draw.nav_bias, draw.nav_noise_sigma, draw.nav_seed
     builder = DiagramBuilder()
     x0 = scenario.initial_state() if initial_state is None else np.asarray(initial_state, float)
-    plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, setup.planet, atmosphere, initial_state=x0,
-                                                           air_data_input=True))
-    air = builder.AddNamedSystem("atmosphere", AtmosphereSystem(atmosphere, setup.planet))
+    plant, air, used = add_plant(builder, vehicle, setup.planet, atmosphere, initial_state=x0,
+                           plant=scenario.simulation.plant)
     nav = builder.AddNamedSystem("navigation", Navigation(bias=nav_bias, noise_sigma=nav_noise,
                                                           period=g.period_s, seed=nav_seed))
     state, conditions = plant.GetOutputPort("state"), plant.GetOutputPort("flight_conditions")
-    builder.Connect(state, air.get_input_port())
-    builder.Connect(air.GetOutputPort("air_data"), plant.GetInputPort("air_data"))
     builder.Connect(state, nav.GetInputPort("true_state"))
     estimate = nav.GetOutputPort("estimated_state")
 
@@ -205,7 +204,7 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
     columns = {"bank_command": ("bank_command_rad",), **{n: s.columns for n, s in commands.logged.items()}}
     diagram = builder.Build()
     diagram.set_name(f"closed_loop_{scenario.name}_{setup.method.name}")
-    return ClosedLoopDiagram(diagram, loggers, sources, columns, step_loggers)
+    return ClosedLoopDiagram(diagram, loggers, sources, columns, step_loggers, used)
 
 
 def terminal_errors(x, setup: ClosedLoopSetup) -> dict:

@@ -1,5 +1,7 @@
 """Open-loop entry diagram: schedules -> bank actuator -> EntryVehicle <- AtmosphereSystem,
-with a termination monitor and loggers; ``simulate`` flies it and returns a Trajectory.
+with a termination monitor and loggers; ``simulate`` flies it and returns a Trajectory. The
+vehicle and atmosphere are the native or the Python plant by ``simulation.plant``
+(systems/native_plant.py).
 
     alpha schedule ---------------------------> alpha
     bank schedule --> BankActuator -----------> bank      EntryVehicle --> state, flight_conditions
@@ -15,10 +17,9 @@ from drake_entry.diagrams.common import run
 from drake_entry.models.trajectory import Trajectory
 from drake_entry.scenario import Scenario
 from drake_entry.systems.actuators import BankActuator
-from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.monitors import TerminationMonitor
+from drake_entry.systems.native_plant import add_plant
 from drake_entry.systems.schedule import make_schedule_source
-from drake_entry.systems.vehicle import EntryVehicle
 
 
 def build_open_loop(scenario: Scenario):
@@ -27,11 +28,9 @@ def build_open_loop(scenario: Scenario):
     planet = scenario.make_planet()
     atmosphere = scenario.make_atmosphere()
     builder = DiagramBuilder()
-    # the vehicle evaluates its own air data (one Python call fewer per derivative); the
-    # AtmosphereSystem serves the Mach witness, evaluated once per step
-    plant = builder.AddNamedSystem("vehicle", EntryVehicle(vehicle, planet, atmosphere,
-                                                           initial_state=scenario.initial_state()))
-    air = builder.AddNamedSystem("atmosphere", AtmosphereSystem(atmosphere, planet))
+    # the atmosphere's air data feed the vehicle and the Mach witness
+    plant, air, _ = add_plant(builder, vehicle, planet, atmosphere, initial_state=scenario.initial_state(),
+                           plant=scenario.simulation.plant)
     alpha = builder.AddNamedSystem("alpha_schedule", make_schedule_source(scenario.schedule("alpha"), planet))
     bank = builder.AddNamedSystem("bank_schedule", make_schedule_source(scenario.schedule("bank"), planet))
     actuator = builder.AddNamedSystem("bank_actuator", BankActuator(
@@ -44,7 +43,6 @@ def build_open_loop(scenario: Scenario):
         geodetic=scenario.altitude_datum == "ellipsoid"))
     state = plant.GetOutputPort("state")
     conditions = plant.GetOutputPort("flight_conditions")
-    builder.Connect(state, air.get_input_port())
     for src in (alpha, bank):
         for port in ("state", "flight_conditions"):
             if src.HasInputPort(port):

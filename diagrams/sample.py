@@ -83,7 +83,7 @@ def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
         row.update(box["draw"].columns())
         row.update(campaign_row(res, setup))
         integrator = box["simulator"].get_integrator()
-        row.update({"integration_steps": integrator.get_num_steps_taken(),
+        row.update({"plant": built.plant, "integration_steps": integrator.get_num_steps_taken(),
                     "derivative_evaluations": integrator.get_num_derivative_evaluations()})
         step = min(trajectory_step_s, DETAILED_STEP_S) if index < DETAILED_SAMPLES else trajectory_step_s
         traj = downsample(tr, index, step) if trajectory_step_s > 0 else None

@@ -6,6 +6,7 @@ Entry controls (SCvx plans), as the closed loop flies them:
 
     TrajectorySource(bank(t + lead)) --> BankActuator (sampled every period) --bank--> EntryVehicle
     TrajectorySource(alpha(t + lead)) or ScheduleSource(alpha(V)) --> AlphaActuator --alpha--> EntryVehicle
+    AtmosphereSystem(state) --air_data--> EntryVehicle; PlantGuard(state) (native plant)
 
 Without ``actuation`` the C2 splines feed the vehicle directly. Optimal-control controls (NLP
 solutions):
@@ -33,8 +34,9 @@ from drake_entry.errors import ModelRangeError, NonFiniteStateError
 from drake_entry.planning.ocp_system import OptimalControlPlant
 from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, OcpControls
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
+from drake_entry.systems.monitors import PlantGuard
+from drake_entry.systems.native_plant import add_plant
 from drake_entry.systems.schedule import ScheduleSource
-from drake_entry.systems.vehicle import EntryVehicle
 
 #: fixed RK5 steps per actuator period (see the module docstring for the measured error)
 ENTRY_STEPS_PER_PERIOD = 2
@@ -48,7 +50,7 @@ FLIGHT_ERRORS = (RuntimeError, ModelRangeError, NonFiniteStateError, OverflowErr
 
 
 def fly_controls(controls: EntryControls | OcpControls, *, accuracy: float | None = None,
-                 log_points: int = LOG_POINTS) -> FlownControls:
+                 log_points: int = LOG_POINTS, plant: str = "auto") -> FlownControls:
     """Fly ``controls`` from their initial state to their final time with the Drake Simulator
     (the verifier of drake_entry.planning.verification).
 
@@ -56,9 +58,11 @@ def fly_controls(controls: EntryControls | OcpControls, *, accuracy: float | Non
       accuracy: error-controlled RK5 at this accuracy instead of the defaults of the module
         docstring (a reference flight to hold the default to, or a looser study).
       log_points: samples logged over the flight.
+      plant: the entry plant: "auto", "native" (systems/native_plant.py, with a PlantGuard) or
+        "python" (systems/native_plant.add_plant).
     """
     if isinstance(controls, EntryControls):
-        return _fly_entry(controls, accuracy, log_points)
+        return _fly_entry(controls, accuracy, log_points, plant)
     if isinstance(controls, OcpControls):
         return _fly_ocp(controls, accuracy or OCP_ACCURACY, log_points)
     raise TypeError(f"fly_controls flies EntryControls or OcpControls, got {type(controls).__name__}")
@@ -69,13 +73,17 @@ def _spline(time, values) -> PiecewisePolynomial:
         np.asarray(time, float), np.atleast_2d(np.asarray(values, float)), periodic_end_condition=False)
 
 
-def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int) -> FlownControls:
+def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_kind: str) -> FlownControls:
     act: Actuation | None = c.actuation
     lead = act.lead_s if act is not None else 0.0
     t = np.asarray(c.time, float) - lead
     builder = DiagramBuilder()
-    plant = builder.AddNamedSystem("vehicle", EntryVehicle(c.vehicle, c.planet, c.atmosphere,
-                                                           initial_state=np.asarray(c.initial_state, float)))
+    plant, _, used = add_plant(builder, c.vehicle, c.planet, c.atmosphere, initial_state=np.asarray(c.initial_state, float),
+                         plant=plant_kind)
+    if used == "native":  # the native plant cannot raise: the guard stops the flight as it would
+        guard = builder.AddNamedSystem("plant_guard", PlantGuard(
+            h_min=c.atmosphere.h_min, h_max=c.atmosphere.h_max, model=type(c.atmosphere).__name__, planet=c.planet))
+        builder.Connect(plant.GetOutputPort("state"), guard.get_input_port())
     bank_source = builder.AddNamedSystem("bank_plan", TrajectorySource(_spline(t, np.reshape(c.bank, (1, -1)))))
     if c.alpha is None:
         schedule = builder.AddNamedSystem("alpha_plan", ScheduleSource(c.alpha_law, c.planet))

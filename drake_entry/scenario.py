@@ -93,6 +93,10 @@ class SimulationSpec:
     closed_loop_step_s: float = 0.0
     # trajectory sample period for logs and plots [s]
     log_period_s: float = 1.0
+    # the plant's realisation: auto (native when every model has a symbolic form, else python) |
+    # native (vehicle, air data and flight conditions evaluated by Drake in C++ from the models'
+    # symbolic form; an aerodynamic table has none) | python (the reference LeafSystems)
+    plant: str = "auto"
 
 
 @dc.dataclass
@@ -263,6 +267,8 @@ class Scenario:
         if step != 0.0 and not (0.0 < step <= period and abs(period / step - round(period / step)) < 1e-9):
             raise ScenarioError(f"simulation.closed_loop_step_s = {step:g} s must be 0 (error control) or divide "
                                 f"guidance.period_s = {period:g} s (e.g. {period:g}, {period / 2:g}, {period / 4:g})")
+        if sim.plant not in ("auto", "native", "python"):
+            raise ScenarioError(f"simulation.plant '{sim.plant}' is unknown; allowed: auto, native, python")
         if sim.integrator not in INTEGRATORS:
             raise ScenarioError(f"simulation.integrator '{sim.integrator}' is unknown; allowed: {', '.join(INTEGRATORS)}")
         for which in ("alpha", "bank"):

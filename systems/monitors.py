@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from pydrake.systems.framework import EventStatus, LeafSystem, PublishEvent, WitnessFunctionDirection
 
-from drake_entry.errors import ScenarioError
+from drake_entry.errors import ModelRangeError, NonFiniteStateError, ScenarioError
 from drake_entry.models.atmosphere import US76_H_MAX
 from drake_entry.models.dynamics import specific_energy
 from drake_entry.models.planet import Earth
@@ -57,8 +57,13 @@ class TerminationMonitor(LeafSystem):
                 f"reached {name}", WitnessFunctionDirection.kPositiveThenNonPositive, self._make_calc(name), event))
 
     def _altitude(self, context) -> float:
-        """The altitude the band bounds [m]: the state altitude, or the geodetic one."""
+        """The altitude the band bounds [m]: the state altitude, or the geodetic one. A
+        non-finite state stops the run here with NonFiniteStateError (the native plant, unlike
+        the Python one, cannot raise from its derivatives; this witness runs every step)."""
         x = self.state_port.Eval(context)
+        total = float(x.sum())
+        if total - total != 0.0:
+            raise NonFiniteStateError(f"non-finite vehicle state at t = {context.get_time():.3f} s: {x.tolist()}")
         return self.planet.atmospheric_altitude(x[0], x[2]) if self.geodetic else x[0]
 
     def _make_calc(self, name):
@@ -91,3 +96,39 @@ class TerminationMonitor(LeafSystem):
 
     def DoGetWitnessFunctions(self, context):
         return self._witnesses
+
+
+class PlantGuard(LeafSystem):
+    """Stops a flight whose state leaves what the models cover, as the Python plant does from
+    inside its derivatives: a non-finite state raises NonFiniteStateError, an altitude outside
+    [h_min, h_max] of the atmosphere model ModelRangeError, each at the end of the integrator
+    step where it happens (one witness evaluation per step, never triggered otherwise). The
+    native plant (systems/native_plant.py) computes in C++ and cannot raise; diagrams without a
+    TerminationMonitor (the plan verifier's flights) add this guard.
+
+    Ports:
+      - input "state" [6]  vehicle state
+    """
+
+    def __init__(self, *, h_min: float, h_max: float, model: str, planet: Earth | None = None):
+        """Args: h_min, h_max [m] the atmosphere model's range; model: its name for the message;
+        planet: whose planet.atmospheric_altitude the atmosphere sees."""
+        super().__init__()
+        self.h_min, self.h_max, self.model = float(h_min), float(h_max), model
+        self.planet = planet or Earth()
+        self.state_port = self.DeclareVectorInputPort("state", 6)
+        self._witness = [self.MakeWitnessFunction("plant guard", WitnessFunctionDirection.kNone, self._check)]
+
+    def _check(self, context) -> float:
+        x = self.state_port.Eval(context)
+        total = float(x.sum())
+        if total - total != 0.0:
+            raise NonFiniteStateError(f"non-finite vehicle state at t = {context.get_time():.3f} s: {x.tolist()}")
+        h = self.planet.atmospheric_altitude(x[0], x[2])
+        if not self.h_min <= h <= self.h_max:
+            raise ModelRangeError(f"altitude h = {h:.6g} m is outside the {self.model} range "
+                                  f"[{self.h_min:.6g}, {self.h_max:.6g}] m")
+        return 1.0
+
+    def DoGetWitnessFunctions(self, context):
+        return self._witness

@@ -27,7 +27,7 @@ def _run(name: str, out_dir) -> object:
 
 #: the examples whose full run takes under about a minute here (docs/examples.md)
 FULL_RUNS = ("01_open_loop_diagram", "02_custom_controller", "03_monte_carlo", "04_custom_vehicle",
-             "05_optimal_control", "06_swarm_bank", "11_shefex3_problem")
+             "05_optimal_control", "06_swarm_bank", "11_shefex3_problem", "13_native_plant")
 
 
 @pytest.mark.slow
@@ -168,4 +168,13 @@ def test_example_12(tmp_path):
     assert r["flights"]["ampi"].success and r["flights"]["ampi"].errors["distance_m"] < 3e3
     assert r["flights"]["ntt"].errors["distance_m"] > 25e3
     assert r["table"]["ampi"][25] == len(r["table"]["ampi"]["rows"]) == 6
+    assert os.path.exists(r["plot"])
+
+
+def test_example_13(tmp_path):
+    """The native and Python plants: derivatives equal to 1e-9 relative (1e-14 measured), the
+    first 400 s of the HORUS-2B closed loop within 22 m of each other, the same verdict."""
+    r = _run("13_native_plant", tmp_path)
+    assert r["worst_relative"] < 1e-9 and r["same_verdict"]
+    assert r["end_gap_m"] < 22.0 and r["altitude_gap_m"] < 22.0
     assert os.path.exists(r["plot"])

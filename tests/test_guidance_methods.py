@@ -53,7 +53,8 @@ def test_paper000_campaign_rows_are_unchanged_and_beat_table3(tmp_path):
     assert added == {"method", "peak_total_load_g", "heat_load_J_m2", "inside_altitude_box", "inside_mach_box",
                      "inside_distance_box", "reached_terminal", "inside_box", "within_limits", "violations",
                      "margin_bank", "bank_reversals", "bank_travel_deg", "peak_bank_rate_deg_s", "time_at_bank_limit_s",
-                     "time_at_bank_rate_limit_s", "box_altitude_error", "box_mach_error", "box_distance_error"}
+                     "time_at_bank_rate_limit_s", "box_altitude_error", "box_mach_error", "box_distance_error",
+                     "plant"}
     st = summary_statistics(pq.read_table(f"{out}/samples.parquet").to_pydict())
     assert st["successful"] == 20
     assert abs(st["errors"]["err_range_m"]["mean"]) < 312.3

@@ -4,7 +4,10 @@ Every model gives density, temperature and speed of sound, and the first and sec
 altitude derivatives of density and temperature that the drag dynamics need (paper 000
 eqs. 42-46, 59). Inputs are geometric altitude h [m]; outputs SI. Methods accept a
 float, an ndarray (vectorised) or a pydrake AutoDiffXd (derivatives by the chain rule);
-``ExponentialAtmosphere.density`` also takes a symbolic Expression.
+``properties`` and ``air_data`` also take a symbolic Expression, for which the layers and
+the splines become piecewise expressions (``piecewise``: a balanced tree of
+``if_then_else`` over the same breakpoints, each piece the float path's own formula), so a
+Drake ``SymbolicVectorSystem`` evaluates the same model in C++ (systems/native_plant.py).
 
 US76 below 86 km is evaluated from the standard's own layer formulas (hydrostatic
 equation with piecewise-linear molecular-scale temperature in geopotential altitude), so
@@ -25,11 +28,12 @@ from importlib import resources
 from typing import NamedTuple
 
 import numpy as np
+from pydrake.symbolic import if_then_else
 from scipy.interpolate import CubicSpline
 
-from drake_entry.errors import ModelRangeError, ScenarioError
+from drake_entry.errors import ModelRangeError, ScenarioError, UnsupportedScalarError
 from drake_entry.models.data_tables import read_csv_rows
-from drake_entry.models.scalar import clamp, is_autodiff, is_symbolic, lift, value_of
+from drake_entry.models.scalar import clamp, is_autodiff, is_symbolic, lift, promote, value_of
 
 # U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
 G0_US76 = 9.80665  # m/s^2
@@ -59,6 +63,22 @@ class Derivatives(NamedTuple):
     value: object
     d_h: object
     d_hh: object
+
+
+def piecewise(x, breaks, piece):
+    """A symbolic Expression equal to ``piece(i)`` where breaks[i] <= x < breaks[i + 1], for the
+    len(breaks) - 1 intervals; below breaks[1] the first piece, from breaks[-2] on the last (the
+    index rule of the float paths, bisect_right clamped). Built as a balanced tree of
+    ``if_then_else``, so an evaluation compares about log2(intervals) times and evaluates one
+    piece (Drake evaluates only the branch taken)."""
+
+    def build(lo: int, hi: int):
+        if hi - lo == 1:
+            return piece(lo)
+        mid = (lo + hi) // 2
+        return if_then_else(x < breaks[mid], build(lo, mid), build(mid, hi))
+
+    return build(0, len(breaks) - 1)
 
 
 def _check_range(name: str, h, lo: float, hi: float):
@@ -94,6 +114,8 @@ class Atmosphere:
 
     def density(self, h):
         """Density rho(h) [kg/m^3]."""
+        if is_symbolic(h):
+            return self.symbolic_profile(h)[0]
         if is_autodiff(h):
             d = self.density_derivatives(h.value())
             return lift([h], d.value, [d.d_h])
@@ -101,6 +123,8 @@ class Atmosphere:
 
     def temperature(self, h):
         """Temperature T(h) [K]."""
+        if is_symbolic(h):
+            return self.symbolic_profile(h)[1]
         if is_autodiff(h):
             d = self.temperature_derivatives(h.value())
             return lift([h], d.value, [d.d_h])
@@ -127,11 +151,30 @@ class Atmosphere:
         d, t = self.derivatives(h)
         return float(d.value), math.sqrt(self.gamma * self.gas_constant * float(t.value))
 
+    def symbolic_profile(self, h) -> tuple:
+        """(density, temperature) as symbolic Expressions of the altitude Expression ``h``: the
+        float model's own formulas, pieces selected by ``if_then_else``. Outside the model's
+        range the end pieces extend (no range check: a symbolic plant is stopped by the
+        termination monitor's altitude band, inside the range). Kept per altitude expression
+        on the instance, so the dispersed copies of one nominal model share its tree."""
+        h = promote(h)
+        key = (h.to_string(), tuple(sorted(v.get_id() for v in h.GetVariables())))
+        cache = self.__dict__.setdefault("_symbolic_profiles", {})
+        if key not in cache:
+            with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
+                cache[key] = self._symbolic_profile(h)
+        return cache[key]
+
+    def _symbolic_profile(self, h) -> tuple:
+        raise UnsupportedScalarError(f"{type(self).__name__} has no symbolic form; use US76, exponential, "
+                                     f"table or a dispersed one of these")
+
     def properties(self, h) -> AtmosphereProperties:
         """(rho, T, a) at altitude h [m]; one model evaluation for float / AutoDiff input."""
         if is_symbolic(h):
-            T = self.temperature(h)
-            return AtmosphereProperties(self.density(h), T, np.sqrt(self.gamma * self.gas_constant * T))
+            rho, T = self.symbolic_profile(h)
+            with np.errstate(all="ignore"):
+                return AtmosphereProperties(rho, T, np.sqrt(self.gamma * self.gas_constant * T))
         d, t = self.derivatives(value_of(h))
         rho = lift([h], d.value, [d.d_h]) if is_autodiff(h) else d.value
         T = lift([h], t.value, [t.d_h]) if is_autodiff(h) else t.value
@@ -210,6 +253,16 @@ class _ScalarCubic:
         t = x - self.x[i]
         return ((c3 * t + c2) * t + c1) * t + c0, (3.0 * c3 * t + 2.0 * c2) * t + c1, 6.0 * c3 * t + 2.0 * c2
 
+    def symbolic(self, x):
+        """The spline's value as a piecewise symbolic Expression of ``x`` (the same cubics)."""
+
+        def piece(i):
+            c3, c2, c1, c0 = self.c[i]
+            t = x - self.x[i]
+            return ((c3 * t + c2) * t + c1) * t + c0
+
+        return piecewise(x, self.x, piece)
+
     def evaluate(self, x: np.ndarray):
         """(value, first, second derivative) arrays at an array of x (the same cubics)."""
         i = np.clip(np.searchsorted(self._x, x, side="right") - 1, 0, len(self.c) - 1)
@@ -232,6 +285,10 @@ class _SplineProfile:
 
     def evaluate(self, z: np.ndarray):
         return np.array(self.ln_rho.evaluate(z) + self.T.evaluate(z))
+
+    def symbolic(self, z):
+        """(ln rho, T) as piecewise symbolic Expressions of the altitude ``z``."""
+        return self.ln_rho.symbolic(z), self.T.symbolic(z)
 
 
 def _load_upper_table() -> _SplineProfile:
@@ -270,6 +327,25 @@ def _lower_layers_array(z: np.ndarray, derivatives: bool = True):
     f_H = -(_GMR + L) / T
     f_HH = (_GMR + L) * L / (T * T)
     return ln_rho, f_H * Hz, f_HH * Hz * Hz + f_H * Hzz, T, L * Hz, L * Hzz
+
+
+def _lower_layers_symbolic(z):
+    """(ln rho, T) of ``_lower_layers`` as piecewise symbolic Expressions of z (the same
+    formulas, the layer chosen by geopotential altitude as there)."""
+    r0 = R0_GEOPOTENTIAL
+    H = r0 * z / (r0 + z)
+    breaks = _H_BASE_LIST + [math.inf]
+
+    def temperature(i):
+        return _T_BASE_LIST[i] + _LAPSE_LIST[i] * (H - _H_BASE_LIST[i])
+
+    def ln_rho(i):
+        L, Tb, dH = _LAPSE_LIST[i], _T_BASE_LIST[i], H - _H_BASE_LIST[i]
+        T = Tb + L * dH
+        lnP = _LN_P_BASE_LIST[i] - _GMR * dH / Tb if L == 0.0 else _LN_P_BASE_LIST[i] + (_GMR / L) * np.log(Tb / T)
+        return lnP - np.log(R_AIR * T)
+
+    return piecewise(H, breaks, ln_rho), piecewise(H, breaks, temperature)
 
 
 def _us76_array(z: np.ndarray):
@@ -324,6 +400,13 @@ class US76Atmosphere(Atmosphere):
             ln_rho, T = _lower_layers_array(h, derivatives=False)
             return np.exp(ln_rho), np.sqrt(GAMMA_AIR * R_AIR * T)
         return super().air_data(h)
+
+    def _symbolic_profile(self, h):
+        """(rho, T) Expressions: the seven layers below 86 km, the upper table's splines above."""
+        lower_ln_rho, lower_T = _lower_layers_symbolic(h)
+        upper_ln_rho, upper_T = _upper_table().symbolic(h)
+        below = h <= US76_LOWER_TOP
+        return np.exp(if_then_else(below, lower_ln_rho, upper_ln_rho)), if_then_else(below, lower_T, upper_T)
 
     def density_derivatives(self, h) -> Derivatives:
         return self.derivatives(h)[0]
@@ -381,6 +464,9 @@ class ExponentialAtmosphere(Atmosphere):
         _check_range(self.name, h, US76_H_MIN, self.H_MAX)
         rho = self.rho0 * np.exp(-np.asarray(h, dtype=float) / self.scale_height)
         return Derivatives(rho, -rho / self.scale_height, rho / self.scale_height**2)
+
+    def _symbolic_profile(self, h):
+        return self.density(h), self.temperature(h)
 
     def temperature(self, h):
         """US76 temperature (held at its range ends: the exponential density model has no
@@ -443,6 +529,10 @@ class TableAtmosphere(Atmosphere):
             raise ScenarioError(f"atmosphere table {name}: {e}") from None
         return cls(values[:, 0], values[:, 1], values[:, 2], source=source or str(name))
 
+    def _symbolic_profile(self, h):
+        ln_rho, T = self._profile.symbolic(h)
+        return np.exp(ln_rho), T
+
     def _evaluate(self, h):
         self.check(h)
         if isinstance(h, (float, int)) or np.ndim(h) == 0:
@@ -491,6 +581,10 @@ class DispersedAtmosphere(Atmosphere):
     def _air_data_float(self, h: float) -> tuple[float, float]:
         rho, a = self.base.air_data(h)
         return rho * self._factor(float(h))[0], a
+
+    def _symbolic_profile(self, h):
+        rho, T = self.base.symbolic_profile(h)
+        return rho * (self.scale * (1.0 + self.amplitude * np.sin(self.k * h + self.phase))), T
 
     def density_derivatives(self, h) -> Derivatives:
         return self.derivatives(h)[0]

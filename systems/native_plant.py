@@ -1,0 +1,152 @@
+"""The plant evaluated natively: the vehicle's equations of motion, its flight conditions and
+the atmosphere's air data as Drake ``SymbolicVectorSystem``s, built from the same model code
+(drake_entry.models: dynamics, atmosphere, aerodynamics, heat flux) called with symbolic
+scalars. Drake then evaluates every derivative and every output in C++: no Python callback
+per integrator stage. The Python systems (``EntryVehicle``, ``AtmosphereSystem``) stay the
+reference; tests hold the two to each other (derivatives, conditions, a flight's end).
+
+NativeEntryVehicle (a Diagram named like the vehicle it replaces, the same ports):
+  - input  "bank" [1], "alpha" [1] [rad], "air_data" [2] (density kg/m^3, speed of sound m/s)
+  - output "state"             [6]  [h m, lon rad, lat rad, V m/s, gamma rad, psi rad]
+  - output "flight_conditions" [9]  drake_entry.models.dynamics.FlightConditions
+  inside: "equations_of_motion", a SymbolicVectorSystem whose continuous state is the
+  deviation from the entry state (a SymbolicVectorSystem's default state is zero, and
+  Drake's RandomSimulation resets every context to its defaults), and "flight_conditions",
+  an algebraic one fed by state, alpha and air data (``stateless``).
+NativeAtmosphere: input "state" [6] -> output "air_data" [2], as AtmosphereSystem.
+
+``add_plant`` builds either realisation into a diagram; the scenario's
+``simulation.plant`` chooses ("auto" by default: native when every model has a symbolic form,
+which every packaged vehicle and atmosphere has; "python" for the reference).
+"""
+from __future__ import annotations
+
+import numpy as np
+from pydrake.symbolic import Expression, Variable
+from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import Multiplexer, SymbolicVectorSystem
+
+from drake_entry.errors import ScenarioError, UnsupportedScalarError
+from drake_entry.models import dynamics
+from drake_entry.models.atmosphere import Atmosphere
+from drake_entry.models.planet import Earth
+from drake_entry.models.vehicles import Vehicle
+from drake_entry.systems.atmosphere import AtmosphereSystem
+from drake_entry.systems.vehicle import N_STATE, EntryVehicle
+
+#: the symbols of every native plant (shared, so each nominal model's expression trees are
+#: built once per process and reused by every dispersed copy: Atmosphere.symbolic_profile)
+STATE = [Variable(name) for name in dynamics.STATE_NAMES]
+DEVIATION = [Variable(f"d{name}") for name in dynamics.STATE_NAMES]
+BANK, ALPHA, RHO, SPEED_OF_SOUND = (Variable(n) for n in ("bank", "alpha", "rho", "speed_of_sound"))
+
+#: the realisations ``add_plant`` builds ("auto": native when the models allow it)
+PLANTS = ("auto", "native", "python")
+
+
+class NativeAtmosphere(Diagram):
+    """Air data of ``atmosphere`` along the state, evaluated natively (module docstring)."""
+
+    def __init__(self, atmosphere: Atmosphere, planet: Earth):
+        Diagram.__init__(self)
+        x = [Expression(v) for v in STATE]
+        with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
+            rho, a = dynamics.air_data(x, planet, atmosphere)
+        builder = DiagramBuilder()
+        leaf = builder.AddNamedSystem("air_data", stateless(STATE, [rho, a]))
+        builder.ExportInput(leaf.get_input_port(), "state")
+        builder.ExportOutput(leaf.get_output_port(), "air_data")
+        builder.BuildInto(self)
+
+
+class NativeEntryVehicle(Diagram):
+    """The 3-DOF entry plant of ``vehicle`` on ``planet``, evaluated natively (module
+    docstring); air data come in on "air_data" (a NativeAtmosphere or AtmosphereSystem).
+
+    Args: vehicle, planet; initial_state [6] SI (the default state, what a context reset keeps).
+    """
+
+    def __init__(self, vehicle: Vehicle, planet: Earth, *, initial_state=None):
+        Diagram.__init__(self)
+        self.x0 = np.zeros(N_STATE) if initial_state is None else np.asarray(initial_state, float).copy()
+        x = [Expression(d) + float(x0) for d, x0 in zip(DEVIATION, self.x0)]
+        bank, alpha, rho, a = (Expression(v) for v in (BANK, ALPHA, RHO, SPEED_OF_SOUND))
+        state = [Expression(v) for v in STATE]
+        with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
+            _, L, D = dynamics.aero_accelerations(x, alpha, rho, a, vehicle)
+            xdot = dynamics.equations_of_motion(x, bank, L, D, planet)
+            conditions = dynamics.conditions_from(state, alpha, rho,
+                                                  *dynamics.aero_accelerations(state, alpha, rho, a, vehicle),
+                                                  vehicle, planet)
+        builder = DiagramBuilder()
+        motion = builder.AddNamedSystem("equations_of_motion", SymbolicVectorSystem(
+            state=DEVIATION, input=[BANK, ALPHA, RHO, SPEED_OF_SOUND], dynamics=list(xdot), output=x))
+        cond = builder.AddNamedSystem("flight_conditions", stateless([*STATE, ALPHA, RHO, SPEED_OF_SOUND],
+                                                                     [_expression(c) for c in conditions]))
+        controls = builder.AddNamedSystem("controls", Multiplexer([1, 1, 2]))
+        flight = builder.AddNamedSystem("state_alpha_air", Multiplexer([N_STATE, 1, 2]))
+        builder.Connect(controls.get_output_port(), motion.get_input_port())
+        builder.Connect(motion.get_output_port(), flight.get_input_port(0))
+        builder.Connect(flight.get_output_port(), cond.get_input_port())
+        builder.ExportInput(controls.get_input_port(0), "bank")
+        for name, k in (("alpha", 1), ("air_data", 2)):  # each input feeds both systems
+            builder.ExportInput(controls.get_input_port(k), name)
+            builder.ConnectInput(name, flight.get_input_port(k))
+        builder.ExportOutput(motion.get_output_port(), "state")
+        builder.ExportOutput(cond.get_output_port(), "flight_conditions")
+        builder.BuildInto(self)
+        self._motion = motion
+
+    def state_derivatives(self, context) -> np.ndarray:
+        """dx/dt [6] (SI per s) at this plant's ``context``: the equations of motion alone."""
+        return self._motion.EvalTimeDerivatives(self.GetSubsystemContext(self._motion, context)).CopyToVector()
+
+    def set_initial_state(self, context, x0):
+        """Set the state [h, lon, lat, V, gamma, psi] (SI) in this plant's ``context``."""
+        self.GetMutableSubsystemContext(self._motion, context).SetContinuousState(np.asarray(x0, float) - self.x0)
+
+
+_CONSTANT = Variable("constant")
+
+
+def stateless(inputs: list, outputs: list) -> SymbolicVectorSystem:
+    """A SymbolicVectorSystem computing ``outputs`` from ``inputs``. It carries one constant
+    continuous state (derivative 0): Drake 1.51 aborts the process when a diagram with
+    continuous state asks a SymbolicVectorSystem without dynamics for its derivatives."""
+    return SymbolicVectorSystem(state=[_CONSTANT], input=inputs, dynamics=[Expression(0.0)], output=outputs)
+
+
+def _expression(v):
+    return v if isinstance(v, Expression) else Expression(float(v))
+
+
+def add_plant(builder, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, *, initial_state,
+              plant: str = "auto"):
+    """Add the vehicle (named "vehicle") and its atmosphere ("atmosphere") to ``builder``, the
+    air data wired in; returns (vehicle system, atmosphere system, the realisation used:
+    "native" or "python").
+
+    ``plant``: "native" (the SymbolicVectorSystems; a model with no symbolic form, such as an
+    aerodynamic table or a user function written with ``math``, is a ScenarioError naming it),
+    "python" (EntryVehicle and AtmosphereSystem, the reference), or "auto" (native when every
+    model has a symbolic form, else python)."""
+    if plant not in PLANTS:
+        raise ScenarioError(f"simulation.plant = '{plant}'; allowed: {', '.join(PLANTS)}")
+    systems, used = None, "python"
+    if plant != "python":
+        try:
+            systems = (NativeEntryVehicle(vehicle, planet, initial_state=initial_state),
+                       NativeAtmosphere(atmosphere, planet))
+            used = "native"
+        except (UnsupportedScalarError, TypeError) as e:
+            if plant == "native":
+                raise ScenarioError(f"simulation.plant = 'native' needs models with a symbolic form: {e} "
+                                    f"(use plant 'auto' or 'python')") from None
+    if systems is None:
+        systems = (EntryVehicle(vehicle, planet, atmosphere, initial_state=initial_state, air_data_input=True),
+                   AtmosphereSystem(atmosphere, planet))
+    body = builder.AddNamedSystem("vehicle", systems[0])
+    air = builder.AddNamedSystem("atmosphere", systems[1])
+    builder.Connect(body.GetOutputPort("state"), air.GetInputPort("state"))
+    builder.Connect(air.GetOutputPort("air_data"), body.GetInputPort("air_data"))
+    return body, air, used

@@ -505,3 +505,40 @@ def test_yaml_verification_tolerances_default_to_the_library_and_are_checked():
     assert (s.dynamics_tolerance, s.propagation_tolerance) == (nlp.DYNAMICS_TOLERANCE, nlp.PROPAGATION_TOLERANCE)
     with pytest.raises(ScenarioError, match=r"solve.dynamics_tolerance = 2.0 is out of range; allowed \(0, 1\)"):
         validate_solve(dc.replace(s, dynamics_tolerance=2.0))
+
+
+def test_a_long_solve_prints_its_progress_and_ctrl_c_stops_it(monkeypatch, capsys):
+    """Progress lines (elapsed, evaluations, objective, LGL collocation violation) once a solve
+    has run PROGRESS_AFTER_S (0 here), the violation falling from the guess to the answer; a
+    Ctrl-C inside a callback reaches the caller as KeyboardInterrupt under both solvers."""
+    from drake_entry.planning.nlp import evaluator
+    from drake_entry.planning.nlp.catalogue import brachistochrone
+
+    monkeypatch.setattr(evaluator, "PROGRESS_AFTER_S", 0.0)
+    monkeypatch.setattr(evaluator, "PROGRESS_INTERVAL_S", 0.0)
+    r = nlp.solve(brachistochrone()[0], nodes=15, solver="ipopt", progress=True)
+    assert r.converged
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("  [lgl 15 nodes, ipopt]")]
+    assert len(lines) > 5 and all("evaluations" in ln and "(Ctrl-C stops the solve)" in ln for ln in lines)
+    violations = [float(ln.split("largest collocation violation ")[1].split()[0]) for ln in lines
+                  if "violation" in ln]
+    assert violations[0] > 1e-3 and violations[-1] < 1e-6
+    assert nlp.solve(brachistochrone()[0], nodes=15, solver="ipopt", progress=False).converged
+    assert "evaluations" not in capsys.readouterr().err
+    with pytest.raises(ScenarioError, match="progress = 'yes'; allowed: True, False, 'auto'"):
+        nlp.solve(brachistochrone()[0], nodes=15, progress="yes")
+
+    calls = {"n": 0}
+    original = evaluator._NodeEvaluator.evaluate
+
+    def interrupted(self, Xs, Us):
+        calls["n"] += 1
+        if calls["n"] == 4:
+            raise KeyboardInterrupt
+        return original(self, Xs, Us)
+
+    monkeypatch.setattr(evaluator._NodeEvaluator, "evaluate", interrupted)
+    for name in nlp.auto_solvers():
+        calls["n"] = 0
+        with pytest.raises(KeyboardInterrupt):
+            nlp.solve(brachistochrone()[0], nodes=15, solver=name, progress=False)

@@ -40,6 +40,7 @@ evaluator (node values and Jacobians), transcription (shared parts), lgl, dircol
 from __future__ import annotations
 
 import math
+import sys
 import tempfile
 import time as _time
 
@@ -48,6 +49,7 @@ from pydrake.solvers import IpoptSolver, SnoptSolver, SolverOptions
 
 from drake_entry.errors import ScenarioError
 from drake_entry.planning.nlp.dircol import _DircolTranscription
+from drake_entry.planning.nlp.evaluator import SolveProgress
 from drake_entry.planning.nlp.guess import initial_guess
 from drake_entry.planning.nlp.lgl import _LglTranscription
 from drake_entry.planning.nlp.mesh import MAX_NODES, MeshStep, mesh_error, next_nodes  # noqa: F401 (API)
@@ -77,7 +79,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
           solver_options: dict | None = None, log_file: str | None = None, verifier=None,
           dynamics_tolerance: float = DYNAMICS_TOLERANCE,
           propagation_tolerance: float = PROPAGATION_TOLERANCE, refine: bool = False,
-          max_nodes: int | None = None) -> NlpResult:
+          max_nodes: int | None = None, progress="auto") -> NlpResult:
     """Solve ``problem`` (see module docstring); ``success`` only when verified.
 
     Args:
@@ -107,23 +109,18 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
         ``dynamics_tolerance`` (and the flown controls ``propagation_tolerance``) or
         ``max_nodes`` is reached; the meshes are in ``result.mesh_history``.
       max_nodes: refinement's node cap (default nlp.mesh.MAX_NODES: LGL 150, dircol 400).
+      progress: a line on stderr every 5 s once a solve has run 5 s (elapsed time, evaluations,
+        objective, LGL collocation violation: evaluator.SolveProgress): True, False, or 'auto'
+        (when stderr is a terminal). Ctrl-C stops the solve with KeyboardInterrupt, as under
+        either solver (SNOPT reports it as a RuntimeError naming it, which is re-raised as such).
     """
-    if transcription not in TRANSCRIPTIONS:
-        raise ScenarioError(f"transcription '{transcription}' is unknown; allowed: {', '.join(TRANSCRIPTIONS)}")
-    if solver not in SOLVERS + ("auto",):
-        raise ScenarioError(f"solver '{solver}' is unknown; allowed: auto, {', '.join(SOLVERS)}")
+    check_options(transcription=transcription, solver=solver, nodes=nodes, tolerance=tolerance,
+                  max_iterations=max_iterations, dynamics_tolerance=dynamics_tolerance,
+                  propagation_tolerance=propagation_tolerance, progress=progress)
     names = auto_solvers() if solver == "auto" else (solver,)
     if solver == "auto" and solver_options:
         raise ScenarioError("solver_options are by the solver's own names: give solver='snopt' or 'ipopt' with them")
-    if not (isinstance(nodes, (int, np.integer)) and nodes >= 3):
-        raise ScenarioError(f"nodes must be an integer >= 3, got {nodes}")
-    if not 0 < tolerance < 1:
-        raise ScenarioError(f"tolerance = {tolerance} is out of range; allowed (0, 1)")
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 1:
-        raise ScenarioError(f"max_iterations = {max_iterations} is out of range; allowed: an integer >= 1")
-    for name, value in (("dynamics_tolerance", dynamics_tolerance), ("propagation_tolerance", propagation_tolerance)):
-        if not 0 < value < 1:
-            raise ScenarioError(f"{name} = {value} is out of range; allowed (0, 1)")
+    show = bool(progress is True or (progress == "auto" and sys.stderr.isatty()))
     engines = {name: _engine(name) for name in names}
     cap = max(MAX_NODES[transcription], nodes) if max_nodes is None else max_nodes
     if refine and not (isinstance(cap, (int, np.integer)) and cap >= nodes):
@@ -149,7 +146,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
         for name, engine in engines.items():
             for label, start in starts:
                 result, words, diagnosis = _solve_mesh(problem, transcription, name, engine, nodes, start, scaling,
-                                                       options[name][0])
+                                                       options[name][0], show)
                 mesh_time, build_time = mesh_time + result.solve_time, build_time + result.build_time
                 calls, callback_time = calls + result.callback_calls, callback_time + result.callback_time
                 words = words + label
@@ -203,6 +200,28 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
         return result
 
 
+def check_options(*, transcription: str = "lgl", solver: str = "auto", nodes: int = 40, tolerance: float = 1e-8,
+                  max_iterations: int = 3000, dynamics_tolerance: float = DYNAMICS_TOLERANCE,
+                  propagation_tolerance: float = PROPAGATION_TOLERANCE, progress="auto") -> None:
+    """``solve``'s options checked (a ScenarioError naming the option and its allowed range), so a
+    caller can refuse bad options before a first, coarse solve."""
+    if transcription not in TRANSCRIPTIONS:
+        raise ScenarioError(f"transcription '{transcription}' is unknown; allowed: {', '.join(TRANSCRIPTIONS)}")
+    if solver not in SOLVERS + ("auto",):
+        raise ScenarioError(f"solver '{solver}' is unknown; allowed: auto, {', '.join(SOLVERS)}")
+    if not (isinstance(nodes, (int, np.integer)) and nodes >= 3):
+        raise ScenarioError(f"nodes must be an integer >= 3, got {nodes}")
+    if not 0 < tolerance < 1:
+        raise ScenarioError(f"tolerance = {tolerance} is out of range; allowed (0, 1)")
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 1:
+        raise ScenarioError(f"max_iterations = {max_iterations} is out of range; allowed: an integer >= 1")
+    for name, value in (("dynamics_tolerance", dynamics_tolerance), ("propagation_tolerance", propagation_tolerance)):
+        if not 0 < value < 1:
+            raise ScenarioError(f"{name} = {value} is out of range; allowed (0, 1)")
+    if progress not in (True, False, "auto"):
+        raise ScenarioError(f"progress = {progress!r}; allowed: True, False, 'auto'")
+
+
 def auto_solvers() -> tuple:
     """The solvers solver='auto' tries in turn: SNOPT (when this pydrake build has it), then
     Ipopt from the same start when SNOPT does not converge. SNOPT first for speed: Drake
@@ -229,10 +248,10 @@ def _engine(name: str, check: bool = True):
     return None
 
 
-def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, options):
+def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, options, show: bool = False):
     """One transcription and solve on ``nodes`` nodes: (NlpResult with ``converged`` and this
     mesh's build and solve times, the solver's verdict in words, the violation diagnosis
-    when not converged)."""
+    when not converged); ``show``: progress lines on stderr (SolveProgress)."""
     t_build = _time.perf_counter()
     scales = resolve_scaling(problem, guess, scaling)
     tx = (_LglTranscription(problem, nodes, scales) if transcription == "lgl"
@@ -241,10 +260,13 @@ def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, o
     tx.scale_objective()
     build_time = _time.perf_counter() - t_build
     t0, calls0, seconds0 = _time.perf_counter(), tx.timer.calls, tx.timer.seconds
-    res = engine.Solve(tx.prog, tx.initial_guess, options)
+    if show:
+        tx.timer.progress = SolveProgress(f"{transcription} {nodes} nodes, {solver}")
+        tx.timer.progress.start()
+    res = _interruptible(engine.Solve, tx.prog, tx.initial_guess, options)
     converged, words = verdict(res, solver)
     if not converged and restartable(res, solver) and tx.worst_violation(res)[0] <= RESTART_VIOLATION:
-        res = engine.Solve(tx.prog, res.GetSolution(), options)  # one warm restart (status.restartable)
+        res = _interruptible(engine.Solve, tx.prog, res.GetSolution(), options)  # one warm restart (status.restartable)
         converged, restart_words = verdict(res, solver)
         words = f"{restart_words} after a warm restart from '{words}'"
     solve_time = _time.perf_counter() - t0
@@ -254,6 +276,17 @@ def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, o
     result.build_time, result.solve_time = build_time, solve_time
     result.callback_calls, result.callback_time = calls, seconds
     return result, words, ("" if result.converged else tx.diagnose())
+
+
+def _interruptible(solve, *args):
+    """``solve(*args)``; a Ctrl-C inside a Python callback reaches the caller as KeyboardInterrupt
+    (SNOPT wraps it in a RuntimeError that names it; Ipopt passes it on)."""
+    try:
+        return solve(*args)
+    except RuntimeError as e:
+        if "KeyboardInterrupt" in str(e):
+            raise KeyboardInterrupt from None
+        raise
 
 
 def _mesh_words(history, tolerance, cap) -> str:

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 import os
+import sys
+import time
 
 from drake_entry.cli import Command
 
@@ -40,7 +42,18 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> int:
-    """Solve, verify, write the solution table, summary.json and figures; exit 0 when verified."""
+    """Solve, verify, write the solution table, summary.json and figures; exit 0 when verified,
+    130 after Ctrl-C (one line, nothing written)."""
+    t0 = time.perf_counter()
+    try:
+        return _solve_and_write(args)
+    except KeyboardInterrupt:
+        print(f"drake-entry optimize: interrupted after {time.perf_counter() - t0:.0f} s; nothing was written",
+              file=sys.stderr)
+        return 130
+
+
+def _solve_and_write(args) -> int:
     from drake_entry.campaign.tables import write_table
     from drake_entry.diagrams.verification import fly_controls
     from drake_entry.planning import nlp
@@ -53,15 +66,19 @@ def run(args) -> int:
     solver = args.solver or settings.solver
     tol = settings.tolerance if args.tolerance is None else args.tolerance
     max_iterations = settings.max_iterations if args.max_iterations is None else args.max_iterations
+    refine = args.refine or settings.refine
+    # the main solve's options first: a bad one is refused before the coarse solve runs
+    nlp.check_options(transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
+                      max_iterations=max_iterations, dynamics_tolerance=settings.dynamics_tolerance,
+                      propagation_tolerance=settings.propagation_tolerance)
     guess = None
     coarse_nodes = settings.coarse_nodes if args.coarse is None else args.coarse
     if coarse_nodes and coarse_nodes < nodes:
         print(f"coarse solve: {transcription}, {coarse_nodes} nodes, {solver} ...", flush=True)
         coarse = nlp.solve(problem, transcription=transcription, solver=solver, nodes=coarse_nodes,
-                           tolerance=max(tol, 1e-6), max_iterations=max_iterations)
+                           tolerance=max(tol, 1e-6), max_iterations=max_iterations, progress=True)
         print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
         guess = coarse if coarse.converged else None
-    refine = args.refine or settings.refine
     max_nodes = (args.max_nodes or settings.max_nodes or None) if refine else None
     how = f"mesh refinement from {nodes} nodes" if refine else f"{nodes} nodes"
     print(f"solve: {problem.name}, {transcription}, {how}, {solver} ...", flush=True)
@@ -69,7 +86,7 @@ def run(args) -> int:
                        max_iterations=max_iterations, guess=guess,
                        verifier=None if args.no_propagate else fly_controls,
                        refine=refine, max_nodes=max_nodes, dynamics_tolerance=settings.dynamics_tolerance,
-                       propagation_tolerance=settings.propagation_tolerance)
+                       propagation_tolerance=settings.propagation_tolerance, progress=True)
     check = result.verification.flight if result.verification is not None else None
     info = nlp.summary(problem, result, check)
     os.makedirs(args.out, exist_ok=True)

@@ -41,7 +41,8 @@ class _DircolTranscription(_Transcription):
         if problem.has_lagrange:  # trapezoid rule over the samples
             for k in range(N - 1):
                 prog.AddCost(self.timer.wrap(lambda z: 0.5 * self.cost_factor * z[-1] * (
-                    self.L_scaled(z[:nx], z[nx:nx + nu]) + self.L_scaled(z[nx + nu:2 * nx + nu], z[2 * nx + nu:-1]))),
+                    self.L_scaled(z[:nx], z[nx:nx + nu]) + self.L_scaled(z[nx + nu:2 * nx + nu], z[2 * nx + nu:-1])),
+                    cost=True),
                              np.concatenate([self.X[k], self.U[k], self.X[k + 1], self.U[k + 1], [self.H[k]]]))
         self.collocation = [b for b in prog.GetAllConstraints()
                             if b.evaluator().get_description().startswith("collocation constraint")]

@@ -3,29 +3,86 @@ and the timer of the Python callbacks a solver calls."""
 from __future__ import annotations
 
 import functools
+import math
+import sys
 import time
 
 import numpy as np
 
 
+#: a solve prints progress once it has run this long [s], then at this interval [s]
+PROGRESS_AFTER_S, PROGRESS_INTERVAL_S = 5.0, 5.0
+
+
+class SolveProgress:
+    """Console progress of a long solve: once it has run ``after`` seconds, a line every
+    ``interval`` seconds with the elapsed time, the solver's evaluations of the problem
+    functions, the objective at the latest evaluation (solver units) and, where one constraint
+    holds every collocation row (LGL), its largest scaled violation there."""
+
+    def __init__(self, label: str, *, stream=None, after: float | None = None, interval: float | None = None):
+        self.label, self.stream = label, stream or sys.stderr
+        self.after = PROGRESS_AFTER_S if after is None else after
+        self.interval = PROGRESS_INTERVAL_S if interval is None else interval
+        self.t0 = self.next = math.inf
+        self.lines = 0
+
+    def start(self):
+        self.t0 = time.perf_counter()
+        self.next = self.t0 + self.after
+
+    def due(self) -> bool:
+        return time.perf_counter() >= self.next
+
+    def report(self, calls: int, objective: float | None, violation: float | None):
+        now = time.perf_counter()
+        self.next = now + self.interval
+        parts = [f"{now - self.t0:6.0f} s", f"{calls} evaluations"]
+        if objective is not None:
+            parts.append(f"objective {objective:.8g}")
+        if violation is not None:
+            parts.append(f"largest collocation violation {violation:.2e} (scaled)")
+        print(f"  [{self.label}] " + ", ".join(parts) + " (Ctrl-C stops the solve)", file=self.stream, flush=True)
+        self.lines += 1
+
+
 class CallbackTimer:
     """Calls and wall time [s] of the Python callbacks handed to the solver (model values,
-    Jacobians, AutoDiff packing): the rest of a solve's time is the solver's own and Drake's."""
+    Jacobians, AutoDiff packing): the rest of a solve's time is the solver's own and Drake's.
+    With ``progress`` (a SolveProgress) it also prints the solve's progress when due."""
 
     def __init__(self):
         self.calls, self.seconds = 0, 0.0
+        self.progress: SolveProgress | None = None
+        self._costs, self._violation = {}, None
 
-    def wrap(self, fn):
-        """``fn`` counted and timed."""
+    def wrap(self, fn, *, cost: bool = False, bounds: tuple | None = None):
+        """``fn`` counted and timed; ``cost``: its value is a term of the objective; ``bounds``
+        (lower, upper): a constraint holding every collocation row, whose violation progress reports."""
         @functools.wraps(fn)
         def timed(*args):
             t0 = time.perf_counter()
+            out = None
             try:
-                return fn(*args)
+                out = fn(*args)
+                return out
             finally:
                 self.seconds += time.perf_counter() - t0
                 self.calls += 1
+                if out is not None and self.progress is not None:
+                    self._observe(timed, out, cost, bounds)
         return timed
+
+    def _observe(self, key, out, cost: bool, bounds):
+        if cost:
+            self._costs[key] = float(out.value() if hasattr(out, "value") else out)
+        if not self.progress.due():
+            return
+        if bounds is not None:
+            v = np.array([e.value() if hasattr(e, "value") else e for e in np.ravel(out)], float)
+            self._violation = float(np.max(np.maximum(bounds[0] - v, 0.0) + np.maximum(v - bounds[1], 0.0),
+                                           initial=0.0))
+        self.progress.report(self.calls, sum(self._costs.values()) if self._costs else None, self._violation)
 
 
 class _NodeEvaluator:

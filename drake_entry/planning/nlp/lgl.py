@@ -39,13 +39,13 @@ class _LglTranscription(_Transcription):
         lo = np.concatenate([np.zeros(N * nx), np.repeat(path_lo, N)])
         hi = np.concatenate([np.zeros(N * nx), np.repeat(path_hi, N)])
         # path rows are ordered path-major: row N nx + c N + k
-        self.collocation = prog.AddConstraint(self.timer.wrap(self._constraint), lo, hi, self.z,
+        self.collocation = prog.AddConstraint(self.timer.wrap(self._constraint, bounds=(lo, hi)), lo, hi, self.z,
                                               description="LGL defects and path")
         self.collocation.evaluator().SetGradientSparsityPattern(self._sparsity())
         self.add_bounds(prog, self.X, self.U, self.X[0], self.X[-1])
         self.add_terminal(prog, self.X[-1], self.U[-1])
         if problem.has_lagrange:
-            prog.AddCost(self.timer.wrap(self._lagrange_cost), self.z)
+            prog.AddCost(self.timer.wrap(self._lagrange_cost, cost=True), self.z)
         self.mayer_cost(prog, self.X[-1], None if self.tf is None else [self.tf])
 
     # -- variable layout ------------------------------------------------------------------

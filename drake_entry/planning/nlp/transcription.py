@@ -99,11 +99,11 @@ class _Transcription:
         nx = self.nx
         if tf_vars is None:
             tf = self.t_lo
-            prog.AddCost(self.timer.wrap(lambda z: self.problem.mayer(z * self.sx, tf) * (self.cost_factor / self.ts)),
-                         x_last)
+            prog.AddCost(self.timer.wrap(lambda z: self.problem.mayer(z * self.sx, tf) * (self.cost_factor / self.ts),
+                                         cost=True), x_last)
         else:
             prog.AddCost(self.timer.wrap(lambda z: self.problem.mayer(z[:nx] * self.sx, z[nx:].sum() * self.ts)
-                                         * (self.cost_factor / self.ts)),
+                                         * (self.cost_factor / self.ts), cost=True),
                          np.concatenate([x_last, np.atleast_1d(tf_vars)]))
 
     def worst_violation(self, res) -> tuple[float, str]:

@@ -9,7 +9,6 @@ import time
 
 import numpy as np
 
-
 #: a solve prints progress once it has run this long [s], then at this interval [s]
 PROGRESS_AFTER_S, PROGRESS_INTERVAL_S = 5.0, 5.0
 

@@ -6,7 +6,7 @@ per integrator stage. The Python systems (``EntryVehicle``, ``AtmosphereSystem``
 reference; tests hold the two to each other (derivatives, conditions, a flight's end).
 
 NativeEntryVehicle (a Diagram named like the vehicle it replaces, the same ports):
-  - input  "bank" [1], "alpha" [1] [rad], "air_data" [2] (density kg/m^3, speed of sound m/s)
+  - input  "bank" [1] and "alpha" [1] in rad, "air_data" [2] (density kg/m^3, speed of sound m/s)
   - output "state"             [6]  [h m, lon rad, lat rad, V m/s, gamma rad, psi rad]
   - output "flight_conditions" [9]  drake_entry.models.dynamics.FlightConditions
   inside: "equations_of_motion", a SymbolicVectorSystem whose continuous state is the

@@ -138,6 +138,9 @@ def summary_statistics(rows: dict) -> dict:
                            "planning_share": float(cost["planning_wall_s"].sum() / w[reached].sum()),
                            "plans_per_sample": float(cost["plans"].mean()),
                            "derivative_evaluations_per_sample": float(cost["derivative_evaluations"].mean())}
+            plants = [p for p in rows.get("plant", []) if isinstance(p, str)]
+            if plants:  # which plant realisation flew (systems/native_plant.py), with its count
+                out["cost"]["plants"] = {p: plants.count(p) for p in sorted(set(plants))}
     return out
 
 
@@ -630,7 +633,9 @@ def _cost(stats_: dict) -> str:
     c = stats_["cost"]
     return (f"## Cost\n\n{c['wall_s_per_sample']:.2f} s of one core per sample, {100 * c['planning_share']:.0f} % of "
             f"it re-planning ({c['plans_per_sample']:.1f} plans), {c['derivative_evaluations_per_sample']:.0f} plant "
-            "derivative evaluations.")
+            "derivative evaluations" + (" on the " + " and ".join(f"{p} plant ({k} samples)" for p, k in
+                                                                  c["plants"].items()) if c.get("plants") else "")
+            + ".")
 
 
 def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: str, meta: dict | None = None) -> list:

@@ -12,6 +12,7 @@ from pydrake.systems.primitives import LogVectorOutput
 from drake_entry.errors import ModelRangeError, NonFiniteStateError
 from drake_entry.models.trajectory import Trajectory
 from drake_entry.scenario import Scenario
+from drake_entry.systems.native_plant import as_flight_error
 
 
 def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loop: bool = False):
@@ -108,8 +109,11 @@ def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_st
     try:
         reason = stop_reason(simulator.AdvanceTo(scenario.simulation.max_time_s))
         final = True
-    except (NonFiniteStateError, ModelRangeError, OverflowError) as e:  # a NaN, an overflow, or a state
-        # the models do not cover: stop with the reason, keep the log
+    except (NonFiniteStateError, ModelRangeError, OverflowError, ValueError) as raised:  # a NaN, an overflow,
+        # or a state the models do not cover: stop with the reason, keep the log
+        e = as_flight_error(raised)
+        if isinstance(e, ValueError):  # a ValueError that is not the native plant's NaN is a bug
+            raise
         reason = f"stopped at t = {simulator.get_context().get_time():.3f} s: {e}"
         final = False
     wall = _time.perf_counter() - t0

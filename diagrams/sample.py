@@ -22,6 +22,7 @@ from drake_entry.errors import load_yaml_typed
 from drake_entry.models.dispersions import draw
 from drake_entry.models.trajectory import control_activity, metrics
 from drake_entry.scenario import Scenario
+from drake_entry.systems.native_plant import as_flight_error
 
 TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
 #: the first samples are stored at this finer step [s] (the report's bank histories), when the
@@ -87,7 +88,8 @@ def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
                     "derivative_evaluations": integrator.get_num_derivative_evaluations()})
         step = min(trajectory_step_s, DETAILED_STEP_S) if index < DETAILED_SAMPLES else trajectory_step_s
         traj = downsample(tr, index, step) if trajectory_step_s > 0 else None
-    except Exception as e:  # one failed sample never stops the campaign
+    except Exception as raised:  # one failed sample never stops the campaign
+        e = as_flight_error(raised)
         row.update(box["draw"].columns() if "draw" in box else {})
         row.update({"success": False, "message": f"{type(e).__name__}: {e}".splitlines()[0][:500],
                     "traceback": traceback.format_exc(limit=3)[-2000:]})

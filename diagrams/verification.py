@@ -35,7 +35,7 @@ from drake_entry.planning.ocp_system import OptimalControlPlant
 from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, OcpControls
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.monitors import PlantGuard
-from drake_entry.systems.native_plant import add_plant
+from drake_entry.systems.native_plant import add_plant, as_flight_error
 from drake_entry.systems.schedule import ScheduleSource
 
 #: fixed RK5 steps per actuator period (see the module docstring for the measured error)
@@ -46,7 +46,7 @@ OCP_ACCURACY = 1e-11
 #: samples logged over a flight (the integrator's own steps are logged as well for entries)
 LOG_POINTS = 2000
 #: what stops a flight early: a model outside its range, a NaN, Drake's own step-size failure
-FLIGHT_ERRORS = (RuntimeError, ModelRangeError, NonFiniteStateError, OverflowError)
+FLIGHT_ERRORS = (RuntimeError, ModelRangeError, NonFiniteStateError, OverflowError, ValueError)
 
 
 def fly_controls(controls: EntryControls | OcpControls, *, accuracy: float | None = None,
@@ -158,7 +158,10 @@ def _advance(simulator: Simulator, tf: float) -> str:
     simulator.Initialize()
     try:
         simulator.AdvanceTo(tf)
-    except FLIGHT_ERRORS as e:  # gamma reaching -90 deg, h below the atmosphere model, a NaN
+    except FLIGHT_ERRORS as raised:  # gamma reaching -90 deg, h below the atmosphere model, a NaN
+        e = as_flight_error(raised)
+        if isinstance(e, ValueError):  # a ValueError that is not the native plant's NaN is a bug
+            raise
         t = simulator.get_context().get_time()
         return f"the flight stopped at t = {t:.2f} s of {tf:.2f} s: {first_sentence(str(e))}"
     return ""

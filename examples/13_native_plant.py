@@ -20,42 +20,25 @@ import time
 
 import matplotlib.pyplot as plt
 import numpy as np
-from pydrake.systems.framework import DiagramBuilder
 
 from drake_entry.claims import Claims
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
 from drake_entry.scenario import load_scenario
-from drake_entry.systems.native_plant import add_plant
+from drake_entry.systems.native_plant import PlantProbe
 
 
 def compare_derivatives(scenario, states: int = 200) -> float:
     """Largest relative difference of the plants' derivatives and flight conditions at random states."""
-    vehicle, planet, atmosphere = scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere()
-    plants = []
-    for kind in ("python", "native"):
-        builder = DiagramBuilder()
-        plant, _, _ = add_plant(builder, vehicle, planet, atmosphere, initial_state=None, plant=kind)
-        builder.ExportInput(plant.GetInputPort("bank"), "bank")
-        builder.ExportInput(plant.GetInputPort("alpha"), "alpha")
-        plants.append((builder.Build(), kind))
+    models = scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere()
+    python, native = (PlantProbe(*models, plant=kind) for kind in ("python", "native"))
     rng = np.random.default_rng(13)
     worst = 0.0
     for _ in range(states):
         x = [rng.uniform(25e3, 85e3), rng.uniform(-3, 3), rng.uniform(-1, 1), rng.uniform(2e3, 7.5e3),
              rng.uniform(-0.1, 0.02), rng.uniform(-3, 3)]
         bank, alpha = rng.uniform(-1.3, 1.3), rng.uniform(0.2, 0.8)
-        out = []
-        for diagram, kind in plants:
-            ctx = diagram.CreateDefaultContext()
-            diagram.GetInputPort("bank").FixValue(ctx, [bank])
-            diagram.GetInputPort("alpha").FixValue(ctx, [alpha])
-            vehicle_system = diagram.GetSubsystemByName("vehicle")
-            sub = vehicle_system.GetMyMutableContextFromRoot(ctx)
-            vehicle_system.set_initial_state(sub, x)
-            xdot = (vehicle_system.state_derivatives(sub) if kind == "native"
-                    else vehicle_system.EvalTimeDerivatives(sub).CopyToVector())
-            out.append(np.concatenate([xdot, vehicle_system.GetOutputPort("flight_conditions").Eval(sub)]))
-        worst = max(worst, float(np.max(np.abs(out[1] - out[0]) / np.abs(out[0]))))
+        ref, got = (np.concatenate(probe(x, bank, alpha)) for probe in (python, native))
+        worst = max(worst, float(np.max(np.abs(got - ref) / np.abs(ref))))
     return worst
 
 

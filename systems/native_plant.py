@@ -26,7 +26,7 @@ from pydrake.symbolic import Expression, Variable
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import Multiplexer, SymbolicVectorSystem
 
-from drake_entry.errors import ScenarioError, UnsupportedScalarError
+from drake_entry.errors import NonFiniteStateError, ScenarioError, UnsupportedScalarError
 from drake_entry.models import dynamics
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
@@ -106,6 +106,20 @@ class NativeEntryVehicle(Diagram):
         self.GetMutableSubsystemContext(self._motion, context).SetContinuousState(np.asarray(x0, float) - self.x0)
 
 
+#: what Drake's symbolic evaluation says when a NaN (or a negative number) reaches a sqrt or log
+SYMBOLIC_DOMAIN_ERROR = "numerical argument out of domain"
+
+
+def as_flight_error(error: BaseException) -> BaseException:
+    """The error a flight stops on for ``error`` raised inside a simulation: a ValueError from
+    Drake's symbolic evaluation of the native plant (a NaN state reaching the atmosphere's sqrt
+    or log, often inside an integrator stage, before a witness sees it) becomes the
+    NonFiniteStateError the Python plant raises; any other error is returned as it is."""
+    if isinstance(error, ValueError) and SYMBOLIC_DOMAIN_ERROR in str(error):
+        return NonFiniteStateError(f"non-finite vehicle state in the native plant ({str(error).splitlines()[0]})")
+    return error
+
+
 _CONSTANT = Variable("constant")
 
 
@@ -150,3 +164,25 @@ def add_plant(builder, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, 
     builder.Connect(body.GetOutputPort("state"), air.GetInputPort("state"))
     builder.Connect(air.GetOutputPort("air_data"), body.GetInputPort("air_data"))
     return body, air, used
+
+
+class PlantProbe:
+    """One plant (``add_plant``) alone, its controls as inputs: ``probe(x, bank, alpha)`` gives its
+    state derivatives [6] and flight conditions [9] (SI) at any state and controls, to compare
+    realisations (tests, example 13). ``plant`` is the realisation built ("native" or "python")."""
+
+    def __init__(self, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, plant: str = "auto"):
+        builder = DiagramBuilder()
+        self.system, _, self.plant = add_plant(builder, vehicle, planet, atmosphere, initial_state=None, plant=plant)
+        builder.ExportInput(self.system.GetInputPort("bank"), "bank")
+        builder.ExportInput(self.system.GetInputPort("alpha"), "alpha")
+        self.diagram = builder.Build()
+
+    def __call__(self, x, bank: float, alpha: float) -> tuple[np.ndarray, np.ndarray]:
+        ctx = self.diagram.CreateDefaultContext()
+        self.diagram.GetInputPort("bank").FixValue(ctx, [bank])
+        self.diagram.GetInputPort("alpha").FixValue(ctx, [alpha])
+        sub = self.system.GetMyMutableContextFromRoot(ctx)
+        self.system.set_initial_state(sub, x)
+        return self.system.state_derivatives(sub), self.system.GetOutputPort("flight_conditions").Eval(sub).copy()
+

@@ -80,6 +80,10 @@ def EntryVehicle_(T):
             rho, mach, L, D = self._aero(context, x, alpha)
             output.SetFromVector(np.array(dynamics.conditions_from(x, alpha, rho, mach, L, D, self.vehicle, self.planet)))
 
+        def state_derivatives(self, context) -> np.ndarray:
+            """dx/dt [6] (SI per s) at this plant's ``context`` (as NativeEntryVehicle's)."""
+            return self.EvalTimeDerivatives(context).CopyToVector()
+
         def set_initial_state(self, context, x0):
             """Set the continuous state [h, lon, lat, V, gamma, psi] (SI) in ``context``."""
             context.get_mutable_continuous_state_vector().SetFromVector(np.asarray(x0))

@@ -10,7 +10,7 @@ from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from drake_entry.errors import ScenarioError
+from drake_entry.errors import ModelRangeError, NonFiniteStateError, ScenarioError
 from drake_entry.models.aerodynamics import ScaledAero, TableAero
 from drake_entry.models.atmosphere import (
     DispersedAtmosphere,
@@ -20,7 +20,14 @@ from drake_entry.models.atmosphere import (
 )
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import load_vehicle
-from drake_entry.systems.native_plant import NativeAtmosphere, NativeEntryVehicle, add_plant
+from drake_entry.systems.monitors import PlantGuard
+from drake_entry.systems.native_plant import (
+    NativeAtmosphere,
+    NativeEntryVehicle,
+    PlantProbe,
+    add_plant,
+    as_flight_error,
+)
 from drake_entry.systems.vehicle import EntryVehicle
 
 VEHICLES = ("horus2b", "sphynx", "shefex3", "cav_h", "marv")
@@ -74,13 +81,14 @@ def test_native_derivatives_and_conditions_equal_the_python_plant(vehicle_name, 
     atm = _atmospheres()["dispersed"]
     base = load_vehicle(vehicle_name)
     for vehicle in (base, _dispersed(base)):
-        diagrams = [_plant_diagram(native, vehicle, earth, atm) for native in (False, True)]
+        probes = [PlantProbe(vehicle, earth, atm, plant=kind) for kind in ("python", "native")]
+        assert [p.plant for p in probes] == ["python", "native"]
         rng = np.random.default_rng(3)
         for _ in range(25):
             x = np.array([rng.uniform(20e3, 90e3), rng.uniform(-3, 3), rng.uniform(-1.2, 1.2),
                           rng.uniform(1500.0, 7500.0), rng.uniform(-0.2, 0.1), rng.uniform(-3, 3)])
             bank, alpha = rng.uniform(-1.4, 1.4), rng.uniform(0.0, 0.8)
-            (xd_py, fc_py), (xd_nat, fc_nat) = (_evaluate(d, x, bank, alpha) for d in diagrams)
+            (xd_py, fc_py), (xd_nat, fc_nat) = (probe(x, bank, alpha) for probe in probes)
             assert np.all(np.abs(xd_nat - xd_py) <= 1e-9 * np.abs(xd_py) + 1e-300), (vehicle_name, x)
             assert np.all(np.abs(fc_nat - fc_py) <= 1e-9 * np.abs(fc_py) + 1e-300), (vehicle_name, x)
 
@@ -149,32 +157,41 @@ def test_a_campaign_row_names_the_plant_it_flew(tmp_path):
         assert row["stop"] == "max_time" and not row["success"]
 
 
+def test_plant_guard_stops_a_native_flight_where_the_python_plant_would_raise():
+    """The native plant cannot raise our errors: the PlantGuard's witness stops a flight at the end
+    of the step where it left the atmosphere model (ModelRangeError, as US76 raises); a NaN
+    state that reaches a sqrt inside a stage is Drake's ValueError, which the flight runners
+    turn into the NonFiniteStateError the Python plant raises (as_flight_error)."""
+    horus, earth, us76 = load_vehicle("horus2b"), Earth.spherical(), US76Atmosphere()
+    for bank, x0, error, words in (
+            (0.3, [999.5e3, 0.1, 0.2, 7000.0, 0.5, 1.0], ModelRangeError, "outside the PlantGuard range"),
+            (math.nan, [60e3, 0.1, 0.2, 6000.0, -0.02, 1.0], ValueError, "numerical argument out of domain")):
+        builder = DiagramBuilder()
+        plant, _, used = add_plant(builder, horus, earth, us76, initial_state=x0, plant="native")
+        guard = builder.AddSystem(PlantGuard(h_min=us76.h_min, h_max=us76.h_max, model="PlantGuard", planet=earth))
+        builder.Connect(plant.GetOutputPort("state"), guard.get_input_port())
+        for port, v in (("bank", bank), ("alpha", 0.6)):
+            builder.Connect(builder.AddSystem(ConstantVectorSource([v])).get_output_port(), plant.GetInputPort(port))
+        simulator = Simulator(builder.Build())
+        ResetIntegratorFromFlags(simulator, "runge_kutta3", 0.1).set_fixed_step_mode(True)
+        with pytest.raises(error, match=words) as raised:
+            simulator.AdvanceTo(30.0)
+        assert used == "native" and simulator.get_context().get_time() < 5.0
+        # a NaN reaches the atmosphere's sqrt inside an integrator stage, where Drake's symbolic
+        # evaluation refuses it: the flight runners take that as the non-finite state it is
+        stop = as_flight_error(raised.value)
+        assert isinstance(stop, error if error is ModelRangeError else NonFiniteStateError), stop
+
+
 # -- helpers ----------------------------------------------------------------------------
 def _dispersed(vehicle):
     return dc.replace(vehicle, mass=vehicle.mass * 1.04, aero=ScaledAero(vehicle.aero, 0.93, 1.07))
 
 
-def _plant_diagram(native, vehicle, earth, atm, *, bank=None, alpha=None, initial_state=None):
+def _plant_diagram(native, vehicle, earth, atm, *, bank, alpha, initial_state):
     builder = DiagramBuilder()
-    x0 = np.zeros(6) if initial_state is None else np.asarray(initial_state, float)
+    x0 = np.asarray(initial_state, float)
     plant, _, _ = add_plant(builder, vehicle, earth, atm, initial_state=x0, plant="native" if native else "python")
-    if bank is None:
-        builder.ExportInput(plant.GetInputPort("bank"), "bank")
-        builder.ExportInput(plant.GetInputPort("alpha"), "alpha")
-        return builder.Build()
     for port, v in (("bank", bank), ("alpha", alpha)):
         builder.Connect(builder.AddSystem(ConstantVectorSource([v])).get_output_port(), plant.GetInputPort(port))
     return builder.Build(), plant
-
-
-def _evaluate(diagram, x, bank, alpha):
-    """(xdot of the vehicle, flight conditions) at state x and fixed controls."""
-    ctx = diagram.CreateDefaultContext()
-    diagram.GetInputPort("bank").FixValue(ctx, [bank])
-    diagram.GetInputPort("alpha").FixValue(ctx, [alpha])
-    plant = diagram.GetSubsystemByName("vehicle")
-    sub = plant.GetMyMutableContextFromRoot(ctx)
-    plant.set_initial_state(sub, x)
-    xdot = plant.state_derivatives(sub) if isinstance(plant, NativeEntryVehicle) else \
-        plant.EvalTimeDerivatives(sub).CopyToVector()
-    return xdot, plant.GetOutputPort("flight_conditions").Eval(sub).copy()

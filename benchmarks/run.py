@@ -10,9 +10,9 @@ dymos           NLP path vs dymos (pip extra "bench"; not in "all") on the Brach
                 Betts' shuttle, same problem and nodes (default 31)
 campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios)
 interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline commit
-method-cost     every packaged guidance scenario: core seconds per sample split into plant,
-                planning, guidance, actuators and the rest, vs a baseline commit (--baseline,
-                default the previous commit; --only scenario names)
+method-cost     every packaged guidance scenario: core seconds per sample split into the plant
+                (the scenario's own, native or Python), on-board planning and the rest, vs a
+                baseline commit (--baseline, default the previous commit; --scenarios names)
 paper001        paper 001: SCvx nominal plan time and iterations by mesh vs the paper, flown by Drake
 aborts          paper 001: the 9 x 9 orbital-abort map through the campaign engine vs the 15-min goal
 paper003        paper 003: AMPI database storage, LD-HD reconstruction, synthesis vs OCP CPU time,

@@ -455,6 +455,7 @@ class ExponentialAtmosphere(Atmosphere):
                                 f"allowed (0, 1e4]")
 
     H_MAX = 1e7  # [m]: the formula holds at any height; this only catches nonsense (and NaN)
+    h_min, h_max = US76_H_MIN, H_MAX  # the range density() accepts (a native plant's PlantGuard reads it)
 
     def density(self, h):
         _check_range(self.name, h, US76_H_MIN, self.H_MAX)

@@ -77,6 +77,10 @@ class ScheduleSpec:
     smooth: bool = False  # quintic smoothstep between breakpoints (C2) instead of straight lines
 
 
+#: the plant realisations ``simulation.plant`` names (systems/native_plant.add_plant builds them)
+PLANTS = ("auto", "native", "python")
+
+
 @dc.dataclass
 class SimulationSpec:
     # hard stop [s] if no terminal condition triggers
@@ -267,8 +271,8 @@ class Scenario:
         if step != 0.0 and not (0.0 < step <= period and abs(period / step - round(period / step)) < 1e-9):
             raise ScenarioError(f"simulation.closed_loop_step_s = {step:g} s must be 0 (error control) or divide "
                                 f"guidance.period_s = {period:g} s (e.g. {period:g}, {period / 2:g}, {period / 4:g})")
-        if sim.plant not in ("auto", "native", "python"):
-            raise ScenarioError(f"simulation.plant '{sim.plant}' is unknown; allowed: auto, native, python")
+        if sim.plant not in PLANTS:
+            raise ScenarioError(f"simulation.plant '{sim.plant}' is unknown; allowed: {', '.join(PLANTS)}")
         if sim.integrator not in INTEGRATORS:
             raise ScenarioError(f"simulation.integrator '{sim.integrator}' is unknown; allowed: {', '.join(INTEGRATORS)}")
         for which in ("alpha", "bank"):

@@ -29,6 +29,15 @@ from drake_entry.models.planet import Earth
 CEILING_M = US76_H_MAX - 100e3
 
 
+def require_finite(x, context):
+    """``x``, the vehicle state [6]; NonFiniteStateError (with the time) when any entry is NaN or
+    infinite: how the witnesses below stop a native-plant flight, which cannot raise itself."""
+    total = float(x.sum())
+    if total - total != 0.0:
+        raise NonFiniteStateError(f"non-finite vehicle state at t = {context.get_time():.3f} s: {x.tolist()}")
+    return x
+
+
 class TerminationMonitor(LeafSystem):
     def __init__(self, *, altitude: float | None = None, mach: float | None = None,
                  energy: float | None = None, velocity: float | None = None, planet: Earth | None = None,
@@ -60,10 +69,7 @@ class TerminationMonitor(LeafSystem):
         """The altitude the band bounds [m]: the state altitude, or the geodetic one. A
         non-finite state stops the run here with NonFiniteStateError (the native plant, unlike
         the Python one, cannot raise from its derivatives; this witness runs every step)."""
-        x = self.state_port.Eval(context)
-        total = float(x.sum())
-        if total - total != 0.0:
-            raise NonFiniteStateError(f"non-finite vehicle state at t = {context.get_time():.3f} s: {x.tolist()}")
+        x = require_finite(self.state_port.Eval(context), context)
         return self.planet.atmospheric_altitude(x[0], x[2]) if self.geodetic else x[0]
 
     def _make_calc(self, name):
@@ -120,10 +126,7 @@ class PlantGuard(LeafSystem):
         self._witness = [self.MakeWitnessFunction("plant guard", WitnessFunctionDirection.kNone, self._check)]
 
     def _check(self, context) -> float:
-        x = self.state_port.Eval(context)
-        total = float(x.sum())
-        if total - total != 0.0:
-            raise NonFiniteStateError(f"non-finite vehicle state at t = {context.get_time():.3f} s: {x.tolist()}")
+        x = require_finite(self.state_port.Eval(context), context)
         h = self.planet.atmospheric_altitude(x[0], x[2])
         if not self.h_min <= h <= self.h_max:
             raise ModelRangeError(f"altitude h = {h:.6g} m is outside the {self.model} range "

@@ -31,6 +31,7 @@ from drake_entry.models import dynamics
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
+from drake_entry.scenario import PLANTS
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.vehicle import N_STATE, EntryVehicle
 
@@ -40,8 +41,6 @@ STATE = [Variable(name) for name in dynamics.STATE_NAMES]
 DEVIATION = [Variable(f"d{name}") for name in dynamics.STATE_NAMES]
 BANK, ALPHA, RHO, SPEED_OF_SOUND = (Variable(n) for n in ("bank", "alpha", "rho", "speed_of_sound"))
 
-#: the realisations ``add_plant`` builds ("auto": native when the models allow it)
-PLANTS = ("auto", "native", "python")
 
 
 class NativeAtmosphere(Diagram):

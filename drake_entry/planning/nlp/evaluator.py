@@ -24,7 +24,6 @@ class SolveProgress:
         self.after = PROGRESS_AFTER_S if after is None else after
         self.interval = PROGRESS_INTERVAL_S if interval is None else interval
         self.t0 = self.next = math.inf
-        self.lines = 0
 
     def start(self):
         self.t0 = time.perf_counter()
@@ -42,7 +41,6 @@ class SolveProgress:
         if violation is not None:
             parts.append(f"largest collocation violation {violation:.2e} (scaled)")
         print(f"  [{self.label}] " + ", ".join(parts) + " (Ctrl-C stops the solve)", file=self.stream, flush=True)
-        self.lines += 1
 
 
 class CallbackTimer:

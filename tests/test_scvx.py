@@ -387,8 +387,9 @@ def test_paper_lossless_plan_reports_its_gap_and_is_refused_when_its_bank_does_n
     """The paper's lossless relaxation (Table 3 'Lossless Bank': no floor on |u|, no rate limit,
     no margins, the heading regulariser) converges near the study's 520 MJ/m^2 with |u| < 1 at
     the skip and the final dive; its real bank flown by the Drake Simulator through the closed
-    loop's actuators misses: more than 5 km from the plan (16.5 km measured) and above the DRS
-    window, so the plan is refused, its message says why and points to the direct polish."""
+    loop's actuators misses: more than 5 km from the plan (12 to 17 km measured on different
+    machines) and above the DRS window, so the plan is refused, its message says why and points
+    to the direct polish."""
     vehicle, planet, atmosphere, _, _ = sphynx_case
     plan = paper_lossless_plan
     assert plan.message.startswith("converged in")

@@ -99,8 +99,9 @@ def fly_nominal(out_dir: str, scenario_yaml: str) -> None:
     DETAILED_STEP_S (``nominal.json``: the report overlays it on the campaign's envelopes).
     A flight that raises is not kept: the report then shows the campaign alone."""
     from drake_entry.diagrams.closed_loop import fly
-    from drake_entry.errors import DrakeEntryError, load_yaml_typed
+    from drake_entry.errors import DrakeEntryError
     from drake_entry.scenario import Scenario
+    from drake_entry.typed_yaml import load_yaml_typed
 
     try:
         scenario = load_yaml_typed(Scenario, text=scenario_yaml, where="campaign scenario").validate()

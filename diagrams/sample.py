@@ -18,11 +18,11 @@ from pydrake.systems.analysis import RandomSimulation
 
 from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, build_closed_loop, summarise
 from drake_entry.diagrams.common import collect_trajectory, make_simulator
-from drake_entry.errors import load_yaml_typed
 from drake_entry.models.dispersions import draw
 from drake_entry.models.trajectory import control_activity, metrics
 from drake_entry.scenario import Scenario
 from drake_entry.systems.native_plant import as_flight_error
+from drake_entry.typed_yaml import load_yaml_typed
 
 TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
 #: the first samples are stored at this finer step [s] (the report's bank histories), when the

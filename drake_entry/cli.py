@@ -180,15 +180,15 @@ def _cmd_campaign(args) -> int:
 
 
 def parse_overrides(items) -> dict:
-    """{'a.b': value} from ["a.b=value", ...]; values are read as YAML (numbers, booleans, lists)."""
-    import yaml
-
+    """{'a.b': 'text'} from ["a.b=text", ...]: the text is read later as YAML by the same typed
+    loader as a scenario file (scenario.apply_overrides), so it is checked against the field's
+    declared type and named by its full path."""
     out = {}
     for item in items:
         key, sep, text = item.partition("=")
-        if not sep or not key:
+        if not sep or not key.strip():
             raise ScenarioError(f"--set {item!r}: write FIELD=VALUE, e.g. guidance.resolve_period_s=100")
-        out[key.strip()] = yaml.safe_load(text)
+        out[key.strip()] = text
     return out
 
 

@@ -1,10 +1,6 @@
-"""User-facing errors and the typed YAML loader that turns schema errors into one line."""
+"""User-facing errors: each is printed by the CLI as one line (drake_entry.typed_yaml reads
+files and overrides into them)."""
 from __future__ import annotations
-
-import os
-import re
-
-from pydrake.common.yaml import yaml_load_typed
 
 
 class DrakeEntryError(Exception):
@@ -55,37 +51,3 @@ def check_range(field: str, value, lo: float, hi: float):
     """Raise a one-line ScenarioError unless lo <= value <= hi (None and NaN fail)."""
     if value is None or not (lo <= value <= hi):
         raise ScenarioError(f"{field} = {value} is out of range; allowed [{lo:g}, {hi:g}]")
-
-
-def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None, where: str | None = None):
-    """``yaml_load_typed`` with errors reported as a ScenarioError naming the file."""
-    where = where or path or "YAML"
-    if path is not None:
-        if not os.path.exists(path):
-            raise ScenarioError(f"file not found: {path}")
-        if os.path.isdir(path):
-            raise ScenarioError(f"{path} is a directory, not a YAML file")
-        try:
-            with open(path, encoding="utf-8") as f:
-                text = f.read()
-        except UnicodeDecodeError:
-            raise ScenarioError(f"{path} is not a text (UTF-8) YAML file") from None
-    if not text or not text.strip():
-        raise ScenarioError(f"{where}: the file is empty; a {schema.__name__} needs its fields")
-    try:
-        return yaml_load_typed(schema=schema, data=text)
-    except RuntimeError as e:  # unknown fields, wrong structure
-        msg = str(e)
-        if "were unknown to the schema" in msg:
-            names = msg[msg.index("["):msg.index("]") + 1]
-            msg = f"unknown field(s) {names}; check the spelling against the {schema.__name__} schema"
-        elif "did not match any of the allowed type options for" in msg:  # a Union field's !Tag
-            m = re.search(r"tag value '([^']*)'.*options for '([^']*)' \((.*)\)", msg)
-            if m:
-                allowed = ", ".join("!" + t for t in re.findall(r"\.(\w+)'>", m.group(3)))
-                msg = f"{m.group(2)}: unknown type tag '!{m.group(1)}'; allowed: {allowed}"
-        raise ScenarioError(f"{where}: {msg}") from None
-    except (ValueError, TypeError) as e:  # wrong scalar types
-        raise ScenarioError(f"{where}: {e}") from None
-    except Exception as e:  # the YAML parser itself
-        raise ScenarioError(f"{where}: not valid YAML: {str(e).splitlines()[0]}") from None

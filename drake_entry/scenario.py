@@ -12,7 +12,7 @@ from typing import Optional
 
 import numpy as np
 
-from drake_entry.errors import ScenarioError, check_range, load_yaml_typed
+from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance import GuidanceSpec, known_tags
 from drake_entry.guidance.drag_energy.spec import DragEnergy
 from drake_entry.models import dispersions as disp
@@ -22,6 +22,7 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import VARIABLES, Schedule
 from drake_entry.models.vehicles import Vehicle, load_vehicle
 from drake_entry.models.verdict import PathLimit, vehicle_path_limits
+from drake_entry.typed_yaml import load_yaml_typed, override
 
 
 @dc.dataclass
@@ -315,6 +316,10 @@ PACKAGED_SCENARIOS = tuple(sorted(p.name[:-5] for p in resources.files("drake_en
 
 def load_scenario(name_or_path: str) -> Scenario:
     """Read and validate a scenario: a packaged name or a YAML file path."""
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        raise ScenarioError(f"a scenario is a packaged name ({', '.join(PACKAGED_SCENARIOS)}) or a YAML file "
+                            f"path; got {type(name_or_path).__name__}")
+    name_or_path = os.fspath(name_or_path)
     if name_or_path in PACKAGED_SCENARIOS:
         text = resources.files("drake_entry").joinpath(f"scenarios/{name_or_path}.yaml").read_text()
         scenario = load_yaml_typed(Scenario, text=text, where=f"scenario '{name_or_path}'")
@@ -322,7 +327,7 @@ def load_scenario(name_or_path: str) -> Scenario:
         try:
             scenario = load_yaml_typed(Scenario, path=name_or_path)
         except ScenarioError as e:
-            if "unknown field(s) ['method']" in str(e):  # a scenario written before the method tags
+            if "guidance.method: unknown field" in str(e):  # a scenario written before the method tags
                 raise ScenarioError(f"{name_or_path}: guidance 'method:' is now a YAML tag: write "
                                     f"'guidance: !DragEnergy' (known: {known_tags()})") from None
             raise
@@ -332,16 +337,20 @@ def load_scenario(name_or_path: str) -> Scenario:
     return scenario.validate()
 
 
-def apply_overrides(scenario: Scenario, overrides: dict):
-    """Set dotted fields, e.g. {'guidance.replan_period_s': 0}."""
-    for key, value in (overrides or {}).items():
-        obj = scenario
-        *path, last = key.split(".")
-        for p in path:
-            obj = getattr(obj, p)
-        if not hasattr(obj, last):
-            raise ScenarioError(f"override '{key}': no such field")
-        setattr(obj, last, value)
+def apply_overrides(scenario: Scenario, overrides: dict | None):
+    """Set dotted fields, e.g. {'guidance.replan_period_s': '0'}, through the same typed checks
+    and loader as a scenario file (drake_entry.typed_yaml.override): a string value is read as
+    YAML text, as after ``--set FIELD=``; other values are written as YAML first. Then the
+    scenario is validated again. Every refusal is one ScenarioError naming the field path."""
+    if overrides is None:
+        overrides = {}
+    if not isinstance(overrides, dict):
+        raise ScenarioError(f"overrides must be a mapping of dotted field paths to values, e.g. "
+                            f"{{'guidance.period_s': 2.0}}; got {type(overrides).__name__}")
+    if not isinstance(scenario, Scenario):
+        raise ScenarioError(f"apply_overrides needs a Scenario (load_scenario), got {type(scenario).__name__}")
+    for key, value in overrides.items():
+        override(scenario, key, value, where="override")
     scenario.validate()
 
 

@@ -1,6 +1,7 @@
 """The layers of docs/architecture.md, read from the import statements of every module.
 
-  models    drake_entry/errors.py, drake_entry/models/     physics; imports nothing else of the project
+  models    drake_entry/errors.py, typed_yaml.py,          physics and the typed YAML reader; import nothing
+            drake_entry/models/                            else of the project
   planning  drake_entry/ (all but the other rows)          shared planning, method planners and specs,
                                                            scenario, campaign outputs
   systems   systems/                                       Drake LeafSystems
@@ -22,7 +23,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 ORDER = ("models", "planning", "systems", "methods", "diagrams", "cli")
-SHARED = ("drake_entry.models", "drake_entry.planning", "drake_entry.campaign", "drake_entry.errors")
+SHARED = ("drake_entry.models", "drake_entry.planning", "drake_entry.campaign", "drake_entry.errors",
+          "drake_entry.typed_yaml")
 
 
 def setuptools_config() -> dict:
@@ -50,7 +52,7 @@ def module_name(path: Path) -> str:
 
 def layer(module: str) -> str:
     parts = module.split(".")
-    if module == "drake_entry.errors" or parts[:2] == ["drake_entry", "models"]:
+    if module in ("drake_entry.errors", "drake_entry.typed_yaml") or parts[:2] == ["drake_entry", "models"]:
         return "models"
     if parts[:2] == ["drake_entry", "systems"]:
         return "systems"

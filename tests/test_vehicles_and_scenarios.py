@@ -61,7 +61,7 @@ def _write(tmp_path, text):
 
 def test_misspelled_field_is_one_clear_line(tmp_path):
     p = _write(tmp_path, "name: x\nvehicle: horus2b\nentry: {altitude_km: 120, velocty_m_s: 7000}\n")
-    with pytest.raises(ScenarioError, match=r"unknown field\(s\) \['velocty_m_s'\]; check the spelling"):
+    with pytest.raises(ScenarioError, match=r"s\.yaml: entry\.velocty_m_s: unknown field; did you mean velocity_m_s\?$"):
         load_scenario(p)
 
 

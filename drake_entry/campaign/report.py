@@ -19,6 +19,7 @@ import json
 import math
 import os
 import re
+import shlex
 
 import numpy as np
 from scipy import stats as sps
@@ -34,9 +35,10 @@ from drake_entry.campaign.statistics import (
     success_lower_bound,
 )
 from drake_entry.campaign.store import coverage, read_nominal, read_trajectories
-from drake_entry.errors import CampaignError, DrakeEntryError, load_yaml_typed
+from drake_entry.errors import CampaignError, DrakeEntryError
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario
+from drake_entry.typed_yaml import load_yaml_typed
 
 # (row column, label, unit) of the terminal errors, in the scenario schema's order
 ERROR_COLUMNS = tuple(zip(ERROR_COLUMN_NAMES,
@@ -362,7 +364,8 @@ def _provenance(meta: dict, stats: dict) -> str:
     overrides = meta.get("overrides") or {}
     command = (f"drake-entry campaign {meta.get('scenario', '?')} --runs {meta.get('runs', '?')} "
                f"--seed {meta.get('seed', '?')} --trajectory-step {meta.get('trajectory_step_s', '?')}"
-               + "".join(f" --set {k}={json.dumps(val)}" for k, val in overrides.items()) + " --out DIR")
+               + "".join(" --set " + shlex.quote(f"{k}={val if isinstance(val, str) else json.dumps(val)}")
+                         for k, val in overrides.items()) + " --out DIR")
     commit = last.get("git_commit") or "not recorded (an installed package, not a git checkout)"
     rows = [("drake_entry", f"{v.get('drake_entry', '?')}, commit {commit}"),
             ("Drake", f"{v.get('drake', '?')} (its build carries the solvers: Clarabel, SCS, Ipopt, SNOPT)"),

@@ -14,9 +14,10 @@ from importlib import resources
 
 import numpy as np
 
-from drake_entry.errors import ScenarioError, load_yaml_typed
+from drake_entry.errors import ScenarioError
 from drake_entry.models import aerodynamics as aero_mod
 from drake_entry.models.constraints import HeatFlux, PathLimits, make_heat_flux
+from drake_entry.typed_yaml import load_yaml_typed
 
 
 @dc.dataclass

@@ -27,7 +27,7 @@ import os
 from importlib import resources
 from typing import Dict, List, Optional
 
-from drake_entry.errors import ScenarioError, load_yaml_typed
+from drake_entry.errors import ScenarioError
 from drake_entry.models.environment import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
 from drake_entry.models.schedules import Schedule
 from drake_entry.models.vehicles import load_vehicle
@@ -38,6 +38,7 @@ from drake_entry.planning.ocp import (
     OptimalControlProblem,
     PathConstraint,
 )
+from drake_entry.typed_yaml import load_yaml_typed
 
 # YAML field -> (state or control name, factor to SI)
 STATE_FIELDS = {"altitude_km": ("h", 1e3), "longitude_deg": ("lon", math.pi / 180), "latitude_deg": ("lat", math.pi / 180),

@@ -1,0 +1,152 @@
+"""One typed loader for files and overrides (drake_entry.typed_yaml): the same value is
+accepted or refused the same way from a scenario file, from ``--set`` and from the API, and
+every refusal is one ScenarioError naming the full field path."""
+import dataclasses as dc
+import re
+
+import pytest
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from drake_entry.errors import ScenarioError  # noqa: E402
+from drake_entry.scenario import PACKAGED_SCENARIOS, Scenario, apply_overrides, load_scenario  # noqa: E402
+from drake_entry.typed_yaml import check, load_yaml_typed, parse  # noqa: E402
+
+
+def test_every_packaged_scenario_passes_the_field_checks():
+    """The checker refuses nothing the packaged files hold (each loads and validates)."""
+    for name in PACKAGED_SCENARIOS:
+        assert isinstance(load_scenario(name), Scenario)
+
+
+@pytest.mark.parametrize("key, text, expected", [
+    ("guidance.period_s", "fast", "guidance.period_s: expected a number, got 'fast'"),
+    ("entry.velocity_m_s", "fast", "entry.velocity_m_s: expected a number, got 'fast'"),
+    ("planet.rotating", "maybe", "planet.rotating: expected true or false, got 'maybe'"),
+    ("simulation.log_period_s", "[1", "not valid YAML"),
+    ("guidance", "null", "guidance: expected a tagged block"),
+    ("guidance", "3", "guidance: expected a tagged block"),
+    ("entry", "7000", "entry: expected a block of fields (a mapping), got 7000"),
+    ("guidance", "!NoSuchMethod {}", "guidance: unknown type tag '!NoSuchMethod'; allowed: !DragEnergy"),
+    ("entry.velocty_m_s", "7000", "entry.velocty_m_s: unknown field 'velocty_m_s' in entry; did you mean velocity_m_s?"),
+    ("nosuch.field", "1", "nosuch.field: unknown field 'nosuch'; allowed: aero, alpha"),
+    ("entry.velocity_m_s.x", "1", "entry.velocity_m_s is a value"),
+    ("entry..x", "1", "a field path is names joined by dots"),
+    ("entry.velocity_m_s", "!!python/object:os.system {}", "not valid YAML"),
+])
+def test_a_bad_override_is_one_line_naming_the_field(key, text, expected):
+    scenario = load_scenario("horus2b")
+    with pytest.raises(ScenarioError) as e:
+        apply_overrides(scenario, {key: text})
+    assert expected in str(e.value) and "\n" not in str(e.value)
+
+
+def test_an_integer_field_refuses_a_fraction_from_the_file_and_from_an_override():
+    """``n_nodes: 40.5`` was refused in a file but ran from ``--set``: now refused by both."""
+    scenario = load_scenario("horus2b")
+    with pytest.raises(ScenarioError, match=r"guidance\.n_nodes: expected an integer, got 40\.5"):
+        apply_overrides(scenario, {"guidance.n_nodes": "40.5"})
+    text = re.sub(r"n_nodes: \d+", "n_nodes: 40.5", _packaged_text("horus2b"))
+    assert "n_nodes: 40.5" in text
+    with pytest.raises(ScenarioError, match=r"guidance\.n_nodes: expected an integer, got 40\.5"):
+        load_yaml_typed(Scenario, text=text, where="f.yaml")
+
+
+def test_an_override_sets_exactly_the_field_and_keeps_the_rest():
+    scenario = load_scenario("sphynx_paper001")
+    before = dc.asdict(scenario.entry)
+    apply_overrides(scenario, {"entry.velocity_m_s": "7000.5", "planet.rotating": False,
+                               "guidance.period_s": 2.0})
+    assert scenario.entry.velocity_m_s == 7000.5 and scenario.planet.rotating is False
+    assert scenario.guidance.period_s == 2.0 and type(scenario.guidance).__name__ == "Scvx"
+    assert {k: v for k, v in dc.asdict(scenario.entry).items() if k != "velocity_m_s"} == \
+           {k: v for k, v in before.items() if k != "velocity_m_s"}
+
+
+def test_a_whole_block_by_its_tag_replaces_the_method():
+    scenario = load_scenario("sphynx_paper001")
+    apply_overrides(scenario, {"guidance": "!DragEnergy {n_nodes: 30}"})
+    assert type(scenario.guidance).__name__ == "DragEnergy" and scenario.guidance.n_nodes == 30
+
+
+def test_an_override_out_of_range_is_refused_by_the_same_validation_as_the_file():
+    scenario = load_scenario("horus2b")
+    with pytest.raises(ScenarioError, match="period_s"):
+        apply_overrides(scenario, {"guidance.period_s": "-1"})
+
+
+def test_file_errors_name_the_section_and_the_closest_field(tmp_path):
+    cases = {
+        "entry:\n  velocty_m_s: 7000\n": "entry.velocty_m_s: unknown field; did you mean velocity_m_s?",
+        "entry:\n  altitude_km: high\n": "entry.altitude_km: expected a number, got 'high'",
+        "# only a comment\n": "the file is empty",
+        "guidance: 3\n": "guidance: expected a tagged block",
+        "dispersions:\n  mass_scale: heavy\n": "dispersions.mass_scale: expected a number or a tagged block",
+        "entry: [1, 2\n": "not valid YAML (line",
+    }
+    for text, expected in cases.items():
+        path = tmp_path / "s.yaml"
+        path.write_text(text)
+        with pytest.raises(ScenarioError) as e:
+            load_scenario(str(path))
+        assert expected in str(e.value), (text, str(e.value))
+        assert str(e.value).startswith(str(path)) and "\n" not in str(e.value)
+
+
+def test_tags_are_kept_and_never_constructed():
+    data = parse("a: !Uniform {min: 0, max: 1}\nb: [1, 2]\n", "t")
+    assert data["a"].tag == "Uniform" and data["a"].value == {"min": 0, "max": 1}
+    with pytest.raises(ScenarioError, match="not valid YAML"):
+        parse("a: !!python/object/apply:os.system ['true']\n", "t")
+
+
+# -- fuzzing: random paths and values never give a traceback, and never a silent wrong type ---
+_PATHS = st.sampled_from(["entry.velocity_m_s", "entry.altitude_km", "guidance.period_s", "guidance.n_nodes",
+                          "planet.rotating", "planet.model", "simulation.integrator", "simulation.max_time_s",
+                          "dispersions.mass_scale", "guidance", "entry", "name", "terminal.altitude_km",
+                          "target.longitude_deg"]) | st.from_regex(r"[a-z_]{1,8}(\.[a-z_]{1,8}){0,2}", fullmatch=True)
+_VALUES = st.one_of(
+    st.sampled_from(["null", "~", "fast", "40.5", "-1", "0", "1e400", ".nan", "[1, 2]", "{a: 1}", "!Foo {}",
+                     "true", "maybe", "''", "[", "{", "!!binary aGk=", "!DragEnergy {}", "7000", "1_000"]),
+    st.text(max_size=12), st.integers(), st.floats(allow_nan=True), st.booleans(), st.none(),
+    st.lists(st.integers(), max_size=3))
+
+
+@settings(max_examples=150, deadline=None, derandomize=True, database=None)
+@given(key=_PATHS, value=_VALUES)
+def test_fuzzed_overrides_give_one_line_or_the_declared_type(key, value):
+    scenario = load_scenario("horus2b")
+    try:
+        apply_overrides(scenario, {key: value})
+    except ScenarioError as e:
+        assert "\n" not in str(e) and str(e)
+        return
+    # accepted: the field holds a value of its declared kind
+    obj = scenario
+    for part in key.split("."):
+        obj = getattr(obj, part)
+    leaf = key.split(".")[-1]
+    if leaf in ("velocity_m_s", "period_s", "max_time_s", "longitude_deg") or key == "entry.altitude_km":
+        assert isinstance(obj, float)
+    elif key == "terminal.altitude_km":  # Optional[float]
+        assert obj is None or isinstance(obj, float)
+    elif leaf == "n_nodes":
+        assert isinstance(obj, int) and not isinstance(obj, bool)
+    elif leaf == "rotating":
+        assert isinstance(obj, bool)
+
+
+def test_check_reports_nested_list_positions():
+    @dc.dataclass
+    class _L:
+        values: list[float] = dc.field(default_factory=list)
+
+    with pytest.raises(ScenarioError, match=r"values\[1\]: expected a number, got 'x'"):
+        check(_L, {"values": [1.0, "x"]}, "")
+
+
+def _packaged_text(name: str) -> str:
+    from importlib import resources
+    return resources.files("drake_entry").joinpath(f"scenarios/{name}.yaml").read_text()

@@ -16,9 +16,15 @@ import hashlib
 import importlib
 import json
 import multiprocessing as mp
+import signal
 import traceback
 
 BACKENDS = ("serial", "processes", "dask")
+
+#: how long a Dask scheduler address is tried before the campaign is refused [s]
+SCHEDULER_TIMEOUT_S = 10
+#: cases submitted to a Dask cluster ahead of the results, per worker
+IN_FLIGHT_PER_WORKER = 4
 
 # Dask settings for CPU-bound pure-Python tasks (see run_dask)
 DASK_QUIET_WORKERS = {
@@ -57,6 +63,18 @@ def _resolve(name: str):
 _WORKER = {}
 
 
+def _ignore_interrupts():
+    """A worker process leaves Ctrl-C to the parent, which ends the pool (a worker that took
+    the SIGINT of the terminal's process group would print its own traceback)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def init_pool_worker(task: Task):
+    """A local pool worker: Ctrl-C is the parent's, then ``init_worker``."""
+    _ignore_interrupts()
+    init_worker(task)
+
+
 def init_worker(task: Task):
     """Build this process's state for ``task`` once."""
     _WORKER.update(key=task.key(), run=None, state=None, error=None)
@@ -92,8 +110,10 @@ def run_serial(task: Task, cases, record):
 
 
 def run_processes(task: Task, cases, record, workers: int):
+    """``cases`` may be any iterable (a lazy one is read as the pool needs cases). On Ctrl-C
+    the workers are terminated (``with Pool`` ends them) and KeyboardInterrupt propagates."""
     ctx = mp.get_context("spawn")
-    with ctx.Pool(workers, initializer=init_worker, initargs=(task,)) as pool:
+    with ctx.Pool(workers, initializer=init_pool_worker, initargs=(task,)) as pool:
         for row, traj in pool.imap_unordered(work, cases, chunksize=1):
             record(row, traj)
 
@@ -116,19 +136,43 @@ def run_dask(task: Task, cases, record, workers: int, scheduler: str | None):
 
     cluster = None
     if scheduler:
-        client = Client(scheduler)
+        try:
+            client = Client(scheduler, timeout=SCHEDULER_TIMEOUT_S)
+        except (OSError, TimeoutError, ValueError, TypeError) as e:
+            from drake_entry.errors import ScenarioError
+
+            reason = " ".join(str(e).split()) or type(e).__name__
+            raise ScenarioError(f"--scheduler {scheduler}: no Dask scheduler answered within {SCHEDULER_TIMEOUT_S} s "
+                                f"({reason[:200]}); start one (dask scheduler) or omit --scheduler for a local "
+                                f"cluster") from None
+        workers = max(workers, len(client.scheduler_info().get("workers", {})))
     else:
         with dask.config.set(DASK_QUIET_WORKERS):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(cluster)
     try:
-        futures = {client.submit(_dask_task, task, case, pure=False): case for case in cases}
-        for fut in as_completed(futures):
+        pending = iter(cases)  # submitted a few per worker at a time: a lazy case list stays lazy
+        futures = {}
+
+        def submit_next(queue=None) -> None:
+            case = next(pending, None)
+            if case is not None:
+                fut = client.submit(_dask_task, task, case, pure=False)
+                futures[fut] = case
+                if queue is not None:
+                    queue.add(fut)
+
+        for _ in range(IN_FLIGHT_PER_WORKER * max(workers, 1)):
+            submit_next()
+        queue = as_completed(list(futures))
+        for fut in queue:
+            case = futures.pop(fut)
             try:
                 row, traj = fut.result()
             except Exception as e:  # the worker itself died: record and go on
-                row, traj = failed_row(futures[fut], f"worker failure: {type(e).__name__}: {e}"), None
+                row, traj = failed_row(case, f"worker failure: {type(e).__name__}: {e}"), None
             record(row, traj)
+            submit_next(queue)
     finally:
         client.close()
         if cluster is not None:

@@ -22,7 +22,7 @@ import numpy as np
 import drake_entry
 from drake_entry.campaign.store import CampaignStore
 from drake_entry.diagrams.backends import BACKENDS, Task, run_backend
-from drake_entry.errors import ScenarioError
+from drake_entry.errors import Interrupted, ScenarioError
 
 
 def versions() -> dict:
@@ -89,13 +89,19 @@ def run_cases(task: Task, cases: list, out_dir: str, manifest: dict, *, backend:
     the Monte-Carlo manifest); a directory holding another campaign is refused (CampaignError).
     workers: local processes (default all cores, at most one per case)."""
     check_backend(backend, workers)
-    indices = [c.get("index") for c in cases]
-    if any(isinstance(i, bool) or not isinstance(i, int) for i in indices) or len(set(indices)) != len(indices):
-        raise ScenarioError("cases need a unique integer 'index' each")
+    if not isinstance(cases, SampleCases):
+        indices = [c.get("index") for c in cases]
+        if any(isinstance(i, bool) or not isinstance(i, int) for i in indices) or len(set(indices)) != len(indices):
+            raise ScenarioError("cases need a unique integer 'index' each")
     store = CampaignStore(out_dir, manifest)
     done = store.done_indices()
-    todo = [c for c in cases if c["index"] not in done]
-    workers = min(workers or os.cpu_count() or 1, max(len(todo), 1))
+    remaining = len(cases) - sum(1 for i in done if i in cases) if isinstance(cases, SampleCases) else None
+    if remaining is None:
+        todo = [c for c in cases if c["index"] not in done]
+        remaining = len(todo)
+    else:
+        todo = (c for c in cases if c["index"] not in done)  # lazy: a huge campaign starts at once
+    workers = min(workers or os.cpu_count() or 1, max(remaining, 1))
     total = int(store.manifest.get("runs", len(cases)))
     bar = None
     if progress:
@@ -113,8 +119,33 @@ def run_cases(task: Task, cases: list, out_dir: str, manifest: dict, *, backend:
                     failed += 1
                     bar.set_postfix(unsuccessful=failed)
 
-        run_backend(backend, task, todo, record, workers=workers, scheduler=scheduler)
+        try:
+            run_backend(backend, task, todo, record, workers=workers, scheduler=scheduler)
+        except KeyboardInterrupt:
+            if bar is not None:
+                bar.close()
+            finished = len(store.done_indices())
+            raise Interrupted(f"interrupted after {finished} of {total} {desc} cases; every finished one is "
+                              f"kept in {out_dir}: run the same command to resume") from None
+        finally:
+            if bar is not None:
+                bar.close()
         store.finalise()
-    if bar is not None:
-        bar.close()
     return out_dir
+
+
+class SampleCases:
+    """The cases ``{'index': i, 'seed': seed_of(i)}`` for i in range(runs), made as they are
+    read (a campaign of 10^9 samples holds no list of them)."""
+
+    def __init__(self, runs: int, seed_of):
+        self.runs, self.seed_of = int(runs), seed_of
+
+    def __len__(self) -> int:
+        return self.runs
+
+    def __contains__(self, index) -> bool:
+        return isinstance(index, int) and 0 <= index < self.runs
+
+    def __iter__(self):
+        return ({"index": i, "seed": self.seed_of(i)} for i in range(self.runs))

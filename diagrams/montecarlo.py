@@ -16,7 +16,7 @@ from pydrake.common.yaml import yaml_dump_typed
 
 from drake_entry.campaign.store import done_indices, finalise, read_nominal, write_nominal  # noqa: F401 (API)
 from drake_entry.diagrams.backends import Task
-from drake_entry.diagrams.campaign import check_backend, run_cases, session, versions
+from drake_entry.diagrams.campaign import SampleCases, check_backend, run_cases, session, versions
 from drake_entry.diagrams.sample import (  # noqa: F401 (API)
     DETAILED_STEP_S,
     TIMING_COLUMNS,
@@ -29,6 +29,10 @@ from drake_entry.diagrams.sample import (  # noqa: F401 (API)
 from drake_entry.errors import ScenarioError
 from drake_entry.models.vehicles import PACKAGED_VEHICLES
 from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
+
+#: the largest campaign accepted: 10^7 samples at 0.5-40 s of a core each are 2-4600 core-days
+MAX_RUNS = 10_000_000
+RUNS_NOTE = " (10^7 samples take 2 to 4600 core-days by method; split larger studies into campaigns)"
 
 
 def _absolute_and_hash(path: str) -> tuple[str, str]:
@@ -75,9 +79,10 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     trajectories to trajectories.jsonl; at the end both are converted to Parquet.
     """
     check_backend(backend, workers)
-    for name, value, lo in (("runs", runs, 1), ("seed", seed, 0)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value < 2**63:
-            raise ScenarioError(f"{name} = {value} is out of range; allowed: an integer >= {lo}")
+    for name, value, lo, hi in (("runs", runs, 1, MAX_RUNS), ("seed", seed, 0, 2**63 - 1)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value <= hi:
+            raise ScenarioError(f"{name} = {value} is out of range; allowed: an integer in [{lo}, {hi}]"
+                                + (RUNS_NOTE if name == "runs" else ""))
     if not (isinstance(trajectory_step_s, (int, float)) and 0 <= trajectory_step_s < math.inf):
         raise ScenarioError(f"trajectory_step_s = {trajectory_step_s} is out of range; allowed: >= 0 s "
                             f"(0 = no trajectories)")
@@ -86,7 +91,7 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     task = Task("drake_entry.diagrams.sample:setup_worker", "drake_entry.diagrams.sample:run_case",
                 {"scenario_yaml": manifest["scenario_yaml"], "seed": int(seed),
                  "trajectory_step_s": float(trajectory_step_s)})
-    cases = [{"index": i, "seed": sample_seed(seed, i)} for i in range(int(runs))]
+    cases = SampleCases(runs, lambda i: sample_seed(seed, i))
     run_cases(task, cases, out_dir, manifest, backend=backend, workers=workers, scheduler=scheduler,
               progress=progress, desc="campaign")
     if trajectory_step_s > 0 and read_nominal(out_dir) is None:

@@ -27,7 +27,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from drake_entry.errors import DrakeEntryError, ScenarioError
+from drake_entry.errors import DrakeEntryError, Interrupted, ScenarioError
 
 
 def _cmd_simulate(args) -> int:
@@ -179,6 +179,19 @@ def _cmd_campaign(args) -> int:
     return 0
 
 
+def check_output_dir(out: str) -> None:
+    """Refuse an output directory that cannot be made or written before any work starts: a
+    file on its path, a read-only or forbidden place (one line naming it)."""
+    parent = out
+    while parent and not os.path.exists(parent):
+        parent = os.path.dirname(parent.rstrip(os.sep))
+    parent = parent or "."
+    if not os.path.isdir(parent):
+        raise ScenarioError(f"--out {out}: {parent} is a file, not a directory; choose another --out")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ScenarioError(f"--out {out}: {parent} is not writable (read-only or no permission); choose another --out")
+
+
 def parse_overrides(items) -> dict:
     """{'a.b': 'text'} from ["a.b=text", ...]: the text is read later as YAML by the same typed
     loader as a scenario file (scenario.apply_overrides), so it is checked against the field's
@@ -312,10 +325,42 @@ def main(argv=None) -> int:
         out = getattr(args, "out", None)
         if out is not None and os.path.exists(out) and not os.path.isdir(out):
             raise ScenarioError(f"--out {out} is a file, not a directory")
+        if out is not None:
+            check_output_dir(out)
         return args.func(args)
+    except Interrupted as e:  # Ctrl-C in a campaign: finished samples kept
+        print(f"\ndrake-entry: {' '.join(str(e).split())}", file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print(f"\ndrake-entry: interrupted (Ctrl-C); '{args.command}' stopped", file=sys.stderr)
+        return 130
     except DrakeEntryError as e:  # bad input, a refused campaign directory, an unusable solver: one line
         print(f"drake-entry: error: {' '.join(str(e).split())}", file=sys.stderr)
         return 2
+    except OSError as e:  # the file system refused a read or write: where and why, one line
+        where = getattr(args, "out", None) or getattr(args, "dir", None)
+        print(f"drake-entry: error: {os_error_line(e, where)}", file=sys.stderr)
+        return 2
+
+
+def os_error_line(e: OSError, where: str | None = None) -> str:
+    """One line for an operating-system error: the path (else a file in ``where``), the
+    cause, and what to do."""
+    import errno
+
+    path = e.filename if e.filename is not None else (f"a file in {where}" if where else "a file")
+    if e.filename2 is not None:
+        path = f"{path} -> {e.filename2}"
+    cause = e.strerror or str(e) or type(e).__name__
+    hint = {errno.ENOSPC: "free some space (finished campaign samples are kept; the same command resumes)",
+            errno.EDQUOT: "free some space (finished campaign samples are kept; the same command resumes)",
+            errno.EROFS: "choose a writable --out",
+            errno.EACCES: "choose a directory you may write (--out) or change its permissions",
+            errno.EPERM: "choose a directory you may write (--out) or change its permissions",
+            errno.ENOTDIR: "a part of the path is a file, not a directory: choose another --out",
+            errno.EISDIR: "a directory is in the way of a file",
+            errno.ENOENT: "check the path"}.get(e.errno, "")
+    return f"cannot use {path}: {cause}" + (f"; {hint}" if hint else "")
 
 
 if __name__ == "__main__":

@@ -47,6 +47,11 @@ class CampaignError(DrakeEntryError):
     nothing to report)."""
 
 
+class Interrupted(DrakeEntryError):
+    """Ctrl-C (SIGINT) stopped a long run cleanly: what was finished is kept, and the message
+    says how to go on. The CLI prints it as one line and exits 130."""
+
+
 def check_range(field: str, value, lo: float, hi: float):
     """Raise a one-line ScenarioError unless lo <= value <= hi (None and NaN fail)."""
     if value is None or not (lo <= value <= hi):

@@ -149,17 +149,21 @@ class CampaignStore:
         """Commit one finished sample: its trajectory line, then its row line (the row is
         what marks it done), each one write on an O_APPEND descriptor, then fsync."""
         if trajectory is not None:
-            _append(self._traj, json.dumps(trajectory))
-        _append(self._rows, json.dumps(row, default=float))
+            _append(self._traj, json.dumps(trajectory), self.path(TRAJECTORIES))
+        _append(self._rows, json.dumps(row, default=float), self.path(ROWS))
 
     def finalise(self):
         finalise(self.out_dir)
 
 
-def _append(fd: int, line: str):
+def _append(fd: int, line: str, path: str):
+    """Append one line to ``path`` (open as ``fd``) and fsync it. A short write (a full disk
+    takes what fits) raises ENOSPC naming the file: the cut line is dropped on resume."""
     data = (line + "\n").encode()
-    if os.write(fd, data) != len(data):
-        raise OSError(f"short write of a campaign line ({len(data)} bytes)")
+    written = os.write(fd, data)
+    if written != len(data):
+        raise OSError(errno.ENOSPC, f"no space left on the device (wrote {written} of {len(data)} bytes of a line)",
+                      path)
     os.fsync(fd)
 
 

@@ -1,0 +1,139 @@
+"""Ctrl-C, output locations, full disks and runaway sizes: one line, the right exit code, no
+process left behind, no finished sample lost."""
+import errno
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from drake_entry.campaign.store import done_indices
+from drake_entry.cli import main
+from drake_entry.diagrams.montecarlo import MAX_RUNS, run_campaign
+from drake_entry.errors import ScenarioError
+
+
+def _rows(out: str) -> int:
+    try:
+        with open(os.path.join(out, "samples.jsonl")) as f:
+            return sum(1 for line in f if line.endswith("}\n"))
+    except FileNotFoundError:
+        return 0
+
+
+def _group_ended(pgid: int, within_s: float) -> bool:
+    """True once no process of the group is left (a zombie waits for init to reap it)."""
+    deadline = time.monotonic() + within_s
+    while time.monotonic() < deadline:
+        try:
+            os.killpg(pgid, 0)
+        except ProcessLookupError:
+            return True
+        time.sleep(0.1)
+    return False
+
+
+def test_ctrl_c_ends_a_campaign_with_one_line_exit_130_and_no_worker_left(tmp_path):
+    """SIGINT to the whole process group (what a terminal's Ctrl-C does) once a sample has
+    landed and before the last: exit 130, one line naming the finished count, no traceback,
+    no pool worker alive afterwards; the rows on disk are the count the line names, and the
+    same command resumes to the full campaign."""
+    out = str(tmp_path / "c")
+    argv = [sys.executable, "-m", "drake_entry.cli", "campaign", "horus2b", "--runs", "12", "--workers", "2",
+            "--trajectory-step", "0", "--out", out]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 300
+    while _rows(out) < 1 and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is None, "the campaign ended before the interrupt could land"
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    lines = [line for line in err.replace("\r", "\n").splitlines() if line.strip() and "campaign:" not in line]
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and len(lines) == 1, lines
+    finished = _rows(out)
+    assert 1 <= finished < 12, finished  # the interrupt landed mid-campaign
+    assert f"interrupted after {finished} of 12 campaign cases" in lines[0] and "same command to resume" in lines[0]
+    assert _group_ended(proc.pid, within_s=15.0)  # nothing of the group survives (pool workers ended)
+    assert not os.path.exists(os.path.join(out, "campaign.lock"))
+    run_campaign("horus2b", runs=12, out_dir=out, workers=2, progress=False, trajectory_step_s=0)
+    assert done_indices(out) == set(range(12))
+
+
+def test_a_full_disk_keeps_finished_rows_and_names_the_file(tmp_path, monkeypatch, capsys):
+    """The third row's write comes back short (what a full disk does): exit 2 with one line
+    naming samples.jsonl and the cause; the two finished rows are intact and resume works."""
+    import drake_entry.campaign.store as store
+
+    real_write, rows_written = os.write, []
+
+    def write(fd, data):
+        if data.startswith(b'{"index"'):
+            rows_written.append(fd)
+            if len(rows_written) == 3:
+                return real_write(fd, data[: len(data) // 2])
+        return real_write(fd, data)
+
+    monkeypatch.setattr(store.os, "write", write)
+    out = str(tmp_path / "c")
+    code = main(["campaign", "horus2b", "--runs", "4", "--workers", "1", "--trajectory-step", "0", "--out", out])
+    err = capsys.readouterr().err
+    tail = [line for line in err.replace("\r", "\n").splitlines() if line.startswith("drake-entry")]
+    assert code == 2 and "Traceback" not in err and len(tail) == 1, err
+    assert f"cannot use {out}/samples.jsonl: no space left on the device" in tail[0] and "resumes" in tail[0]
+    assert done_indices(out) == {0, 1}
+    monkeypatch.setattr(store.os, "write", real_write)
+    run_campaign("horus2b", runs=4, out_dir=out, workers=1, progress=False, trajectory_step_s=0)
+    assert done_indices(out) == {0, 1, 2, 3}
+    with open(os.path.join(out, "samples.jsonl")) as f:
+        kept = [json.loads(line) for line in f if line.endswith("}\n")]
+    assert sorted(r["index"] for r in kept) == [0, 1, 2, 3]
+
+
+@pytest.mark.parametrize("command", [["campaign", "horus2b", "--runs", "1"], ["fly", "horus2b"],
+                                     ["simulate", "horus2b"], ["plan", "horus2b"]])
+def test_out_below_a_regular_file_is_one_line_before_any_work(tmp_path, capsys, command):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("x")
+    t0 = time.perf_counter()
+    code = main(command + ["--out", str(blocker / "sub" / "dir")])
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert f"{blocker} is a file, not a directory" in err
+    assert time.perf_counter() - t0 < 5.0  # refused before flying anything
+
+
+def test_an_os_error_from_any_command_is_one_line_naming_the_path(tmp_path, capsys, monkeypatch):
+    """A read-only file system (simulated: os.makedirs refused with EROFS) in the report."""
+    import drake_entry.cli as cli
+
+    def refuse(*a, **k):
+        raise OSError(errno.EROFS, "Read-only file system", str(tmp_path / "r"))
+
+    monkeypatch.setattr(cli, "_write_and_print_report", refuse)
+    (tmp_path / "r").mkdir()
+    code = main(["report", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.strip() == (f"drake-entry: error: cannot use {tmp_path / 'r'}: Read-only file system; "
+                                         f"choose a writable --out")
+
+
+def test_a_runaway_campaign_size_is_refused_at_once(tmp_path):
+    t0 = time.perf_counter()
+    with pytest.raises(ScenarioError, match=r"runs = 1000000000000 is out of range; allowed: an integer in \[1, 10000000\]"):
+        run_campaign("horus2b", runs=10 ** 12, out_dir=str(tmp_path / "c"), progress=False)
+    assert time.perf_counter() - t0 < 5.0 and MAX_RUNS == 10 ** 7
+    assert not (tmp_path / "c").exists()
+
+
+def test_an_unreachable_dask_scheduler_is_one_line(tmp_path, monkeypatch):
+    pytest.importorskip("dask.distributed")
+    import drake_entry.diagrams.backends as backends
+
+    monkeypatch.setattr(backends, "SCHEDULER_TIMEOUT_S", 1)
+    with pytest.raises(ScenarioError, match=r"--scheduler tcp://127\.0\.0\.1:9: no Dask scheduler answered within 1 s"):
+        run_campaign("horus2b", runs=1, out_dir=str(tmp_path / "c"), progress=False, backend="dask",
+                     scheduler="tcp://127.0.0.1:9")

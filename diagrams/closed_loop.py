@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses as dc
 import math
+import os
 
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder
@@ -39,7 +40,7 @@ from drake_entry.models.trajectory import Trajectory
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.models.verdict import Verdict, box_text, judge
 from drake_entry.models.verdict import acceptance_box as box_at
-from drake_entry.scenario import Scenario
+from drake_entry.scenario import Scenario, load_scenario
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.native_plant import add_plant
@@ -75,7 +76,13 @@ class ClosedLoopSetup:
     def from_scenario(scenario: Scenario, planner=None, method: GuidanceMethod | None = None) -> "ClosedLoopSetup":
         """The setup of a scenario; ``planner`` overrides the method's own (tests, studies);
         ``method`` flies a GuidanceMethod of your own instead of the registered one of the
-        scenario's ``guidance:`` spec (which it may read; examples/02_custom_controller.py)."""
+        scenario's ``guidance:`` spec (which it may read; examples/02_custom_controller.py).
+        ``scenario`` may also be a packaged name or a YAML path (read by load_scenario)."""
+        if isinstance(scenario, (str, os.PathLike)):
+            scenario = load_scenario(scenario)
+        if not isinstance(scenario, Scenario):
+            raise ScenarioError(f"ClosedLoopSetup.from_scenario needs a Scenario (load_scenario) or a scenario name "
+                                f"or path; got {type(scenario).__name__}")
         method = method_for(scenario.guidance) if method is None else method
         return ClosedLoopSetup(
             scenario=scenario, method=method, planner=method.make_planner(scenario, fly_controls) if planner is None else planner,

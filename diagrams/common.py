@@ -12,7 +12,7 @@ from pydrake.systems.primitives import LogVectorOutput
 from drake_entry.errors import ModelRangeError, NonFiniteStateError
 from drake_entry.models.trajectory import Trajectory
 from drake_entry.scenario import Scenario
-from drake_entry.systems.native_plant import as_flight_error
+from drake_entry.systems.native_plant import flight_stop
 
 
 def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loop: bool = False):
@@ -111,8 +111,8 @@ def run(diagram, loggers: dict, scenario: Scenario, *, sources: dict, initial_st
         final = True
     except (NonFiniteStateError, ModelRangeError, OverflowError, ValueError) as raised:  # a NaN, an overflow,
         # or a state the models do not cover: stop with the reason, keep the log
-        e = as_flight_error(raised)
-        if isinstance(e, ValueError):  # a ValueError that is not the native plant's NaN is a bug
+        e = flight_stop(raised)
+        if e is None:  # a ValueError that is neither the native plant's NaN nor a ModelRangeError: a bug
             raise
         reason = f"stopped at t = {simulator.get_context().get_time():.3f} s: {e}"
         final = False

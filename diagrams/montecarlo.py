@@ -79,6 +79,10 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     trajectories to trajectories.jsonl; at the end both are converted to Parquet.
     """
     check_backend(backend, workers)
+    for name, value in (("scenario_path", scenario_path), ("out_dir", out_dir)):
+        if not isinstance(value, (str, os.PathLike)):
+            raise ScenarioError(f"{name} must be a path (text); got {type(value).__name__}")
+    scenario_path, out_dir = os.fspath(scenario_path), os.fspath(out_dir)
     for name, value, lo, hi in (("runs", runs, 1, MAX_RUNS), ("seed", seed, 0, 2**63 - 1)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value <= hi:
             raise ScenarioError(f"{name} = {value} is out of range; allowed: an integer in [{lo}, {hi}]"

@@ -30,12 +30,12 @@ from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.diagrams.common import add_step_loggers, collect_trajectory
-from drake_entry.errors import ModelRangeError, NonFiniteStateError
+from drake_entry.errors import ModelRangeError, NonFiniteStateError, ScenarioError
 from drake_entry.planning.ocp_system import OptimalControlPlant
 from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, OcpControls
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.monitors import PlantGuard
-from drake_entry.systems.native_plant import add_plant, as_flight_error
+from drake_entry.systems.native_plant import add_plant, flight_stop
 from drake_entry.systems.schedule import ScheduleSource
 
 #: fixed RK5 steps per actuator period (see the module docstring for the measured error)
@@ -65,12 +65,16 @@ def fly_controls(controls: EntryControls | OcpControls, *, accuracy: float | Non
         return _fly_entry(controls, accuracy, log_points, plant)
     if isinstance(controls, OcpControls):
         return _fly_ocp(controls, accuracy or OCP_ACCURACY, log_points)
-    raise TypeError(f"fly_controls flies EntryControls or OcpControls, got {type(controls).__name__}")
+    raise ScenarioError(f"fly_controls flies EntryControls or OcpControls, got {type(controls).__name__}")
 
 
 def _spline(time, values) -> PiecewisePolynomial:
-    return PiecewisePolynomial.CubicWithContinuousSecondDerivatives(
-        np.asarray(time, float), np.atleast_2d(np.asarray(values, float)), periodic_end_condition=False)
+    """The C2 cubic spline through the samples; through two samples, the straight line (Drake's
+    spline needs three; a C2 interpolant of two points is the line)."""
+    t, v = np.asarray(time, float), np.atleast_2d(np.asarray(values, float))
+    if t.size < 3:
+        return PiecewisePolynomial.FirstOrderHold(t, v)
+    return PiecewisePolynomial.CubicWithContinuousSecondDerivatives(t, v, periodic_end_condition=False)
 
 
 def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_kind: str) -> FlownControls:
@@ -159,8 +163,8 @@ def _advance(simulator: Simulator, tf: float) -> str:
     try:
         simulator.AdvanceTo(tf)
     except FLIGHT_ERRORS as raised:  # gamma reaching -90 deg, h below the atmosphere model, a NaN
-        e = as_flight_error(raised)
-        if isinstance(e, ValueError):  # a ValueError that is not the native plant's NaN is a bug
+        e = flight_stop(raised)
+        if e is None:  # a ValueError that is neither the native plant's NaN nor a ModelRangeError: a bug
             raise
         t = simulator.get_context().get_time()
         return f"the flight stopped at t = {t:.2f} s of {tf:.2f} s: {first_sentence(str(e))}"

@@ -26,7 +26,7 @@ from pydrake.symbolic import Expression, Variable
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import Multiplexer, SymbolicVectorSystem
 
-from drake_entry.errors import NonFiniteStateError, ScenarioError, UnsupportedScalarError
+from drake_entry.errors import ModelRangeError, NonFiniteStateError, ScenarioError, UnsupportedScalarError
 from drake_entry.models import dynamics
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
@@ -117,6 +117,16 @@ def as_flight_error(error: BaseException) -> BaseException:
     if isinstance(error, ValueError) and SYMBOLIC_DOMAIN_ERROR in str(error):
         return NonFiniteStateError(f"non-finite vehicle state in the native plant ({str(error).splitlines()[0]})")
     return error
+
+
+def flight_stop(error: BaseException) -> BaseException | None:
+    """The error a flight stops on (``as_flight_error``), or None when ``error`` is a bug to
+    re-raise: a ValueError that is neither the native plant's NaN nor a ModelRangeError (a state
+    the models do not cover, e.g. below the atmosphere model: a stop, not a bug)."""
+    e = as_flight_error(error)
+    if isinstance(e, ValueError) and not isinstance(e, ModelRangeError):
+        return None
+    return e
 
 
 _CONSTANT = Variable("constant")

@@ -26,7 +26,7 @@ from drake_entry.systems.native_plant import (
     NativeEntryVehicle,
     PlantProbe,
     add_plant,
-    as_flight_error,
+    flight_stop,
 )
 from drake_entry.systems.vehicle import EntryVehicle
 
@@ -161,7 +161,8 @@ def test_plant_guard_stops_a_native_flight_where_the_python_plant_would_raise():
     """The native plant cannot raise our errors: the PlantGuard's witness stops a flight at the end
     of the step where it left the atmosphere model (ModelRangeError, as US76 raises); a NaN
     state that reaches a sqrt inside a stage is Drake's ValueError, which the flight runners
-    turn into the NonFiniteStateError the Python plant raises (as_flight_error)."""
+    turn into the NonFiniteStateError the Python plant raises (flight_stop); any other ValueError
+    is a bug the runners re-raise."""
     horus, earth, us76 = load_vehicle("horus2b"), Earth.spherical(), US76Atmosphere()
     for bank, x0, error, words in (
             (0.3, [999.5e3, 0.1, 0.2, 7000.0, 0.5, 1.0], ModelRangeError, "outside the PlantGuard range"),
@@ -179,8 +180,23 @@ def test_plant_guard_stops_a_native_flight_where_the_python_plant_would_raise():
         assert used == "native" and simulator.get_context().get_time() < 5.0
         # a NaN reaches the atmosphere's sqrt inside an integrator stage, where Drake's symbolic
         # evaluation refuses it: the flight runners take that as the non-finite state it is
-        stop = as_flight_error(raised.value)
+        stop = flight_stop(raised.value)
         assert isinstance(stop, error if error is ModelRangeError else NonFiniteStateError), stop
+    assert flight_stop(ValueError("any other ValueError")) is None  # a bug: re-raised by the runners
+
+
+def test_a_verified_flight_that_leaves_the_atmosphere_model_stops_with_the_reason():
+    """Controls that dive the vehicle into the ground, flown by the verifier: the flight stops
+    below the atmosphere model with that reason (a failed flight), not an exception."""
+    from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.planning.verification import EntryControls
+
+    horus, earth, us76 = load_vehicle("horus2b"), Earth.spherical(), US76Atmosphere()
+    controls = EntryControls(horus, earth, us76, np.array([2e3, 0.1, 0.2, 800.0, -0.5, 1.0]), 300.0,
+                             np.array([0.0, 300.0]), np.array([0.0, 0.0]), np.array([0.0, 0.0]))
+    flown = fly_controls(controls)
+    assert "the flight stopped at t = " in flown.failure and "outside the" in flown.failure
+    assert flown.time[-1] < 100.0
 
 
 # -- helpers ----------------------------------------------------------------------------

@@ -511,11 +511,12 @@ def test_a_long_solve_prints_its_progress_and_ctrl_c_stops_it(monkeypatch, capsy
     """Progress lines (elapsed, evaluations, objective, LGL collocation violation) once a solve
     has run PROGRESS_AFTER_S (0 here), the violation falling from the guess to the answer; a
     Ctrl-C inside a callback reaches the caller as KeyboardInterrupt under both solvers."""
+    from drake_entry.planning import progress
     from drake_entry.planning.nlp import evaluator
     from drake_entry.planning.nlp.catalogue import brachistochrone
 
-    monkeypatch.setattr(evaluator, "PROGRESS_AFTER_S", 0.0)
-    monkeypatch.setattr(evaluator, "PROGRESS_INTERVAL_S", 0.0)
+    monkeypatch.setattr(progress, "PROGRESS_AFTER_S", 0.0)
+    monkeypatch.setattr(progress, "PROGRESS_INTERVAL_S", 0.0)
     r = nlp.solve(brachistochrone()[0], nodes=15, solver="ipopt", progress=True)
     assert r.converged
     lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("  [lgl 15 nodes, ipopt]")]

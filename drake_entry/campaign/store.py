@@ -5,6 +5,7 @@ trajectories streamed as samples finish.
                          seed, trajectory step, versions, the fingerprint of all of these,
                          the number of samples requested so far, and one ``sessions`` record
                          per run (date, command, library versions, commit: not identity)
+  campaign.json.copy     the same manifest, written with it (restores a damaged campaign.json)
   campaign.lock          held (flock) by the one process writing the directory, removed when it
                          closes
   samples.jsonl          one row per finished sample, appended and flushed at once
@@ -32,6 +33,11 @@ from drake_entry.errors import CampaignError
 FORMAT = 2
 ROWS, TRAJECTORIES, QUARANTINE, MANIFEST, LOCK = ("samples.jsonl", "trajectories.jsonl", "quarantine.jsonl",
                                                   "campaign.json", "campaign.lock")
+#: a second copy of the manifest, written with it: a damaged campaign.json is restored from it
+MANIFEST_COPY = "campaign.json.copy"
+#: the types a sound manifest's fields have (checked when read)
+MANIFEST_TYPES = {"runs": int, "seed": int, "trajectory_step_s": (int, float), "scenario_yaml": str,
+                  "format": int, "fingerprint": str, "overrides": dict, "sessions": list, "versions": dict}
 #: the undispersed flight of the campaign's scenario (trajectory columns), not a sample
 NOMINAL = "nominal.json"
 # what the fingerprint covers, and how a mismatch is named
@@ -112,7 +118,9 @@ class CampaignStore:
                     f"with the same settings and a larger --runs, or start afresh with another --out")
             manifest["runs"] = max(int(old.get("runs", 0)), int(manifest["runs"]))
             manifest["sessions"] = list(old.get("sessions", [])) + list(manifest.get("sessions", []))
-        _write_atomic(self.path(MANIFEST), json.dumps(manifest, indent=2).encode())
+        data = json.dumps(manifest, indent=2).encode()
+        _write_atomic(self.path(MANIFEST), data)
+        _write_atomic(self.path(MANIFEST_COPY), data)
         return manifest
 
     def path(self, name: str) -> str:
@@ -177,18 +185,46 @@ def _write_atomic(path: str, data: bytes):
     os.replace(tmp, path)
 
 
-def read_manifest(out_dir: str) -> dict | None:
-    path = os.path.join(out_dir, MANIFEST)
-    if not os.path.exists(path):
-        return None
+def _manifest_problem(path: str) -> tuple[dict | None, str]:
+    """(manifest, '') from ``path``, or (None, what is wrong with it)."""
     try:
-        with open(path) as f:
+        with open(path, encoding="utf-8") as f:
             manifest = json.load(f)
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise CampaignError(f"{path} is not a campaign manifest ({e}); start afresh with another --out") from None
+        return None, f"not JSON ({e})"
+    except IsADirectoryError:
+        return None, "a directory"
     if not isinstance(manifest, dict):
-        raise CampaignError(f"{path} is not a campaign manifest; start afresh with another --out")
-    return manifest
+        return None, "not a JSON object"
+    for key, kinds in MANIFEST_TYPES.items():
+        if key in manifest and (isinstance(manifest[key], bool) or not isinstance(manifest[key], kinds)):
+            return None, f"its {key!r} is {manifest[key]!r}"
+    if isinstance(manifest.get("runs"), int) and manifest["runs"] < 0:
+        return None, f"its 'runs' is {manifest['runs']}"
+    return manifest, ""
+
+
+def read_manifest(out_dir: str) -> dict | None:
+    """The campaign manifest of ``out_dir`` (None when there is none). A damaged campaign.json
+    is replaced by its copy (campaign.json.copy, written with it) when that one is sound."""
+    path, copy = os.path.join(out_dir, MANIFEST), os.path.join(out_dir, MANIFEST_COPY)
+    if not os.path.exists(path):
+        if os.path.exists(copy):
+            manifest, _ = _manifest_problem(copy)
+            return manifest
+        return None
+    manifest, problem = _manifest_problem(path)
+    if manifest is not None:
+        return manifest
+    backup, _ = _manifest_problem(copy) if os.path.exists(copy) else (None, "")
+    if backup is not None:
+        try:
+            _write_atomic(path, json.dumps(backup, indent=2).encode())
+        except OSError:
+            pass  # read-only: the copy serves this time
+        return backup
+    raise CampaignError(f"{path} is not a campaign manifest ({problem}) and has no sound copy; its rows are in "
+                        f"{ROWS}; start afresh with another --out") from None
 
 
 def _is_row(r) -> bool:

@@ -145,12 +145,49 @@ def _check_distribution(where: str, d) -> None:
         raise ScenarioError(f"{where}: Uniform min = {params['min']} is above max = {params['max']}")
 
 
+#: a Gaussian scale is refused when its mean minus this many standard deviations is <= 0 (a
+#: draw that far out has probability 3e-7)
+GAUSSIAN_REACH = 5.0
+
+
+def _support_floor(d) -> float:
+    """The lowest value a scalar distribution draws (Gaussian: mean - GAUSSIAN_REACH stddev)."""
+    if isinstance(d, (int, float)):
+        return float(d)
+    if isinstance(d, schema.Deterministic):
+        return float(d.value)
+    if isinstance(d, schema.Uniform):
+        return float(d.min)
+    if isinstance(d, schema.Gaussian):
+        return float(d.mean) - GAUSSIAN_REACH * float(d.stddev)
+    return math.nan
+
+
+def _support_ceiling(d) -> float:
+    """The highest value a scalar distribution draws (Gaussian: mean + GAUSSIAN_REACH stddev)."""
+    if isinstance(d, schema.Uniform):
+        return float(d.max)
+    if isinstance(d, schema.Gaussian):
+        return float(d.mean) + GAUSSIAN_REACH * float(d.stddev)
+    return _support_floor(d)
+
+
 def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
     """Shape and range checks that do not need a draw."""
     for f in dc.fields(EntryDispersionSpec):
         _check_distribution(f"{where}.entry.{f.name}", getattr(spec.entry, f.name))
     for name in ("density_scale", "density_wave_amplitude", "lift_scale", "drag_scale", "mass_scale", "nav_bias"):
         _check_distribution(f"{where}.{name}", getattr(spec, name))
+    for name in ("density_scale", "lift_scale", "drag_scale", "mass_scale"):
+        low = _support_floor(getattr(spec, name))
+        if not low > 0:
+            raise ScenarioError(f"{where}.{name} reaches {low:g}; a scale must stay > 0 over its whole distribution "
+                                f"(the value, a Uniform's min, a Gaussian's mean - {GAUSSIAN_REACH:g} stddev)")
+    amplitude = spec.density_wave_amplitude
+    reach = max(abs(_support_floor(amplitude)), abs(_support_ceiling(amplitude)))
+    if not reach < 1:
+        raise ScenarioError(f"{where}.density_wave_amplitude reaches {reach:g}; allowed: |amplitude| < 1 over its "
+                            f"whole distribution (density stays positive)")
     if np.asarray(spec.nav_bias.Mean()).size != 6:
         raise ScenarioError(f"{where}.nav_bias needs 6 entries [h, lon, lat, V, gamma, psi]")
     if len(spec.nav_noise_sigma) != 6 or not all(0 <= v < math.inf for v in spec.nav_noise_sigma):

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import dataclasses as dc
 import json
+import os
+import zipfile
 from functools import lru_cache
 
 import numpy as np
@@ -58,6 +60,11 @@ def hd_matrix(n_ld: int, n_hd: int) -> np.ndarray:
     P = interpolation_matrix(lgl_nodes(n_ld), np.linspace(-1.0, 1.0, n_hd))
     P.flags.writeable = False
     return P
+
+
+#: what ``TrajectoryDatabase.save`` stamps in a file's layout, and the arrays it holds
+FILE_FORMAT, FILE_VERSION = "drake_entry.ampi.trajectory_database", 1
+ARRAYS = ("values", "final_time", "objective", "verified", "meta")
 
 
 @dc.dataclass
@@ -214,16 +221,66 @@ class TrajectoryDatabase:
 
     # -- files ------------------------------------------------------------------------
     def save(self, path: str):
-        """One .npz file: the arrays and the layout (JSON)."""
-        meta = {"grid": self.grid.as_dict(), "state_names": list(self.state_names),
-                "control_names": list(self.control_names), "provenance": self.provenance}
+        """One .npz file: the arrays and the layout (JSON, with FILE_FORMAT and FILE_VERSION)."""
+        meta = {"format": FILE_FORMAT, "version": FILE_VERSION, "grid": self.grid.as_dict(),
+                "state_names": list(self.state_names), "control_names": list(self.control_names),
+                "provenance": self.provenance}
         np.savez_compressed(path, values=self.values, final_time=self.final_time, objective=self.objective,
                             verified=self.verified, meta=np.array(json.dumps(meta)))
 
     @staticmethod
     def load(path: str) -> "TrajectoryDatabase":
-        with np.load(path, allow_pickle=False) as f:
-            meta = json.loads(str(f["meta"]))
-            return TrajectoryDatabase(ParameterGrid.from_dict(meta["grid"]), tuple(meta["state_names"]),
-                                      tuple(meta["control_names"]), f["values"], f["final_time"], f["objective"],
-                                      f["verified"].astype(bool), meta.get("provenance", {}))
+        """Read a database file written by ``save``: its format, version, arrays and shapes are
+        checked and every problem is one ScenarioError naming the file. Pickled objects are never
+        loaded (files from before the format stamp are read as version 1)."""
+        if not isinstance(path, (str, os.PathLike)):
+            raise ScenarioError(f"an AMPI database is a file path; got {type(path).__name__}")
+        where = f"AMPI database {os.fspath(path)}"
+        if not os.path.exists(path):
+            raise ScenarioError(f"{where}: file not found")
+        if os.path.isdir(path):
+            raise ScenarioError(f"{where} is a directory, not a database file (.npz)")
+        try:
+            archive = np.load(path, allow_pickle=False)
+        except ValueError:
+            with open(path, "rb") as raw:
+                pickled = raw.read(1) == b"\x80"  # a pickle's protocol marker
+            if pickled:
+                raise ScenarioError(f"{where} holds pickled Python objects, which are never loaded") from None
+            raise ScenarioError(f"{where} is not a database file (an .npz written by TrajectoryDatabase.save: "
+                                f"its first bytes are neither a zip archive nor an array)") from None
+        except (OSError, EOFError, zipfile.BadZipFile) as e:
+            raise ScenarioError(f"{where} cannot be read as a database file (.npz): {str(e).splitlines()[0]}") from None
+        if not isinstance(archive, np.lib.npyio.NpzFile):
+            raise ScenarioError(f"{where} is a single array (.npy), not a database file (.npz with {', '.join(ARRAYS)})")
+        with archive as f:
+            missing = [k for k in ARRAYS if k not in f.files]
+            if missing:
+                raise ScenarioError(f"{where} lacks the array(s) {', '.join(missing)}; a database file holds "
+                                    f"{', '.join(ARRAYS)}")
+            try:
+                meta = json.loads(str(f["meta"]))
+                fmt, version = meta.get("format", FILE_FORMAT), meta.get("version", 1)
+                if fmt != FILE_FORMAT:
+                    raise ScenarioError(f"{where} is a {fmt!r} file, not an AMPI trajectory database")
+                if not isinstance(version, int) or not 1 <= version <= FILE_VERSION:
+                    raise ScenarioError(f"{where} has format version {version!r}; this drake_entry reads "
+                                        f"versions 1 to {FILE_VERSION} (a newer drake_entry wrote it?)")
+                grid = ParameterGrid.from_dict(meta["grid"])
+                db = TrajectoryDatabase(grid, tuple(meta["state_names"]), tuple(meta["control_names"]),
+                                        np.asarray(f["values"], float), np.asarray(f["final_time"], float),
+                                        np.asarray(f["objective"], float), f["verified"].astype(bool),
+                                        meta.get("provenance", {}))
+            except ScenarioError:
+                raise
+            except Exception as e:  # a layout that is not a database's (JSON, keys, types)
+                raise ScenarioError(f"{where}: its layout is not a database's ({type(e).__name__}: "
+                                    f"{str(e).splitlines()[0] if str(e) else ''})") from None
+        n, width = grid.size, len(db.state_names) + len(db.control_names)
+        if db.values.ndim != 3 or db.values.shape[0] != n or db.values.shape[2] != width:
+            raise ScenarioError(f"{where}: values has shape {db.values.shape}; its grid and layout need "
+                                f"({n}, nodes, {width})")
+        for name in ("final_time", "objective", "verified"):
+            if getattr(db, name).shape != (n,):
+                raise ScenarioError(f"{where}: {name} has shape {getattr(db, name).shape}; its grid needs ({n},)")
+        return db

@@ -34,6 +34,7 @@ from drake_entry.guidance.swarm_bank.optimizers import (
     pso_search,
 )
 from drake_entry.models.geodesy import destination
+from drake_entry.planning.progress import ProgressLine, wanted
 
 SWARMS = ("pio", "pso", "pso_stable")
 BASELINES = ("grid", "brentq", "secant", "bounded", "differential_evolution")
@@ -43,11 +44,15 @@ class Objective:
     """J (eq. 32) of positions in degrees, (m, 1) = sigma_0 or (m, 2) = (sigma_0, sigma_f),
     evaluated as one population; counts trajectories and keeps every evaluation."""
 
-    def __init__(self, problem: SwarmProblem):
+    def __init__(self, problem: SwarmProblem, progress: ProgressLine | None = None, budget: int | None = None):
         self.problem = problem
         self.trajectories = 0
         self.calls = 0
         self.log: list[tuple[np.ndarray, Evaluation]] = []
+        self.progress, self.budget = progress, budget
+        self.best_J = math.inf
+        if progress is not None:
+            progress.start()
 
     def evaluate(self, X) -> Evaluation:
         X = np.atleast_2d(np.asarray(X, float))
@@ -56,6 +61,10 @@ class Objective:
         self.trajectories += len(X)
         self.calls += 1
         self.log.append((X.copy(), ev))
+        self.best_J = min(self.best_J, float(np.min(ev.J)))
+        if self.progress is not None and self.progress.due():
+            of = f" of {self.budget}" if self.budget else ""
+            self.progress.emit([f"{self.trajectories}{of} trajectories", f"best J {self.best_J:.6g}"])
         return ev
 
     def __call__(self, X) -> np.ndarray:
@@ -95,14 +104,23 @@ def swarm_searches(method: str, bounds, seeds, *, n: int = 10, k_max: int = 20, 
     return [pso_search(bounds, n=n, k_max=k_max, seed=s, **settings) for s in seeds]
 
 
+def swarm_trajectories(n: int, k_max: int) -> int:
+    """Trajectories a swarm search integrates: its start and ``k_max`` iterations of ``n``."""
+    return int(n) * (int(k_max) + 1)
+
+
 def search(problem: SwarmProblem, method: str, bounds_deg=((0.0, 89.0),), *, seed: int = 0, n: int = 10,
-           k_max: int = 20, k_c: int = 14, R: float = 0.2) -> SearchResult:
+           k_max: int = 20, k_c: int = 14, R: float = 0.2, progress="auto") -> SearchResult:
     """Minimise J over ``bounds_deg`` (one pair: sigma_0; two: sigma_0, sigma_f) with ``method``
-    (SWARMS or BASELINES; the root-finding baselines take sigma_0 only)."""
+    (SWARMS or BASELINES; the root-finding baselines take sigma_0 only). ``progress``: a line on
+    stderr every 5 s once the search has run 5 s (trajectories so far of the swarm's budget, best
+    J): True, False or 'auto' (stderr is a terminal)."""
     bounds = [tuple(map(float, b)) for b in bounds_deg]
     if not 1 <= len(bounds) <= 2:
         raise ScenarioError(f"bounds_deg has {len(bounds)} pairs; allowed: 1 (sigma_0) or 2 (sigma_0, sigma_f)")
-    f = Objective(problem)
+    budget = swarm_trajectories(n, k_max) if method in SWARMS else None
+    line = ProgressLine(f"{method} search", hint="Ctrl-C stops the search") if wanted(progress) else None
+    f = Objective(problem, line, budget)
     t0 = time.perf_counter()
     swarm, message = None, ""
     if method in SWARMS:

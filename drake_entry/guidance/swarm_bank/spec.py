@@ -11,6 +11,11 @@ from drake_entry.guidance.spec import ReversingBankSpec
 OPTIMIZERS = ("pio", "pso", "pso_stable", "grid", "brentq", "secant", "bounded", "differential_evolution")
 
 
+#: the largest swarm search accepted [trajectories]: 10^5 take about 0.5-9 h on one core
+#: (20 ms each in populations of 100, 340 ms in populations of 10)
+MAX_SEARCH_TRAJECTORIES = 100_000
+
+
 @dc.dataclass
 class SwarmBank(ReversingBankSpec):
     """|sigma| linear in e = mu/r - V^2/2 from bank_start_deg at entry to bank_end_deg at the
@@ -82,6 +87,13 @@ class SwarmBank(ReversingBankSpec):
         check_range("guidance.population", self.population, 2, 10000)
         check_range("guidance.iterations", self.iterations, 1, 10000)
         check_range("guidance.landmark_iteration", self.landmark_iteration, 1, self.iterations)
+        trajectories = self.population * (self.iterations + 1)
+        if self.optimizer in ("pio", "pso", "pso_stable") and trajectories > MAX_SEARCH_TRAJECTORIES:
+            raise ScenarioError(
+                f"guidance.population x (guidance.iterations + 1) = {trajectories:,} trajectories to integrate "
+                f"before flight (20-340 ms each: {trajectories * 0.02 / 3600:,.0f} h or more); allowed up to "
+                f"{MAX_SEARCH_TRAJECTORIES:,} (paper 004: 10 x 21 = 210)")
+        check_range("guidance.seed", self.seed, 0, 2**32 - 1)
         check_range("guidance.map_compass_factor", self.map_compass_factor, 0.0, 10.0)
         check_range("guidance.resolve_period_s", self.resolve_period_s, 0.0, 1e4)
         if self.resolve_period_s and self.resolve_period_s < self.period_s:

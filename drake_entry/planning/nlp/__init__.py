@@ -40,7 +40,6 @@ evaluator (node values and Jacobians), transcription (shared parts), lgl, dircol
 from __future__ import annotations
 
 import math
-import sys
 import tempfile
 import time as _time
 
@@ -66,6 +65,7 @@ from drake_entry.planning.nlp.verify import (  # noqa: F401 (API)
     propagate,
 )
 from drake_entry.planning.nlp.verify import verify as verify_solution
+from drake_entry.planning.progress import wanted
 
 TRANSCRIPTIONS = ("lgl", "dircol")
 #: a solver stopped near an optimum (status.restartable) at a point this feasible (largest
@@ -116,11 +116,11 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
     """
     check_options(transcription=transcription, solver=solver, nodes=nodes, tolerance=tolerance,
                   max_iterations=max_iterations, dynamics_tolerance=dynamics_tolerance,
-                  propagation_tolerance=propagation_tolerance, progress=progress)
+                  propagation_tolerance=propagation_tolerance, progress=progress, refine=refine, max_nodes=max_nodes)
     names = auto_solvers() if solver == "auto" else (solver,)
     if solver == "auto" and solver_options:
         raise ScenarioError("solver_options are by the solver's own names: give solver='snopt' or 'ipopt' with them")
-    show = bool(progress is True or (progress == "auto" and sys.stderr.isatty()))
+    show = wanted(progress)
     engines = {name: _engine(name) for name in names}
     cap = max(MAX_NODES[transcription], nodes) if max_nodes is None else max_nodes
     if refine and not (isinstance(cap, (int, np.integer)) and cap >= nodes):
@@ -202,7 +202,8 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
 
 def check_options(*, transcription: str = "lgl", solver: str = "auto", nodes: int = 40, tolerance: float = 1e-8,
                   max_iterations: int = 3000, dynamics_tolerance: float = DYNAMICS_TOLERANCE,
-                  propagation_tolerance: float = PROPAGATION_TOLERANCE, progress="auto") -> None:
+                  propagation_tolerance: float = PROPAGATION_TOLERANCE, progress="auto", refine: bool = False,
+                  max_nodes: int | None = None) -> None:
     """``solve``'s options checked (a ScenarioError naming the option and its allowed range), so a
     caller can refuse bad options before a first, coarse solve."""
     if transcription not in TRANSCRIPTIONS:
@@ -220,6 +221,9 @@ def check_options(*, transcription: str = "lgl", solver: str = "auto", nodes: in
             raise ScenarioError(f"{name} = {value} is out of range; allowed (0, 1)")
     if progress not in (True, False, "auto"):
         raise ScenarioError(f"progress = {progress!r}; allowed: True, False, 'auto'")
+    if refine and max_nodes is not None and not (isinstance(max_nodes, (int, np.integer))
+                                                 and not isinstance(max_nodes, bool) and max_nodes >= nodes):
+        raise ScenarioError(f"max_nodes = {max_nodes} is out of range; allowed: an integer >= nodes ({nodes})")
 
 
 def auto_solvers() -> tuple:

@@ -68,9 +68,10 @@ def _solve_and_write(args) -> int:
     max_iterations = settings.max_iterations if args.max_iterations is None else args.max_iterations
     refine = args.refine or settings.refine
     # the main solve's options first: a bad one is refused before the coarse solve runs
+    max_nodes = (args.max_nodes or settings.max_nodes or None) if refine else None
     nlp.check_options(transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
                       max_iterations=max_iterations, dynamics_tolerance=settings.dynamics_tolerance,
-                      propagation_tolerance=settings.propagation_tolerance)
+                      propagation_tolerance=settings.propagation_tolerance, refine=refine, max_nodes=max_nodes)
     guess = None
     coarse_nodes = settings.coarse_nodes if args.coarse is None else args.coarse
     if coarse_nodes and coarse_nodes < nodes:
@@ -79,7 +80,6 @@ def _solve_and_write(args) -> int:
                            tolerance=max(tol, 1e-6), max_iterations=max_iterations, progress=True)
         print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
         guess = coarse if coarse.converged else None
-    max_nodes = (args.max_nodes or settings.max_nodes or None) if refine else None
     how = f"mesh refinement from {nodes} nodes" if refine else f"{nodes} nodes"
     print(f"solve: {problem.name}, {transcription}, {how}, {solver} ...", flush=True)
     result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,

@@ -3,44 +3,28 @@ and the timer of the Python callbacks a solver calls."""
 from __future__ import annotations
 
 import functools
-import math
-import sys
 import time
 
 import numpy as np
 
-#: a solve prints progress once it has run this long [s], then at this interval [s]
-PROGRESS_AFTER_S, PROGRESS_INTERVAL_S = 5.0, 5.0
+from drake_entry.planning.progress import ProgressLine
 
 
-class SolveProgress:
-    """Console progress of a long solve: once it has run ``after`` seconds, a line every
-    ``interval`` seconds with the elapsed time, the solver's evaluations of the problem
-    functions, the objective at the latest evaluation (solver units) and, where one constraint
-    holds every collocation row (LGL), its largest scaled violation there."""
+class SolveProgress(ProgressLine):
+    """Console progress of a long solve (planning.progress): the solver's evaluations of the
+    problem functions, the objective at the latest evaluation (solver units) and, where one
+    constraint holds every collocation row (LGL), its largest scaled violation there."""
 
     def __init__(self, label: str, *, stream=None, after: float | None = None, interval: float | None = None):
-        self.label, self.stream = label, stream or sys.stderr
-        self.after = PROGRESS_AFTER_S if after is None else after
-        self.interval = PROGRESS_INTERVAL_S if interval is None else interval
-        self.t0 = self.next = math.inf
-
-    def start(self):
-        self.t0 = time.perf_counter()
-        self.next = self.t0 + self.after
-
-    def due(self) -> bool:
-        return time.perf_counter() >= self.next
+        super().__init__(label, hint="Ctrl-C stops the solve", stream=stream, after=after, interval=interval)
 
     def report(self, calls: int, objective: float | None, violation: float | None):
-        now = time.perf_counter()
-        self.next = now + self.interval
-        parts = [f"{now - self.t0:6.0f} s", f"{calls} evaluations"]
+        parts = [f"{calls} evaluations"]
         if objective is not None:
             parts.append(f"objective {objective:.8g}")
         if violation is not None:
             parts.append(f"largest collocation violation {violation:.2e} (scaled)")
-        print(f"  [{self.label}] " + ", ".join(parts) + " (Ctrl-C stops the solve)", file=self.stream, flush=True)
+        self.emit(parts)
 
 
 class CallbackTimer:

@@ -16,6 +16,7 @@ import hashlib
 import importlib
 import json
 import multiprocessing as mp
+import os
 import signal
 import traceback
 
@@ -147,8 +148,20 @@ def run_dask(task: Task, cases, record, workers: int, scheduler: str | None):
                                 f"cluster") from None
         workers = max(workers, len(client.scheduler_info().get("workers", {})))
     else:
-        with dask.config.set(DASK_QUIET_WORKERS):
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        # the cluster's processes start with SIGINT ignored (kept across exec, and Python and
+        # asyncio leave an ignored SIGINT alone): Ctrl-C is the parent's, which ends the cluster
+        # and log errors only (a task cancelled by Ctrl-C is not news)
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        env = os.environ.get("DASK_LOGGING__DISTRIBUTED")
+        os.environ["DASK_LOGGING__DISTRIBUTED"] = env or "error"
+        try:
+            with dask.config.set(DASK_QUIET_WORKERS):
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
+        finally:
+            signal.signal(signal.SIGINT, previous)
+            if env is None:
+                del os.environ["DASK_LOGGING__DISTRIBUTED"]
         client = Client(cluster)
     try:
         pending = iter(cases)  # submitted a few per worker at a time: a lazy case list stays lazy
@@ -173,6 +186,11 @@ def run_dask(task: Task, cases, record, workers: int, scheduler: str | None):
                 row, traj = failed_row(case, f"worker failure: {type(e).__name__}: {e}"), None
             record(row, traj)
             submit_next(queue)
+    except KeyboardInterrupt:  # the cluster's own shutdown warnings would follow the one line
+        import logging
+
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
+        raise
     finally:
         client.close()
         if cluster is not None:

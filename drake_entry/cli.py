@@ -182,7 +182,13 @@ def _cmd_campaign(args) -> int:
 def check_output_dir(out: str) -> None:
     """Refuse an output directory that cannot be made or written before any work starts: a
     file on its path, a read-only or forbidden place (one line naming it)."""
-    parent = out
+    if not out or not out.strip():
+        raise ScenarioError("--out is empty; give a directory")
+    if "\0" in out:
+        raise ScenarioError(f"--out {out!r} contains a NUL character; give a directory path")
+    parent = os.path.normpath(out)  # 'a_file/' names the file too
+    if os.path.exists(parent) and not os.path.isdir(parent):
+        raise ScenarioError(f"--out {out} is a file, not a directory")
     while parent and not os.path.exists(parent):
         parent = os.path.dirname(parent.rstrip(os.sep))
     parent = parent or "."

@@ -41,8 +41,33 @@ class Tagged(NamedTuple):
     value: Any
 
 
+class DuplicateKeyError(yaml.YAMLError):
+    """A mapping that names one key twice (YAML keeps the last silently)."""
+
+    def __init__(self, key, mark):
+        super().__init__(f"the field {key!r} is given twice")
+        self.problem_mark = mark
+
+
 class _TagKeepingLoader(yaml.SafeLoader):
-    """PyYAML's safe loader that keeps local ``!Tags`` as ``Tagged`` (never constructs objects)."""
+    """PyYAML's safe loader that keeps local ``!Tags`` as ``Tagged`` (never constructs objects)
+    and refuses a key given twice in one mapping."""
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen = set()
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":  # '<<': merged keys may be overridden
+                    continue
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    duplicate = key in seen
+                    seen.add(key)
+                except TypeError:  # an unhashable key: the base loader says so
+                    duplicate = False
+                if duplicate:
+                    raise DuplicateKeyError(key, key_node.start_mark)
+        return super().construct_mapping(node, deep=deep)
 
 
 def _construct_tagged(loader, suffix, node):

@@ -85,6 +85,7 @@ def test_file_errors_name_the_section_and_the_closest_field(tmp_path):
         "guidance: 3\n": "guidance: expected a tagged block",
         "dispersions:\n  mass_scale: heavy\n": "dispersions.mass_scale: expected a number or a tagged block",
         "entry: [1, 2\n": "not valid YAML (line",
+        "name: a\nname: b\n": "not valid YAML (line 2, column 1): the field 'name' is given twice",
     }
     for text, expected in cases.items():
         path = tmp_path / "s.yaml"

@@ -9,6 +9,7 @@ import sys
 import time
 
 from drake_entry.cli import Command
+from drake_entry.errors import ScenarioError
 
 
 def add_arguments(parser) -> None:
@@ -74,6 +75,9 @@ def _solve_and_write(args) -> int:
                       propagation_tolerance=settings.propagation_tolerance, refine=refine, max_nodes=max_nodes)
     guess = None
     coarse_nodes = settings.coarse_nodes if args.coarse is None else args.coarse
+    if coarse_nodes and coarse_nodes < 3:
+        raise ScenarioError(f"--coarse {coarse_nodes} is out of range; allowed: 0 (start from the propagated guess) "
+                            f"or an integer >= 3")
     if coarse_nodes and coarse_nodes < nodes:
         print(f"coarse solve: {transcription}, {coarse_nodes} nodes, {solver} ...", flush=True)
         coarse = nlp.solve(problem, transcription=transcription, solver=solver, nodes=coarse_nodes,

@@ -195,14 +195,28 @@ def test_a_second_writer_is_refused(tmp_path):
 
 
 def test_repeated_kills_lose_and_repeat_no_sample(tmp_path):
+    """SIGKILL three times, each once the campaign has written 1, 3 and 4 rows (asserted: every
+    kill landed mid-campaign), then resume: every sample once, each trajectory once."""
     out = tmp_path / "killed"
     code = ("from drake_entry.diagrams.montecarlo import run_campaign; "
             f"run_campaign('horus2b', runs=6, out_dir={str(out)!r}, seed=5, workers=1, progress=False)")
-    for delay in (4.0, 2.5, 3.0):
+    def rows_done() -> int:
+        try:
+            return sum(1 for line in (out / "samples.jsonl").read_text().splitlines() if line.endswith("}"))
+        except FileNotFoundError:
+            return 0
+
+    killed_at = []
+    for target in (1, 3, 4):  # each kill lands once the campaign has this many rows, mid-run
         p = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path)
-        time.sleep(delay)
+        deadline = time.monotonic() + 300
+        while rows_done() < target and p.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert p.poll() is None, f"the campaign ended before the kill at {target} rows"
         p.send_signal(signal.SIGKILL)
         p.wait()
+        killed_at.append(rows_done())
+    assert all(0 < k < 6 for k in killed_at) and killed_at == sorted(killed_at), killed_at
     subprocess.run([sys.executable, "-c", code], cwd=tmp_path, check=True, timeout=300)
     rows = [json.loads(line) for line in (out / "samples.jsonl").read_text().splitlines()]
     assert sorted(r["index"] for r in rows) == list(range(6))

@@ -16,6 +16,7 @@ from drake_entry.guidance.scvx.engine import (
     ScvxSettings,
     defect_correction,
     golden_section,
+    max_violation,
     solve_scvx,
 )
 from drake_entry.guidance.scvx.entry import EntryProblem, heading_regulariser_sign
@@ -104,7 +105,9 @@ def test_engine_refuses_a_convex_constraint_it_cannot_shift():
 
 
 def test_engine_reports_an_infeasible_problem_with_its_constraint():
-    """x^2 + y^2 = 1 with y >= 2 cannot hold: the engine stops with the violated constraint named."""
+    """x^2 + y^2 = 1 with y >= 2 cannot hold: the engine stops at the least-infeasible point,
+    the top of the circle (0, 1) where y misses its bound by exactly 1 (the l1 merit's minimum
+    of the violation on the circle), and names that constraint and its violation."""
 
     class Named(Circle):
         def describe_inequality(self, i):
@@ -112,7 +115,10 @@ def test_engine_reports_an_infeasible_problem_with_its_constraint():
 
     out = solve_scvx(Named(y_min=2.0), np.array([0.5, 0.5]), ScvxSettings(max_iterations=40))
     assert not out.converged
-    assert "y lower bound" in out.message or "defect" in out.message
+    assert out.message.startswith("stationary at an infeasible point")
+    assert "largest violation 1 (y lower bound)" in out.message
+    assert out.z == pytest.approx([0.0, 1.0], abs=0.01)
+    assert max_violation(out.evaluation) == pytest.approx(1.0, abs=1e-3)
 
 
 def test_defect_correction_is_the_least_norm_step_that_cancels_the_defects():

@@ -43,8 +43,27 @@ def test_negative_mass_names_the_field_and_range(tmp_path):
 
 @pytest.mark.parametrize("name", PACKAGED_SCENARIOS)
 def test_packaged_scenarios_validate(name):
+    """Each packaged scenario loads, validates, and survives the round trip a campaign manifest
+    makes (Drake's yaml_dump_typed, then load: the same text again); its mission is physical:
+    the entry interface lies above the terminal altitude with more specific energy than the
+    guidance's terminal interface (closed-loop scenarios), and the target is a point on Earth."""
+    from pydrake.common.yaml import yaml_dump_typed
+
+    from drake_entry.cli import closed_loop_scenarios
+    from drake_entry.scenario import Scenario
+    from drake_entry.typed_yaml import load_yaml_typed
+
     s = load_scenario(name)
-    assert s.initial_state().shape == (6,)
+    dumped = yaml_dump_typed(s)
+    assert yaml_dump_typed(load_yaml_typed(Scenario, text=dumped, where=name).validate()) == dumped
+    x0 = s.initial_state()
+    assert x0.shape == (6,) and np.all(np.isfinite(x0))
+    assert -90.0 <= s.target.latitude_deg <= 90.0 and -360.0 <= s.target.longitude_deg <= 360.0
+    if s.terminal.altitude_km is not None:
+        assert s.entry.altitude_km > s.terminal.altitude_km
+    if name in closed_loop_scenarios():
+        h_f, V_f, E_f = s.guidance_terminal_state()
+        assert x0[0] > h_f and x0[3] > V_f and s.entry_energy() > E_f
 
 
 def test_horus_scenario_is_paper000_table1():

@@ -139,8 +139,9 @@ def extremal_controls(problem, result: NlpResult) -> np.ndarray:
         raise ScenarioError("the result has no costates (the solver returned no multipliers)")
     t = terms[0]
     lam = result.costates
-    u = np.column_stack([-t.u_alpha_max ** 2 * lam[:, 6] / (2.0 * t.weight * t.k[1]),
-                         -t.u_sigma_max ** 2 * lam[:, 7] / (2.0 * t.weight * t.k[2])])
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # extreme bounds: inf, then clipped
+        u = np.column_stack([-np.float64(t.u_alpha_max) ** 2 * lam[:, 6] / (2.0 * t.weight * t.k[1]),
+                             -np.float64(t.u_sigma_max) ** 2 * lam[:, 7] / (2.0 * t.weight * t.k[2])])
     _, _, ul, uh = problem.bounds_arrays()
     return np.clip(u, ul, uh)
 

@@ -1,0 +1,125 @@
+"""A re-plan that fails mid-flight (the solver raises, or returns an unsuccessful plan): the
+guidance keeps serving the previous reference, records the failure with its time and reason,
+and retries one re-plan period later, as systems/drag_energy_guidance.py documents."""
+import types
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource
+
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.systems.drag_energy_guidance import DragEnergyGuidance
+
+
+class ScriptedPlanner:
+    """A planner stub: plan k (1, 2, ...) serves the constant drag k m/s^2, unless the script
+    says the k-th call raises or returns an unsuccessful plan."""
+
+    E_entry, E_final = 0.0, -1.0
+
+    def __init__(self, script: dict):
+        self.script, self.calls, self.call_times = script, 0, []
+
+    def energy(self, x):
+        return -0.5  # half-way: re-planning stays allowed (replan_until_e 0.9)
+
+    def drag_state(self, x, sensed):
+        return types.SimpleNamespace(D_prime=1.0)  # drag no longer rising: guidance may engage
+
+    def plan_from_state(self, x, previous=None, sensed_drag=None):
+        self.calls += 1
+        what = self.script.get(self.calls)
+        if what == "raise":
+            raise FloatingPointError("forced solver failure")
+        level = float(self.calls)
+        return types.SimpleNamespace(
+            success=what != "unsuccessful", message="forced: not converged" if what == "unsuccessful" else "ok",
+            profile=lambda E, level=level: (np.array([level]), np.array([0.0]), np.array([0.0])))
+
+
+def _fly(planner, until_s: float, replan_s: float = 10.0):
+    builder = DiagramBuilder()
+    guidance = builder.AddSystem(DragEnergyGuidance(planner, period=1.0, pre_guidance_min_s=0.0,
+                                                    replan_period_s=replan_s))
+    estimate = builder.AddSystem(ConstantVectorSource(np.array([60e3, 0.1, 0.2, 6000.0, -0.01, 1.0])))
+    conditions = builder.AddSystem(ConstantVectorSource(np.ones(len(FLIGHT_CONDITION_NAMES))))
+    builder.Connect(estimate.get_output_port(), guidance.GetInputPort("estimated_state"))
+    builder.Connect(conditions.get_output_port(), guidance.GetInputPort("flight_conditions"))
+    simulator = Simulator(builder.Build())
+    served = []
+    for t in np.arange(0.5, until_s, 1.0):  # between the 1-s guidance updates
+        simulator.AdvanceTo(t)
+        context = guidance.GetMyContextFromRoot(simulator.get_context())
+        served.append(guidance.GetOutputPort("reference").Eval(context)[0])
+    return np.array(served), guidance.memory(guidance.GetMyContextFromRoot(simulator.get_context()))
+
+
+def test_a_failed_replan_keeps_the_previous_reference_and_is_retried_a_period_later():
+    planner = ScriptedPlanner({2: "raise", 3: "unsuccessful"})
+    served, memory = _fly(planner, 45.0)
+    # plans at t = 0 (1), 10 (raises), 20 (unsuccessful), 30 (drag 4), 40 (drag 5)
+    assert planner.calls == 5
+    expected = np.repeat([1.0, 1.0, 1.0, 4.0, 5.0], 10)[: len(served)]
+    assert np.array_equal(served, expected)
+    assert memory.plans == 3 and memory.engaged_at == 0.0
+    assert [(t, m) for t, m in memory.failures] == [(10.0, "FloatingPointError: forced solver failure"),
+                                                    (20.0, "forced: not converged")]
+
+
+def test_a_failed_first_plan_stays_in_pre_guidance_until_one_succeeds():
+    planner = ScriptedPlanner({1: "raise", 2: "unsuccessful"})
+    served, memory = _fly(planner, 35.0)
+    # without a reference the guidance serves zeros (not engaged); the first plan is retried at
+    # the next guidance update (no re-plan period applies before engagement)
+    assert np.array_equal(served[:2], [0.0, 0.0]) and served[2] == 3.0
+    assert memory.engaged_at == 2.0 and len(memory.failures) == 2
+
+
+class _StubPlan:
+    """What ScvxGuidance reads of a plan: its commands (a constant bank ``level`` rad), t_f,
+    success and message."""
+
+    def __init__(self, level: float, success: bool = True, message: str = "converged"):
+        self.level, self.success, self.message, self.final_time = level, success, message, 2000.0
+
+    def control_samples(self):
+        t = np.array([0.0, self.final_time])
+        return t, np.full(2, self.level), np.full(2, 0.2)
+
+
+def test_a_refused_scvx_replan_keeps_the_plan_in_flight(monkeypatch):
+    """ScvxGuidance re-plans every 100 s; the first re-plan raises, the second is not a verified
+    success, the third succeeds: the pre-flight plan's bank flies until t = 300 s, both refusals
+    are recorded with time and reason, and plan_stats counts 1 re-plan and 2 refused."""
+    import drake_entry.systems.scvx_guidance as scvx_guidance
+
+    calls = []
+
+    def scripted_replan(plan, x, t_plan, bank, alpha, settings=None):
+        calls.append(t_plan)
+        if len(calls) == 1:
+            raise ValueError("forced: Clarabel failed")
+        if len(calls) == 2:
+            return _StubPlan(2.0, success=False, message="converged but its controls flown end 9 km away")
+        return _StubPlan(3.0)
+
+    monkeypatch.setattr(scvx_guidance, "replan_from", scripted_replan)
+    builder = DiagramBuilder()
+    guidance = builder.AddSystem(scvx_guidance.ScvxGuidance(_StubPlan(1.0), period=1.0, replan_period=100.0,
+                                                            min_time_to_go=300.0))
+    estimate = builder.AddSystem(ConstantVectorSource(np.array([60e3, 0.1, 0.2, 6000.0, -0.01, 1.0])))
+    builder.Connect(estimate.get_output_port(), guidance.GetInputPort("estimated_state"))
+    simulator = Simulator(builder.Build())
+    bank = []
+    for t in np.arange(50.0, 451.0, 50.0):
+        simulator.AdvanceTo(t + 0.5)
+        context = guidance.GetMyContextFromRoot(simulator.get_context())
+        bank.append(guidance.GetOutputPort("bank_command").Eval(context)[0])
+    assert calls == [100.0, 200.0, 300.0, 100.0]  # time since the flown plan began (a new one at 300 s)
+    assert bank == [1.0, 1.0, 1.0, 1.0, 1.0, 3.0, 3.0, 3.0, 3.0]
+    memory = guidance.memory(context)
+    assert memory.refused == [(100.0, "ValueError: forced: Clarabel failed"),
+                              (200.0, "converged but its controls flown end 9 km away")]
+    stats = guidance.GetOutputPort("plan_stats").Eval(context)
+    assert stats[0] == 2 and stats[1] == 2  # t = 300 s and 400 s succeeded

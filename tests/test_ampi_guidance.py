@@ -33,11 +33,16 @@ def test_packaged_database_is_the_full_eq_5_grid_verified_consistent_and_reaches
     assert V.min() >= 570.0 - 1e-3 and V.max() <= 620.0 + 1e-3
     h_geo = [problem.planet.atmospheric_altitude(x[0], x[2]) for x in end]
     assert min(h_geo) >= 21e3 - 1.0 and max(h_geo) <= 26e3 + 1.0
-    # Table 2's bank limit holds at the NLP's knots but not between them: the first-order-held
-    # rate dips the bank up to 3 deg past 60 deg between DirectCollocation knots (case 591:
-    # -63.0 deg at 77.9 s), and the between-node verification does not check state bounds
-    # (docs/methods/ampi.md, known limitation); the tracker clips the command at 60 deg
-    assert 60.0 < np.degrees(np.abs(db.values[:, :, names.index("sigma")])).max() < 63.1
+
+
+@pytest.mark.xfail(strict=True, reason="known limitation (docs/methods/ampi.md): the first-order-held bank "
+                   "rate dips the bank up to 3 deg past 60 deg between DirectCollocation knots (case 591: "
+                   "-63.0 deg at 77.9 s) and the between-node verification does not check state bounds; "
+                   "the tracker clips the command at 60 deg. Remove this mark when the database is rebuilt")
+def test_packaged_database_bank_holds_the_table_2_limit_between_knots(planner):
+    """Paper 003 Table 2: |sigma| <= 60 deg along every stored trajectory (the LD nodes)."""
+    db = planner.database
+    assert np.degrees(np.abs(db.values[:, :, db.state_names.index("sigma")])).max() <= 60.0 + 1e-6
 
 
 def test_offsets_are_eq_6_with_a_geodetic_altitude(planner):

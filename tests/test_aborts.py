@@ -86,9 +86,17 @@ def test_orbital_grid_is_centred_on_the_nominal_eip_and_sees_the_site_as_it_does
     assert (centre["entry_longitude_deg"], centre["entry_latitude_deg"]) == (-115.0, 30.0)
     assert centre["entry_heading_deg"] == pytest.approx(mission.entry_heading_deg, abs=1e-9)
     assert centre["range_km"] == pytest.approx(8076.0, abs=5.0)  # paper 001 Table 1 mission (notes: 8076 km)
-    assert heading_offset(mission, planet) == pytest.approx(-14.05, abs=0.01)
+    # the offset is Table 1's heading minus the initial great-circle bearing from the EIP to the
+    # site, computed here by the spherical-trigonometry formula on the geocentric coordinates
+    x0, (lon_s, lat_s) = mission.entry_state(planet), mission.site(planet)
+    dlon = lon_s - x0[1]
+    bearing = math.degrees(math.atan2(math.sin(dlon) * math.cos(lat_s), math.cos(x0[2]) * math.sin(lat_s)
+                                      - math.sin(x0[2]) * math.cos(lat_s) * math.cos(dlon)))
+    expected = mission.entry_heading_deg - bearing
+    assert heading_offset(mission, planet) == pytest.approx(expected, abs=1e-9)
+    assert expected == pytest.approx(-14.05, abs=0.01)  # regression pin of the value
     for c in cases:  # every EIP keeps the nominal's heading offset from the bearing to the site
-        assert heading_offset(case_mission(mission, c), planet) == pytest.approx(-14.05, abs=0.01)
+        assert heading_offset(case_mission(mission, c), planet) == pytest.approx(expected, abs=1e-6)
     with pytest.raises(ScenarioError, match="rows = 0"):
         orbital_abort_cases(mission, planet, shape=(0, 3))
     with pytest.raises(ScenarioError, match="within 80 deg"):

@@ -19,7 +19,8 @@ Ports:
   - output "bank_magnitude"     [1]  |sigma| [rad]
   - output "alpha_command"      [1]  alpha [rad]
   - output "sigma0"             [1]  the sigma_0 in use [rad]
-  - output "plan_stats"         [3]  re-solutions, re-solutions without a bracketed root, wall time [s]
+  - output "plan_stats"         [3]  re-solutions, re-solutions without a bracketed root (or that
+                                   raised: the sigma_0 in use flies on), wall time [s]
 
 The commands are computed from the inputs and the law's memory (previous alpha command, Case 2
 switch) at each sample: the actuators sample them at the same instant, as the planner's
@@ -124,10 +125,14 @@ class SwarmBankGuidance(LeafSystem):
                                   initial_alpha=alpha, initial_bank=bank, initial_sign=1.0 if bank >= 0 else -1.0,
                                   memory=(bool(nxt.mach_was_above[0]), bool(nxt.switched[0])),
                                   max_time_s=max(p.max_time_s - t, p.guidance_step_s))
-                r = resolve_sigma0(here, math.degrees(m[_SIGMA0]), self.bounds_deg)
-                m[_SIGMA0] = math.radians(r.sigma0_deg)
+                try:
+                    r = resolve_sigma0(here, math.degrees(m[_SIGMA0]), self.bounds_deg)
+                except Exception:  # a failed re-solution must not stop the flight: sigma_0 flies on
+                    r = None
+                if r is not None and math.isfinite(r.sigma0_deg):
+                    m[_SIGMA0] = math.radians(r.sigma0_deg)
                 m[_PLANS] += 1
-                m[_FAILED] += not r.bracketed
+                m[_FAILED] += r is None or not r.bracketed or not math.isfinite(r.sigma0_deg)
                 m[_WALL] += time.perf_counter() - t0
         discrete_state.get_mutable_vector(self._state).SetFromVector(m)
 

@@ -4,6 +4,7 @@ and retries one re-plan period later, as systems/drag_energy_guidance.py documen
 import types
 
 import numpy as np
+import pytest
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
@@ -123,3 +124,42 @@ def test_a_refused_scvx_replan_keeps_the_plan_in_flight(monkeypatch):
                               (200.0, "converged but its controls flown end 9 km away")]
     stats = guidance.GetOutputPort("plan_stats").Eval(context)
     assert stats[0] == 2 and stats[1] == 2  # t = 300 s and 400 s succeeded
+
+
+def test_a_swarm_resolution_that_raises_keeps_sigma0_and_is_counted(monkeypatch):
+    """SwarmBankGuidance re-solves sigma_0 every 10 s; a re-solution that raises (the first) or
+    returns a non-finite sigma_0 (the second) leaves the sigma_0 in use, and plan_stats counts
+    both as failed; the third re-solution's bracketed root is taken."""
+    import math
+
+    import drake_entry.systems.swarm_bank_guidance as swarm
+    from drake_entry.guidance.swarm_bank.search import Resolution, problem_from_scenario
+    from drake_entry.scenario import load_scenario
+
+    problem = problem_from_scenario(load_scenario("cav_h_paper004"))
+    script = iter([FloatingPointError("forced"), Resolution(math.nan, False, math.nan, 8),
+                   Resolution(61.0, True, 0.0, 24)])
+
+    def scripted(here, previous_deg, bounds_deg):
+        outcome = next(script)
+        if isinstance(outcome, Exception):
+            raise outcome
+        return outcome
+
+    monkeypatch.setattr(swarm, "resolve_sigma0", scripted)
+    builder = DiagramBuilder()
+    guidance = builder.AddSystem(swarm.SwarmBankGuidance(problem, math.radians(58.0), period=1.0,
+                                                         resolve_period=10.0, resolve_scaling=False))
+    for port, value in (("estimated_state", problem.x0), ("flight_conditions", np.ones(len(FLIGHT_CONDITION_NAMES))),
+                        ("bank_command", [0.5])):
+        builder.Connect(builder.AddSystem(ConstantVectorSource(np.asarray(value, float))).get_output_port(),
+                        guidance.GetInputPort(port))
+    simulator = Simulator(builder.Build())
+    sigma0 = []
+    for t in (5.5, 15.5, 25.5, 35.5):
+        simulator.AdvanceTo(t)
+        context = guidance.GetMyContextFromRoot(simulator.get_context())
+        sigma0.append(math.degrees(guidance.GetOutputPort("sigma0").Eval(context)[0]))
+    assert sigma0 == pytest.approx([58.0, 58.0, 58.0, 61.0], abs=1e-12)
+    stats = guidance.GetOutputPort("plan_stats").Eval(context)
+    assert stats[0] == 3 and stats[1] == 2

@@ -33,7 +33,7 @@ FULL_RUNS = ("01_open_loop_diagram", "02_custom_controller", "03_monte_carlo", "
 
 
 @pytest.mark.slow
-@pytest.mark.full_example
+@pytest.mark.long
 @pytest.mark.parametrize("name", FULL_RUNS)
 def test_full_example_exits_0_with_every_claim_and_no_warning(name, tmp_path):
     """The full run as a user types it, in a fresh process: exit status 0 (its claims hold), its

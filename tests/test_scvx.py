@@ -337,6 +337,7 @@ def test_the_verifiers_fixed_steps_fly_the_plan_as_a_tight_error_controlled_flig
 
 
 @pytest.mark.slow
+@pytest.mark.long  # 9 min on the 2-core machine: local only (CI time)
 def test_nominal_heat_load_matches_the_nlp_path(sphynx_case, nominal_plan):
     """Paper 001 Table 3 against the NLP path: the same direct minimum-heat-load problem (``as_ocp.mission_problem``:
     same models, limits and DRS box) through ``nlp.solve`` with DirectCollocation + SNOPT at 100

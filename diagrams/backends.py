@@ -150,10 +150,11 @@ def run_dask(task: Task, cases, record, workers: int, scheduler: str | None):
     else:
         # the cluster's processes start with SIGINT ignored (kept across exec, and Python and
         # asyncio leave an ignored SIGINT alone): Ctrl-C is the parent's, which ends the cluster
-        # and log errors only (a task cancelled by Ctrl-C is not news)
+        # and log only critical messages (a task cancelled, a heartbeat lost at Ctrl-C are not news;
+        # a worker that fails is a failed row of its case)
         previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
         env = os.environ.get("DASK_LOGGING__DISTRIBUTED")
-        os.environ["DASK_LOGGING__DISTRIBUTED"] = env or "error"
+        os.environ["DASK_LOGGING__DISTRIBUTED"] = env or "critical"
         try:
             with dask.config.set(DASK_QUIET_WORKERS):
                 cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,

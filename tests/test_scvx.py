@@ -300,7 +300,7 @@ def test_nominal_plan_converges_and_its_controls_fly_to_the_site(sphynx_case, no
     assert plan.formulation == "direct" and plan.lossless_gap == pytest.approx(0.0, abs=1e-12)
     assert plan.max_defect <= 1e-6 and plan.max_violation <= 1e-6
     assert plan.iterations <= 60
-    assert 460.0 < plan.objective < 500.0  # MJ/m^2
+    assert 460.0 < plan.objective < 500.0  # MJ/m^2: regression pin of our model (paper: 540.4 with its aero)
     assert plan.peaks["heat_flux_W_m2"] <= 670e3 * (1 + 1e-6) and plan.peaks["total_load_g"] <= 3.0 + 1e-6
     # its margins hold between the nodes too (at 3dec588: 671.0 kW/m^2 and gamma 0.508 deg there)
     assert plan.between_nodes["heat_flux"] == 0.0 and plan.between_nodes["flight_path_rad"] == 0.0
@@ -407,6 +407,17 @@ def test_paper_lossless_plan_reports_its_gap_and_is_refused_when_its_bank_does_n
     assert flight.from_plan_m > 5e3 and not flight.ok
     assert not plan.success
     assert "converged but its controls flown end" in plan.message and "'direct'" in plan.message
+
+
+def test_planning_alpha_lowers_the_heat_load_as_paper001_table3_reports(nominal_plan, paper_lossless_plan):
+    """Paper 001 Table 3: with the angle of attack in the optimisation the minimum heat load
+    falls from 573.455 (lossless bank) to 540.382 MJ/m^2 (direct AOA and bank), 5.8 % (its
+    Sec. V text). Ours, with the labelled representative aerodynamics (the paper's table is not
+    public), must show the same effect within a factor of two: 3 to 12 % (8.4 % measured:
+    477 vs 521 MJ/m^2). The absolute bands of the other tests are regression pins of our model."""
+    reduction = 1.0 - nominal_plan.objective / paper_lossless_plan.objective
+    assert 1.0 - 540.382 / 573.455 == pytest.approx(0.0577, abs=1e-4)
+    assert 0.03 < reduction < 0.12, reduction
 
 
 def test_default_lossless_margin_is_what_flies_it_into_the_drs_window(sphynx_case):

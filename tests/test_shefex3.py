@@ -186,7 +186,10 @@ def test_table_1_target_lies_outside_the_representative_vehicles_footprint():
                   verifier=fly_controls)
     assert r.success, r.message
     miss = problem.planet.great_circle_distance(r.states[-1, 1], r.states[-1, 2], *target)
-    assert 20e3 < miss < 60e3
+    # outside: the least miss is many times the solve's verified accuracy (the flown controls end
+    # within 2 km of the plan, the packaged problem's test); 31 km measured (a regression pin)
+    assert miss > 5 * r.verification.propagation["position_m"] and miss > 10e3
+    assert miss == pytest.approx(31e3, abs=3e3)
 
 
 def test_problem_yaml_reads_eq_1_and_names_bad_fields(tmp_path):

@@ -50,7 +50,10 @@ def test_ctrl_c_ends_a_campaign_with_one_line_exit_130_and_no_worker_left(tmp_pa
     out = str(tmp_path / "c")
     argv = [sys.executable, "-m", "drake_entry.cli", "campaign", "horus2b", "--runs", "12", "--workers", "2",
             "--trajectory-step", "0", "--out", out, "--backend", backend]
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    # cwd outside the repository: `python -m` puts the cwd first on the path, and the working tree
+    # is not the installed package (its diagrams/ and systems/ are mapped in by the install)
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            cwd=str(tmp_path))
     deadline = time.monotonic() + 300
     while _rows(out) < 1 and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)

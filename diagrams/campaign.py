@@ -95,12 +95,12 @@ def run_cases(task: Task, cases: list, out_dir: str, manifest: dict, *, backend:
             raise ScenarioError("cases need a unique integer 'index' each")
     store = CampaignStore(out_dir, manifest)
     done = store.done_indices()
-    remaining = len(cases) - sum(1 for i in done if i in cases) if isinstance(cases, SampleCases) else None
-    if remaining is None:
+    if isinstance(cases, SampleCases):  # lazy: a huge campaign starts at once
+        todo = (c for c in cases if c["index"] not in done)
+        remaining = len(cases) - sum(1 for i in done if i in cases)
+    else:
         todo = [c for c in cases if c["index"] not in done]
         remaining = len(todo)
-    else:
-        todo = (c for c in cases if c["index"] not in done)  # lazy: a huge campaign starts at once
     workers = min(workers or os.cpu_count() or 1, max(remaining, 1))
     total = int(store.manifest.get("runs", len(cases)))
     bar = None
@@ -122,8 +122,6 @@ def run_cases(task: Task, cases: list, out_dir: str, manifest: dict, *, backend:
         try:
             run_backend(backend, task, todo, record, workers=workers, scheduler=scheduler)
         except KeyboardInterrupt:
-            if bar is not None:
-                bar.close()
             finished = len(store.done_indices())
             raise Interrupted(f"interrupted after {finished} of {total} {desc} cases; every finished one is "
                               f"kept in {out_dir}: run the same command to resume") from None

@@ -329,8 +329,6 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         out = getattr(args, "out", None)
-        if out is not None and os.path.exists(out) and not os.path.isdir(out):
-            raise ScenarioError(f"--out {out} is a file, not a directory")
         if out is not None:
             check_output_dir(out)
         return args.func(args)

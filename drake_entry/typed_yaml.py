@@ -131,6 +131,10 @@ def _union_args(hint) -> tuple | None:
     return None
 
 
+#: the scalar kinds a schema field may declare, in the order a Union tries them, and their words
+_KIND = {float: "a number", int: "an integer", bool: "true or false", str: "text"}
+
+
 def _scalar(hint, value):
     """``value`` as Drake's loader converts it to ``hint`` (bool, int or float), None when it
     refuses: int -> float, an integral float -> int, number text by Python's parsers (YAML
@@ -174,11 +178,10 @@ def check(hint, value, path: str) -> None:
                 check(hints[key], item, _join(path, key))
     elif hint in (bool, int, float):
         if _scalar(hint, value) is None:
-            wanted = {bool: "true or false", int: "an integer", float: "a number"}[hint]
-            raise ScenarioError(f"{path}: expected {wanted}, got {_describe(value)}")
+            raise ScenarioError(f"{path}: expected {_KIND[hint]}, got {_describe(value)}")
     elif hint is str:
         if not isinstance(value, str):
-            raise ScenarioError(f"{path}: expected text, got {_describe(value)}")
+            raise ScenarioError(f"{path}: expected {_KIND[str]}, got {_describe(value)}")
     elif typing.get_origin(hint) in (list, typing.List):
         if not isinstance(value, list):
             raise ScenarioError(f"{path}: expected a list, got {_describe(value)}")
@@ -206,7 +209,7 @@ def _check_union(alternatives: tuple, value, path: str) -> None:
         return
     if len(options) == 1:
         return check(options[0], value, path)
-    classes = [a for a in options if isinstance(a, type) and a not in (float, int, bool, str)]
+    classes = [a for a in options if isinstance(a, type) and a not in _KIND]
     if isinstance(value, Tagged):
         chosen = {_tag_name(a): a for a in classes}.get(value.tag)
         if chosen is not None and dc.is_dataclass(chosen):
@@ -215,7 +218,7 @@ def _check_union(alternatives: tuple, value, path: str) -> None:
             raise ScenarioError(f"{path}: unknown type tag '!{value.tag}'; allowed: "
                                 + ", ".join("!" + _tag_name(a) for a in classes))
         return  # one of Drake's own schema types (distributions): its loader decides
-    for scalar in (float, int, bool, str):
+    for scalar in _KIND:
         if scalar in options:
             try:
                 return check(scalar, value, path)
@@ -225,8 +228,7 @@ def _check_union(alternatives: tuple, value, path: str) -> None:
         if dc.is_dataclass(classes[0]):
             check(classes[0], value, path)
         return
-    kinds = [{float: "a number", int: "an integer", bool: "true or false", str: "text"}[s]
-             for s in (float, int, bool, str) if s in options]
+    kinds = [_KIND[s] for s in _KIND if s in options]
     tags = ", ".join("!" + _tag_name(a) for a in classes)
     wanted = " or ".join(kinds + ([f"a tagged block ({tags})"] if tags else []))
     raise ScenarioError(f"{path}: expected {wanted}, got {_describe(value)}")

@@ -33,10 +33,10 @@ from drake_entry.guidance.swarm_bank.optimizers import (
     pio_search,
     pso_search,
 )
+from drake_entry.guidance.swarm_bank.spec import SWARMS, swarm_trajectories
 from drake_entry.models.geodesy import destination
 from drake_entry.planning.progress import ProgressLine, wanted
 
-SWARMS = ("pio", "pso", "pso_stable")
 BASELINES = ("grid", "brentq", "secant", "bounded", "differential_evolution")
 
 
@@ -102,11 +102,6 @@ def swarm_searches(method: str, bounds, seeds, *, n: int = 10, k_max: int = 20, 
     if settings is None:
         raise ScenarioError(f"swarm method {method!r}; allowed: {', '.join(SWARMS)}")
     return [pso_search(bounds, n=n, k_max=k_max, seed=s, **settings) for s in seeds]
-
-
-def swarm_trajectories(n: int, k_max: int) -> int:
-    """Trajectories a swarm search integrates: its start and ``k_max`` iterations of ``n``."""
-    return int(n) * (int(k_max) + 1)
 
 
 def search(problem: SwarmProblem, method: str, bounds_deg=((0.0, 89.0),), *, seed: int = 0, n: int = 10,

@@ -8,7 +8,14 @@ from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import ReversingBankSpec
 
 #: sigma_0 searches: the paper's swarms and the scipy baselines (guidance/swarm_bank/search.py)
-OPTIMIZERS = ("pio", "pso", "pso_stable", "grid", "brentq", "secant", "bounded", "differential_evolution")
+#: the swarm optimizers (paper 004's PIO and PSO; their budget: swarm_trajectories)
+SWARMS = ("pio", "pso", "pso_stable")
+OPTIMIZERS = SWARMS + ("grid", "brentq", "secant", "bounded", "differential_evolution")
+
+
+def swarm_trajectories(n: int, k_max: int) -> int:
+    """Trajectories a swarm search integrates: its start and ``k_max`` iterations of ``n``."""
+    return int(n) * (int(k_max) + 1)
 
 
 #: the largest swarm search accepted [trajectories]: 10^5 take about 0.5-9 h on one core
@@ -87,8 +94,8 @@ class SwarmBank(ReversingBankSpec):
         check_range("guidance.population", self.population, 2, 10000)
         check_range("guidance.iterations", self.iterations, 1, 10000)
         check_range("guidance.landmark_iteration", self.landmark_iteration, 1, self.iterations)
-        trajectories = self.population * (self.iterations + 1)
-        if self.optimizer in ("pio", "pso", "pso_stable") and trajectories > MAX_SEARCH_TRAJECTORIES:
+        trajectories = swarm_trajectories(self.population, self.iterations)
+        if self.optimizer in SWARMS and trajectories > MAX_SEARCH_TRAJECTORIES:
             raise ScenarioError(
                 f"guidance.population x (guidance.iterations + 1) = {trajectories:,} trajectories to integrate "
                 f"before flight (20-340 ms each: {trajectories * 0.02 / 3600:,.0f} h or more); allowed up to "

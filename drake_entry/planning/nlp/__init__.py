@@ -122,9 +122,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
         raise ScenarioError("solver_options are by the solver's own names: give solver='snopt' or 'ipopt' with them")
     show = wanted(progress)
     engines = {name: _engine(name) for name in names}
-    cap = max(MAX_NODES[transcription], nodes) if max_nodes is None else max_nodes
-    if refine and not (isinstance(cap, (int, np.integer)) and cap >= nodes):
-        raise ScenarioError(f"max_nodes = {max_nodes} is out of range; allowed: an integer >= nodes ({nodes})")
+    cap = max(MAX_NODES[transcription], nodes) if max_nodes is None else max_nodes  # checked by check_options
     t_guess = _time.perf_counter()
     if guess is None:
         guess = initial_guess(problem)

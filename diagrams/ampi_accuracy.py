@@ -100,7 +100,7 @@ def flown_controls(problem, syn, n_ld: int):
     return controls
 
 
-def _fly_ld(problem, syn, n_ld: int, x0, *, accuracy: float, samples_per_interval: int, log_points: int):
+def fly_ld(problem, syn, n_ld: int, x0, *, accuracy: float, samples_per_interval: int, log_points: int):
     """nlp.propagate of a Synthesis at the LD nodes (``flown_controls``) from ``x0`` by the
     Drake verifier at ``accuracy`` with ``log_points`` logged: the PropagationCheck."""
     flown = SimpleNamespace(time=syn.time, final_time=syn.final_time, transcription="lgl", controls=syn.controls,
@@ -112,9 +112,15 @@ def _fly_ld(problem, syn, n_ld: int, x0, *, accuracy: float, samples_per_interva
 
 def fly_reference(problem, syn, n_ld: int, x0) -> dict:
     """Fly a Synthesis at the LD nodes open loop (``flown_controls``) from the entry state
-    ``x0`` (the reference's own initial bank and clock): miss from the target [m] and the
-    final altitude and speed errors from the reference's."""
-    check = _fly_ld(problem, syn, n_ld, np.array(x0, float), accuracy=1e-9, samples_per_interval=16, log_points=200)
+    ``x0`` (the reference's own initial bank and clock): ``reference_errors`` of that flight."""
+    return reference_errors(problem, syn, fly_ld(problem, syn, n_ld, np.array(x0, float), accuracy=1e-9,
+                                                 samples_per_interval=16, log_points=200))
+
+
+def reference_errors(problem, syn, check) -> dict:
+    """A flight ``check`` (PropagationCheck) of a Synthesis: miss from the problem's target [m]
+    and the final altitude [m] and speed [m/s] errors from the reference's ({'failed': why}
+    when the flight stopped early)."""
     if "failed" in check.terminal_error:
         return {"failed": check.terminal_error["failed"]}
     xf = check.states[-1]
@@ -244,7 +250,7 @@ def reconstruction_error(db: TrajectoryDatabase, index: int, problem, hd_points:
     rad) and the final position difference [m]."""
     ld = db.entry(index)
     hd = db.entry(index, hd_points)
-    check = _fly_ld(problem, ld, db.n_ld, ld.states[0], accuracy=1e-10, samples_per_interval=32,
+    check = fly_ld(problem, ld, db.n_ld, ld.states[0], accuracy=1e-10, samples_per_interval=32,
                     log_points=4 * (hd_points - 1))  # the log times include the HD times
     if "failed" in check.terminal_error:
         raise ScenarioError(f"case {index}: {check.terminal_error['failed']}")

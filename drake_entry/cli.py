@@ -7,8 +7,8 @@ Commands:
                       exit 1 when a sample is not successful
   report DIR          (re)write the report (report.md, report.html) of a campaign directory
   fly SCENARIO        one closed-loop guided flight with plots
-  plan SCENARIO       the guidance method's reference plan with its figures (drag-energy:
-                      corridor, reference at engagement, extraction vs propagation, paper 000 Figs. 3-5)
+  plan SCENARIO       the guidance method's reference plan, flown by Drake, with its figures
+                      (drag-energy, SCvx, AMPI and swarm-bank methods)
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
 and the commands the methods and shared packages contribute (their commands.py modules), e.g.
   optimize PROBLEM    optimal reference by the NLP path (paper 002), verified and flown by Drake
@@ -308,8 +308,10 @@ def main(argv=None) -> int:
     fl.add_argument("--out", default="out/fly", help="output directory: trajectory table, summary.json, figures")
     fl.add_argument("--format", choices=("parquet", "csv"), default="parquet", help="trajectory table format")
     fl.set_defaults(func=_cmd_fly)
-    pl = sub.add_parser("plan", help="the guidance method's plan report (drag-energy: corridor, reference and "
-                        "extraction, paper 000 Figs. 3-5; swarm bank: sigma_0 search, Drake check, paper 004 figures)",
+    pl = sub.add_parser("plan", help="the guidance method's plan report, flown by the Drake Simulator (drag-energy: "
+                        "corridor, reference and extraction, paper 000 Figs. 3-5; SCvx: the pre-flight plan and its "
+                        "flight, paper 001; AMPI: the database reference for the entry state, paper 003; swarm "
+                        "bank: sigma_0 search, Drake check, paper 004 figures); exit 1 when it is not verified",
                         formatter_class=defaults)
     pl.add_argument("scenario", help=scenario_help)
     pl.add_argument("--out", default="out/plan", help="output directory: figures and tables of the plan")

@@ -15,16 +15,13 @@ radius with a labelled representative aerodynamic model (drake_entry/vehicles/sp
 """
 import argparse
 import math
-import os
-
-import matplotlib.pyplot as plt
-import numpy as np
 
 from drake_entry.claims import Claims
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.guidance.scvx.as_ocp import nlp_form
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.planner import plan_entry
+from drake_entry.guidance.scvx.plots import plan_figure
 from drake_entry.guidance.scvx.settings import FORMULATIONS, EntryProblemSettings
 from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.models.planet import Earth
@@ -66,33 +63,9 @@ def main(quick: bool = False, out_dir: str = "out/examples/07", formulation: str
               f"{crosscheck.objective / 1e6:.2f} MJ/m^2 (SCvx {plan.objective / (crosscheck.objective / 1e6) - 1:+.2%}), "
               f"t_f {crosscheck.final_time:.0f} s, {crosscheck.solve_time:.1f} s; flown {flown / 1e3:.2f} km from it")
 
-    os.makedirs(out_dir, exist_ok=True)
-    fig, ax = plt.subplots(2, 2, figsize=(11, 7))
-    t = np.linspace(0.0, plan.final_time, 600)
-    ref = plan.evaluate(t)
-    ax[0, 0].plot(ref["V"] / 1e3, ref["h"] / 1e3, label="plan")
-    ax[0, 0].plot(flight.states[:, 3] / 1e3, flight.states[:, 0] / 1e3, "--", label="flown (Drake)")
-    ax[0, 0].set(xlabel="V [km/s]", ylabel="h above the equatorial sphere [km]")
-    ax[0, 0].legend()
-    ax[0, 1].plot(np.degrees(ref["lon"]), np.degrees(ref["lat"]), label="plan")
-    ax[0, 1].plot(np.degrees(flight.states[:, 1]), np.degrees(flight.states[:, 2]), "--", label="flown")
-    lon_s, lat_s = mission.site(planet)
-    ax[0, 1].plot(math.degrees(lon_s), math.degrees(lat_s), "r*", ms=12, label="site")
-    ax[0, 1].set(xlabel="longitude [deg]", ylabel="geocentric latitude [deg]")
-    ax[0, 1].legend()
-    ax[1, 0].plot(t, np.degrees(ref["bank"]), label="bank")
-    ax[1, 0].plot(t, np.degrees(ref["alpha"]), label="alpha")
-    ax[1, 0].set(xlabel="t [s]", ylabel="[deg]")
-    ax[1, 0].legend()
-    ax[1, 1].plot(flight.time, np.degrees(flight.states[:, 4]), label="flown")
-    ax[1, 1].plot(t, np.degrees(ref["gamma"]), "--", label="plan")
-    ax[1, 1].set(xlabel="t [s]", ylabel="flight-path angle [deg]")
-    ax[1, 1].legend()
-    fig.suptitle(f"SCvx minimum heat load ({plan.formulation}), SPHYNX (representative aero), paper 001 Table 1 mission")
-    fig.tight_layout()
-    plot = os.path.join(out_dir, "scvx_entry.png")
-    fig.savefig(plot, dpi=110)
-    plt.close(fig)
+    plot = plan_figure(plan, flight, mission.site(planet), out_dir, title=f"SCvx minimum heat load ({plan.formulation}), "
+                       "SPHYNX (representative aero), paper 001 Table 1 mission: what is planned and what the "
+                       "Drake Simulator flies of it")
     return {"plan": plan, "flight": flight, "plot": plot, "nlp": crosscheck}
 
 

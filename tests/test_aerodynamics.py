@@ -1,3 +1,5 @@
+import ast
+
 import numpy as np
 import pytest
 
@@ -140,3 +142,26 @@ def test_sphynx_representative_aero_has_paper001_lift_to_drag():
         left = (v.aero.coefficients(a, m - e)[1] - v.aero.coefficients(a, m - 2 * e)[1]) / e
         right = (v.aero.coefficients(a, m + 2 * e)[1] - v.aero.coefficients(a, m + e)[1]) / e
         assert left == pytest.approx(right, abs=1e-3)
+
+
+def test_cli_fit_horus_prints_coefficients_whose_residuals_it_states(capsys):
+    """``drake-entry fit-horus`` exits 0 and prints coefficients that, put back into eqs. 32-33 on
+    the packaged M-692 cells (recomputed here from the CSV, not by the fit), give the cell
+    counts, RMS and largest residual it prints."""
+    from drake_entry.cli import main
+
+    assert main(["fit-horus"]) == 0
+    out = capsys.readouterr().out
+    lines = {line.split(":")[0].split(" =")[0]: line for line in out.splitlines()}
+    coefs = {k: np.array(ast.literal_eval(lines[k].split("=", 1)[1])) for k in ("aD", "aL")}
+    with packaged_data("horus2b_clean_aero_m692.csv") as f:
+        rows = read_csv_rows(f)
+    mach = [float(h.lstrip("Mm")) for h in rows[0][2:]]
+    for name, form, key in (("CD", horus_cd_form, "aD"), ("CL", horus_cl_form, "aL")):
+        a, m, data = np.array([(float(r[1]), mm, float(v)) for r in rows[1:] if r[0] == name
+                               for mm, v in zip(mach, r[2:]) if v.strip()]).T
+        res = form(coefs[key], a, m) - data
+        words = lines[f"C_{name[1]}"].replace(",", "").split()
+        assert int(words[1]) == len(data)
+        assert float(words[words.index("RMS") + 1]) == pytest.approx(np.sqrt(np.mean(res ** 2)), abs=6e-5)
+        assert float(words[-1]) == pytest.approx(np.abs(res).max(), abs=6e-5)

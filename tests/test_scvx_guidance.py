@@ -1,9 +1,8 @@
 """Paper 001's SCvx as a registered guidance method (``guidance: !Scvx``): the spec's errors,
-the mission it builds from the scenario, the guidance system against its plan, and the nominal
-closed-loop flight with and without on-board re-planning."""
+the mission it builds from the scenario and the guidance system against its plan (the closed
+loop and a campaign: example 09's test)."""
 import dataclasses as dc
 
-import numpy as np
 import pytest
 
 from drake_entry.errors import ScenarioError
@@ -71,53 +70,5 @@ def test_guidance_system_serves_the_plan_bank_and_alpha(setup):
     assert list(system.GetOutputPort("plan_stats").Eval(context)) == [0.0, 0.0, 0.0]
 
 
-def test_nominal_closed_loop_reaches_the_site_with_replanning(setup):
-    """The nominal mission flown through the shared closed loop (navigation, bank and alpha
-    actuators): re-planned every 200 s from the estimate it ends at the planned 10 km, inside the
-    acceptance box (15 km, Mach <= 1), every path limit held, stopping at the DRS altitude. The
-    pre-flight plan alone lands inside the box too (9.6 km measured) because the guidance reads
-    the plan 1 s ahead (the actuators' lag); read without the lead it ends 21 km away."""
-    from drake_entry.diagrams.closed_loop import fly
-
-    assert setup.planner.success, setup.planner.message
-    flown = fly(setup)
-    assert flown.success, flown.message
-    assert flown.method == "scvx" and flown.guidance.plans >= 5
-    assert "altitude" in flown.trajectory.reason
-    assert flown.errors["distance_m"] <= 15e3
-    h, lat = flown.trajectory.state[-1][0], flown.trajectory.state[-1][2]
-    geodetic = setup.planet.atmospheric_altitude(h, lat)
-    assert 10e3 <= geodetic <= 13e3  # the DRS window of eq. 64
-    open_loop = dc.replace(setup, scenario=dc.replace(
-        setup.scenario, guidance=dc.replace(setup.scenario.guidance, replan_period_s=0.0)))
-    plain = fly(open_loop)
-    assert plain.guidance.plans == 0 and plain.success, plain.message
-    no_lead = fly(dc.replace(open_loop, scenario=dc.replace(
-        open_loop.scenario, guidance=dc.replace(open_loop.scenario.guidance, command_lead_s=0.0))))
-    assert no_lead.errors["distance_m"] > 15e3 and not no_lead.success and not no_lead.verdict.inside_box
-    assert np.isfinite(flown.guidance.planning_wall_s) and flown.guidance.planning_wall_s > 0
-
-
-@pytest.mark.slow
-def test_scvx_campaign_rows_and_report(tmp_path):
-    """A reduced Monte-Carlo of the SCvx guidance through the shared campaign engine (2 samples of
-    the scenario's labelled dispersions): every sample reaches the DRS altitude inside the
-    acceptance box with every path limit held (heat flux, load, bank, eq. 70's gamma bounds), its
-    rows carry the method's fields and the verdict, and the report counts them."""
-    import pyarrow.parquet as pq
-
-    from drake_entry.campaign.report import summary_statistics, write_report
-    from drake_entry.diagrams.montecarlo import run_campaign
-
-    out = run_campaign("sphynx_paper001", runs=2, out_dir=str(tmp_path / "mc"), seed=1, workers=2, progress=False)
-    rows = pq.read_table(f"{out}/samples.parquet").to_pydict()
-    assert rows["method"] == ["scvx", "scvx"]
-    assert all(rows["reached_terminal"]) and all(p >= 3 for p in rows["plans"])
-    st = summary_statistics(rows)
-    assert st["reached"] == 2 and st["successful"] == 2 and st["within_limits"] == 2
-    assert all(rows["within_limits"]) and rows["violations"] == ["", ""]
-    assert min(rows["margin_heat_flux"]) > 0.0 and min(rows["margin_flight_path"]) > 0.0
-    assert max(rows["err_distance_m"]) <= 15e3
-    report = open(write_report(out)).read()
-    assert "2 successful (reached, inside the acceptance box and within every path limit)" in report
-    assert "flight_path in [-30, 0.5] deg" in report
+# The nominal closed loop (re-planned, plan alone, without the lead) and a campaign of the
+# scenario's dispersions are flown once per session, by example 09 (tests/test_examples.py).

@@ -76,3 +76,38 @@ def test_describe_reports_only_resolved_percentiles():
     big = describe(np.arange(1000.0))
     assert big["p0.13"] == pytest.approx(1.2987) and big["p99.87"] == pytest.approx(997.7013)
     assert describe([np.nan, np.inf])["n"] == 0
+
+
+def test_describe_mean_and_a_single_sample():
+    """The mean is numpy's; one sample has sigma 0 and only its median resolved (P50 needs one
+    sample, P1 and P99 a hundred); NaN and inf are dropped before counting."""
+    x = np.array([3.0, 1.0, 4.0, 1.0, 5.0, np.nan, np.inf])
+    d = describe(x)
+    assert d["n"] == 5 and d["mean"] == pytest.approx(2.8) and d["sigma"] == pytest.approx(np.std(x[:5], ddof=1))
+    one = describe([7.5])
+    assert one == {"n": 1, "min": 7.5, "mean": 7.5, "sigma": 0.0, "max": 7.5, "p0.13": None, "p1": None,
+                   "p50": 7.5, "p99": None, "p99.87": None}
+    two = describe([1.0, 3.0])
+    assert two["sigma"] == pytest.approx(math.sqrt(2.0)) and two["p50"] == 2.0
+
+
+@pytest.mark.parametrize("call, field", [
+    (lambda: success_lower_bound(1, 1, 0.5), "level"), (lambda: success_lower_bound(1, 1, 1.0), "level"),
+    (lambda: success_lower_bound(0, 0, 0.9), "runs"), (lambda: runs_for_bound(0.0, 0.9), "coverage"),
+    (lambda: runs_for_bound(0.99, 1.0), "confidence"), (lambda: order_statistic_rank(10, 1.0, 0.9), "coverage"),
+    (lambda: order_statistic_rank(10, 0.9, 0.0), "confidence")])
+def test_the_open_intervals_exclude_their_ends_and_name_the_field(call, field):
+    with pytest.raises(ScenarioError, match=f"^{field} must be"):
+        call()
+
+
+def test_the_smallest_cases_at_the_ends_of_the_ranges():
+    """One run, one success: the exact (Clopper-Pearson) lower bound is 1 - level; just inside
+    (0.5, 1) is allowed. The maximum of
+    runs_for_bound samples is the last rank that qualifies (r = runs exactly when even the
+    smallest sample bounds the quantile: runs = 1, coverage 0.5, confidence 0.5)."""
+    assert success_lower_bound(1, 1, 0.9) == pytest.approx(0.1)
+    assert success_lower_bound(1, 1, 0.5000001) == pytest.approx(0.4999999)
+    assert order_statistic_rank(runs_for_bound(0.9, 0.9), 0.9, 0.9) == 1
+    assert order_statistic_rank(1, 0.5, 0.5) == 1 and order_statistic_rank(3, 0.5, 0.1) == 3
+    assert runs_for_bound(0.5, 0.75) == 2  # 1 - 0.5^2 = 0.75 exactly: two runs suffice

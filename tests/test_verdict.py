@@ -135,3 +135,71 @@ def test_control_activity_counts_reversals_travel_rate_and_time_at_the_limits():
     assert a["peak_bank_rate_deg_s"] == pytest.approx(10.0, rel=1e-6)
     assert a["time_at_bank_rate_limit_s"] == pytest.approx(24.0, abs=0.11)
     assert a["time_at_bank_limit_s"] == pytest.approx(150.0 - 24.0, abs=0.11)  # +60 and -60 are both the limit
+
+
+def _terminal(**kw):
+    from types import SimpleNamespace
+
+    base = {"altitude_km": None, "altitude_tolerance_km": None, "mach": None, "mach_tolerance": None,
+            "distance_tolerance_km": None}
+    return SimpleNamespace(**{**base, **kw})
+
+
+def test_acceptance_box_has_each_criterion_given_in_km_and_is_closed():
+    """A criterion is in the box only with its centre and tolerance; km become m; an error equal
+    to its tolerance is inside (a closed box), a hair beyond is not."""
+    from drake_entry.models.verdict import acceptance_box
+
+    full = _terminal(altitude_km=30.0, altitude_tolerance_km=2.0, mach=0.75, mach_tolerance=0.25,
+                     distance_tolerance_km=50.0)
+    b = acceptance_box(full, altitude_m=32_000.0, mach=0.5, distance_m=50_000.0)
+    assert b == {"altitude": {"error": 2000.0, "tolerance": 2000.0, "inside": True},
+                 "mach": {"error": -0.25, "tolerance": 0.25, "inside": True},
+                 "distance": {"error": 50_000.0, "tolerance": 50_000.0, "inside": True}}
+    out = acceptance_box(full, altitude_m=27_999.0, mach=1.01, distance_m=50_001.0)
+    assert [v["inside"] for v in out.values()] == [False, False, False]
+    assert acceptance_box(_terminal(altitude_km=30.0, mach=0.8), altitude_m=0.0, mach=5.0, distance_m=1e9) == {}
+    assert acceptance_box(_terminal(altitude_tolerance_km=1.0, mach_tolerance=0.1), altitude_m=0.0, mach=5.0,
+                          distance_m=1e9) == {}
+    assert list(acceptance_box(_terminal(distance_tolerance_km=2.0), altitude_m=0.0, mach=0.0,
+                               distance_m=1999.0)) == ["distance"]
+
+
+def test_limit_checks_with_nan_samples_absolute_and_lower_bounds():
+    """NaN samples are skipped (the peak is the finite maximum), a limit with no finite sample
+    does not hold and does not stop the next one being checked; an absolute limit reads |bank|
+    (-85 deg breaks an 80 deg limit); a lower bound met exactly holds, a 1 % breach of it holds
+    only with a tolerance above 1 %."""
+    t = np.array([0.0, 1.0, 2.0])
+    cols = {"heat_flux": np.array([1.0, np.nan, 3.0]), "q": np.full(3, np.nan), "bank": np.radians([0.0, -85.0, 10.0]),
+            "gamma": np.array([-0.5, -0.3, -0.4]), "g2": np.array([-0.505, -0.3, -0.4])}
+    limits = [PathLimit("heat_flux", "heat_flux", upper=10.0), PathLimit("q", "q", upper=1.0),
+              PathLimit("bank", "bank", upper=math.radians(80.0), absolute=True),
+              PathLimit("gamma", "gamma", lower=-0.5), PathLimit("g2", "g2", lower=-0.5)]
+    heat, q, bank, gamma, g2 = check_limits(t, cols.__getitem__, limits)
+    assert heat.held and heat.peak == 3.0 and heat.time == 2.0 and heat.margin == pytest.approx(0.7)
+    assert not q.held and math.isnan(q.peak) and math.isnan(q.margin) and q.limit.name == "q"
+    assert not bank.held and bank.peak == pytest.approx(math.radians(85.0)) and bank.time == 1.0
+    assert gamma.held and gamma.margin == 0.0 and not g2.held and g2.margin == pytest.approx(-0.01)
+    widened = check_limits(t, cols.__getitem__, limits[3:], tolerance=0.011)
+    assert [c.held for c in widened] == [True, True]
+    assert [c.held for c in check_limits(t, cols.__getitem__, limits[3:], tolerance=0.009)] == [True, False]
+
+
+def test_vehicle_limits_name_their_columns_units_and_print_their_bounds():
+    """Every finite vehicle limit becomes a PathLimit on its own Trajectory column, printed in
+    its display unit; the bank limit is on |bank| in degrees; two-sided and lower bounds print
+    as intervals and '>='."""
+    lims = vehicle_path_limits(PathLimits(heat_flux_max=500e3, dynamic_pressure_max=40e3, normal_load_max=2.5,
+                                          total_load_max=3.0), bank_limit=math.radians(80.0))
+    assert [(x.name, x.column, x.unit) for x in lims] == [
+        ("heat_flux", "heat_flux", "kW/m^2"), ("dynamic_pressure", "dynamic_pressure", "kPa"),
+        ("normal_load", "normal_load", "g"), ("total_load", "total_load", "g"), ("bank", "bank", "deg")]
+    assert [x.bound_text() for x in lims] == ["<= 500 kW/m^2", "<= 40 kPa", "<= 2.5 g", "<= 3 g", "|.| <= 80 deg"]
+    assert lims[-1].absolute and not any(x.absolute for x in lims[:-1])
+    assert [x.name for x in vehicle_path_limits(PathLimits(heat_flux_max=1.0))] == ["heat_flux"]
+    gamma = PathLimit("flight_path", "gamma", upper=math.radians(0.5), lower=math.radians(-30.0), unit="deg",
+                      scale=180.0 / math.pi)
+    assert gamma.bound_text() == "in [-30, 0.5] deg"
+    assert PathLimit("h", "h", lower=20e3, unit="km", scale=1e-3).bound_text() == ">= 20 km"
+    assert PathLimit("x", "x", lower=-1.0).bound_text() == ">= -1"

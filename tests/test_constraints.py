@@ -126,3 +126,36 @@ def test_load_factors_and_equilibrium_glide():
     r = 6.4e6
     assert equilibrium_glide_lift(np.sqrt(9.5 * r), r, 9.5) == pytest.approx(0.0, abs=1e-12)
     assert equilibrium_glide_lift(3000.0, r, 9.5) == pytest.approx(9.5 - 9e6 / r)
+
+
+def test_normal_load_is_the_body_normal_projection_at_any_alpha():
+    """Paper 000 eq. 35 against the geometry: the aerodynamic force (drag -D along the wind x
+    axis, lift L along the wind z axis) projected on the body normal axis, the wind axes rotated
+    by alpha; at 40 deg neither term vanishes, so a sign error shows."""
+    L, D, a = 3.0, 4.0, np.radians(40.0)
+    force_wind = np.array([-D, L])  # (along the velocity, normal to it in the symmetry plane, up)
+    # the body axes: the nose alpha above the velocity, so the body normal (up) axis is the wind
+    # normal axis tilted back by alpha: (-sin(alpha), cos(alpha)) in wind axes
+    body_normal = np.array([-np.sin(a), np.cos(a)])
+    assert normal_load_factor(L, D, a, 2.0) == pytest.approx(abs(force_wind @ body_normal) / 2.0, rel=1e-12)
+
+
+def test_form_labels_constants_and_the_alpha_factor_tuple():
+    """Each named form carries its name (messages and reports say which published constants are
+    in use); paper 001 eq. 9's defaults are c* = 1.1097e8, n = 0.5, m = 3.15, rho0 = 1.225 kg/m^3,
+    V_c = 7905 m/s; an angle-of-attack factor is stored as a tuple of floats (hashable, frozen)."""
+    for form, kw in (("chapman", {}), ("sutton_graves", {}), ("normalised", {}), ("betts_shuttle", {}),
+                     ("lumped", {"coefficient": 1e-4, "velocity_exponent": 3.0})):
+        assert make_heat_flux(form, nose_radius=1.0, **kw).form == form
+    rho, V = 2e-5, 7000.0
+    assert HeatFlux.normalised(0.8)(rho, V) == pytest.approx(
+        1.1097e8 / 0.8 ** 0.5 * (rho / 1.225) ** 0.5 * (V / 7905.0) ** 3.15, rel=1e-12)
+    hf = HeatFlux(1.0, alpha_factor=[1, 2])
+    assert hf.alpha_factor == (1.0, 2.0) and hash(hf)
+    assert make_heat_flux("normalised", nose_radius=1.0, circular_speed=0.5).velocity_exponent == 3.15
+    with pytest.raises(ValueError, match=r"must be in \(0, 1e5\)"):
+        make_heat_flux("normalised", nose_radius=1.0, circular_speed=1e5)
+    for kwargs, message in (({"form": "lumped", "coefficient": 1e-4}, "^heat_flux form 'lumped' needs"),
+                            ({"form": "betts_shuttle", "coefficient": 1.0}, "^heat_flux form 'betts_shuttle' takes")):
+        with pytest.raises(ValueError, match=message):
+            make_heat_flux(kwargs.pop("form"), nose_radius=1.0, **kwargs)

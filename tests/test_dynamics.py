@@ -159,3 +159,44 @@ def test_equations_of_motion_are_newtons_law_in_the_rotating_frame(planet):
             dv += (vp - vm) / (2 * scale[i]) * xdot[i]
         assert np.allclose(dr, v, rtol=0, atol=1e-6 * np.linalg.norm(v)), (x, dr - v)
         assert np.allclose(dv, accel, rtol=0, atol=1e-6 * (np.linalg.norm(accel) + 1.0)), (x, dv - accel)
+
+
+def test_energy_rate_is_the_derivative_of_the_energy_along_the_motion():
+    """On the oblate rotating Earth (J2: the potential depends on latitude) the chain-rule
+    energy rate equals the central difference of specific_energy along x_dot, at several
+    latitudes and with every state derivative non-zero."""
+    p = Earth.oblate()
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        x = np.array([rng.uniform(20e3, 100e3), 0.3, np.radians(rng.uniform(-70, 70)), 6000.0, -0.1, 0.4])
+        xdot = rng.uniform(-1.0, 1.0, 6) * np.array([200.0, 1e-3, 1e-3, 20.0, 1e-3, 1e-3])
+        e = 1e-3
+        fd = (specific_energy(x + e * xdot, p) - specific_energy(x - e * xdot, p)) / (2 * e)
+        assert energy_rate(x, xdot, p) == pytest.approx(fd, rel=1e-7)
+
+
+def test_a_non_finite_derivative_stops_with_the_state_named():
+    from drake_entry.errors import NonFiniteStateError
+    from drake_entry.models.dynamics import equations_of_motion_lift_components
+
+    with pytest.raises(NonFiniteStateError, match=r"non-finite state derivative at h = 50000 m, V = nan m/s"):
+        equations_of_motion_lift_components(np.array([5e4, 0.0, 0.0, np.nan, 0.0, 0.0]), 1.0, 0.0, 1.0, Earth.oblate())
+
+
+def test_flight_conditions_mach_and_an_alpha_dependent_heat_flux(us76):
+    """Mach is V over the atmosphere's speed of sound at the state's altitude, and a heat-flux
+    form with an angle-of-attack factor (Betts' shuttle) is evaluated at the flown alpha."""
+    import dataclasses as dc
+
+    from drake_entry.models.constraints import HeatFlux
+    from drake_entry.models.vehicles import load_vehicle
+
+    p = Earth.spherical()
+    v = dc.replace(load_vehicle("horus2b"), heat_flux=HeatFlux.betts_shuttle())
+    x = np.array([60e3, 0.0, 0.3, 5000.0, -0.02, 0.5])
+    alpha = np.radians(35.0)
+    c = flight_conditions(x, 0.3, alpha, v, p, us76)
+    h = p.atmospheric_altitude(x[0], x[2])
+    rho, a = us76.density(h), us76.speed_of_sound(h)
+    assert c.mach == pytest.approx(5000.0 / a, rel=1e-12) and c.rho == pytest.approx(rho, rel=1e-12)
+    assert c.heat_flux == pytest.approx(HeatFlux.betts_shuttle()(rho, 5000.0, alpha), rel=1e-12)

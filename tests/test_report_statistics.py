@@ -111,3 +111,13 @@ def test_the_smallest_cases_at_the_ends_of_the_ranges():
     assert order_statistic_rank(runs_for_bound(0.9, 0.9), 0.9, 0.9) == 1
     assert order_statistic_rank(1, 0.5, 0.5) == 1 and order_statistic_rank(3, 0.5, 0.1) == 3
     assert runs_for_bound(0.5, 0.75) == 2  # 1 - 0.5^2 = 0.75 exactly: two runs suffice
+
+
+def test_order_statistic_bound_uses_the_confidence_it_is_given():
+    """At 90 % coverage and 50 % confidence 30 samples allow a deeper rank than at 90 %
+    confidence: the bound is that rank's sample, from both ends."""
+    x = np.arange(30.0)
+    r50, r90 = order_statistic_rank(30, 0.9, 0.5), order_statistic_rank(30, 0.9, 0.9)
+    assert r50 > r90 >= 1
+    assert order_statistic_bound(x, 0.9, 0.5) == x[-r50] and order_statistic_bound(x, 0.9, 0.9) == x[-r90]
+    assert order_statistic_bound(x, 0.9, 0.5, upper=False) == x[r50 - 1]

@@ -203,3 +203,25 @@ def test_vehicle_limits_name_their_columns_units_and_print_their_bounds():
     assert gamma.bound_text() == "in [-30, 0.5] deg"
     assert PathLimit("h", "h", lower=20e3, unit="km", scale=1e-3).bound_text() == ">= 20 km"
     assert PathLimit("x", "x", lower=-1.0).bound_text() == ">= -1"
+
+
+def test_texts_zero_bounds_and_the_recorded_tolerance():
+    """A limit at 0 takes its margin in absolute terms (flight-path angle <= 0: a peak of 0.25
+    rad is a margin of -0.25); a missed criterion reads in km (Mach as a number); breaches are
+    joined by '; '; bounds without a unit print without a trailing space; the verdict records
+    the tolerance it judged with; a limit without finite samples is not held, with no time."""
+    from drake_entry.models.verdict import box_text, breaches_text
+
+    t = np.array([0.0, 1.0])
+    cols = {"gamma": np.array([-0.1, 0.25]), "q": np.array([np.nan, np.nan])}
+    zero, q = check_limits(t, cols.__getitem__, [PathLimit("gamma", "gamma", upper=0.0), PathLimit("q", "q", upper=1.0)])
+    assert zero.margin == pytest.approx(-0.25) and not zero.held
+    assert q.held is False and math.isnan(q.time)
+    assert breaches_text([zero, q]).count("; ") == 1 and breaches_text([zero]).startswith("gamma 0.25")
+    assert box_text("distance", {"error": 2500.0, "tolerance": 2000.0}) == "error +2.500 km outside +-2 km"
+    assert box_text("altitude", {"error": -1500.0, "tolerance": 1000.0}) == "error -1.500 km outside +-1 km"
+    assert box_text("mach", {"error": 0.3, "tolerance": 0.2}) == "error +0.300 outside +-0.2"
+    assert PathLimit("x", "x", lower=-1.0, upper=1.0).bound_text() == "in [-1, 1]"
+    assert PathLimit("x", "x", upper=3.0).bound_text() == "<= 3"
+    tr = _trajectory([0.0, 1.0], [1.0, 2.0])
+    assert judge(tr, [], reached=True, inside_box=True, tolerance=0.02).tolerance == 0.02

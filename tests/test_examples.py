@@ -101,6 +101,9 @@ def test_example_05(tmp_path):
     assert res.success and res.mesh_history[0].nodes == 30 and res.mesh_history[0].error > 1e-3
     assert res.states[-1, 0] == pytest.approx(0.0, abs=1.0) and math.degrees(res.states[-1, 4]) == pytest.approx(-80.0)
     assert flown.time[-1] == pytest.approx(res.verification.flight.time[-1])
+    again = r["resolved"]  # re-solved from +200 m, +10 m/s at 500 s: on eq. 16's end, verified
+    assert again.success and again.states[-1, 0] == pytest.approx(0.0, abs=1.0)
+    assert again.final_time == pytest.approx(res.final_time - 500.0, rel=0.05)
 
 
 def test_example_06(tmp_path):

@@ -39,7 +39,6 @@ from drake_entry.models.schedules import Schedule
 from drake_entry.models.trajectory import Trajectory
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.models.verdict import Verdict, box_text, judge
-from drake_entry.models.verdict import acceptance_box as box_at
 from drake_entry.scenario import Scenario, load_scenario
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.monitors import TerminationMonitor
@@ -225,12 +224,10 @@ def terminal_errors(x, setup: ClosedLoopSetup) -> dict:
 
 
 def acceptance_box(tr: Trajectory, setup: ClosedLoopSetup, distance_m: float) -> dict:
-    """The mission's acceptance box (drake_entry.models.verdict.acceptance_box) at the final state:
-    the altitude geodetic with altitude_datum 'ellipsoid', the Mach number flown, the distance
-    to the target ``distance_m`` (terminal_errors')."""
-    x = tr.state[-1]
-    h = setup.planet.atmospheric_altitude(x[0], x[2]) if setup.scenario.altitude_datum == "ellipsoid" else x[0]
-    return box_at(setup.scenario.terminal, altitude_m=float(h), mach=float(tr.column("mach")[-1]), distance_m=distance_m)
+    """The mission's acceptance box (Scenario.acceptance_box) at the final state: the Mach number
+    flown, the distance to the target ``distance_m`` (terminal_errors')."""
+    return setup.scenario.acceptance_box(setup.planet, tr.state[-1], mach=float(tr.column("mach")[-1]),
+                                         distance_m=distance_m)
 
 
 def fly(scenario: Scenario | ClosedLoopSetup, planner=None, *, initial_state=None, nav_seed: int = 0,

@@ -21,7 +21,7 @@ from drake_entry.models.environment import AtmosphereSpec, PlanetSpec, atmospher
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import VARIABLES, Schedule
 from drake_entry.models.vehicles import Vehicle, load_vehicle
-from drake_entry.models.verdict import PathLimit, vehicle_path_limits
+from drake_entry.models.verdict import PathLimit, acceptance_box, vehicle_path_limits
 from drake_entry.typed_yaml import load_yaml_typed, override
 
 
@@ -182,6 +182,13 @@ class Scenario:
             h = self.make_planet().state_altitude(h, np.radians(e.latitude_deg))
         return np.array([h, np.radians(e.longitude_deg), np.radians(e.latitude_deg),
                          e.velocity_m_s, np.radians(e.flight_path_deg), np.radians(e.heading_deg)])
+
+    def acceptance_box(self, planet: Earth, x, *, mach: float, distance_m: float) -> dict:
+        """The acceptance box (drake_entry.models.verdict.acceptance_box) at a final state ``x``
+        [h, lon, lat, ...] on ``planet``: the altitude geodetic with altitude_datum 'ellipsoid', else
+        the state altitude; the Mach number and the distance to the target [m] as measured."""
+        h = planet.atmospheric_altitude(x[0], x[2]) if self.altitude_datum == "ellipsoid" else x[0]
+        return acceptance_box(self.terminal, altitude_m=float(h), mach=float(mach), distance_m=float(distance_m))
 
     def entry_energy(self) -> float:
         """Specific energy at the entry interface [J/kg] (central gravity, eq. 37 convention)."""

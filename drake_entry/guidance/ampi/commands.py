@@ -12,11 +12,13 @@ import sys
 import numpy as np
 
 from drake_entry.diagrams.ampi_accuracy import flown_controls, fly_ld, reference_errors
+from drake_entry.models.verdict import box_text
+from drake_entry.planning.nlp.evaluator import model_values
 
 
 def plan_report(scenario, out_dir: str) -> int:
     """Exit 0 when the database is verified and consistent and the reference, flown open loop,
-    reaches the scenario's acceptance box (distance and altitude tolerances) with every path
+    ends inside the scenario's acceptance box (Scenario.acceptance_box) with every path
     constraint of the database's problem (eq. 3) held; 1 otherwise."""
     from drake_entry.guidance.ampi.method import METHOD
 
@@ -50,17 +52,19 @@ def plan_report(scenario, out_dir: str) -> int:
         ok = False
     else:
         peaks = _path_peaks(problem, at_ld, db.n_ld, check)
-        term = scenario.terminal
-        h_f = problem.planet.atmospheric_altitude(check.states[-1, 0], check.states[-1, 2])
-        inside = bool(errors["miss_m"] <= term.distance_tolerance_km * 1e3
-                  and abs(h_f - term.altitude_km * 1e3) <= term.altitude_tolerance_km * 1e3)
+        xf = check.states[-1]
+        h_f = problem.planet.atmospheric_altitude(xf[0], xf[2])
+        box = scenario.acceptance_box(problem.planet, xf, mach=xf[3] / float(problem.atmosphere.air_data(h_f)[1]),
+                                      distance_m=errors["miss_m"])
+        inside = all(b["inside"] for b in box.values())
         held = all(p["held"] for p in peaks.values())
         ok = ok and inside and held
-        summary.update(flown_geodetic_altitude_m=float(h_f), inside_box=inside, path_peaks=peaks, within_limits=held)
-        print(f"flown open loop by Drake: {errors['miss_m'] / 1e3:.2f} km from the target (box "
-              f"{term.distance_tolerance_km:g} km), geodetic altitude {h_f / 1e3:.2f} km (box {term.altitude_km:g} "
-              f"+- {term.altitude_tolerance_km:g} km), {errors['altitude_m']:+.1f} m and "
-              f"{errors['velocity_m_s']:+.2f} m/s from the reference's end")
+        summary.update(flown_geodetic_altitude_m=float(h_f), box=box, inside_box=inside, path_peaks=peaks,
+                       within_limits=held)
+        print(f"flown open loop by Drake: {errors['miss_m'] / 1e3:.2f} km from the target, geodetic altitude "
+              f"{h_f / 1e3:.2f} km, {errors['altitude_m']:+.1f} m and {errors['velocity_m_s']:+.2f} m/s from the "
+              f"reference's end; acceptance box: " + ("inside" if inside else "; ".join(
+                  f"{k} {box_text(k, b)}" for k, b in box.items() if not b["inside"])))
         print("path constraints (eq. 3): " + "; ".join(
             f"{n} peak {p['peak']:.4g} of {p['max']:.4g}{'' if p['held'] else ' EXCEEDED'}" for n, p in peaks.items()))
         paths.append(_figure(scenario, problem, syn, check, out_dir))
@@ -76,10 +80,9 @@ def _path_peaks(problem, syn, n_ld: int, check) -> dict:
     """Each path constraint's peak along the flown states (the flown controls at the log
     times), with its upper bound and whether it held."""
     controls = flown_controls(problem, syn, n_ld)
-    values = np.array([problem.path_values(x, u) for x, u in zip(check.states, controls(check.time))], float)
-    return {c.label: {"peak": float(values[:, i].max()), "max": float(c.max),
-                      "held": bool(values[:, i].max() <= c.max and values[:, i].min() >= c.min)}
-            for i, c in enumerate(problem.path)}
+    g = model_values(problem, check.states.T, controls(check.time).T)[1]
+    return {c.label: {"peak": float(row.max()), "max": float(c.max),
+                      "held": bool(row.max() <= c.max and row.min() >= c.min)} for c, row in zip(problem.path, g)}
 
 
 def _figure(scenario, problem, syn, check, out_dir: str) -> str:
@@ -88,7 +91,8 @@ def _figure(scenario, problem, syn, check, out_dir: str) -> str:
     names = problem.state_names
     i_lon, i_lat, i_v, i_s = (names.index(n) for n in ("lon", "lat", "V", "sigma"))
     fig, ax = plt.subplots(2, 2, figsize=(11, 7))
-    for label, t, x, style in (("reference", syn.time, syn.states, "-"), ("flown (Drake)", check.time, check.states, "--")):
+    for label, t, x, style in (("reference", syn.time, syn.states, "-"),
+                               ("flown (Drake)", check.time, check.states, "--")):
         ax[0, 0].plot(x[:, i_v] / 1e3, x[:, 0] / 1e3, style, label=label)
         ax[0, 1].plot(np.degrees(x[:, i_lon]), np.degrees(x[:, i_lat]), style, label=label)
         ax[1, 0].plot(t, np.degrees(x[:, i_s]), style, label=label)

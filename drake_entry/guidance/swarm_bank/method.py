@@ -33,7 +33,7 @@ from drake_entry.guidance.swarm_bank.evaluator import (
     evaluate,
 )
 from drake_entry.guidance.swarm_bank.search import SearchResult, problem_from_scenario, search
-from drake_entry.models.verdict import acceptance_box, box_text, breaches_text, check_limits, vehicle_path_limits
+from drake_entry.models.verdict import box_text, breaches_text, check_limits, vehicle_path_limits
 from drake_entry.planning.result import PlanResult
 from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, require_verifier
 from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
@@ -110,15 +110,12 @@ def verify(problem: SwarmProblem, flown: FlownControls, tolerance: float = 0.0) 
 
 
 def terminal_box(scenario, problem: SwarmProblem, x) -> dict:
-    """The scenario's acceptance box (drake_entry.models.verdict.acceptance_box) at the replica's TAEM
-    state ``x`` [h, lon, lat, V, gamma, psi]: the state altitude (paper 004's sphere), the Mach
-    number there, the great-circle distance to the target."""
+    """The scenario's acceptance box (Scenario.acceptance_box) at the replica's TAEM state ``x``
+    [h, lon, lat, V, gamma, psi]: the Mach number there, the great-circle distance to the target."""
     pl = problem.planet
-    geodetic = float(pl.atmospheric_altitude(x[0], x[2]))
-    h = geodetic if scenario.altitude_datum == "ellipsoid" else float(x[0])
-    a = float(problem.atmosphere.air_data(geodetic)[1])
-    distance = float(pl.great_circle_distance(x[1], x[2], *problem.target))
-    return acceptance_box(scenario.terminal, altitude_m=h, mach=float(x[3]) / a, distance_m=distance)
+    a = float(problem.atmosphere.air_data(float(pl.atmospheric_altitude(x[0], x[2])))[1])
+    return scenario.acceptance_box(pl, x, mach=float(x[3]) / a,
+                                   distance_m=float(pl.great_circle_distance(x[1], x[2], *problem.target)))
 
 
 def plan(scenario, verifier, problem: SwarmProblem | None = None) -> SwarmPlan:

@@ -22,6 +22,16 @@ def table():
     return horus2b_table()
 
 
+def _m692_cells(name: str) -> np.ndarray:
+    """The published clean M-692 cells of coefficient ``name`` ('CD' or 'CL') as rows (alpha
+    [deg], Mach, value), read from the packaged CSV (blank cells left out)."""
+    with packaged_data("horus2b_clean_aero_m692.csv") as f:
+        rows = read_csv_rows(f)
+    mach = [float(h.lstrip("Mm")) for h in rows[0][2:]]
+    return np.array([(float(r[1]), m, float(v)) for r in rows[1:] if r[0] == name
+                     for m, v in zip(mach, r[2:]) if v.strip()])
+
+
 def test_table_reproduces_every_cell_of_m692_and_the_2024_fill(table):
     for i, a in enumerate(table.alpha_deg):
         for j, m in enumerate(table.mach):
@@ -50,14 +60,8 @@ def test_table_is_held_constant_above_mach_20(table):
 def test_packaged_horus_fit_residuals_as_documented():
     """horus2b.yaml states C_D RMS 0.0145 and C_L RMS 0.0087 over the published M-692 cells."""
     fit = load_vehicle("horus2b").aero
-    with packaged_data("horus2b_clean_aero_m692.csv") as f:
-        rows = read_csv_rows(f)
-    mach = [float(h[1:]) for h in rows[0][2:]]
-    cells = {"CD": [], "CL": []}
-    for r in rows[1:]:
-        cells[r[0]] += [(float(r[1]), m, float(v)) for m, v in zip(mach, r[2:]) if v.strip()]
     for name, form, coefs, rms_doc in (("CD", horus_cd_form, fit.aD, 0.0145), ("CL", horus_cl_form, fit.aL, 0.0087)):
-        a, m, data = np.array(cells[name]).T
+        a, m, data = _m692_cells(name).T
         res = form(coefs, a, m) - data
         assert np.sqrt(np.mean(res**2)) == pytest.approx(rms_doc, abs=1e-4)
 
@@ -75,11 +79,7 @@ def test_fit_of_paper000_forms_from_a_generic_start(fit_report):
     the RMS. The RMS itself (0.014509) is a regression pin of that optimum on these 66 cells."""
     rep = fit_horus_forms()
     assert rep.cells_CD == 66 and rep.cells_CL == 63
-    with packaged_data("horus2b_clean_aero_m692.csv") as f:
-        rows = read_csv_rows(f)
-    mach = [float(h.lstrip("Mm")) for h in rows[0][2:]]
-    cells = np.array([(float(r[1]), m, float(v)) for r in rows[1:] if r[0] == "CD"
-                      for m, v in zip(mach, r[2:]) if v.strip()])
+    cells = _m692_cells("CD")
     basis = np.stack([horus_cd_form(np.eye(10)[k], cells[:, 0], cells[:, 1]) for k in range(10)], -1)
     residual = basis @ rep.aD - cells[:, 2]
     assert np.sqrt(np.mean(residual ** 2)) == pytest.approx(rep.rms_CD, rel=1e-12)
@@ -163,12 +163,8 @@ def test_cli_fit_horus_prints_coefficients_whose_residuals_it_states(capsys, mon
     out = capsys.readouterr().out
     lines = {line.split(":")[0].split(" =")[0]: line for line in out.splitlines()}
     coefs = {k: np.array(ast.literal_eval(lines[k].split("=", 1)[1])) for k in ("aD", "aL")}
-    with packaged_data("horus2b_clean_aero_m692.csv") as f:
-        rows = read_csv_rows(f)
-    mach = [float(h.lstrip("Mm")) for h in rows[0][2:]]
     for name, form, key in (("CD", horus_cd_form, "aD"), ("CL", horus_cl_form, "aL")):
-        a, m, data = np.array([(float(r[1]), mm, float(v)) for r in rows[1:] if r[0] == name
-                               for mm, v in zip(mach, r[2:]) if v.strip()]).T
+        a, m, data = _m692_cells(name).T
         res = form(coefs[key], a, m) - data
         words = lines[f"C_{name[1]}"].replace(",", "").split()
         assert int(words[1]) == len(data)

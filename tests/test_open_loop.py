@@ -37,15 +37,16 @@ def test_run_stops_exactly_on_the_terminal_interface():
 
 
 def test_cli_simulate_writes_table_summary_and_plots(tmp_path):
+    """The written table (CSV, 10 significant digits) recomputes from first principles: dynamic
+    pressure 0.5 rho V^2, the Chapman heat flux of paper 000 eq. 34 (R_N 0.8 m), the specific
+    energy V^2/2 - mu/r with WGS-84's mu and radius (central gravity); summary.json's peaks are
+    the table's maxima and its heat load the trapezoid integral of the tabulated heat flux
+    (within 0.5 %: 1-s samples); the flight ends on Mach 2.5 as the scenario's terminal interface
+    says; six PNG figures."""
+    import json
+
     from drake_entry.campaign.tables import read_table
     from drake_entry.cli import main
-
-    """The written table (CSV, 10 significant digits) recomputes from first principles: dynamic pressure 0.5 rho V^2, the
-    Chapman heat flux of paper 000 eq. 34 (R_N 0.8 m), the specific energy V^2/2 - mu/r with
-    WGS-84's mu and radius (central gravity); summary.json's peaks are the table's maxima and its
-    heat load the trapezoid integral of the tabulated heat flux (within 0.5 %: 1-s samples); the
-    flight ends on Mach 2.5 as the scenario's terminal interface says; six PNG figures."""
-    import json
 
     assert main(["simulate", "horus2b", "--out", str(tmp_path), "--format", "csv"]) == 0
     t = read_table(str(tmp_path / "trajectory.csv"))

@@ -78,7 +78,7 @@ def test_a_failed_first_plan_stays_in_pre_guidance_until_one_succeeds():
 
 
 class _StubPlan:
-    """What ScvxGuidance reads of a plan: its commands (a constant bank ``level`` rad), t_f,
+    """What ReplanningGuidance reads of a plan: its commands (a constant bank ``level`` rad), t_f,
     success and message."""
 
     def __init__(self, level: float, success: bool = True, message: str = "converged"):
@@ -90,14 +90,14 @@ class _StubPlan:
 
 
 def test_a_refused_scvx_replan_keeps_the_plan_in_flight(monkeypatch):
-    """ScvxGuidance re-plans every 100 s; the first re-plan raises, the second is not a verified
+    """ReplanningGuidance re-plans every 100 s; the first re-plan raises, the second is not a verified
     success, the third succeeds: the pre-flight plan's bank flies until t = 300 s, both refusals
     are recorded with time and reason, and plan_stats counts 1 re-plan and 2 refused."""
-    import drake_entry.systems.scvx_guidance as scvx_guidance
+    from drake_entry.systems.replanning_guidance import ReplanningGuidance
 
     calls = []
 
-    def scripted_replan(plan, x, t_plan, bank, alpha, settings=None):
+    def scripted_replan(plan, x, t_plan, bank, alpha):
         calls.append(t_plan)
         if len(calls) == 1:
             raise ValueError("forced: Clarabel failed")
@@ -105,10 +105,9 @@ def test_a_refused_scvx_replan_keeps_the_plan_in_flight(monkeypatch):
             return _StubPlan(2.0, success=False, message="converged but its controls flown end 9 km away")
         return _StubPlan(3.0)
 
-    monkeypatch.setattr(scvx_guidance, "replan_from", scripted_replan)
     builder = DiagramBuilder()
-    guidance = builder.AddSystem(scvx_guidance.ScvxGuidance(_StubPlan(1.0), period=1.0, replan_period=100.0,
-                                                            min_time_to_go=300.0))
+    guidance = builder.AddSystem(ReplanningGuidance(_StubPlan(1.0), replan=scripted_replan, period=1.0,
+                                                    replan_period=100.0, min_time_to_go=300.0))
     estimate = builder.AddSystem(ConstantVectorSource(np.array([60e3, 0.1, 0.2, 6000.0, -0.01, 1.0])))
     builder.Connect(estimate.get_output_port(), guidance.GetInputPort("estimated_state"))
     simulator = Simulator(builder.Build())
@@ -124,6 +123,7 @@ def test_a_refused_scvx_replan_keeps_the_plan_in_flight(monkeypatch):
                               (200.0, "converged but its controls flown end 9 km away")]
     stats = guidance.GetOutputPort("plan_stats").Eval(context)
     assert stats[0] == 2 and stats[1] == 2  # t = 300 s and 400 s succeeded
+    assert [(t, ok) for t, _, ok in memory.log] == [(100.0, False), (200.0, False), (300.0, True), (400.0, True)]
 
 
 def test_a_swarm_resolution_that_raises_keeps_sigma0_and_is_counted(monkeypatch):

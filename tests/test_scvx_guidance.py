@@ -56,10 +56,10 @@ def test_mission_of_the_scenario_is_paper001_table1(scenario):
 def test_guidance_system_serves_the_plan_bank_and_alpha(setup):
     """The system's commands are the plan's own bank and (direct formulation) alpha at the
     flight time, held after its end."""
-    from drake_entry.systems.scvx_guidance import ScvxGuidance
+    from drake_entry.systems.replanning_guidance import ReplanningGuidance
 
     plan = setup.planner
-    system = ScvxGuidance(plan)
+    system = ReplanningGuidance(plan)
     context = system.CreateDefaultContext()
     for t in (0.0, 400.0, 0.5 * plan.final_time, plan.final_time + 50.0):
         context.SetTime(t)

@@ -1,7 +1,7 @@
 """Paper 001's guidance as a GuidanceMethod.
 
-  estimate --> ScvxGuidance (the plan's sigma(t), alpha(t) or alpha(V); re-plans) --bank_command-->
-      (shared bank actuator);   ScvxGuidance --alpha_command--> (shared alpha actuator)
+  estimate --> ReplanningGuidance (the plan's sigma(t), alpha(t) or alpha(V); re-plans) --bank_command-->
+      (shared bank actuator);   ReplanningGuidance --alpha_command--> (shared alpha actuator)
 
 The pre-flight plan (``make_planner``) is made once per mission from the scenario's entry
 state to its target's DRS box and verified (between-node limits, its controls propagated);
@@ -10,6 +10,7 @@ estimate. The bank is flown signed: the plan chooses its reversals (no shared re
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -22,8 +23,8 @@ from drake_entry.guidance.interface import (
     LoggedSignal,
     PlantPorts,
 )
-from drake_entry.guidance.scvx.planner import ScvxPlan, plan_entry
-from drake_entry.systems.scvx_guidance import ScvxGuidance
+from drake_entry.guidance.scvx.planner import ScvxPlan, plan_entry, replan_from
+from drake_entry.systems.replanning_guidance import ReplanningGuidance
 
 GUIDANCE_SYSTEM = "scvx_guidance"
 
@@ -39,9 +40,11 @@ class ScvxMethod(GuidanceMethod):
 
     def add_systems(self, builder, scenario, planner: ScvxPlan, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance
-        guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, ScvxGuidance(
-            planner, period=g.period_s, replan_period=g.replan_period_s, min_time_to_go=g.replan_min_time_to_go_s,
-            scvx_settings=g.planner_settings()[1], lead=g.command_lead_s))
+        settings = g.planner_settings()[1]
+        guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, ReplanningGuidance(
+            planner, replan=functools.partial(replan_from, settings=settings),
+            period=g.period_s, replan_period=g.replan_period_s, min_time_to_go=g.replan_min_time_to_go_s,
+            lead=g.command_lead_s))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         lo, hi = np.radians(g.alpha_bounds_deg)
         return GuidanceCommands(

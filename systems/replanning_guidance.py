@@ -1,13 +1,18 @@
-"""ScvxGuidance: flies an SCvx plan's bank and angle of attack in time (paper 001) and
-re-plans on board from the navigation estimate.
+"""ReplanningGuidance: flies a plan's bank and angle of attack in time and re-plans on board
+from the navigation estimate (paper 001's SCvx plans, paper 002's shrinking-horizon LGL
+solutions).
 
-The plan's commands are its own segment polynomials sampled densely (``ScvxPlan.control_samples``)
-and read at the time since the plan began; alpha is the planned one where the formulation plans
-it, else the mission's alpha(V) law at the estimated speed. With ``replan_period`` > 0, every
-period (while the plan in use has more than ``min_time_to_go`` seconds left) a new plan is
-made from the estimate, holding the bank and alpha being commanded
-(``guidance.scvx.planner.replan_from``); a plan that is not a verified success is recorded and
-the previous one is kept.
+A plan is any object with ``control_samples() -> (t [s], bank [rad], alpha [rad] or None)``
+(dense samples from its start), ``final_time`` [s], ``success`` and ``message``; a plan whose
+alpha samples are None flies ``plan.problem.alpha(V)`` (an alpha(V) law) at the estimated
+speed. The commands are read at the time since the plan began, ``lead`` seconds ahead (the
+actuators' lag), and held after its end.
+
+With ``replan_period`` > 0, every period (while the plan in use has more than
+``min_time_to_go`` seconds left) a new plan is made from the estimate by the method's
+``replan(plan, x, elapsed, bank, alpha)`` callable, holding the bank and alpha being commanded;
+a re-plan that raises or is not a verified success is recorded with its time and reason, and
+the previous plan flies on.
 
 Ports:
   - input  "estimated_state"  [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
@@ -19,12 +24,11 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
-
-from drake_entry.guidance.scvx.planner import ScvxPlan, replan_from
 
 
 @dataclass(frozen=True)
@@ -32,14 +36,14 @@ class FlownPlan:
     """A plan as flown: it began at ``start`` [s] of the flight; commands sampled at ``time``
     [s since start]: ``bank`` [rad] (unwrapped) and ``alpha`` [rad] or None (alpha(V) law)."""
 
-    plan: ScvxPlan
+    plan: object
     start: float
     time: np.ndarray
     bank: np.ndarray
     alpha: np.ndarray | None
 
     @staticmethod
-    def of(plan: ScvxPlan, start: float) -> "FlownPlan":
+    def of(plan, start: float) -> "FlownPlan":
         t, bank, alpha = plan.control_samples()
         return FlownPlan(plan, start, t, bank, alpha)
 
@@ -54,29 +58,42 @@ class FlownPlan:
 
 
 @dataclass
-class ScvxMemory:
+class ReplanMemory:
+    """The guidance's state: the plan flown, when the next re-plan is due [s], the re-plans made,
+    the refused ones as (time [s], reason), per re-plan (time [s], wall time [s], accepted), and
+    the wall time spent re-planning [s]."""
+
     flown: FlownPlan
     next_replan: float
     replans: int = 0
-    refused: list = field(default_factory=list)  # (time, message)
+    refused: list = field(default_factory=list)
+    log: list = field(default_factory=list)
     wall_s: float = 0.0
 
     def __deepcopy__(self, memo):  # the plans are never mutated: copies share them
-        return ScvxMemory(self.flown, self.next_replan, self.replans, list(self.refused), self.wall_s)
+        return ReplanMemory(self.flown, self.next_replan, self.replans, list(self.refused), list(self.log),
+                            self.wall_s)
 
 
-class ScvxGuidance(LeafSystem):
-    def __init__(self, plan: ScvxPlan, *, period: float = 1.0, replan_period: float = 0.0,
-                 min_time_to_go: float = 300.0, scvx_settings=None, lead: float = 0.0):
-        """Args: plan (the pre-flight plan, flown from t = 0); period [s] of the re-plan check;
-        replan_period [s] (0: no re-planning); min_time_to_go [s]: no re-plan with less left;
-        scvx_settings: ScvxSettings of the re-plans; lead [s]: the commands are read this far
-        ahead on the plan (the actuators' lag; the plans are verified flown the same way)."""
+#: replan(plan, x [6], elapsed [s since the plan began], bank [rad], alpha [rad]) -> a new plan
+Replan = Callable[[object, np.ndarray, float, float, float], object]
+
+
+class ReplanningGuidance(LeafSystem):
+    def __init__(self, plan, *, replan: Replan | None = None, period: float = 1.0, replan_period: float = 0.0,
+                 min_time_to_go: float = 300.0, lead: float = 0.0):
+        """Args: plan (the pre-flight plan, flown from t = 0); replan: the method's re-planner
+        (needed when replan_period > 0); period [s] of the re-plan check; replan_period [s] (0: no
+        re-planning); min_time_to_go [s]: no re-plan with less left; lead [s]: the commands are
+        read this far ahead on the plan (the actuators' lag; the plans are verified flown the
+        same way)."""
         super().__init__()
-        self.lead = lead
-        self.replan_period, self.min_time_to_go, self.scvx_settings = replan_period, min_time_to_go, scvx_settings
+        if replan_period > 0 and replan is None:
+            raise ValueError("ReplanningGuidance: replan_period > 0 needs a replan callable")
+        self.lead, self.replan = lead, replan
+        self.replan_period, self.min_time_to_go = replan_period, min_time_to_go
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
-        first = ScvxMemory(FlownPlan.of(plan, 0.0), replan_period if replan_period > 0 else np.inf)
+        first = ReplanMemory(FlownPlan.of(plan, 0.0), replan_period if replan_period > 0 else np.inf)
         self._memory = self.DeclareAbstractState(AbstractValue.Make(first))
         if replan_period > 0:
             self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._update)
@@ -87,7 +104,7 @@ class ScvxGuidance(LeafSystem):
                                      prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("plan_stats", 3, self._stats, prerequisites_of_calc={self.all_state_ticket()})
 
-    def memory(self, context) -> ScvxMemory:
+    def memory(self, context) -> ReplanMemory:
         return context.get_abstract_state(int(self._memory)).get_value()
 
     def _commands(self, context):
@@ -104,17 +121,21 @@ class ScvxGuidance(LeafSystem):
         flown = mem.flown
         if t < mem.next_replan - 1e-9 or flown.start + flown.plan.final_time - t < self.min_time_to_go:
             return
-        new = ScvxMemory(flown, mem.next_replan + self.replan_period, mem.replans, list(mem.refused), mem.wall_s)
+        new = ReplanMemory(flown, mem.next_replan + self.replan_period, mem.replans, list(mem.refused),
+                           list(mem.log), mem.wall_s)
         x = np.asarray(self.est_port.Eval(context), float)
         bank, alpha = flown.commands(t, float(x[3]))
         t_wall = time.perf_counter()
         try:
-            plan = replan_from(flown.plan, x, t - flown.start, bank, alpha, settings=self.scvx_settings)
+            plan = self.replan(flown.plan, x, t - flown.start, bank, alpha)
         except Exception as e:  # a failed re-plan must not stop the flight: the previous plan flies on
             plan = None
             new.refused.append((t, f"{type(e).__name__}: {e}"))
-        new.wall_s += time.perf_counter() - t_wall
-        if plan is not None and plan.success:
+        wall = time.perf_counter() - t_wall
+        new.wall_s += wall
+        accepted = plan is not None and bool(plan.success)
+        new.log.append((t, wall, accepted))
+        if accepted:
             new.flown = FlownPlan.of(plan, t)
             new.replans += 1
         elif plan is not None:

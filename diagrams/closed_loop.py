@@ -225,9 +225,9 @@ def terminal_errors(x, setup: ClosedLoopSetup) -> dict:
 
 def acceptance_box(tr: Trajectory, setup: ClosedLoopSetup, distance_m: float) -> dict:
     """The mission's acceptance box (Scenario.acceptance_box) at the final state: the Mach number
-    flown, the distance to the target ``distance_m`` (terminal_errors')."""
+    and angle of attack flown, the distance to the target ``distance_m`` (terminal_errors')."""
     return setup.scenario.acceptance_box(setup.planet, tr.state[-1], mach=float(tr.column("mach")[-1]),
-                                         distance_m=distance_m)
+                                         distance_m=distance_m, alpha_rad=float(tr.column("alpha")[-1]))
 
 
 def fly(scenario: Scenario | ClosedLoopSetup, planner=None, *, initial_state=None, nav_seed: int = 0,

@@ -104,7 +104,7 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
     method's fields, final state, terminal errors, peak path quantities
     (drake_entry.models.trajectory.metrics), the bank's activity (``control_activity``), the
     margin of every path limit (drake_entry.models.verdict), and each acceptance criterion's
-    inside flag and error (``box_<criterion>_error``: m, or Mach)."""
+    inside flag and error (``box_<criterion>_error``: SI, m, m/s, rad, or Mach)."""
     tr, x = res.trajectory, res.trajectory.state[-1]
     g, v = res.guidance, res.verdict
     return {

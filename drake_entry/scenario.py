@@ -6,6 +6,7 @@ in the name. Every bad value raises a one-line ``ScenarioError`` naming the fiel
 allowed range.
 """
 import dataclasses as dc
+import math
 import os
 from importlib import resources
 from typing import Optional
@@ -50,8 +51,9 @@ class TargetSpec:
 class TerminalSpec:
     """Terminal interface: an open-loop run stops at the first condition reached. The
     tolerances are the mission's acceptance box (paper 000 Table 1): a closed-loop flight
-    is a success only inside every box criterion given (altitude and Mach about the values
-    above, distance to the target); a criterion without its tolerance is not checked."""
+    is a success only inside every box criterion given (altitude, Mach, speed, flight-path
+    angle and angle of attack about the values given, distance to the target); a criterion
+    without its tolerance is not checked (drake_entry.models.verdict.BOX_CRITERIA)."""
 
     altitude_km: Optional[float] = None  # stop altitude (open loop) and the box centre
     mach: Optional[float] = None  # stop Mach number and the box centre
@@ -61,6 +63,12 @@ class TerminalSpec:
     altitude_tolerance_km: Optional[float] = None  # acceptance box: |h - altitude_km| <= this
     mach_tolerance: Optional[float] = None  # acceptance box: |M - mach| <= this
     distance_tolerance_km: Optional[float] = None  # acceptance box: distance to the target <= this
+    velocity_tolerance_m_s: Optional[float] = None  # acceptance box: |V - velocity_m_s| <= this
+    # terminal flight-path angle and angle of attack [deg] and their acceptance windows (+- deg)
+    flight_path_deg: Optional[float] = None
+    flight_path_tolerance_deg: Optional[float] = None
+    alpha_deg: Optional[float] = None
+    alpha_tolerance_deg: Optional[float] = None
     # relative tolerance on every path limit (vehicle and mission): a limit counts as held up to
     # limit + this x |limit|, at every log sample and integrator step; 0: a limit is a limit
     path_limit_tolerance: float = 0.0
@@ -183,12 +191,15 @@ class Scenario:
         return np.array([h, np.radians(e.longitude_deg), np.radians(e.latitude_deg),
                          e.velocity_m_s, np.radians(e.flight_path_deg), np.radians(e.heading_deg)])
 
-    def acceptance_box(self, planet: Earth, x, *, mach: float, distance_m: float) -> dict:
+    def acceptance_box(self, planet: Earth, x, *, mach: float, distance_m: float, alpha_rad: float = math.nan) -> dict:
         """The acceptance box (drake_entry.models.verdict.acceptance_box) at a final state ``x``
-        [h, lon, lat, ...] on ``planet``: the altitude geodetic with altitude_datum 'ellipsoid', else
-        the state altitude; the Mach number and the distance to the target [m] as measured."""
+        [h, lon, lat, V, gamma, ...] on ``planet``: the altitude geodetic with altitude_datum
+        'ellipsoid', else the state altitude; speed and flight-path angle from ``x``; the Mach
+        number, the distance to the target [m] and the angle of attack [rad] as measured (an
+        alpha criterion with no alpha given is missed)."""
         h = planet.atmospheric_altitude(x[0], x[2]) if self.altitude_datum == "ellipsoid" else x[0]
-        return acceptance_box(self.terminal, altitude_m=float(h), mach=float(mach), distance_m=float(distance_m))
+        return acceptance_box(self.terminal, altitude_m=float(h), mach=float(mach), distance_m=float(distance_m),
+                              velocity_m_s=float(x[3]), flight_path_rad=float(x[4]), alpha_rad=float(alpha_rad))
 
     def entry_energy(self) -> float:
         """Specific energy at the entry interface [J/kg] (central gravity, eq. 37 convention)."""
@@ -251,9 +262,18 @@ class Scenario:
             planet = self.make_planet().with_(j2=0.0)
             check_range("terminal.energy_MJ_kg", t.energy_MJ_kg, planet.specific_energy(0.0, 0.0) / 1e6,
                         self.entry_energy() / 1e6)
-        for name in ("altitude_tolerance_km", "mach_tolerance", "distance_tolerance_km"):
+        for name in ("altitude_tolerance_km", "mach_tolerance", "distance_tolerance_km", "velocity_tolerance_m_s",
+                     "flight_path_tolerance_deg", "alpha_tolerance_deg"):
             if getattr(t, name) is not None:
                 check_range(f"terminal.{name}", getattr(t, name), 0.0, 1e5)
+        if t.flight_path_deg is not None:
+            check_range("terminal.flight_path_deg", t.flight_path_deg, -90.0, 90.0)
+        if t.alpha_deg is not None:
+            check_range("terminal.alpha_deg", t.alpha_deg, -90.0, 90.0)
+        for centre, tol in (("velocity_m_s", "velocity_tolerance_m_s"), ("flight_path_deg", "flight_path_tolerance_deg"),
+                            ("alpha_deg", "alpha_tolerance_deg")):
+            if getattr(t, tol) is not None and getattr(t, centre) is None:
+                raise ScenarioError(f"terminal.{tol} is given without terminal.{centre}, the value it is about")
         check_range("terminal.path_limit_tolerance", t.path_limit_tolerance, 0.0, 0.5)
         for col, v in self.reference_results.errors.items():
             if col not in ERROR_COLUMNS:

@@ -140,8 +140,9 @@ def test_control_activity_counts_reversals_travel_rate_and_time_at_the_limits():
 def _terminal(**kw):
     from types import SimpleNamespace
 
-    base = {"altitude_km": None, "altitude_tolerance_km": None, "mach": None, "mach_tolerance": None,
-            "distance_tolerance_km": None}
+    from drake_entry.scenario import TerminalSpec
+
+    base = {f.name: None for f in dc.fields(TerminalSpec)}
     return SimpleNamespace(**{**base, **kw})
 
 
@@ -163,6 +164,25 @@ def test_acceptance_box_has_each_criterion_given_in_km_and_is_closed():
                           distance_m=1e9) == {}
     assert list(acceptance_box(_terminal(distance_tolerance_km=2.0), altitude_m=0.0, mach=0.0,
                                distance_m=1999.0)) == ["distance"]
+
+
+def test_impact_criteria_speed_flight_path_and_alpha_are_windows_about_their_values_in_si():
+    """Speed, flight-path angle and angle of attack are windows about the spec's values: degrees
+    become radians (an error of exactly the tolerance inside, 1e-9 rad beyond outside), a value
+    not measured (nan) is never inside, and the missed criterion prints in the spec's units."""
+    from drake_entry.models.verdict import acceptance_box, box_text
+
+    spec = _terminal(velocity_m_s=1219.0, velocity_tolerance_m_s=50.0, flight_path_deg=-80.0,
+                     flight_path_tolerance_deg=5.0, alpha_deg=0.0, alpha_tolerance_deg=1.0)
+    b = acceptance_box(spec, altitude_m=0.0, mach=3.6, distance_m=0.0, velocity_m_s=1169.0,
+                       flight_path_rad=math.radians(-85.0), alpha_rad=math.radians(1.0))
+    assert list(b) == ["velocity", "flight_path", "alpha"] and all(v["inside"] for v in b.values())
+    assert b["velocity"]["error"] == pytest.approx(-50.0) and b["flight_path"]["tolerance"] == pytest.approx(math.radians(5.0))
+    out = acceptance_box(spec, altitude_m=0.0, mach=3.6, distance_m=0.0, velocity_m_s=1269.001,
+                         flight_path_rad=math.radians(-75.0) + 1e-9, alpha_rad=math.nan)
+    assert [v["inside"] for v in out.values()] == [False, False, False]
+    assert box_text("flight_path", out["flight_path"]) == "error +5.00 deg outside +-5 deg"
+    assert box_text("velocity", out["velocity"]) == "error +50.00 m/s outside +-50 m/s"
 
 
 def test_limit_checks_with_nan_samples_absolute_and_lower_bounds():

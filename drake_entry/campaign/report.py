@@ -36,6 +36,7 @@ from drake_entry.campaign.statistics import (
 )
 from drake_entry.campaign.store import coverage, read_nominal, read_trajectories
 from drake_entry.errors import CampaignError, DrakeEntryError
+from drake_entry.models.verdict import BOX_CRITERIA
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario
 from drake_entry.typed_yaml import load_yaml_typed
@@ -459,26 +460,19 @@ def _requirements(rows: dict, reached, stats: dict, scenario) -> str:
     term = scenario.terminal if scenario is not None else None
     lines.append(f"| reach the terminal interface | every sample | count | {nr} of {n} | — | "
                  f"{'PASS' if nr == n else 'FAIL'} |")
-    box = (("altitude", "terminal altitude", "altitude_tolerance_km", 1e3, "km", "km"),
-           ("mach", "terminal Mach", "mach_tolerance", 1.0, "", "-"),
-           ("distance", "distance to the target", "distance_tolerance_km", 1e3, "km", "km"))
-    for key, label, field, scale, unit, show in box:
-        col = f"box_{key}_error"
-        flag = f"inside_{key}_box"
-        if term is None or getattr(term, field, None) is None or flag not in rows:
+    for c in BOX_CRITERIA:
+        col, flag = f"box_{c.name}_error", f"inside_{c.name}_box"
+        if term is None or getattr(term, c.tolerance, None) is None or flag not in rows:
             continue
-        tol = getattr(term, field)
+        tol = getattr(term, c.tolerance)
+        unit = f" {c.unit}" if c.unit else ""
         inside = int(sum(bool(v) for v, r in zip(rows[flag], reached) if r and v is not None))
-        e = _finite(rows, col, n)[reached] / scale if col in rows else np.array([])
+        e = _finite(rows, col, n)[reached] / c.si if col in rows else np.array([])
         e = e[np.isfinite(e)]
         worst = float(np.abs(e).max()) if e.size else math.nan
-        centre = ""
-        if key == "altitude" and term.altitude_km is not None:
-            centre = f" about {term.altitude_km:g} km"
-        elif key == "mach" and term.mach is not None:
-            centre = f" about {term.mach:g}"
-        lines.append(f"| {label}{centre} | ≤ {tol:g} {unit} | largest absolute error of {nr} | "
-                     f"{_fmt(worst)} {unit} | {_fmt(tol - worst)} {unit} | "
+        centre = "" if c.centre is None or getattr(term, c.centre) is None else f" about {getattr(term, c.centre):g}{unit}"
+        lines.append(f"| {c.label}{centre} | ≤ {tol:g}{unit} | largest absolute error of {nr} | "
+                     f"{_fmt(worst)}{unit} | {_fmt(tol - worst)}{unit} | "
                      f"{'PASS' if inside == nr == n else 'FAIL'} ({inside} of {n} inside) |")
     limits = []
     if scenario is not None:

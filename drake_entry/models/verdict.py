@@ -137,26 +137,69 @@ def _scale(bound: float) -> float:
     return abs(bound) if bound != 0.0 else 1.0
 
 
-def acceptance_box(terminal, *, altitude_m: float, mach: float, distance_m: float) -> dict:
+@dc.dataclass(frozen=True)
+class BoxCriterion:
+    """One criterion of the acceptance box: |value - centre| <= tolerance.
+
+    Attributes:
+      name: the key in the box and the row ('box_<name>_error', 'inside_<name>_box').
+      label: what the report calls it.
+      centre, tolerance: the TerminalSpec fields that give them (centre None: 0, a miss
+        distance); in the spec's units (km, deg, m/s, Mach).
+      si: the factor from the spec's units to SI (1e3 for km, pi/180 for deg); errors are SI.
+      unit: the spec's unit, as printed.
+    """
+
+    name: str
+    label: str
+    centre: str | None
+    tolerance: str
+    si: float
+    unit: str
+
+
+#: every criterion an acceptance box may hold, in report order (a scenario checks those whose
+#: tolerance it gives)
+BOX_CRITERIA = (
+    BoxCriterion("altitude", "terminal altitude", "altitude_km", "altitude_tolerance_km", 1e3, "km"),
+    BoxCriterion("mach", "terminal Mach", "mach", "mach_tolerance", 1.0, ""),
+    BoxCriterion("distance", "distance to the target", None, "distance_tolerance_km", 1e3, "km"),
+    BoxCriterion("velocity", "terminal speed", "velocity_m_s", "velocity_tolerance_m_s", 1.0, "m/s"),
+    BoxCriterion("flight_path", "terminal flight-path angle", "flight_path_deg", "flight_path_tolerance_deg",
+                 math.pi / 180.0, "deg"),
+    BoxCriterion("alpha", "terminal angle of attack", "alpha_deg", "alpha_tolerance_deg", math.pi / 180.0, "deg"),
+)
+_CRITERIA = {c.name: c for c in BOX_CRITERIA}
+
+
+def acceptance_box(terminal, *, altitude_m: float, mach: float, distance_m: float, velocity_m_s: float = math.nan,
+                   flight_path_rad: float = math.nan, alpha_rad: float = math.nan) -> dict:
     """The mission's acceptance box (a scenario's TerminalSpec, paper 000 Table 1) at a final
-    point: {criterion: {"error": e, "tolerance": tol, "inside": |e| <= tol}} for each criterion
-    whose tolerance is given: 'altitude' [m] about terminal.altitude_km (``altitude_m`` in the
-    scenario's datum), 'mach' about terminal.mach, 'distance' [m] to the target."""
-    t, box = terminal, {}
-    if t.altitude_km is not None and t.altitude_tolerance_km is not None:
-        box["altitude"] = (float(altitude_m - t.altitude_km * 1e3), t.altitude_tolerance_km * 1e3)
-    if t.mach is not None and t.mach_tolerance is not None:
-        box["mach"] = (float(mach - t.mach), t.mach_tolerance)
-    if t.distance_tolerance_km is not None:
-        box["distance"] = (float(distance_m), t.distance_tolerance_km * 1e3)
-    return {k: {"error": e, "tolerance": tol, "inside": bool(abs(e) <= tol)} for k, (e, tol) in box.items()}
+    point: {criterion: {"error": e, "tolerance": tol, "inside": |e| <= tol}} (SI: m, m/s, rad;
+    Mach) for each criterion of ``BOX_CRITERIA`` whose tolerance (and centre) is given:
+    'altitude' about terminal.altitude_km (``altitude_m`` in the scenario's datum), 'mach',
+    'distance' to the target, 'velocity', 'flight_path' and 'alpha' about their values. The box
+    is closed, up to ``ROUNDING`` (the degree-radian conversion's rounding at an edge); a
+    criterion whose measured value is not given (nan) is never inside."""
+    measured = {"altitude": altitude_m, "mach": mach, "distance": distance_m, "velocity": velocity_m_s,
+                "flight_path": flight_path_rad, "alpha": alpha_rad}
+    box = {}
+    for c in BOX_CRITERIA:
+        tol = getattr(terminal, c.tolerance, None)
+        centre = 0.0 if c.centre is None else getattr(terminal, c.centre, None)
+        if tol is None or centre is None:
+            continue
+        e, t = float(measured[c.name] - centre * c.si), tol * c.si
+        box[c.name] = {"error": e, "tolerance": t, "inside": bool(abs(e) <= t * (1.0 + ROUNDING))}
+    return box
 
 
 def box_text(name: str, b: dict) -> str:
-    """One acceptance criterion missed, in words."""
-    if name == "mach":
-        return f"error {b['error']:+.3f} outside +-{b['tolerance']:g}"
-    return f"error {b['error'] / 1e3:+.3f} km outside +-{b['tolerance'] / 1e3:g} km"
+    """One acceptance criterion missed, in words (in the spec's units)."""
+    c = _CRITERIA[name]
+    unit = f" {c.unit}" if c.unit else ""
+    digits = 3 if c.unit in ("km", "") else 2
+    return f"error {b['error'] / c.si:+.{digits}f}{unit} outside +-{b['tolerance'] / c.si:g}{unit}"
 
 
 @dc.dataclass(frozen=True)

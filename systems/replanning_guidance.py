@@ -81,19 +81,21 @@ Replan = Callable[[object, np.ndarray, float, float, float], object]
 
 class ReplanningGuidance(LeafSystem):
     def __init__(self, plan, *, replan: Replan | None = None, period: float = 1.0, replan_period: float = 0.0,
-                 min_time_to_go: float = 300.0, lead: float = 0.0):
+                 min_time_to_go: float = 300.0, lead: float = 0.0, first_replan: float | None = None):
         """Args: plan (the pre-flight plan, flown from t = 0); replan: the method's re-planner
         (needed when replan_period > 0); period [s] of the re-plan check; replan_period [s] (0: no
         re-planning); min_time_to_go [s]: no re-plan with less left; lead [s]: the commands are
         read this far ahead on the plan (the actuators' lag; the plans are verified flown the
-        same way)."""
+        same way); first_replan [s]: the flight time of the first re-plan (default
+        replan_period), the next ones every replan_period after it."""
         super().__init__()
         if replan_period > 0 and replan is None:
             raise ValueError("ReplanningGuidance: replan_period > 0 needs a replan callable")
         self.lead, self.replan = lead, replan
         self.replan_period, self.min_time_to_go = replan_period, min_time_to_go
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
-        first = ReplanMemory(FlownPlan.of(plan, 0.0), replan_period if replan_period > 0 else np.inf)
+        first_at = (replan_period if first_replan is None else first_replan) if replan_period > 0 else np.inf
+        first = ReplanMemory(FlownPlan.of(plan, 0.0), first_at)
         self._memory = self.DeclareAbstractState(AbstractValue.Make(first))
         if replan_period > 0:
             self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._update)

@@ -1,0 +1,168 @@
+"""Plans of paper 002's terminal guidance: an LGL solution of the scenario's problem, verified as
+the closed loop flies it.
+
+    plan = plan_terminal(scenario, verifier)            # before flight (the spec's nodes)
+    again = replan(plan, x_nav, elapsed, bank, alpha)   # in flight: the horizon that remains
+
+A plan is a success only when (1) the NLP solution is verified (drake_entry.planning.nlp.verify:
+the dynamics between the nodes and its controls flown on the problem's own dynamics) and (2) its
+bank and angle of attack, flown by the Drake Simulator through the closed loop's actuators (the
+guidance period, the command lead, the vehicle's bank limits, the problem's alpha bounds and
+rate bound), end inside the scenario's acceptance box at the plan's t_f and hold every path
+limit of the closed loop's verdict (``PlanFlight``).
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+
+import numpy as np
+
+from drake_entry.models.verdict import box_text, breaches_text, check_limits
+from drake_entry.planning.verification import Actuation, EntryControls, require_verifier
+
+#: command samples per second of a plan (linear interpolation between them by the guidance)
+SAMPLES_PER_S = 4.0
+
+
+@dc.dataclass
+class PlanFlight:
+    """A plan's bank and alpha flown through the closed loop's actuators, and the verdict.
+
+    Attributes:
+      box: the scenario's acceptance box at the plan's t_f; checks: the closed loop's path limits
+        on the flight (every log sample and integrator step); failure: why it stopped early.
+    """
+
+    box: dict
+    checks: list
+    failure: str = ""
+    trajectory: object = dc.field(default=None, repr=False)
+
+    @property
+    def ok(self) -> bool:
+        return not self.failure and all(b["inside"] for b in self.box.values()) and all(c.held for c in self.checks)
+
+    def text(self) -> str:
+        if self.failure:
+            return f"flown through the actuators it stopped early: {self.failure}"
+        parts = [f"{k} {box_text(k, b)}" for k, b in self.box.items() if not b["inside"]]
+        if not all(c.held for c in self.checks):
+            parts.append(f"path limits breached: {breaches_text(self.checks)}")
+        return ("flown through the actuators: " + "; ".join(parts)) if parts else \
+            "flown through the actuators: inside the acceptance box, every path limit held"
+
+
+@dc.dataclass
+class LglPlan:
+    """One LGL solution as the guidance flies it.
+
+    Attributes:
+      result: the NlpResult (its clock: t = 0 where this plan begins).
+      flight: the PlanFlight; success: result.success and flight.ok; message: both in words.
+      scenario, spec, verifier: what re-plans need.
+    """
+
+    result: object
+    flight: PlanFlight | None
+    success: bool
+    message: str
+    scenario: object = dc.field(repr=False, default=None)
+    verifier: object = dc.field(repr=False, default=None)
+
+    @property
+    def final_time(self) -> float:
+        return self.result.final_time
+
+    def control_samples(self):
+        """(t [s], bank [rad], alpha [rad]) sampled at SAMPLES_PER_S from the solution's states."""
+        tf = self.final_time
+        t = np.linspace(0.0, tf, max(int(tf * SAMPLES_PER_S) + 1, 3))
+        X = self.result.state_function()(t)
+        names = list(self.result.problem.state_names)
+        return t, X[:, names.index("sigma")], X[:, names.index("alpha")]
+
+
+def actuation(problem, spec, initial_bank: float, initial_alpha: float) -> Actuation:
+    """The closed loop's actuators for a plan of ``problem``: the vehicle's bank limits, the
+    problem's alpha bounds and alpha-rate bound (eq. 17), the spec's period, lead and alpha
+    acceleration limit."""
+    v = problem.vehicle
+    lo, hi = problem.state_bounds["alpha"]
+    rate = max(abs(r) for r in problem.control_bounds["u_alpha"])
+    return Actuation(period_s=spec.period_s, lead_s=spec.command_lead_s, bank_limit=v.bank_limit,
+                     bank_rate_limit=v.bank_rate_limit, bank_accel_limit=v.bank_accel_limit,
+                     alpha_bounds=(float(lo), float(hi)), alpha_rate_limit=float(rate),
+                     alpha_accel_limit=math.radians(spec.alpha_accel_limit_deg_s2),
+                     initial_bank=float(initial_bank), initial_alpha=float(initial_alpha))
+
+
+def fly_plan(plan: LglPlan, scenario, verifier) -> PlanFlight:
+    """Fly the plan's bank and alpha from its first node through the closed loop's actuators and
+    judge the flight as the closed loop's verdict would (acceptance box at t_f, path limits)."""
+    r, spec = plan.result, scenario.guidance
+    t, bank, alpha = plan.control_samples()
+    x0 = r.states[0]
+    controls = EntryControls(r.problem.vehicle, r.problem.planet, r.problem.atmosphere, x0[:6].astype(float),
+                             r.final_time, t, bank, alpha, None, actuation(r.problem, spec, bank[0], alpha[0]))
+    flown = verifier(controls)
+    tr = flown.trajectory
+    planet = r.problem.planet
+    xf = tr.state[-1]
+    distance = planet.great_circle_distance(xf[1], xf[2], math.radians(scenario.target.longitude_deg),
+                                            math.radians(scenario.target.latitude_deg))
+    box = scenario.acceptance_box(planet, xf, mach=float(tr.column("mach")[-1]), distance_m=float(distance),
+                                  alpha_rad=float(tr.column("alpha")[-1]))
+    checks = check_limits(tr.flown_time(), tr.flown, scenario.path_limits(r.problem.vehicle))
+    return PlanFlight(box, checks, flown.failure, tr)
+
+
+def judged(result, scenario, verifier) -> LglPlan:
+    """An LglPlan of an NlpResult: flown through the actuators only when the NLP solution is
+    verified (an unverified one is not flown)."""
+    plan = LglPlan(result, None, False, result.message, scenario, verifier)
+    if not result.success:
+        return plan
+    plan.flight = fly_plan(plan, scenario, verifier)
+    plan.success = plan.flight.ok
+    plan.message = f"{result.message}; {plan.flight.text()}"
+    return plan
+
+
+def plan_terminal(scenario, verifier, *, progress="auto") -> LglPlan:
+    """The pre-flight plan: the scenario's problem on the spec's nodes, from the built-in
+    propagated guess, verified (module docstring)."""
+    from drake_entry.planning import nlp
+
+    spec = scenario.guidance
+    verifier = require_verifier(verifier, "the terminal guidance's plan")
+    result = nlp.solve(spec.problem_for(scenario), nodes=spec.nodes, solver=spec.solver, tolerance=spec.tolerance,
+                       max_iterations=spec.max_iterations, verifier=verifier, progress=progress)
+    return judged(result, scenario, verifier)
+
+
+def replan_nodes(spec, horizon_s: float) -> int:
+    """Nodes of a re-solve: one per replan_node_spacing_s of the horizon, within replan_nodes."""
+    lo, hi = spec.replan_nodes
+    return int(np.clip(math.ceil(horizon_s / spec.replan_node_spacing_s) + 1, lo, hi))
+
+
+def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float) -> LglPlan:
+    """Re-solve from the navigation state ``x`` [h, lon, lat, V, gamma, psi] reached ``elapsed`` [s]
+    into ``previous``, with the bank and alpha being commanded [rad] as the initial alpha and
+    sigma states (clipped into their bounds), on the horizon that remains, warm-started from
+    ``previous`` (shrinking_horizon.resolve_from); judged as the pre-flight plan is."""
+    from drake_entry.planning.nlp.shrinking_horizon import resolve_from
+
+    r, scenario = previous.result, previous.scenario
+    spec = scenario.guidance
+    names = list(r.problem.state_names)
+    x_now = np.zeros(len(names))
+    x_now[:6] = x
+    lo, hi = r.problem.state_bounds["alpha"]
+    x_now[names.index("alpha")] = float(np.clip(alpha, lo, hi))
+    x_now[names.index("sigma")] = float(bank)
+    again = resolve_from(r, x_now, elapsed, nodes=replan_nodes(spec, r.final_time - elapsed), solver=spec.solver,
+                         tolerance=spec.replan_tolerance, max_iterations=spec.max_iterations,
+                         verifier=previous.verifier, progress=False)
+    return judged(again, scenario, previous.verifier)

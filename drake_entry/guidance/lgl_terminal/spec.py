@@ -1,0 +1,93 @@
+"""Scenario spec of paper 002's terminal guidance; YAML tag ``guidance: !LglTerminal``."""
+
+import dataclasses as dc
+from typing import Optional
+
+from drake_entry.errors import ScenarioError, check_range
+from drake_entry.guidance.spec import GuidanceSpecBase
+
+SOLVERS = ("snopt", "ipopt")
+
+
+@dc.dataclass
+class LglTerminal(GuidanceSpecBase):
+    """Paper 002's optimal-control problem (a packaged problem or a problem YAML path: final
+    conditions, bounds, path constraints, objective; eqs. 11, 16-19) solved before flight by the
+    Legendre pseudospectral method from the scenario's entry state to its target with the
+    scenario's vehicle, planet and atmosphere; its bank and angle of attack (states of the
+    'rates' layout) flown in time through the shared actuators, and the problem re-solved from
+    the navigation estimate every ``replan_period_s`` with the horizon that remains, warm-started
+    from the solution in use (drake_entry.planning.nlp.shrinking_horizon)."""
+
+    # the closed loop stops at impact
+    stops_at_altitude = True
+    terminal_altitude_km: float = 0.0
+    problem: str = "marv"
+    # the final flight-path angle [deg] planned (None: the problem's)
+    final_flight_path_deg: Optional[float] = None
+    # design margin of the plans (not the paper's): each path constraint planned this fraction
+    # inside its bound (q >= 12 kPa planned as >= 12 (1 + m) kPa), so that the closed loop,
+    # dispersed, holds the bounds its verdict checks
+    path_margin: float = 0.08
+    # the pre-flight solve: LGL nodes, NLP solver, its tolerance and iteration cap
+    nodes: int = 80
+    solver: str = "snopt"
+    tolerance: float = 1.0e-7
+    max_iterations: int = 3000
+    # re-solves from replan_start_s [s] every replan_period_s [s] (0: fly the pre-flight solution)
+    # while more than replan_min_time_to_go_s [s] remain, on one node per replan_node_spacing_s
+    # [s] of the remaining horizon, within replan_nodes [min, max], to replan_tolerance
+    replan_start_s: float = 200.0
+    replan_period_s: float = 100.0
+    replan_min_time_to_go_s: float = 60.0
+    replan_node_spacing_s: float = 10.0
+    replan_nodes: list[int] = dc.field(default_factory=lambda: [20, 60])
+    replan_tolerance: float = 1.0e-6
+    # commands read this far ahead on the plan [s] (the actuators' lag, as paper 001's guidance);
+    # the angle-of-attack actuator's acceleration limit [deg/s^2] (its rate limit is the
+    # problem's alpha-rate bound, eq. 17)
+    command_lead_s: float = 1.0
+    alpha_accel_limit_deg_s2: float = 40.0
+
+    def terminal_speed(self, speed_of_sound: float) -> float:
+        """V_f [m/s]: the problem's final speed (the impact speed of eq. 16)."""
+        from drake_entry.guidance.lgl_terminal.mission import load_guidance_problem
+
+        return float(load_guidance_problem(self).final["V"])
+
+    def path_limits(self, scenario) -> list:
+        """The problem's path constraints (eq. 18: q >= 12 kPa, a <= 45 g0) as flown limits."""
+        from drake_entry.guidance.lgl_terminal.mission import mission_path_limits, problem_for_scenario
+
+        return mission_path_limits(problem_for_scenario(self, scenario, margin=False))
+
+    def problem_for(self, scenario):
+        """The OptimalControlProblem planned (planner.problem_for_scenario, with the design margin)."""
+        from drake_entry.guidance.lgl_terminal.mission import problem_for_scenario
+
+        return problem_for_scenario(self, scenario)
+
+    def validate(self, scenario) -> None:
+        super().validate(scenario)
+        if self.solver not in SOLVERS:
+            raise ScenarioError(f"guidance.solver = '{self.solver}' is unknown; allowed: {', '.join(SOLVERS)}")
+        check_range("guidance.nodes", self.nodes, 10, 400)
+        check_range("guidance.path_margin", self.path_margin, 0.0, 0.5)
+        check_range("guidance.tolerance", self.tolerance, 1e-12, 1e-2)
+        check_range("guidance.max_iterations", self.max_iterations, 1, 100000)
+        check_range("guidance.replan_period_s", self.replan_period_s, 0.0, 1e4)
+        if self.replan_period_s and self.replan_period_s < self.period_s:
+            raise ScenarioError(f"guidance.replan_period_s = {self.replan_period_s} must be 0 or >= guidance.period_s "
+                                f"= {self.period_s}")
+        check_range("guidance.replan_start_s", self.replan_start_s, 0.0, 1e4)
+        check_range("guidance.replan_min_time_to_go_s", self.replan_min_time_to_go_s, 0.0, 1e4)
+        check_range("guidance.replan_node_spacing_s", self.replan_node_spacing_s, 0.1, 1e3)
+        if len(self.replan_nodes) != 2 or not 5 <= self.replan_nodes[0] <= self.replan_nodes[1] <= 400:
+            raise ScenarioError(f"guidance.replan_nodes = {self.replan_nodes}; allowed [min, max] with "
+                                f"5 <= min <= max <= 400")
+        check_range("guidance.replan_tolerance", self.replan_tolerance, 1e-12, 1e-2)
+        check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
+        check_range("guidance.alpha_accel_limit_deg_s2", self.alpha_accel_limit_deg_s2, 0.1, 1e3)
+        if self.final_flight_path_deg is not None:
+            check_range("guidance.final_flight_path_deg", self.final_flight_path_deg, -89.9, 0.0)
+        self.problem_for(scenario)

@@ -9,13 +9,18 @@ speed. The commands are read at the time since the plan began, ``lead`` seconds 
 actuators' lag), and held after its end.
 
 With ``replan_period`` > 0, every period (while the plan in use has more than
-``min_time_to_go`` seconds left) a new plan is made from the estimate by the method's
+``min_time_to_go`` seconds left; with ``time_to_go_fraction`` the period shrinks to that
+fraction of the time to go, never below the guidance period) a new plan is made from the estimate by the method's
 ``replan(plan, x, elapsed, bank, alpha)`` callable, holding the bank and alpha being commanded;
 a re-plan that raises or is not a verified success is recorded with its time and reason, and
 the previous plan flies on.
 
+With ``model_scales``, the re-planner is also given ``scales=(k_L, k_D)``, the lift and drag
+ratios the flight has shown (systems/acceleration_ratios.py), read from the "model_scales" input.
+
 Ports:
   - input  "estimated_state"  [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
+  - input  "model_scales"     [2]  k_L, k_D (only with model_scales)
   - output "bank_command"     [1]  sigma [rad] (signed: the plan chooses its reversals)
   - output "alpha_command"    [1]  alpha [rad]
   - output "plan_stats"       [3]  re-plans made, re-plans refused, wall time of re-planning [s]
@@ -81,19 +86,24 @@ Replan = Callable[[object, np.ndarray, float, float, float], object]
 
 class ReplanningGuidance(LeafSystem):
     def __init__(self, plan, *, replan: Replan | None = None, period: float = 1.0, replan_period: float = 0.0,
-                 min_time_to_go: float = 300.0, lead: float = 0.0, first_replan: float | None = None):
+                 min_time_to_go: float = 300.0, lead: float = 0.0, first_replan: float | None = None,
+                 time_to_go_fraction: float | None = None, model_scales: bool = False):
         """Args: plan (the pre-flight plan, flown from t = 0); replan: the method's re-planner
         (needed when replan_period > 0); period [s] of the re-plan check; replan_period [s] (0: no
         re-planning); min_time_to_go [s]: no re-plan with less left; lead [s]: the commands are
         read this far ahead on the plan (the actuators' lag; the plans are verified flown the
         same way); first_replan [s]: the flight time of the first re-plan (default
-        replan_period), the next ones every replan_period after it."""
+        replan_period), the next ones every replan_period after it, or, with
+        time_to_go_fraction, after min(replan_period, max(period, fraction x time to go)) [s]
+        (the time to go of the plan in use after the re-plan); model_scales: declare the
+        "model_scales" input and pass its value to ``replan`` as ``scales``."""
         super().__init__()
         if replan_period > 0 and replan is None:
             raise ValueError("ReplanningGuidance: replan_period > 0 needs a replan callable")
-        self.lead, self.replan = lead, replan
+        self.lead, self.replan, self.period, self.time_to_go_fraction = lead, replan, period, time_to_go_fraction
         self.replan_period, self.min_time_to_go = replan_period, min_time_to_go
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
+        self.scales_port = self.DeclareVectorInputPort("model_scales", 2) if model_scales else None
         first_at = (replan_period if first_replan is None else first_replan) if replan_period > 0 else np.inf
         first = ReplanMemory(FlownPlan.of(plan, 0.0), first_at)
         self._memory = self.DeclareAbstractState(AbstractValue.Make(first))
@@ -129,7 +139,8 @@ class ReplanningGuidance(LeafSystem):
         bank, alpha = flown.commands(t, float(x[3]))
         t_wall = time.perf_counter()
         try:
-            plan = self.replan(flown.plan, x, t - flown.start, bank, alpha)
+            extra = {} if self.scales_port is None else {"scales": tuple(self.scales_port.Eval(context))}
+            plan = self.replan(flown.plan, x, t - flown.start, bank, alpha, **extra)
         except Exception as e:  # a failed re-plan must not stop the flight: the previous plan flies on
             plan = None
             new.refused.append((t, f"{type(e).__name__}: {e}"))
@@ -142,4 +153,7 @@ class ReplanningGuidance(LeafSystem):
             new.replans += 1
         elif plan is not None:
             new.refused.append((t, plan.message))
+        if self.time_to_go_fraction is not None:
+            to_go = new.flown.start + new.flown.plan.final_time - t
+            new.next_replan = t + min(self.replan_period, max(self.period, self.time_to_go_fraction * to_go))
         state.get_mutable_abstract_state(int(self._memory)).set_value(new)

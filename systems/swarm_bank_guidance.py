@@ -39,16 +39,14 @@ from drake_entry.errors import ScenarioError
 from drake_entry.guidance.swarm_bank.evaluator import SwarmProblem
 from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, law_commands
 from drake_entry.guidance.swarm_bank.search import resolve_sigma0
+from drake_entry.models.acceleration_ratios import filtered_ratios
 from drake_entry.models.aerodynamics import ScaledAero
-from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 
 _FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
 # discrete state: law memory (3), sigma_0, re-solutions, failed ones, wall time, next re-solution
 # time, filtered sensed/modelled lift and drag ratios
 _ALPHA, _ABOVE, _SWITCHED, _SIGMA0, _PLANS, _FAILED, _WALL, _NEXT, _KL, _KD = range(10)
-#: time constant [s] of the sensed/modelled acceleration ratios, and the drag [m/s^2] below
-#: which they are not updated (thin air: the ratio is noise)
-RATIO_TIME_CONSTANT_S, RATIO_MIN_DRAG = 30.0, 0.5
 
 
 class SwarmBankGuidance(LeafSystem):
@@ -142,10 +140,5 @@ class SwarmBankGuidance(LeafSystem):
         p = self.problem
         x = np.asarray(self.est_port.Eval(context), float)
         fc = self.fc_port.Eval(context)
-        rho, a = p.atmosphere.air_data(p.planet.atmospheric_altitude(float(x[0]), float(x[2])))
-        _, L, D = aero_accelerations(x, float(m[_ALPHA]), rho, a, p.vehicle)
-        if D < RATIO_MIN_DRAG or not L > 0:
-            return
-        w = min(1.0, self.period / RATIO_TIME_CONSTANT_S)
-        m[_KL] += w * (fc[_FC["lift"]] / L - m[_KL])
-        m[_KD] += w * (fc[_FC["drag"]] / D - m[_KD])
+        m[_KL], m[_KD] = filtered_ratios((m[_KL], m[_KD]), x, float(m[_ALPHA]), float(fc[_FC["lift"]]),
+                                         float(fc[_FC["drag"]]), p.vehicle, p.planet, p.atmosphere, self.period)

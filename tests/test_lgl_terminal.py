@@ -47,8 +47,8 @@ def test_path_constraints_are_planned_inside_the_bounds_the_verdict_checks(scena
 def test_resolve_mesh_is_one_node_per_spacing_within_the_bounds(scenario):
     from drake_entry.guidance.lgl_terminal.planner import replan_nodes
 
-    g = scenario.guidance  # 10 s per node, within [20, 60]
-    assert [replan_nodes(g, h) for h in (700.0, 400.0, 120.0, 5.0)] == [60, 41, 20, 20]
+    g = scenario.guidance  # 10 s per node, within [40, 60]
+    assert [replan_nodes(g, h) for h in (700.0, 500.0, 450.0, 120.0, 5.0)] == [60, 51, 46, 40, 40]
 
 
 def test_a_plan_flight_is_ok_only_inside_every_criterion_with_every_limit_held():

@@ -1,8 +1,9 @@
 """Paper 002's terminal guidance as a GuidanceMethod.
 
-  estimate --> ReplanningGuidance (the LGL solution's sigma(t), alpha(t); re-solves on the
-      remaining horizon) --bank_command--> (shared bank actuator)
-                         --alpha_command--> (shared alpha actuator)
+  estimate, sensed lift and drag --> AccelerationRatioFilter --ratios (k_L, k_D)--+
+  estimate --> ReplanningGuidance (the LGL solution's sigma(t), alpha(t); re-solves on the   <--+
+      remaining horizon with the models scaled by k_L, k_D) --bank_command--> (shared bank actuator)
+                                                            --alpha_command--> (shared alpha actuator)
 
 The pre-flight plan (``make_planner``) is solved once per mission and verified (planner module
 docstring); each flight flies it and re-solves it from the navigation estimate every
@@ -24,9 +25,10 @@ from drake_entry.guidance.interface import (
     PlantPorts,
 )
 from drake_entry.guidance.lgl_terminal.planner import LglPlan, plan_terminal, replan
+from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 from drake_entry.systems.replanning_guidance import ReplanningGuidance
 
-GUIDANCE_SYSTEM = "lgl_terminal_guidance"
+GUIDANCE_SYSTEM, RATIO_SYSTEM = "lgl_terminal_guidance", "acceleration_ratios"
 
 
 class LglTerminalMethod(GuidanceMethod):
@@ -39,8 +41,16 @@ class LglTerminalMethod(GuidanceMethod):
         g = scenario.guidance
         guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, ReplanningGuidance(
             planner, replan=replan, period=g.period_s, replan_period=g.replan_period_s,
-            min_time_to_go=g.replan_min_time_to_go_s, lead=g.command_lead_s, first_replan=g.replan_start_s))
+            min_time_to_go=g.replan_min_time_to_go_s, lead=g.command_lead_s, first_replan=g.replan_start_s,
+            time_to_go_fraction=g.replan_time_to_go_fraction or None, model_scales=g.replan_model_scales))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
+        if g.replan_model_scales:
+            ratios = builder.AddNamedSystem(RATIO_SYSTEM, AccelerationRatioFilter(
+                scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere(), period=g.period_s))
+            builder.Connect(plant.estimated_state, ratios.GetInputPort("estimated_state"))
+            builder.Connect(plant.flight_conditions, ratios.GetInputPort("flight_conditions"))
+            builder.Connect(guidance.GetOutputPort("alpha_command"), ratios.GetInputPort("alpha_command"))
+            builder.Connect(ratios.GetOutputPort("ratios"), guidance.GetInputPort("model_scales"))
         problem = planner.result.problem
         lo, hi = problem.state_bounds["alpha"]
         _, bank, alpha = planner.control_samples()

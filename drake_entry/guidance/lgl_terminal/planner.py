@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.verdict import box_text, breaches_text, check_limits
 from drake_entry.planning.verification import Actuation, EntryControls, require_verifier
 
@@ -147,11 +148,25 @@ def replan_nodes(spec, horizon_s: float) -> int:
     return int(np.clip(math.ceil(horizon_s / spec.replan_node_spacing_s) + 1, lo, hi))
 
 
-def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float) -> LglPlan:
+def final_windows(problem, spec):
+    """``problem`` with a fixed final speed and flight-path angle opened to windows of the spec's
+    half-widths about them (a window already open stays as it is)."""
+    final = dict(problem.final)
+    for name, half in (("V", spec.replan_speed_window_m_s), ("gamma", math.radians(spec.replan_flight_path_window_deg))):
+        v = final.get(name)
+        if isinstance(v, (int, float)) and half > 0:
+            final[name] = (float(v) - half, float(v) + half)
+    return dc.replace(problem, final=final)
+
+
+def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scales=None) -> LglPlan:
     """Re-solve from the navigation state ``x`` [h, lon, lat, V, gamma, psi] reached ``elapsed`` [s]
     into ``previous``, with the bank and alpha being commanded [rad] as the initial alpha and
     sigma states (clipped into their bounds), on the horizon that remains, warm-started from
-    ``previous`` (shrinking_horizon.resolve_from); judged as the pre-flight plan is."""
+    ``previous`` (shrinking_horizon.resolve_from), aiming at the final speed and flight-path
+    angle within the spec's re-solve windows (``final_windows``), with the nominal lift and drag
+    times ``scales`` = (k_L, k_D) when given (the sensed/modelled ratios); judged, with the same
+    models, as the pre-flight plan is."""
     from drake_entry.planning.nlp.shrinking_horizon import resolve_from
 
     r, scenario = previous.result, previous.scenario
@@ -162,7 +177,11 @@ def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float) -> L
     lo, hi = r.problem.state_bounds["alpha"]
     x_now[names.index("alpha")] = float(np.clip(alpha, lo, hi))
     x_now[names.index("sigma")] = float(bank)
-    again = resolve_from(r, x_now, elapsed, nodes=replan_nodes(spec, r.final_time - elapsed), solver=spec.solver,
+    problem = final_windows(r.problem, spec)
+    if scales is not None:
+        nominal = scenario.make_vehicle()
+        problem = dc.replace(problem, vehicle=dc.replace(nominal, aero=ScaledAero(nominal.aero, *map(float, scales))))
+    again = resolve_from(r, x_now, elapsed, problem=problem, nodes=replan_nodes(spec, r.final_time - elapsed), solver=spec.solver,
                          tolerance=spec.replan_tolerance, max_iterations=spec.max_iterations,
                          verifier=previous.verifier, progress=False)
     return judged(again, scenario, previous.verifier)

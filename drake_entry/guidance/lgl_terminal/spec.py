@@ -39,10 +39,21 @@ class LglTerminal(GuidanceSpecBase):
     # [s] of the remaining horizon, within replan_nodes [min, max], to replan_tolerance
     replan_start_s: float = 200.0
     replan_period_s: float = 100.0
-    replan_min_time_to_go_s: float = 60.0
+    replan_min_time_to_go_s: float = 30.0
     replan_node_spacing_s: float = 10.0
-    replan_nodes: list[int] = dc.field(default_factory=lambda: [20, 60])
+    replan_nodes: list[int] = dc.field(default_factory=lambda: [40, 60])
     replan_tolerance: float = 1.0e-6
+    # the re-solve period shrinks to this fraction of the time to go (never below period_s; 0:
+    # every replan_period_s): re-solves come closer together as impact nears
+    replan_time_to_go_fraction: float = 0.4
+    # re-solves aim at the final speed and flight-path angle within these windows [m/s, deg]
+    # (the pre-flight plan at the values themselves): from a dispersed state the exact values
+    # may be out of reach while a point inside the acceptance box is not
+    replan_speed_window_m_s: float = 25.0
+    replan_flight_path_window_deg: float = 2.5
+    # re-solves predict with the nominal lift and drag times the low-passed ratios of the sensed
+    # to the modelled accelerations (a density, aerodynamic or mass error the flight has shown)
+    replan_model_scales: bool = True
     # commands read this far ahead on the plan [s] (the actuators' lag, as paper 001's guidance);
     # the angle-of-attack actuator's acceleration limit [deg/s^2] (its rate limit is the
     # problem's alpha-rate bound, eq. 17)
@@ -86,6 +97,9 @@ class LglTerminal(GuidanceSpecBase):
             raise ScenarioError(f"guidance.replan_nodes = {self.replan_nodes}; allowed [min, max] with "
                                 f"5 <= min <= max <= 400")
         check_range("guidance.replan_tolerance", self.replan_tolerance, 1e-12, 1e-2)
+        check_range("guidance.replan_time_to_go_fraction", self.replan_time_to_go_fraction, 0.0, 1.0)
+        check_range("guidance.replan_speed_window_m_s", self.replan_speed_window_m_s, 0.0, 1e3)
+        check_range("guidance.replan_flight_path_window_deg", self.replan_flight_path_window_deg, 0.0, 45.0)
         check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
         check_range("guidance.alpha_accel_limit_deg_s2", self.alpha_accel_limit_deg_s2, 0.1, 1e3)
         if self.final_flight_path_deg is not None:

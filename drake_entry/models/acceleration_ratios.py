@@ -1,0 +1,30 @@
+"""What the flight has shown of a density or aerodynamic error: the ratios of the sensed lift and
+drag accelerations (the accelerometer's) to the nominal models' at the estimated state, low-passed.
+
+A guidance that predicts with its nominal models scales them by these ratios (lift by k_L,
+drag by k_D: ``ScaledAero``), so a density, aerodynamic or mass error seen so far is carried
+into the prediction. Used by paper 004's on-board re-solution and paper 002's re-solves.
+"""
+from __future__ import annotations
+
+from drake_entry.models.dynamics import aero_accelerations
+
+#: time constant [s] of the low-pass, and the modelled drag [m/s^2] below which the ratios are
+#: not updated (thin air: the ratio is noise)
+RATIO_TIME_CONSTANT_S, RATIO_MIN_DRAG = 30.0, 0.5
+
+
+def filtered_ratios(ratios, x, alpha: float, lift: float, drag: float, vehicle, planet, atmosphere,
+                    step_s: float) -> tuple[float, float]:
+    """(k_L, k_D) after one step of ``step_s`` [s] of the first-order low-pass (time constant
+    RATIO_TIME_CONSTANT_S) from ``ratios`` toward sensed/modelled: ``lift``, ``drag`` [m/s^2]
+    sensed, the models' at the estimate ``x`` [h, lon, lat, V, ...] and angle of attack
+    ``alpha`` [rad]. Unchanged where the modelled drag is under RATIO_MIN_DRAG or lift is not
+    positive."""
+    k_l, k_d = float(ratios[0]), float(ratios[1])
+    rho, a = atmosphere.air_data(planet.atmospheric_altitude(float(x[0]), float(x[2])))
+    _, L, D = aero_accelerations(x, alpha, rho, a, vehicle)
+    if D < RATIO_MIN_DRAG or not L > 0:
+        return k_l, k_d
+    w = min(1.0, step_s / RATIO_TIME_CONSTANT_S)
+    return k_l + w * (lift / L - k_l), k_d + w * (drag / D - k_d)

@@ -141,9 +141,9 @@ class ReplanningGuidance(LeafSystem):
         try:
             extra = {} if self.scales_port is None else {"scales": tuple(self.scales_port.Eval(context))}
             plan = self.replan(flown.plan, x, t - flown.start, bank, alpha, **extra)
+            reason = "the re-planner returned no plan" if plan is None else plan.message
         except Exception as e:  # a failed re-plan must not stop the flight: the previous plan flies on
-            plan = None
-            new.refused.append((t, f"{type(e).__name__}: {e}"))
+            plan, reason = None, f"{type(e).__name__}: {e}"
         wall = time.perf_counter() - t_wall
         new.wall_s += wall
         accepted = plan is not None and bool(plan.success)
@@ -151,8 +151,8 @@ class ReplanningGuidance(LeafSystem):
         if accepted:
             new.flown = FlownPlan.of(plan, t)
             new.replans += 1
-        elif plan is not None:
-            new.refused.append((t, plan.message))
+        else:
+            new.refused.append((t, reason))
         if self.time_to_go_fraction is not None:
             to_go = new.flown.start + new.flown.plan.final_time - t
             new.next_replan = t + min(self.replan_period, max(self.period, self.time_to_go_fraction * to_go))

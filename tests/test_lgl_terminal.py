@@ -107,3 +107,17 @@ def test_terminal_windows_need_their_centre():
     bad = dc.replace(s, terminal=dc.replace(s.terminal, flight_path_deg=None))
     with pytest.raises(ScenarioError, match="terminal.flight_path_tolerance_deg is given without terminal.flight_path_deg"):
         bad.validate()
+
+
+def test_resolves_aim_at_windows_of_the_final_speed_and_flight_path_angle(scenario):
+    """A re-solve's problem opens the fixed final speed and flight-path angle to the spec's
+    windows (25 m/s, 2.5 deg) and keeps the final position and alpha fixed; opening twice changes
+    nothing."""
+    from drake_entry.guidance.lgl_terminal.planner import final_windows
+
+    p = scenario.guidance.problem_for(scenario)
+    w = final_windows(p, scenario.guidance)
+    assert w.final["V"] == (1194.0, 1244.0)
+    assert w.final["gamma"] == pytest.approx((math.radians(-82.5), math.radians(-77.5)))
+    assert all(w.final[k] == p.final[k] for k in ("h", "lon", "lat", "alpha"))
+    assert final_windows(w, scenario.guidance).final == w.final

@@ -163,3 +163,35 @@ def test_a_swarm_resolution_that_raises_keeps_sigma0_and_is_counted(monkeypatch)
     assert sigma0 == pytest.approx([58.0, 58.0, 58.0, 61.0], abs=1e-12)
     stats = guidance.GetOutputPort("plan_stats").Eval(context)
     assert stats[0] == 3 and stats[1] == 2
+
+
+def test_replans_come_closer_as_the_time_to_go_shrinks_and_carry_the_model_scales():
+    """With time_to_go_fraction 0.4 the next re-plan is min(replan_period, max(period, 0.4 x time
+    to go)) after the last (the plan in use ends at 2000 s): 100 s apart while more than 250 s
+    remain, then 0.4 of the time to go, none with less than min_time_to_go left; each re-plan
+    gets the "model_scales" input as ``scales``."""
+    from drake_entry.systems.replanning_guidance import ReplanningGuidance
+
+    calls = []
+
+    def scripted_replan(plan, x, elapsed, bank, alpha, scales=None):
+        calls.append((elapsed, scales))
+        return None if len(calls) == 1 else _StubPlan(2.0, success=False, message="refused")
+
+    builder = DiagramBuilder()
+    guidance = builder.AddSystem(ReplanningGuidance(
+        _StubPlan(1.0), replan=scripted_replan, period=1.0, replan_period=100.0, min_time_to_go=30.0,
+        first_replan=1600.0, time_to_go_fraction=0.4, model_scales=True))
+    estimate = builder.AddSystem(ConstantVectorSource(np.array([60e3, 0.1, 0.2, 6000.0, -0.01, 1.0])))
+    scales = builder.AddSystem(ConstantVectorSource(np.array([1.05, 0.97])))
+    builder.Connect(estimate.get_output_port(), guidance.GetInputPort("estimated_state"))
+    builder.Connect(scales.get_output_port(), guidance.GetInputPort("model_scales"))
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(2000.0)
+    times = [t for t, _ in calls]
+    # 1600 (400 to go) -> 1700 (300) -> 1800 (200: 80 s) -> 1880 (120: 48 s) -> 1928 (72: 28.8 s)
+    # -> 1957 (43: 17.2 s) -> 1975 (25 to go: under min_time_to_go, no re-plan)
+    assert times == [1600.0, 1700.0, 1800.0, 1880.0, 1928.0, 1957.0]
+    assert all(s == (1.05, 0.97) for _, s in calls)
+    memory = guidance.memory(guidance.GetMyContextFromRoot(simulator.get_context()))
+    assert memory.refused[0] == (1600.0, "the re-planner returned no plan") and len(memory.refused) == 6

@@ -246,3 +246,41 @@ def test_population_actuator_takes_per_member_limits():
     for i, lim in enumerate(per):
         s, _ = integrate_actuator(x[i], rate[i], cmd[i], 0.02, 50, **lim)
         assert positions[:, i] == pytest.approx(s, abs=1e-14)
+
+
+def test_acceleration_ratio_filter_low_passes_sensed_over_modelled_lift_and_drag():
+    """Sensed lift 5 % over and drag 3 % under the nominal models at the estimate: after 30 updates
+    of 1 s (time constant 30 s) the ratios have closed 1 - (29/30)^30 = 63.8 % of the gap, and
+    they converge to 1.05 and 0.97; in thin air (modelled drag under 0.5 m/s^2) they hold."""
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    from drake_entry.models.acceleration_ratios import filtered_ratios
+    from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations, air_data
+    from drake_entry.scenario import load_scenario
+    from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
+
+    s = load_scenario("marv_guidance")
+    vehicle, planet, atmosphere = s.make_vehicle(), s.make_planet(), s.make_atmosphere()
+    x, alpha = np.array([30e3, 0.1, 0.0, 5000.0, -0.05, 1.5]), np.radians(10.0)
+    _, L, D = aero_accelerations(x, alpha, *air_data(x, planet, atmosphere), vehicle)
+    fc = np.zeros(len(FLIGHT_CONDITION_NAMES))
+    fc[FLIGHT_CONDITION_NAMES.index("lift")], fc[FLIGHT_CONDITION_NAMES.index("drag")] = 1.05 * L, 0.97 * D
+
+    builder = DiagramBuilder()
+    f = builder.AddSystem(AccelerationRatioFilter(vehicle, planet, atmosphere, period=1.0))
+    for port, value in (("estimated_state", x), ("flight_conditions", fc), ("alpha_command", [alpha])):
+        builder.Connect(builder.AddSystem(ConstantVectorSource(np.asarray(value, float))).get_output_port(),
+                        f.GetInputPort(port))
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(29.5)  # updates at t = 0, 1, ..., 29
+    k = f.GetOutputPort("ratios").Eval(f.GetMyContextFromRoot(simulator.get_context()))
+    closed = 1.0 - (29.0 / 30.0) ** 30
+    assert k == pytest.approx([1.0 + 0.05 * closed, 1.0 - 0.03 * closed], rel=1e-12)
+    far = (1.0, 1.0)
+    for _ in range(1000):
+        far = filtered_ratios(far, x, alpha, 1.05 * L, 0.97 * D, vehicle, planet, atmosphere, 1.0)
+    assert far == pytest.approx((1.05, 0.97), rel=1e-12)
+    thin = np.array([90e3, 0.1, 0.0, 7000.0, 0.0, 1.5])
+    assert filtered_ratios((1.2, 0.8), thin, alpha, 1.0, 1.0, vehicle, planet, atmosphere, 1.0) == (1.2, 0.8)

@@ -4,6 +4,8 @@ boxes and limits (not against the planner's own verdict)."""
 import dataclasses as dc
 import json
 
+import pytest
+
 from pydrake.common.yaml import yaml_dump_typed
 
 from drake_entry.cli import main
@@ -51,3 +53,23 @@ def test_ampi_plan_report_flies_the_reference_inside_paper003_limits(tmp_path, c
     assert "the reference is not verified" in capsys.readouterr().err
     assert json.loads((tmp_path / "tight" / "plan.json").read_text())["inside_box"] is False
 
+
+
+@pytest.mark.slow
+def test_lgl_terminal_plan_report_refuses_an_under_resolved_plan_with_its_figures(tmp_path, capsys):
+    """paper 002's pre-flight plan on 40 LGL nodes (marv_guidance has 80): SNOPT converges but the
+    dynamics between the nodes miss by more than the 1e-3 tolerance, so the plan is not a success,
+    is not flown through the actuators, and the report says so by its exit code, its words and
+    plan.json (the figures still show the solution against its Drake propagation)."""
+    s = load_scenario("marv_guidance")
+    path = tmp_path / "marv40.yaml"
+    path.write_text(yaml_dump_typed(dc.replace(s, guidance=dc.replace(s.guidance, nodes=40)), schema=Scenario))
+    out = tmp_path / "plan"
+    code = main(["plan", str(path), "--out", str(out)])
+    summary = json.loads((out / "plan.json").read_text())
+    err = capsys.readouterr().err
+    assert code == 1 and not summary["success"] and "converged but inaccurate" in err
+    v = summary["verification"]
+    assert not v["verified"] and v["dynamics_error"] > v["dynamics_tolerance"] == 1e-3
+    assert "actuator_flight" not in summary and summary["nodes"] == 40
+    assert (out / "fig01_altitude.png").exists()

@@ -6,7 +6,7 @@
                                                            scenario, campaign outputs
   systems   systems/                                       Drake LeafSystems
   methods   drake_entry/guidance/<method>/method.py,       a method's wiring
-            drake_entry/guidance/reversal_wiring.py
+            drake_entry/guidance/reversal_wiring.py, replanning_wiring.py
   diagrams  diagrams/                                      builders, campaign runner
   cli       drake_entry/cli.py, */commands.py              commands
 
@@ -60,8 +60,8 @@ def layer(module: str) -> str:
         return "diagrams"
     if module == "drake_entry.cli" or parts[-1] == "commands":
         return "cli"
-    if module == "drake_entry.guidance.reversal_wiring" or (parts[:2] == ["drake_entry", "guidance"]
-                                                             and parts[-1] == "method"):
+    if module in ("drake_entry.guidance.reversal_wiring", "drake_entry.guidance.replanning_wiring") or (
+            parts[:2] == ["drake_entry", "guidance"] and parts[-1] == "method"):
         return "methods"
     return "planning"
 

@@ -5,7 +5,6 @@ import dataclasses as dc
 import json
 
 import pytest
-
 from pydrake.common.yaml import yaml_dump_typed
 
 from drake_entry.cli import main

@@ -59,3 +59,27 @@ class ReversingBankSpec(GuidanceSpecBase):
             raise ScenarioError(f"guidance.reversal_velocity_m_s = {self.reversal_velocity_m_s} must be increasing")
         for v in self.reversal_heading_deg:
             check_range("guidance.reversal_heading_deg", v, 1e-3, 180.0)
+
+
+@dc.dataclass
+class ReplanningSpec(GuidanceSpecBase):
+    """A method whose plans are flown in time through the shared actuators and re-planned on
+    board from the navigation estimate (systems/replanning_guidance.py: paper 001's SCvx, paper
+    002's LGL)."""
+
+    # each command is read this far ahead on the plan [s]: the actuators' lag (half the guidance
+    # period for the hold, 1/bandwidth for the loop: 1.0 s at 1 s; drake_entry.models.actuator.command_lag)
+    command_lead_s: float = 1.0
+    # on-board re-planning from the navigation estimate every replan_period_s [s] (0 = fly the
+    # pre-flight plan), while the plan in use has more than replan_min_time_to_go_s [s] to go
+    replan_period_s: float = 0.0
+    replan_min_time_to_go_s: float = 300.0
+
+    def validate(self, scenario) -> None:
+        super().validate(scenario)
+        check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
+        check_range("guidance.replan_period_s", self.replan_period_s, 0.0, 1e4)
+        if self.replan_period_s and self.replan_period_s < self.period_s:
+            raise ScenarioError(f"guidance.replan_period_s = {self.replan_period_s} must be 0 or >= guidance.period_s "
+                                f"= {self.period_s}")
+        check_range("guidance.replan_min_time_to_go_s", self.replan_min_time_to_go_s, 0.0, 1e4)

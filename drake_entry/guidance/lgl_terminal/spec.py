@@ -4,13 +4,13 @@ import dataclasses as dc
 from typing import Optional
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance.spec import GuidanceSpecBase
+from drake_entry.guidance.spec import ReplanningSpec
 
 SOLVERS = ("snopt", "ipopt")
 
 
 @dc.dataclass
-class LglTerminal(GuidanceSpecBase):
+class LglTerminal(ReplanningSpec):
     """Paper 002's optimal-control problem (a packaged problem or a problem YAML path: final
     conditions, bounds, path constraints, objective; eqs. 11, 16-19) solved before flight by the
     Legendre pseudospectral method from the scenario's entry state to its target with the
@@ -37,9 +37,9 @@ class LglTerminal(GuidanceSpecBase):
     # re-solves from replan_start_s [s] every replan_period_s [s] (0: fly the pre-flight solution)
     # while more than replan_min_time_to_go_s [s] remain, on one node per replan_node_spacing_s
     # [s] of the remaining horizon, within replan_nodes [min, max], to replan_tolerance
-    replan_start_s: float = 200.0
     replan_period_s: float = 100.0
     replan_min_time_to_go_s: float = 30.0
+    replan_start_s: float = 200.0
     replan_node_spacing_s: float = 10.0
     replan_nodes: list[int] = dc.field(default_factory=lambda: [40, 60])
     replan_tolerance: float = 1.0e-6
@@ -54,10 +54,8 @@ class LglTerminal(GuidanceSpecBase):
     # re-solves predict with the nominal lift and drag times the low-passed ratios of the sensed
     # to the modelled accelerations (a density, aerodynamic or mass error the flight has shown)
     replan_model_scales: bool = True
-    # commands read this far ahead on the plan [s] (the actuators' lag, as paper 001's guidance);
     # the angle-of-attack actuator's acceleration limit [deg/s^2] (its rate limit is the
     # problem's alpha-rate bound, eq. 17)
-    command_lead_s: float = 1.0
     alpha_accel_limit_deg_s2: float = 40.0
 
     def terminal_speed(self, speed_of_sound: float) -> float:
@@ -86,12 +84,7 @@ class LglTerminal(GuidanceSpecBase):
         check_range("guidance.path_margin", self.path_margin, 0.0, 0.5)
         check_range("guidance.tolerance", self.tolerance, 1e-12, 1e-2)
         check_range("guidance.max_iterations", self.max_iterations, 1, 100000)
-        check_range("guidance.replan_period_s", self.replan_period_s, 0.0, 1e4)
-        if self.replan_period_s and self.replan_period_s < self.period_s:
-            raise ScenarioError(f"guidance.replan_period_s = {self.replan_period_s} must be 0 or >= guidance.period_s "
-                                f"= {self.period_s}")
         check_range("guidance.replan_start_s", self.replan_start_s, 0.0, 1e4)
-        check_range("guidance.replan_min_time_to_go_s", self.replan_min_time_to_go_s, 0.0, 1e4)
         check_range("guidance.replan_node_spacing_s", self.replan_node_spacing_s, 0.1, 1e3)
         if len(self.replan_nodes) != 2 or not 5 <= self.replan_nodes[0] <= self.replan_nodes[1] <= 400:
             raise ScenarioError(f"guidance.replan_nodes = {self.replan_nodes}; allowed [min, max] with "
@@ -100,7 +93,6 @@ class LglTerminal(GuidanceSpecBase):
         check_range("guidance.replan_time_to_go_fraction", self.replan_time_to_go_fraction, 0.0, 1.0)
         check_range("guidance.replan_speed_window_m_s", self.replan_speed_window_m_s, 0.0, 1e3)
         check_range("guidance.replan_flight_path_window_deg", self.replan_flight_path_window_deg, 0.0, 45.0)
-        check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
         check_range("guidance.alpha_accel_limit_deg_s2", self.alpha_accel_limit_deg_s2, 0.1, 1e3)
         if self.final_flight_path_deg is not None:
             check_range("guidance.final_flight_path_deg", self.final_flight_path_deg, -89.9, 0.0)

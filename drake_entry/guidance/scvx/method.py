@@ -15,16 +15,9 @@ import math
 
 import numpy as np
 
-from drake_entry.guidance.interface import (
-    ActuatorLimits,
-    GuidanceCommands,
-    GuidanceMethod,
-    GuidanceSummary,
-    LoggedSignal,
-    PlantPorts,
-)
+from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, PlantPorts
+from drake_entry.guidance.replanning_wiring import add_replanning_guidance, replanning_commands, replanning_record
 from drake_entry.guidance.scvx.planner import ScvxPlan, plan_entry, replan_from
-from drake_entry.systems.replanning_guidance import ReplanningGuidance
 
 GUIDANCE_SYSTEM = "scvx_guidance"
 
@@ -40,33 +33,21 @@ class ScvxMethod(GuidanceMethod):
 
     def add_systems(self, builder, scenario, planner: ScvxPlan, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance
-        settings = g.planner_settings()[1]
-        guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, ReplanningGuidance(
-            planner, replan=functools.partial(replan_from, settings=settings),
-            period=g.period_s, replan_period=g.replan_period_s, min_time_to_go=g.replan_min_time_to_go_s,
-            lead=g.command_lead_s))
-        builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
+        guidance = add_replanning_guidance(builder, GUIDANCE_SYSTEM, planner,
+                                           functools.partial(replan_from, settings=g.planner_settings()[1]), g, plant)
         lo, hi = np.radians(g.alpha_bounds_deg)
-        return GuidanceCommands(
-            bank=guidance.GetOutputPort("bank_command"), alpha=guidance.GetOutputPort("alpha_command"),
-            alpha_limits=ActuatorLimits(float(lo), float(hi), math.radians(g.alpha_rate_limit_deg_s),
-                                        math.radians(planner.flight.alpha_acceleration_deg_s2)),
-            initial_bank=float(planner.bank[0]), initial_alpha=float(planner.alpha[0]),
-            logged={"alpha_command": LoggedSignal(guidance.GetOutputPort("alpha_command"), ("alpha_command_rad",)),
-                    "plan_stats": LoggedSignal(guidance.GetOutputPort("plan_stats"),
-                                               ("replans", "replans_refused", "replan_wall_s"))})
+        return replanning_commands(guidance, ActuatorLimits(float(lo), float(hi), math.radians(g.alpha_rate_limit_deg_s),
+                                                            math.radians(planner.flight.alpha_acceleration_deg_s2)),
+                                   planner.bank[0], planner.alpha[0])
 
     def summarise(self, diagram, context, planner: ScvxPlan) -> GuidanceSummary:
-        system = diagram.GetSubsystemByName(GUIDANCE_SYSTEM)
-        mem = system.memory(system.GetMyContextFromRoot(context))
-        flown = mem.flown.plan
+        mem, fields = replanning_record(diagram, context, GUIDANCE_SYSTEM)
         return GuidanceSummary(
             planner.success, "" if planner.success else f"the pre-flight plan is not verified: {planner.message}",
             plans=mem.replans, planning_wall_s=mem.wall_s,
-            fields={"replans_refused": len(mem.refused), "plan_heat_load_MJ_m2": planner.metrics["heat_load_MJ_m2"],
-                    "plan_final_time_s": planner.final_time, "plan_iterations": planner.iterations,
-                    "last_plan_start_s": mem.flown.start, "last_plan_final_time_s": mem.flown.start + flown.final_time},
-            details={"plan": planner, "last_plan": flown, "refused": mem.refused})
+            fields={**fields, "plan_heat_load_MJ_m2": planner.metrics["heat_load_MJ_m2"],
+                    "plan_final_time_s": planner.final_time, "plan_iterations": planner.iterations},
+            details={"plan": planner, "last_plan": mem.flown.plan, "refused": mem.refused, "replans": mem.log})
 
 
 METHOD = ScvxMethod()

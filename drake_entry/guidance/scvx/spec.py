@@ -4,14 +4,14 @@ import dataclasses as dc
 import math
 from typing import Optional
 
-from drake_entry.errors import FieldError, ScenarioError, check_range
+from drake_entry.errors import FieldError, ScenarioError
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
-from drake_entry.guidance.spec import GuidanceSpecBase
+from drake_entry.guidance.spec import ReplanningSpec
 
 
 @dc.dataclass
-class Scvx(GuidanceSpecBase):
+class Scvx(ReplanningSpec):
     """An SCvx plan (paper 001) from the entry state to the target's DRS box (eqs. 64-70),
     its bank and angle of attack flown in time through the shared actuators, re-planned from
     the navigation estimate every ``replan_period_s`` (0: the pre-flight plan is flown). The
@@ -59,15 +59,8 @@ class Scvx(GuidanceSpecBase):
     path_margin: Optional[float] = None
     flight_path_margins_deg: Optional[list[float]] = None
     bank_margin_deg: Optional[float] = None
-    # each command is read this far ahead on the plan [s]: the actuators' lag (half the guidance
-    # period for the hold, 1/bandwidth for the loop: 1.0 s at 1 s; drake_entry.models.actuator.command_lag)
-    command_lead_s: float = 1.0
     max_iterations: int = 100
     solver: str = "clarabel"
-    # on-board re-planning from the navigation estimate every replan_period_s [s] (0 = fly the
-    # pre-flight plan), while the plan in use has more than replan_min_time_to_go_s to go
-    replan_period_s: float = 0.0
-    replan_min_time_to_go_s: float = 300.0
 
     def mission(self, scenario) -> ScvxMission:
         """The ScvxMission: entry state and target from the scenario (geocentric, converted to
@@ -97,12 +90,6 @@ class Scvx(GuidanceSpecBase):
         super().validate(scenario)
         self.mission(scenario)
         self.planner_settings()
-        check_range("guidance.replan_period_s", self.replan_period_s, 0.0, 1e4)
-        if self.replan_period_s and self.replan_period_s < self.period_s:
-            raise ScenarioError(f"guidance.replan_period_s = {self.replan_period_s} must be 0 or >= guidance.period_s "
-                                f"= {self.period_s}")
-        check_range("guidance.replan_min_time_to_go_s", self.replan_min_time_to_go_s, 0.0, 1e4)
-        check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
         if self.terminal_mach > self.final_mach_max:
             raise ScenarioError(f"guidance.terminal_mach = {self.terminal_mach} exceeds guidance.final_mach_max = "
                                 f"{self.final_mach_max}")

@@ -1,0 +1,47 @@
+"""The shared re-planning guidance (systems/replanning_guidance.py) wired and read the same way
+for every method whose plans are flown in time and re-planned on board (``ReplanningSpec``:
+paper 001's SCvx, paper 002's LGL)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, LoggedSignal, PlantPorts
+from drake_entry.systems.replanning_guidance import ReplanMemory, ReplanningGuidance
+
+
+def add_replanning_guidance(builder, name: str, plan, replan, spec, plant: PlantPorts, **options):
+    """Add ReplanningGuidance (named ``name``) flying ``plan`` with the method's ``replan``, the
+    spec's period, re-plan period, time to go and command lead (``options``: the system's other
+    arguments), connected to the navigation estimate; return it."""
+    system = builder.AddNamedSystem(name, ReplanningGuidance(
+        plan, replan=replan, period=spec.period_s, replan_period=spec.replan_period_s,
+        min_time_to_go=spec.replan_min_time_to_go_s, lead=spec.command_lead_s, **options))
+    builder.Connect(plant.estimated_state, system.GetInputPort("estimated_state"))
+    return system
+
+
+def replanning_commands(system, alpha_limits: ActuatorLimits, initial_bank: float,
+                        initial_alpha: float) -> GuidanceCommands:
+    """The commands of a ReplanningGuidance: its signed bank and its alpha through the shared
+    actuators, its alpha command and re-plan statistics logged."""
+    return GuidanceCommands(
+        bank=system.GetOutputPort("bank_command"), alpha=system.GetOutputPort("alpha_command"),
+        alpha_limits=alpha_limits, initial_bank=float(initial_bank), initial_alpha=float(initial_alpha),
+        logged={"alpha_command": LoggedSignal(system.GetOutputPort("alpha_command"), ("alpha_command_rad",)),
+                "plan_stats": LoggedSignal(system.GetOutputPort("plan_stats"),
+                                           ("replans", "replans_refused", "replan_wall_s"))})
+
+
+def replanning_record(diagram, context, name: str) -> tuple[ReplanMemory, dict]:
+    """(memory, row fields) of the ReplanningGuidance ``name`` after a flight: re-plans tried and
+    refused, the median and largest wall time of one [s] (nan without any), and when the last
+    plan flown began and ends [s of the flight]."""
+    system = diagram.GetSubsystemByName(name)
+    mem = system.memory(system.GetMyContextFromRoot(context))
+    walls = np.array([w for _, w, _ in mem.log]) if mem.log else np.array([math.nan])
+    return mem, {"replans_tried": len(mem.log), "replans_refused": len(mem.refused),
+                 "replan_wall_median_s": float(np.median(walls)), "replan_wall_max_s": float(np.max(walls)),
+                 "last_plan_start_s": mem.flown.start,
+                 "last_plan_final_time_s": mem.flown.start + mem.flown.plan.final_time}

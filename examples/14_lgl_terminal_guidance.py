@@ -7,8 +7,8 @@ warm-started from the solution in use).
 1. The pre-flight plan: 80 LGL nodes, verified between the nodes, its controls propagated, and
    flown through the actuators into the acceptance box (impact within 1 km, 1219 +- 50 m/s,
    -80 +- 5 deg, alpha within 2 deg of 0) with q >= 12 kPa and a <= 45 g held.
-2. The nominal closed loop re-solving from 200 s (500 s with --quick) every 100 s, then every
-   0.4 x the time to go, and the plan alone.
+2. The nominal closed loop re-solving from 200 s every 100 s, then every 0.4 x the time to go
+   (full run only), and the plan alone.
 3. One dispersed flight (a campaign draw: density, aerodynamics, mass, entry state, navigation)
    with and without the re-solves: what the re-solves buy.
 
@@ -40,14 +40,13 @@ def _with_replan_period(setup: cl.ClosedLoopSetup, period_s: float) -> cl.Closed
 def main(quick: bool = False, out_dir: str = "out/examples/14") -> dict:
     os.makedirs(out_dir, exist_ok=True)
     scenario = load_scenario("marv_guidance")
-    if quick:
-        scenario = dc.replace(scenario, guidance=dc.replace(scenario.guidance, replan_start_s=500.0))
     setup = cl.ClosedLoopSetup.from_scenario(scenario)
     plan = setup.planner
     r = plan.result
     print(f"pre-flight plan ({r.nodes} nodes, {r.total_time:.1f} s): {plan.message}")
     start = scenario.guidance.replan_start_s
-    flights = {f"re-solved from {start:g} s": cl.fly(setup), "plan alone": cl.fly(_with_replan_period(setup, 0.0))}
+    flights = {} if quick else {f"re-solved from {start:g} s": cl.fly(setup)}
+    flights["plan alone"] = cl.fly(_with_replan_period(setup, 0.0))
     draw = dispersions.draw(scenario.dispersions, RandomGenerator(DRAW_SEED))
     flights["dispersed, re-solved"] = cl.fly(setup, draw=draw)
     flights["dispersed, plan alone"] = cl.fly(_with_replan_period(setup, 0.0), draw=draw)
@@ -57,8 +56,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/14") -> dict:
               f"target, V {f.trajectory.state[-1][3]:.1f} m/s, gamma {math.degrees(f.trajectory.state[-1][4]):.2f} deg, "
               f"alpha {math.degrees(b['alpha']['error']):.2f} deg; {f.guidance.plans} re-solves accepted of "
               f"{f.guidance.fields['replans_tried']}, {f.guidance.planning_wall_s:.1f} s")
-    nominal = flights[f"re-solved from {start:g} s"]
-    for t, wall, ok in nominal.guidance.details["replans"]:
+    for t, wall, ok in flights["dispersed, re-solved"].guidance.details["replans"]:
         print(f"  re-solve at t = {t:5.0f} s: {wall:5.1f} s wall, {'accepted' if ok else 'refused'}")
     figure = _figure(plan, flights, os.path.join(out_dir, "lgl_terminal_guidance.png"))
     print(f"figure: {figure}")
@@ -118,7 +116,7 @@ def check(r: dict, quick: bool = False) -> Claims:
     c.check("the pre-flight plan is verified and flies into the acceptance box through the actuators",
             r["plan"].success, r["plan"].message[-120:])
     f = r["flights"]
-    for name in (f"re-solved from {r['start']:g} s", "plan alone", "dispersed, re-solved"):
+    for name in [n for n in (f"re-solved from {r['start']:g} s", "plan alone", "dispersed, re-solved") if n in f]:
         c.check(f"{name}: impact inside the acceptance box, every path limit held", f[name].success, f[name].message)
     resolved = f["dispersed, re-solved"]
     c.check("the dispersed flight re-solved at least twice", resolved.guidance.plans >= 2,
@@ -131,7 +129,7 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="the first re-solve at 500 s instead of 200 s")
+    parser.add_argument("--quick", action="store_true", help="without the nominal re-solved flight")
     parser.add_argument("--out", default="out/examples/14")
     args = parser.parse_args()
     raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())

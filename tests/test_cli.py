@@ -76,14 +76,15 @@ def test_results_runs_the_chosen_scenarios_into_one_index(tmp_path, capsys):
 @pytest.mark.slow
 def test_results_of_every_closed_loop_scenario_in_reduced_size(tmp_path):
     """CI's reduced run of the command that makes docs/results/campaigns: every packaged
-    closed-loop scenario, 2 samples each, a report each; the packaged paper 004 scenario flies
-    its pre-flight sigma_0 without on-board re-solution and misses the 50-km box under
-    dispersions, so the command exits 1 and says so."""
+    closed-loop scenario but marv_guidance, 2 samples each, a report each; the packaged paper 004
+    scenario flies its pre-flight sigma_0 without on-board re-solution and misses the 50-km box
+    under dispersions, so the command exits 1 and says so. (marv_guidance's 2-run campaign would
+    add 6 minutes of its 80-node plan, solved in each process; example 14 flies it closed loop.)"""
     from drake_entry.cli import closed_loop_scenarios
 
     out = tmp_path / "results"
-    code = main(["results", "--runs", "2", "--out", str(out)])
-    names = closed_loop_scenarios()
+    names = [n for n in closed_loop_scenarios() if n != "marv_guidance"]
+    code = main(["results", "--runs", "2", "--out", str(out), "--only", *names])
     assert set(names) >= {"horus2b", "sphynx_paper001", "shefex3_ampi", "cav_h_paper004"}
     for name in names:
         assert (out / name / "report.md").exists() and (out / name / "report.html").exists(), name

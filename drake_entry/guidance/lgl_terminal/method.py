@@ -12,10 +12,8 @@ use flies on. The closed loop stops at impact (``stops_at_altitude``).
 """
 from __future__ import annotations
 
-import math
-
 from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, PlantPorts
-from drake_entry.guidance.lgl_terminal.planner import LglPlan, plan_terminal, replan
+from drake_entry.guidance.lgl_terminal.planner import LglPlan, actuation, plan_terminal, replan
 from drake_entry.guidance.replanning_wiring import add_replanning_guidance, replanning_commands, replanning_record
 from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 
@@ -41,12 +39,10 @@ class LglTerminalMethod(GuidanceMethod):
             builder.Connect(plant.flight_conditions, ratios.GetInputPort("flight_conditions"))
             builder.Connect(guidance.GetOutputPort("alpha_command"), ratios.GetInputPort("alpha_command"))
             builder.Connect(ratios.GetOutputPort("ratios"), guidance.GetInputPort("model_scales"))
-        problem = planner.result.problem
-        lo, hi = problem.state_bounds["alpha"]
-        rate = max(abs(r) for r in problem.control_bounds["u_alpha"])
         _, bank, alpha = planner.control_samples()
-        return replanning_commands(guidance, ActuatorLimits(float(lo), float(hi), float(rate),
-                                                            math.radians(g.alpha_accel_limit_deg_s2)), bank[0], alpha[0])
+        act = actuation(planner.result.problem, g, bank[0], alpha[0])  # the actuators the plans are verified with
+        return replanning_commands(guidance, ActuatorLimits(*act.alpha_bounds, act.alpha_rate_limit, act.alpha_accel_limit),
+                                   act.initial_bank, act.initial_alpha)
 
     def summarise(self, diagram, context, planner: LglPlan) -> GuidanceSummary:
         mem, fields = replanning_record(diagram, context, GUIDANCE_SYSTEM)

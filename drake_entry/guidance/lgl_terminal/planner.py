@@ -14,6 +14,7 @@ limit of the closed loop's verdict (``PlanFlight``).
 from __future__ import annotations
 
 import dataclasses as dc
+import functools
 import math
 
 import numpy as np
@@ -61,7 +62,7 @@ class LglPlan:
     Attributes:
       result: the NlpResult (its clock: t = 0 where this plan begins).
       flight: the PlanFlight; success: result.success and flight.ok; message: both in words.
-      scenario, spec, verifier: what re-plans need.
+      scenario, verifier: what re-plans need.
     """
 
     result: object
@@ -76,7 +77,12 @@ class LglPlan:
         return self.result.final_time
 
     def control_samples(self):
-        """(t [s], bank [rad], alpha [rad]) sampled at SAMPLES_PER_S from the solution's states."""
+        """(t [s], bank [rad], alpha [rad]) sampled at SAMPLES_PER_S from the solution's states
+        (computed once: the actuator flight, the closed loop's wiring and the guidance read them)."""
+        return self._samples
+
+    @functools.cached_property
+    def _samples(self):
         tf = self.final_time
         t = np.linspace(0.0, tf, max(int(tf * SAMPLES_PER_S) + 1, 3))
         X = self.result.state_function()(t)

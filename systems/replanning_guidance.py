@@ -15,6 +15,13 @@ fraction of the time to go, never below the guidance period) a new plan is made 
 a re-plan that raises or is not a verified success is recorded with its time and reason, and
 the previous plan flies on.
 
+With ``feedback``, the commands are the plan's plus offsets that a tracking law of the plan in
+use builds up between re-plans: ``feedback(plan)`` gives an object whose ``rates(s, x, offsets)``
+is d(offsets)/dt [rad/s] at s seconds into the plan (planning.tracking.CommandFeedback); every
+period the offsets (bank, alpha) [rad] advance by the rates times the period, clipped to
+``offset_limits``, and an accepted re-plan (which starts from the commands flown) sets them
+back to zero.
+
 With ``model_scales``, the re-planner is also given ``scales=(k_L, k_D)``, the lift and drag
 ratios the flight has shown (systems/acceleration_ratios.py), read from the "model_scales" input.
 
@@ -24,6 +31,7 @@ Ports:
   - output "bank_command"     [1]  sigma [rad] (signed: the plan chooses its reversals)
   - output "alpha_command"    [1]  alpha [rad]
   - output "plan_stats"       [3]  re-plans made, re-plans refused, wall time of re-planning [s]
+  - output "command_offsets"  [2]  the feedback's bank and alpha offsets [rad] (zero without feedback)
 """
 from __future__ import annotations
 
@@ -46,11 +54,13 @@ class FlownPlan:
     time: np.ndarray
     bank: np.ndarray
     alpha: np.ndarray | None
+    feedback: object = None
 
     @staticmethod
-    def of(plan, start: float) -> "FlownPlan":
+    def of(plan, start: float, feedback=None) -> "FlownPlan":
+        """The plan flown from ``start`` [s]; ``feedback``: the plan's tracking law maker (or None)."""
         t, bank, alpha = plan.control_samples()
-        return FlownPlan(plan, start, t, bank, alpha)
+        return FlownPlan(plan, start, t, bank, alpha, None if feedback is None else feedback(plan))
 
     def commands(self, t: float, speed: float, lead: float = 0.0) -> tuple[float, float]:
         """(bank, alpha) [rad] at flight time t [s] and speed [m/s] (held after the plan's end),
@@ -87,7 +97,8 @@ Replan = Callable[[object, np.ndarray, float, float, float], object]
 class ReplanningGuidance(LeafSystem):
     def __init__(self, plan, *, replan: Replan | None = None, period: float = 1.0, replan_period: float = 0.0,
                  min_time_to_go: float = 300.0, lead: float = 0.0, first_replan: float | None = None,
-                 time_to_go_fraction: float | None = None, model_scales: bool = False):
+                 time_to_go_fraction: float | None = None, model_scales: bool = False,
+                 feedback: Callable[[object], object] | None = None, offset_limits=(0.0, 0.0)):
         """Args: plan (the pre-flight plan, flown from t = 0); replan: the method's re-planner
         (needed when replan_period > 0); period [s] of the re-plan check; replan_period [s] (0: no
         re-planning); min_time_to_go [s]: no re-plan with less left; lead [s]: the commands are
@@ -96,18 +107,22 @@ class ReplanningGuidance(LeafSystem):
         replan_period), the next ones every replan_period after it, or, with
         time_to_go_fraction, after min(replan_period, max(period, fraction x time to go)) [s]
         (the time to go of the plan in use after the re-plan); model_scales: declare the
-        "model_scales" input and pass its value to ``replan`` as ``scales``."""
+        "model_scales" input and pass its value to ``replan`` as ``scales``; feedback: the
+        tracking law maker of a plan and offset_limits (bank, alpha) [rad] its offsets' bounds
+        (module docstring)."""
         super().__init__()
         if replan_period > 0 and replan is None:
             raise ValueError("ReplanningGuidance: replan_period > 0 needs a replan callable")
         self.lead, self.replan, self.period, self.time_to_go_fraction = lead, replan, period, time_to_go_fraction
         self.replan_period, self.min_time_to_go = replan_period, min_time_to_go
+        self.feedback, self.offset_limits = feedback, np.asarray(offset_limits, float)
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.scales_port = self.DeclareVectorInputPort("model_scales", 2) if model_scales else None
         first_at = (replan_period if first_replan is None else first_replan) if replan_period > 0 else np.inf
-        first = ReplanMemory(FlownPlan.of(plan, 0.0), first_at)
+        first = ReplanMemory(FlownPlan.of(plan, 0.0, feedback), first_at)
         self._memory = self.DeclareAbstractState(AbstractValue.Make(first))
-        if replan_period > 0:
+        self._offsets = self.DeclareDiscreteState(2)
+        if replan_period > 0 or feedback is not None:
             self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._update)
         deps = {self.est_port.ticket(), self.all_state_ticket(), self.time_ticket()}
         self.DeclareVectorOutputPort("bank_command", 1, lambda c, o: o.SetAtIndex(0, self._commands(c)[0]),
@@ -115,13 +130,16 @@ class ReplanningGuidance(LeafSystem):
         self.DeclareVectorOutputPort("alpha_command", 1, lambda c, o: o.SetAtIndex(0, self._commands(c)[1]),
                                      prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("plan_stats", 3, self._stats, prerequisites_of_calc={self.all_state_ticket()})
+        self.DeclareStateOutputPort("command_offsets", self._offsets)
 
     def memory(self, context) -> ReplanMemory:
         return context.get_abstract_state(int(self._memory)).get_value()
 
-    def _commands(self, context):
+    def _commands(self, context, offsets=None):
         x = self.est_port.Eval(context)
-        return self.memory(context).flown.commands(context.get_time(), float(x[3]), self.lead)
+        bank, alpha = self.memory(context).flown.commands(context.get_time(), float(x[3]), self.lead)
+        d = context.get_discrete_state(self._offsets).value() if offsets is None else offsets
+        return bank + float(d[0]), alpha + float(d[1])
 
     def _stats(self, context, output):
         mem = self.memory(context)
@@ -131,26 +149,34 @@ class ReplanningGuidance(LeafSystem):
         mem = self.memory(context)
         t = context.get_time()
         flown = mem.flown
+        x = np.asarray(self.est_port.Eval(context), float)
+        offsets = context.get_discrete_state(self._offsets).value().copy()
+        if flown.feedback is not None and t - flown.start < flown.plan.final_time:
+            offsets = np.clip(offsets + self.period * flown.feedback.rates(t - flown.start, x, offsets),
+                              -self.offset_limits, self.offset_limits)
+            state.get_mutable_discrete_state(self._offsets).SetFromVector(offsets)
         if t < mem.next_replan - 1e-9 or flown.start + flown.plan.final_time - t < self.min_time_to_go:
             return
         new = ReplanMemory(flown, mem.next_replan + self.replan_period, mem.replans, list(mem.refused),
                            list(mem.log), mem.wall_s)
-        x = np.asarray(self.est_port.Eval(context), float)
-        bank, alpha = flown.commands(t, float(x[3]))
+        bank, alpha = flown.commands(t, float(x[3]))  # the commands flown now (not read ahead)
+        bank, alpha = bank + float(offsets[0]), alpha + float(offsets[1])
         t_wall = time.perf_counter()
         try:
             extra = {} if self.scales_port is None else {"scales": tuple(self.scales_port.Eval(context))}
             plan = self.replan(flown.plan, x, t - flown.start, bank, alpha, **extra)
             reason = "the re-planner returned no plan" if plan is None else plan.message
+            accepted = plan is not None and bool(plan.success)
+            flown_next = FlownPlan.of(plan, t, self.feedback) if accepted else None
         except Exception as e:  # a failed re-plan must not stop the flight: the previous plan flies on
-            plan, reason = None, f"{type(e).__name__}: {e}"
+            plan, reason, accepted = None, f"{type(e).__name__}: {e}", False
         wall = time.perf_counter() - t_wall
         new.wall_s += wall
-        accepted = plan is not None and bool(plan.success)
         new.log.append((t, wall, accepted))
         if accepted:
-            new.flown = FlownPlan.of(plan, t)
+            new.flown = flown_next
             new.replans += 1
+            state.get_mutable_discrete_state(self._offsets).SetFromVector(np.zeros(2))  # it starts where we are
         else:
             new.refused.append((t, reason))
         if self.time_to_go_fraction is not None:

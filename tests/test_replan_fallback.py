@@ -195,3 +195,49 @@ def test_replans_come_closer_as_the_time_to_go_shrinks_and_carry_the_model_scale
     assert all(s == (1.05, 0.97) for _, s in calls)
     memory = guidance.memory(guidance.GetMyContextFromRoot(simulator.get_context()))
     assert memory.refused[0] == (1600.0, "the re-planner returned no plan") and len(memory.refused) == 6
+
+
+class _RampFeedback:
+    """A tracking law stub: the offsets (bank, alpha) change at constant rates [rad/s]."""
+
+    def __init__(self, plan):
+        self.level = plan.level
+
+    def rates(self, s, x, offsets):
+        return np.array([0.01, -0.002]) * self.level
+
+
+def test_feedback_offsets_integrate_clip_and_restart_with_each_accepted_replan():
+    """Every 1-s period the offsets advance by rates x period (bank +0.01 rad/s, alpha -0.002
+    rad/s for the plan of level 1), bounded by offset_limits (0.5, 0.05 rad); the commands are the
+    plan's plus the offsets; the re-plan at 100 s is handed the commands flown (offsets included)
+    and, accepted, starts its own offsets from zero (its rates doubled: level 2)."""
+    from drake_entry.systems.replanning_guidance import ReplanningGuidance
+
+    handed = []
+
+    def scripted_replan(plan, x, elapsed, bank, alpha):
+        handed.append((elapsed, bank, alpha))
+        return _StubPlan(2.0)
+
+    builder = DiagramBuilder()
+    guidance = builder.AddSystem(ReplanningGuidance(
+        _StubPlan(1.0), replan=scripted_replan, period=1.0, replan_period=100.0, min_time_to_go=1900.0,
+        feedback=_RampFeedback, offset_limits=(0.5, 0.05)))
+    estimate = builder.AddSystem(ConstantVectorSource(np.array([60e3, 0.1, 0.2, 6000.0, -0.01, 1.0])))
+    builder.Connect(estimate.get_output_port(), guidance.GetInputPort("estimated_state"))
+    simulator = Simulator(builder.Build())
+    seen = {}
+    for t in (10.5, 30.5, 99.5, 100.5, 110.5):
+        simulator.AdvanceTo(t)
+        context = guidance.GetMyContextFromRoot(simulator.get_context())
+        seen[t] = (guidance.GetOutputPort("bank_command").Eval(context)[0],
+                   guidance.GetOutputPort("alpha_command").Eval(context)[0])
+    # updates at 0, 1, ..., 10: 11 steps by 10.5 s; alpha's offset reaches -0.05 after 25 steps
+    assert seen[10.5] == pytest.approx((1.0 + 0.11, 0.2 - 0.022), abs=1e-12)
+    assert seen[30.5] == pytest.approx((1.0 + 0.31, 0.2 - 0.05), abs=1e-12)
+    assert seen[99.5] == pytest.approx((1.0 + 0.5, 0.2 - 0.05), abs=1e-12)
+    # the update at 100 s advances the offsets (already at their bounds), then re-plans from them
+    assert handed == [(100.0, pytest.approx(1.5, abs=1e-12), pytest.approx(0.15, abs=1e-12))]
+    assert seen[100.5] == pytest.approx((2.0, 0.2), abs=1e-12)
+    assert seen[110.5] == pytest.approx((2.0 + 10 * 0.02, 0.2 - 10 * 0.004), abs=1e-12)

@@ -8,7 +8,7 @@ import pytest
 from scipy.linalg import solve_continuous_are
 
 from drake_entry.errors import ScenarioError
-from drake_entry.planning.tracking import TrackingLaw, TrackingWeights, linearise, tvlqr
+from drake_entry.planning.tracking import CommandFeedback, TrackingLaw, TrackingWeights, linearise, tvlqr
 
 
 class _Oscillator:
@@ -86,3 +86,19 @@ def test_entry_defaults_are_the_ampi_guidance_defaults():
     from drake_entry.guidance.ampi.spec import Ampi
 
     assert Ampi().weights() == TrackingWeights.entry()
+
+
+def test_command_feedback_puts_the_estimate_and_the_offsets_into_the_law_state():
+    """An 8-state law (six entry states, alpha, sigma; controls u_alpha, u_sigma) with a known
+    gain: the offsets (sigma, alpha) are the commanded states' deviations, the estimate gives
+    the first six, and the rates are -K (x - x_ref) of each offset's rate control."""
+    K = np.arange(16.0).reshape(2, 8) / 10.0
+    x_ref = np.array([30e3, 0.1, 0.0, 5000.0, -0.1, 1.5, 0.2, 0.7])
+    law = TrackingLaw(np.array([0.0, 100.0]), np.vstack([x_ref, x_ref]), np.zeros((2, 2)),
+                      np.array([0.0, 100.0]), np.stack([K, K]))
+    fb = CommandFeedback(law, ((7, 1), (6, 0)))  # offsets (sigma, alpha)
+    assert fb.rates(50.0, x_ref[:6], [0.0, 0.0]) == pytest.approx([0.0, 0.0], abs=1e-12)
+    estimate = x_ref[:6] + np.array([100.0, 0.0, 0.0, -5.0, 0.0, 0.0])
+    dx = np.array([100.0, 0.0, 0.0, -5.0, 0.0, 0.0, -0.03, 0.02])
+    expected = -K @ dx
+    assert fb.rates(50.0, estimate, [0.02, -0.03]) == pytest.approx([expected[1], expected[0]], rel=1e-12)

@@ -127,6 +127,32 @@ class TrackingLaw:
         return ur - self.gain(t) @ (np.asarray(x, float) - xr)
 
 
+@dc.dataclass(frozen=True)
+class CommandFeedback:
+    """A TrackingLaw used as feedback on commands that follow a reference in time: the
+    navigation estimate gives the law's first six states (the entry states), the commanded
+    states (e.g. alpha and sigma of the 'rates' layout) are the reference's plus the offsets the
+    feedback has built up, and the law's rate controls change those offsets.
+
+    Attributes:
+      law: the TrackingLaw (its clock: 0 where the reference begins);
+      commanded: for each offset, (index of its state, index of its rate control) in the law.
+    """
+
+    law: TrackingLaw
+    commanded: tuple
+
+    def rates(self, s: float, estimate, offsets) -> np.ndarray:
+        """d(offsets)/dt [SI/s] at ``s`` [s of the reference], the estimate [6] and the offsets."""
+        x_ref, _ = self.law.reference(s)
+        x = x_ref.copy()
+        x[:6] = np.asarray(estimate, float)[:6]
+        for (i, _), d in zip(self.commanded, offsets):
+            x[i] += d
+        du = -self.law.gain(s) @ (x - x_ref)
+        return np.array([du[j] for _, j in self.commanded])
+
+
 def _lerp(times: np.ndarray, values: np.ndarray, t: float) -> np.ndarray:
     """values linearly interpolated at t (held outside [times[0], times[-1]])."""
     k = int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, times.size - 2))

@@ -12,8 +12,10 @@ use flies on. The closed loop stops at impact (``stops_at_altitude``).
 """
 from __future__ import annotations
 
+import math
+
 from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, PlantPorts
-from drake_entry.guidance.lgl_terminal.planner import LglPlan, actuation, plan_terminal, replan
+from drake_entry.guidance.lgl_terminal.planner import LglPlan, actuation, plan_feedback, plan_terminal, replan
 from drake_entry.guidance.replanning_wiring import add_replanning_guidance, replanning_commands, replanning_record
 from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 
@@ -31,7 +33,9 @@ class LglTerminalMethod(GuidanceMethod):
         guidance = add_replanning_guidance(builder, GUIDANCE_SYSTEM, planner, replan, g, plant,
                                            first_replan=g.replan_start_s,
                                            time_to_go_fraction=g.replan_time_to_go_fraction or None,
-                                           model_scales=g.replan_model_scales)
+                                           model_scales=g.replan_model_scales, feedback=plan_feedback,
+                                           offset_limits=(math.radians(g.feedback_bank_limit_deg),
+                                                          math.radians(g.feedback_alpha_limit_deg)))
         if g.replan_model_scales:
             ratios = builder.AddNamedSystem(RATIO_SYSTEM, AccelerationRatioFilter(
                 scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere(), period=g.period_s))

@@ -21,6 +21,7 @@ import numpy as np
 
 from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.verdict import box_text, breaches_text, check_limits
+from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlqr
 from drake_entry.planning.verification import Actuation, EntryControls, require_verifier
 
 #: command samples per second of a plan (linear interpolation between them by the guidance)
@@ -82,12 +83,45 @@ class LglPlan:
         return self._samples
 
     @functools.cached_property
+    def feedback(self) -> CommandFeedback:
+        """The time-varying LQR about this solution (feedback_weights; its bank and alpha offsets
+        driven by their rate controls)."""
+        t = self.control_samples()[0]
+        r = self.result
+        problem = r.problem
+        law = tvlqr(problem, t, r.state_function()(t), r.control_function()(t),
+                    feedback_weights(self.scenario.guidance), samples=max(40, int(math.ceil(r.final_time / 5.0))))
+        names, controls = list(problem.state_names), list(problem.control_names)
+        return CommandFeedback(law, ((names.index("sigma"), controls.index("u_sigma")),
+                                     (names.index("alpha"), controls.index("u_alpha"))))
+
+    @functools.cached_property
     def _samples(self):
         tf = self.final_time
         t = np.linspace(0.0, tf, max(int(tf * SAMPLES_PER_S) + 1, 3))
         X = self.result.state_function()(t)
         names = list(self.result.problem.state_names)
         return t, X[:, names.index("sigma")], X[:, names.index("alpha")]
+
+
+def feedback_weights(spec) -> TrackingWeights:
+    """The LQR weights of the feedback between re-solves (scaled units, planning.tracking): a
+    deviation of 1 km, 0.1 deg of position or path angles, 10 m/s, 1 deg of alpha or bank costs
+    1 per second times ``spec.feedback_state_weight``; 1 deg/s of alpha or bank rate costs 1;
+    the final position weighted by 0.01 deg (1.1 km), the final speed by 10 m/s and the final
+    flight-path angle by 1 deg."""
+    d = math.radians
+    return TrackingWeights(
+        state_scale={"h": 1.0e3, "lon": d(0.1), "lat": d(0.1), "V": 10.0, "gamma": d(0.1), "psi": d(0.1),
+                     "alpha": d(1.0), "sigma": d(1.0)},
+        control_scale={"u_alpha": d(1.0), "u_sigma": d(1.0)}, state_weight=spec.feedback_state_weight,
+        terminal_scale={"lon": d(0.01), "lat": d(0.01), "V": 10.0, "gamma": d(1.0)})
+
+
+def plan_feedback(plan: "LglPlan") -> CommandFeedback | None:
+    """The plan's TVLQR as feedback on the commanded bank and alpha (None with feedback "none"):
+    computed once per plan, about the solution's own (possibly scaled) model."""
+    return plan.feedback if plan.scenario.guidance.feedback == "tvlqr" else None
 
 
 def actuation(problem, spec, initial_bank: float, initial_alpha: float) -> Actuation:

@@ -75,8 +75,9 @@ class FlownPlan:
 @dataclass
 class ReplanMemory:
     """The guidance's state: the plan flown, when the next re-plan is due [s], the re-plans made,
-    the refused ones as (time [s], reason), per re-plan (time [s], wall time [s], accepted), and
-    the wall time spent re-planning [s]."""
+    the refused ones as (time [s], reason), per re-plan (time [s], wall time [s], accepted), the
+    wall time spent re-planning [s], and the flight times [s] at which a plan began without the
+    feedback law asked for (it could not be made: the plan flies on its own)."""
 
     flown: FlownPlan
     next_replan: float
@@ -84,10 +85,11 @@ class ReplanMemory:
     refused: list = field(default_factory=list)
     log: list = field(default_factory=list)
     wall_s: float = 0.0
+    unfed: list = field(default_factory=list)
 
     def __deepcopy__(self, memo):  # the plans are never mutated: copies share them
         return ReplanMemory(self.flown, self.next_replan, self.replans, list(self.refused), list(self.log),
-                            self.wall_s)
+                            self.wall_s, list(self.unfed))
 
 
 #: replan(plan, x [6], elapsed [s since the plan began], bank [rad], alpha [rad]) -> a new plan
@@ -120,6 +122,7 @@ class ReplanningGuidance(LeafSystem):
         self.scales_port = self.DeclareVectorInputPort("model_scales", 2) if model_scales else None
         first_at = (replan_period if first_replan is None else first_replan) if replan_period > 0 else np.inf
         first = ReplanMemory(FlownPlan.of(plan, 0.0, feedback), first_at)
+        first.unfed = [0.0] if feedback is not None and first.flown.feedback is None else []
         self._memory = self.DeclareAbstractState(AbstractValue.Make(first))
         self._offsets = self.DeclareDiscreteState(2)
         if replan_period > 0 or feedback is not None:
@@ -158,7 +161,7 @@ class ReplanningGuidance(LeafSystem):
         if t < mem.next_replan - 1e-9 or flown.start + flown.plan.final_time - t < self.min_time_to_go:
             return
         new = ReplanMemory(flown, mem.next_replan + self.replan_period, mem.replans, list(mem.refused),
-                           list(mem.log), mem.wall_s)
+                           list(mem.log), mem.wall_s, list(mem.unfed))
         bank, alpha = flown.commands(t, float(x[3]))  # the commands flown now (not read ahead)
         bank, alpha = bank + float(offsets[0]), alpha + float(offsets[1])
         t_wall = time.perf_counter()
@@ -176,6 +179,8 @@ class ReplanningGuidance(LeafSystem):
         if accepted:
             new.flown = flown_next
             new.replans += 1
+            if self.feedback is not None and flown_next.feedback is None:
+                new.unfed.append(t)
             state.get_mutable_discrete_state(self._offsets).SetFromVector(np.zeros(2))  # it starts where we are
         else:
             new.refused.append((t, reason))

@@ -72,6 +72,9 @@ def test_a_plan_flight_is_ok_only_inside_every_criterion_with_every_limit_held()
     ("final_flight_path_deg", -95.0, "guidance.final_flight_path_deg"),
     ("replan_period_s", 0.5, "must be 0 or >= guidance.period_s"),
     ("problem", "no_such_problem", "no_such_problem"),
+    ("feedback", "pid", "guidance.feedback = 'pid' is unknown; allowed: tvlqr, costate, none"),
+    ("feedback_state_weight", 0.0, "guidance.feedback_state_weight"),
+    ("feedback_alpha_limit_deg", 50.0, "guidance.feedback_alpha_limit_deg"),
 ])
 def test_bad_spec_fields_are_named(scenario, field, value, words):
     import dataclasses as dc
@@ -121,3 +124,15 @@ def test_resolves_aim_at_windows_of_the_final_speed_and_flight_path_angle(scenar
     assert w.final["gamma"] == pytest.approx((math.radians(-82.5), math.radians(-77.5)))
     assert all(w.final[k] == p.final[k] for k in ("h", "lon", "lat", "alpha"))
     assert final_windows(w, scenario.guidance).final == w.final
+
+
+def test_feedback_kinds_map_to_the_plans_laws():
+    """'none' gives no law maker; 'tvlqr' and 'costate' ask the plan for that law."""
+    from drake_entry.guidance.lgl_terminal.planner import feedback_maker
+
+    class Plan:
+        def feedback(self, kind):
+            return f"law {kind}"
+
+    assert feedback_maker("none") is None
+    assert feedback_maker("tvlqr")(Plan()) == "law tvlqr" and feedback_maker("costate")(Plan()) == "law costate"

@@ -241,3 +241,24 @@ def test_feedback_offsets_integrate_clip_and_restart_with_each_accepted_replan()
     assert handed == [(100.0, pytest.approx(1.5, abs=1e-12), pytest.approx(0.15, abs=1e-12))]
     assert seen[100.5] == pytest.approx((2.0, 0.2), abs=1e-12)
     assert seen[110.5] == pytest.approx((2.0 + 10 * 0.02, 0.2 - 10 * 0.004), abs=1e-12)
+
+
+def test_a_plan_whose_feedback_law_cannot_be_made_flies_on_its_own_and_is_counted():
+    """The law maker returns None (e.g. a conjugate point of the costate law): the commands are the
+    plan's alone, and the flight times at which such a plan began are recorded."""
+    from drake_entry.systems.replanning_guidance import ReplanningGuidance
+
+    builder = DiagramBuilder()
+    guidance = builder.AddSystem(ReplanningGuidance(
+        _StubPlan(1.0), replan=lambda *a: _StubPlan(2.0), period=1.0, replan_period=100.0, min_time_to_go=1900.0,
+        feedback=lambda plan: None, offset_limits=(0.5, 0.05)))
+    estimate = builder.AddSystem(ConstantVectorSource(np.array([60e3, 0.1, 0.2, 6000.0, -0.01, 1.0])))
+    builder.Connect(estimate.get_output_port(), guidance.GetInputPort("estimated_state"))
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(50.5)
+    context = guidance.GetMyContextFromRoot(simulator.get_context())
+    assert guidance.GetOutputPort("bank_command").Eval(context)[0] == pytest.approx(1.0, abs=1e-15)
+    simulator.AdvanceTo(100.5)
+    context = guidance.GetMyContextFromRoot(simulator.get_context())
+    assert guidance.GetOutputPort("bank_command").Eval(context)[0] == pytest.approx(2.0, abs=1e-15)
+    assert guidance.memory(context).unfed == [0.0, 100.0]

@@ -1,12 +1,14 @@
 """Paper 002's terminal guidance as a GuidanceMethod.
 
   estimate, sensed lift and drag --> AccelerationRatioFilter --ratios (k_L, k_D)--+
-  estimate --> ReplanningGuidance (the LGL solution's sigma(t), alpha(t); re-solves on the   <--+
-      remaining horizon with the models scaled by k_L, k_D) --bank_command--> (shared bank actuator)
+  estimate --> ReplanningGuidance (the LGL solution's sigma(t), alpha(t) plus the offsets of   <--+
+      its TVLQR; re-solves on the remaining horizon with the models
+      scaled by k_L, k_D)                                   --bank_command--> (shared bank actuator)
                                                             --alpha_command--> (shared alpha actuator)
 
 The pre-flight plan (``make_planner``) is solved once per mission and verified (planner module
-docstring); each flight flies it and re-solves it from the navigation estimate every
+docstring); each flight flies it, corrected between re-solves by the time-varying LQR of the
+solution in use (``feedback: tvlqr``), and re-solves it from the navigation estimate every
 ``replan_period_s``; a re-solve that fails or is not verified is recorded and the solution in
 use flies on. The closed loop stops at impact (``stops_at_altitude``).
 """
@@ -14,8 +16,15 @@ from __future__ import annotations
 
 import math
 
-from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, PlantPorts
-from drake_entry.guidance.lgl_terminal.planner import LglPlan, actuation, plan_feedback, plan_terminal, replan
+from drake_entry.guidance.interface import (
+    ActuatorLimits,
+    GuidanceCommands,
+    GuidanceMethod,
+    GuidanceSummary,
+    LoggedSignal,
+    PlantPorts,
+)
+from drake_entry.guidance.lgl_terminal.planner import LglPlan, actuation, feedback_maker, plan_terminal, replan
 from drake_entry.guidance.replanning_wiring import add_replanning_guidance, replanning_commands, replanning_record
 from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 
@@ -33,7 +42,8 @@ class LglTerminalMethod(GuidanceMethod):
         guidance = add_replanning_guidance(builder, GUIDANCE_SYSTEM, planner, replan, g, plant,
                                            first_replan=g.replan_start_s,
                                            time_to_go_fraction=g.replan_time_to_go_fraction or None,
-                                           model_scales=g.replan_model_scales, feedback=plan_feedback,
+                                           model_scales=g.replan_model_scales,
+                                           feedback=feedback_maker(g.feedback),
                                            offset_limits=(math.radians(g.feedback_bank_limit_deg),
                                                           math.radians(g.feedback_alpha_limit_deg)))
         if g.replan_model_scales:
@@ -45,15 +55,20 @@ class LglTerminalMethod(GuidanceMethod):
             builder.Connect(ratios.GetOutputPort("ratios"), guidance.GetInputPort("model_scales"))
         _, bank, alpha = planner.control_samples()
         act = actuation(planner.result.problem, g, bank[0], alpha[0])  # the actuators the plans are verified with
-        return replanning_commands(guidance, ActuatorLimits(*act.alpha_bounds, act.alpha_rate_limit, act.alpha_accel_limit),
-                                   act.initial_bank, act.initial_alpha)
+        commands = replanning_commands(guidance, ActuatorLimits(*act.alpha_bounds, act.alpha_rate_limit,
+                                                                act.alpha_accel_limit),
+                                       act.initial_bank, act.initial_alpha)
+        commands.logged["command_offsets"] = LoggedSignal(guidance.GetOutputPort("command_offsets"),
+                                                          ("bank_offset_rad", "alpha_offset_rad"))
+        return commands
 
     def summarise(self, diagram, context, planner: LglPlan) -> GuidanceSummary:
         mem, fields = replanning_record(diagram, context, GUIDANCE_SYSTEM)
         return GuidanceSummary(
             planner.success, "" if planner.success else f"the pre-flight plan is not verified: {planner.message}",
             plans=mem.replans, planning_wall_s=mem.wall_s,
-            fields={**fields, "plan_objective": float(planner.result.objective), "plan_final_time_s": planner.final_time},
+            fields={**fields, "plan_objective": float(planner.result.objective), "plan_final_time_s": planner.final_time,
+                    "plans_without_feedback": len(mem.unfed)},
             details={"plan": planner, "last_plan": mem.flown.plan, "refused": mem.refused, "replans": mem.log})
 
 

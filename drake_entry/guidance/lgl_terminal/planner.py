@@ -19,8 +19,10 @@ import math
 
 import numpy as np
 
+from drake_entry.errors import ScenarioError
 from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.verdict import box_text, breaches_text, check_limits
+from drake_entry.planning.neighbouring_optimal import neighbouring_optimal, without_odd_even_mode
 from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlqr
 from drake_entry.planning.verification import Actuation, EntryControls, require_verifier
 
@@ -82,15 +84,33 @@ class LglPlan:
         (computed once: the actuator flight, the closed loop's wiring and the guidance read them)."""
         return self._samples
 
-    @functools.cached_property
-    def feedback(self) -> CommandFeedback:
-        """The time-varying LQR about this solution (feedback_weights; its bank and alpha offsets
-        driven by their rate controls)."""
+    def feedback(self, kind: str) -> CommandFeedback | None:
+        """The feedback law about this solution, its bank and alpha offsets driven by their rate
+        controls: kind "tvlqr" (planning.tracking, ``feedback_weights``) or "costate" (the
+        neighbouring-optimal law of its costates, without their odd-even mode,
+        planning.neighbouring_optimal, with the same terminal penalty). Computed once per kind; None when it cannot be made (the reason in
+        ``feedback_errors``: the plan then flies without feedback)."""
+        cache = self.__dict__.setdefault("_feedback", {})
+        if kind not in cache:
+            cache[kind] = None
+            try:
+                cache[kind] = self._make_feedback(kind)
+            except ScenarioError as e:
+                self.__dict__.setdefault("feedback_errors", []).append(f"{kind}: {e}")
+        return cache[kind]
+
+    def _make_feedback(self, kind: str) -> CommandFeedback:
         t = self.control_samples()[0]
         r = self.result
-        problem = r.problem
-        law = tvlqr(problem, t, r.state_function()(t), r.control_function()(t),
-                    feedback_weights(self.scenario.guidance), samples=max(40, int(math.ceil(r.final_time / 5.0))))
+        problem, weights = r.problem, feedback_weights(self.scenario.guidance)
+        X, U, samples = r.state_function()(t), r.control_function()(t), max(40, int(math.ceil(r.final_time / 5.0)))
+        if kind == "costate":
+            if r.costates is None:
+                raise ScenarioError("the solution carries no costates (the solver returned no multipliers)")
+            law = neighbouring_optimal(problem, t, X, U, r.costate_time, without_odd_even_mode(r.costates), weights,
+                                       samples=samples)
+        else:
+            law = tvlqr(problem, t, X, U, weights, samples=samples)
         names, controls = list(problem.state_names), list(problem.control_names)
         return CommandFeedback(law, ((names.index("sigma"), controls.index("u_sigma")),
                                      (names.index("alpha"), controls.index("u_alpha"))))
@@ -118,10 +138,10 @@ def feedback_weights(spec) -> TrackingWeights:
         terminal_scale={"lon": d(0.01), "lat": d(0.01), "V": 10.0, "gamma": d(1.0)})
 
 
-def plan_feedback(plan: "LglPlan") -> CommandFeedback | None:
-    """The plan's TVLQR as feedback on the commanded bank and alpha (None with feedback "none"):
-    computed once per plan, about the solution's own (possibly scaled) model."""
-    return plan.feedback if plan.scenario.guidance.feedback == "tvlqr" else None
+def feedback_maker(kind: str):
+    """What ReplanningGuidance calls on each plan it flies: the plan's feedback law of ``kind``
+    ("tvlqr" or "costate"; ``LglPlan.feedback``), or None for kind "none"."""
+    return None if kind == "none" else lambda plan: plan.feedback(kind)
 
 
 def actuation(problem, spec, initial_bank: float, initial_alpha: float) -> Actuation:

@@ -7,7 +7,7 @@ from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import ReplanningSpec
 
 SOLVERS = ("snopt", "ipopt")
-FEEDBACKS = ("tvlqr", "none")
+FEEDBACKS = ("tvlqr", "costate", "none")
 
 
 @dc.dataclass
@@ -56,9 +56,10 @@ class LglTerminal(ReplanningSpec):
     # to the modelled accelerations (a density, aerodynamic or mass error the flight has shown)
     replan_model_scales: bool = True
     # between re-solves the commands track the solution in use: "tvlqr" (a time-varying LQR of
-    # the solution's linearised dynamics, planning.tracking) or "none" (its controls in time
-    # only); feedback_state_weight: the LQR's path weight (planner.feedback_weights); the
-    # feedback's bank and alpha offsets are bounded by the two limits [deg]
+    # the solution's linearised dynamics, planning.tracking), "costate" (the neighbouring-optimal
+    # law of its costates, planning.neighbouring_optimal) or "none" (its controls in time only);
+    # feedback_state_weight: the LQR's path weight (planner.feedback_weights); the feedback's
+    # bank and alpha offsets are bounded by the two limits [deg]
     feedback: str = "tvlqr"
     feedback_state_weight: float = 1.0e-3
     feedback_bank_limit_deg: float = 30.0

@@ -259,6 +259,16 @@ def _limits_text(scenario) -> str:
             + f"; tolerance {100 * scenario.terminal.path_limit_tolerance:g} % of each limit")
 
 
+def _mission_limits(scenario) -> list:
+    """The guidance spec's mission path limits (PathLimits; [] without a readable scenario)."""
+    if scenario is None:
+        return []
+    try:
+        return list(scenario.guidance.path_limits(scenario))
+    except DrakeEntryError:
+        return []
+
+
 def _method(rows: dict) -> str:
     names = sorted({str(m) for m in rows.get("method", []) if m})
     return ", ".join(names) or "?"
@@ -651,7 +661,7 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
     figs.append(figures.peak_histograms(peaks, out_dir, title))
     if traj is not None:
         figs.append(figures.envelopes(traj, out_dir, title, nominal=read_nominal(out_dir)))
-        figs.append(figures.path_quantities(traj, out_dir, title, limits))
+        figs.append(figures.path_quantities(traj, out_dir, title, limits, mission_limits=_mission_limits(scenario)))
         figs.append(figures.drag_profiles(traj, out_dir, title))
         target = ((scenario.target.longitude_deg, scenario.target.latitude_deg) if scenario is not None else None)
         figs.append(figures.ground_tracks(traj, out_dir, title, target=target))

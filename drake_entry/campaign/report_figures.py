@@ -193,22 +193,41 @@ def envelopes(traj: dict, out_dir: str, title: str, *, nominal: dict | None = No
                   "The bank panel shows magnitudes and signs mixed: see the bank histories for single flights.")
 
 
-def path_quantities(traj: dict, out_dir: str, title: str, limits) -> tuple[str, str]:
-    """Dynamic pressure, heat flux and normal load against normalised energy, every sample, limits labelled."""
+#: a limit further than this factor above the largest flown value is named, not drawn (the
+#: axis stays on the data: e.g. a vehicle file's "no limit" 1e6 kPa)
+OFF_SCALE = 3.0
+
+
+def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits=()) -> tuple[str, str]:
+    """Dynamic pressure, heat flux and normal load against normalised energy, every sample; the
+    vehicle's limits (``limits``) dashed and the mission's (``mission_limits``: PathLimits on the
+    same quantities, e.g. a lower bound on q) dotted, each labelled."""
     sample = np.asarray(traj["sample"])
     e = normalised_energy(traj)
     groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.0))
-    for ax, (col, scale, label, lim, unit) in zip(axes, (
-            ("dynamic_pressure_Pa", 1e-3, "dynamic pressure [kPa]", "dynamic_pressure_max", "kPa"),
-            ("heat_flux_W_m2", 1e-3, "heat flux [kW/m^2]", "heat_flux_max", "kW/m^2"),
-            ("normal_load_g", 1.0, "normal load [g]", "normal_load_max", "g"))):
+    for ax, (col, quantity, scale, label, lim, unit) in zip(axes, (
+            ("dynamic_pressure_Pa", "dynamic_pressure", 1e-3, "dynamic pressure [kPa]", "dynamic_pressure_max", "kPa"),
+            ("heat_flux_W_m2", "heat_flux", 1e-3, "heat flux [kW/m^2]", "heat_flux_max", "kW/m^2"),
+            ("normal_load_g", "normal_load", 1.0, "normal load [g]", "normal_load_max", "g"))):
         v = np.asarray(traj[col], float) * scale
         for g in groups:
             ax.plot(e[g], v[g], lw=0.4, alpha=0.4, color="C0")
+        top = float(np.nanmax(v)) if v.size else 0.0
         value = getattr(limits, lim, None) if limits is not None else None
-        if value is not None and np.isfinite(value):
-            ax.axhline(value * scale, color="r", ls="--", lw=1.2, label=f"limit {value * scale:g} {unit}")
+        lines = [] if value is None or not np.isfinite(value) else [(value * scale, f"vehicle limit {value * scale:g} {unit}",
+                                                                       "--")]
+        for m in mission_limits:
+            if m.column == quantity:
+                for bound in (m.lower, m.upper):  # SI, as the columns before ``scale``
+                    if np.isfinite(bound):
+                        lines.append((bound * scale, f"{m.name} {m.bound_text()}", ":"))
+        for y, text, style in lines:
+            if top > 0 and y > OFF_SCALE * top:
+                ax.plot([], [], " ", label=f"{text} (off scale)")
+            else:
+                ax.axhline(y, color="r", ls=style, lw=1.2, label=text)
+        if lines:
             ax.legend(fontsize=8)
         ax.set_xlabel(ENERGY_AXIS)
         ax.set_ylabel(label)
@@ -216,7 +235,8 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits) -> tuple[str, 
     path = _save(fig, out_dir, "path_quantities.png", title)
     return path, (f"Path quantities of the {len(groups)} stored trajectories against normalised energy (one line per "
                   "sample, at the storage step: the peaks between stored points are in the peak histograms), the "
-                  f"vehicle's limits dashed. {ENERGY_DEFINITION}.")
+                  "vehicle's limits dashed and the mission's dotted (a limit more than "
+                  f"{OFF_SCALE:g} times the largest flown value is named in the legend, not drawn). {ENERGY_DEFINITION}.")
 
 
 def drag_profiles(traj: dict, out_dir: str, title: str) -> tuple[str, str] | None:

@@ -29,7 +29,7 @@ from pydrake.autodiffutils import ExtractGradient, InitializeAutoDiff
 from scipy.integrate import solve_ivp
 
 from drake_entry.errors import ScenarioError
-from drake_entry.planning.tracking import TrackingLaw, TrackingWeights, linearise
+from drake_entry.planning.tracking import TrackingLaw, TrackingWeights, lerp, resample, scaled_linearisation
 
 #: relative step of the central differences of H's gradient (of each variable's scale)
 HESSIAN_STEP = 1.0e-5
@@ -94,15 +94,11 @@ def neighbouring_optimal(problem, time_s, states, controls, costate_time, costat
     nx, nu = problem.n_states, problem.n_controls
     sx, su, _, R_w, Qf_w = weights.matrices(problem.state_names, problem.control_names)
     ts = np.linspace(time_s[0], time_s[-1], samples)
-    xs = np.array([np.interp(ts, time_s, c) for c in states.T]).T
-    us = np.array([np.interp(ts, time_s, c) for c in controls.T]).T
-    lam = np.array([np.interp(ts, costate_time, c) for c in costates.T]).T
-    A, B = linearise(problem, ts, xs, us)
+    xs, us, lam = resample(ts, time_s, states), resample(ts, time_s, controls), resample(ts, costate_time, costates)
+    A_s, B_s = scaled_linearisation(problem, ts, xs, us, sx, su)
     scale = np.concatenate([sx, su])
     W = np.array([hamiltonian_hessian(problem, l, x, u, scale) for l, x, u in zip(lam, xs, us)])
     W_s = W * scale[None, :, None] * scale[None, None, :]  # in scaled variables
-    A_s = A * sx[None, None, :] / sx[None, :, None]
-    B_s = B * su[None, None, :] / sx[None, :, None]
     Q_s, N_s, R_s = W_s[:, :nx, :nx], W_s[:, :nx, nx:], W_s[:, nx:, nx:]
     for k, R in enumerate(R_s):
         if np.linalg.eigvalsh(R).min() <= 0.0:
@@ -111,16 +107,11 @@ def neighbouring_optimal(problem, time_s, states, controls, costate_time, costat
     # the terminal penalty in H_uu's units: the TVLQR's Q_f relative to its R = I
     Qf = Qf_w * float(np.mean([np.trace(R) / nu for R in R_s])) / float(np.trace(R_w) / nu)
 
-    def at(M, t):
-        k = int(np.clip(np.searchsorted(ts, t, side="right") - 1, 0, ts.size - 2))
-        w = (t - ts[k]) / (ts[k + 1] - ts[k])
-        return (1.0 - w) * M[k] + w * M[k + 1]
-
     def rhs(t, s):
         if not np.all(np.isfinite(s)) or np.abs(s).max() > DIVERGED:
             raise _Diverged(t)
         S = s.reshape(nx, nx)
-        Ak, Bk, Qk, Nk, Rk = at(A_s, t), at(B_s, t), at(Q_s, t), at(N_s, t), at(R_s, t)
+        Ak, Bk, Qk, Nk, Rk = (lerp(ts, M, t) for M in (A_s, B_s, Q_s, N_s, R_s))
         G = S @ Bk + Nk
         dS = -(Qk + S @ Ak + Ak.T @ S - G @ np.linalg.solve(Rk, G.T))
         return (0.5 * (dS + dS.T)).ravel()

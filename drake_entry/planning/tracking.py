@@ -116,10 +116,10 @@ class TrackingLaw:
 
     def reference(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """(x_ref(t), u_ref(t))."""
-        return _lerp(self.time, self.states, t), _lerp(self.time, self.controls, t)
+        return lerp(self.time, self.states, t), lerp(self.time, self.controls, t)
 
     def gain(self, t: float) -> np.ndarray:
-        return _lerp(self.gain_time, self.gains, t)
+        return lerp(self.gain_time, self.gains, t)
 
     def command(self, t: float, x) -> np.ndarray:
         """u(t, x) [SI] (before any limits)."""
@@ -153,11 +153,23 @@ class CommandFeedback:
         return np.array([du[j] for _, j in self.commanded])
 
 
-def _lerp(times: np.ndarray, values: np.ndarray, t: float) -> np.ndarray:
+def lerp(times: np.ndarray, values: np.ndarray, t: float) -> np.ndarray:
     """values linearly interpolated at t (held outside [times[0], times[-1]])."""
     k = int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, times.size - 2))
     w = float(np.clip((t - times[k]) / (times[k + 1] - times[k]), 0.0, 1.0))
     return (1.0 - w) * values[k] + w * values[k + 1]
+
+
+def resample(ts, time_s, values) -> np.ndarray:
+    """values (n, m) given at time_s (n,) linearly interpolated at ts [s] -> (len(ts), m)."""
+    return np.array([np.interp(ts, time_s, c) for c in np.asarray(values, float).T]).T
+
+
+def scaled_linearisation(problem, ts, states, controls, sx, su) -> tuple[np.ndarray, np.ndarray]:
+    """(A_s, B_s): ``linearise`` at the samples, in the scaled variables x / sx, u / su:
+    d(x/sx)/dt = A_s (x/sx) + B_s (u/su)."""
+    A, B = linearise(problem, ts, states, controls)
+    return A * sx[None, None, :] / sx[None, :, None], B * su[None, None, :] / sx[None, :, None]
 
 
 def linearise(problem, time_s, states, controls) -> tuple[np.ndarray, np.ndarray]:
@@ -191,11 +203,7 @@ def tvlqr(problem, time_s, states, controls, weights: TrackingWeights, samples: 
         raise ScenarioError(f"tvlqr: samples = {samples}; allowed >= 2")
     sx, su, Q, R, Qf = weights.matrices(problem.state_names, problem.control_names)
     ts = np.linspace(time_s[0], time_s[-1], samples)
-    xs = np.array([np.interp(ts, time_s, c) for c in states.T]).T
-    us = np.array([np.interp(ts, time_s, c) for c in controls.T]).T
-    A, B = linearise(problem, ts, xs, us)
-    A_s = A * sx[None, None, :] / sx[None, :, None]  # scaled: d(x/sx)/dt = A_s (x/sx) + B_s (u/su)
-    B_s = B * su[None, None, :] / sx[None, :, None]
+    A_s, B_s = scaled_linearisation(problem, ts, resample(ts, time_s, states), resample(ts, time_s, controls), sx, su)
     nx, nu = problem.n_states, problem.n_controls
     system = TrajectoryLinearSystem(PiecewisePolynomial.FirstOrderHold(ts, list(A_s)),
                                     PiecewisePolynomial.FirstOrderHold(ts, list(B_s)),

@@ -121,8 +121,8 @@ class ReplanningGuidance(LeafSystem):
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.scales_port = self.DeclareVectorInputPort("model_scales", 2) if model_scales else None
         first_at = (replan_period if first_replan is None else first_replan) if replan_period > 0 else np.inf
-        first = ReplanMemory(FlownPlan.of(plan, 0.0, feedback), first_at)
-        first.unfed = [0.0] if feedback is not None and first.flown.feedback is None else []
+        flown = FlownPlan.of(plan, 0.0, feedback)
+        first = ReplanMemory(flown, first_at, unfed=[0.0] if feedback is not None and flown.feedback is None else [])
         self._memory = self.DeclareAbstractState(AbstractValue.Make(first))
         self._offsets = self.DeclareDiscreteState(2)
         if replan_period > 0 or feedback is not None:
@@ -138,10 +138,10 @@ class ReplanningGuidance(LeafSystem):
     def memory(self, context) -> ReplanMemory:
         return context.get_abstract_state(int(self._memory)).get_value()
 
-    def _commands(self, context, offsets=None):
+    def _commands(self, context):
         x = self.est_port.Eval(context)
         bank, alpha = self.memory(context).flown.commands(context.get_time(), float(x[3]), self.lead)
-        d = context.get_discrete_state(self._offsets).value() if offsets is None else offsets
+        d = context.get_discrete_state(self._offsets).value()
         return bank + float(d[0]), alpha + float(d[1])
 
     def _stats(self, context, output):

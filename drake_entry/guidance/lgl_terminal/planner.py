@@ -66,6 +66,7 @@ class LglPlan:
       result: the NlpResult (its clock: t = 0 where this plan begins).
       flight: the PlanFlight; success: result.success and flight.ok; message: both in words.
       scenario, verifier: what re-plans need.
+      feedback_errors: why a feedback law of this solution could not be made (``feedback``).
     """
 
     result: object
@@ -74,6 +75,8 @@ class LglPlan:
     message: str
     scenario: object = dc.field(repr=False, default=None)
     verifier: object = dc.field(repr=False, default=None)
+    feedback_errors: list = dc.field(default_factory=list)
+    _feedback_laws: dict = dc.field(repr=False, default_factory=dict)
 
     @property
     def final_time(self) -> float:
@@ -90,14 +93,13 @@ class LglPlan:
         neighbouring-optimal law of its costates, without their odd-even mode,
         planning.neighbouring_optimal, with the same terminal penalty). Computed once per kind; None when it cannot be made (the reason in
         ``feedback_errors``: the plan then flies without feedback)."""
-        cache = self.__dict__.setdefault("_feedback", {})
-        if kind not in cache:
-            cache[kind] = None
+        if kind not in self._feedback_laws:
+            self._feedback_laws[kind] = None
             try:
-                cache[kind] = self._make_feedback(kind)
+                self._feedback_laws[kind] = self._make_feedback(kind)
             except ScenarioError as e:
-                self.__dict__.setdefault("feedback_errors", []).append(f"{kind}: {e}")
-        return cache[kind]
+                self.feedback_errors.append(f"{kind}: {e}")
+        return self._feedback_laws[kind]
 
     def _make_feedback(self, kind: str) -> CommandFeedback:
         t = self.control_samples()[0]

@@ -70,7 +70,8 @@ def main(quick: bool = False, out_dir: str = "out/examples/14") -> dict:
     flights["dispersed, plan alone"] = cl.fly(_variant(setup, resolves=False, feedback=False), draw=draw)
     for name, f in flights.items():
         b = f.box
-        print(f"{name:24s}: {'success' if f.success else 'FAILED'}; impact {f.errors['distance_m']:.0f} m from the "
+        end = "impact" if f.reached else f"stopped at t = {f.trajectory.time[-1]:.0f} s,"
+        print(f"{name:24s}: {'success' if f.success else 'FAILED'}; {end} {f.errors['distance_m']:.0f} m from the "
               f"target, V {f.trajectory.state[-1][3]:.1f} m/s, gamma {math.degrees(f.trajectory.state[-1][4]):.2f} deg, "
               f"alpha {math.degrees(b['alpha']['error']):.2f} deg; {f.guidance.plans} re-solves accepted of "
               f"{f.guidance.fields['replans_tried']}, {f.guidance.planning_wall_s:.1f} s")
@@ -86,17 +87,22 @@ def _figure(plan, flights: dict, path: str) -> str:
     t = np.linspace(0.0, r.final_time, 800)
     X = r.state_function()(t)
     R = r.problem.planet.reference_radius
+    # one colour and line style per flight in every panel: flights that coincide (the re-solved-only
+    # flight whose one re-solve is refused flies as the plan alone) stay visible on each other
+    colours = ("C0", "C1", "C2", "C4", "C5", "C6")  # not red: the bounds are drawn in red
+    style = {name: dict(color=colours[i % len(colours)], ls=("-", "--", "-.", ":")[i % 4], lw=(2.4, 1.8, 1.4, 1.4)[i % 4])
+             for i, name in enumerate(flights)}
     fig, ax = plt.subplots(2, 2, figsize=(13, 9))
     a = ax[0, 0]
     a.plot(np.degrees(X[:, 1]) * R * math.pi / 180 / 1e3, X[:, 0] / 1e3, "k--", lw=2, label="pre-flight plan")
     for name, f in flights.items():
         s = f.trajectory.state
-        a.plot(np.degrees(s[:, 1]) * R * math.pi / 180 / 1e3, s[:, 0] / 1e3, label=name)
+        a.plot(np.degrees(s[:, 1]) * R * math.pi / 180 / 1e3, s[:, 0] / 1e3, label=name, **style[name])
     a.set(xlabel="downrange along the equator [km]", ylabel="altitude [km]", title="Altitude against downrange")
     a.legend(fontsize=8)
     a = ax[0, 1]
     for name, f in flights.items():
-        a.plot(f.trajectory.time, np.degrees(f.trajectory.alpha), label=f"alpha, {name}")
+        a.plot(f.trajectory.time, np.degrees(f.trajectory.alpha), label=f"alpha, {name}", **style[name])
     a.plot(t, np.degrees(X[:, 6]), "k--", label="alpha planned")
     a.axhline(25.0, color="r", ls=":", label="alpha bound 25 deg (eq. 18)")
     a.set(xlabel="time [s]", ylabel="angle of attack [deg]", title="Angle of attack flown (to 0 at impact, eq. 16)")
@@ -105,7 +111,7 @@ def _figure(plan, flights: dict, path: str) -> str:
     for name, f in flights.items():
         q = f.trajectory.column("dynamic_pressure") / 1e3
         k = int(np.argmin(q))
-        a.plot(f.trajectory.time, q, label=f"{name} (min {q[k]:.1f} kPa at {f.trajectory.time[k]:.0f} s)")
+        a.plot(f.trajectory.time, q, label=f"{name} (min {q[k]:.1f} kPa at {f.trajectory.time[k]:.0f} s)", **style[name])
     a.axhline(12.0, color="r", ls=":", label="q >= 12 kPa (eq. 18)")
     a.set(xlabel="time [s]", ylabel="dynamic pressure [kPa]", ylim=(0.0, 40.0),
           title="Dynamic pressure at the altitude maxima and its lower bound")
@@ -114,11 +120,11 @@ def _figure(plan, flights: dict, path: str) -> str:
     for name, f in flights.items():
         log = f.guidance.details["replans"]
         if log:
-            tt, wall, ok = zip(*log)
-            a.scatter(tt, wall, marker="o", label=f"{name}: accepted / refused (x)", s=[40 if k else 5 for k in ok])
+            good = [(x, w) for x, w, k in log if k]
             bad = [(x, w) for x, w, k in log if not k]
-            if bad:
-                a.scatter(*zip(*bad), marker="x", color="k")
+            a.scatter([x for x, _ in good], [w for _, w in good], marker="o", s=40, color=style[name]["color"],
+                      label=f"{name}: {len(good)} accepted (o), {len(bad)} refused (x)")
+            a.scatter([x for x, _ in bad], [w for _, w in bad], marker="x", s=60, color=style[name]["color"])
     a.set(xlabel="flight time of the re-solve [s]", ylabel="wall time of the re-solve [s]",
           title="Re-solve wall time (solve, verification, actuator flight)")
     a.legend(fontsize=8)

@@ -142,6 +142,10 @@ class Scenario:
     vehicle: str = ""  # packaged vehicle name or a vehicle YAML path
     # which aero model of the vehicle file ('' = its default)
     aero: str = ""
+    # the mission's path and bank limits where they differ from the vehicle file's (keys:
+    # heat_flux_max_kW_m2, dynamic_pressure_max_kPa, normal_load_max_g, total_load_max_g,
+    # bank_limit_deg, bank_rate_limit_deg_s, bank_accel_limit_deg_s2)
+    vehicle_limits: dict[str, float] = dc.field(default_factory=dict)
     planet: PlanetSpec = dc.field(default_factory=PlanetSpec)  # the Earth model
     # what entry.altitude_km and terminal.altitude_km are measured from: 'sphere' (the state
     # altitude, above the reference sphere) or 'ellipsoid' (geodetic altitude above WGS-84, the
@@ -166,7 +170,7 @@ class Scenario:
 
     # -- models ----------------------------------------------------------------------
     def make_vehicle(self) -> Vehicle:
-        return load_vehicle(self.vehicle, aero=self.aero or None)
+        return load_vehicle(self.vehicle, aero=self.aero or None, limits=self.vehicle_limits)
 
     def make_planet(self) -> Earth:
         return planet_from_spec(self.planet)

@@ -241,3 +241,18 @@ def test_example_14(tmp_path):
     assert only.trajectory.time[-1] == pytest.approx(300.0, abs=1.0)
     assert only.trajectory.column("dynamic_pressure").min() < 12e3
     assert os.path.getsize(r["figure"]) > 50_000
+
+
+@pytest.mark.slow
+def test_example_15(tmp_path):
+    """FNPEG on Lu's CAV-H case, quick run (with and without phugoid damping to 900 s, the
+    corrector every 5 s): the damping lowers the first pull-out's heat-rate peak and the
+    phugoid's load and q peaks, as in Lu 2014; every correction converges."""
+    r = _run("15_fnpeg_cav_h", tmp_path)
+    p = r["peaks"]
+    for k in ("heat rate [kW/m^2]", "load [g]", "q [kPa]"):
+        assert p["with damping"][k] < p["without damping"][k], k
+    for row in r["rows"].values():
+        assert row["plans"] > 100 and row["corrections_unconverged"] <= 0.05 * row["plans"]
+    assert os.path.exists(r["plot"])
+

@@ -15,6 +15,7 @@ from drake_entry.errors import ScenarioError
 from drake_entry.guidance.ampi.spec import Ampi
 from drake_entry.guidance.bank_profile.spec import BankProfile
 from drake_entry.guidance.drag_energy.spec import DragEnergy
+from drake_entry.guidance.fnpeg.spec import Fnpeg
 from drake_entry.guidance.lgl_terminal.spec import LglTerminal
 from drake_entry.guidance.scvx.spec import Scvx
 from drake_entry.guidance.swarm_bank.spec import SwarmBank
@@ -26,6 +27,7 @@ REGISTRY = {
     Scvx: "drake_entry.guidance.scvx.method",
     Ampi: "drake_entry.guidance.ampi.method",
     LglTerminal: "drake_entry.guidance.lgl_terminal.method",
+    Fnpeg: "drake_entry.guidance.fnpeg.method",
 }
 
 #: the scenario's ``guidance:`` field type (the first is the default when untagged)

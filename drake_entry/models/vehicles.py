@@ -243,11 +243,27 @@ def vehicle_spec(name_or_path: str) -> VehicleSpec:
     return load_yaml_typed(VehicleSpec, path=name_or_path)
 
 
-def load_vehicle(name: str, *, aero: str | None = None) -> Vehicle:
+#: the vehicle-file fields a scenario may replace for its mission (Scenario.vehicle_limits)
+LIMIT_FIELDS = ("heat_flux_max_kW_m2", "dynamic_pressure_max_kPa", "normal_load_max_g", "total_load_max_g",
+                "bank_limit_deg", "bank_rate_limit_deg_s", "bank_accel_limit_deg_s2")
+
+
+def load_vehicle(name: str, *, aero: str | None = None, limits: dict | None = None) -> Vehicle:
     """Load a vehicle by packaged name or YAML path.
 
     Args:
       name: 'horus2b', 'cav_h', 'marv', 'shefex3', 'sphynx', or a path to a vehicle YAML.
       aero: which of the file's aero models to use (default: the file's default_aero).
+      limits: path and bank limits replacing the file's (keys: LIMIT_FIELDS, the file's units).
     """
-    return vehicle_from_spec(vehicle_spec(name), aero=aero, where=f"vehicle '{name}'")
+    spec = vehicle_spec(name)
+    if limits:
+        unknown = sorted(set(limits) - set(LIMIT_FIELDS))
+        if unknown:
+            raise ScenarioError(f"vehicle_limits: {', '.join(unknown)} cannot be replaced; allowed: "
+                                f"{', '.join(LIMIT_FIELDS)}")
+        for k, v in limits.items():
+            if not (isinstance(v, (int, float)) and v > 0):
+                raise ScenarioError(f"vehicle_limits.{k} = {v} is out of range: must be > 0")
+        spec = dc.replace(spec, **{k: float(v) for k, v in limits.items()})
+    return vehicle_from_spec(spec, aero=aero, where=f"vehicle '{name}'")

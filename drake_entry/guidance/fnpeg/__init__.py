@@ -1,0 +1,2 @@
+"""FNPEG: the fully numerical predictor-corrector entry guidance of Lu (2014), the field's
+baseline (docs/methods/fnpeg.md)."""

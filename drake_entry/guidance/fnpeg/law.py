@@ -1,0 +1,128 @@
+"""FNPEG's bank-magnitude law (Lu 2014), written once for float and symbolic scalars: the
+predictor (guidance/fnpeg/predictor.py) builds it into a native Drake system, the on-board
+guidance (systems/fnpeg_guidance.py) evaluates it on the navigated state.
+
+- The baseline profile: |sigma| linear in the energy-like variable e = mu/r - V^2/2 (Lu 2014
+  eq. 19 in SI; e increases along the flight), from sigma_0 (solved) at the current e_0 to
+  sigma_f (fixed) at the terminal e_f.
+- The altitude-rate feedback augmentation (Lu 2014 Sec. IV): L cos(sigma_cmd) = L cos(sigma_base)
+  - k (hdot - hdot_ref), in Lu's nondimensional units (length R0, speed sqrt(g0 R0)), converted
+  here to SI: cos(sigma_cmd) = cos(sigma_base) - k sqrt(g0/R0) (hdot - hdot_ref) / L.
+  Two references:
+  * phugoid damping: hdot_ref = V sin(gamma_QEGC), sin(gamma_QEGC) = -2 / (beta V^2 cos(sigma_QEGC)
+    (L/D)) with V in sqrt(g0 R0) and beta = R0 / H the nondimensional inverse scale height
+    (the quasi-equilibrium glide's descent rate; Lu writes beta_r = rho'/rho = -beta), gain k_0
+    above V_off + ramp, ramped linearly to 0 at V_off;
+  * path limits: sin(gamma_ref) = max{sin gamma, U_a, U_Q, U_q}, the smallest flight-path angle
+    that keeps the load, heat rate and dynamic pressure under their limits ``delta`` seconds
+    ahead (a first-order prediction in an exponential atmosphere), gain k_path.
+  The two corrections add (this library's reading where both are active).
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+
+import numpy as np
+from pydrake.symbolic import max as symbolic_max
+
+from drake_entry.models.scalar import clamp, is_symbolic
+
+#: exponent of V in the heat-rate law the path-limit reference assumes (Lu 2014: 3.15)
+HEAT_RATE_VELOCITY_EXPONENT = 3.15
+
+
+@dc.dataclass(frozen=True)
+class FeedbackSettings:
+    """The altitude-rate feedback's constants (SI but the gains, which are Lu's nondimensional).
+
+    Attributes:
+      R0, g0: Lu's length [m] and acceleration [m/s^2] units.
+      beta: R0 / H, the nondimensional inverse density scale height (about 900 for Earth).
+      damping_gain: k_0 of the phugoid damping (Lu 2014: 20; 0 = off).
+      damping_bank: sigma_QEGC [rad] (Lu 2014: 60 deg).
+      damping_off_speed: V_off [m/s] where the damping gain reaches 0; ramp: the speed band [m/s]
+        over which it ramps from k_0 (Lu 2014: off at V_f* + 1000 m/s).
+      path_gain: k of the path-limit feedback (Lu 2014: 40; 0 = off).
+      horizon: delta [s] of the path-limit prediction (Lu 2014: 0.02 nondimensional, about 16 s).
+      load_max [m/s^2] (total aerodynamic acceleration), heat_max [W/m^2], q_max [Pa]: limits
+        (inf = not enforced).
+      bank_limit: the largest |sigma_cmd| [rad].
+    """
+
+    R0: float
+    g0: float
+    beta: float = 900.0
+    damping_gain: float = 20.0
+    damping_bank: float = math.radians(60.0)
+    damping_off_speed: float = 3000.0
+    ramp: float = 1000.0
+    path_gain: float = 40.0
+    horizon: float = 16.0
+    load_max: float = math.inf
+    heat_max: float = math.inf
+    q_max: float = math.inf
+    bank_limit: float = math.radians(90.0)
+
+
+def linear_bank(e, e0, ef: float, sigma0, sigmaf: float):
+    """|sigma| [rad] of the baseline profile: sigma0 at e0, sigmaf at ef, linear in e [J/kg]
+    (Lu 2014 eq. 19)."""
+    return sigma0 + (e - e0) / (ef - e0) * (sigmaf - sigma0)
+
+
+def _max(a, b):
+    return symbolic_max(a, b) if is_symbolic(a) or is_symbolic(b) else max(a, b)
+
+
+def _ramp(v, lo: float, width: float):
+    """0 below lo, 1 above lo + width, linear between (any scalar type)."""
+    return clamp((v - lo) / width, 0.0, 1.0)
+
+
+def qegc_sin_flight_path(V, lift_to_drag, s: FeedbackSettings):
+    """sin(gamma_QEGC): the quasi-equilibrium glide's flight-path angle at speed V [m/s] and
+    bank sigma_QEGC, in an exponential atmosphere of inverse scale height beta / R0."""
+    v2 = V * V / (s.g0 * s.R0)
+    return -2.0 / (s.beta * v2 * math.cos(s.damping_bank) * lift_to_drag)
+
+
+def path_limit_sin_flight_path(V, D, load, heat, q, s: FeedbackSettings):
+    """max{U_a, U_Q, U_q}: the smallest sin(gamma) that keeps the aerodynamic acceleration
+    ``load`` [m/s^2], the heat rate ``heat`` [W/m^2] and the dynamic pressure ``q`` [Pa] under
+    their limits ``horizon`` seconds ahead. With rho'/rho = -beta/R0 and dV/dt = -D:
+    a(t + delta) = a [1 + (-beta V sin(gamma)/R0 - 2D/V) delta] <= a_max gives
+    U_a = [a_max - a (1 - 2 D delta / V)] / (-a beta V delta / R0); the heat rate (sqrt(rho) V^3.15)
+    gives U_Q with 0.5 beta and 3.15 D. A limit that is inf contributes -1 (no bound)."""
+    d = s.horizon
+    k = s.beta * V * d / s.R0
+    bounds = []
+    if math.isfinite(s.load_max):
+        bounds.append((s.load_max - load * (1.0 - 2.0 * D * d / V)) / (-load * k))
+    if math.isfinite(s.q_max):
+        bounds.append((s.q_max - q * (1.0 - 2.0 * D * d / V)) / (-q * k))
+    if math.isfinite(s.heat_max):
+        n = HEAT_RATE_VELOCITY_EXPONENT
+        bounds.append((s.heat_max - heat * (1.0 - n * D * d / V)) / (-0.5 * heat * k))
+    out = -1.0
+    for b in bounds:
+        out = _max(out, b)
+    return out
+
+
+def commanded_bank(sigma_base, V, gamma, L, D, load, heat, q, s: FeedbackSettings):
+    """|sigma_cmd| [rad] in [0, bank_limit]: the baseline magnitude with the altitude-rate
+    feedback (module docstring), at speed V [m/s], flight-path angle gamma [rad], lift and drag
+    accelerations L, D [m/s^2], aerodynamic acceleration ``load`` [m/s^2], heat rate [W/m^2]
+    and q [Pa]. Any scalar type (float or symbolic)."""
+    sg = np.sin(gamma)
+    hdot = V * sg
+    correction = 0.0
+    if s.damping_gain > 0.0:
+        k = s.damping_gain * _ramp(V, s.damping_off_speed, s.ramp)
+        correction = correction + k * (hdot - V * qegc_sin_flight_path(V, L / D, s))
+    if s.path_gain > 0.0 and (math.isfinite(s.load_max) or math.isfinite(s.heat_max) or math.isfinite(s.q_max)):
+        limit = path_limit_sin_flight_path(V, D, load, heat, q, s)
+        correction = correction + s.path_gain * V * (sg - _max(sg, limit))  # <= 0: only lifts
+    c = np.cos(sigma_base) - correction * math.sqrt(s.g0 / s.R0) / L
+    return np.arccos(clamp(c, math.cos(s.bank_limit), 1.0))

@@ -1,0 +1,195 @@
+"""FNPEG's predictor (Lu 2014 Sec. III): the full 3-DOF equations over the rotating spherical
+Earth with the range integrated, ds/dt = V cos(gamma) R0 / r, flown with the baseline bank
+profile and its altitude-rate feedback (guidance/fnpeg/law.py) from the current state until
+the terminal energy e_f.
+
+The equations are built once from the same model code as the plant (drake_entry.models:
+dynamics, atmosphere, aerodynamics, heat flux) called with symbolic scalars, as a Drake
+``SymbolicVectorSystem`` that Drake integrates in C++ (fixed ``step_s`` Runge-Kutta 3 steps: a
+fixed grid keeps the corrector's finite differences free of step-size noise). Time, not energy,
+is the independent variable: a high-lift glider's phugoid climbs where drag, and so de/dt,
+nearly vanishes (the pitfall of energy-domain prediction). The prediction stops exactly at e_f
+(Newton on time from the last step, de/dt from the equations), below ``floor_m``, above
+``ceiling_m`` or at ``max_time_s``.
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+
+import numpy as np
+from pydrake.symbolic import Expression, Variable
+from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
+from pydrake.systems.primitives import SymbolicVectorSystem
+
+from drake_entry.errors import ScenarioError
+from drake_entry.guidance.fnpeg.law import FeedbackSettings, commanded_bank, linear_bank
+from drake_entry.models import dynamics
+from drake_entry.models.atmosphere import piecewise
+from drake_entry.models.schedules import Schedule
+
+_STATE = [Variable(n) for n in ("h", "lon", "lat", "V", "gamma", "psi", "s")]
+_INPUT = [Variable(n) for n in ("sigma0", "e0", "sign")]
+_TIME = Variable("t")
+#: prediction steps advanced per Simulator call (the energy is checked between calls)
+_STEPS_PER_CALL = 10
+
+
+@dc.dataclass(frozen=True)
+class Prediction:
+    """One predicted trajectory.
+
+    Attributes:
+      range_m: ground range flown [m] (at the reference radius) until the stop: nan when the
+        stop says nothing about the range at e_f (skip-out, time-out); below the floor it is the
+        range to the impact (short, whatever the rest).
+      state: [h, lon, lat, V, gamma, psi] at the stop. time_s: flight time to the stop [s].
+      reached: the stop is the terminal energy e_f; otherwise ``reason`` says which stop.
+    """
+
+    range_m: float
+    state: np.ndarray
+    time_s: float
+    reached: bool
+    reason: str = ""
+
+
+def alpha_expression(alpha: Schedule, V):
+    """The angle-of-attack profile alpha(V) [rad] (a 'velocity' Schedule, linear between its
+    breakpoints, held outside) as a symbolic expression of V."""
+    if alpha.variable != "velocity":
+        raise ScenarioError(f"FNPEG's predictor flies an alpha profile in velocity, got variable '{alpha.variable}'")
+    bp, v = alpha.breakpoints, alpha.values
+    if len(bp) == 1:
+        return Expression(float(v[0]))
+    edges = [-math.inf, *bp, math.inf]
+
+    def piece(i):
+        if i == 0:
+            return Expression(float(v[0]))
+        if i == len(bp):
+            return Expression(float(v[-1]))
+        return v[i - 1] + (V - bp[i - 1]) * ((v[i] - v[i - 1]) / (bp[i] - bp[i - 1]))
+
+    return piecewise(V, edges, piece)
+
+
+class Predictor:
+    """Predicts FNPEG trajectories of one vehicle (module docstring).
+
+    Args: vehicle, planet, atmosphere (the on-board models); law: the feedback settings;
+    sigma_f [rad]: the profile's terminal bank; e_f [J/kg]: the terminal energy (mu/r - V^2/2);
+    alpha: the angle-of-attack profile (Schedule in velocity); step_s: the fixed integration step
+    [s]; floor_m, ceiling_m: altitudes that end a prediction; max_time_s: the longest prediction.
+    """
+
+    def __init__(self, vehicle, planet, atmosphere, law: FeedbackSettings, *, sigma_f: float, e_f: float,
+                 alpha: Schedule, step_s: float = 2.0, floor_m: float = 0.0, ceiling_m: float = 200e3,
+                 max_time_s: float = 10000.0):
+        if not step_s > 0:
+            raise ScenarioError(f"FNPEG predictor step_s = {step_s}; allowed > 0 s")
+        self.planet, self.mu, self.e_f = planet, planet.mu, e_f
+        self.step_s, self.floor_m, self.ceiling_m, self.max_time_s = step_s, floor_m, ceiling_m, max_time_s
+        x = [Expression(v) for v in _STATE[:6]]
+        sigma0, e0, sign = (Expression(u) for u in _INPUT)
+        h, V, gamma = x[0], x[3], x[4]
+        r = planet.radius(h)
+        with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
+            a = alpha_expression(alpha, V)
+            rho, sound = dynamics.air_data(x, planet, atmosphere)
+            _, L, D = dynamics.aero_accelerations(x, a, rho, sound, vehicle)
+            e = self.mu / r - 0.5 * V * V
+            base = linear_bank(e, e0, e_f, sigma0, sigma_f)
+            load = np.sqrt(L * L + D * D)
+            q = dynamics.dynamic_pressure(rho, V)
+            heat = vehicle.heat_flux(rho, V, a)
+            bank = sign * commanded_bank(base, V, gamma, L, D, load, heat, q, law)
+            xdot = dynamics.equations_of_motion(x, bank, L, D, planet)
+            sdot = V * np.cos(gamma) * planet.reference_radius / r
+        self.system = SymbolicVectorSystem(time=_TIME, state=_STATE, input=_INPUT, dynamics=[*xdot, sdot],
+                                           output=[Expression(v) for v in _STATE])
+        self.simulator = Simulator(self.system)
+        integrator = ResetIntegratorFromFlags(self.simulator, "runge_kutta3", step_s)
+        integrator.set_fixed_step_mode(True)
+        integrator.set_maximum_step_size(step_s)
+        self.context = self.simulator.get_mutable_context()
+        self.input = self.system.get_input_port()
+        self.evaluations = 0
+        self.predictions = 0
+
+    def energy(self, x) -> float:
+        """e = mu/r - V^2/2 [J/kg] of a state."""
+        return self.mu / self.planet.radius(x[0]) - 0.5 * x[3] * x[3]
+
+    def _state(self) -> np.ndarray:
+        return self.context.get_continuous_state_vector().CopyToVector()
+
+    def predict(self, x, sigma0: float, sign: float = 1.0) -> Prediction:
+        """Fly the profile from sigma0 [rad] at state ``x`` [6] (its energy is e_0) with the bank
+        sign ``sign`` held, until e_f or another stop (class docstring)."""
+        x = np.asarray(x, float)
+        ctx = self.context
+        ctx.SetTime(0.0)
+        ctx.SetContinuousState([*x, 0.0])
+        self.input.FixValue(ctx, [float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0])
+        integrator = self.simulator.get_mutable_integrator()
+        n0 = integrator.get_num_derivative_evaluations()
+        self.predictions += 1
+        self.simulator.Initialize()
+        try:
+            return self._fly()
+        except ValueError as err:  # a NaN reaching a sqrt or log inside the native evaluation
+            return Prediction(math.nan, self._state()[:6], ctx.get_time(), False,
+                              f"the prediction left the models' domain ({str(err).splitlines()[0]})")
+        finally:
+            self.evaluations += integrator.get_num_derivative_evaluations() - n0
+
+    def _fly(self) -> Prediction:
+        ctx, sim, e_f = self.context, self.simulator, self.e_f
+        chunk = _STEPS_PER_CALL * self.step_s
+        while True:
+            t0, before = ctx.get_time(), self._state()
+            sim.AdvanceTo(t0 + chunk)
+            y = self._state()
+            if self.energy(y) >= e_f:
+                return self._finish(t0, before)
+            stop = self._stop(y, ctx.get_time())
+            if stop:
+                flown = y[6] if y[0] < self.floor_m else math.nan
+                return Prediction(flown, y[:6], ctx.get_time(), False, stop)
+
+    def _stop(self, y, t) -> str:
+        if y[0] < self.floor_m:
+            return f"below {self.floor_m / 1e3:.0f} km before the terminal energy"
+        if y[0] > self.ceiling_m:
+            return f"above {self.ceiling_m / 1e3:.0f} km (skip-out)"
+        if t >= self.max_time_s:
+            return f"the terminal energy is not reached in {self.max_time_s:.0f} s"
+        return ""
+
+    def _finish(self, t0: float, before) -> Prediction:
+        """Step again from ``before`` (at t0) one step at a time to the step that crosses e_f,
+        then Newton on time to e_f."""
+        ctx, sim = self.context, self.simulator
+        ctx.SetTime(t0)
+        ctx.SetContinuousState(before)
+        sim.Initialize()
+        while True:
+            t, y = ctx.get_time(), self._state()
+            sim.AdvanceTo(t + self.step_s)
+            if self.energy(self._state()) >= self.e_f:
+                break
+        ctx.SetTime(t)
+        ctx.SetContinuousState(y)
+        sim.Initialize()
+        for _ in range(3):
+            y = self._state()
+            xdot = self.system.EvalTimeDerivatives(ctx).CopyToVector()
+            r = self.planet.radius(y[0])
+            edot = -self.mu * xdot[0] / (r * r) - y[3] * xdot[3]
+            dt = (self.e_f - self.energy(y)) / edot
+            if not edot > 0 or not dt > 1e-6:
+                break
+            sim.AdvanceTo(ctx.get_time() + dt)
+        y = self._state()
+        return Prediction(y[6], y[:6], ctx.get_time(), True)

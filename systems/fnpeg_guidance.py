@@ -1,0 +1,107 @@
+"""FnpegGuidance: Lu (2014)'s predictor-corrector on board (drake_entry.guidance.fnpeg).
+
+Every ``period`` seconds, from the navigation estimate and the sensed flight conditions:
+before engagement |sigma| holds ``bank_before``; the guidance engages when the sensed
+aerodynamic acceleration sqrt(L^2 + D^2) reaches ``engage_acceleration``. Engaged, every
+``corrector_period`` seconds (while V is above the setup's hold speed) the corrector solves
+sigma_0 from the estimate with the current bank sign held in the predictions; every period
+|sigma| is the profile's sigma_0 with the altitude-rate feedback on the navigated hdot and the
+sensed L, D, heat rate and q. The shared reversal logic signs |sigma|; the shared actuators fly
+it and the alpha profile's command. The commands computed at a sample are output from the
+next (one guidance period of computing delay).
+
+Ports:
+  - input  "estimated_state"    [6]  [h m, lon, lat rad, V m/s, gamma, psi rad]
+  - input  "flight_conditions"  [9]  sensed rho, Mach, q, heat flux, loads, L, D, E
+  - input  "bank_command"       [1]  the signed bank command [rad] (its sign is held in the predictions)
+  - output "bank_magnitude"     [1]  |sigma| [rad]
+  - output "alpha_command"      [1]  alpha [rad]
+  - output "sigma0"             [1]  the sigma_0 in use [rad]
+  - output "range_error"        [1]  the last corrector's predicted range error z [m] (nan before)
+  - output "stats"              [6]  engaged (0/1), engagement time [s], corrections, predictions,
+                                   corrections not converged, wall time correcting [s]
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from drake_entry.errors import ScenarioError
+from drake_entry.guidance.fnpeg.onboard import FnpegSetup
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+
+_FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
+(_ENGAGED, _T_ENGAGE, _CORRECTIONS, _PREDICTIONS, _UNCONVERGED, _WALL, _SIGMA0, _SLOPE, _MAGNITUDE, _ALPHA,
+ _NEXT, _Z) = range(12)
+
+
+class FnpegGuidance(LeafSystem):
+    def __init__(self, setup: FnpegSetup, *, sigma0_guess: float, bank_before: float, initial_alpha: float,
+                 engage_acceleration: float, period: float = 1.0, corrector_period: float = 1.0):
+        """Args: setup (the mission's predictor, corrector and law); sigma0_guess [rad] (the first
+        corrector's start); bank_before [rad] (|sigma| before engagement); initial_alpha [rad] (the
+        alpha command before the first sample); engage_acceleration [m/s^2]; period,
+        corrector_period [s]."""
+        super().__init__()
+        if not period > 0 or not corrector_period >= period:
+            raise ScenarioError(f"FnpegGuidance: period = {period} s must be > 0 and corrector_period = "
+                                f"{corrector_period} s at least the period")
+        self.setup, self.engage_acceleration, self.corrector_period = setup, engage_acceleration, corrector_period
+        self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
+        self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
+        self.bank_port = self.DeclareVectorInputPort("bank_command", 1)
+        start = np.zeros(12)
+        start[[_T_ENGAGE, _SLOPE, _Z]] = math.nan
+        start[_SIGMA0], start[_MAGNITUDE] = sigma0_guess, bank_before
+        start[_ALPHA] = initial_alpha
+        self._state = self.DeclareDiscreteState(BasicVector(start))
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+        deps = {self.xd_ticket()}
+        for name, index in (("bank_magnitude", _MAGNITUDE), ("alpha_command", _ALPHA), ("sigma0", _SIGMA0),
+                            ("range_error", _Z)):
+            self.DeclareVectorOutputPort(name, 1, lambda c, o, i=index: o.SetAtIndex(0, self._memory(c)[i]),
+                                         prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort("stats", 6, lambda c, o: o.SetFromVector(self._memory(c)[_ENGAGED:_SIGMA0]),
+                                     prerequisites_of_calc=deps)
+
+    def _memory(self, context) -> np.ndarray:
+        return context.get_discrete_state(self._state).get_value()
+
+    def _update(self, context, discrete_state):
+        m = self._memory(context).copy()
+        s = self.setup
+        t = context.get_time()
+        x = np.asarray(self.est_port.Eval(context), float)
+        fc = self.fc_port.Eval(context)
+        L, D = float(fc[_FC["lift"]]), float(fc[_FC["drag"]])
+        if not m[_ENGAGED] and math.hypot(L, D) >= self.engage_acceleration:
+            m[_ENGAGED], m[_T_ENGAGE], m[_NEXT] = 1.0, t, t
+        if m[_ENGAGED]:
+            if t >= m[_NEXT] - 1e-9 and x[3] > s.hold_speed:
+                m[_NEXT] += self.corrector_period
+                self._correct(context, x, m)
+            m[_MAGNITUDE] = s.bank_magnitude(x, float(m[_SIGMA0]), L, D, float(fc[_FC["heat_flux"]]),
+                                             float(fc[_FC["dynamic_pressure"]]))
+        m[_ALPHA] = s.alpha_command(x[3])
+        discrete_state.get_mutable_vector(self._state).SetFromVector(m)
+
+    def _correct(self, context, x, m):
+        t0 = time.perf_counter()
+        sign = 1.0 if float(self.bank_port.Eval(context)[0]) >= 0 else -1.0
+        slope = None if not math.isfinite(m[_SLOPE]) else float(m[_SLOPE])
+        n0 = self.setup.predictor.predictions
+        try:
+            c = self.setup.correct(x, float(m[_SIGMA0]), sign, slope)
+        except Exception:  # a failed correction must not stop the flight: sigma_0 flies on
+            c = None
+        m[_CORRECTIONS] += 1
+        m[_PREDICTIONS] += self.setup.predictor.predictions - n0
+        if c is None or not math.isfinite(c.z):
+            m[_UNCONVERGED] += 1
+        else:
+            m[_SIGMA0], m[_SLOPE], m[_Z] = c.sigma0, c.slope, c.z
+            m[_UNCONVERGED] += not c.converged
+        m[_WALL] += time.perf_counter() - t0

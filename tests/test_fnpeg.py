@@ -1,0 +1,202 @@
+"""FNPEG (Lu 2014): the law's feedback terms against their derivations, the corrector on
+functions with known roots, the native predictor against the models and its own step, the
+spec's errors, and the closed loop through engagement and the first corrections."""
+import math
+
+import numpy as np
+import pytest
+from pydrake.symbolic import Variable
+
+from drake_entry.errors import ScenarioError
+from drake_entry.guidance.fnpeg.corrector import SIGMA0_BOUNDS, CorrectorSettings, correct
+from drake_entry.guidance.fnpeg.law import (
+    FeedbackSettings,
+    commanded_bank,
+    linear_bank,
+    path_limit_sin_flight_path,
+    qegc_sin_flight_path,
+)
+from drake_entry.guidance.fnpeg.onboard import FnpegSetup
+from drake_entry.models import dynamics
+from drake_entry.scenario import apply_overrides, load_scenario
+
+R0, G0 = 6378137.0, 9.80665
+#: a CAV-H state a few seconds after engagement (sqrt(L^2 + D^2) ~ 1.5 m/s^2), from the packaged scenario
+ENGAGED = np.array([5.96448e4, -0.869685, 0.933247, 7461.26, -0.0296397, 0.995540])
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return FnpegSetup.from_scenario(load_scenario("cav_h_fnpeg"))
+
+
+def test_linear_bank_runs_from_sigma0_to_sigmaf():
+    assert linear_bank(3.0, 3.0, 7.0, 0.4, 1.0) == pytest.approx(0.4)
+    assert linear_bank(7.0, 3.0, 7.0, 0.4, 1.0) == pytest.approx(1.0)
+    assert linear_bank(5.0, 3.0, 7.0, 0.4, 1.0) == pytest.approx(0.7)
+
+
+def test_without_feedback_the_command_is_the_profile_and_the_limit_clips_it():
+    s = FeedbackSettings(R0, G0, damping_gain=0.0, path_gain=0.0, bank_limit=math.radians(85.0))
+    assert commanded_bank(0.7, 6000.0, -0.01, 5.0, 1.6, 5.2, 3e6, 3e4, s) == pytest.approx(0.7, abs=1e-12)
+    assert commanded_bank(1.55, 6000.0, -0.01, 5.0, 1.6, 5.2, 3e6, 3e4, s) == pytest.approx(math.radians(85.0))
+
+
+def test_phugoid_damping_is_zero_on_the_qegc_descent_and_lifts_a_faster_descent():
+    s = FeedbackSettings(R0, G0, damping_gain=20.0, path_gain=0.0, damping_off_speed=2000.0, ramp=1000.0)
+    V, L, D = 6000.0, 5.0, 1.6
+    gamma_qegc = math.asin(qegc_sin_flight_path(V, L / D, s))
+    assert -0.01 < gamma_qegc < 0.0  # a shallow glide descent
+    assert commanded_bank(0.8, V, gamma_qegc, L, D, 5.2, 3e6, 3e4, s) == pytest.approx(0.8, abs=1e-12)
+    assert commanded_bank(0.8, V, gamma_qegc - 0.01, L, D, 5.2, 3e6, 3e4, s) < 0.8  # more vertical lift
+    assert commanded_bank(0.8, V, gamma_qegc + 0.01, L, D, 5.2, 3e6, 3e4, s) > 0.8
+    # the gain ramps to 0 at damping_off_speed: no correction there
+    assert commanded_bank(0.8, 2000.0, gamma_qegc - 0.01, L, D, 5.2, 3e6, 3e4, s) == pytest.approx(0.8, abs=1e-12)
+
+
+def test_qegc_angle_is_the_equilibrium_glide_derivative():
+    """sin(gamma_QEGC) = -2 / (beta v^2 cos(sigma) L/D): differentiate the equilibrium glide
+    L cos(sigma) = g - V^2/r in an exponential atmosphere (rho' / rho = -beta / R0, dV/dt = -D)
+    numerically and compare."""
+    s = FeedbackSettings(R0, G0, beta=900.0)
+    V, ld = 5000.0, 3.0
+    # equilibrium glide altitude h(V): rho(h) V^2 k cos(sigma) = g0 - V^2/R0 with rho = exp(-beta h / R0)
+    k = 1e-3
+
+    def h_eq(v):
+        return -R0 / s.beta * math.log((G0 - v * v / R0) / (v * v * k * math.cos(s.damping_bank)))
+
+    dv = 0.01
+    dh_dv = (h_eq(V + dv) - h_eq(V - dv)) / (2 * dv)
+    L = G0 - V * V / R0  # vertical lift per cos(sigma) on the glide, with D = L / ld ...
+    D = L / math.cos(s.damping_bank) / ld
+    sin_gamma = dh_dv * (-D) / V  # hdot = dh/dV * dV/dt
+    assert qegc_sin_flight_path(V, ld, s) == pytest.approx(sin_gamma, rel=2e-3)
+
+
+@pytest.mark.parametrize("which", ["load", "q", "heat"])
+def test_path_limit_bound_keeps_the_predicted_quantity_at_its_limit(which):
+    """At sin(gamma) = U, the first-order prediction of the quantity ``horizon`` seconds ahead
+    (rho'/rho = -beta/R0, dV/dt = -D) equals its limit."""
+    V, D, d, beta = 6500.0, 2.0, 16.0, 900.0
+    value, exponent_rho, exponent_v = {"load": (12.0, 1.0, 2.0), "q": (4e4, 1.0, 2.0),
+                                       "heat": (4e6, 0.5, 3.15)}[which]
+    limit = 0.9 * value
+    kwargs = {"load_max": limit} if which == "load" else {"q_max": limit} if which == "q" else {"heat_max": limit}
+    s = FeedbackSettings(R0, G0, beta=beta, horizon=d, **kwargs)
+    loads = {"load": value, "q": 1.0, "heat": 1.0}
+    u = path_limit_sin_flight_path(V, D, loads["load"], value if which == "heat" else 1.0,
+                                   value if which == "q" else 1.0, s)
+    rate = exponent_rho * (-beta * V * u / R0) - exponent_v * D / V
+    assert value * (1.0 + rate * d) == pytest.approx(limit, rel=1e-12)
+
+
+def test_law_is_the_same_for_float_and_symbolic_scalars():
+    s = FeedbackSettings(R0, G0, path_gain=40.0, load_max=1.8 * G0, heat_max=4.3e6, q_max=6e4,
+                         bank_limit=math.radians(85.0))
+    names = ("sigma", "V", "gamma", "L", "D", "a", "heat", "q")
+    xs = [Variable(n) for n in names]
+    with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
+        expr = commanded_bank(*xs, s)
+    rng = np.random.default_rng(40)
+    for _ in range(20):
+        vals = [rng.uniform(0.2, 1.3), rng.uniform(2500, 7400), rng.uniform(-0.05, 0.02), rng.uniform(1, 20),
+                rng.uniform(0.3, 6), rng.uniform(1, 25), rng.uniform(1e6, 6e6), rng.uniform(5e3, 9e4)]
+        assert expr.Evaluate(dict(zip(xs, vals))) == pytest.approx(commanded_bank(*vals, s), rel=1e-12, abs=1e-12)
+
+
+def test_corrector_finds_a_root_by_the_damped_secant():
+    target = math.radians(63.0)
+    z = lambda s0: 4e6 * (math.cos(target) - math.cos(s0))  # noqa: E731  (z grows with the bank: less range flown)
+    c = correct(z, math.radians(20.0), CorrectorSettings(tolerance=50.0))
+    assert c.converged and abs(c.z) <= 50.0 and c.sigma0 == pytest.approx(target, abs=2e-5)
+    assert c.predictions <= 10
+    again = correct(z, c.sigma0, CorrectorSettings(tolerance=50.0), slope=c.slope)  # the next cycle
+    assert again.converged and again.predictions == 1
+
+
+def test_corrector_without_a_root_stops_on_the_bound_not_a_traceback():
+    """Energy short: the range falls short whatever the bank (z > 0 everywhere) -> sigma_0 = 0,
+    not converged, with the reason."""
+    z = lambda s0: 2e5 + 4e6 * (1.0 - math.cos(s0))  # noqa: E731
+    c = correct(z, math.radians(40.0), CorrectorSettings(tolerance=100.0))
+    assert not c.converged and c.sigma0 == pytest.approx(SIGMA0_BOUNDS[0]) and c.stop
+    # too long whatever the bank: sigma_0 stays at 90 deg, never beyond
+    c = correct(lambda s0: -1e5 + 1e3 * s0, math.radians(80.0), CorrectorSettings())
+    assert not c.converged and c.sigma0 == pytest.approx(SIGMA0_BOUNDS[1])
+
+
+def test_predictor_derivatives_are_the_plants_with_the_laws_bank(setup):
+    """The native predictor's dx/dt at a state equals drake_entry.models.dynamics with the bank
+    commanded_bank gives there, in float."""
+    p = setup.predictor
+    sigma0, sign = math.radians(55.0), -1.0
+    ctx = p.context
+    ctx.SetContinuousState([*ENGAGED, 0.0])
+    p.input.FixValue(ctx, [sigma0, setup.energy(ENGAGED) + 1e5, sign])  # e0 below: the profile has moved
+    got = p.system.EvalTimeDerivatives(ctx).CopyToVector()
+    x = ENGAGED
+    alpha = setup.alpha_command(x[3])
+    rho, a = dynamics.air_data(x, setup.planet, setup.atmosphere)
+    _, L, D = dynamics.aero_accelerations(x, alpha, rho, a, setup.vehicle)
+    base = linear_bank(setup.energy(x), setup.energy(x) + 1e5, setup.e_f, sigma0, setup.sigma_f)
+    bank = sign * commanded_bank(base, x[3], x[4], L, D, math.hypot(L, D), setup.vehicle.heat_flux(rho, x[3], alpha),
+                                 0.5 * rho * x[3] ** 2, setup.feedback)
+    want = dynamics.equations_of_motion(list(x), bank, L, D, setup.planet)
+    r = setup.planet.radius(x[0])
+    np.testing.assert_allclose(got[:6], want, rtol=1e-10)
+    assert got[6] == pytest.approx(x[3] * math.cos(x[4]) * setup.planet.reference_radius / r, rel=1e-12)
+
+
+def test_prediction_stops_at_the_terminal_energy_and_converges_with_the_step(setup):
+    sigma0 = math.radians(70.0)
+    coarse = setup.predict(ENGAGED, sigma0)
+    assert coarse.reached and setup.energy(coarse.state) == pytest.approx(setup.e_f, rel=1e-9)
+    fine_predictor = FnpegSetup.from_scenario(_scenario({"guidance.predictor_step_s": 1.0})).predictor
+    fine = fine_predictor.predict(ENGAGED, sigma0)
+    # measured: 4-s steps within about 60 m of 0.5-s steps over a 3700-s, 22 000-km prediction
+    assert abs(coarse.range_m - fine.range_m) < 200.0, (coarse.range_m, fine.range_m)
+    assert 5e6 < fine.range_m < 2e7 and 1000.0 < fine.time_s < 4000.0
+
+
+def _scenario(overrides):
+    sc = load_scenario("cav_h_fnpeg")
+    apply_overrides(sc, overrides)
+    return sc
+
+
+@pytest.mark.parametrize("overrides, field", [
+    ({"guidance.alpha_deg": [10.0, 12.0], "guidance.alpha_velocity_m_s": [1000.0]}, "guidance.alpha_deg"),
+    ({"guidance.alpha_velocity_m_s": [7000.0, 2000.0]}, "guidance.alpha_velocity_m_s"),
+    ({"guidance.corrector_period_s": 0.5}, "guidance.corrector_period_s"),
+    ({"guidance.bank_end_deg": 95.0}, "guidance.bank_end_deg"),
+    ({"guidance.predictor_step_s": 0.0}, "guidance.predictor_step_s"),
+    ({"vehicle_limits": {"mass_kg": 1.0}}, "vehicle_limits"),
+    ({"vehicle_limits": {"total_load_max_g": -1.0}}, "vehicle_limits.total_load_max_g"),
+])
+def test_bad_settings_name_the_field(overrides, field):
+    with pytest.raises(ScenarioError, match=field.replace(".", r"\.")):
+        _scenario(overrides).validate()
+
+
+def test_vehicle_limits_replace_the_files():
+    v = _scenario({}).make_vehicle()
+    assert v.bank_rate_limit == pytest.approx(math.radians(10.0)) and v.limits.total_load_max == pytest.approx(2.5)
+    assert load_scenario("cav_h").make_vehicle().limits.total_load_max == pytest.approx(2.0)
+
+
+def test_closed_loop_engages_on_the_acceleration_and_corrects_every_second():
+    """The first 420 s of the packaged flight: ballistic until sqrt(L^2 + D^2) reaches 1.52 m/s^2
+    (about 315 s), then one correction a second, each converged."""
+    from drake_entry.diagrams.closed_loop import fly
+
+    sc = _scenario({})
+    sc.simulation.max_time_s = 420.0
+    r = fly(sc)
+    f = r.guidance.fields
+    assert r.guidance.active and 250.0 < f["engage_time_s"] < 380.0
+    assert r.guidance.plans == pytest.approx(420.0 - f["engage_time_s"], abs=2)
+    assert f["corrections_unconverged"] == 0 and abs(f["last_predicted_range_error_m"]) <= 100.0
+    L, D = r.trajectory.column("lift"), r.trajectory.column("drag")
+    engaged = r.trajectory.time >= f["engage_time_s"]
+    assert np.all(np.hypot(L, D)[~engaged][:-1] < 1.52 + 1e-9)

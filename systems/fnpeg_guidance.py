@@ -31,29 +31,35 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.fnpeg.onboard import FnpegSetup
+from drake_entry.models.acceleration_ratios import filtered_ratios
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 
 _FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
 (_ENGAGED, _T_ENGAGE, _CORRECTIONS, _PREDICTIONS, _UNCONVERGED, _WALL, _SIGMA0, _SLOPE, _MAGNITUDE, _ALPHA,
- _NEXT, _Z) = range(12)
+ _NEXT, _Z, _KL, _KD) = range(14)
 
 
 class FnpegGuidance(LeafSystem):
     def __init__(self, setup: FnpegSetup, *, sigma0_guess: float, bank_before: float, initial_alpha: float,
-                 engage_acceleration: float, period: float = 1.0, corrector_period: float = 1.0):
+                 engage_acceleration: float, period: float = 1.0, corrector_period: float = 1.0,
+                 scaling: bool = True):
         """Args: setup (the mission's predictor, corrector and law); sigma0_guess [rad] (the first
         corrector's start); bank_before [rad] (|sigma| before engagement); initial_alpha [rad] (the
         alpha command before the first sample); engage_acceleration [m/s^2]; period,
-        corrector_period [s]."""
+        corrector_period [s]; scaling: the
+        predictions fly the nominal lift and drag times the low-passed ratios of the sensed to the
+        modelled accelerations (models.acceleration_ratios), else the nominal models."""
         super().__init__()
         if not period > 0 or not corrector_period >= period:
             raise ScenarioError(f"FnpegGuidance: period = {period} s must be > 0 and corrector_period = "
                                 f"{corrector_period} s at least the period")
         self.setup, self.engage_acceleration, self.corrector_period = setup, engage_acceleration, corrector_period
+        self.scaling, self.period = scaling, period
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self.bank_port = self.DeclareVectorInputPort("bank_command", 1)
-        start = np.zeros(12)
+        start = np.zeros(14)
+        start[[_KL, _KD]] = 1.0
         start[[_T_ENGAGE, _SLOPE, _Z]] = math.nan
         start[_SIGMA0], start[_MAGNITUDE] = sigma0_guess, bank_before
         start[_ALPHA] = initial_alpha
@@ -77,6 +83,9 @@ class FnpegGuidance(LeafSystem):
         x = np.asarray(self.est_port.Eval(context), float)
         fc = self.fc_port.Eval(context)
         L, D = float(fc[_FC["lift"]]), float(fc[_FC["drag"]])
+        if self.scaling:
+            m[_KL], m[_KD] = filtered_ratios((m[_KL], m[_KD]), x, float(m[_ALPHA]), L, D, s.vehicle, s.planet,
+                                             s.atmosphere, self.period)
         if not m[_ENGAGED] and math.hypot(L, D) >= self.engage_acceleration:
             m[_ENGAGED], m[_T_ENGAGE], m[_NEXT] = 1.0, t, t
         if m[_ENGAGED]:
@@ -94,7 +103,7 @@ class FnpegGuidance(LeafSystem):
         slope = None if not math.isfinite(m[_SLOPE]) else float(m[_SLOPE])
         n0 = self.setup.predictor.predictions
         try:
-            c = self.setup.correct(x, float(m[_SIGMA0]), sign, slope)
+            c = self.setup.correct(x, float(m[_SIGMA0]), sign, slope, (float(m[_KL]), float(m[_KD])))
         except Exception:  # a failed correction must not stop the flight: sigma_0 flies on
             c = None
         m[_CORRECTIONS] += 1

@@ -127,18 +127,20 @@ def test_corrector_without_a_root_stops_on_the_bound_not_a_traceback():
 
 
 def test_predictor_derivatives_are_the_plants_with_the_laws_bank(setup):
-    """The native predictor's dx/dt at a state equals drake_entry.models.dynamics with the bank
-    commanded_bank gives there, in float."""
+    """The native predictor's dx/dt at a state equals drake_entry.models.dynamics with the lift and
+    drag scaled as the flight has shown and the bank commanded_bank gives there, in float."""
     p = setup.predictor
     sigma0, sign = math.radians(55.0), -1.0
     ctx = p.context
     ctx.SetContinuousState([*ENGAGED, 0.0])
-    p.input.FixValue(ctx, [sigma0, setup.energy(ENGAGED) + 1e5, sign])  # e0 below: the profile has moved
+    k_lift, k_drag = 1.04, 0.97  # what the flight has shown: the predictions fly the models times these
+    p.input.FixValue(ctx, [sigma0, setup.energy(ENGAGED) + 1e5, sign, k_lift, k_drag])  # e0 below: the profile has moved
     got = p.system.EvalTimeDerivatives(ctx).CopyToVector()
     x = ENGAGED
     alpha = setup.alpha_command(x[3])
     rho, a = dynamics.air_data(x, setup.planet, setup.atmosphere)
     _, L, D = dynamics.aero_accelerations(x, alpha, rho, a, setup.vehicle)
+    L, D = k_lift * L, k_drag * D
     base = linear_bank(setup.energy(x), setup.energy(x) + 1e5, setup.e_f, sigma0, setup.sigma_f)
     bank = sign * commanded_bank(base, x[3], x[4], L, D, math.hypot(L, D), setup.vehicle.heat_flux(rho, x[3], alpha),
                                  0.5 * rho * x[3] ** 2, setup.feedback)

@@ -66,17 +66,18 @@ class FnpegSetup:
         """Great-circle distance [m] from the state's position to the target."""
         return float(self.planet.great_circle_distance(x[1], x[2], *self.target))
 
-    def predict(self, x, sigma0: float, sign: float = 1.0) -> Prediction:
-        return self.predictor.predict(x, sigma0, sign)
+    def predict(self, x, sigma0: float, sign: float = 1.0, scales=(1.0, 1.0)) -> Prediction:
+        return self.predictor.predict(x, sigma0, sign, scales)
 
     def range_error(self, x, sigma0: float, sign: float = 1.0) -> float:
         """z = s_to_go - s_flown(sigma0) - s_f* [m] of one prediction (> 0: short)."""
         return self.range_to_go(x) - self.predict(x, sigma0, sign).range_m - self.final_range
 
-    def correct(self, x, sigma0: float, sign: float, slope: float | None = None) -> Correction:
-        """The corrector's sigma_0 [rad] from the state ``x`` with the bank sign ``sign`` held."""
+    def correct(self, x, sigma0: float, sign: float, slope: float | None = None, scales=(1.0, 1.0)) -> Correction:
+        """The corrector's sigma_0 [rad] from the state ``x`` with the bank sign ``sign`` held and
+        the predictions' lift and drag times ``scales`` (k_L, k_D)."""
         s_to_go = self.range_to_go(x) - self.final_range
-        return correct(lambda s0: s_to_go - self.predict(x, s0, sign).range_m, sigma0, self.corrector, slope)
+        return correct(lambda s0: s_to_go - self.predict(x, s0, sign, scales).range_m, sigma0, self.corrector, slope)
 
     def energy(self, x) -> float:
         return self.predictor.energy(x)

@@ -29,7 +29,7 @@ from drake_entry.models.atmosphere import piecewise
 from drake_entry.models.schedules import Schedule
 
 _STATE = [Variable(n) for n in ("h", "lon", "lat", "V", "gamma", "psi", "s")]
-_INPUT = [Variable(n) for n in ("sigma0", "e0", "sign")]
+_INPUT = [Variable(n) for n in ("sigma0", "e0", "sign", "lift_scale", "drag_scale")]
 _TIME = Variable("t")
 #: prediction steps advanced per Simulator call (the energy is checked between calls)
 _STEPS_PER_CALL = 10
@@ -91,13 +91,14 @@ class Predictor:
         self.planet, self.mu, self.e_f = planet, planet.mu, e_f
         self.step_s, self.floor_m, self.ceiling_m, self.max_time_s = step_s, floor_m, ceiling_m, max_time_s
         x = [Expression(v) for v in _STATE[:6]]
-        sigma0, e0, sign = (Expression(u) for u in _INPUT)
+        sigma0, e0, sign, k_lift, k_drag = (Expression(u) for u in _INPUT)
         h, V, gamma = x[0], x[3], x[4]
         r = planet.radius(h)
         with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
             a = alpha_expression(alpha, V)
             rho, sound = dynamics.air_data(x, planet, atmosphere)
             _, L, D = dynamics.aero_accelerations(x, a, rho, sound, vehicle)
+            L, D = k_lift * L, k_drag * D
             e = self.mu / r - 0.5 * V * V
             base = linear_bank(e, e0, e_f, sigma0, sigma_f)
             load = np.sqrt(L * L + D * D)
@@ -124,14 +125,15 @@ class Predictor:
     def _state(self) -> np.ndarray:
         return self.context.get_continuous_state_vector().CopyToVector()
 
-    def predict(self, x, sigma0: float, sign: float = 1.0) -> Prediction:
+    def predict(self, x, sigma0: float, sign: float = 1.0, scales=(1.0, 1.0)) -> Prediction:
         """Fly the profile from sigma0 [rad] at state ``x`` [6] (its energy is e_0) with the bank
-        sign ``sign`` held, until e_f or another stop (class docstring)."""
+        sign ``sign`` held and the modelled lift and drag times ``scales`` (k_L, k_D: what the
+        flight has shown, models.acceleration_ratios), until e_f or another stop (class docstring)."""
         x = np.asarray(x, float)
         ctx = self.context
         ctx.SetTime(0.0)
         ctx.SetContinuousState([*x, 0.0])
-        self.input.FixValue(ctx, [float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0])
+        self.input.FixValue(ctx, [float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0, *map(float, scales)])
         integrator = self.simulator.get_mutable_integrator()
         n0 = integrator.get_num_derivative_evaluations()
         self.predictions += 1

@@ -39,6 +39,9 @@ class Fnpeg(ReversingBankSpec):
     first_difference_deg: float = 1.0
     # sigma_0 is held (not corrected) below this speed above V_f [m/s]: dz/dsigma_0 -> 0 at the end
     hold_speed_margin_m_s: float = 300.0
+    # the predictions fly the nominal lift and drag times the low-passed sensed/modelled ratios
+    # (what the flight has shown of a density or aerodynamic error), else the nominal models
+    acceleration_scaling: bool = True
     # predictor: fixed Runge-Kutta 3 step [s]
     predictor_step_s: float = 4.0
     # altitude-rate feedback (Lu 2014 Sec. IV; gains nondimensional, 0 = off)

@@ -12,12 +12,12 @@ from drake_entry.guidance.fnpeg.corrector import SIGMA0_BOUNDS, CorrectorSetting
 from drake_entry.guidance.fnpeg.law import (
     FeedbackSettings,
     commanded_bank,
-    linear_bank,
     path_limit_sin_flight_path,
     qegc_sin_flight_path,
 )
 from drake_entry.guidance.fnpeg.onboard import FnpegSetup
 from drake_entry.models import dynamics
+from drake_entry.models.schedules import linear_bank
 from drake_entry.scenario import apply_overrides, load_scenario
 
 R0, G0 = 6378137.0, 9.80665

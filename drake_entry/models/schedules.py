@@ -122,3 +122,10 @@ class Schedule:
         if isinstance(s, np.ndarray) and s.dtype == object:
             return np.array([self.at(e) for e in s.ravel()], dtype=object).reshape(s.shape)
         return self(float(s) if np.ndim(s) == 0 else s)
+
+
+def linear_bank(e, e0, ef: float, sigma0, sigmaf):
+    """|sigma| [rad] linear in the energy-like variable e = mu/r - V^2/2 [J/kg] (increasing along
+    the flight): sigma0 at e0, sigmaf at ef (paper 004 eq. 17; Lu 2014's baseline profile). Any
+    scalar type or numpy arrays."""
+    return sigma0 + (e - e0) / (ef - e0) * (sigmaf - sigma0)

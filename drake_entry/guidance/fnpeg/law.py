@@ -2,9 +2,9 @@
 predictor (guidance/fnpeg/predictor.py) builds it into a native Drake system, the on-board
 guidance (systems/fnpeg_guidance.py) evaluates it on the navigated state.
 
-- The baseline profile: |sigma| linear in the energy-like variable e = mu/r - V^2/2 (Lu 2014
-  eq. 19 in SI; e increases along the flight), from sigma_0 (solved) at the current e_0 to
-  sigma_f (fixed) at the terminal e_f.
+- The baseline profile (``models.schedules.linear_bank``, shared with paper 004): |sigma| linear
+  in the energy-like variable e = mu/r - V^2/2 (SI; e increases along the flight), from sigma_0
+  (solved) at the current e_0 to sigma_f (fixed) at the terminal e_f.
 - The altitude-rate feedback augmentation (Lu 2014 Sec. IV): L cos(sigma_cmd) = L cos(sigma_base)
   - k (hdot - hdot_ref), in Lu's nondimensional units (length R0, speed sqrt(g0 R0)), converted
   here to SI: cos(sigma_cmd) = cos(sigma_base) - k sqrt(g0/R0) (hdot - hdot_ref) / L.
@@ -63,12 +63,6 @@ class FeedbackSettings:
     heat_max: float = math.inf
     q_max: float = math.inf
     bank_limit: float = math.radians(90.0)
-
-
-def linear_bank(e, e0, ef: float, sigma0, sigmaf: float):
-    """|sigma| [rad] of the baseline profile: sigma0 at e0, sigmaf at ef, linear in e [J/kg]
-    (Lu 2014 eq. 19)."""
-    return sigma0 + (e - e0) / (ef - e0) * (sigmaf - sigma0)
 
 
 def _max(a, b):

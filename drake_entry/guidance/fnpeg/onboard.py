@@ -1,7 +1,7 @@
 """FNPEG on board: the predictor and corrector of one mission, and the commands of one
-guidance cycle (Lu 2014 Sec. III-IV). ``Fnpeg.from_scenario`` builds it from a scenario; the
+guidance cycle (Lu 2014 Sec. III-IV). ``FnpegSetup.from_scenario`` builds it from a scenario; the
 closed loop's guidance system (systems/fnpeg_guidance.py) calls ``correct`` every corrector
-period and ``bank_magnitude`` / ``alpha`` every guidance period."""
+period and ``bank_magnitude`` / ``alpha_command`` every guidance period."""
 from __future__ import annotations
 
 import dataclasses as dc
@@ -10,9 +10,9 @@ import math
 import numpy as np
 
 from drake_entry.guidance.fnpeg.corrector import Correction, CorrectorSettings, correct
-from drake_entry.guidance.fnpeg.law import FeedbackSettings, commanded_bank, linear_bank
+from drake_entry.guidance.fnpeg.law import FeedbackSettings, commanded_bank
 from drake_entry.guidance.fnpeg.predictor import Prediction, Predictor
-from drake_entry.models.schedules import Schedule
+from drake_entry.models.schedules import Schedule, linear_bank
 
 
 @dc.dataclass
@@ -68,10 +68,6 @@ class FnpegSetup:
 
     def predict(self, x, sigma0: float, sign: float = 1.0, scales=(1.0, 1.0)) -> Prediction:
         return self.predictor.predict(x, sigma0, sign, scales)
-
-    def range_error(self, x, sigma0: float, sign: float = 1.0) -> float:
-        """z = s_to_go - s_flown(sigma0) - s_f* [m] of one prediction (> 0: short)."""
-        return self.range_to_go(x) - self.predict(x, sigma0, sign).range_m - self.final_range
 
     def correct(self, x, sigma0: float, sign: float, slope: float | None = None, scales=(1.0, 1.0)) -> Correction:
         """The corrector's sigma_0 [rad] from the state ``x`` with the bank sign ``sign`` held and

@@ -23,10 +23,10 @@ from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.primitives import SymbolicVectorSystem
 
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.fnpeg.law import FeedbackSettings, commanded_bank, linear_bank
+from drake_entry.guidance.fnpeg.law import FeedbackSettings, commanded_bank
 from drake_entry.models import dynamics
 from drake_entry.models.atmosphere import piecewise
-from drake_entry.models.schedules import Schedule
+from drake_entry.models.schedules import Schedule, linear_bank
 
 _STATE = [Variable(n) for n in ("h", "lon", "lat", "V", "gamma", "psi", "s")]
 _INPUT = [Variable(n) for n in ("sigma0", "e0", "sign", "lift_scale", "drag_scale")]

@@ -16,12 +16,7 @@ import math
 import numpy as np
 
 from drake_entry.errors import ScenarioError
-
-
-def linear_bank(e, e0: float, ef: float, sigma0, sigmaf):
-    """|sigma| [rad] linear in the energy-like variable from sigma0 at e0 to sigmaf at ef
-    (paper 004 eq. 17; e = mu/r - V^2/2 increases along the flight, eqs. 10-11)."""
-    return sigma0 + (np.asarray(e) - e0) / (ef - e0) * (sigmaf - sigma0)
+from drake_entry.models.schedules import linear_bank
 
 
 def equilibrium_glide_radius(V, lift_coefficient_term, beta: float):

@@ -41,7 +41,8 @@ def _schemas(root):
 
 
 @pytest.mark.parametrize("module, name", [("drake_entry.scenario", "Scenario"), ("drake_entry.models.vehicles", "VehicleSpec"),
-                                          ("drake_entry.planning.ocp_yaml", "ProblemSpec")])
+                                          ("drake_entry.planning.ocp_yaml", "ProblemSpec"),
+                                          ("drake_entry.comparison", "Comparison")])
 def test_yaml_reference_has_every_schema_field(module, name):
     import importlib
 
@@ -76,7 +77,8 @@ def test_every_page_in_the_navigation_exists():
     import yaml
 
     config = yaml.safe_load(_read("mkdocs.yml").replace("!!python", "#"))
-    generated = {"reference/scenario.md", "reference/vehicle.md", "reference/problem.md"}
+    generated = set(re.findall(r'^    "(reference/\w+\.md)"', _read("docs/hooks/reference.py"), re.M))  # YAML pages
+    assert {"reference/scenario.md", "reference/vehicle.md", "reference/problem.md"} <= generated
     generated |= set(re.findall(r'\("(api/\w+\.md)"', _read("docs/hooks/reference.py")))  # the API pages
     assert {"api/models.md", "api/guidance.md"} <= generated
 

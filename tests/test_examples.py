@@ -256,3 +256,15 @@ def test_example_15(tmp_path):
         assert row["plans"] > 100 and row["corrections_unconverged"] <= 0.05 * row["plans"]
     assert os.path.exists(r["plot"])
 
+
+
+@pytest.mark.slow
+def test_example_16(tmp_path):
+    """Every method on HORUS-2B, quick run (drag-energy and the fixed bank profile, 2 samples
+    each): the same draws for both, drag-energy inside the 2-km box, the profile outside it, and
+    the methods that cannot fly the mission listed with their reasons."""
+    r = _run("16_compare_methods", tmp_path)
+    s = r["summary"]
+    assert s["same_dispersions"] and set(s["methods"]) == {"drag_energy", "bank_profile"}
+    assert {"scvx", "ampi", "lgl_terminal"} <= set(s["not_flown"])
+    assert "Not flown:** Its planner constrains the total aerodynamic load" in open(r["report"]).read()

@@ -49,6 +49,11 @@ PAGES = {
                              "A vehicle file (`vehicle: path/to/file.yaml` in a scenario; packaged vehicles live "
                              "in `drake_entry/vehicles/`). `aero` maps model names to aerodynamic models; "
                              "`default_aero` picks one."),
+    "reference/comparison.md": ("drake_entry.comparison", "Comparison", "Comparison YAML",
+                                "A comparison file (`drake-entry compare FILE.yaml`, `load_comparison(path)`): one "
+                                "mission and every guidance method's settings for it, or why it cannot fly it. "
+                                "Packaged comparisons live in `drake_entry/comparisons/`; see "
+                                "[Comparing methods](../comparisons.md)."),
     "reference/problem.md": ("drake_entry.planning.ocp_yaml", "ProblemSpec", "Optimal-control problem YAML",
                              "A problem file for the NLP path (`drake-entry optimize FILE.yaml`, "
                              "`load_problem(path)`)."),
@@ -79,8 +84,10 @@ API_PAGES = (
      "`drake_entry.diagrams.<module>`).",
      ("diagrams",), ()),
     ("api/campaign.md", "Scenarios, reports and outputs",
-     "The scenario file, the campaign directory, the report and its figures, the examples' claims.",
-     ("campaign",), ("drake_entry.scenario", "drake_entry.claims", "drake_entry.scipy_open_loop")),
+     "The scenario and comparison files, the campaign directory, the reports and their figures, the examples' "
+     "claims.",
+     ("campaign",), ("drake_entry.scenario", "drake_entry.comparison", "drake_entry.claims",
+                     "drake_entry.scipy_open_loop")),
 )
 
 

@@ -1,0 +1,94 @@
+"""Several guidance methods flown on one mission with the same dispersions and seeds.
+
+``run_comparison`` takes a comparison (drake_entry.comparison: the mission and each method's
+settings, or why a method cannot fly it) and, for every method that flies, writes the
+scenario it flies (``scenarios/<label>.yaml``), times its pre-flight planning once, and runs
+an ordinary Monte-Carlo campaign of it (``montecarlo.run_campaign``, resumable) into
+``<label>/`` with the same seed: sample i of every method draws the same dispersions, because
+a sample's draws come first from a generator seeded by (seed, i) alone (diagrams.sample).
+Then each campaign's report and the comparison's report (campaign.comparison_report).
+"""
+from __future__ import annotations
+
+import json
+import os
+import time
+
+from pydrake.common.yaml import yaml_dump_typed
+
+from drake_entry.campaign.comparison_report import MANIFEST, read_comparison_manifest, write_comparison_report
+from drake_entry.campaign.store import _write_atomic
+from drake_entry.comparison import Comparison, load_comparison, method_scenario
+from drake_entry.diagrams.campaign import session, versions
+from drake_entry.diagrams.montecarlo import TRAJECTORY_STEP_S, run_campaign
+from drake_entry.errors import DrakeEntryError, ScenarioError
+
+#: the folder of a comparison directory that holds the scenario each method flew
+SCENARIOS = "scenarios"
+
+
+def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, workers: int | None = None,
+                   only: list[str] | None = None, progress: bool = True,
+                   trajectory_step_s: float = TRAJECTORY_STEP_S) -> str:
+    """Fly every method of ``comparison`` (a Comparison, a packaged name or a file) that can fly
+    its mission as a campaign of ``runs`` samples (seed ``seed``) into ``out_dir/<label>``, then
+    write ``out_dir/report.md``; returns the report's path. ``only``: these labels only (the
+    others keep what an earlier run left). A method whose planner cannot be built for the mission
+    is recorded with its reason and the others still fly. The campaigns resume like any other."""
+    from drake_entry.campaign.report import write_report
+    from drake_entry.diagrams.closed_loop import ClosedLoopSetup
+
+    comp = comparison if isinstance(comparison, Comparison) else load_comparison(comparison)
+    comp.validate()
+    labels = [m.label for m in comp.methods]
+    unknown = [x for x in (only or []) if x not in labels]
+    if unknown:
+        raise ScenarioError(f"only: {', '.join(unknown)} not in comparison {comp.name}; allowed: {', '.join(labels)}")
+    scenarios = {m.label: method_scenario(comp, m) for m in comp.flown()}  # every bad entry before any flight
+    os.makedirs(os.path.join(out_dir, SCENARIOS), exist_ok=True)
+    manifest = read_comparison_manifest(out_dir) or {}
+    if manifest and (manifest.get("comparison") != comp.name or manifest.get("seed") != seed):
+        raise ScenarioError(f"{out_dir} holds comparison {manifest.get('comparison')!r} with seed "
+                            f"{manifest.get('seed')}; use another --out")
+    methods = dict(manifest.get("methods", {}))
+    for entry in comp.methods:
+        if entry.not_flown:
+            methods[entry.label] = {"method": entry.method, "flown": False, "reason": entry.not_flown,
+                                    "mapping": entry.mapping}
+            continue
+        if only and entry.label not in only:
+            methods.setdefault(entry.label, {"method": entry.method, "flown": False, "mapping": entry.mapping,
+                                             "reason": ""})  # not in this run; an earlier run's record stays
+            continue
+        scenario = scenarios[entry.label]
+        path = os.path.join(out_dir, SCENARIOS, f"{entry.label}.yaml")
+        _write_atomic(path, yaml_dump_typed(scenario).encode())
+        record = {"method": entry.method, "flown": True, "mapping": entry.mapping,
+                  "scenario": os.path.join(SCENARIOS, f"{entry.label}.yaml")}
+        if progress:
+            print(f"== {entry.label} (!{entry.method}): pre-flight planning", flush=True)
+        t = time.perf_counter()
+        try:
+            setup = ClosedLoopSetup.from_scenario(scenario)
+        except DrakeEntryError as e:
+            methods[entry.label] = {**record, "flown": False, "reason": f"its planner failed on this mission: {e}"}
+            print(f"   {entry.label}: not flown: {e}", flush=True)
+            continue
+        record["preflight_planning_s"] = time.perf_counter() - t
+        record["preflight_plan"] = getattr(setup.planner, "message", "") if setup.planner is not None else ""
+        del setup
+        if progress:
+            print(f"   {record['preflight_planning_s']:.1f} s; {runs} samples", flush=True)
+        campaign_dir = os.path.join(out_dir, entry.label)
+        run_campaign(path, runs=runs, out_dir=campaign_dir, seed=seed, workers=workers, progress=progress,
+                     trajectory_step_s=trajectory_step_s)
+        write_report(campaign_dir, title=f"{comp.name}: {entry.label}")
+        methods[entry.label] = {**record, "campaign": entry.label}
+    order = {label: i for i, label in enumerate(labels)}
+    manifest = {"comparison": comp.name, "description": comp.description, "mission": comp.mission,
+                "comparison_yaml": yaml_dump_typed(comp), "runs": max(int(runs), int(manifest.get("runs", 0))),
+                "seed": int(seed), "versions": versions(),
+                "sessions": list(manifest.get("sessions", [])) + [session()],
+                "methods": dict(sorted(methods.items(), key=lambda kv: order.get(kv[0], len(order))))}
+    _write_atomic(os.path.join(out_dir, MANIFEST), json.dumps(manifest, indent=2).encode())
+    return write_comparison_report(out_dir)

@@ -1,0 +1,157 @@
+"""Comparisons: the file format, the mission shared by every method, the same draws, the report."""
+import dataclasses as dc
+import json
+
+import numpy as np
+import pytest
+from pydrake.common.yaml import yaml_dump_typed
+from scipy import stats
+
+from drake_entry.campaign.comparison_report import clopper_pearson, dispersion_check, method_summary
+from drake_entry.comparison import (
+    PACKAGED_COMPARISONS,
+    ComparedMethod,
+    Comparison,
+    load_comparison,
+    method_scenario,
+)
+from drake_entry.errors import ScenarioError
+from drake_entry.guidance import REGISTRY
+from drake_entry.guidance.bank_profile.spec import BankProfile
+from drake_entry.scenario import load_scenario
+
+
+@pytest.mark.parametrize("name", PACKAGED_COMPARISONS)
+def test_a_packaged_comparison_lists_every_registered_method_once(name):
+    comp = load_comparison(name)
+    assert sorted(m.method for m in comp.methods) == sorted(spec.__name__ for spec in REGISTRY)
+    for m in comp.methods:
+        assert m.mapping or m.not_flown, f"{m.label}: say how the mission maps to it, or why it is not flown"
+
+
+@pytest.mark.parametrize("name", PACKAGED_COMPARISONS)
+def test_every_flown_method_shares_the_mission_and_flies_its_own_method(name):
+    comp = load_comparison(name)
+    mission = load_scenario(comp.mission)
+    for m in comp.flown():
+        s = method_scenario(comp, m)
+        assert type(s.guidance).__name__ == m.method
+        assert s.name == f"{mission.name}-{m.label}"
+        # everything but the method's own settings (guidance, alpha) is the mission, to the byte
+        s.name, s.guidance, s.alpha = mission.name, mission.guidance, mission.alpha
+        assert yaml_dump_typed(s) == yaml_dump_typed(mission), m.label
+
+
+def _comparison(**entry) -> Comparison:
+    return Comparison(name="t", mission="horus2b", methods=[ComparedMethod(**{"label": "a", "method": "DragEnergy",
+                                                                              "mapping": "x", **entry})])
+
+
+@pytest.mark.parametrize("entry, words", [
+    ({"overrides": {"entry.altitude_km": "121"}}, "entry.altitude_km: only the method's settings"),
+    ({"overrides": {"dispersions.density_scale": "!Uniform {min: 0.9, max: 1.1}"}}, "dispersions.density_scale"),
+    ({"method": "Foo"}, "method = 'Foo'; allowed: DragEnergy"),
+    ({"label": "a b"}, "label = 'a b'"),
+    ({"not_flown": "why", "overrides": {"guidance.period_s": "2"}}, "not_flown and settings"),
+    ({"guidance": BankProfile()}, "guidance is !BankProfile but method is DragEnergy"),
+])
+def test_a_bad_entry_is_one_line_naming_it(entry, words):
+    with pytest.raises(ScenarioError, match=None) as e:
+        _comparison(**entry).validate()
+    assert words in str(e.value) and "\n" not in str(e.value)
+
+
+def test_a_label_given_twice_and_an_entry_whose_settings_do_not_fit_are_refused():
+    comp = _comparison()
+    comp.methods.append(dc.replace(comp.methods[0]))
+    with pytest.raises(ScenarioError, match="label = 'a' is given twice"):
+        comp.validate()
+    bad = _comparison(overrides={"guidance.terminal_mach": "99"}).validate()
+    with pytest.raises(ScenarioError, match=r"comparison t, method a: .*guidance.terminal_mach = 99"):
+        method_scenario(bad, bad.methods[0])
+    wrong = _comparison(method="Fnpeg").validate()  # the mission flies !DragEnergy: a block is needed
+    with pytest.raises(ScenarioError, match="give this entry a guidance: !Fnpeg block"):
+        method_scenario(wrong, wrong.methods[0])
+
+
+def test_a_comparison_file_is_read_and_checked_like_a_scenario(tmp_path):
+    path = tmp_path / "c.yaml"
+    path.write_text("name: c\nmission: horus2b\nmethods:\n  - {label: de, method: DragEnergy, mapping: own}\n"
+                    "  - label: bp\n    method: BankProfile\n    guidance: !BankProfile {bank_start_deg: 66.0}\n"
+                    "    mapping: fixed\n  - {label: s, method: Scvx, not_flown: 'no DRS box'}\n")
+    comp = load_comparison(str(path))
+    assert [m.label for m in comp.flown()] == ["de", "bp"]
+    assert method_scenario(comp, comp.methods[1]).guidance.bank_start_deg == 66.0
+    path.write_text("name: c\nmission: horus2b\nmethods:\n  - {label: de, method: DragEnergy, mapingg: own}\n")
+    with pytest.raises(ScenarioError, match="mapingg: unknown field; did you mean mapping"):
+        load_comparison(str(path))
+    with pytest.raises(ScenarioError, match="neither a packaged comparison"):
+        load_comparison(str(tmp_path / "nope.yaml"))
+
+
+@pytest.mark.parametrize("k, n", [(0, 10), (10, 10), (5, 10), (17, 20), (1, 1)])
+def test_the_success_interval_is_the_exact_clopper_pearson_interval(k, n):
+    lo, hi = clopper_pearson(k, n, 0.9)
+    # the beta-quantile form of the exact interval (alpha/2 in each tail)
+    want_lo = 0.0 if k == 0 else stats.beta.ppf(0.05, k, n - k + 1)
+    want_hi = 1.0 if k == n else stats.beta.ppf(0.95, k + 1, n - k)
+    assert lo == pytest.approx(want_lo, abs=1e-9) and hi == pytest.approx(want_hi, abs=1e-9)
+    if 0 < k < n:
+        assert lo < k / n < hi
+
+
+def _rows(n, **cols):
+    base = {"index": list(range(n)), "success": [True] * n, "reached_terminal": [True] * n,
+            "err_distance_m": [100.0 * (i + 1) for i in range(n)], "disp_dh_m": [float(i) for i in range(n)]}
+    return {**base, **cols}
+
+
+def test_the_dispersion_check_finds_a_different_draw():
+    a, b = _rows(3), _rows(3)
+    assert dispersion_check({"a": a, "b": b}) == (True, 3, 0.0)
+    b["disp_dh_m"] = [0.0, 1.0, 2.5]
+    same, compared, worst = dispersion_check({"a": a, "b": b})
+    assert not same and compared == 3 and worst == pytest.approx(0.5)
+
+
+def test_the_method_summary_counts_and_measures_the_rows():
+    rows = _rows(4, success=[True, False, True, True], inside_box=[True, False, True, True],
+                 within_limits=[True, True, True, True], message=["ok", "outside the acceptance box: distance", "ok",
+                                                                 "ok"],
+                 err_range_m=[1000.0, -3000.0, 500.0, 0.0], margin_heat_flux=[0.1, 0.05, -0.01, 0.2],
+                 bank_reversals=[2, 3, 4, 5], wall_time_s=[1.0, 2.0, 3.0, 4.0])
+    s = method_summary(rows)
+    assert (s["samples"], s["successful"], s["inside_box"]) == (4, 3, 3)
+    assert s["successful_interval"] == pytest.approx(clopper_pearson(3, 4))
+    assert s["miss_km"]["median"] == pytest.approx(0.25) and s["miss_km"]["max"] == pytest.approx(0.4)
+    assert s["err_range_m"]["mean"] == pytest.approx(-375.0)
+    assert s["err_range_m"]["std"] == pytest.approx(np.std([1000.0, -3000.0, 500.0, 0.0], ddof=1))
+    assert s["margins"]["margin_heat_flux"] == {"worst": -0.01, "breached": 1}
+    assert s["bank_reversals"] == {"mean": 3.5, "max": 5.0}
+
+
+def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path):
+    from drake_entry.diagrams.comparison import run_comparison
+
+    comp = Comparison(name="tiny", description="drag-energy and a fixed bank profile", mission="horus2b", methods=[
+        ComparedMethod(label="drag_energy", method="DragEnergy", mapping="the mission's own settings"),
+        ComparedMethod(label="bank_profile", method="BankProfile", mapping="66 to 50 deg",
+                       guidance=BankProfile(terminal_altitude_km=26.5, bank_start_deg=66.0, bank_end_deg=50.0)),
+        ComparedMethod(label="ampi", method="Ampi", not_flown="no database of this vehicle")])
+    path = run_comparison(comp, runs=2, out_dir=str(tmp_path / "cmp"), seed=7, workers=1, progress=False)
+    text = open(path).read()
+    summary = json.loads((tmp_path / "cmp" / "comparison_summary.json").read_text())
+    assert summary["same_dispersions"] and summary["samples_compared"] == 2
+    de, bp = summary["methods"]["drag_energy"], summary["methods"]["bank_profile"]
+    assert de["successful"] == 2 and bp["successful"] == 0  # the fixed profile misses the 2-km box
+    assert bp["miss_km"]["median"] > 2.0 > de["miss_km"]["max"]
+    assert summary["not_flown"] == {"ampi": "no database of this vehicle"}
+    assert "| ampi (!Ampi) | — | not flown |" in text and "Same dispersions: sample i drew the same" in text
+    assert "| drag_energy (!DragEnergy) | 2 | 2 [" in text
+    for fig in ("comparison_footprints.png", "comparison_success.png", "comparison_miss.png"):
+        assert (tmp_path / "cmp" / fig).stat().st_size > 10_000 and fig in text
+    assert (tmp_path / "cmp" / "drag_energy" / "report.md").exists()
+    assert "guidance: !BankProfile" in (tmp_path / "cmp" / "scenarios" / "bank_profile.yaml").read_text()
+    # a second call with another seed into the same directory is refused, not mixed
+    with pytest.raises(ScenarioError, match="holds comparison 'tiny' with seed 7"):
+        run_comparison(comp, runs=2, out_dir=str(tmp_path / "cmp"), seed=8, workers=1, progress=False)

@@ -67,9 +67,10 @@ def _cmd_fly(args) -> int:
     from drake_entry.campaign.tables import write_table
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
     from drake_entry.diagrams.sample import campaign_row
-    from drake_entry.scenario import load_scenario
+    from drake_entry.scenario import apply_overrides, load_scenario
 
     scenario = load_scenario(args.scenario)
+    apply_overrides(scenario, parse_overrides(args.overrides))
     setup = ClosedLoopSetup.from_scenario(scenario)
     res = fly(setup)
     tr = res.trajectory
@@ -307,6 +308,9 @@ def main(argv=None) -> int:
     fl.add_argument("scenario", help=scenario_help)
     fl.add_argument("--out", default="out/fly", help="output directory: trajectory table, summary.json, figures")
     fl.add_argument("--format", choices=("parquet", "csv"), default="parquet", help="trajectory table format")
+    fl.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE", dest="overrides",
+                    help="override a scenario field, e.g. --set guidance.bank_end_deg=45 (repeatable; the value is "
+                         "read as YAML, as in campaign)")
     fl.set_defaults(func=_cmd_fly)
     pl = sub.add_parser("plan", help="the guidance method's plan report, flown by the Drake Simulator (drag-energy: "
                         "corridor, reference and extraction, paper 000 Figs. 3-5; SCvx: the pre-flight plan and its "

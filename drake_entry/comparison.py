@@ -11,15 +11,13 @@ campaign engine flies them all with the same seed, so sample i of every method d
 dispersions (``drake_entry.diagrams.comparison``). Pure data: loading one imports no solver.
 """
 import dataclasses as dc
-import os
 import re
-from importlib import resources
 from typing import Optional
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance import REGISTRY, GuidanceSpec, known_tags
 from drake_entry.scenario import Scenario, apply_overrides, load_scenario
-from drake_entry.typed_yaml import load_yaml_typed
+from drake_entry.typed_yaml import load_packaged_or_file, packaged_names
 
 #: the scenario fields an entry may override: the method's settings, never the mission
 METHOD_FIELDS = ("guidance", "alpha")
@@ -91,25 +89,12 @@ class Comparison:
 
 
 #: the comparisons shipped in drake_entry/comparisons (``<name>.yaml``)
-PACKAGED_COMPARISONS = tuple(sorted(p.name[:-5] for p in resources.files("drake_entry").joinpath("comparisons")
-                                    .iterdir() if p.name.endswith(".yaml")))
+PACKAGED_COMPARISONS = packaged_names("comparisons")
 
 
 def load_comparison(name_or_path) -> Comparison:
     """Read and validate a comparison: a packaged name or a YAML file path."""
-    if not isinstance(name_or_path, (str, os.PathLike)):
-        raise ScenarioError(f"a comparison is a packaged name ({', '.join(PACKAGED_COMPARISONS)}) or a YAML file "
-                            f"path; got {type(name_or_path).__name__}")
-    name_or_path = os.fspath(name_or_path)
-    if name_or_path in PACKAGED_COMPARISONS:
-        text = resources.files("drake_entry").joinpath(f"comparisons/{name_or_path}.yaml").read_text()
-        comparison = load_yaml_typed(Comparison, text=text, where=f"comparison '{name_or_path}'")
-    elif os.path.isfile(name_or_path):
-        comparison = load_yaml_typed(Comparison, path=name_or_path)
-    else:
-        raise ScenarioError(f"comparison '{name_or_path}' is neither a packaged comparison "
-                            f"({', '.join(PACKAGED_COMPARISONS)}) nor a file")
-    return comparison.validate()
+    return load_packaged_or_file(Comparison, name_or_path, kind="comparison", folder="comparisons").validate()
 
 
 def method_scenario(comparison: Comparison, entry: ComparedMethod) -> Scenario:

@@ -7,8 +7,6 @@ allowed range.
 """
 import dataclasses as dc
 import math
-import os
-from importlib import resources
 from typing import Optional
 
 import numpy as np
@@ -23,7 +21,7 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import VARIABLES, Schedule
 from drake_entry.models.vehicles import Vehicle, load_vehicle
 from drake_entry.models.verdict import PathLimit, acceptance_box, vehicle_path_limits
-from drake_entry.typed_yaml import load_yaml_typed, override
+from drake_entry.typed_yaml import load_packaged_or_file, override, packaged_names
 
 
 @dc.dataclass
@@ -341,30 +339,18 @@ SCHEDULE_BREAKPOINTS = {"time": (-1e5, 1e5), "normalized_energy": (-1.0, 2.0), "
 
 
 #: the scenarios shipped in drake_entry/scenarios (``<name>.yaml``), found in the package
-PACKAGED_SCENARIOS = tuple(sorted(p.name[:-5] for p in resources.files("drake_entry").joinpath("scenarios").iterdir()
-                                  if p.name.endswith(".yaml")))
+PACKAGED_SCENARIOS = packaged_names("scenarios")
 
 
 def load_scenario(name_or_path: str) -> Scenario:
     """Read and validate a scenario: a packaged name or a YAML file path."""
-    if not isinstance(name_or_path, (str, os.PathLike)):
-        raise ScenarioError(f"a scenario is a packaged name ({', '.join(PACKAGED_SCENARIOS)}) or a YAML file "
-                            f"path; got {type(name_or_path).__name__}")
-    name_or_path = os.fspath(name_or_path)
-    if name_or_path in PACKAGED_SCENARIOS:
-        text = resources.files("drake_entry").joinpath(f"scenarios/{name_or_path}.yaml").read_text()
-        scenario = load_yaml_typed(Scenario, text=text, where=f"scenario '{name_or_path}'")
-    elif os.path.exists(name_or_path):
-        try:
-            scenario = load_yaml_typed(Scenario, path=name_or_path)
-        except ScenarioError as e:
-            if "guidance.method: unknown field" in str(e):  # a scenario written before the method tags
-                raise ScenarioError(f"{name_or_path}: guidance 'method:' is now a YAML tag: write "
-                                    f"'guidance: !DragEnergy' (known: {known_tags()})") from None
-            raise
-    else:
-        raise ScenarioError(f"scenario '{name_or_path}' is neither a packaged scenario "
-                            f"({', '.join(PACKAGED_SCENARIOS)}) nor a file")
+    try:
+        scenario = load_packaged_or_file(Scenario, name_or_path, kind="scenario", folder="scenarios")
+    except ScenarioError as e:
+        if "guidance.method: unknown field" in str(e):  # a scenario written before the method tags
+            raise ScenarioError(f"{name_or_path}: guidance 'method:' is now a YAML tag: write "
+                                f"'guidance: !DragEnergy' (known: {known_tags()})") from None
+        raise
     return scenario.validate()
 
 

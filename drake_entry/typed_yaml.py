@@ -256,6 +256,33 @@ def _drake_load(schema, text: str, where: str, defaults=None):
         raise ScenarioError(f"{where}: not valid YAML: {str(e).splitlines()[0]}") from None
 
 
+def packaged_names(folder: str) -> tuple:
+    """The names of the YAML files shipped in drake_entry/<folder> (``<name>.yaml``), sorted."""
+    from importlib import resources
+
+    return tuple(sorted(p.name[:-5] for p in resources.files("drake_entry").joinpath(folder).iterdir()
+                        if p.name.endswith(".yaml")))
+
+
+def load_packaged_or_file(schema, name_or_path, *, kind: str, folder: str):
+    """``schema`` read from a packaged file by name (drake_entry/<folder>/<name>.yaml) or from a
+    YAML file path (``load_yaml_typed``); anything else is one ScenarioError naming the packaged
+    ones. ``kind`` names the file in messages ('scenario', 'comparison')."""
+    from importlib import resources
+
+    packaged = packaged_names(folder)
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        raise ScenarioError(f"a {kind} is a packaged name ({', '.join(packaged)}) or a YAML file path; got "
+                            f"{type(name_or_path).__name__}")
+    name_or_path = os.fspath(name_or_path)
+    if name_or_path in packaged:
+        text = resources.files("drake_entry").joinpath(f"{folder}/{name_or_path}.yaml").read_text()
+        return load_yaml_typed(schema, text=text, where=f"{kind} '{name_or_path}'")
+    if os.path.isfile(name_or_path):
+        return load_yaml_typed(schema, path=name_or_path)
+    raise ScenarioError(f"{kind} '{name_or_path}' is neither a packaged {kind} ({', '.join(packaged)}) nor a file")
+
+
 def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None, where: str | None = None):
     """Read ``schema`` from a YAML file (``path``) or ``text``: checked field by field
     (``check``), then built by Drake's ``yaml_load_typed``; every problem is one

@@ -42,7 +42,7 @@ def test_version_names_the_package_and_drake(capsys):
     assert f"Drake {importlib.metadata.version('drake')}" in out
 
 
-@pytest.mark.parametrize("command", ["scenarios", "campaign", "report", "fly", "plan", "simulate", "optimize",
+@pytest.mark.parametrize("command", ["scenarios", "campaign", "report", "fly", "plan", "simulate", "optimize", "compare",
                                      "fit-horus"])
 def test_every_argument_has_help(command, capsys, monkeypatch):
     """Each subcommand's every argument carries a help text (the parsers are built by main)."""
@@ -91,3 +91,12 @@ def test_results_of_every_closed_loop_scenario_in_reduced_size(tmp_path):
     index = (out / "index.md").read_text()
     assert all(f"`{name}`" in index for name in names)
     assert code == (0 if all(" 2 of 2 " in line for line in index.splitlines() if line.startswith("| `")) else 1)
+
+
+def test_fly_takes_overrides_through_the_typed_checks(tmp_path, capsys):
+    assert main(["fly", "horus2b", "--set", "guidance.terminal_mach=99", "--out", str(tmp_path)]) == 2
+    assert "guidance.terminal_mach = 99" in capsys.readouterr().err
+    # a valid override is flown: the fixed bank profile block in place of the drag-energy guidance
+    assert main(["fly", "horus2b", "--set", "guidance=!BankProfile {terminal_altitude_km: 26.5, bank_start_deg: 66.0, "
+                 "bank_end_deg: 50.0}", "--out", str(tmp_path), "--format", "csv"]) == 1  # misses the 2-km box
+    assert "method                       bank_profile" in capsys.readouterr().out

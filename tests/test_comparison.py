@@ -147,7 +147,7 @@ def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path):
     assert bp["miss_km"]["median"] > 2.0 > de["miss_km"]["max"]
     assert summary["not_flown"] == {"ampi": "no database of this vehicle"}
     assert "| ampi (!Ampi) | — | not flown |" in text and "Same dispersions: sample i drew the same" in text
-    assert "| drag_energy (!DragEnergy) | 2 | 2 [" in text
+    assert "| [drag_energy](drag_energy/report.md) (!DragEnergy) | 2 | 2 [" in text
     for fig in ("comparison_footprints.png", "comparison_success.png", "comparison_miss.png"):
         assert (tmp_path / "cmp" / fig).stat().st_size > 10_000 and fig in text
     assert (tmp_path / "cmp" / "drag_energy" / "report.md").exists()

@@ -30,7 +30,7 @@ from drake_entry.campaign.report import (
     flown_scenario,
     reached_terminal,
     summary_statistics,
-    write_html,
+    write_markdown_report,
 )
 from drake_entry.campaign.store import coverage
 from drake_entry.errors import CampaignError
@@ -147,12 +147,7 @@ def write_comparison_report(out_dir: str) -> str:
     sections = [_header(meta, summaries, same, compared, worst, scenario), _verdict_table(meta, summaries),
                 _error_table(summaries), _margin_table(summaries), _activity_table(meta, summaries),
                 _mapping_table(meta), _figure_list(figs) if figs else ""]
-    md = "\n\n".join(s for s in sections if s) + "\n"
-    path = os.path.join(out_dir, "report.md")
-    with open(path, "w") as f:
-        f.write(md)
-    write_html(md, out_dir, title=title)
-    return path
+    return write_markdown_report(sections, out_dir, title=title)
 
 
 def _campaign_manifest(out_dir: str, label: str) -> dict:
@@ -203,7 +198,7 @@ def _verdict_table(meta, summaries) -> str:
     lvl = f"{100 * LEVEL:g} %"
     out = ["## Verdict", "",
            f"Counts out of the samples flown; brackets: the exact two-sided {lvl} Clopper-Pearson interval on the "
-           "probability.", "",
+           "probability; each method's name links to its own campaign report.", "",
            "| method | samples | successful | inside the box | within every limit | why not successful |",
            "|---|---|---|---|---|---|"]
     for label, info in meta["methods"].items():
@@ -217,7 +212,8 @@ def _verdict_table(meta, summaries) -> str:
             lo, hi = s[f"{key}_interval"]
             cells.append(f"{s[key]} [{_pct(lo)}, {_pct(hi)}]")
         reasons = "; ".join(f"{k}: {v}" for k, v in sorted(s["failure_reasons"].items(), key=lambda kv: -kv[1]))
-        out.append(f"| {label} (!{info['method']}) | {s['samples']} | {' | '.join(cells)} | {_cell(reasons) or '—'} |")
+        out.append(f"| [{label}]({label}/report.md) (!{info['method']}) | {s['samples']} | {' | '.join(cells)} | "
+                   f"{_cell(reasons) or '—'} |")
     return "\n".join(out)
 
 
@@ -384,7 +380,7 @@ def success_intervals(summaries: dict, out_dir: str, title: str) -> tuple[str, s
 
 def miss_distributions(all_rows: dict, out_dir: str, title: str, radius_km) -> tuple[str, str]:
     """Empirical distribution of the miss distance [km] of every method (logarithmic axis)."""
-    fig, ax = plt.subplots(figsize=(7.0, 4.2))
+    fig, ax = plt.subplots(figsize=(9.5, 4.2))
     for k, (label, rows) in enumerate(all_rows.items()):
         n = len(rows["index"])
         d = np.sort(_finite(rows, "err_distance_m", n)[reached_terminal(rows)] / 1e3)
@@ -398,7 +394,7 @@ def miss_distributions(all_rows: dict, out_dir: str, title: str, radius_km) -> t
     ax.set_xlabel("miss distance to the target at the terminal interface [km] (log scale)")
     ax.set_ylabel("fraction of samples [-]")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8, loc="upper left")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     paths = []
     save_figure(fig, out_dir, "comparison_miss.png", paths, title)
     return paths[0], ("Empirical distribution of the miss distance per method, as a fraction of all its samples "

@@ -238,11 +238,17 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
                 _requirements(rows, reached, stats, scenario), _outcome(rows, stats, traj),
                 _distributions(rows, quantities, reached, stats, reference), _contributors(stats), _cost(stats),
                 _figure_list(figs)]
+    return write_markdown_report(sections, out_dir, title=name)
+
+
+def write_markdown_report(sections: list, out_dir: str, *, title: str) -> str:
+    """report.md (the non-empty ``sections``, blank-line separated) and report.html in ``out_dir``;
+    returns the path of report.md."""
     md = "\n\n".join(section for section in sections if section) + "\n"
     path = os.path.join(out_dir, "report.md")
     with open(path, "w") as f:
         f.write(md)
-    write_html(md, out_dir, title=name)
+    write_html(md, out_dir, title=title)
     return path
 
 

@@ -278,7 +278,9 @@ def load_packaged_or_file(schema, name_or_path, *, kind: str, folder: str):
     if name_or_path in packaged:
         text = resources.files("drake_entry").joinpath(f"{folder}/{name_or_path}.yaml").read_text()
         return load_yaml_typed(schema, text=text, where=f"{kind} '{name_or_path}'")
-    if os.path.isfile(name_or_path):
+    if os.path.isdir(name_or_path):
+        raise ScenarioError(f"{kind} '{name_or_path}' is a directory, not a YAML file")
+    if os.path.exists(name_or_path):
         return load_yaml_typed(schema, path=name_or_path)
     raise ScenarioError(f"{kind} '{name_or_path}' is neither a packaged {kind} ({', '.join(packaged)}) nor a file")
 

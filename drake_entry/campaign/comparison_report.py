@@ -32,7 +32,7 @@ from drake_entry.campaign.report import (
     summary_statistics,
     write_markdown_report,
 )
-from drake_entry.campaign.store import coverage
+from drake_entry.campaign.store import coverage, read_manifest
 from drake_entry.errors import CampaignError
 
 #: the file a comparison directory is identified by
@@ -131,10 +131,8 @@ def write_comparison_report(out_dir: str) -> str:
             if rows is not None:
                 all_rows[label], summaries[label] = rows, method_summary(rows)
     same, compared, worst = dispersion_check(all_rows)
-    scenario = None
-    for label in all_rows:
-        scenario = flown_scenario(_campaign_manifest(out_dir, label))
-        break
+    first = next(iter(all_rows), None)  # every method flies the same mission: its terminal box
+    scenario = flown_scenario(read_manifest(os.path.join(out_dir, first))) if first else None
     radius = getattr(getattr(scenario, "terminal", None), "distance_tolerance_km", None)
     with open(os.path.join(out_dir, "comparison_summary.json"), "w") as f:
         json.dump({"comparison": meta["comparison"], "mission": meta["mission"], "seed": meta["seed"],
@@ -148,11 +146,6 @@ def write_comparison_report(out_dir: str) -> str:
                 _error_table(summaries), _margin_table(summaries), _activity_table(meta, summaries),
                 _mapping_table(meta), _figure_list(figs) if figs else ""]
     return write_markdown_report(sections, out_dir, title=title)
-
-
-def _campaign_manifest(out_dir: str, label: str) -> dict:
-    with open(os.path.join(out_dir, label, "campaign.json")) as f:
-        return json.load(f)
 
 
 def _num(x) -> str:

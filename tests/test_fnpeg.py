@@ -202,3 +202,78 @@ def test_closed_loop_engages_on_the_acceleration_and_corrects_every_second():
     L, D = r.trajectory.column("lift"), r.trajectory.column("drag")
     engaged = r.trajectory.time >= f["engage_time_s"]
     assert np.all(np.hypot(L, D)[~engaged][:-1] < 1.52 + 1e-9)
+
+
+# -- Lu (2008)'s capsule setting (capsule_lu2008) ----------------------------------------------
+
+@pytest.fixture(scope="module")
+def capsule():
+    return FnpegSetup.from_scenario(load_scenario("capsule_lu2008"))
+
+
+#: a capsule state shortly after engagement (about 215 s into the packaged flight)
+CAPSULE_ENGAGED = np.array([7.94583e4, -2.044727, 0.292517, 7453.09, -0.0234551, 1.107283])
+
+
+def test_capsule_dispersions_are_lu2008s():
+    """Lu (2008): 3-sigma Gaussian entry longitude 0.59 deg, latitude 0.66, speed 0.41 m/s,
+    flight path 0.023 deg, heading 0.39 deg; uniform C_L +-3 %, C_D +-6 %, mass +-5 %, density +-30 %."""
+    d = load_scenario("capsule_lu2008").dispersions
+    for field, three_sigma in (("longitude_deg", 0.59), ("latitude_deg", 0.66), ("velocity_m_s", 0.41),
+                               ("flight_path_deg", 0.023), ("heading_deg", 0.39)):
+        g = getattr(d.entry, field)
+        assert (g.mean, 3.0 * g.stddev) == (0.0, pytest.approx(three_sigma, rel=1e-12)), field
+    for field, half in (("lift_scale", 0.03), ("drag_scale", 0.06), ("mass_scale", 0.05), ("density_scale", 0.30)):
+        u = getattr(d, field)
+        assert (u.min, u.max) == (pytest.approx(1.0 - half), pytest.approx(1.0 + half)), field
+    assert d.entry.altitude_m == 0.0
+
+
+def test_apollo_cm_is_the_apollo10_compilation():
+    v = load_vehicle_named("apollo_cm")
+    assert (v.mass, v.reference_area) == (5498.22, 12.017) and v.representative
+    cl, cd = v.aero.coefficients(math.radians(20.0), 25.0)
+    assert (cl, cd) == (0.40815, 1.2569) and v.aero.coefficients(0.0, 0.5) == (cl, cd)  # trim: no alpha, no Mach
+    assert cl / cd == pytest.approx(0.3247, abs=1e-4)
+
+
+def load_vehicle_named(name):
+    from drake_entry.models.vehicles import load_vehicle
+
+    return load_vehicle(name)
+
+
+def test_constant_profile_predicts_the_linear_profile_with_sigma_f_equal_to_sigma_0(capsule):
+    """guidance.bank_profile: constant flies |sigma| = sigma_0 to e_f: the same prediction as the
+    linear profile whose sigma_f is sigma_0, and a different one from the packaged sigma_f."""
+    sigma0 = math.radians(55.0)
+    constant = FnpegSetup.from_scenario(_capsule({"guidance.bank_profile": "constant"})).predict(CAPSULE_ENGAGED, sigma0)
+    flat = FnpegSetup.from_scenario(_capsule({"guidance.bank_end_deg": 55.0})).predict(CAPSULE_ENGAGED, sigma0)
+    linear = capsule.predict(CAPSULE_ENGAGED, sigma0)
+    assert constant.reached and flat.reached and linear.reached
+    assert constant.range_m == pytest.approx(flat.range_m, rel=1e-12)
+    np.testing.assert_allclose(constant.state, flat.state, rtol=1e-12)
+    assert abs(linear.range_m - constant.range_m) > 10e3  # sigma_f 70 deg shortens the range
+
+
+def test_bad_profile_names_the_field_and_the_allowed_values():
+    with pytest.raises(ScenarioError, match=r"guidance\.bank_profile = 'quadratic'; allowed: 'linear' or 'constant'"):
+        _capsule({"guidance.bank_profile": "quadratic"}).validate()
+
+
+def _capsule(overrides):
+    sc = load_scenario("capsule_lu2008")
+    apply_overrides(sc, overrides)
+    return sc
+
+
+@pytest.mark.parametrize("profile, within_km", [("linear", 1.0), ("constant", 2.5)])
+def test_capsule_nominal_flights_reach_the_target(profile, within_km):
+    """The packaged capsule flight, nominal (no dispersion): the linear profile ends within 1 km
+    (measured 0.46 km), the constant one within Lu (2008)'s 2.5 km (measured 1.60 km), each a
+    verified success (box and every path limit)."""
+    from drake_entry.diagrams.closed_loop import fly
+
+    r = fly(_capsule({"guidance.bank_profile": profile}))
+    assert r.success, r.message
+    assert r.errors["distance_m"] < within_km * 1e3

@@ -10,14 +10,13 @@ import dataclasses as dc
 import math
 import numbers
 import os
-from importlib import resources
 
 import numpy as np
 
 from drake_entry.errors import ScenarioError
 from drake_entry.models import aerodynamics as aero_mod
 from drake_entry.models.constraints import HeatFlux, PathLimits, make_heat_flux
-from drake_entry.typed_yaml import load_yaml_typed
+from drake_entry.typed_yaml import load_packaged_or_file, packaged_names
 
 
 @dc.dataclass
@@ -228,19 +227,12 @@ def vehicle_from_spec(spec: VehicleSpec, aero: str | None = None, where: str = "
     )
 
 
-PACKAGED_VEHICLES = ("horus2b", "cav_h", "marv", "shefex3", "sphynx")
+PACKAGED_VEHICLES = packaged_names("vehicles")
 
 
 def vehicle_spec(name_or_path: str) -> VehicleSpec:
-    """Read a vehicle YAML: a packaged name or a file path."""
-    if name_or_path in PACKAGED_VEHICLES:
-        text = resources.files("drake_entry").joinpath(f"vehicles/{name_or_path}.yaml").read_text()
-        return load_yaml_typed(VehicleSpec, text=text, where=f"vehicle '{name_or_path}'")
-    if not os.path.exists(name_or_path):
-        raise ScenarioError(
-            f"vehicle '{name_or_path}' is neither a packaged vehicle ({', '.join(PACKAGED_VEHICLES)}) nor a file"
-        )
-    return load_yaml_typed(VehicleSpec, path=name_or_path)
+    """Read a vehicle YAML: a packaged name (``PACKAGED_VEHICLES``) or a file path."""
+    return load_packaged_or_file(VehicleSpec, name_or_path, kind="vehicle", folder="vehicles")
 
 
 #: the vehicle-file fields a scenario may replace for its mission (Scenario.vehicle_limits)
@@ -252,7 +244,7 @@ def load_vehicle(name: str, *, aero: str | None = None, limits: dict | None = No
     """Load a vehicle by packaged name or YAML path.
 
     Args:
-      name: 'horus2b', 'cav_h', 'marv', 'shefex3', 'sphynx', or a path to a vehicle YAML.
+      name: a packaged vehicle (``PACKAGED_VEHICLES``) or a path to a vehicle YAML.
       aero: which of the file's aero models to use (default: the file's default_aero).
       limits: path and bank limits replacing the file's (keys: LIMIT_FIELDS, the file's units).
     """

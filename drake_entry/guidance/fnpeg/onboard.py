@@ -54,7 +54,7 @@ class FnpegSetup:
         alpha = Schedule(tuple(g.alpha_velocity_m_s), tuple(np.radians(g.alpha_deg)), "velocity")
         sigma_f = math.radians(g.bank_end_deg)
         predictor = Predictor(vehicle, planet, atmosphere, feedback, sigma_f=sigma_f, e_f=e_f, alpha=alpha,
-                              step_s=g.predictor_step_s)
+                              step_s=g.predictor_step_s, constant=g.bank_profile == "constant")
         return FnpegSetup(vehicle, planet, atmosphere, e_f,
                           (math.radians(scenario.target.longitude_deg), math.radians(scenario.target.latitude_deg)),
                           g.final_range_km * 1e3, sigma_f, alpha, feedback,

@@ -79,13 +79,15 @@ class Predictor:
 
     Args: vehicle, planet, atmosphere (the on-board models); law: the feedback settings;
     sigma_f [rad]: the profile's terminal bank; e_f [J/kg]: the terminal energy (mu/r - V^2/2);
+    constant: fly |sigma| = sigma_0 to e_f (Lu 2008's constant-bank profile) instead of the
+    linear profile to sigma_f;
     alpha: the angle-of-attack profile (Schedule in velocity); step_s: the fixed integration step
     [s]; floor_m, ceiling_m: altitudes that end a prediction; max_time_s: the longest prediction.
     """
 
     def __init__(self, vehicle, planet, atmosphere, law: FeedbackSettings, *, sigma_f: float, e_f: float,
                  alpha: Schedule, step_s: float = 2.0, floor_m: float = 0.0, ceiling_m: float = 200e3,
-                 max_time_s: float = 10000.0):
+                 max_time_s: float = 10000.0, constant: bool = False):
         if not step_s > 0:
             raise ScenarioError(f"FNPEG predictor step_s = {step_s}; allowed > 0 s")
         self.planet, self.mu, self.e_f = planet, planet.mu, e_f
@@ -100,7 +102,7 @@ class Predictor:
             _, L, D = dynamics.aero_accelerations(x, a, rho, sound, vehicle)
             L, D = k_lift * L, k_drag * D
             e = self.mu / r - 0.5 * V * V
-            base = linear_bank(e, e0, e_f, sigma0, sigma_f)
+            base = sigma0 if constant else linear_bank(e, e0, e_f, sigma0, sigma_f)
             load = np.sqrt(L * L + D * D)
             q = dynamics.dynamic_pressure(rho, V)
             heat = vehicle.heat_flux(rho, V, a)

@@ -23,6 +23,9 @@ class Fnpeg(ReversingBankSpec):
     final_range_km: float = 0.0
     # the profile: sigma_f fixed [deg] (Lu 2008: 60-70), sigma_0's first guess [deg]
     bank_end_deg: float = 60.0
+    # 'linear' (sigma_0 to sigma_f, Lu 2008/2014) or 'constant' (sigma_0 to the end: Lu 2008's
+    # comparison profile; bank_end_deg is then unused)
+    bank_profile: str = "linear"
     bank_start_guess_deg: float = 45.0
     bank_before_engagement_deg: float = 0.0
     engage_acceleration_m_s2: float = 1.52
@@ -66,6 +69,8 @@ class Fnpeg(ReversingBankSpec):
         check_range("guidance.final_range_km", self.final_range_km, 0.0, 1e4)
         limit = math.degrees(scenario.make_vehicle().bank_limit)
         check_range("guidance.bank_end_deg", self.bank_end_deg, 0.0, limit)
+        if self.bank_profile not in ("linear", "constant"):
+            raise ScenarioError(f"guidance.bank_profile = '{self.bank_profile}'; allowed: 'linear' or 'constant'")
         check_range("guidance.bank_start_guess_deg", self.bank_start_guess_deg, 0.0, 90.0)
         check_range("guidance.bank_before_engagement_deg", self.bank_before_engagement_deg, 0.0, limit)
         check_range("guidance.engage_acceleration_m_s2", self.engage_acceleration_m_s2, 0.0, 100.0)

@@ -76,12 +76,12 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
             continue
         record["preflight_planning_s"] = time.perf_counter() - t
         record["preflight_plan"] = getattr(setup.planner, "message", "") if setup.planner is not None else ""
-        del setup
         if progress:
             print(f"   {record['preflight_planning_s']:.1f} s; {runs} samples", flush=True)
         campaign_dir = os.path.join(out_dir, entry.label)
         run_campaign(path, runs=runs, out_dir=campaign_dir, seed=seed, workers=workers, progress=progress,
-                     trajectory_step_s=trajectory_step_s)
+                     trajectory_step_s=trajectory_step_s, nominal_setup=setup)  # its nominal: no third plan
+        del setup
         write_report(campaign_dir, title=f"{comp.name}: {entry.label}")
         methods[entry.label] = {**record, "campaign": entry.label}
     order = {label: i for i, label in enumerate(labels)}

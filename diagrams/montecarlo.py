@@ -63,7 +63,8 @@ def campaign_manifest(scenario_path: str, *, seed: int, trajectory_step_s: float
 
 def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, workers: int | None = None,
                  overrides: dict | None = None, progress: bool = True, backend: str = "processes",
-                 scheduler: str | None = None, trajectory_step_s: float = TRAJECTORY_STEP_S) -> str:
+                 scheduler: str | None = None, trajectory_step_s: float = TRAJECTORY_STEP_S,
+                 nominal_setup=None) -> str:
     """Run (or resume, or extend) a campaign of ``runs`` samples; returns out_dir.
 
     backend: 'serial', 'processes' (``workers`` local processes, default all cores) or
@@ -72,6 +73,9 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
 
     trajectory_step_s: spacing [s] of the down-sampled trajectories kept per sample (0 keeps
     none: the smallest output for large campaigns; the report then omits the envelopes).
+
+    nominal_setup: the ClosedLoopSetup of this very scenario, already built by the caller (its
+    pre-flight planning done), flown for the nominal trajectory instead of planning again.
 
     The directory's manifest fingerprints the scenario content, seed, trajectory step and
     versions: a directory holding another campaign is refused (CampaignError); a larger
@@ -99,13 +103,14 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     run_cases(task, cases, out_dir, manifest, backend=backend, workers=workers, scheduler=scheduler,
               progress=progress, desc="campaign")
     if trajectory_step_s > 0 and read_nominal(out_dir) is None:
-        fly_nominal(out_dir, manifest["scenario_yaml"])
+        fly_nominal(out_dir, manifest["scenario_yaml"], setup=nominal_setup)
     return out_dir
 
 
-def fly_nominal(out_dir: str, scenario_yaml: str) -> None:
+def fly_nominal(out_dir: str, scenario_yaml: str, *, setup=None) -> None:
     """Fly the campaign's scenario once without dispersions and keep its trajectory every
     DETAILED_STEP_S (``nominal.json``: the report overlays it on the campaign's envelopes).
+    ``setup``: that scenario's ClosedLoopSetup when the caller has built it (else built here).
     A flight that raises is not kept: the report then shows the campaign alone."""
     from drake_entry.diagrams.closed_loop import fly
     from drake_entry.errors import DrakeEntryError
@@ -113,8 +118,9 @@ def fly_nominal(out_dir: str, scenario_yaml: str) -> None:
     from drake_entry.typed_yaml import load_yaml_typed
 
     try:
-        scenario = load_yaml_typed(Scenario, text=scenario_yaml, where="campaign scenario").validate()
-        tr = fly(scenario).trajectory
+        flown = setup if setup is not None else load_yaml_typed(Scenario, text=scenario_yaml,
+                                                                where="campaign scenario").validate()
+        tr = fly(flown).trajectory
     except (DrakeEntryError, RuntimeError) as e:
         print(f"drake-entry: the nominal flight of the campaign failed ({e}); the report shows the campaign alone")
         return

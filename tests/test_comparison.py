@@ -130,8 +130,14 @@ def test_the_method_summary_counts_and_measures_the_rows():
     assert s["bank_reversals"] == {"mean": 3.5, "max": 5.0}
 
 
-def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path):
+def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path, monkeypatch):
+    from drake_entry.diagrams.closed_loop import ClosedLoopSetup
     from drake_entry.diagrams.comparison import run_comparison
+
+    built = []  # pre-flight plans made in this process (workers=1 runs the samples here too)
+    from_scenario = ClosedLoopSetup.from_scenario
+    monkeypatch.setattr(ClosedLoopSetup, "from_scenario",
+                        classmethod(lambda cls, *a, **k: built.append(a[0].name) or from_scenario(*a, **k)))
 
     comp = Comparison(name="tiny", description="drag-energy and a fixed bank profile", mission="horus2b", methods=[
         ComparedMethod(label="drag_energy", method="DragEnergy", mapping="the mission's own settings"),
@@ -151,6 +157,9 @@ def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path):
     for fig in ("comparison_footprints.png", "comparison_success.png", "comparison_miss.png"):
         assert (tmp_path / "cmp" / fig).stat().st_size > 10_000 and fig in text
     assert (tmp_path / "cmp" / "drag_energy" / "report.md").exists()
+    # two plans per flown method: the timed one, which the nominal flight then flies, and the
+    # worker's (one process here); the nominal flight used to plan a third time
+    assert sorted(built) == ["horus2b-bank_profile"] * 2 + ["horus2b-drag_energy"] * 2 and all((tmp_path / "cmp" / m / "nominal.json").exists() for m in ("drag_energy", "bank_profile"))
     assert "guidance: !BankProfile" in (tmp_path / "cmp" / "scenarios" / "bank_profile.yaml").read_text()
     # a second call with another seed into the same directory is refused, not mixed
     with pytest.raises(ScenarioError, match="holds comparison 'tiny' with seed 7"):

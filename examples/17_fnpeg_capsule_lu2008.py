@@ -19,7 +19,7 @@ figure of the three miss distributions, and checks what the comparison shows.
 
     python examples/17_fnpeg_capsule_lu2008.py [--quick] [--runs N] [--out out/examples/17]
 
-Full size (500 runs each) took 42 minutes on 2 cores; ``--quick`` flies 10 runs each.
+Full size (500 runs each) took 42 minutes on 2 cores; ``--quick`` flies 5 runs each.
 """
 import argparse
 import os
@@ -44,7 +44,7 @@ LU2008 = {"linear": (0.945, 0.353, 2.44), "constant": (1.478, 1.24, 7.09)}
 #: Lu (2008): every linear-profile run within this [km]; the scenario's acceptance radius too
 LU2008_RADIUS_KM = 2.5
 #: runs per campaign of the quick run
-QUICK_RUNS = 10
+QUICK_RUNS = 5
 
 
 def miss_statistics(df: pd.DataFrame) -> dict:
@@ -133,7 +133,7 @@ def check(stats: dict, quick: bool = False) -> Claims:
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="10 runs per campaign instead of --runs")
+    parser.add_argument("--quick", action="store_true", help="5 runs per campaign instead of --runs")
     parser.add_argument("--runs", type=int, default=500, help="runs per campaign (default: Lu's 500)")
     parser.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
     parser.add_argument("--out", default="out/examples/17", help="output directory")

@@ -272,11 +272,11 @@ def test_example_16(tmp_path):
 
 @pytest.mark.slow
 def test_example_17(tmp_path):
-    """FNPEG on the capsule with Lu (2008)'s dispersions, quick run (10 samples per profile):
+    """FNPEG on the capsule with Lu (2008)'s dispersions, quick run (5 samples per profile):
     the same draws in the three campaigns, every linear-profile flight inside 2.5 km, and the
     constant profile and the nominal-model predictions missing more on average."""
     r = _run("17_fnpeg_capsule_lu2008", tmp_path)
-    assert {k: v["runs"] for k, v in r.items()} == {"linear": 10, "constant": 10, "nominal_models": 10}
+    assert {k: v["runs"] for k, v in r.items()} == {"linear": 5, "constant": 5, "nominal_models": 5}
     assert r["linear"]["max"] < 2.5 and os.path.exists(tmp_path / "miss_distributions.png")
     for label in r:
         assert os.path.exists(tmp_path / label / "report.md")

@@ -33,11 +33,11 @@ from drake_entry.claims import Claims
 from drake_entry.diagrams.montecarlo import run_campaign
 
 SCENARIO, SEED = "capsule_lu2008", 2008
-#: the three campaigns: label -> scenario overrides
+#: the three campaigns: label -> (scenario overrides, report title)
 VARIANTS = {
-    "linear": {},
-    "constant": {"guidance.bank_profile": "constant"},
-    "nominal_models": {"guidance.acceleration_scaling": False},
+    "linear": ({}, f"{SCENARIO} (linear profile)"),
+    "constant": ({"guidance.bank_profile": "constant"}, f"{SCENARIO} (constant profile)"),
+    "nominal_models": ({"guidance.acceleration_scaling": False}, f"{SCENARIO} (linear profile, nominal on-board models)"),
 }
 #: Lu (2008), 500 runs: miss distance [km] mean, 1-sigma, max, per profile
 LU2008 = {"linear": (0.945, 0.353, 2.44), "constant": (1.478, 1.24, 7.09)}
@@ -99,15 +99,13 @@ def main(quick: bool = False, out_dir: str = "out/examples/17", runs: int = 500,
     runs = QUICK_RUNS if quick else runs
     os.makedirs(out_dir, exist_ok=True)
     stats = {}
-    for label, overrides in VARIANTS.items():
+    for label, (overrides, title) in VARIANTS.items():
         d = os.path.join(out_dir, label)
         print(f"{label}: {runs} runs, overrides {overrides or 'none'}", flush=True)
         run_campaign(SCENARIO, runs=runs, seed=SEED, out_dir=d, overrides=overrides or None, workers=workers)
-        write_report(d, title=f"{SCENARIO} ({label} profile)" if label != "nominal_models"
-                     else f"{SCENARIO} (linear profile, nominal on-board models)")
-        df = pd.read_parquet(os.path.join(d, "samples.parquet")).sort_values("index")
-        stats[label] = miss_statistics(df.head(runs))
-        stats[label]["disp"] = df.head(runs).filter(like="disp_").to_numpy(float)
+        write_report(d, title=title)
+        df = pd.read_parquet(os.path.join(d, "samples.parquet")).sort_values("index").head(runs)
+        stats[label] = {**miss_statistics(df), "disp": df.filter(like="disp_").to_numpy(float)}
     print("\n" + table(stats))
     print(f"wrote {figure(stats, os.path.join(out_dir, 'miss_distributions.png'))}")
     return stats

@@ -18,6 +18,7 @@ from drake_entry.guidance.fnpeg.law import (
 from drake_entry.guidance.fnpeg.onboard import FnpegSetup
 from drake_entry.models import dynamics
 from drake_entry.models.schedules import linear_bank
+from drake_entry.models.vehicles import load_vehicle
 from drake_entry.scenario import apply_overrides, load_scenario
 
 R0, G0 = 6378137.0, 9.80665
@@ -161,8 +162,8 @@ def test_prediction_stops_at_the_terminal_energy_and_converges_with_the_step(set
     assert 5e6 < fine.range_m < 2e7 and 1000.0 < fine.time_s < 4000.0
 
 
-def _scenario(overrides):
-    sc = load_scenario("cav_h_fnpeg")
+def _scenario(overrides, name="cav_h_fnpeg"):
+    sc = load_scenario(name)
     apply_overrides(sc, overrides)
     return sc
 
@@ -230,25 +231,19 @@ def test_capsule_dispersions_are_lu2008s():
 
 
 def test_apollo_cm_is_the_apollo10_compilation():
-    v = load_vehicle_named("apollo_cm")
+    v = load_vehicle("apollo_cm")
     assert (v.mass, v.reference_area) == (5498.22, 12.017) and v.representative
     cl, cd = v.aero.coefficients(math.radians(20.0), 25.0)
     assert (cl, cd) == (0.40815, 1.2569) and v.aero.coefficients(0.0, 0.5) == (cl, cd)  # trim: no alpha, no Mach
     assert cl / cd == pytest.approx(0.3247, abs=1e-4)
 
 
-def load_vehicle_named(name):
-    from drake_entry.models.vehicles import load_vehicle
-
-    return load_vehicle(name)
-
-
 def test_constant_profile_predicts_the_linear_profile_with_sigma_f_equal_to_sigma_0(capsule):
     """guidance.bank_profile: constant flies |sigma| = sigma_0 to e_f: the same prediction as the
     linear profile whose sigma_f is sigma_0, and a different one from the packaged sigma_f."""
     sigma0 = math.radians(55.0)
-    constant = FnpegSetup.from_scenario(_capsule({"guidance.bank_profile": "constant"})).predict(CAPSULE_ENGAGED, sigma0)
-    flat = FnpegSetup.from_scenario(_capsule({"guidance.bank_end_deg": 55.0})).predict(CAPSULE_ENGAGED, sigma0)
+    constant = FnpegSetup.from_scenario(_scenario({"guidance.bank_profile": "constant"}, "capsule_lu2008")).predict(CAPSULE_ENGAGED, sigma0)
+    flat = FnpegSetup.from_scenario(_scenario({"guidance.bank_end_deg": 55.0}, "capsule_lu2008")).predict(CAPSULE_ENGAGED, sigma0)
     linear = capsule.predict(CAPSULE_ENGAGED, sigma0)
     assert constant.reached and flat.reached and linear.reached
     assert constant.range_m == pytest.approx(flat.range_m, rel=1e-12)
@@ -258,13 +253,7 @@ def test_constant_profile_predicts_the_linear_profile_with_sigma_f_equal_to_sigm
 
 def test_bad_profile_names_the_field_and_the_allowed_values():
     with pytest.raises(ScenarioError, match=r"guidance\.bank_profile = 'quadratic'; allowed: 'linear' or 'constant'"):
-        _capsule({"guidance.bank_profile": "quadratic"}).validate()
-
-
-def _capsule(overrides):
-    sc = load_scenario("capsule_lu2008")
-    apply_overrides(sc, overrides)
-    return sc
+        _scenario({"guidance.bank_profile": "quadratic"}, "capsule_lu2008").validate()
 
 
 @pytest.mark.parametrize("profile, within_km", [("linear", 1.0), ("constant", 2.5)])
@@ -274,6 +263,6 @@ def test_capsule_nominal_flights_reach_the_target(profile, within_km):
     verified success (box and every path limit)."""
     from drake_entry.diagrams.closed_loop import fly
 
-    r = fly(_capsule({"guidance.bank_profile": profile}))
+    r = fly(_scenario({"guidance.bank_profile": profile}, "capsule_lu2008"))
     assert r.success, r.message
     assert r.errors["distance_m"] < within_km * 1e3

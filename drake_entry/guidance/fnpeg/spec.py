@@ -11,9 +11,9 @@ from drake_entry.guidance.spec import ReversingBankSpec
 class Fnpeg(ReversingBankSpec):
     """|sigma| linear in e = mu/r - V^2/2 from sigma_0 (solved on board every
     ``corrector_period_s`` by the damped secant on the predicted range error) to
-    ``bank_end_deg`` at the terminal energy (or held at sigma_0: ``bank_profile: constant``), with Lu's altitude-rate feedback for phugoid
-    damping and path limits; bank sign from the shared reversal logic; alpha a profile in
-    velocity. Engages when the sensed aerodynamic acceleration reaches
+    ``bank_end_deg`` at the terminal energy (or held at sigma_0: ``bank_profile: constant``),
+    with Lu's altitude-rate feedback for phugoid damping and path limits; bank sign from the
+    shared reversal logic; alpha a profile in velocity. Engages when the sensed aerodynamic acceleration reaches
     ``engage_acceleration_m_s2`` (before: ``bank_before_engagement_deg``)."""
 
     # the terminal interface (Lu's e_f: altitude and speed); the flight stops at its energy

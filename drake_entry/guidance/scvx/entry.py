@@ -50,13 +50,15 @@ u) passes through the lift-up direction the plan never saw.
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 import scipy.sparse as sp
 from pydrake.autodiffutils import AutoDiffXd, ExtractGradient, ExtractValue, InitializeAutoDiff
+from pydrake.symbolic import Expression, Variable, uninterpreted_function
 
-from drake_entry.errors import ScenarioError
+from drake_entry.errors import ScenarioError, UnsupportedScalarError
 from drake_entry.guidance.scvx.engine import ConvexifiableProblem, Evaluation, Linearisation
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import (
@@ -67,8 +69,9 @@ from drake_entry.guidance.scvx.settings import (
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.constraints import total_load_factor
 from drake_entry.models.dynamics import STATE_NAMES, aero_accelerations, air_data, equations_of_motion_lift_components
+from drake_entry.models.expression_tape import ExpressionTape, TracedAtmosphere
 from drake_entry.models.planet import Earth
-from drake_entry.models.scalar import lift, value_of
+from drake_entry.models.scalar import is_symbolic, lift, value_of
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.planning.pseudospectral import SegmentMesh
 
@@ -165,9 +168,12 @@ class EntryProblem(ConvexifiableProblem):
         self._gamma_bounds = np.radians(mission.flight_path_bounds_deg) + np.radians(
             settings.flight_path_margins_deg) * np.array([1.0, -1.0])
         self.rate_chords = f.bank == "lossless" and settings.lossless_rate_limit
-        #: heat flux [W/m^2] and load [g] bounds at the nodes: the vehicle's less the path margin
-        self.node_limits = ((1.0 - settings.path_margin) * limits.heat_flux_max,
-                            (1.0 - settings.path_margin) * limits.total_load_max)
+        #: heat flux [W/m^2] and load [g] bounds at nodes 1..n-1 (n - 1 each): the vehicle's less
+        #: the path margin, ramped in over the first path_margin_ramp_s of the final-time guess
+        t_nodes = self.mesh.s[1:] * final_time_guess
+        ramp = np.minimum(1.0, t_nodes / settings.path_margin_ramp_s) if settings.path_margin_ramp_s > 0 else 1.0
+        margin = settings.path_margin * np.broadcast_to(ramp, t_nodes.shape)
+        self.node_limits = ((1.0 - margin) * limits.heat_flux_max, (1.0 - margin) * limits.total_load_max)
 
     # ----- layout -------------------------------------------------------------------------
     def _set_bounds(self, tf_guess):
@@ -231,7 +237,10 @@ class EntryProblem(ConvexifiableProblem):
     # ----- the physics at one node ------------------------------------------------------
     def alpha_of(self, V):
         """alpha(V) [rad] of the mission's law for float or AutoDiffXd V (the C2 schedule and
-        its slope)."""
+        its slope); for a symbolic V the uninterpreted function ``alpha_schedule(V)``, which the
+        node tape evaluates with the schedule's array path (``_alpha_schedule``)."""
+        if is_symbolic(V):
+            return uninterpreted_function("alpha_schedule", [V])
         value, slope, _ = self.alpha.derivatives(value_of(V))
         return lift([V], value, [slope])
 
@@ -245,11 +254,12 @@ class EntryProblem(ConvexifiableProblem):
         alpha = x[self.i_alpha] if self.i_alpha is not None else self.alpha_of(x[3])
         return c, s, alpha
 
-    def node_outputs(self, x, u):
+    def node_outputs(self, x, u, atmosphere: Atmosphere | None = None):
         """[xdot (n_x), heat flux W/m^2, total load g, speed of sound m/s, geodetic altitude m]
-        at state x and control u (eqs. 1-10, 34-41, 54-57). Any scalar type."""
+        at state x and control u (eqs. 1-10, 34-41, 54-57). Any scalar type; ``atmosphere``
+        replaces the problem's (the tape's trace)."""
         position = x[:6]
-        rho, a = air_data(position, self.planet, self.atmosphere)
+        rho, a = air_data(position, self.planet, atmosphere or self.atmosphere)
         c, s, alpha = self.bank_and_alpha(x, u)
         _, L, D = aero_accelerations(position, alpha, rho, a, self.vehicle)
         xdot = list(equations_of_motion_lift_components(position, L * c, L * s, D, self.planet))
@@ -259,9 +269,39 @@ class EntryProblem(ConvexifiableProblem):
         n = total_load_factor(L, D, self.planet.g0)
         return [*xdot, q, n, a, self.planet.atmospheric_altitude(x[0], x[2])]
 
+    @functools.cached_property
+    def tape(self) -> ExpressionTape | None:
+        """node_outputs of every node at once (an ExpressionTape of its symbolic form, the
+        atmosphere its own array path), or None when a model has no symbolic form (the nodes
+        are then evaluated one by one)."""
+        xs = [Variable(f"x{i}") for i in range(self.n_x)]
+        us = [Variable(f"u{i}") for i in range(self.n_u)]
+        atmosphere = TracedAtmosphere(self.atmosphere)
+        try:
+            with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
+                outputs = self.node_outputs([Expression(v) for v in xs], [Expression(v) for v in us], atmosphere)
+            return ExpressionTape(outputs, xs + us, {**atmosphere.functions, "alpha_schedule": self._alpha_schedule})
+        except (UnsupportedScalarError, TypeError):
+            return None
+
+    def _alpha_schedule(self, V):
+        """(alpha(V), [d alpha / d V]) on an array of speeds [m/s] (the tape's alpha_schedule)."""
+        return self.alpha(V), [self.alpha.slope(V)]
+
     def _nodes(self, X, U, gradients: bool):
         """Node outputs (n, n_outputs) and, with gradients, their Jacobians
         (n, n_outputs, n_x + n_u) with respect to (x, u)."""
+        if self.tape is not None:
+            return self._nodes_by_tape(X, U, gradients)
+        return self._nodes_one_by_one(X, U, gradients)
+
+    def _nodes_by_tape(self, X, U, gradients: bool):
+        points = np.hstack([np.asarray(X, float), np.asarray(U, float)])
+        if not gradients:
+            return self.tape(points), None
+        return self.tape(points, gradients=True)
+
+    def _nodes_one_by_one(self, X, U, gradients: bool):
         n, nx, nv = self.n_nodes, self.n_x, self.n_x + self.n_u
         values = np.empty((n, self.n_outputs))
         if not gradients:
@@ -394,7 +434,7 @@ class EntryProblem(ConvexifiableProblem):
         r_idx = [np.repeat(path_rows, nv), np.repeat(path_rows + 1, nv), path_rows + 2, path_rows + 3]
         c_idx = [var_cols[k].ravel(), var_cols[k].ravel(), self._col_x(k, 4), self._col_x(k, 4)]
         q_max, n_max = self.node_limits
-        vals = [(jac[k, self.out_q, :] / q_max).ravel(), (jac[k, self.out_n, :] / n_max).ravel(),
+        vals = [(jac[k, self.out_q, :] / q_max[:, None]).ravel(), (jac[k, self.out_n, :] / n_max[:, None]).ravel(),
                 np.full(n - 1, -1.0 / 0.1), np.full(n - 1, 1.0 / 0.1)]
         objective = self.settings.objective
         e0 = self.n_path

@@ -138,6 +138,12 @@ class EntryProblemSettings:
         with 0.02 its load was 0.8 % over), 0.02 for a bank state, whose plans flown through the
         closed loop's actuators, dispersed, peak up to 1 % above their nodes' heat flux (the
         margin shrinks the reachable set: the 9 x 9 abort map loses EIPs that rode the limits).
+      path_margin_ramp_s: the margin grows linearly from 0 at the plan's first node to
+        ``path_margin`` at this flight time [s] (the final-time guess's): a re-plan begins where
+        the vehicle is, and a vehicle flying within the margin of a limit (a dispersed closed
+        loop rides the heat-flux limit within 0.4 %) cannot leave it in the seconds to its next
+        nodes; with the margin at full strength there, the re-plan is infeasible at its first
+        node. 0: the full margin from the first node.
       flight_path_margins_deg: the nodes keep gamma this far [deg] inside the mission's
         flight-path bounds (eq. 70), (above the lower bound, below the upper), so that the plan
         flown through the actuators, and a dispersed closed loop flying it, stays inside them:
@@ -159,6 +165,7 @@ class EntryProblemSettings:
     max_lossless_gap: float = 0.01
     lossless_rate_limit: bool = True
     path_margin: float | None = None
+    path_margin_ramp_s: float = 60.0
     flight_path_margins_deg: tuple = (1.0, 0.2)
     bank_margin_deg: float = 2.0
 
@@ -185,6 +192,9 @@ class EntryProblemSettings:
             self.path_margin = DEFAULT_PATH_MARGIN[FORMULATIONS[self.formulation].bank]
         if not 0.0 <= self.path_margin <= 0.5:
             raise FieldError("EntryProblemSettings", "path_margin", f"= {self.path_margin} must be in [0, 0.5]")
+        if not 0.0 <= self.path_margin_ramp_s <= 600.0:
+            raise FieldError("EntryProblemSettings", "path_margin_ramp_s", f"= {self.path_margin_ramp_s} must be in "
+                                f"[0, 600] s")
         margins = tuple(self.flight_path_margins_deg)
         if len(margins) != 2 or not all(isinstance(v, (int, float)) and 0.0 <= v <= 5.0 for v in margins):
             raise FieldError("EntryProblemSettings", "flight_path_margins_deg", f"= {margins} needs two margins in "

@@ -55,8 +55,11 @@ class Scvx(ReplanningSpec):
     # inside the vehicle's limits at the nodes, gamma this far [deg] inside the flight-path
     # bounds (above the lower, below the upper), |bank| this far [deg] inside the vehicle's
     # limit, so that the closed loop, dispersed, holds the limits its verdict checks (None:
-    # EntryProblemSettings' defaults: 0.02, [1.0, 0.2] deg, 2 deg)
+    # EntryProblemSettings' defaults: 0.02, [1.0, 0.2] deg, 2 deg); the heat-flux and load
+    # margin grows from 0 at a plan's first node to its value this far into the plan [s] (a
+    # re-plan starts where the vehicle is, possibly riding a limit; None: 60 s)
     path_margin: Optional[float] = None
+    path_margin_ramp_s: Optional[float] = None
     flight_path_margins_deg: Optional[list[float]] = None
     bank_margin_deg: Optional[float] = None
     max_iterations: int = 100

@@ -4,9 +4,16 @@ planners receive ``fly_controls`` as their ``verifier``).
 
 Entry controls (SCvx plans), as the closed loop flies them:
 
-    TrajectorySource(bank(t + lead)) --> BankActuator (sampled every period) --bank--> EntryVehicle
-    TrajectorySource(alpha(t + lead)) or ScheduleSource(alpha(V)) --> AlphaActuator --alpha--> EntryVehicle
+    bank(t + lead) --> BankActuator (sampled every period) --bank--> EntryVehicle
+    alpha(t + lead) or ScheduleSource(alpha(V)) --> AlphaActuator --alpha--> EntryVehicle
     AtmosphereSystem(state) --air_data--> EntryVehicle; PlantGuard(state) (native plant)
+
+A command known in advance (the plan's spline) is flown as its actuator's response, computed
+before the flight by the actuator's own law and segments (``LimitedActuator.response``: the
+segments its periodic update would make, joined into a cubic Hermite TrajectorySource), so the
+flight makes no Python call per integrator stage; ``actuator_systems=True`` flies the sampled
+actuator systems themselves (tests hold the two to each other). alpha(V), a law of the state,
+always goes through the AlphaActuator system.
 
 Without ``actuation`` the C2 splines feed the vehicle directly. Optimal-control controls (NLP
 solutions):
@@ -26,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
+from pydrake.systems.primitives import LogVectorOutput, TrajectorySource, ZeroOrderHold
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.diagrams.common import add_step_loggers, collect_trajectory
@@ -50,7 +57,7 @@ FLIGHT_ERRORS = (RuntimeError, ModelRangeError, NonFiniteStateError, OverflowErr
 
 
 def fly_controls(controls: EntryControls | OcpControls, *, accuracy: float | None = None,
-                 log_points: int = LOG_POINTS, plant: str = "auto") -> FlownControls:
+                 log_points: int = LOG_POINTS, plant: str = "auto", actuator_systems: bool = False) -> FlownControls:
     """Fly ``controls`` from their initial state to their final time with the Drake Simulator
     (the verifier of drake_entry.planning.verification).
 
@@ -60,9 +67,12 @@ def fly_controls(controls: EntryControls | OcpControls, *, accuracy: float | Non
       log_points: samples logged over the flight.
       plant: the entry plant: "auto", "native" (systems/native_plant.py, with a PlantGuard) or
         "python" (systems/native_plant.add_plant).
+      actuator_systems: fly a command known in advance through the sampled actuator systems
+        (a Python call per integrator stage) instead of their precomputed response (the same
+        law and segments; the reference the tests hold the default to).
     """
     if isinstance(controls, EntryControls):
-        return _fly_entry(controls, accuracy, log_points, plant)
+        return _fly_entry(controls, accuracy, log_points, plant, actuator_systems)
     if isinstance(controls, OcpControls):
         return _fly_ocp(controls, accuracy or OCP_ACCURACY, log_points)
     raise ScenarioError(f"fly_controls flies EntryControls or OcpControls, got {type(controls).__name__}")
@@ -77,7 +87,8 @@ def _spline(time, values) -> PiecewisePolynomial:
     return PiecewisePolynomial.CubicWithContinuousSecondDerivatives(t, v, periodic_end_condition=False)
 
 
-def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_kind: str) -> FlownControls:
+def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_kind: str,
+               actuator_systems: bool) -> FlownControls:
     act: Actuation | None = c.actuation
     lead = act.lead_s if act is not None else 0.0
     t = np.asarray(c.time, float) - lead
@@ -88,31 +99,29 @@ def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_
         guard = builder.AddNamedSystem("plant_guard", PlantGuard(
             h_min=c.atmosphere.h_min, h_max=c.atmosphere.h_max, model=type(c.atmosphere).__name__, planet=c.planet))
         builder.Connect(plant.GetOutputPort("state"), guard.get_input_port())
-    bank_source = builder.AddNamedSystem("bank_plan", TrajectorySource(_spline(t, np.reshape(c.bank, (1, -1)))))
-    if c.alpha is None:
+    tf = float(c.final_time)
+    bank_plan = _spline(t, np.reshape(c.bank, (1, -1)))
+    alpha_plan = None if c.alpha is None else _spline(t, np.reshape(c.alpha, (1, -1)))
+    if act is None:
+        bank_act = alpha_act = None
+    else:
+        lo, hi = act.alpha_bounds
+        bank_act = BankActuator(bank_limit=act.bank_limit, rate_limit=act.bank_rate_limit,
+                                accel_limit=act.bank_accel_limit, initial_bank=act.initial_bank, period=act.period_s)
+        alpha_act = AlphaActuator(alpha_min=lo, alpha_max=hi, rate_limit=act.alpha_rate_limit,
+                                  accel_limit=act.alpha_accel_limit, initial_alpha=act.initial_alpha,
+                                  period=act.period_s)
+    bank_out = _actuated(builder, "bank", bank_plan, bank_act, tf, actuator_systems)
+    if alpha_plan is None:  # the alpha(V) law, fed back from the state
         schedule = builder.AddNamedSystem("alpha_plan", ScheduleSource(c.alpha_law, c.planet))
         builder.Connect(plant.GetOutputPort("state"), schedule.GetInputPort("state"))
-        alpha_out = schedule.get_output_port()
+        alpha_out = _actuated(builder, "alpha", schedule.get_output_port(), alpha_act, tf, actuator_systems)
     else:
-        alpha_out = builder.AddNamedSystem("alpha_plan", TrajectorySource(
-            _spline(t, np.reshape(c.alpha, (1, -1))))).get_output_port()
-    bank_out = bank_source.get_output_port()
-    if act is not None:
-        lo, hi = act.alpha_bounds
-        bank_act = builder.AddNamedSystem("bank_actuator", BankActuator(
-            bank_limit=act.bank_limit, rate_limit=act.bank_rate_limit, accel_limit=act.bank_accel_limit,
-            initial_bank=act.initial_bank, period=act.period_s))
-        alpha_act = builder.AddNamedSystem("alpha_actuator", AlphaActuator(
-            alpha_min=lo, alpha_max=hi, rate_limit=act.alpha_rate_limit, accel_limit=act.alpha_accel_limit,
-            initial_alpha=act.initial_alpha, period=act.period_s))
-        builder.Connect(bank_out, bank_act.get_input_port())
-        builder.Connect(alpha_out, alpha_act.get_input_port())
-        bank_out, alpha_out = bank_act.GetOutputPort("bank"), alpha_act.GetOutputPort("alpha")
+        alpha_out = _actuated(builder, "alpha", alpha_plan, alpha_act, tf, actuator_systems)
     builder.Connect(bank_out, plant.GetInputPort("bank"))
     builder.Connect(alpha_out, plant.GetInputPort("alpha"))
     signals = {"state": plant.GetOutputPort("state"), "conditions": plant.GetOutputPort("flight_conditions"),
                "bank": bank_out, "alpha": alpha_out}
-    tf = float(c.final_time)
     loggers = {name: LogVectorOutput(port, builder, tf / log_points) for name, port in signals.items()}
     sources = {name: (port.get_system().get_name(), port.get_name()) for name, port in signals.items()}
     step_loggers = add_step_loggers(builder, signals)
@@ -130,6 +139,31 @@ def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_
                             reason=failure or "t_f", wall_time=0.0, step_loggers=step_loggers,
                             final_instant=not failure)
     return FlownControls(tr.time, tr.state, tr, failure)
+
+
+def _actuated(builder, name: str, command, actuator, t_end: float, as_system: bool):
+    """The output port of ``name`` ("bank" or "alpha") as the plant receives it. ``command``: a
+    PiecewisePolynomial known in advance (the plan's) or an output port (a law of the state);
+    ``actuator``: a sampled LimitedActuator, or None for the command itself. A command known in
+    advance goes through the actuator's ``response`` (its own law and segments, before the
+    flight: a TrajectorySource, no Python call per integrator stage) unless ``as_system``; a
+    port goes through the actuator system."""
+    if isinstance(command, PiecewisePolynomial):
+        if actuator is not None and not as_system:
+            response = actuator.response(lambda t: command.value(t)[0, 0], t_end)
+            out = builder.AddNamedSystem(f"{name}_actuator", TrajectorySource(response)).get_output_port()
+            # the actuator system's periodic update ends an integrator step at every sample instant;
+            # a ZeroOrderHold at the same period (C++, its output unused) keeps those step ends, so
+            # both realisations take the same steps
+            instants = builder.AddNamedSystem(f"{name}_actuator_samples", ZeroOrderHold(actuator.period, 1))
+            builder.Connect(out, instants.get_input_port())
+            return out
+        command = builder.AddNamedSystem(f"{name}_plan", TrajectorySource(command)).get_output_port()
+    if actuator is None:
+        return command
+    builder.AddNamedSystem(f"{name}_actuator", actuator)
+    builder.Connect(command, actuator.get_input_port())
+    return actuator.GetOutputPort(name)
 
 
 def _fly_ocp(c: OcpControls, accuracy: float, log_points: int) -> FlownControls:

@@ -20,8 +20,10 @@ Ports (``name`` = "bank" or "alpha"):
 """
 from __future__ import annotations
 
+import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.errors import ScenarioError
 from drake_entry.models.actuator import BANDWIDTH_RAD_S, SUBSTEP_S, actuator_rates, integrate_actuator
@@ -45,7 +47,7 @@ class LimitedActuator(LeafSystem):
         self.limits = dict(lower=lower, upper=upper, rate_limit=rate_limit, accel_limit=accel_limit,
                            bandwidth=bandwidth)
         self.cmd_port = self.DeclareVectorInputPort(f"{name}_command", 1)
-        self.period = period
+        self.period, self.initial = period, float(initial)
         if period is None:
             self.DeclareContinuousState(BasicVector([initial, 0.0]))
             state = {self.all_state_ticket()}
@@ -76,6 +78,27 @@ class LimitedActuator(LeafSystem):
     # -- sampled realisation -------------------------------------------------------------
     def _sample(self, context):
         return context.get_abstract_state(int(self._segment)).get_value().at(context.get_time())
+
+    def response(self, command, t_end: float) -> PiecewisePolynomial:
+        """The sampled realisation's output from t = 0 to ``t_end`` [s] when the command is known
+        in advance (``command(t)`` [rad], e.g. a plan's spline): the segments ``_plan_segment``
+        makes at every period, from the same law and start, joined into one C1 cubic Hermite
+        PiecewisePolynomial (x [rad] and its rate). Flown by a TrajectorySource it is this
+        actuator without a Python call per integrator stage (the plan verifier's open-loop
+        flights); tests hold the two to each other."""
+        if self.period is None:
+            raise ScenarioError(f"{type(self).__name__}.response needs the sampled realisation (a period)")
+        h = self.period / self.n_sub
+        times, xs, rates = [0.0], [self.initial], [0.0]
+        x, rate, k = self.initial, 0.0, 0
+        while k * self.period < t_end:
+            t0 = k * self.period
+            seg_x, seg_r = integrate_actuator(x, rate, float(command(t0)), h, self.n_sub, **self.limits)
+            times.extend(t0 + h * np.arange(1, self.n_sub + 1))
+            xs.extend(seg_x[1:])
+            rates.extend(seg_r[1:])
+            x, rate, k = seg_x[-1], seg_r[-1], k + 1
+        return PiecewisePolynomial.CubicHermite(np.array(times), np.array(xs)[None, :], np.array(rates)[None, :])
 
     def _plan_segment(self, context, state):
         t0 = context.get_time()

@@ -109,6 +109,40 @@ def test_bank_command_is_clipped_to_the_bank_limit():
     assert bank[-1] == pytest.approx(np.radians(89.0), abs=np.radians(0.01))
 
 
+def test_sampled_actuator_response_equals_the_actuator_system():
+    """A command known in advance (a bank reversal and a slow weave, sampled every 1 s):
+    ``response`` (the actuator's segments computed before a flight, one Hermite polynomial)
+    equals the sampled actuator system's output and rate at every instant to 1e-12 rad,
+    through the rate- and acceleration-limited reversal (where the RK2 sub-steps act)."""
+    from pydrake.systems.primitives import TrajectorySource
+    from pydrake.trajectories import PiecewisePolynomial
+
+    t_cmd = np.linspace(0.0, 60.0, 121)
+    cmd = np.where(t_cmd < 20.0, np.radians(60.0), np.radians(-55.0)) + np.radians(5.0) * np.sin(t_cmd / 7.0)
+    command = PiecewisePolynomial.FirstOrderHold(t_cmd, cmd[None, :])
+    kw = dict(bank_limit=np.radians(80.0), rate_limit=np.radians(10.0), accel_limit=np.radians(5.0),
+              initial_bank=np.radians(50.0), period=1.0)
+    b = DiagramBuilder()
+    src = b.AddSystem(TrajectorySource(command))
+    act = b.AddSystem(BankActuator(**kw))
+    b.Connect(src.get_output_port(), act.get_input_port())
+    sim = Simulator(b.Build())
+    ctx = act.GetMyContextFromRoot(sim.get_mutable_context())
+    response = BankActuator(**kw).response(lambda t: command.value(t)[0, 0], 50.0)
+    ts = np.sort(np.concatenate([np.linspace(0.0, 50.0, 337), np.arange(1.0, 50.0, 1.0) + 0.5e-3]))
+    worst, rates = 0.0, []
+    for t in ts:
+        sim.AdvanceTo(t)
+        worst = max(worst, abs(act.get_output_port(0).Eval(ctx)[0] - response.value(t)[0, 0]),
+                    abs(act.GetOutputPort("bank_rate").Eval(ctx)[0] - response.EvalDerivative(t, 1)[0, 0]))
+        rates.append(act.GetOutputPort("bank_rate").Eval(ctx)[0])
+    assert worst < 1e-12, worst
+    assert max(np.abs(rates)) == pytest.approx(np.radians(10.0), rel=1e-3)  # the reversal rode the rate limit
+    assert response.end_time() >= 50.0
+    with pytest.raises(Exception, match="sampled realisation"):
+        BankActuator(**{**kw, "period": None}).response(lambda t: 0.0, 10.0)
+
+
 def test_navigation_noise_is_reproducible_from_the_seed():
     """The same seed gives the same estimates, another seed others; over 4000 updates the
     error has the bias as its mean (within 4 standard errors), each channel's sigma as its

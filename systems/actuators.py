@@ -88,24 +88,25 @@ class LimitedActuator(LeafSystem):
         flights); tests hold the two to each other."""
         if self.period is None:
             raise ScenarioError(f"{type(self).__name__}.response needs the sampled realisation (a period)")
-        h = self.period / self.n_sub
         times, xs, rates = [0.0], [self.initial], [0.0]
         x, rate, k = self.initial, 0.0, 0
         while k * self.period < t_end:
-            t0 = k * self.period
-            seg_x, seg_r = integrate_actuator(x, rate, float(command(t0)), h, self.n_sub, **self.limits)
-            times.extend(t0 + h * np.arange(1, self.n_sub + 1))
-            xs.extend(seg_x[1:])
-            rates.extend(seg_r[1:])
-            x, rate, k = seg_x[-1], seg_r[-1], k + 1
+            seg = self._next_segment(k * self.period, x, rate, command(k * self.period))
+            times.extend(seg.t0 + seg.h * np.arange(1, self.n_sub + 1))
+            xs.extend(seg.sigma[1:])
+            rates.extend(seg.rate[1:])
+            x, rate, k = seg.sigma[-1], seg.rate[-1], k + 1
         return PiecewisePolynomial.CubicHermite(np.array(times), np.array(xs)[None, :], np.array(rates)[None, :])
 
-    def _plan_segment(self, context, state):
-        t0 = context.get_time()
-        x, rate = self._sample(context)
+    def _next_segment(self, t0: float, x: float, rate: float, command: float) -> "_Segment":
+        """The segment of the period starting at t0 [s] from position x [rad] and rate [rad/s]
+        under ``command`` [rad]: the law integrated over n_sub sub-steps."""
         h = self.period / self.n_sub
-        s, r = integrate_actuator(x, rate, float(self.cmd_port.Eval(context)[0]), h, self.n_sub, **self.limits)
-        state.get_mutable_abstract_state(int(self._segment)).set_value(_Segment(t0, h, s, r))
+        return _Segment(t0, h, *integrate_actuator(x, rate, float(command), h, self.n_sub, **self.limits))
+
+    def _plan_segment(self, context, state):
+        segment = self._next_segment(context.get_time(), *self._sample(context), self.cmd_port.Eval(context)[0])
+        state.get_mutable_abstract_state(int(self._segment)).set_value(segment)
 
 
 class BankActuator(LimitedActuator):

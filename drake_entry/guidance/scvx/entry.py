@@ -171,8 +171,8 @@ class EntryProblem(ConvexifiableProblem):
         #: heat flux [W/m^2] and load [g] bounds at nodes 1..n-1 (n - 1 each): the vehicle's less
         #: the path margin, ramped in over the first path_margin_ramp_s of the final-time guess
         t_nodes = self.mesh.s[1:] * final_time_guess
-        ramp = np.minimum(1.0, t_nodes / settings.path_margin_ramp_s) if settings.path_margin_ramp_s > 0 else 1.0
-        margin = settings.path_margin * np.broadcast_to(ramp, t_nodes.shape)
+        ramp_s = settings.path_margin_ramp_s
+        margin = settings.path_margin * (np.minimum(1.0, t_nodes / ramp_s) if ramp_s > 0 else np.ones_like(t_nodes))
         self.node_limits = ((1.0 - margin) * limits.heat_flux_max, (1.0 - margin) * limits.total_load_max)
 
     # ----- layout -------------------------------------------------------------------------

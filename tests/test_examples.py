@@ -1,5 +1,9 @@
 """Every script in examples/ runs in its reduced size (``main(quick=True)``) and gives what its
-docstring promises, so no example rots."""
+docstring promises, so no example rots.
+
+The quick runs that take over about 10 s of a core (a campaign, a refined NLP, a closed loop that
+re-plans) are marked ``slow``: the default run leaves them out and CI runs them with the other
+reduced-size reproductions (``-m "slow and not long"``); the full sizes are also ``long``."""
 import importlib.util
 import math
 import os
@@ -78,6 +82,7 @@ def test_example_02(tmp_path):
     assert (tmp_path / "controllers.png").exists()
 
 
+@pytest.mark.slow
 def test_example_03(tmp_path):
     df = _run("03_monte_carlo", tmp_path)
     assert len(df) == 4 and df["stop"].eq("reached energy").all()
@@ -93,6 +98,7 @@ def test_example_04(tmp_path):
     assert (tmp_path / "my_vehicle.yaml").exists() and (tmp_path / "corridor.png").exists()
 
 
+@pytest.mark.slow
 def test_example_05(tmp_path):
     """Refined from 30 nodes until verified (80 nodes: between-node error 3.2e-4, the flown
     controls 19 m from the planned end); the example flies what solve() flew."""
@@ -106,6 +112,7 @@ def test_example_05(tmp_path):
     assert again.final_time == pytest.approx(res.final_time - 500.0, rel=0.05)
 
 
+@pytest.mark.slow
 def test_example_06(tmp_path):
     r = _run("06_swarm_bank", tmp_path)
     flight = r["flight"]
@@ -127,6 +134,7 @@ def test_example_07(tmp_path):
     assert r["nlp"] is None  # the NLP cross-check runs in the full example and in the slow tests
 
 
+@pytest.mark.slow
 def test_example_09(tmp_path):
     """The SCvx guidance in the closed loop (the one nominal flight of the suite): re-planned
     every 200 s it stops at the DRS altitude with its geodetic altitude in paper 001's 10-13 km
@@ -156,6 +164,7 @@ def test_example_09(tmp_path):
     assert "flight_path in [-30, 0.5] deg" in report
 
 
+@pytest.mark.slow
 def test_example_08(tmp_path):
     """Orbital aborts from the nominal EIP and its two longitude neighbours, two descent aborts
     (300 s and 600 s to Ben Guerir): rows, reports and maps written; the nominal EIP is feasible."""
@@ -170,6 +179,7 @@ def test_example_08(tmp_path):
     assert os.path.exists(os.path.join(descent["directory"], "descent_tracks.png"))
 
 
+@pytest.mark.slow
 def test_example_10(tmp_path):
     """Every catalogue problem as a user poses it, solved with no option (the library defaults):
     verified and within 1e-4 of its published optimum (brachistochrone: the cycloid, exact;
@@ -190,6 +200,7 @@ def test_example_10(tmp_path):
     assert os.path.exists(r["plot"])
 
 
+@pytest.mark.slow
 def test_example_11(tmp_path):
     r = _run("11_shefex3_problem", tmp_path)
     assert 590.0 < r["open_loop"].time[-1] < 620.0
@@ -199,6 +210,7 @@ def test_example_11(tmp_path):
     assert os.path.exists(r["plot"])
 
 
+@pytest.mark.slow
 def test_example_12(tmp_path):
     r = _run("12_ampi_guidance", tmp_path)
     # between the grid levels AMPI's reference is nearer the entry's own optimum than NTT's,

@@ -198,11 +198,12 @@ def test_on_board_predictions_learn_the_lift_and_drag_the_flight_shows():
 
 
 def test_plan_evaluate_gives_controls_that_fly_the_plan():
-    """``SwarmPlan.evaluate``'s alpha and bank, flown open loop by the Drake Simulator (an
-    EntryVehicle fed by first-order-hold sources on a 0.02 s grid, RK5 at 1e-10) from the entry
-    state to the plan's TAEM time, end within 0.5 km of the plan's TAEM point (great circle)
-    and 50 m in altitude. (The guidance-step samples interpolated linearly ended 6.0 km along
-    track from it: the actuators move within each 1-s step.)"""
+    """``SwarmPlan.evaluate``'s alpha and bank, flown open loop by the Drake Simulator (the
+    native plant, held to the Python one by tests/test_native_plant.py, fed by first-order-hold
+    sources on a 0.02 s grid, RK5 at 1e-10) from the entry state to the plan's TAEM time, end
+    within 0.5 km of the plan's TAEM point (great circle) and 50 m in altitude. (The
+    guidance-step samples interpolated linearly ended 6.0 km along track from it: the actuators
+    move within each 1-s step.)"""
     from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import TrajectorySource
@@ -210,7 +211,7 @@ def test_plan_evaluate_gives_controls_that_fly_the_plan():
 
     from drake_entry.diagrams.verification import fly_controls
     from drake_entry.guidance.swarm_bank.method import plan as swarm_plan
-    from drake_entry.systems.vehicle import EntryVehicle
+    from drake_entry.systems.native_plant import add_plant
 
     scenario = _scenario(bank_start_deg=SIGMA0_CASE1)
     plan = swarm_plan(scenario, fly_controls)
@@ -219,7 +220,7 @@ def test_plan_evaluate_gives_controls_that_fly_the_plan():
     t = np.arange(0.0, tf, 0.02)
     u = plan.evaluate(t)
     builder = DiagramBuilder()
-    plant = builder.AddNamedSystem("vehicle", EntryVehicle(p.vehicle, p.planet, p.atmosphere, initial_state=p.x0))
+    plant, _, _ = add_plant(builder, p.vehicle, p.planet, p.atmosphere, initial_state=p.x0, plant="native")
     for port, name in (("bank", "bank_rad"), ("alpha", "alpha_rad")):
         src = builder.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, u[name][None, :])))
         builder.Connect(src.get_output_port(), plant.GetInputPort(port))

@@ -20,6 +20,15 @@ def _scenario(**guidance):
 
 
 @pytest.fixture(scope="module")
+def case1_plan():
+    """The plan at sigma_0* (fixed, no search), verified by its Drake flight."""
+    from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.guidance.swarm_bank.method import plan as swarm_plan
+
+    return swarm_plan(_scenario(bank_start_deg=SIGMA0_CASE1), fly_controls)
+
+
+@pytest.fixture(scope="module")
 def case1_flight():
     from drake_entry.diagrams.closed_loop import fly
 
@@ -150,7 +159,8 @@ def test_campaign_rows_and_report_for_fixed_and_on_board_sigma0(tmp_path):
 
 
 def test_cli_plan_report_searches_flies_and_plots(tmp_path, capsys):
-    """``drake-entry plan`` on a paper-004 scenario (brentq search to keep it short): exit 0
+    """``drake-entry plan`` on a paper-004 scenario (a brentq search bracketed in [50, 65] deg to
+    keep it short; the full [0, 89] deg searches are test_bracketed_root_finding's): exit 0
     when the plan is verified and the Drake flight agrees with it; figures written."""
     from pydrake.common.yaml import yaml_dump_typed
 
@@ -158,7 +168,8 @@ def test_cli_plan_report_searches_flies_and_plots(tmp_path, capsys):
     from drake_entry.scenario import Scenario
 
     path = tmp_path / "p004.yaml"
-    path.write_text(yaml_dump_typed(_scenario(optimizer="brentq"), schema=Scenario))
+    path.write_text(yaml_dump_typed(_scenario(optimizer="brentq", bank_start_bounds_deg=[50.0, 65.0]),
+                                    schema=Scenario))
     assert main(["plan", str(path), "--out", str(tmp_path / "plan")]) == 0
     out = capsys.readouterr().out
     assert "by brentq" in out and "flown minus planned at TAEM" in out
@@ -197,7 +208,7 @@ def test_on_board_predictions_learn_the_lift_and_drag_the_flight_shows():
     assert ratios == pytest.approx([1.04, 0.97], abs=1e-4)
 
 
-def test_plan_evaluate_gives_controls_that_fly_the_plan():
+def test_plan_evaluate_gives_controls_that_fly_the_plan(case1_plan):
     """``SwarmPlan.evaluate``'s alpha and bank, flown open loop by the Drake Simulator (the
     native plant, held to the Python one by tests/test_native_plant.py, fed by first-order-hold
     sources on a 0.02 s grid, RK5 at 1e-10) from the entry state to the plan's TAEM time, end
@@ -209,12 +220,9 @@ def test_plan_evaluate_gives_controls_that_fly_the_plan():
     from pydrake.systems.primitives import TrajectorySource
     from pydrake.trajectories import PiecewisePolynomial
 
-    from drake_entry.diagrams.verification import fly_controls
-    from drake_entry.guidance.swarm_bank.method import plan as swarm_plan
     from drake_entry.systems.native_plant import add_plant
 
-    scenario = _scenario(bank_start_deg=SIGMA0_CASE1)
-    plan = swarm_plan(scenario, fly_controls)
+    plan = case1_plan
     p, ev = plan.problem, plan.evaluation
     tf = float(ev.time_s[0])
     t = np.arange(0.0, tf, 0.02)
@@ -234,7 +242,7 @@ def test_plan_evaluate_gives_controls_that_fly_the_plan():
     assert abs(x[0] - xf[0]) < 50.0
 
 
-def test_a_plan_that_reaches_taem_far_from_the_target_is_not_a_success():
+def test_a_plan_that_reaches_taem_far_from_the_target_is_not_a_success(case1_plan):
     """sigma_0 = 30 deg reaches the TAEM energy inside every path limit but 2453 km from the
     target (its commands flown by Drake; the replica: 2452 km), far outside the scenario's 50-km
     box: refused, naming the criterion (reaching TAEM inside the limits is not a success);
@@ -246,7 +254,7 @@ def test_a_plan_that_reaches_taem_far_from_the_target_is_not_a_success():
     far = swarm_plan(_scenario(bank_start_deg=30.0), fly_controls)
     assert far.evaluation.reached[0] and not far.violations
     assert not far.success and "ends outside the acceptance box: distance error +2453" in far.message
-    best = swarm_plan(_scenario(bank_start_deg=SIGMA0_CASE1), fly_controls)
+    best = case1_plan
     assert best.success, best.message
     assert best.from_replica_m < 0.5 * FLOWN_TOLERANCE_M and best.flown.time[-1] == pytest.approx(
         best.evaluation.time_s[0], abs=1e-9)

@@ -130,6 +130,7 @@ def test_the_method_summary_counts_and_measures_the_rows():
     assert s["bank_reversals"] == {"mean": 3.5, "max": 5.0}
 
 
+@pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
 def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path, monkeypatch):
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup
     from drake_entry.diagrams.comparison import run_comparison

@@ -24,6 +24,7 @@ from drake_entry.scenario import Scenario, load_scenario
 DATA = Path(__file__).parent / "data"
 
 
+@pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
 def test_paper000_campaign_rows_are_unchanged_and_beat_table3(tmp_path):
     """20 samples of the paper 000 Sec. VII.A campaign (Table 2 dispersions, seed 2018, 2
     workers) give the rows recorded before the guidance-method interface existed (a regression

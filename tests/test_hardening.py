@@ -119,6 +119,7 @@ def test_a_campaign_refuses_other_settings_and_extends_with_more_runs(tmp_path):
     assert len((Path(out) / "samples.jsonl").read_text().splitlines()) == 2
 
 
+@pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
 def test_report_covers_partial_killed_and_all_failed_campaigns(tmp_path, capsys):
     from drake_entry.campaign.report import write_report
 
@@ -194,6 +195,7 @@ def test_a_second_writer_is_refused(tmp_path):
     CampaignStore(str(out), {"runs": 1, "seed": 0}).close()  # a killed writer's lock is gone with it
 
 
+@pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
 def test_repeated_kills_lose_and_repeat_no_sample(tmp_path):
     """SIGKILL three times, each once the campaign has written 1, 3 and 4 rows (asserted: every
     kill landed mid-campaign), then resume: every sample once, each trajectory once."""

@@ -38,6 +38,7 @@ def _group_ended(pgid: int, within_s: float) -> bool:
     return False
 
 
+@pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
 @pytest.mark.parametrize("backend", ["processes", "dask"])
 def test_ctrl_c_ends_a_campaign_with_one_line_exit_130_and_no_worker_left(tmp_path, backend):
     """SIGINT to the whole process group (what a terminal's Ctrl-C does) once a sample has

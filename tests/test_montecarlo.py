@@ -133,6 +133,7 @@ def test_statistics_against_a_hand_computed_case():
     assert st["margins"]["margin_heat_flux"] == {"worst": -0.01, "violations": 1, "worst_sample": 1}
 
 
+@pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
 def test_dask_backend_gives_the_same_rows_as_local_processes(tmp_path):
     """One interface, three backends: the rows depend on (seed, index) only."""
     import pyarrow.parquet as pq

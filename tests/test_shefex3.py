@@ -172,6 +172,7 @@ def test_packaged_problem_solves_verified_within_the_limits():
     assert r.verification.propagation["position_m"] < 2e3  # the flown bank ends within 2 km of the plan
 
 
+@pytest.mark.slow  # a reproduction (a verified NLP solve): CI's -m "slow and not long" set
 def test_table_1_target_lies_outside_the_representative_vehicles_footprint():
     """Why the packaged problem aims elsewhere (a labelled substitute): with the representative
     aerodynamics and the Table 1 windows hard, the least miss of the Table 1 target (66.40 N,

@@ -11,6 +11,9 @@ import numpy as np
 BANDWIDTH_RAD_S = 2.0
 #: the sampled actuators' integration sub-step [s]
 SUBSTEP_S = 0.02
+#: up to this many rate- or acceleration-limited members, ``integrate_actuators`` steps them one by
+#: one on floats (faster than NumPy's per-call cost on a few elements; the same numbers)
+FEW_LIMITED = 4
 
 
 def command_lag(period: float, bandwidth: float = BANDWIDTH_RAD_S) -> float:
@@ -75,12 +78,20 @@ def integrate_actuator(sigma: float, rate: float, command: float, step: float, s
               and np.abs(4.0 * w * (w * x + v)).max() <= accel_limit)
     if linear:
         return (x + c).tolist(), v.tolist()
+    return _limited_path(sigma, rate, c, step, steps, w, rate_limit, accel_limit)
+
+
+def _limited_path(sigma: float, rate: float, c: float, step: float, steps: int, omega: float,
+                  rate_limit: float, accel_limit: float) -> tuple[list, list]:
+    """(x, x_dot) lists at 0, step, ..., steps * step of midpoint-RK2 steps of ``_accel``
+    towards the clipped command ``c`` (Python floats: for one member this is several times
+    faster than the same steps on NumPy arrays)."""
     s_out, r_out = [sigma], [rate]
     s, r, hh = sigma, rate, 0.5 * step
     for _ in range(steps):
-        a1 = _accel(c - s, r, w, rate_limit, accel_limit)
+        a1 = _accel(c - s, r, omega, rate_limit, accel_limit)
         r_mid = r + hh * a1
-        a2 = _accel(c - (s + hh * r), r_mid, w, rate_limit, accel_limit)
+        a2 = _accel(c - (s + hh * r), r_mid, omega, rate_limit, accel_limit)
         s += step * r_mid
         r += step * a2
         s_out.append(s)
@@ -111,7 +122,7 @@ def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upp
               & (np.abs(4.0 * w * (w * dev + vel)).max(axis=0) <= accel_limit))
     positions, rates = dev + c, vel
     limited = np.flatnonzero(~linear)
-    if limited.size:
+    if limited.size > FEW_LIMITED:
         s, r, cl, hh = x[limited], rate[limited], c[limited], 0.5 * step
         rl, al = (rate_limit[limited], accel_limit[limited]) if per_member else (rate_limit, accel_limit)
         path_s, path_r = [s], [r]
@@ -124,6 +135,11 @@ def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upp
             path_s.append(s)
             path_r.append(r)
         positions[:, limited], rates[:, limited] = path_s, path_r
+    else:  # a few members: the same steps on floats, member by member
+        for i in limited:
+            rl, al = (rate_limit[i], accel_limit[i]) if per_member else (rate_limit, accel_limit)
+            positions[:, i], rates[:, i] = _limited_path(float(x[i]), float(rate[i]), float(c[i]), step, steps, w,
+                                                         float(rl), float(al))
     return positions[-1].copy(), rates[-1].copy(), positions
 
 

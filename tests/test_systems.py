@@ -243,11 +243,16 @@ def test_segment_integrator_equals_midpoint_steps_of_the_actuator_law():
     assert integrate_actuator(0.3, 0.0, 0.3, h, 5, **lim) == ([0.3] * 6, [0.0] * 6)
 
 
-def test_population_actuator_equals_the_scalar_actuator_member_by_member():
+@pytest.mark.parametrize("few_limited", [0, 4])
+def test_population_actuator_equals_the_scalar_actuator_member_by_member(few_limited, monkeypatch):
     """integrate_actuators (a population, used by the paper-004 evaluator) gives every member
     what integrate_actuator gives it alone: limited reversals, settled members and linear
-    tracking mixed in one call."""
+    tracking mixed in one call; its limited members stepped as arrays (FEW_LIMITED 0) or one
+    by one on floats (4, the default) alike."""
+    from drake_entry.models import actuator
     from drake_entry.models.actuator import integrate_actuator, integrate_actuators
+
+    monkeypatch.setattr(actuator, "FEW_LIMITED", few_limited)
 
     lim = dict(lower=math.radians(10), upper=math.radians(20), rate_limit=math.radians(4), accel_limit=math.radians(8),
                bandwidth=2.0)

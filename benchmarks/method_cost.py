@@ -53,10 +53,11 @@ name, n, seed, rounds = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys
 name, _, variant = name.partition(":")  # NAME:field=value[,field=value]: a variant of the packaged scenario
 t0 = time.process_time()
 scenario = load_scenario(name)
-if variant:
+if variant:  # read as --set FIELD=VALUE is, through the CLI's parser and the typed loader
+    from drake_entry.cli import parse_overrides
     from drake_entry.scenario import apply_overrides
 
-    apply_overrides(scenario, dict(item.split("=", 1) for item in variant.split(",")))
+    apply_overrides(scenario, parse_overrides(variant.split(",")))
 setup = ClosedLoopSetup.from_scenario(scenario)
 setup_s = time.process_time() - t0
 run_sample(setup, seed, 10_000, trajectory_step_s=10.0)  # warm caches and imports

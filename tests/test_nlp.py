@@ -293,6 +293,28 @@ def test_solver_statuses_are_in_words_and_options_pass_through(tmp_path):
     assert r.success and r.log_file == str(log) and log.exists()
 
 
+def test_guess_bracket_is_superlinear_and_bisects_where_a_value_is_missing():
+    """The entry guess's root finder (regula falsi, Illinois): x^3 + x - 1 on [0, 1] to 1e-12
+    in at most 9 trials (bisection needs 40); an end without a value (a flight that did not
+    land) gives the midpoint."""
+    from drake_entry.planning.nlp.guess import _Bracket
+
+    def f(x):
+        return x ** 3 + x - 1.0
+
+    root = 0.6823278038280193  # the real root (Cardano)
+    b = _Bracket(0.0, 1.0, f(0.0), f(1.0))
+    for trials in range(1, 40):
+        x = b.trial()
+        assert b.lo < x < b.hi
+        b.keep(x, f(x), to_hi=f(x) > 0)
+        if abs(x - root) < 1e-12:
+            break
+    assert abs(x - root) < 1e-12 and trials <= 9, (trials, x)
+    assert _Bracket(0.0, 1.0, None, f(1.0)).trial() == 0.5
+    assert _Bracket(0.0, 1.0, f(0.0), None).trial() == 0.5
+
+
 def test_entry_guess_respects_the_control_bounds_and_meets_the_final_conditions():
     """Betts' shuttle: bank in [-89, 1] deg, no max-L/D alpha in its polynomial aero (found
     numerically), final h, V and gamma fixed, final position free."""

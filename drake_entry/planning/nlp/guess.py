@@ -16,8 +16,8 @@ def initial_guess(problem, samples: int = 200):
     Entry problems: fly a constant angle of attack (alpha-bar, within the bounds, or the
     problem's alpha schedule) and a
     constant bank (within its bounds, turning towards a fixed final position) whose magnitude
-    is found by bisection so the flight (with one bank reversal, its time found by bisection,
-    when the final position is off the initial heading and the constant bank turns past it)
+    is found by regula falsi (_Bracket) so the flight (with one bank reversal, its time found
+    the same way, when the final position is off the initial heading and the constant bank turns past it)
     ends at the final altitude near the final position (or at the fixed/maximum final time),
     with controls at rest; then each state is shifted linearly over the last 5 % of the
     flight to end inside its final bounds, and clipped to the state bounds. The flight ends at
@@ -93,7 +93,7 @@ def _entry_guess(problem: OptimalControlProblem, samples):
     def bank_at(t, mag, t_rev):
         return side * mag if t < t_rev else -side * mag
 
-    def fly(mag, t_rev=math.inf):
+    def fly(mag, t_rev=math.inf, max_step=GUESS_MAX_STEP_S):
         """The flight with |bank| = mag towards ``side``, reversed at t_rev [s]."""
         def f(t, y):
             bank = bank_at(t, mag, t_rev)
@@ -104,7 +104,7 @@ def _entry_guess(problem: OptimalControlProblem, samples):
             return height(y)
         ground.terminal, ground.direction = True, -1
         return solve_ivp(f, (0.0, t_max), attitude(x0, side * mag), events=ground, rtol=1e-7, atol=1e-9,
-                         max_step=5.0)
+                         max_step=max_step)
 
     def miss(sol):  # flown central angle beyond the target's [rad]
         xf = sol.y[:, -1]
@@ -121,21 +121,26 @@ def _entry_guess(problem: OptimalControlProblem, samples):
                                                   problem.planet.reference_radius))
 
     def range_fit(t_rev, steps):
-        """Bisection on the bank magnitude (more bank = shorter flight): (magnitude, flight)."""
-        lo, hi = m_lo, max(m_hi, m_lo)
-        best = fly(hi, t_rev)
+        """The bank magnitude whose flight lands on the final position's range (more bank =
+        shorter flight): (magnitude, flight), the flight never too long; to 1e-4 rad of bank
+        or GUESS_MISS_TOL_RAD of central angle. Without a final position: the least bank that
+        lands, by bisection."""
+        best = fly(max(m_hi, m_lo), t_rev)
+        bracket = _Bracket(m_lo, max(m_hi, m_lo), None, miss(best) if target is not None and best.status == 1 else None)
         for _ in range(steps):
-            mid = 0.5 * (lo + hi)
+            mid = bracket.trial()
             s = fly(mid, t_rev)
-            if too_long(s):
-                lo = mid
-            else:
-                hi, best = mid, s  # best is always the flight with bank hi
-            if hi - lo < 1e-4:
+            long = too_long(s)
+            bracket.keep(mid, miss(s) if target is not None and s.status == 1 else None, to_hi=not long)
+            if not long:
+                best = s  # best is always the flight with bank bracket.hi
+                if target is not None and -miss(s) < GUESS_MISS_TOL_RAD:
+                    break
+            if bracket.hi - bracket.lo < 1e-4:
                 break
-        return hi, best
+        return bracket.hi, best
 
-    # bisection on a constant bank magnitude (more bank = shorter flight), on the side the
+    # a constant bank magnitude fitted to the range (more bank = shorter flight), on the side the
     # bank bounds allow most of
     b_lo, b_hi = (xl[bank_i], xh[bank_i]) if bank_where == "state" else (ul[bank_i], uh[bank_i])
     side, turn = (1.0 if b_hi >= -b_lo else -1.0), 0.0
@@ -147,21 +152,26 @@ def _entry_guess(problem: OptimalControlProblem, samples):
     m_hi = min(math.radians(89.0), side * (b_hi if side > 0 else b_lo))
     hi, best = range_fit(math.inf, 25)
     t_rev = math.inf
-    # the constant bank turned past the target: one reversal, its time by bisection (earlier =
-    # less turn), the magnitude fitted to the range at each (both signs within the bounds)
+    # the constant bank turned past the target: one reversal, its time by regula falsi on the
+    # end's lateral distance (earlier = less turn), the magnitude fitted to the range at each (both signs within the bounds)
     reversible = b_lo <= -m_hi and m_hi <= b_hi
     if (target is not None and reversible and abs(turn) > REVERSAL_MIN_TURN and best.status == 1
             and side * lateral(best) > REVERSAL_TRIGGER_M):
-        lo_t, hi_t = 0.0, float(best.t[-1])
+        times = _Bracket(0.0, float(best.t[-1]), None, side * lateral(best))  # reversal at t=0 not flown
         for _ in range(REVERSAL_STEPS):
-            mid = 0.5 * (lo_t + hi_t)
+            mid = times.trial()
             m, s = range_fit(mid, 12)
             if s.status == 1 and abs(lateral(s)) < abs(lateral(best)):
                 hi, best, t_rev = m, s, mid
-            if s.status == 1 and side * lateral(s) > 0:
-                hi_t = mid
-            else:
-                lo_t = mid
+            beyond = None if s.status != 1 else side * lateral(s)  # > 0: reverse earlier
+            times.keep(mid, beyond, to_hi=beyond is not None and beyond > 0)
+            if abs(lateral(best)) < GUESS_LATERAL_TOL_M:
+                break
+    # the samples: the chosen flight again in steps of at most GUESS_SAMPLE_STEP_S, interpolated
+    # linearly (the search's longer steps sampled from the dense output change the guess within
+    # the integration tolerance, and SNOPT at 1e-8 on Betts' heating-limited shuttle then stops
+    # at info 3 where it converged from this guess)
+    best = fly(hi, t_rev, GUESS_SAMPLE_STEP_S)
     t = np.linspace(0.0, best.t[-1], samples)
     from scipy.interpolate import interp1d
 
@@ -200,6 +210,45 @@ def _end_height(problem: OptimalControlProblem, xfl):
 REVERSAL_TRIGGER_M = 10e3
 REVERSAL_MIN_TURN = math.radians(1.0)
 REVERSAL_STEPS = 12
+#: the search flights' step cap [s] (catches a dip through the end height between steps; at
+#: 20 s RK45 takes two thirds of the derivatives of 5-s steps), the sampled flight's [s], and
+#: the range fit's stop: the flight lands within this central angle short of the final
+#: position [rad] (1e-6 rad is 6.4 m on Earth)
+GUESS_MAX_STEP_S = 20.0
+GUESS_SAMPLE_STEP_S = 5.0
+GUESS_MISS_TOL_RAD = 1e-6
+#: the reversal time's stop: the flight ends within this distance of the great circle to the
+#: final position [m]
+GUESS_LATERAL_TOL_M = 50.0
+
+
+class _Bracket:
+    """[lo, hi] around the root of a monotone function, its values f_lo, f_hi where known
+    (None: not flown, or no value there). The next trial: regula falsi with the Illinois
+    modification (the end kept twice in a row has its value halved) once both are known,
+    bisection before."""
+
+    def __init__(self, lo: float, hi: float, f_lo: float | None = None, f_hi: float | None = None):
+        self.lo, self.hi, self.f_lo, self.f_hi = lo, hi, f_lo, f_hi
+        self._last = 0  # +1: the last trial replaced hi, -1: lo
+
+    def trial(self) -> float:
+        if self.f_lo is not None and self.f_hi is not None and self.f_lo != self.f_hi:
+            x = self.hi - self.f_hi * (self.hi - self.lo) / (self.f_hi - self.f_lo)
+            if self.lo < x < self.hi:
+                return x
+        return 0.5 * (self.lo + self.hi)
+
+    def keep(self, x: float, fx: float | None, to_hi: bool):
+        """x (its value fx) replaces hi when ``to_hi``, else lo."""
+        if to_hi:
+            if self._last == 1 and self.f_lo is not None:
+                self.f_lo *= 0.5
+            self.hi, self.f_hi, self._last = x, fx, 1
+        else:
+            if self._last == -1 and self.f_hi is not None:
+                self.f_hi *= 0.5
+            self.lo, self.f_lo, self._last = x, fx, -1
 
 #: the share of the guess's flight over which its states are shifted to the final conditions
 MEET_FINAL_SHARE = 0.05

@@ -11,7 +11,8 @@ with the paper's figures, every plan flown by the Drake Simulator:
    21.8 iterations (abort means) and the project's goals (<= 5 s per plan at 100 nodes, <= 15 s
    at the flyable accuracy, <= 5 km flown from the plan).
 4. NLP cross-check: the same direct minimum-heat-load problem through ``planning.nlp.solve``
-   (DirectCollocation and LGL with SNOPT) from the same glide guess (the goal: within 1 %).
+   (Hermite-Simpson vectorised, Drake's DirectCollocation of the same NLP, and LGL, with SNOPT)
+   from the same glide guess (the goal: within 1 %).
 
 The paper's numbers come from its own (non-public) SPHYNX aerodynamic table; ours use the
 labelled representative model (drake_entry/vehicles/sphynx.yaml), so values differ by the
@@ -126,7 +127,7 @@ def meshes(case, meshes=((99, 2), (33, 4), (50, 4), (66, 4))) -> list:
     return rows
 
 
-def nlp_crosscheck(case, solves=(("dircol", "snopt", 100), ("lgl", "snopt", 60))) -> list:
+def nlp_crosscheck(case, solves=(("hermite_simpson", "snopt", 100), ("dircol", "snopt", 100), ("lgl", "snopt", 60))) -> list:
     """The direct minimum-heat-load problem through the NLP path from the same glide guess
     (``guidance.scvx.as_ocp``), its controls flown by the Drake Simulator, beside the SCvx plan."""
     from drake_entry.diagrams.verification import fly_controls
@@ -136,9 +137,9 @@ def nlp_crosscheck(case, solves=(("dircol", "snopt", 100), ("lgl", "snopt", 60))
     plan, wall, _ = _plan_and_fly(case)
     problem, start = nlp_form(plan)
     print("\nNLP cross-check: minimum heat load, direct formulation, both from the glide guess")
-    print(f"{'method':>22s} {'Q MJ/m2':>8s} {'/SCvx':>7s} {'t_f s':>6s} {'solve s':>8s} {'/SCvx':>7s} "
+    print(f"{'method':>26s} {'Q MJ/m2':>8s} {'/SCvx':>7s} {'t_f s':>6s} {'solve s':>8s} {'/SCvx':>7s} "
           f"{'flown-plan km':>13s} success")
-    print(f"{'SCvx 33x4 Clarabel':>22s} {plan.objective:8.2f} {1.0:7.4f} {plan.final_time:6.0f} {wall:8.2f} "
+    print(f"{'SCvx 33x4 Clarabel':>26s} {plan.objective:8.2f} {1.0:7.4f} {plan.final_time:6.0f} {wall:8.2f} "
           f"{1.0:7.2f} {plan.propagated_error_m / 1e3:13.2f} {plan.success}")
     rows = [{"method": "scvx", "heat_load_MJ_m2": plan.objective, "solve_s": wall, "success": plan.success}]
     for transcription, solver, nodes in solves:
@@ -148,7 +149,7 @@ def nlp_crosscheck(case, solves=(("dircol", "snopt", 100), ("lgl", "snopt", 60))
         flown = error.get("position_m", float("nan")) / 1e3
         label = f"{transcription} {nodes} {solver}"
         q = result.objective / 1e6
-        print(f"{label:>22s} {q:8.2f} {q / plan.objective:7.4f} {result.final_time:6.0f} {result.solve_time:8.2f} "
+        print(f"{label:>26s} {q:8.2f} {q / plan.objective:7.4f} {result.final_time:6.0f} {result.solve_time:8.2f} "
               f"{result.solve_time / wall:7.2f} {flown:13.2f} {result.success}")
         rows.append({"method": label, "heat_load_MJ_m2": q, "solve_s": result.solve_time, "success": result.success,
                      "flown_km": flown})

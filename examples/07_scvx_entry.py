@@ -4,7 +4,7 @@ rates as controls, eqs. 54-55, the form of the paper's Tables 2 and 4-7; free fi
 fly the plan's bank and alpha with the Drake Simulator and compare with the plan and the site.
 ``--formulation lossless`` plans the lossless bank (eqs. 37-45) instead: its relaxed |u| < 1 shows
 up as a flown error, and the planner says so. The direct plan is then cross-checked: the same
-problem (``guidance.scvx.as_ocp``) solved by the NLP path (Drake DirectCollocation + SNOPT) from
+problem (``guidance.scvx.as_ocp``) solved by the NLP path (Hermite-Simpson collocation + SNOPT) from
 the same glide guess, its controls flown by the Drake Simulator; the two heat loads agree
 within 1 % (0.5 % measured).
 
@@ -56,10 +56,10 @@ def main(quick: bool = False, out_dir: str = "out/examples/07", formulation: str
     crosscheck = None
     if formulation == "direct" and not quick:  # the same problem by the NLP path, from the same glide guess
         problem, start = nlp_form(plan)
-        crosscheck = nlp.solve(problem, transcription="dircol", solver="snopt", nodes=100, guess=start, tolerance=1e-6,
+        crosscheck = nlp.solve(problem, transcription="hermite_simpson", solver="snopt", nodes=100, guess=start, tolerance=1e-6,
                                verifier=fly_controls)
         flown = nlp.propagate(problem, crosscheck, fly_controls).terminal_error.get("position_m", math.nan)
-        print(f"NLP path (DirectCollocation + SNOPT, {crosscheck.nodes} samples): {crosscheck.message}; heat load "
+        print(f"NLP path (Hermite-Simpson collocation + SNOPT, {crosscheck.nodes} samples): {crosscheck.message}; heat load "
               f"{crosscheck.objective / 1e6:.2f} MJ/m^2 (SCvx {plan.objective / (crosscheck.objective / 1e6) - 1:+.2%}), "
               f"t_f {crosscheck.final_time:.0f} s, {crosscheck.solve_time:.1f} s; flown {flown / 1e3:.2f} km from it")
 

@@ -278,7 +278,7 @@ def load_problem_spec(name_or_path: str) -> ProblemSpec:
 
 def validate_solve(s: SolveSpec) -> SolveSpec:
     """One-line ScenarioError on a bad ``solve:`` field."""
-    for field, allowed in (("transcription", ("lgl", "dircol")), ("solver", ("auto", "ipopt", "snopt"))):
+    for field, allowed in (("transcription", ("lgl", "dircol", "hermite_simpson")), ("solver", ("auto", "ipopt", "snopt"))):
         if getattr(s, field) not in allowed:
             raise ScenarioError(f"solve.{field} = '{getattr(s, field)}' is unknown; allowed: {', '.join(allowed)}")
     for field, lo in (("nodes", 3), ("max_iterations", 1), ("coarse_nodes", 0), ("max_nodes", 0)):

@@ -1,7 +1,8 @@
 """NLP path: entry optimal control by Legendre pseudospectral (LGL) collocation or Drake's
 DirectCollocation, solved with Ipopt or SNOPT (paper 002).
 
-    result = solve(problem, transcription="lgl" | "dircol", solver="auto" | "snopt" | "ipopt", nodes=N)
+    result = solve(problem, transcription="lgl" | "dircol" | "hermite_simpson", solver="auto" | "snopt" | "ipopt",
+                   nodes=N)
 
 ``problem`` is an ``OptimalControlProblem`` (entry dynamics, planning/ocp.py) or a
 ``CustomProblem``. The NLP runs in scaled units (scaling: canonical units as in paper 002,
@@ -17,7 +18,9 @@ its exact sparse Jacobian (lgl, evaluator). Costates come from the defects' KKT 
 DirectCollocation: Drake's Hermite-Simpson transcription of planning.ocp_system (the same
 scaled dynamics as a Drake System) with N samples; the running cost is the trapezoid rule
 over the samples; costates are estimated at the segment midpoints from the collocation
-multipliers, lambda(t_k+1/2) = 3 nu_k / (2 h_k).
+multipliers, lambda(t_k+1/2) = 3 nu_k / (2 h_k). hermite_simpson poses the same NLP (same rows,
+cost and costates) with LGL's machinery: one constraint, vectorised model calls at the samples
+and midpoints, the Jacobian assembled with its sparsity declared.
 
 The result reports the Hamiltonian H = L + lambda' f along the solution (zero on an
 extremal with free final time, paper 002 Fig. 10) and ``verify.propagate`` flies the controls
@@ -34,7 +37,8 @@ the solver's word).
 
 Modules: result (NlpResult, extremal controls, summary), guess (initial guesses), scaling
 (the factors the solver sees), status (solver verdicts in words), verify, mesh (refinement),
-evaluator (node values and Jacobians), transcription (shared parts), lgl, dircol, catalogue
+evaluator (node values and Jacobians), transcription (shared parts), node_program (what lgl and
+hermite_simpson share), lgl, dircol, hermite_simpson, catalogue
 (published problems with their optima).
 """
 from __future__ import annotations
@@ -50,6 +54,7 @@ from drake_entry.errors import ScenarioError
 from drake_entry.planning.nlp.dircol import _DircolTranscription
 from drake_entry.planning.nlp.evaluator import SolveProgress
 from drake_entry.planning.nlp.guess import initial_guess
+from drake_entry.planning.nlp.hermite_simpson import _HermiteSimpsonTranscription
 from drake_entry.planning.nlp.lgl import _LglTranscription
 from drake_entry.planning.nlp.mesh import MAX_NODES, MeshStep, mesh_error, next_nodes  # noqa: F401 (API)
 from drake_entry.planning.nlp.result import NlpError, NlpResult, extremal_controls, summary  # noqa: F401 (API)
@@ -67,7 +72,7 @@ from drake_entry.planning.nlp.verify import (  # noqa: F401 (API)
 from drake_entry.planning.nlp.verify import verify as verify_solution
 from drake_entry.planning.progress import wanted
 
-TRANSCRIPTIONS = ("lgl", "dircol")
+TRANSCRIPTIONS = ("lgl", "dircol", "hermite_simpson")
 #: a solver stopped near an optimum (status.restartable) at a point this feasible (largest
 #: scaled violation) is restarted once from that point
 RESTART_VIOLATION = 1e-6
@@ -83,7 +88,8 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
     """Solve ``problem`` (see module docstring); ``success`` only when verified.
 
     Args:
-      transcription: 'lgl' (Legendre pseudospectral, paper 002 eqs. 12-14) or 'dircol'.
+      transcription: 'lgl' (Legendre pseudospectral, paper 002 eqs. 12-14), 'dircol' (Drake's
+        DirectCollocation, Hermite-Simpson) or 'hermite_simpson' (the same NLP, vectorised).
       solver: 'snopt', 'ipopt' or 'auto' (default: SNOPT when this pydrake build has it,
         else Ipopt; see default_solver()).
       nodes: LGL nodes or DirectCollocation samples (>= 3).
@@ -108,7 +114,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
         each mesh warm-started from the last solution, until the between-node error meets
         ``dynamics_tolerance`` (and the flown controls ``propagation_tolerance``) or
         ``max_nodes`` is reached; the meshes are in ``result.mesh_history``.
-      max_nodes: refinement's node cap (default nlp.mesh.MAX_NODES: LGL 150, dircol 400).
+      max_nodes: refinement's node cap (default nlp.mesh.MAX_NODES: LGL 150, Hermite-Simpson 400).
       progress: a line on stderr every 5 s once a solve has run 5 s (elapsed time, evaluations,
         objective, LGL collocation violation: evaluator.SolveProgress): True, False, or 'auto'
         (when stderr is a terminal). Ctrl-C stops the solve with KeyboardInterrupt, as under
@@ -257,6 +263,7 @@ def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, o
     t_build = _time.perf_counter()
     scales = resolve_scaling(problem, guess, scaling)
     tx = (_LglTranscription(problem, nodes, scales) if transcription == "lgl"
+          else _HermiteSimpsonTranscription(problem, nodes, scales) if transcription == "hermite_simpson"
           else _DircolTranscription(problem, nodes, scales, float(guess[0][-1])))
     tx.set_guess(*guess)
     tx.scale_objective()

@@ -15,8 +15,9 @@ from drake_entry.errors import ScenarioError
 def add_arguments(parser) -> None:
     parser.add_argument("problem", help="packaged problem (marv, shefex3) or a problem YAML path")
     parser.add_argument("--nodes", type=int, default=None, help="LGL nodes / collocation samples (default: the YAML)")
-    parser.add_argument("--transcription", choices=("lgl", "dircol"), default=None,
-                        help="Legendre pseudospectral (paper 002) or Drake's DirectCollocation (default: the YAML)")
+    parser.add_argument("--transcription", choices=("lgl", "dircol", "hermite_simpson"), default=None,
+                        help="Legendre pseudospectral (paper 002), Drake's DirectCollocation, or the same "
+                             "Hermite-Simpson NLP vectorised (default: the YAML)")
     parser.add_argument("--solver", choices=("auto", "ipopt", "snopt"), default=None,
                         help="NLP solver; auto tries SNOPT, then Ipopt (default: the YAML)")
     parser.add_argument("--tolerance", type=float, default=None,
@@ -31,7 +32,7 @@ def add_arguments(parser) -> None:
                              "verification tolerance (default: the YAML's solve.refine)")
     parser.add_argument("--max-nodes", type=int, default=None, metavar="N",
                         help="mesh refinement's node cap (default: the YAML's solve.max_nodes, else 150 LGL / "
-                             "400 dircol)")
+                             "400 Hermite-Simpson)")
     parser.add_argument("--no-propagate", action="store_true",
                         help="skip the verification (between-node dynamics and the Drake flight of the "
                              "controls): the answer is reported converged, not verified (success false), "

@@ -14,7 +14,7 @@ transcription's convergence:
   and aims at half the tolerance.
 
 Each step grows N by at least 25 % (a smaller step rarely changes the error class) and at
-most 2x (LGL) / 3x (dircol), capped at ``max_nodes``.
+most 2x (LGL) / 3x (Hermite-Simpson), capped at ``max_nodes``.
 """
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ from drake_entry.planning.nlp.verify import interval_errors
 
 #: default node caps: one LGL polynomial of 150 nodes already resolves minutes-long entry
 #: flights to 1e-4; Hermite-Simpson needs more samples for the same error
-MAX_NODES = {"lgl": 150, "dircol": 400}
+MAX_NODES = {"lgl": 150, "dircol": 400, "hermite_simpson": 400}
 TARGET_SHARE = 0.5  # aim each new mesh at this share of the tolerance
 
 

@@ -26,7 +26,7 @@ class NlpResult(PlanResult):
       time: node times [s] (nodes,). states: (nodes, n_states) SI in the problem's state
         order ([h, lon, lat, V, gamma, psi] first). controls: (nodes, n_controls) SI.
       objective: J in the problem's cost units (Lagrange terms integrated in seconds).
-      costates: (nodes, n_states) d J / d x, SI (LGL: at the nodes; dircol: at segment
+      costates: (nodes, n_states) d J / d x, SI (LGL: at the nodes; dircol, hermite_simpson: at segment
         midpoints, see costate_time), or None if the solver returned no multipliers.
       costate_time: times of the costate rows [s].
       hamiltonian: H = L + lambda' f at costate_time [cost units / s].
@@ -88,7 +88,7 @@ class NlpResult(PlanResult):
 
     def control_function(self):
         """u(t) [SI] between the nodes: the Lagrange interpolant of the LGL nodes (the
-        method's own representation) or first-order hold for dircol."""
+        method's own representation) or first-order hold for dircol and hermite_simpson."""
         t, U = self.time, self.controls
         if self.transcription == "lgl":
             tf = t[-1]
@@ -104,7 +104,7 @@ class NlpResult(PlanResult):
 
     def state_function(self):
         """x(t) [SI] between the nodes: the Lagrange interpolant for LGL, the cubic Hermite
-        spline with the dynamics as slopes for dircol (Hermite-Simpson's own)."""
+        spline with the dynamics as slopes for dircol and hermite_simpson (Hermite-Simpson's own)."""
         t, X = self.time, self.states
         if self.transcription == "lgl":
             tau_nodes = 2.0 * t / t[-1] - 1.0

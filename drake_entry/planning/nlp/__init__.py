@@ -57,7 +57,13 @@ from drake_entry.planning.nlp.guess import initial_guess
 from drake_entry.planning.nlp.hermite_simpson import _HermiteSimpsonTranscription
 from drake_entry.planning.nlp.lgl import _LglTranscription
 from drake_entry.planning.nlp.mesh import MAX_NODES, MeshStep, mesh_error, next_nodes  # noqa: F401 (API)
-from drake_entry.planning.nlp.result import NlpError, NlpResult, extremal_controls, summary  # noqa: F401 (API)
+from drake_entry.planning.nlp.result import (  # noqa: F401 (API)
+    TRANSCRIPTION_LABELS,
+    NlpError,
+    NlpResult,
+    extremal_controls,
+    summary,
+)
 from drake_entry.planning.nlp.scaling import Scaling  # noqa: F401 (API)
 from drake_entry.planning.nlp.scaling import resolve as resolve_scaling
 from drake_entry.planning.nlp.status import restartable, verdict

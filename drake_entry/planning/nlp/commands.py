@@ -113,7 +113,8 @@ def _solve_and_write(args) -> int:
     except ValueError:
         pass
     pngs = nlp_solution_plots(problem, result, args.out, propagated=check, extremal=ext,
-                              title=f"{problem.name}: {transcription.upper()} {result.nodes} nodes, {result.solver}")
+                              title=f"{problem.name}: {nlp.TRANSCRIPTION_LABELS[transcription]} {result.nodes} nodes, "
+                                    f"{result.solver}")
     print(json.dumps(info, indent=2, default=float))
     print(f"wrote solution, summary.json and {len(pngs)} plots to {args.out}")
     return 0 if result.success or (args.no_propagate and result.converged) else 1

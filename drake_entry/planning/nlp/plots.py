@@ -6,6 +6,7 @@ import os
 import numpy as np
 
 from drake_entry.campaign.plots import plt, save_figure  # the Agg backend is set there
+from drake_entry.planning.nlp.result import TRANSCRIPTION_LABELS
 
 
 def nlp_solution_plots(problem, result, out_dir: str, *, propagated=None, extremal=None, title: str = "") -> list[str]:
@@ -29,7 +30,7 @@ def nlp_solution_plots(problem, result, out_dir: str, *, propagated=None, extrem
         fig, ax = plt.subplots(figsize=(6, 4))
         if prop_values is not None:
             ax.plot(P.time, prop_values * scale, "-", lw=1, label="Drake propagation")
-        ax.plot(t, node_values * scale, "o", ms=3, label=f"{result.transcription.upper()} nodes")
+        ax.plot(t, node_values * scale, "o", ms=3, label=f"{TRANSCRIPTION_LABELS[result.transcription]} nodes")
         for value, label in limits:
             ax.axhline(value, color="r", ls="--", lw=1, label=label)
         ax.set_xlabel("time [s]")
@@ -42,7 +43,8 @@ def nlp_solution_plots(problem, result, out_dir: str, *, propagated=None, extrem
     series("fig01_altitude.png", "altitude [km]", X[:, 0], None if P is None else P.states[:, 0], 1e-3)
     q = np.array([problem.conditions(x, u).dynamic_pressure for x, u in zip(X, U)])
     qp = None if P is None else np.array([problem.conditions(x, np.zeros(2)).dynamic_pressure for x in P.states])
-    qlim = [(c.min / 1e3, "q min") for c in problem.path if c.quantity == "dynamic_pressure" and np.isfinite(c.min)]
+    qlim = [(v / 1e3, f"q {end}") for c in problem.path if c.quantity == "dynamic_pressure"
+            for v, end in ((c.min, "min"), (c.max, "max")) if np.isfinite(v)]
     series("fig02_dynamic_pressure.png", "dynamic pressure [kPa]", q, qp, 1e-3, qlim)
     fig, ax = plt.subplots(figsize=(6, 4))
     d, c = downtrack_crosstrack(X[:, 1], X[:, 2], x0[1], x0[2], xf[1], xf[2], R)

@@ -118,6 +118,10 @@ class NlpResult(PlanResult):
         return lambda tt: spline(np.clip(np.atleast_1d(tt), t[0], t[-1]))
 
 
+#: transcriptions by name in figures and messages
+TRANSCRIPTION_LABELS = {"lgl": "LGL", "dircol": "DirectCollocation", "hermite_simpson": "Hermite-Simpson"}
+
+
 class NlpError(DrakeEntryError, RuntimeError):
     """The NLP could not be built (bad options or problem)."""
 

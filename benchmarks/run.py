@@ -1,11 +1,14 @@
 """Benchmarks, each printing its figures and ratios measured side by side in one run.
 
-    python benchmarks/run.py [open-loop|socp|nlp|dymos|campaign|interface-cost|method-cost|paper001|aborts|paper003|paper004|examples|all] [options]
+    python benchmarks/run.py [open-loop|socp|nlp|nlp-cost|dymos|campaign|interface-cost|method-cost|paper001|aborts|paper003|paper004|examples|all] [options]
 
 open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
 socp            both SOCP planners with Clarabel vs SCS: drag-energy SOCP by node count, SCvx
                 nominal plan, closed-loop drag-energy campaign
 nlp             NLP path: LGL / DirectCollocation x Ipopt / SNOPT from the same starts
+nlp-cost        NLP path's guesses and solves (--cases guess:NAME, solve:NAME:TRANSCRIPTION:NODES,
+                scvx_crosscheck:TRANSCRIPTION), core seconds vs a baseline commit (--baseline,
+                default the previous commit), objectives side by side
 dymos           NLP path vs dymos (pip extra "bench"; not in "all") on the Brachistochrone and
                 Betts' shuttle, same problem and nodes (default 31)
 campaign        closed-loop campaign runs/s: 1 worker, 2 processes, Dask (ratios)
@@ -31,7 +34,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("which", nargs="?", default="all",
-                        choices=("all", "open-loop", "socp", "nlp", "dymos", "campaign", "interface-cost", "method-cost",
+                        choices=("all", "open-loop", "socp", "nlp", "nlp-cost", "dymos", "campaign", "interface-cost",
+                                 "method-cost",
                                  "paper001", "aborts", "paper003", "paper004", "examples"))
     parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
     parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
@@ -43,7 +47,8 @@ if __name__ == "__main__":
     parser.add_argument("--grid", type=int, nargs=2, default=(9, 9), metavar=("ROWS", "COLUMNS"),
                         help="aborts: EIP grid size")
     parser.add_argument("--seeds", type=int, default=20, help="paper004: seeds per swarm method (Table 1)")
-    parser.add_argument("--cases", type=int, default=100, help="paper003: entries of the accuracy study")
+    parser.add_argument("--cases", nargs="*", default=None,
+                        help="paper003: entries of the accuracy study (one number, default 100); nlp-cost: case names")
     parser.add_argument("--out", default="out/paper004", help="paper004: figure directory")
     parser.add_argument("--mode", default="both", choices=("quick", "full", "both"), help="examples: which runs")
     parser.add_argument("--only", nargs="*", default=None, help="examples: numbers or names to run")
@@ -70,6 +75,11 @@ if __name__ == "__main__":
         from nlp import nlp_benchmark
 
         nlp_benchmark(nodes=args.nodes)
+    if args.which in ("all", "nlp-cost"):
+        from nlp_cost import nlp_cost_benchmark
+
+        nlp_cost_benchmark(baseline=args.baseline or "HEAD~1", rounds=args.rounds if args.which == "nlp-cost" else 1,
+                           cases=args.cases if args.which == "nlp-cost" else None)
     if args.which == "dymos":  # needs the 'bench' extra, so not part of 'all'
         from dymos_peer import dymos_benchmark
 
@@ -97,7 +107,7 @@ if __name__ == "__main__":
     if args.which in ("all", "paper003"):
         from paper003 import paper003_benchmark
 
-        paper003_benchmark(cases=args.cases)
+        paper003_benchmark(cases=int(args.cases[0]) if args.cases else 100)
     if args.which in ("all", "paper004"):
         from paper004 import paper004_study
 

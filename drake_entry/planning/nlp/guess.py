@@ -225,8 +225,8 @@ GUESS_LATERAL_TOL_M = 50.0
 class _Bracket:
     """[lo, hi] around the root of a monotone function, its values f_lo, f_hi where known
     (None: not flown, or no value there). The next trial: regula falsi with the Illinois
-    modification (the end kept twice in a row has its value halved) once both are known,
-    bisection before."""
+    modification (Dowell & Jarratt 1971: the end kept twice in a row has its value halved)
+    once both are known, bisection before."""
 
     def __init__(self, lo: float, hi: float, f_lo: float | None = None, f_hi: float | None = None):
         self.lo, self.hi, self.f_lo, self.f_hi = lo, hi, f_lo, f_hi

@@ -4,7 +4,7 @@ trapezoid rule over the samples), with every model call of an evaluation in one 
 call and the Jacobian assembled from the node and midpoint Jacobians with its sparsity
 declared (node_program), as the LGL transcription has.
 
-On interval k of length h = t_f / (N - 1) (Hargraves & Paris 1987; Betts 2010, Sec. 4.5):
+On interval k of length h = t_f / (N - 1) (Hargraves & Paris 1987, the compressed form):
 
     x_c = (x_k + x_k+1) / 2 + h (f_k - f_k+1) / 8,   u_c = (u_k + u_k+1) / 2
     c_k = 3 (x_k+1 - x_k) / (2 h) - (f_k + f_k+1) / 4 - f(x_c, u_c) = 0

@@ -360,7 +360,7 @@ def test_auto_solver_tries_snopt_then_ipopt():
         solve(double_integrator(), solver="knitro")
 
 
-@pytest.mark.parametrize("transcription,start", [("lgl", 5), ("dircol", 6)])
+@pytest.mark.parametrize("transcription,start", [("lgl", 5), ("dircol", 6), ("hermite_simpson", 6)])
 def test_mesh_refinement_raises_the_nodes_until_the_between_node_error_meets_the_tolerance(transcription, start):
     """From a mesh too coarse for the tolerance, each mesh warm-started from the last: the
     errors in mesh_history fall to the tolerance, the last mesh is the result's and verified."""

@@ -93,7 +93,7 @@ class ObjectiveSpec:
 
 @dc.dataclass
 class SolveSpec:
-    transcription: str = "lgl"
+    transcription: str = "lgl"  # lgl | dircol (Drake DirectCollocation) | hermite_simpson (the same NLP, vectorised)
     solver: str = "auto"  # auto (SNOPT when available, else Ipopt) | snopt | ipopt
     nodes: int = 40
     tolerance: float = 1.0e-8

@@ -111,6 +111,9 @@ def _entry_guess(problem: OptimalControlProblem, samples):
         start = (float(x0[1]), float(x0[2]))
         return central_angle_smooth(*start, float(xf[1]), float(xf[2])) - central_angle_smooth(*start, *target)
 
+    def landed_miss(sol):  # miss(sol) where the flight landed and there is a final position, else None
+        return miss(sol) if target is not None and sol.status == 1 else None
+
     def too_long(sol):  # did not land, or landed beyond the final position
         return sol.status != 1 or (target is not None and miss(sol) > 0)
 
@@ -125,16 +128,17 @@ def _entry_guess(problem: OptimalControlProblem, samples):
         shorter flight): (magnitude, flight), the flight never too long; to 1e-4 rad of bank
         or GUESS_MISS_TOL_RAD of central angle. Without a final position: the least bank that
         lands, by bisection."""
-        best = fly(max(m_hi, m_lo), t_rev)
-        bracket = _Bracket(m_lo, max(m_hi, m_lo), None, miss(best) if target is not None and best.status == 1 else None)
+        top = max(m_hi, m_lo)
+        best = fly(top, t_rev)
+        bracket = _Bracket(m_lo, top, None, landed_miss(best))
         for _ in range(steps):
             mid = bracket.trial()
             s = fly(mid, t_rev)
-            long = too_long(s)
-            bracket.keep(mid, miss(s) if target is not None and s.status == 1 else None, to_hi=not long)
+            long, short_by = too_long(s), landed_miss(s)
+            bracket.keep(mid, short_by, to_hi=not long)
             if not long:
                 best = s  # best is always the flight with bank bracket.hi
-                if target is not None and -miss(s) < GUESS_MISS_TOL_RAD:
+                if short_by is not None and -short_by < GUESS_MISS_TOL_RAD:
                     break
             if bracket.hi - bracket.lo < 1e-4:
                 break

@@ -240,6 +240,9 @@ def test_repeated_kills_lose_and_repeat_no_sample(tmp_path):
     (["optimize", "marv", "--nodes", "1"], "nodes"),
     (["optimize", "marv", "--nodes", "0"], "nodes"),
     (["optimize", "marv", "--tolerance", "0"], "tolerance"),
+    (["optimize", "marv", "--segments", "0"], "segments = 0"),
+    (["optimize", "marv", "--segments", "3"], "nodes = 125 with segments = 3"),
+    (["optimize", "marv", "--transcription", "dircol", "--segments", "4"], "lgl transcription only"),
     (["simulate", "/"], "directory"),
 ])
 def test_cli_bad_arguments_are_one_line(argv, needle, capsys, tmp_path):

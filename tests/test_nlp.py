@@ -93,6 +93,44 @@ def test_brachistochrone_minimum_time_equals_the_cycloid(transcription, nodes, t
         assert np.abs(r.hamiltonian[1:-1] + 1.0).max() < 1e-3
 
 
+@pytest.mark.parametrize("solver", ["ipopt", "snopt"])
+def test_segmented_lgl_double_integrator_costates_are_exact_at_the_knots_too(solver):
+    """Three LGL segments of 5 nodes sharing their end nodes (13 nodes): J, u and the
+    costates exact, at the knots (nodes 4 and 8: both segments' multipliers, each times its
+    segment length, over the summed weights) as between them."""
+    r = solve(double_integrator(), transcription="lgl", solver=solver, nodes=13, segments=3)
+    assert r.success, r.message
+    assert r.segments == 3 and r.nodes == 13
+    t = r.time
+    assert t[[4, 8]] == pytest.approx([1 / 3, 2 / 3], abs=1e-15)
+    assert r.objective == pytest.approx(6.0, abs=1e-7)
+    assert np.abs(r.controls[:, 0] - (6 - 12 * t)).max() < 1e-5
+    assert np.abs(r.costates[:, 0] + 12.0).max() < 1e-5
+    assert np.abs(r.costates[:, 1] - (12 * t - 6)).max() < 1e-5
+    assert np.abs(r.hamiltonian - r.hamiltonian.mean()).max() < 1e-5
+
+
+def test_segmented_lgl_brachistochrone_and_its_piecewise_interpolant():
+    """3 segments of 8 nodes: the cycloid's time to 2e-5 and H = -1 to 1e-3 between the knots;
+    the result's interpolant is each segment's own polynomial (a function with a kink at the
+    knots is reproduced exactly, which one polynomial through all the nodes would not)."""
+    r = solve(brachistochrone(), transcription="lgl", nodes=22, segments=3, solver="ipopt")
+    assert r.success, r.message
+    assert r.final_time == pytest.approx(cycloid_time(2.0, 1.0), rel=2e-5)
+    assert np.abs(r.hamiltonian[1:-1] + 1.0).max() < 1e-3
+    knot1, knot2 = r.time[7], r.time[14]
+
+    def kinked(t):  # continuous, a polynomial on each segment, kinks at the knots
+        return np.abs(t - knot1) + (t - knot2) * np.abs(t - knot2) + t**5
+
+    piece = dc.replace(r, states=np.column_stack([kinked(r.time)] * 3))
+    tt = np.linspace(0.0, r.final_time, 301)
+    want = kinked(tt)
+    assert piece.state_function()(tt)[:, 0] == pytest.approx(want, abs=1e-12)
+    whole = dc.replace(piece, segments=1).state_function()(tt)[:, 0]
+    assert np.abs(whole - want).max() > 1e-3
+
+
 def test_propagated_controls_reach_the_nlp_final_state():
     p = brachistochrone()
     r = solve(p, nodes=20)
@@ -116,6 +154,15 @@ def test_bad_options_and_problems_are_rejected_with_the_allowed_values():
         solve(p, solver="knitro")
     with pytest.raises(ValueError, match="nodes must be an integer >= 3"):
         solve(p, nodes=2)
+    with pytest.raises(ScenarioError, match=r"nodes = 12 with segments = 3: nodes - 1 must be a multiple of segments "
+                                            r"with at least 3 nodes per segment; allowed near it: 10 or 13"):
+        solve(p, nodes=12, segments=3)
+    with pytest.raises(ScenarioError, match="allowed near it: 9$"):
+        solve(p, nodes=5, segments=4)
+    with pytest.raises(ScenarioError, match="segments = 0; allowed: an integer >= 1"):
+        solve(p, nodes=12, segments=0)
+    with pytest.raises(ScenarioError, match="segments = 2 applies to the lgl transcription only"):
+        solve(p, nodes=13, segments=2, transcription="hermite_simpson")
     with pytest.raises(ValueError, match="unknown state 'z'"):
         double_integrator(final={"z": 1.0})
     with pytest.raises(ValueError, match="min <= max"):
@@ -152,12 +199,12 @@ def test_marv_solution_satisfies_paper_002_constraints_and_extremal_controls():
     assert np.abs(ext - U).max() < 1e-6 * 100
 
 
-@pytest.mark.parametrize("transcription", ["lgl", "dircol", "hermite_simpson"])
-def test_user_path_callable_binds_on_both_transcriptions(transcription):
+@pytest.mark.parametrize("transcription, segments", [("lgl", 1), ("lgl", 4), ("dircol", 1), ("hermite_simpson", 1)])
+def test_user_path_callable_binds_on_every_transcription(transcription, segments):
     """v <= 1.2 (the free optimum peaks at 1.5) as a user callable: active, met at the nodes,
     and the cost rises above the free optimum (DirectCollocation evaluates it in AutoDiff)."""
     p = double_integrator(path=[PathConstraint(lambda x, u, env: x[1], max=1.2, name="speed")])
-    r = solve(p, transcription=transcription, nodes=21)
+    r = solve(p, transcription=transcription, nodes=21, segments=segments)
     assert r.success, r.message
     assert r.states[:, 1].max() == pytest.approx(1.2, abs=1e-6)
     assert r.objective > 6.0 * 1.05
@@ -377,6 +424,22 @@ def test_mesh_refinement_raises_the_nodes_until_the_between_node_error_meets_the
     assert r.solve_time == pytest.approx(sum(m.solve_time for m in steps), rel=1e-9)
 
 
+def test_segmented_mesh_refinement_keeps_its_segments():
+    """Two LGL segments from 9 nodes: every mesh is a node count the two segments share
+    (odd), the errors fall to the tolerance and the answer is the cycloid's. (From 5 or 7
+    nodes, like 4 on one polynomial, the built-in guess leads to the straight slide, 25 %
+    slower and exact between the nodes: verification checks accuracy, not optimality.)"""
+    problem, published = catalogue.brachistochrone()
+    r = solve(problem, nodes=9, segments=2, refine=True, dynamics_tolerance=1e-6)
+    assert r.success, r.message
+    nodes = [m.nodes for m in r.mesh_history]
+    assert len(nodes) >= 2 and nodes[0] == 9 and all(n % 2 == 1 for n in nodes) and r.segments == 2
+    assert r.mesh_history[-1].error <= 1e-6
+    assert r.objective == pytest.approx(published["objective"], rel=1e-4)
+    r = solve(problem, nodes=5, segments=2, refine=True, max_nodes=10, dynamics_tolerance=1e-12)
+    assert r.nodes == 9 and "stopped at max_nodes = 9" in r.message  # the cap rounded down to a shared count
+
+
 def test_mesh_refinement_stops_at_max_nodes_and_says_so():
     problem, _ = catalogue.brachistochrone()
     r = solve(problem, nodes=5, refine=True, max_nodes=6, dynamics_tolerance=1e-9)
@@ -562,39 +625,55 @@ def test_a_long_solve_prints_its_progress_and_ctrl_c_stops_it(monkeypatch, capsy
             nlp.solve(brachistochrone()[0], nodes=15, solver=name, progress=False)
 
 
-def _hermite_simpson_at(problem, nodes, seed=0):
-    """The vectorised Hermite-Simpson transcription of ``problem`` at its guess, perturbed by
-    1 % (scaled): (transcription, scaled variables in z order)."""
+def _transcription_at(problem, nodes, seed=0, segments=None):
+    """The vectorised Hermite-Simpson transcription of ``problem`` (LGL on ``segments``
+    segments when given) at its guess, perturbed by 1 % (scaled): (transcription, scaled
+    variables in z order)."""
     from drake_entry.planning.nlp.hermite_simpson import _HermiteSimpsonTranscription
+    from drake_entry.planning.nlp.lgl import _LglTranscription
     from drake_entry.planning.nlp.scaling import resolve
 
     guess = nlp.initial_guess(problem)
-    tx = _HermiteSimpsonTranscription(problem, nodes, resolve(problem, guess, None))
+    scales = resolve(problem, guess, None)
+    tx = (_HermiteSimpsonTranscription(problem, nodes, scales) if segments is None
+          else _LglTranscription(problem, nodes, scales, segments))
     tx.set_guess(*guess)
     z = tx.initial_guess[[tx.prog.FindDecisionVariableIndex(v) for v in tx.z]]
     return tx, z * (1.0 + 0.01 * np.random.default_rng(seed).standard_normal(z.size))
 
 
-def test_hermite_simpson_jacobian_equals_finite_differences_inside_its_declared_sparsity():
-    """The assembled Jacobian of the collocation and path rows (chain rule through the
-    midpoint state x_c, the t_f column) against central differences of the rows themselves,
-    on Betts' heating-limited shuttle (6 states, 2 controls, one path row) at 9 samples: within
-    1e-8 relative to the largest entry, and no entry outside the pattern given to the solver."""
+@pytest.mark.parametrize("segments", [None, 1, 3])
+def test_vectorised_jacobians_equal_finite_differences_inside_their_declared_sparsity(segments):
+    """The assembled Jacobian of each part's collocation and path rows against central
+    differences of the rows themselves, on Betts' heating-limited shuttle (6 states, 2
+    controls, one path row) at 10 nodes: Hermite-Simpson (one part; chain rule through the
+    midpoint state x_c, the t_f column), LGL on one polynomial and on 3 segments of 4 nodes
+    (a part each, over its own nodes and t_f; each knot with both segments' rows, its path
+    row in the first): within 1e-8 relative to the largest entry, and no entry outside the
+    pattern given to the solver; the segments declare fewer entries."""
     problem, _ = catalogue.shuttle_crossrange(heating_limit=True)
-    tx, z = _hermite_simpson_at(problem, 9)
+    tx, z_all = _transcription_at(problem, 10, segments=segments)
     assert tx.tf is not None and tx.n_path == 1
-    values, J = tx._values_jacobian(z)
-    assert values.shape == ((9 - 1) * 6 + 9,)
-    numeric = np.zeros_like(J)
-    for j in range(z.size):
-        e = 1e-6 * max(1.0, abs(z[j]))
-        a, b = z.copy(), z.copy()
-        a[j] += e
-        b[j] -= e
-        numeric[:, j] = (tx._values_jacobian(a)[0] - tx._values_jacobian(b)[0]) / (2 * e)
-    assert np.abs(J - numeric).max() <= 1e-8 * np.abs(J).max()
-    pattern = set(tx._sparsity())
-    assert set(zip(*np.nonzero(J))) <= pattern and set(zip(*np.nonzero(np.abs(numeric) > 1e-9))) <= pattern
+    rows = {None: 10 - 1, 1: 10, 3: 3 * 4}[segments]
+    assert tx.n_rows == rows * 6 and sum(p.path_nodes for p in tx.parts) == 10
+    where = {tx.prog.FindDecisionVariableIndex(v): i for i, v in enumerate(tx.z)}
+    for part in tx.parts:
+        z = z_all[[where[tx.prog.FindDecisionVariableIndex(v)] for v in tx.part_variables(part)]]
+        values, J = tx._values_jacobian(part, z)
+        assert values.shape == (part.n_rows + part.path_nodes,) and J.shape == (values.size, z.size)
+        numeric = np.zeros_like(J)
+        for j in range(z.size):
+            e = 1e-6 * max(1.0, abs(z[j]))
+            a, b = z.copy(), z.copy()
+            a[j] += e
+            b[j] -= e
+            numeric[:, j] = (tx._values_jacobian(part, a)[0] - tx._values_jacobian(part, b)[0]) / (2 * e)
+        assert np.abs(J - numeric).max() <= 1e-8 * np.abs(J).max()
+        pattern = set(tx._sparsity(part))
+        assert set(zip(*np.nonzero(J))) <= pattern and set(zip(*np.nonzero(np.abs(numeric) > 1e-9))) <= pattern
+    if segments == 3:
+        single = _transcription_at(problem, 10, segments=1)[0]
+        assert sum(len(tx._sparsity(p)) for p in tx.parts) < len(single._sparsity(single.parts[0]))
 
 
 def test_hermite_simpson_is_drakes_direct_collocation_nlp():

@@ -96,9 +96,12 @@ class SolveSpec:
     transcription: str = "lgl"  # lgl | dircol (Drake DirectCollocation) | hermite_simpson (the same NLP, vectorised)
     solver: str = "auto"  # auto (SNOPT when available, else Ipopt) | snopt | ipopt
     nodes: int = 40
+    # lgl only: equal LGL segments sharing their end nodes ((nodes - 1) a multiple of
+    # segments, >= 3 nodes each; 1 = one global polynomial, paper 002)
+    segments: int = 1
     tolerance: float = 1.0e-8
     max_iterations: int = 3000
-    # solve first on this many nodes and start from that solution (0 = propagated guess)
+    # solve first on this many nodes (lgl: one polynomial) and start from that solution (0 = propagated guess)
     coarse_nodes: int = 0
     # mesh refinement: raise the node count from `nodes` until the between-node error meets
     # the verification tolerance (nlp.mesh), up to max_nodes (0 = the transcription's default)
@@ -281,7 +284,7 @@ def validate_solve(s: SolveSpec) -> SolveSpec:
     for field, allowed in (("transcription", ("lgl", "dircol", "hermite_simpson")), ("solver", ("auto", "ipopt", "snopt"))):
         if getattr(s, field) not in allowed:
             raise ScenarioError(f"solve.{field} = '{getattr(s, field)}' is unknown; allowed: {', '.join(allowed)}")
-    for field, lo in (("nodes", 3), ("max_iterations", 1), ("coarse_nodes", 0), ("max_nodes", 0)):
+    for field, lo in (("nodes", 3), ("segments", 1), ("max_iterations", 1), ("coarse_nodes", 0), ("max_nodes", 0)):
         v = getattr(s, field)
         if isinstance(v, bool) or not isinstance(v, int) or v < lo:
             raise ScenarioError(f"solve.{field} = {v} is out of range; allowed: an integer >= {lo}")

@@ -12,7 +12,7 @@ energy as the independent variable.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 from numpy.polynomial import legendre
@@ -132,17 +132,28 @@ def lobatto_integration_matrix(n_nodes: int) -> np.ndarray:
     return A
 
 
+#: Lobatto integration matrices above this many nodes come from an ill-conditioned
+#: Vandermonde solve (lobatto_integration_matrix); SegmentMesh.integration refuses them
+INTEGRATION_MAX_NODES = 16
+#: a segment's node count cap (the LGL nodes and differentiation matrix stay accurate far beyond)
+SEGMENT_MAX_NODES = 400
+
+
 @dataclass
 class SegmentMesh:
     """A mesh of ``n_segments`` equal segments of normalised time s in [0, 1], each with
-    ``nodes_per_segment`` LGL nodes; neighbouring segments share their end node.
+    ``nodes_per_segment`` LGL nodes; neighbouring segments share their end node (the knots
+    of Ross & Fahroo's pseudospectral knotting methods).
 
     Attributes:
       s: the n_nodes node positions in [0, 1]; n_nodes = n_segments (nodes_per_segment - 1) + 1.
       weights: quadrature weights on [0, 1] (sum 1; exact to degree 2 nodes_per_segment - 3).
       segment_nodes: (n_segments, nodes_per_segment) global node indices of each segment.
+      length: a segment's length in s (1 / n_segments).
+      differentiation, segment_weights: the LGL differentiation matrix and quadrature
+        weights of one segment on its own [-1, 1] (d/ds = differentiation / (length / 2)).
       integration: the segment's Lobatto integration matrix scaled to the segment length
-        (x_j - x_0 = sum_k integration[j-1, k] dx/ds(s_k)).
+        (x_j - x_0 = sum_k integration[j-1, k] dx/ds(s_k); nodes_per_segment <= 16).
     """
 
     n_segments: int
@@ -151,12 +162,13 @@ class SegmentMesh:
     def __post_init__(self):
         if not (isinstance(self.n_segments, (int, np.integer)) and self.n_segments >= 1):
             raise ScenarioError(f"SegmentMesh.n_segments = {self.n_segments} must be an integer >= 1")
-        if not 2 <= self.nodes_per_segment <= 16:
-            raise ScenarioError(f"SegmentMesh.nodes_per_segment = {self.nodes_per_segment} must be in [2, 16]")
+        if not 2 <= self.nodes_per_segment <= SEGMENT_MAX_NODES:
+            raise ScenarioError(f"SegmentMesh.nodes_per_segment = {self.nodes_per_segment} must be in "
+                                f"[2, {SEGMENT_MAX_NODES}]")
         m = int(self.nodes_per_segment)
-        tau, w_tau, _, _, self._bary = _reference_operators(m)
-        self._tau = tau
-        h = 1.0 / self.n_segments
+        tau, w_tau, self.differentiation, _, self._bary = _reference_operators(m)
+        self._tau, self.segment_weights = tau, w_tau
+        h = self.length = 1.0 / self.n_segments
         starts = np.arange(self.n_segments) * h
         self.segment_nodes = np.arange(self.n_segments)[:, None] * (m - 1) + np.arange(m)[None, :]
         self.n_nodes = self.n_segments * (m - 1) + 1
@@ -166,7 +178,13 @@ class SegmentMesh:
             self.s[self.segment_nodes[k]] = starts[k] + 0.5 * h * (tau + 1.0)
             self.weights[self.segment_nodes[k]] += 0.5 * h * w_tau
         self.s[-1] = 1.0
-        self.integration = 0.5 * h * lobatto_integration_matrix(m)
+
+    @cached_property
+    def integration(self) -> np.ndarray:
+        if self.nodes_per_segment > INTEGRATION_MAX_NODES:
+            raise ScenarioError(f"SegmentMesh.integration: nodes_per_segment = {self.nodes_per_segment} must be in "
+                                f"[2, {INTEGRATION_MAX_NODES}] (the Lobatto matrix's Vandermonde solve)")
+        return 0.5 * self.length * lobatto_integration_matrix(int(self.nodes_per_segment))
 
     def interpolation(self, s) -> np.ndarray:
         """Matrix (len(s), n_nodes) mapping nodal values to the segment polynomials at s in [0, 1]."""

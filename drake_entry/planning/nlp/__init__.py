@@ -13,7 +13,9 @@ LGL (paper 002 eqs. 12-14, Fahroo & Ross): states and controls at the N LGL node
 tau_k of [-1, 1], t = (tau + 1) t_f / 2. One constraint holds the defects
 D X - (t_f / 2) f(X, U) = 0 and the path rows, evaluated by one vectorised model call with
 its exact sparse Jacobian (lgl, evaluator). Costates come from the defects' KKT multipliers
-(eq. 15): lambda(t_k) = nu_k / w_k, converted back to SI.
+(eq. 15): lambda(t_k) = nu_k / w_k, converted back to SI. ``segments=S`` splits the N nodes
+into S equal LGL segments sharing their end nodes (Ross & Fahroo's knotting): the same
+N, S dense differentiation blocks of (N - 1) / S + 1 nodes instead of one of N.
 
 DirectCollocation: Drake's Hermite-Simpson transcription of planning.ocp_system (the same
 scaled dynamics as a Drake System) with N samples; the running cost is the trapezoid rule
@@ -55,7 +57,7 @@ from drake_entry.planning.nlp.dircol import _DircolTranscription
 from drake_entry.planning.nlp.evaluator import SolveProgress
 from drake_entry.planning.nlp.guess import initial_guess
 from drake_entry.planning.nlp.hermite_simpson import _HermiteSimpsonTranscription
-from drake_entry.planning.nlp.lgl import _LglTranscription
+from drake_entry.planning.nlp.lgl import _LglTranscription, nodes_per_segment, segment_compatible
 from drake_entry.planning.nlp.mesh import MAX_NODES, MeshStep, mesh_error, next_nodes  # noqa: F401 (API)
 from drake_entry.planning.nlp.result import (  # noqa: F401 (API)
     TRANSCRIPTION_LABELS,
@@ -90,7 +92,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
           solver_options: dict | None = None, log_file: str | None = None, verifier=None,
           dynamics_tolerance: float = DYNAMICS_TOLERANCE,
           propagation_tolerance: float = PROPAGATION_TOLERANCE, refine: bool = False,
-          max_nodes: int | None = None, progress="auto") -> NlpResult:
+          max_nodes: int | None = None, progress="auto", segments: int = 1) -> NlpResult:
     """Solve ``problem`` (see module docstring); ``success`` only when verified.
 
     Args:
@@ -99,6 +101,9 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
       solver: 'snopt', 'ipopt' or 'auto' (default: SNOPT when this pydrake build has it,
         else Ipopt; see default_solver()).
       nodes: LGL nodes or DirectCollocation samples (>= 3).
+      segments: LGL only: equal segments sharing their end nodes ((nodes - 1) a multiple of
+        segments, >= 3 nodes per segment; 1: paper 002's global polynomial). A refined mesh
+        keeps the segments and rounds its node count up to one they share.
       guess: an NlpResult, or (t [s], states (n, nx), controls (n, nu)) SI, or None for the
         built-in propagated guess (``initial_guess``).
       tolerance: solver optimality and feasibility tolerance (scaled units).
@@ -128,13 +133,16 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
     """
     check_options(transcription=transcription, solver=solver, nodes=nodes, tolerance=tolerance,
                   max_iterations=max_iterations, dynamics_tolerance=dynamics_tolerance,
-                  propagation_tolerance=propagation_tolerance, progress=progress, refine=refine, max_nodes=max_nodes)
+                  propagation_tolerance=propagation_tolerance, progress=progress, refine=refine, max_nodes=max_nodes,
+                  segments=segments)
     names = auto_solvers() if solver == "auto" else (solver,)
     if solver == "auto" and solver_options:
         raise ScenarioError("solver_options are by the solver's own names: give solver='snopt' or 'ipopt' with them")
     show = wanted(progress)
     engines = {name: _engine(name) for name in names}
     cap = max(MAX_NODES[transcription], nodes) if max_nodes is None else max_nodes  # checked by check_options
+    if segments > 1:  # the largest node count the segments share (nodes is one: check_options)
+        cap = segments * ((cap - 1) // segments) + 1
     t_guess = _time.perf_counter()
     if guess is None:
         guess = initial_guess(problem)
@@ -156,7 +164,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
         for name, engine in engines.items():
             for label, start in starts:
                 result, words, diagnosis = _solve_mesh(problem, transcription, name, engine, nodes, start, scaling,
-                                                       options[name][0], show)
+                                                       options[name][0], show, segments)
                 mesh_time, build_time = mesh_time + result.solve_time, build_time + result.build_time
                 calls, callback_time = calls + result.callback_calls, callback_time + result.callback_time
                 words = words + label
@@ -183,8 +191,8 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
             result.success, result.message = False, f"solved, not verified (no verifier given): {words}"
             return result
         if refine and history[-1].error > target and nodes < cap:
-            nodes, guess = next_nodes(transcription, history, target, cap), (result.time, result.states,
-                                                                             result.controls)
+            nodes, guess = _next_mesh(transcription, history, target, cap, segments), (result.time, result.states,
+                                                                                        result.controls)
             continue
         if verifier is None:
             result.success = False
@@ -199,8 +207,8 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
         if refine and not check.verified and nodes < cap and check.dynamics_error <= target:
             # between the nodes it meets the tolerance, the flight does not: tighten and go on
             target = check.dynamics_error / 10.0
-            nodes, guess = next_nodes(transcription, history, target, cap), (result.time, result.states,
-                                                                             result.controls)
+            nodes, guess = _next_mesh(transcription, history, target, cap, segments), (result.time, result.states,
+                                                                                        result.controls)
             continue
         result.success = check.verified
         result.message = (f"solved and verified: {words}; " if check.verified else
@@ -213,7 +221,7 @@ def solve(problem, *, transcription: str = "lgl", solver: str = "auto", nodes: i
 def check_options(*, transcription: str = "lgl", solver: str = "auto", nodes: int = 40, tolerance: float = 1e-8,
                   max_iterations: int = 3000, dynamics_tolerance: float = DYNAMICS_TOLERANCE,
                   propagation_tolerance: float = PROPAGATION_TOLERANCE, progress="auto", refine: bool = False,
-                  max_nodes: int | None = None) -> None:
+                  max_nodes: int | None = None, segments: int = 1) -> None:
     """``solve``'s options checked (a ScenarioError naming the option and its allowed range), so a
     caller can refuse bad options before a first, coarse solve."""
     if transcription not in TRANSCRIPTIONS:
@@ -231,6 +239,11 @@ def check_options(*, transcription: str = "lgl", solver: str = "auto", nodes: in
             raise ScenarioError(f"{name} = {value} is out of range; allowed (0, 1)")
     if progress not in (True, False, "auto"):
         raise ScenarioError(f"progress = {progress!r}; allowed: True, False, 'auto'")
+    if segments != 1:
+        if transcription != "lgl":
+            raise ScenarioError(f"segments = {segments!r} applies to the lgl transcription only; "
+                                f"'{transcription}' takes segments = 1")
+        nodes_per_segment(int(nodes), segments)
     if refine and max_nodes is not None and not (isinstance(max_nodes, (int, np.integer))
                                                  and not isinstance(max_nodes, bool) and max_nodes >= nodes):
         raise ScenarioError(f"max_nodes = {max_nodes} is out of range; allowed: an integer >= nodes ({nodes})")
@@ -252,6 +265,12 @@ def default_solver() -> str:
     return auto_solvers()[0]
 
 
+def _next_mesh(transcription, history, target, cap, segments) -> int:
+    """mesh.next_nodes rounded up to a node count the LGL ``segments`` share."""
+    nodes = next_nodes(transcription, history, target, cap)
+    return nodes if segments == 1 else segment_compatible(nodes, segments)
+
+
 def _engine(name: str, check: bool = True):
     """The Drake solver object (None, or NlpError with ``check``, when this build lacks it)."""
     engine = IpoptSolver() if name == "ipopt" else SnoptSolver()
@@ -262,13 +281,14 @@ def _engine(name: str, check: bool = True):
     return None
 
 
-def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, options, show: bool = False):
-    """One transcription and solve on ``nodes`` nodes: (NlpResult with ``converged`` and this
-    mesh's build and solve times, the solver's verdict in words, the violation diagnosis
-    when not converged); ``show``: progress lines on stderr (SolveProgress)."""
+def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, options, show: bool = False,
+                segments: int = 1):
+    """One transcription and solve on ``nodes`` nodes (LGL: in ``segments`` segments): (NlpResult
+    with ``converged`` and this mesh's build and solve times, the solver's verdict in words, the
+    violation diagnosis when not converged); ``show``: progress lines on stderr (SolveProgress)."""
     t_build = _time.perf_counter()
     scales = resolve_scaling(problem, guess, scaling)
-    tx = (_LglTranscription(problem, nodes, scales) if transcription == "lgl"
+    tx = (_LglTranscription(problem, nodes, scales, segments) if transcription == "lgl"
           else _HermiteSimpsonTranscription(problem, nodes, scales) if transcription == "hermite_simpson"
           else _DircolTranscription(problem, nodes, scales, float(guess[0][-1])))
     tx.set_guess(*guess)
@@ -276,7 +296,8 @@ def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, o
     build_time = _time.perf_counter() - t_build
     t0, calls0, seconds0 = _time.perf_counter(), tx.timer.calls, tx.timer.seconds
     if show:
-        tx.timer.progress = SolveProgress(f"{transcription} {nodes} nodes, {solver}")
+        where = f" in {segments} segments" if segments > 1 else ""
+        tx.timer.progress = SolveProgress(f"{transcription} {nodes} nodes{where}, {solver}")
         tx.timer.progress.start()
     res = _interruptible(engine.Solve, tx.prog, tx.initial_guess, options)
     converged, words = verdict(res, solver)

@@ -18,13 +18,16 @@ def add_arguments(parser) -> None:
     parser.add_argument("--transcription", choices=("lgl", "dircol", "hermite_simpson"), default=None,
                         help="Legendre pseudospectral (paper 002), Drake's DirectCollocation, or the same "
                              "Hermite-Simpson NLP vectorised (default: the YAML)")
+    parser.add_argument("--segments", type=int, default=None, metavar="S",
+                        help="LGL only: S equal segments sharing their end nodes, (nodes - 1) a multiple of S "
+                             "(default: the YAML's solve.segments, 1 = one global polynomial)")
     parser.add_argument("--solver", choices=("auto", "ipopt", "snopt"), default=None,
                         help="NLP solver; auto tries SNOPT, then Ipopt (default: the YAML)")
     parser.add_argument("--tolerance", type=float, default=None,
                         help="solver optimality and feasibility tolerance, scaled units (default: the YAML)")
     parser.add_argument("--coarse", type=int, default=None, metavar="N",
-                        help="first solve with N nodes and start the full solve from it (0 = the propagated "
-                             "guess; default: the YAML's coarse_nodes)")
+                        help="first solve with N nodes (LGL: one polynomial) and start the full solve from it "
+                             "(0 = the propagated guess; default: the YAML's coarse_nodes)")
     parser.add_argument("--max-iterations", type=int, default=None, metavar="N",
                         help="solver iteration limit (default: the YAML's solve.max_iterations)")
     parser.add_argument("--refine", action="store_true",
@@ -65,6 +68,7 @@ def _solve_and_write(args) -> int:
     problem, settings = load_problem(args.problem)
     nodes = settings.nodes if args.nodes is None else args.nodes
     transcription = args.transcription or settings.transcription
+    segments = settings.segments if args.segments is None else args.segments
     solver = args.solver or settings.solver
     tol = settings.tolerance if args.tolerance is None else args.tolerance
     max_iterations = settings.max_iterations if args.max_iterations is None else args.max_iterations
@@ -73,7 +77,8 @@ def _solve_and_write(args) -> int:
     max_nodes = (args.max_nodes or settings.max_nodes or None) if refine else None
     nlp.check_options(transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
                       max_iterations=max_iterations, dynamics_tolerance=settings.dynamics_tolerance,
-                      propagation_tolerance=settings.propagation_tolerance, refine=refine, max_nodes=max_nodes)
+                      propagation_tolerance=settings.propagation_tolerance, refine=refine, max_nodes=max_nodes,
+                      segments=segments)
     guess = None
     coarse_nodes = settings.coarse_nodes if args.coarse is None else args.coarse
     if coarse_nodes and coarse_nodes < 3:
@@ -85,10 +90,11 @@ def _solve_and_write(args) -> int:
                            tolerance=max(tol, 1e-6), max_iterations=max_iterations, progress=True)
         print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
         guess = coarse if coarse.converged else None
-    how = f"mesh refinement from {nodes} nodes" if refine else f"{nodes} nodes"
+    how = (f"mesh refinement from {nodes} nodes" if refine else f"{nodes} nodes") + (
+        f" in {segments} segments" if segments > 1 else "")
     print(f"solve: {problem.name}, {transcription}, {how}, {solver} ...", flush=True)
     result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
-                       max_iterations=max_iterations, guess=guess,
+                       max_iterations=max_iterations, guess=guess, segments=segments,
                        verifier=None if args.no_propagate else fly_controls,
                        refine=refine, max_nodes=max_nodes, dynamics_tolerance=settings.dynamics_tolerance,
                        propagation_tolerance=settings.propagation_tolerance, progress=True)
@@ -113,8 +119,8 @@ def _solve_and_write(args) -> int:
     except ValueError:
         pass
     pngs = nlp_solution_plots(problem, result, args.out, propagated=check, extremal=ext,
-                              title=f"{problem.name}: {nlp.TRANSCRIPTION_LABELS[transcription]} {result.nodes} nodes, "
-                                    f"{result.solver}")
+                              title=f"{problem.name}: {nlp.TRANSCRIPTION_LABELS[transcription]} {result.nodes} nodes"
+                                    f"{f' in {segments} segments' if segments > 1 else ''}, {result.solver}")
     print(json.dumps(info, indent=2, default=float))
     print(f"wrote solution, summary.json and {len(pngs)} plots to {args.out}")
     return 0 if result.success or (args.no_propagate and result.converged) else 1

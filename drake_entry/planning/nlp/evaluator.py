@@ -6,14 +6,15 @@ import functools
 import time
 
 import numpy as np
+from pydrake.autodiffutils import ExtractValue
 
 from drake_entry.planning.progress import ProgressLine
 
 
 class SolveProgress(ProgressLine):
     """Console progress of a long solve (planning.progress): the solver's evaluations of the
-    problem functions, the objective at the latest evaluation (solver units) and, where one
-    constraint holds every collocation row (LGL), its largest scaled violation there."""
+    problem functions, the objective at the latest evaluation (solver units) and, where
+    constraints hold the collocation rows (LGL, Hermite-Simpson), their largest scaled violation."""
 
     def __init__(self, label: str, *, stream=None, after: float | None = None, interval: float | None = None):
         super().__init__(label, hint="Ctrl-C stops the solve", stream=stream, after=after, interval=interval)
@@ -35,11 +36,12 @@ class CallbackTimer:
     def __init__(self):
         self.calls, self.seconds = 0, 0.0
         self.progress: SolveProgress | None = None
-        self._costs, self._violation = {}, None
+        self._costs, self._violations = {}, {}
 
     def wrap(self, fn, *, cost: bool = False, bounds: tuple | None = None):
         """``fn`` counted and timed; ``cost``: its value is a term of the objective; ``bounds``
-        (lower, upper): a constraint holding every collocation row, whose violation progress reports."""
+        (lower, upper): a constraint holding collocation rows, whose violation progress reports
+        (the largest over such constraints at their latest evaluations)."""
         @functools.wraps(fn)
         def timed(*args):
             t0 = time.perf_counter()
@@ -57,13 +59,15 @@ class CallbackTimer:
     def _observe(self, key, out, cost: bool, bounds):
         if cost:
             self._costs[key] = float(out.value() if hasattr(out, "value") else out)
+        if bounds is not None:  # every evaluation (C++ value extraction), so none is stale
+            out = np.ravel(out)
+            v = ExtractValue(out).ravel() if out.dtype == object else np.asarray(out, float)
+            self._violations[key] = float(np.max(np.maximum(bounds[0] - v, 0.0) + np.maximum(v - bounds[1], 0.0),
+                                                 initial=0.0))
         if not self.progress.due():
             return
-        if bounds is not None:
-            v = np.array([e.value() if hasattr(e, "value") else e for e in np.ravel(out)], float)
-            self._violation = float(np.max(np.maximum(bounds[0] - v, 0.0) + np.maximum(v - bounds[1], 0.0),
-                                           initial=0.0))
-        self.progress.report(self.calls, sum(self._costs.values()) if self._costs else None, self._violation)
+        self.progress.report(self.calls, sum(self._costs.values()) if self._costs else None,
+                             max(self._violations.values()) if self._violations else None)
 
 
 class _NodeEvaluator:

@@ -19,7 +19,7 @@ import numpy as np
 
 from drake_entry.planning.nlp.dircol import DIRCOL_COSTATE_FACTOR
 from drake_entry.planning.nlp.evaluator import _NodeEvaluator
-from drake_entry.planning.nlp.node_program import _NodeProgram
+from drake_entry.planning.nlp.node_program import _NodeProgram, _Part
 from drake_entry.planning.nlp.result import NlpResult
 
 MIN_FINAL_TIME = 1e-6  # [time scales]
@@ -27,12 +27,12 @@ MIN_FINAL_TIME = 1e-6  # [time scales]
 
 class _HermiteSimpsonTranscription(_NodeProgram):
     """Hermite-Simpson collocation rows (interval-major: row k nx + i) and the path rows at
-    the N samples; z = [X, U, t_f] (scaled)."""
+    the N samples, in one part; z = [X, U, t_f] (scaled)."""
 
     description = "Hermite-Simpson collocation and path"
 
     def __init__(self, problem, nodes, scaling):
-        super().__init__(problem, nodes, scaling, n_rows=(nodes - 1) * problem.n_states)
+        super().__init__(problem, nodes, scaling, [_Part(0, nodes, (nodes - 1) * problem.n_states, nodes)])
         self.midpoints_eval = _NodeEvaluator(self)
         if self.tf is not None:
             self.prog.AddBoundingBoxConstraint(MIN_FINAL_TIME, np.inf, self.tf)
@@ -40,18 +40,17 @@ class _HermiteSimpsonTranscription(_NodeProgram):
     def node_times(self, tf):
         return np.linspace(0.0, tf, self.N)
 
-    def _collocation_sparsity(self):
-        pairs = []
-        for k in range(self.N - 1):
-            cols = self._node_cols(k) + self._node_cols(k + 1) + self._tf_cols()
+    def _collocation_sparsity(self, part):
+        pairs, N = [], part.size
+        for k in range(N - 1):
+            cols = self._node_cols(k, N) + self._node_cols(k + 1, N) + self._tf_cols(N)
             for i in range(self.nx):
                 pairs += [(k * self.nx + i, c) for c in cols]
         return pairs
 
-    def _values_jacobian(self, zv):
-        N, nx, nu = self.N, self.nx, self.nu
-        Xs, Us, tf = self._split(zv)
-        f, g, _, df, dg, _ = self.nodes_eval.evaluate(Xs, Us)
+    def _collocation(self, part, Xs, Us, tf, J):
+        N, nx, nu = part.size, self.nx, self.nu
+        f, _, _, df, _, _ = self.nodes_eval.evaluate(Xs, Us)
         n = N - 1
         h = tf / n
         f0, f1 = f[:-1], f[1:]
@@ -66,7 +65,6 @@ class _HermiteSimpsonTranscription(_NodeProgram):
         d_u0 = -(h / 8.0 * Ac @ B0 + 0.5 * Bc + 0.25 * B0)
         d_x1 = -(Ac @ (0.5 * eye - h / 8.0 * A1) - 1.5 / h * eye + 0.25 * A1)
         d_u1 = -(-h / 8.0 * Ac @ B1 + 0.5 * Bc + 0.25 * B1)
-        J = np.zeros((n * nx + self.n_path * N, zv.size))
         Jx = J[:n * nx, :N * nx].reshape(n, nx, N, nx)  # views into J
         Ju = J[:n * nx, N * nx:N * (nx + nu)].reshape(n, nx, N, nu)
         k = np.arange(n)
@@ -77,24 +75,13 @@ class _HermiteSimpsonTranscription(_NodeProgram):
         if self.tf is not None:  # d/d t_f = (d/d h) / (N - 1)
             d_h = -np.einsum("kij,kj->ki", Ac, (f0 - f1) / 8.0) - 1.5 / h ** 2 * (Xs[1:] - Xs[:-1])
             J[:n * nx, -1] = (d_h / n).ravel()
-        values = np.concatenate([rows.ravel(), self._path_jacobian(J, g, dg)])
-        return values, J
+        return rows.ravel()
 
-    def _lagrange_value_gradient(self, zv):
-        """c t_f / (N - 1) (sum L_k - (L_0 + L_N-1) / 2): the trapezoid rule of dircol."""
-        N, nx, nu = self.N, self.nx, self.nu
-        Xs, Us, tf = self._split(zv)
-        *_, L, _, _, dL = self.nodes_eval.evaluate(Xs, Us)
-        w = np.full(N, 1.0 / (N - 1))
+    def _quadrature_weights(self, part):
+        """1 / (N - 1) (sum L_k - (L_0 + L_N-1) / 2) over t_f: the trapezoid rule of dircol."""
+        w = np.full(part.size, 1.0 / (part.size - 1))
         w[[0, -1]] *= 0.5
-        c = self.cost_factor
-        value = c * tf * float(w @ L)
-        grad = np.zeros(zv.size)
-        grad[:N * nx] = (c * tf * w[:, None] * dL[:, :nx]).ravel()
-        grad[N * nx:N * (nx + nu)] = (c * tf * w[:, None] * dL[:, nx:]).ravel()
-        if self.tf is not None:
-            grad[-1] = c * float(w @ L)
-        return value, grad
+        return w
 
     def result(self, res) -> NlpResult:
         t, X, U, nu = self.solution(res)

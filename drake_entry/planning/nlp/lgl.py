@@ -1,77 +1,103 @@
-"""Legendre pseudospectral (LGL) transcription, paper 002 eqs. 12-15."""
+"""Legendre pseudospectral (LGL) transcription, paper 002 eqs. 12-15, on one global
+polynomial or on equal segments that share their end nodes (Ross & Fahroo's knotting)."""
 from __future__ import annotations
 
 import numpy as np
 
-from drake_entry.planning.nlp.node_program import _NodeProgram
+from drake_entry.errors import ScenarioError
+from drake_entry.planning.nlp.node_program import _NodeProgram, _Part
 from drake_entry.planning.nlp.result import NlpResult
-from drake_entry.planning.pseudospectral import LGL
+from drake_entry.planning.pseudospectral import SegmentMesh
+
+
+def nodes_per_segment(nodes: int, segments: int) -> int:
+    """LGL nodes of each of ``segments`` equal segments sharing their end nodes, for ``nodes``
+    in all; ScenarioError naming the node counts allowed when they do not divide."""
+    if not (isinstance(segments, (int, np.integer)) and not isinstance(segments, bool) and segments >= 1):
+        raise ScenarioError(f"segments = {segments!r}; allowed: an integer >= 1 (LGL segments)")
+    m, rest = divmod(nodes - 1, segments)
+    if rest or m < 2:
+        near = f"{2 * segments + 1}" if m < 2 else f"{segments * m + 1} or {segments * (m + 1) + 1}"
+        raise ScenarioError(f"nodes = {nodes} with segments = {segments}: nodes - 1 must be a multiple of segments "
+                            f"with at least 3 nodes per segment; allowed near it: {near}")
+    return m + 1
+
+
+def segment_compatible(nodes: int, segments: int) -> int:
+    """The smallest node count >= ``nodes`` that ``segments`` segments of >= 3 nodes share."""
+    m = max(2, -(-(int(nodes) - 1) // segments))
+    return segments * m + 1
 
 
 class _LglTranscription(_NodeProgram):
-    """Paper 002 eqs. 12-14 on LGL nodes.
+    """Paper 002 eqs. 12-14 on LGL nodes, one polynomial per segment.
 
-    Decision variables z = [X (N x nx), U (N x nu), t_f] (scaled). One constraint holds
-    the defects D X - (t_f / 2) f(X, U) = 0 (eq. 13, rows node-major) and the path
-    functions (eq. 14); its Jacobian is assembled from the exact D and the node Jacobians
-    of _NodeEvaluator, with the true sparsity pattern declared to the solver. The cost is
-    (t_f / 2) sum w_k L_k (eq. 12) plus the Mayer term. Costates: the defect rows'
-    multipliers divided by the LGL weights (eq. 15)."""
+    Decision variables z = [X (N x nx), U (N x nu), t_f] (scaled). With normalised time
+    s = t / t_f and ``segments`` equal segments of length h (h = 1: the paper's global
+    polynomial), segment j's rows are D X_j - (h / 2) t_f f(X_j, U_j) = 0 (eq. 13 on the
+    segment's own [-1, 1], rows node-major); a knot (the node two segments share) carries
+    both segments' rows. Each segment is one constraint over its own nodes (node_program's
+    parts) holding its rows and the path functions (eq. 14) of its nodes (a knot's in the
+    segment before it); its Jacobian is assembled from the exact D and the node Jacobians of
+    _NodeEvaluator, with the sparsity declared to the solver. The cost is (t_f / 2) sum W_k L_k
+    (eq. 12, W the composite weights on [-1, 1]) plus the Mayer term. Costates (eq. 15): the
+    multipliers of a node's rows, each times its segment's h, summed and divided by W_k; on
+    one segment, nu_k / w_k."""
 
     description = "LGL defects and path"
 
-    def __init__(self, problem, nodes, scaling):
-        self.lgl = LGL(nodes)
-        super().__init__(problem, nodes, scaling, n_rows=nodes * problem.n_states)
+    def __init__(self, problem, nodes, scaling, segments: int = 1):
+        self.mesh = SegmentMesh(segments, nodes_per_segment(nodes, segments))
+        m, nx = self.mesh.nodes_per_segment, problem.n_states
+        self.h = self.mesh.length
+        self.weights_tau = 2.0 * self.mesh.weights  # composite quadrature on [-1, 1]
+        parts = [_Part(int(seg[0]), int(seg[-1]) + 1, m * nx, m if j == segments - 1 else m - 1, j)
+                 for j, seg in enumerate(self.mesh.segment_nodes)]
+        super().__init__(problem, nodes, scaling, parts)
+
+    @property
+    def segments(self) -> int:
+        return self.mesh.n_segments
 
     def node_times(self, tf):
-        return (self.lgl.tau + 1.0) * 0.5 * tf
+        return self.mesh.s * tf
 
-    def _collocation_sparsity(self):
-        N, nx = self.N, self.nx
+    def _collocation_sparsity(self, part):
+        m, nx = part.size, self.nx
         pairs = []
-        for k in range(N):
+        for k in range(m):
             for i in range(nx):
-                cols = set(self._x_col(m, i) for m in range(N)) | set(self._node_cols(k)) | set(self._tf_cols())
+                cols = set(self._x_col(j, i) for j in range(m)) | set(self._node_cols(k, m)) | set(self._tf_cols(m))
                 pairs += [(k * nx + i, c) for c in sorted(cols)]
         return pairs
 
-    def _values_jacobian(self, zv):
-        N, nx, nu, npth = self.N, self.nx, self.nu, self.n_path
-        Xs, Us, tf = self._split(zv)
-        f, g, L, df, dg, dL = self.nodes_eval.evaluate(Xs, Us)
-        D = self.lgl.D1_tau
-        defect = (D @ Xs - 0.5 * tf * f).ravel()
-        J = np.zeros((N * nx + npth * N, zv.size))
+    def _collocation(self, part, Xs, Us, tf, J):
+        m, nx, nu = part.size, self.nx, self.nu
+        f, _, _, df, _, _ = self.nodes_eval.evaluate(Xs, Us)
+        D, c = self.mesh.differentiation, 0.5 * self.h * tf
+        defect = (D @ Xs - c * f).ravel()
         for i in range(nx):  # D acts on each state's nodal values
-            idx = np.arange(N) * nx + i
+            idx = np.arange(m) * nx + i
             J[np.ix_(idx, idx)] += D
-        for k in range(N):
-            rows = k * nx + np.arange(nx)
-            J[np.ix_(rows, k * nx + np.arange(nx))] -= 0.5 * tf * df[k, :, :nx]
-            J[np.ix_(rows, N * nx + k * nu + np.arange(nu))] -= 0.5 * tf * df[k, :, nx:]
+        k = np.arange(m)
+        rows = (k * nx)[:, None, None] + np.arange(nx)[None, :, None]  # (m, nx, 1)
+        J[rows, (k * nx)[:, None, None] + np.arange(nx)[None, None, :]] -= c * df[:, :, :nx]
+        J[rows, (m * nx + k * nu)[:, None, None] + np.arange(nu)[None, None, :]] -= c * df[:, :, nx:]
         if self.tf is not None:
-            J[:N * nx, -1] = -0.5 * f.ravel()
-        values = np.concatenate([defect, self._path_jacobian(J, g, dg)])
-        return values, J
+            J[:m * nx, -1] = -0.5 * self.h * f.ravel()
+        return defect
 
-    def _lagrange_value_gradient(self, zv):
-        N, nx, nu = self.N, self.nx, self.nu
-        Xs, Us, tf = self._split(zv)
-        *_, L, _, _, dL = self.nodes_eval.evaluate(Xs, Us)
-        w = self.lgl.weights_tau
-        c = self.cost_factor
-        value = 0.5 * c * tf * float(w @ L)
-        grad = np.zeros(zv.size)
-        grad[:N * nx] = (0.5 * c * tf * w[:, None] * dL[:, :nx]).ravel()
-        grad[N * nx:N * (nx + nu)] = (0.5 * c * tf * w[:, None] * dL[:, nx:]).ravel()
-        if self.tf is not None:
-            grad[-1] = 0.5 * c * float(w @ L)
-        return value, grad
+    def _quadrature_weights(self, part):
+        """(h / 2) w_tau of the segment: its share of (t_f / 2) sum W_k L_k (eq. 12)."""
+        return 0.5 * self.h * self.mesh.segment_weights
 
     def result(self, res) -> NlpResult:
         t, X, U, nu = self.solution(res)
         costates = None
-        if nu is not None:  # eq. 15: lambda_k = nu_k / w_k (scaled), then d J / d x in SI
-            costates = self.costates_from(nu.reshape(self.N, self.nx) / self.lgl.weights_tau[:, None])
-        return self.make_result(res, t, X, U, costates, t if costates is not None else None, "lgl")
+        if nu is not None:  # eq. 15 summed over a knot's rows: lambda_k = sum h nu / W_k (scaled), then SI
+            per_node = np.zeros((self.N, self.nx))
+            np.add.at(per_node, self.mesh.segment_nodes.ravel(), self.h * nu.reshape(-1, self.nx))
+            costates = self.costates_from(per_node / self.weights_tau[:, None])
+        result = self.make_result(res, t, X, U, costates, t if costates is not None else None, "lgl")
+        result.segments = self.segments
+        return result

@@ -45,6 +45,7 @@ class NlpResult(PlanResult):
         callback_time is the solver's own time with Drake's conversions.
       max_defect: largest scaled dynamics/constraint violation at the nodes.
       log_file: the solver's log (solve(log_file=...) or verbose SNOPT), else None.
+      segments: LGL segments sharing their end nodes (1: the paper's global polynomial).
     """
 
     time: np.ndarray
@@ -66,6 +67,7 @@ class NlpResult(PlanResult):
     callback_time: float = 0.0
     mesh_history: list = dc.field(default_factory=list)
     log_file: str | None = None
+    segments: int = 1
     problem: object = dc.field(repr=False, default=None)
 
     @property
@@ -91,24 +93,37 @@ class NlpResult(PlanResult):
         method's own representation) or first-order hold for dircol and hermite_simpson."""
         t, U = self.time, self.controls
         if self.transcription == "lgl":
-            tf = t[-1]
-            tau_nodes = 2.0 * t / tf - 1.0
+            return self._lgl_interpolant(U)
 
-            def u(tt):
-                tau = np.clip(2.0 * np.atleast_1d(tt) / tf - 1.0, -1.0, 1.0)
-                return interpolation_matrix(tau_nodes, tau) @ U
-        else:
-            def u(tt):
-                return np.column_stack([np.interp(np.atleast_1d(tt), t, U[:, j]) for j in range(U.shape[1])])
+        def u(tt):
+            return np.column_stack([np.interp(np.atleast_1d(tt), t, U[:, j]) for j in range(U.shape[1])])
         return u
+
+    def _lgl_interpolant(self, values):
+        """t [s] -> the LGL Lagrange polynomial of each segment through its nodes' ``values``
+        (segments split the nodes every (nodes - 1) / segments; times clipped to [0, t_f])."""
+        t = self.time
+        m = (len(t) - 1) // self.segments  # node intervals per segment
+        starts = np.arange(self.segments) * m
+
+        def at(tt):
+            tt = np.clip(np.atleast_1d(np.asarray(tt, float)), t[0], t[-1])
+            seg = np.clip(np.searchsorted(t[starts], tt, side="right") - 1, 0, self.segments - 1)
+            out = np.empty((tt.size, values.shape[1]))
+            for j in np.unique(seg):
+                nodes, rows = slice(starts[j], starts[j] + m + 1), np.flatnonzero(seg == j)
+                a, b = t[starts[j]], t[starts[j] + m]
+                out[rows] = interpolation_matrix(2.0 * (t[nodes] - a) / (b - a) - 1.0,
+                                                 2.0 * (tt[rows] - a) / (b - a) - 1.0) @ values[nodes]
+            return out
+        return at
 
     def state_function(self):
         """x(t) [SI] between the nodes: the Lagrange interpolant for LGL, the cubic Hermite
         spline with the dynamics as slopes for dircol and hermite_simpson (Hermite-Simpson's own)."""
         t, X = self.time, self.states
         if self.transcription == "lgl":
-            tau_nodes = 2.0 * t / t[-1] - 1.0
-            return lambda tt: interpolation_matrix(tau_nodes, np.clip(2.0 * np.atleast_1d(tt) / t[-1] - 1.0, -1, 1)) @ X
+            return self._lgl_interpolant(X)
         if self.problem is None:
             return lambda tt: np.column_stack([np.interp(np.atleast_1d(tt), t, X[:, j]) for j in range(X.shape[1])])
         from scipy.interpolate import CubicHermiteSpline
@@ -157,7 +172,7 @@ def summary(problem, result: NlpResult, check=None) -> dict:
     (an nlp.verify.PropagationCheck), the propagated terminal errors."""
     out = {"success": result.success, "converged": result.converged, "message": result.message,
            "transcription": result.transcription, "solver": result.solver, "nodes": result.nodes,
-           "objective": result.objective, "final_time_s": result.final_time, "solve_time_s": result.solve_time,
+           "segments": result.segments, "objective": result.objective, "final_time_s": result.final_time, "solve_time_s": result.solve_time,
            "build_time_s": result.build_time, "guess_time_s": result.guess_time, "verify_time_s": result.verify_time,
            "callback_calls": result.callback_calls, "callback_time_s": result.callback_time,
            "total_time_s": result.total_time, "max_constraint_violation_scaled": result.max_defect,

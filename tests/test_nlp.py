@@ -642,17 +642,23 @@ def _transcription_at(problem, nodes, seed=0, segments=None):
     return tx, z * (1.0 + 0.01 * np.random.default_rng(seed).standard_normal(z.size))
 
 
-@pytest.mark.parametrize("segments", [None, 1, 3])
-def test_vectorised_jacobians_equal_finite_differences_inside_their_declared_sparsity(segments):
+@pytest.mark.parametrize("segments, hs_part_intervals", [(None, None), (None, 4), (1, None), (3, None)])
+def test_vectorised_jacobians_equal_finite_differences_inside_their_declared_sparsity(segments, hs_part_intervals,
+                                                                                     monkeypatch):
     """The assembled Jacobian of each part's collocation and path rows against central
     differences of the rows themselves, on Betts' heating-limited shuttle (6 states, 2
-    controls, one path row) at 10 nodes: Hermite-Simpson (one part; chain rule through the
-    midpoint state x_c, the t_f column), LGL on one polynomial and on 3 segments of 4 nodes
+    controls, one path row) at 10 nodes: Hermite-Simpson (one part, or two of 4 and 5
+    intervals; chain rule through the midpoint state x_c, the t_f column), LGL on one polynomial and on 3 segments of 4 nodes
     (a part each, over its own nodes and t_f; each knot with both segments' rows, its path
     row in the first): within 1e-8 relative to the largest entry, and no entry outside the
     pattern given to the solver; the segments declare fewer entries."""
+    from drake_entry.planning.nlp import hermite_simpson
+
+    if hs_part_intervals:
+        monkeypatch.setattr(hermite_simpson, "PART_INTERVALS", hs_part_intervals)
     problem, _ = catalogue.shuttle_crossrange(heating_limit=True)
     tx, z_all = _transcription_at(problem, 10, segments=segments)
+    assert len(tx.parts) == (2 if hs_part_intervals else segments or 1)
     assert tx.tf is not None and tx.n_path == 1
     rows = {None: 10 - 1, 1: 10, 3: 3 * 4}[segments]
     assert tx.n_rows == rows * 6 and sum(p.path_nodes for p in tx.parts) == 10

@@ -70,6 +70,11 @@ class CallbackTimer:
                              max(self._violations.values()) if self._violations else None)
 
 
+#: evaluations a _NodeEvaluator keeps by default: the constraint and the running cost of each
+#: part of a program evaluate the same points in turn (node_program raises it above its parts)
+CACHED_EVALUATIONS = 16
+
+
 class _NodeEvaluator:
     """Dynamics, path functions and Lagrangian at all nodes with their Jacobians.
 
@@ -80,7 +85,8 @@ class _NodeEvaluator:
 
     def __init__(self, tx, step: float = 6e-6):
         self.tx, self.step = tx, step
-        self._key, self._out = None, None
+        self._cache = {}  # the latest evaluations by their points (one per part of a program)
+        self.capacity = CACHED_EVALUATIONS
         self.vectorised = True
         self.path_scale = np.array([c.scale for c in tx.problem.path], float).reshape(-1, 1)
 
@@ -94,8 +100,8 @@ class _NodeEvaluator:
         """Values and node Jacobians: f (N, nx), g (N, np), L (N,), and df (N, nx, nx+nu),
         dg (N, np, nx+nu), dL (N, nx+nu) with respect to the scaled node variables."""
         key = np.concatenate([Xs.ravel(), Us.ravel()]).tobytes()
-        if key == self._key:
-            return self._out
+        if key in self._cache:
+            return self._cache[key]
         N, nx = Xs.shape
         nu = Us.shape[1]
         nv = nx + nu
@@ -120,8 +126,10 @@ class _NodeEvaluator:
             df[:, :, j] = ((f[:, a] - f[:, b]) / den).T
             dg[:, :, j] = ((g[:, a] - g[:, b]) / den).T
             dL[:, j] = (L[a] - L[b]) / den
-        self._key, self._out = key, (f0, g0, L0, df, dg, dL)
-        return self._out
+        if len(self._cache) >= self.capacity:
+            self._cache.pop(next(iter(self._cache)))  # the oldest
+        out = self._cache[key] = (f0, g0, L0, df, dg, dL)
+        return out
 
 
 def model_values(problem, x, u, vectorised: bool = True):

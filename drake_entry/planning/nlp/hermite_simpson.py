@@ -23,16 +23,29 @@ from drake_entry.planning.nlp.node_program import _NodeProgram, _Part
 from drake_entry.planning.nlp.result import NlpResult
 
 MIN_FINAL_TIME = 1e-6  # [time scales]
+#: intervals per part (one constraint each, node_program): Drake packs a Python constraint's
+#: Jacobian as AutoDiff over all its variables, so parts of this size cost far less than one
+#: over every sample (the SCvx cross-check's 100 samples: see docs/performance.md)
+PART_INTERVALS = 25
+
+
+def interval_parts(nodes: int, nx: int, per_part: int | None = None) -> list:
+    """Parts of about ``per_part`` (default PART_INTERVALS) intervals each, neighbours sharing
+    a sample (its path rows in the part before it, the last sample's in the last part)."""
+    n_parts = max(1, round((nodes - 1) / (per_part or PART_INTERVALS)))
+    edges = np.linspace(0, nodes - 1, n_parts + 1).round().astype(int)
+    return [_Part(int(a), int(b) + 1, int(b - a) * nx, int(b - a) + (j == n_parts - 1), j)
+            for j, (a, b) in enumerate(zip(edges[:-1], edges[1:]))]
 
 
 class _HermiteSimpsonTranscription(_NodeProgram):
     """Hermite-Simpson collocation rows (interval-major: row k nx + i) and the path rows at
-    the N samples, in one part; z = [X, U, t_f] (scaled)."""
+    the N samples, in parts of about PART_INTERVALS intervals; z = [X, U, t_f] (scaled)."""
 
     description = "Hermite-Simpson collocation and path"
 
     def __init__(self, problem, nodes, scaling):
-        super().__init__(problem, nodes, scaling, [_Part(0, nodes, (nodes - 1) * problem.n_states, nodes)])
+        super().__init__(problem, nodes, scaling, interval_parts(nodes, problem.n_states))
         self.midpoints_eval = _NodeEvaluator(self)
         if self.tf is not None:
             self.prog.AddBoundingBoxConstraint(MIN_FINAL_TIME, np.inf, self.tf)
@@ -51,8 +64,8 @@ class _HermiteSimpsonTranscription(_NodeProgram):
     def _collocation(self, part, Xs, Us, tf, J):
         N, nx, nu = part.size, self.nx, self.nu
         f, _, _, df, _, _ = self.nodes_eval.evaluate(Xs, Us)
-        n = N - 1
-        h = tf / n
+        n, intervals = N - 1, self.N - 1  # the part's intervals, all of them
+        h = tf / intervals
         f0, f1 = f[:-1], f[1:]
         xc = 0.5 * (Xs[:-1] + Xs[1:]) + h / 8.0 * (f0 - f1)
         uc = 0.5 * (Us[:-1] + Us[1:])
@@ -74,12 +87,13 @@ class _HermiteSimpsonTranscription(_NodeProgram):
         Ju[k, :, k + 1, :] = d_u1
         if self.tf is not None:  # d/d t_f = (d/d h) / (N - 1)
             d_h = -np.einsum("kij,kj->ki", Ac, (f0 - f1) / 8.0) - 1.5 / h ** 2 * (Xs[1:] - Xs[:-1])
-            J[:n * nx, -1] = (d_h / n).ravel()
+            J[:n * nx, -1] = (d_h / intervals).ravel()
         return rows.ravel()
 
     def _quadrature_weights(self, part):
-        """1 / (N - 1) (sum L_k - (L_0 + L_N-1) / 2) over t_f: the trapezoid rule of dircol."""
-        w = np.full(part.size, 1.0 / (part.size - 1))
+        """The part's share of 1 / (N - 1) (sum L_k - (L_0 + L_N-1) / 2) over t_f: the trapezoid
+        rule of dircol."""
+        w = np.full(part.size, 1.0 / (self.N - 1))
         w[[0, -1]] *= 0.5
         return w
 

@@ -56,6 +56,7 @@ class _NodeProgram(_Transcription):
         self.nodes_eval = _NodeEvaluator(self)
         self.n_path = len(problem.path)
         self.parts = list(parts)
+        self.nodes_eval.capacity = max(self.nodes_eval.capacity, len(self.parts) + 1)
         self.n_rows = sum(p.n_rows for p in self.parts)
         self.z = self.part_variables(_Part(0, nodes, self.n_rows, nodes))
         path_lo, path_hi = self.scaled_bounds(problem.path)

@@ -292,3 +292,14 @@ def test_example_17(tmp_path):
     assert r["linear"]["max"] < 2.5 and os.path.exists(tmp_path / "miss_distributions.png")
     for label in r:
         assert os.path.exists(tmp_path / label / "report.md")
+
+
+@pytest.mark.slow
+def test_example_18(tmp_path):
+    """LGL on one polynomial and in 4 segments, quick run (Betts' heating-limited shuttle at 81
+    nodes): both verified, the segments' optimum within 1e-4 of Betts' and in less core time."""
+    r = _run("18_lgl_segments", tmp_path)
+    (one, t_one), (seg, t_seg) = r["cases"]["shuttle"]["solves"][1], r["cases"]["shuttle"]["solves"][4]
+    assert one.segments == 1 and seg.segments == 4 and one.nodes == seg.nodes == 81
+    assert seg.objective == pytest.approx(-0.5345158, rel=1e-4) and t_seg < t_one
+    assert os.path.exists(tmp_path / "segments.png")

@@ -236,6 +236,11 @@ def test_optimize_command_writes_solution_summary_and_the_ten_figures(tmp_path):
     assert info["extremal_control_max_diff_deg_s"] < 1e-3
     assert len(list(out.glob("fig*.png"))) == 10 and (out / "solution.csv").exists()
     assert main(["optimize", "no_such_problem", "--out", str(out)]) == 2
+    # in 4 LGL segments of 11 nodes, from a 24-node solve on one polynomial
+    rc = main(["optimize", "marv", "--nodes", "41", "--segments", "4", "--coarse", "24", "--solver", "snopt",
+               "--tolerance", "1e-7", "--out", str(out), "--no-propagate"])
+    info = json.load(open(out / "summary.json"))
+    assert rc == 0 and info["converged"] and (info["nodes"], info["segments"]) == (41, 4)
 
 
 def test_objective_terms_have_their_geometric_values():
@@ -585,6 +590,9 @@ def test_yaml_verification_tolerances_default_to_the_library_and_are_checked():
     assert (s.dynamics_tolerance, s.propagation_tolerance) == (nlp.DYNAMICS_TOLERANCE, nlp.PROPAGATION_TOLERANCE)
     with pytest.raises(ScenarioError, match=r"solve.dynamics_tolerance = 2.0 is out of range; allowed \(0, 1\)"):
         validate_solve(dc.replace(s, dynamics_tolerance=2.0))
+    assert s.segments == 1  # paper 002's one polynomial unless asked
+    with pytest.raises(ScenarioError, match=r"solve.segments = 0 is out of range; allowed: an integer >= 1"):
+        validate_solve(dc.replace(s, segments=0))
 
 
 def test_a_long_solve_prints_its_progress_and_ctrl_c_stops_it(monkeypatch, capsys):

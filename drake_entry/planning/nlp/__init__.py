@@ -21,8 +21,9 @@ DirectCollocation: Drake's Hermite-Simpson transcription of planning.ocp_system 
 scaled dynamics as a Drake System) with N samples; the running cost is the trapezoid rule
 over the samples; costates are estimated at the segment midpoints from the collocation
 multipliers, lambda(t_k+1/2) = 3 nu_k / (2 h_k). hermite_simpson poses the same NLP (same rows,
-cost and costates) with LGL's machinery: one constraint, vectorised model calls at the samples
-and midpoints, the Jacobian assembled with its sparsity declared.
+cost and costates) with LGL's machinery: a constraint per part of about 25 intervals,
+vectorised model calls at the samples and midpoints, the Jacobian assembled with its sparsity
+declared.
 
 The result reports the Hamiltonian H = L + lambda' f along the solution (zero on an
 extremal with free final time, paper 002 Fig. 10) and ``verify.propagate`` flies the controls

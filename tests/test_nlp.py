@@ -612,6 +612,11 @@ def test_a_long_solve_prints_its_progress_and_ctrl_c_stops_it(monkeypatch, capsy
     violations = [float(ln.split("largest collocation violation ")[1].split()[0]) for ln in lines
                   if "violation" in ln]
     assert violations[0] > 1e-3 and violations[-1] < 1e-6
+    # in 2 segments (a constraint each): the evaluations are the solver's, not every callback
+    r = nlp.solve(brachistochrone()[0], nodes=15, segments=2, solver="ipopt", progress=True)
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("  [lgl 15 nodes in 2 segments, ipopt]")]
+    counted = int(lines[-1].split(" evaluations")[0].split()[-1])
+    assert r.converged and len(lines) > 5 and 0 < 2 * counted <= r.callback_calls
     assert nlp.solve(brachistochrone()[0], nodes=15, solver="ipopt", progress=False).converged
     assert "evaluations" not in capsys.readouterr().err
     with pytest.raises(ScenarioError, match="progress = 'yes'; allowed: True, False, 'auto'"):

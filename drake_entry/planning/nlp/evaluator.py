@@ -31,17 +31,20 @@ class SolveProgress(ProgressLine):
 class CallbackTimer:
     """Calls and wall time [s] of the Python callbacks handed to the solver (model values,
     Jacobians, AutoDiff packing): the rest of a solve's time is the solver's own and Drake's.
-    With ``progress`` (a SolveProgress) it also prints the solve's progress when due."""
+    With ``progress`` (a SolveProgress) it also prints the solve's progress when due: the
+    evaluations are the calls of the callback wrapped with ``evaluation=True`` (one per point
+    the solver evaluates the problem at), else all calls."""
 
     def __init__(self):
-        self.calls, self.seconds = 0, 0.0
+        self.calls, self.seconds, self.evaluations = 0, 0.0, 0
         self.progress: SolveProgress | None = None
         self._costs, self._violations = {}, {}
 
-    def wrap(self, fn, *, cost: bool = False, bounds: tuple | None = None):
+    def wrap(self, fn, *, cost: bool = False, bounds: tuple | None = None, evaluation: bool = False):
         """``fn`` counted and timed; ``cost``: its value is a term of the objective; ``bounds``
         (lower, upper): a constraint holding collocation rows, whose violation progress reports
-        (the largest over such constraints at their latest evaluations)."""
+        (the largest over such constraints at their latest evaluations); ``evaluation``: its
+        calls count the solver's evaluations."""
         @functools.wraps(fn)
         def timed(*args):
             t0 = time.perf_counter()
@@ -52,6 +55,7 @@ class CallbackTimer:
             finally:
                 self.seconds += time.perf_counter() - t0
                 self.calls += 1
+                self.evaluations += evaluation
                 if out is not None and self.progress is not None:
                     self._observe(timed, out, cost, bounds)
         return timed
@@ -66,7 +70,7 @@ class CallbackTimer:
                                                  initial=0.0))
         if not self.progress.due():
             return
-        self.progress.report(self.calls, sum(self._costs.values()) if self._costs else None,
+        self.progress.report(self.evaluations or self.calls, sum(self._costs.values()) if self._costs else None,
                              max(self._violations.values()) if self._violations else None)
 
 

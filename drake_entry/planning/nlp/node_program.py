@@ -66,7 +66,8 @@ class _NodeProgram(_Transcription):
             hi = np.concatenate([np.zeros(p.n_rows), np.repeat(path_hi, p.path_nodes)])
             where = f" (part {p.index + 1} of {len(self.parts)}: nodes {p.start}-{p.stop - 1})" if len(self.parts) > 1 \
                 else ""
-            binding = prog.AddConstraint(self.timer.wrap(functools.partial(self._constraint, p), bounds=(lo, hi)),
+            binding = prog.AddConstraint(self.timer.wrap(functools.partial(self._constraint, p), bounds=(lo, hi),
+                                                         evaluation=p.index == 0),
                                          lo, hi, self.part_variables(p), description=self.description + where)
             binding.evaluator().SetGradientSparsityPattern(self._sparsity(p))
             self.collocation.append(binding)

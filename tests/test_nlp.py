@@ -236,11 +236,12 @@ def test_optimize_command_writes_solution_summary_and_the_ten_figures(tmp_path):
     assert info["extremal_control_max_diff_deg_s"] < 1e-3
     assert len(list(out.glob("fig*.png"))) == 10 and (out / "solution.csv").exists()
     assert main(["optimize", "no_such_problem", "--out", str(out)]) == 2
-    # in 4 LGL segments of 11 nodes, from a 24-node solve on one polynomial
-    rc = main(["optimize", "marv", "--nodes", "41", "--segments", "4", "--coarse", "24", "--solver", "snopt",
-               "--tolerance", "1e-7", "--out", str(out), "--no-propagate"])
+    # --segments reaches the solve (4 LGL segments of 7 nodes, stopped after 3 iterations: exit 1, unconverged)
+    rc = main(["optimize", "marv", "--nodes", "25", "--segments", "4", "--coarse", "0", "--solver", "snopt",
+               "--max-iterations", "3", "--out", str(out), "--no-propagate"])
     info = json.load(open(out / "summary.json"))
-    assert rc == 0 and info["converged"] and (info["nodes"], info["segments"]) == (41, 4)
+    assert rc == 1 and not info["converged"] and (info["nodes"], info["segments"]) == (25, 4)
+    assert "iteration limit" in info["message"]
 
 
 def test_objective_terms_have_their_geometric_values():
@@ -693,6 +694,20 @@ def test_vectorised_jacobians_equal_finite_differences_inside_their_declared_spa
     if segments == 3:
         single = _transcription_at(problem, 10, segments=1)[0]
         assert sum(len(tx._sparsity(p)) for p in tx.parts) < len(single._sparsity(single.parts[0]))
+
+
+def test_model_values_dynamics_only_gives_the_same_dynamics_and_skips_the_rest():
+    """Hermite-Simpson's midpoints need f only: the same f to the bit, no path rows, L zero,
+    vectorised and node by node."""
+    from drake_entry.planning.nlp.evaluator import model_values
+
+    problem, _ = catalogue.shuttle_crossrange(heating_limit=True)
+    t, X, U = nlp.initial_guess(problem)
+    for vectorised in (True, False):
+        f, g, L, _ = model_values(problem, X[::50].T, U[::50].T, vectorised)
+        f_only, g_only, L_only, _ = model_values(problem, X[::50].T, U[::50].T, vectorised, dynamics_only=True)
+        assert np.array_equal(f, f_only) and g.shape[0] == 1 and g_only.shape == (0, f.shape[1])
+        assert not np.any(L_only)
 
 
 def test_hermite_simpson_is_drakes_direct_collocation_nlp():

@@ -85,10 +85,12 @@ class _NodeEvaluator:
     Every node's values depend only on that node's state and control, so one vectorised
     model call on the nodes and their 2 (n_x + n_u) central perturbations gives all
     Jacobian blocks (step (eps^(1/3)) in scaled units, truncation error ~1e-10). Models only
-    need to accept float arrays; a model that does not is evaluated node by node."""
+    need to accept float arrays; a model that does not is evaluated node by node. With
+    ``dynamics_only`` the path functions and the Lagrangian are not evaluated (returned as
+    zero rows and zeros: Hermite-Simpson's midpoints need f only)."""
 
-    def __init__(self, tx, step: float = 6e-6):
-        self.tx, self.step = tx, step
+    def __init__(self, tx, step: float = 6e-6, dynamics_only: bool = False):
+        self.tx, self.step, self.dynamics_only = tx, step, dynamics_only
         self._cache = {}  # the latest evaluations by their points (one per part of a program)
         self.capacity = CACHED_EVALUATIONS
         self.vectorised = True
@@ -97,8 +99,9 @@ class _NodeEvaluator:
     def _models(self, Xs, Us):
         """f_scaled (nx, M), path_scaled (np, M), L (M,) at M scaled points (columns)."""
         tx = self.tx
-        f, g, L, self.vectorised = model_values(tx.problem, Xs * tx.sx[:, None], Us * tx.su[:, None], self.vectorised)
-        return f * (tx.ts / tx.sx)[:, None], g / self.path_scale, L
+        f, g, L, self.vectorised = model_values(tx.problem, Xs * tx.sx[:, None], Us * tx.su[:, None], self.vectorised,
+                                                dynamics_only=self.dynamics_only)
+        return f * (tx.ts / tx.sx)[:, None], (g / self.path_scale if g.shape[0] else g), L
 
     def evaluate(self, Xs, Us):
         """Values and node Jacobians: f (N, nx), g (N, np), L (N,), and df (N, nx, nx+nu),
@@ -136,24 +139,27 @@ class _NodeEvaluator:
         return out
 
 
-def model_values(problem, x, u, vectorised: bool = True):
+def model_values(problem, x, u, vectorised: bool = True, dynamics_only: bool = False):
     """Dynamics f (nx, M), path values (np, M) and Lagrangian (M,), SI, at the M columns of
     x (nx, M), u (nu, M): one vectorised model call, or column by column when the models
-    take scalars only. Returns (f, g, L, vectorised)."""
+    take scalars only. Returns (f, g, L, vectorised); with ``dynamics_only``, g has no rows
+    and L is zero (neither evaluated)."""
     if vectorised:
         try:
-            return (*_call(problem, x, u), True)
+            return (*_call(problem, x, u, dynamics_only), True)
         except Exception:  # noqa: BLE001 - a model without array support
             pass
-    cols = [_call(problem, x[:, m], u[:, m]) for m in range(x.shape[1])]
+    cols = [_call(problem, x[:, m], u[:, m], dynamics_only) for m in range(x.shape[1])]
     return (np.column_stack([c[0] for c in cols]), np.column_stack([c[1] for c in cols]).reshape(-1, x.shape[1]),
             np.array([c[2] for c in cols], float), False)
 
 
-def _call(problem, x, u):
+def _call(problem, x, u, dynamics_only: bool = False):
     xs, us = list(x), list(u)
     m = np.shape(x)[1:] or ()
     f = np.array([np.broadcast_to(np.asarray(v, float), m) for v in problem.dynamics(xs, us)])
+    if dynamics_only:
+        return f, np.zeros((0,) + tuple(m)), np.zeros(m)
     if problem.path:
         g = np.array([np.broadcast_to(np.asarray(v, float), m) for v in problem.path_values(xs, us)])
     else:

@@ -46,7 +46,7 @@ class _HermiteSimpsonTranscription(_NodeProgram):
 
     def __init__(self, problem, nodes, scaling):
         super().__init__(problem, nodes, scaling, interval_parts(nodes, problem.n_states))
-        self.midpoints_eval = _NodeEvaluator(self)
+        self.midpoints_eval = _NodeEvaluator(self, dynamics_only=True)  # the rows need f there only
         if self.tf is not None:
             self.prog.AddBoundingBoxConstraint(MIN_FINAL_TIME, np.inf, self.tf)
 

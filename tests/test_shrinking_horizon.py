@@ -46,6 +46,21 @@ def test_from_a_point_of_the_optimum_the_rest_of_it_is_optimal(brachistochrone_s
     assert np.abs(r.states[:, :2] - exact).max() < 1e-6
 
 
+def test_a_segmented_solution_is_resolved_in_its_segments():
+    """An LGL solution in 3 segments is re-solved in 3 segments on the same nodes (unless told
+    otherwise), and from the cycloid's state at half time takes the rest of its time to 1e-6."""
+    problem, _ = catalogue.brachistochrone()
+    previous = nlp.solve(problem, nodes=22, segments=3, solver="ipopt")
+    R, w, T = _cycloid()
+    g = catalogue.G_BRACHISTOCHRONE
+    phi = w * 0.5 * T
+    x = [R * (phi - math.sin(phi)), R * (1 - math.cos(phi)), math.sqrt(2 * g * R * (1 - math.cos(phi)))]
+    r = resolve_from(previous, x, 0.5 * T, solver="ipopt")
+    assert previous.converged and r.converged and (r.segments, r.nodes) == (3, 22)
+    assert r.final_time == pytest.approx(0.5 * T, rel=1e-6)
+    assert resolve_from(previous, x, 0.5 * T, solver="ipopt", segments=1).segments == 1
+
+
 def test_the_warm_start_starts_at_the_measured_state_and_ends_where_the_previous_did(brachistochrone_solution):
     prev = brachistochrone_solution
     x = prev.state_function()(np.array([0.3]))[0] + np.array([0.01, -0.02, 0.05])

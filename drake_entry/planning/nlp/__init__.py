@@ -10,7 +10,7 @@ altitude in 10 km, controls by their bounds, the objective by its gradient at th
 reported in ``result.scaling``); results are SI.
 
 LGL (paper 002 eqs. 12-14, Fahroo & Ross): states and controls at the N LGL nodes
-tau_k of [-1, 1], t = (tau + 1) t_f / 2. One constraint holds the defects
+tau_k of [-1, 1], t = (tau + 1) t_f / 2. One constraint (one per segment) holds the defects
 D X - (t_f / 2) f(X, U) = 0 and the path rows, evaluated by one vectorised model call with
 its exact sparse Jacobian (lgl, evaluator). Costates come from the defects' KKT multipliers
 (eq. 15): lambda(t_k) = nu_k / w_k, converted back to SI. ``segments=S`` splits the N nodes

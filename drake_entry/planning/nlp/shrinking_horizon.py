@@ -64,8 +64,8 @@ def resolve_from(previous, x_now, elapsed_s: float, *, problem=None, nodes: int 
 
     Args:
       nodes: the re-solution's nodes (default: the previous solution's).
-      solve_options: passed to ``nlp.solve`` (transcription default: the previous one's;
-        verifier, tolerance, solver, ...).
+      solve_options: passed to ``nlp.solve`` (transcription default: the previous one's, and
+        on LGL its segments; verifier, tolerance, solver, ...).
 
     Returns the NlpResult on the remaining horizon's clock (t = 0 at ``x_now``); its
     ``success`` is the solve's (verified when a verifier is given).
@@ -77,5 +77,7 @@ def resolve_from(previous, x_now, elapsed_s: float, *, problem=None, nodes: int 
         raise ScenarioError("resolve_from needs the problem: the previous result carries none, give problem=")
     remaining = remaining_problem(base, x_now, elapsed_s)
     solve_options.setdefault("transcription", previous.transcription)
+    if solve_options["transcription"] == "lgl" == previous.transcription:
+        solve_options.setdefault("segments", previous.segments)
     return nlp.solve(remaining, nodes=previous.nodes if nodes is None else nodes,
                      guess=shifted_guess(previous, x_now, elapsed_s), **solve_options)

@@ -65,6 +65,7 @@ from drake_entry.planning.nlp.result import (  # noqa: F401 (API)
     NlpError,
     NlpResult,
     extremal_controls,
+    segment_words,
     summary,
 )
 from drake_entry.planning.nlp.scaling import Scaling  # noqa: F401 (API)
@@ -297,8 +298,7 @@ def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, o
     build_time = _time.perf_counter() - t_build
     t0, calls0, seconds0 = _time.perf_counter(), tx.timer.calls, tx.timer.seconds
     if show:
-        where = f" in {segments} segments" if segments > 1 else ""
-        tx.timer.progress = SolveProgress(f"{transcription} {nodes} nodes{where}, {solver}")
+        tx.timer.progress = SolveProgress(f"{transcription} {nodes} nodes{segment_words(segments)}, {solver}")
         tx.timer.progress.start()
     res = _interruptible(engine.Solve, tx.prog, tx.initial_guess, options)
     converged, words = verdict(res, solver)

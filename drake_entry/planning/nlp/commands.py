@@ -90,8 +90,7 @@ def _solve_and_write(args) -> int:
                            tolerance=max(tol, 1e-6), max_iterations=max_iterations, progress=True)
         print(f"  {coarse.message}; J = {coarse.objective:.6g} in {coarse.solve_time:.1f} s")
         guess = coarse if coarse.converged else None
-    how = (f"mesh refinement from {nodes} nodes" if refine else f"{nodes} nodes") + (
-        f" in {segments} segments" if segments > 1 else "")
+    how = (f"mesh refinement from {nodes} nodes" if refine else f"{nodes} nodes") + nlp.segment_words(segments)
     print(f"solve: {problem.name}, {transcription}, {how}, {solver} ...", flush=True)
     result = nlp.solve(problem, transcription=transcription, solver=solver, nodes=nodes, tolerance=tol,
                        max_iterations=max_iterations, guess=guess, segments=segments,
@@ -120,7 +119,7 @@ def _solve_and_write(args) -> int:
         pass
     pngs = nlp_solution_plots(problem, result, args.out, propagated=check, extremal=ext,
                               title=f"{problem.name}: {nlp.TRANSCRIPTION_LABELS[transcription]} {result.nodes} nodes"
-                                    f"{f' in {segments} segments' if segments > 1 else ''}, {result.solver}")
+                                    f"{nlp.segment_words(segments)}, {result.solver}")
     print(json.dumps(info, indent=2, default=float))
     print(f"wrote solution, summary.json and {len(pngs)} plots to {args.out}")
     return 0 if result.success or (args.no_propagate and result.converged) else 1

@@ -9,7 +9,7 @@ import numpy as np
 from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.planning.nlp.evaluator import model_values
 from drake_entry.planning.ocp import OptimalControlProblem
-from drake_entry.planning.pseudospectral import interpolation_matrix
+from drake_entry.planning.pseudospectral import SegmentMesh
 from drake_entry.planning.result import PlanResult
 
 
@@ -100,23 +100,11 @@ class NlpResult(PlanResult):
         return u
 
     def _lgl_interpolant(self, values):
-        """t [s] -> the LGL Lagrange polynomial of each segment through its nodes' ``values``
-        (segments split the nodes every (nodes - 1) / segments; times clipped to [0, t_f])."""
-        t = self.time
-        m = (len(t) - 1) // self.segments  # node intervals per segment
-        starts = np.arange(self.segments) * m
-
-        def at(tt):
-            tt = np.clip(np.atleast_1d(np.asarray(tt, float)), t[0], t[-1])
-            seg = np.clip(np.searchsorted(t[starts], tt, side="right") - 1, 0, self.segments - 1)
-            out = np.empty((tt.size, values.shape[1]))
-            for j in np.unique(seg):
-                nodes, rows = slice(starts[j], starts[j] + m + 1), np.flatnonzero(seg == j)
-                a, b = t[starts[j]], t[starts[j] + m]
-                out[rows] = interpolation_matrix(2.0 * (t[nodes] - a) / (b - a) - 1.0,
-                                                 2.0 * (tt[rows] - a) / (b - a) - 1.0) @ values[nodes]
-            return out
-        return at
+        """t [s] -> each LGL segment's Lagrange polynomial through its nodes' ``values``
+        (pseudospectral.SegmentMesh on s = t / t_f; times clipped to [0, t_f])."""
+        mesh = SegmentMesh(self.segments, (len(self.time) - 1) // self.segments + 1)
+        tf = self.time[-1]
+        return lambda tt: mesh.interpolation(np.atleast_1d(np.asarray(tt, float)) / tf) @ values
 
     def state_function(self):
         """x(t) [SI] between the nodes: the Lagrange interpolant for LGL, the cubic Hermite
@@ -135,6 +123,11 @@ class NlpResult(PlanResult):
 
 #: transcriptions by name in figures and messages
 TRANSCRIPTION_LABELS = {"lgl": "LGL", "dircol": "DirectCollocation", "hermite_simpson": "Hermite-Simpson"}
+
+
+def segment_words(segments: int) -> str:
+    """' in S segments' for LGL segments (S > 1), else '': for progress lines and titles."""
+    return f" in {segments} segments" if segments > 1 else ""
 
 
 class NlpError(DrakeEntryError, RuntimeError):
@@ -172,7 +165,8 @@ def summary(problem, result: NlpResult, check=None) -> dict:
     (an nlp.verify.PropagationCheck), the propagated terminal errors."""
     out = {"success": result.success, "converged": result.converged, "message": result.message,
            "transcription": result.transcription, "solver": result.solver, "nodes": result.nodes,
-           "segments": result.segments, "objective": result.objective, "final_time_s": result.final_time, "solve_time_s": result.solve_time,
+           "segments": result.segments, "objective": result.objective, "final_time_s": result.final_time,
+           "solve_time_s": result.solve_time,
            "build_time_s": result.build_time, "guess_time_s": result.guess_time, "verify_time_s": result.verify_time,
            "callback_calls": result.callback_calls, "callback_time_s": result.callback_time,
            "total_time_s": result.total_time, "max_constraint_violation_scaled": result.max_defect,

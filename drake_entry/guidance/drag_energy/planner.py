@@ -15,9 +15,9 @@ Range: eq. 71 (R = -int dE / D) neglects cos(gamma) and R/r. We weight each node
 kappa = R_E cos(gamma) / r from the extracted states and re-solve (``range_iterations``),
 so the ground range of the extracted trajectory equals the range to go.
 
-After the solve, states and bank are extracted node by node (eqs. 93-96): altitude and
-speed from (E, D), gamma from D' (eq. 94), u_FF (eq. 95) and sigma (eq. 96), with the
-bank saturated explicitly at [0, sigma_max] (flags returned).
+After the solve, states and bank are extracted node by node on first use (eqs. 93-96):
+altitude and speed from (E, D), gamma from D' (eq. 94), u_FF (eq. 95) and sigma (eq. 96),
+with the bank saturated explicitly at [0, sigma_max] (flags returned).
 """
 from __future__ import annotations
 
@@ -135,10 +135,18 @@ class DragEnergyReference(PlanResult):
     lgl: LGL | None = None
     I: np.ndarray | None = None  # 1/D at the nodes [s^2/m]
     kappa: np.ndarray | None = None
-    extraction: Extraction | None = None
     solver: str = ""
     binding: list = field(default_factory=list)  # which bounds bind, where (diagnosis)
     _nodal: np.ndarray | None = field(default=None, repr=False)
+    _extraction: Extraction | None = field(default=None, repr=False)
+
+    @property
+    def extraction(self) -> Extraction | None:
+        """States and bank at the nodes (eqs. 93-96), extracted on first use (None unless
+        solved). The closed loop tracks D(E) alone, so its re-plans never pay for them."""
+        if self._extraction is None and self.I is not None:
+            self._extraction = extract(self.problem, self.lgl, self.I)
+        return self._extraction
 
     # -- the profile and its energy derivatives -----------------------------------------
     @property
@@ -223,7 +231,8 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
     ref = None
     total_build = total_solve = 0.0
     total_iterations = 0
-    for _ in range(max(1, p.range_iterations)):
+    iterations = max(1, p.range_iterations)
+    for k in range(iterations):
         ref = solve_socp(p, op, D_lo, D_hi, kappa)
         total_build += ref.build_time
         total_solve += ref.solve_time
@@ -231,9 +240,9 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
         if not ref.success:
             break
         ref.kappa = kappa  # the weights this solve satisfied exactly (eq. 83)
-        ref.extraction = extract(p, op, ref.I)
-        x = ref.extraction
-        kappa = p.planet.reference_radius * np.cos(x.gamma) / p.planet.radius(x.h)
+        if k + 1 < iterations:  # the next solve's weights from this one's states
+            x = ref.extraction
+            kappa = p.planet.reference_radius * np.cos(x.gamma) / p.planet.radius(x.h)
     ref.build_time, ref.solve_time, ref.iterations = total_build, total_solve, total_iterations
     ref.message += note
     if ref.success:

@@ -89,17 +89,17 @@ class ReferenceTracker(LeafSystem):
         t, T, lead = context.get_time(), self.period, self.lead
         sigma = float(context.get_discrete_state(self._bank).GetAtIndex(0))
         law = ref.law
-        ff_now, ff_next = law.reference(t + lead)[0][6], law.reference(t + T + lead)[0][6]
-        x_ref = law.reference(t)[0]
+        ff_now, ff_next = law.state(t + lead)[6], law.state(t + T + lead)[6]
+        x_ref = law.state(t)
         # the bank deviation is the command's from the feed-forward (the reference bank
         # ``lead`` seconds ahead, which the lagging actuator delivers now)
         x = np.concatenate([self.est_port.Eval(context), [x_ref[6] + sigma - ff_now, t]])
         feedback = float(law.gain(t)[0] @ (x - x_ref))
         target = ff_next + (sigma - ff_now) - feedback * T
-        step = float(np.clip(target - sigma, -self.rate_limit * T, self.rate_limit * T))
+        step = min(max(target - sigma, -self.rate_limit * T), self.rate_limit * T)
         discrete_state.get_mutable_vector(self._bank).SetFromVector(
-            [float(np.clip(sigma + step, -self.bank_limit, self.bank_limit))])
+            [min(max(sigma + step, -self.bank_limit), self.bank_limit)])
 
     def _reference_state(self, context, output):
         ref = self.memory(context).reference
-        output.SetFromVector(np.full(7, np.nan) if ref is None else ref.law.reference(context.get_time())[0][:7])
+        output.SetFromVector(np.full(7, np.nan) if ref is None else ref.law.state(context.get_time())[:7])

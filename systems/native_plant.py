@@ -30,6 +30,7 @@ from drake_entry.errors import ModelRangeError, NonFiniteStateError, ScenarioErr
 from drake_entry.models import dynamics
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
+from drake_entry.models.symbolic_system import stateless
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.scenario import PLANTS
 from drake_entry.systems.atmosphere import AtmosphereSystem
@@ -127,16 +128,6 @@ def flight_stop(error: BaseException) -> BaseException | None:
     if isinstance(e, ValueError) and not isinstance(e, ModelRangeError):
         return None
     return e
-
-
-_CONSTANT = Variable("constant")
-
-
-def stateless(inputs: list, outputs: list) -> SymbolicVectorSystem:
-    """A SymbolicVectorSystem computing ``outputs`` from ``inputs``. It carries one constant
-    continuous state (derivative 0): Drake 1.51 aborts the process when a diagram with
-    continuous state asks a SymbolicVectorSystem without dynamics for its derivatives."""
-    return SymbolicVectorSystem(state=[_CONSTANT], input=inputs, dynamics=[Expression(0.0)], output=outputs)
 
 
 def _expression(v):

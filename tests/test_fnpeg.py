@@ -132,11 +132,9 @@ def test_predictor_derivatives_are_the_plants_with_the_laws_bank(setup):
     drag scaled as the flight has shown and the bank commanded_bank gives there, in float."""
     p = setup.predictor
     sigma0, sign = math.radians(55.0), -1.0
-    ctx = p.context
-    ctx.SetContinuousState([*ENGAGED, 0.0])
     k_lift, k_drag = 1.04, 0.97  # what the flight has shown: the predictions fly the models times these
-    p.input.FixValue(ctx, [sigma0, setup.energy(ENGAGED) + 1e5, sign, k_lift, k_drag])  # e0 below: the profile has moved
-    got = p.system.EvalTimeDerivatives(ctx).CopyToVector()
+    # e0 below: the profile has moved
+    got = p.derivatives([*ENGAGED, 0.0], [sigma0, setup.energy(ENGAGED) + 1e5, sign, k_lift, k_drag])
     x = ENGAGED
     alpha = setup.alpha_command(x[3])
     rho, a = dynamics.air_data(x, setup.planet, setup.atmosphere)

@@ -8,6 +8,7 @@ import pytest
 from pydrake.symbolic import Variable
 
 from drake_entry.errors import ScenarioError
+from drake_entry.guidance.fnpeg import predictor as predictor_module
 from drake_entry.guidance.fnpeg.corrector import SIGMA0_BOUNDS, CorrectorSettings, correct
 from drake_entry.guidance.fnpeg.law import (
     FeedbackSettings,
@@ -127,10 +128,19 @@ def test_corrector_without_a_root_stops_on_the_bound_not_a_traceback():
     assert not c.converged and c.sigma0 == pytest.approx(SIGMA0_BOUNDS[1])
 
 
-def test_predictor_derivatives_are_the_plants_with_the_laws_bank(setup):
+@pytest.mark.parametrize("stages", ["as chosen", "one system", "two stages"])
+def test_predictor_derivatives_are_the_plants_with_the_laws_bank(setup, stages, monkeypatch):
     """The native predictor's dx/dt at a state equals drake_entry.models.dynamics with the lift and
-    drag scaled as the flight has shown and the bank commanded_bank gives there, in float."""
-    p = setup.predictor
+    drag scaled as the flight has shown and the bank commanded_bank gives there, in float: in
+    the form the predictor chose for CAV-H (two stages: its expressions repeat the Mach tables)
+    and in both forms forced."""
+    if stages == "as chosen":
+        p = setup.predictor
+        assert p.staged  # CAV-H's one-system expressions are 3.6 times the stages'
+    else:
+        monkeypatch.setattr(predictor_module, "STAGED_SIZE_RATIO", math.inf if stages == "one system" else 0.0)
+        p = FnpegSetup.from_scenario(load_scenario("cav_h_fnpeg")).predictor
+        assert p.staged == (stages == "two stages")
     sigma0, sign = math.radians(55.0), -1.0
     k_lift, k_drag = 1.04, 0.97  # what the flight has shown: the predictions fly the models times these
     # e0 below: the profile has moved
@@ -212,6 +222,12 @@ def capsule():
 
 #: a capsule state shortly after engagement (about 215 s into the packaged flight)
 CAPSULE_ENGAGED = np.array([7.94583e4, -2.044727, 0.292517, 7453.09, -0.0234551, 1.107283])
+
+
+def test_capsule_predicts_in_one_system(capsule):
+    """The capsule's expressions repeat little (1.7 times the stages' expanded size): a second
+    native stage would cost more than it saves, so its predictor stays one system."""
+    assert not capsule.predictor.staged
 
 
 def test_capsule_dispersions_are_lu2008s():

@@ -4,17 +4,20 @@ profile and its altitude-rate feedback (guidance/fnpeg/law.py) from the current 
 the terminal energy e_f.
 
 The equations are built once from the same model code as the plant (drake_entry.models:
-dynamics, atmosphere, aerodynamics, heat flux) called with symbolic scalars, as a Diagram of
-three ``SymbolicVectorSystem``s that Drake integrates in C++ (fixed ``step_s`` Runge-Kutta 3
-steps: a fixed grid keeps the corrector's finite differences free of step-size noise):
+dynamics, atmosphere, aerodynamics, heat flux) called with symbolic scalars, as Drake
+``SymbolicVectorSystem``s that Drake integrates in C++ (fixed ``step_s`` Runge-Kutta 3 steps: a
+fixed grid keeps the corrector's finite differences free of step-size noise). The prediction's
+inputs (sigma_0, e_0, the sign, k_L, k_D) are held as constant states of the motion system.
 
-  motion --state--> aerodynamics (k_L L, k_D D, rho) --> bank_law (the commanded bank)
-  aerodynamics, bank_law --> motion (equations of motion and ds/dt)
-
-Three stages, not one expression: Drake evaluates an expression tree without reusing its
-shared parts, and the bank law holds L, D and the air data several times over; staged, each is
-evaluated once per derivative (a prediction takes 0.78 of the one-system time, the same state
-to 3e-14 relative). Time, not energy,
+Drake evaluates an expression tree without reusing its shared parts, and the bank law holds L,
+D and the air data several times over. Where that repetition is large, the prediction runs in
+two stages, an algebraic "aerodynamics" system (k_L L, k_D D, rho) feeding the "motion" system,
+so each is evaluated once per derivative; otherwise in one system, as a second system costs
+its own evaluation. ``STAGED_SIZE_RATIO`` decides, on the trees' expanded sizes. Measured per
+prediction: CAV-H (Mach tables, US76; expanded 3.6 times larger in one system) 39-47 -> 27 ms
+staged; Lu 2008's capsule (1.7 times) 8.0 ms in one system against 9.6-10.2 staged. Both forms
+end at the same state to 3e-14 (relative).
+Time, not energy,
 is the independent variable: a high-lift glider's phugoid climbs where drag, and so de/dt,
 nearly vanishes (the pitfall of energy-domain prediction). The prediction stops exactly at e_f
 (Newton on time from the last step, de/dt from the equations), below ``floor_m``, above
@@ -29,7 +32,7 @@ import numpy as np
 from pydrake.symbolic import Expression, Variable
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import Multiplexer, SymbolicVectorSystem
+from pydrake.systems.primitives import SymbolicVectorSystem
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.fnpeg.law import FeedbackSettings, commanded_bank
@@ -42,7 +45,8 @@ _STATE = [Variable(n) for n in ("h", "lon", "lat", "V", "gamma", "psi", "s")]
 _INPUT = [Variable(n) for n in ("sigma0", "e0", "sign", "lift_scale", "drag_scale")]
 #: the aerodynamic stage's outputs (scaled lift and drag accelerations [m/s^2], density [kg/m^3])
 _AERO = [Variable(n) for n in ("L", "D", "rho")]
-_BANK = Variable("bank")
+#: two stages when one system's expanded expressions are at least this many times the stages'
+STAGED_SIZE_RATIO = 2.0
 #: prediction steps advanced per Simulator call (the energy is checked between calls)
 _STEPS_PER_CALL = 10
 
@@ -113,22 +117,25 @@ class Predictor:
             a = alpha_expression(alpha, V)
             air = dynamics.air_data(x, planet, atmosphere)
             _, lift, drag = dynamics.aero_accelerations(x, a, *air, vehicle)
+            aero = [k_lift * lift, k_drag * drag, air[0]]
             e = self.mu / r - 0.5 * V * V
             base = sigma0 if constant else linear_bank(e, e0, e_f, sigma0, sigma_f)
             load = np.sqrt(L * L + D * D)
             q = dynamics.dynamic_pressure(rho, V)
             heat = vehicle.heat_flux(rho, V, a)
             bank = sign * commanded_bank(base, V, gamma, L, D, load, heat, q, law)
-            xdot = dynamics.equations_of_motion(x, Expression(_BANK), L, D, planet)
+            xdot = dynamics.equations_of_motion(x, bank, L, D, planet)
             sdot = V * np.cos(gamma) * planet.reference_radius / r
-        self.system, self._motion = _staged([k_lift * lift, k_drag * drag, air[0]], bank, [*xdot, sdot])
+        motion = [*xdot, sdot]
+        one = [f.Substitute(dict(zip(_AERO, aero))) for f in motion]
+        self.staged = _size(one) >= STAGED_SIZE_RATIO * (_size(aero) + _size(motion))
+        self.system, self._motion = _build(aero, motion) if self.staged else _build(None, one)
         self.simulator = Simulator(self.system)
         integrator = ResetIntegratorFromFlags(self.simulator, "runge_kutta3", step_s)
         integrator.set_fixed_step_mode(True)
         integrator.set_maximum_step_size(step_s)
         self.context = self.simulator.get_mutable_context()
         self._motion_context = self._motion.GetMyMutableContextFromRoot(self.context)
-        self.input = self.system.get_input_port()
         self.evaluations = 0
         self.predictions = 0
 
@@ -145,12 +152,11 @@ class Predictor:
     def derivatives(self, y, params) -> np.ndarray:
         """d/dt of the 7 states [h, lon, lat, V, gamma, psi, s] (SI) at ``y`` with the inputs
         ``params`` = [sigma_0 rad, e_0 J/kg, sign, k_L, k_D], evaluated natively."""
-        self._set_state(y)
-        self.input.FixValue(self.context, [float(v) for v in params])
+        self._set_state([*map(float, y), *map(float, params)])
         return self._xdot()
 
     def _xdot(self) -> np.ndarray:
-        return self._motion.EvalTimeDerivatives(self._motion_context).CopyToVector()
+        return self._motion.EvalTimeDerivatives(self._motion_context).CopyToVector()[:len(_STATE)]
 
     def predict(self, x, sigma0: float, sign: float = 1.0, scales=(1.0, 1.0)) -> Prediction:
         """Fly the profile from sigma0 [rad] at state ``x`` [6] (its energy is e_0) with the bank
@@ -159,8 +165,7 @@ class Predictor:
         x = np.asarray(x, float)
         ctx = self.context
         ctx.SetTime(0.0)
-        self._set_state([*x, 0.0])
-        self.input.FixValue(ctx, [float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0, *map(float, scales)])
+        self._set_state([*x, 0.0, float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0, *map(float, scales)])
         integrator = self.simulator.get_mutable_integrator()
         n0 = integrator.get_num_derivative_evaluations()
         self.predictions += 1
@@ -224,27 +229,24 @@ class Predictor:
         return Prediction(y[6], y[:6], ctx.get_time(), True)
 
 
-def _staged(aerodynamics: list, bank, motion: list):
-    """(Diagram, its motion system): the predictor's three native stages (module docstring).
-    ``aerodynamics``: [k_L L, k_D D, rho] of the state and the inputs; ``bank``: the commanded
-    bank of the state, the inputs and those three; ``motion``: d/dt of the 7 states from L, D and
-    the bank. The Diagram's input port "params" is the 5 inputs (_INPUT)."""
+def _size(expressions) -> int:
+    """The expanded size of expression trees (characters of their text: what an evaluation
+    walks, shared parts counted each time they occur)."""
+    return sum(len(str(f)) for f in expressions)
+
+
+def _build(aerodynamics, motion: list):
+    """(Diagram, its motion system): the motion system integrates the 7 states and holds the 5
+    inputs (_INPUT) as constant states; with ``aerodynamics`` ([k_L L, k_D D, rho] of those 12)
+    an algebraic system computes them for it (``motion`` then reads _AERO), else ``motion``
+    holds them itself."""
+    held = [*_STATE, *_INPUT]
     builder = DiagramBuilder()
-    aero = builder.AddNamedSystem("aerodynamics", stateless([*_STATE, *_INPUT], aerodynamics))
-    law = builder.AddNamedSystem("bank_law", stateless([*_STATE, *_INPUT, *_AERO], [bank]))
     body = builder.AddNamedSystem("motion", SymbolicVectorSystem(
-        state=_STATE, input=[*_AERO, _BANK], dynamics=motion, output=[Expression(v) for v in _STATE]))
-    to_aero = builder.AddSystem(Multiplexer([len(_STATE), len(_INPUT)]))
-    to_law = builder.AddSystem(Multiplexer([len(_STATE), len(_INPUT), len(_AERO)]))
-    to_body = builder.AddSystem(Multiplexer([len(_AERO), 1]))
-    builder.ExportInput(to_aero.get_input_port(1), "params")
-    builder.ConnectInput("params", to_law.get_input_port(1))
-    for mux in (to_aero, to_law):
-        builder.Connect(body.get_output_port(), mux.get_input_port(0))
-    builder.Connect(to_aero.get_output_port(), aero.get_input_port())
-    builder.Connect(aero.get_output_port(), to_law.get_input_port(2))
-    builder.Connect(to_law.get_output_port(), law.get_input_port())
-    builder.Connect(aero.get_output_port(), to_body.get_input_port(0))
-    builder.Connect(law.get_output_port(), to_body.get_input_port(1))
-    builder.Connect(to_body.get_output_port(), body.get_input_port())
+        state=held, input=_AERO if aerodynamics else [], dynamics=[*motion, *[Expression(0.0)] * len(_INPUT)],
+        output=[Expression(v) for v in held]))
+    if aerodynamics:
+        aero = builder.AddNamedSystem("aerodynamics", stateless(held, aerodynamics))
+        builder.Connect(body.get_output_port(), aero.get_input_port())
+        builder.Connect(aero.get_output_port(), body.get_input_port())
     return builder.Build(), body

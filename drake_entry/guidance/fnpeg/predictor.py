@@ -17,11 +17,11 @@ its own evaluation. ``STAGED_SIZE_RATIO`` decides, on the trees' expanded sizes.
 prediction: CAV-H (Mach tables, US76; expanded 3.6 times larger in one system) 39-47 -> 27 ms
 staged; Lu 2008's capsule (1.7 times) 8.0 ms in one system against 9.6-10.2 staged. Both forms
 end at the same state to 3e-14 (relative).
-Time, not energy,
-is the independent variable: a high-lift glider's phugoid climbs where drag, and so de/dt,
-nearly vanishes (the pitfall of energy-domain prediction). The prediction stops exactly at e_f
-(Newton on time from the last step, de/dt from the equations), below ``floor_m``, above
-``ceiling_m`` or at ``max_time_s``.
+
+Time, not energy, is the independent variable: a high-lift glider's phugoid climbs where drag,
+and so de/dt, nearly vanishes (the pitfall of energy-domain prediction). The prediction stops
+exactly at e_f (Newton on time from the last step, de/dt from the equations), below
+``floor_m``, above ``ceiling_m`` or at ``max_time_s``.
 """
 from __future__ import annotations
 
@@ -99,6 +99,7 @@ class Predictor:
     linear profile to sigma_f;
     alpha: the angle-of-attack profile (Schedule in velocity); step_s: the fixed integration step
     [s]; floor_m, ceiling_m: altitudes that end a prediction; max_time_s: the longest prediction.
+    Attribute ``staged``: whether the aerodynamics run as a stage of their own (module docstring).
     """
 
     def __init__(self, vehicle, planet, atmosphere, law: FeedbackSettings, *, sigma_f: float, e_f: float,

@@ -156,9 +156,11 @@ def run_dask(task: Task, cases, record, workers: int, scheduler: str | None):
         env = os.environ.get("DASK_LOGGING__DISTRIBUTED")
         os.environ["DASK_LOGGING__DISTRIBUTED"] = env or "critical"
         try:
+            # no dashboard; the scheduler's own HTTP server (health, metrics) on a free port, as
+            # its default 8787 is taken whenever another cluster runs (a warning on stderr)
             with dask.config.set(DASK_QUIET_WORKERS):
                 cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None)
+                                       dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"})
         finally:
             signal.signal(signal.SIGINT, previous)
             if env is None:

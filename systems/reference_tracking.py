@@ -78,8 +78,7 @@ class ReferenceTracker(LeafSystem):
             state.get_mutable_abstract_state(int(self._memory)).set_value(TrackerMemory(None, str(e)))
             return
         state.get_mutable_abstract_state(int(self._memory)).set_value(TrackerMemory(ref))
-        sigma0 = float(np.clip(ref.law.reference(context.get_time() + self.lead)[0][6], -self.bank_limit,
-                               self.bank_limit))
+        sigma0 = float(np.clip(ref.law.state(context.get_time() + self.lead)[6], -self.bank_limit, self.bank_limit))
         state.get_mutable_discrete_state(self._bank).SetFromVector([sigma0])
 
     def _update(self, context, discrete_state):

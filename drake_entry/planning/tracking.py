@@ -116,7 +116,7 @@ class TrackingLaw:
 
     def reference(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """(x_ref(t), u_ref(t))."""
-        return lerp(self.time, self.states, t), lerp(self.time, self.controls, t)
+        return self.state(t), lerp(self.time, self.controls, t)
 
     def state(self, t: float) -> np.ndarray:
         """x_ref(t) alone (what a tracker reads every period)."""

@@ -18,9 +18,9 @@ def aborts_benchmark(*, rows: int = 9, columns: int = 9, workers: int | None = N
     import numpy as np
 
     from drake_entry.campaign.store import read_rows
-    from drake_entry.diagrams.aborts import run_orbital_aborts
-    from drake_entry.guidance.scvx.abort_report import write_abort_report
-    from drake_entry.guidance.scvx.aborts import FEASIBLE_RADII_M, feasible
+    from drake_entry.guidance.scvx.aborts.cases import FEASIBLE_RADII_M, feasible
+    from drake_entry.guidance.scvx.aborts.report import write_abort_report
+    from drake_entry.guidance.scvx.aborts.study import run_orbital_aborts
 
     workers = workers or os.cpu_count() or 1
     shutil.rmtree(out_dir, ignore_errors=True)

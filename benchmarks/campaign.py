@@ -11,7 +11,7 @@ def campaign_benchmark(*, samples: int = 100, scenario_name: str = "horus2b", se
     import tempfile
     import time
 
-    from drake_entry.diagrams.montecarlo import run_campaign
+    from drake_entry.campaign.montecarlo import run_campaign
 
     cases = (("1 worker (serial)", "serial", 1), ("2 workers (processes)", "processes", 2),
              ("Dask LocalCluster, 2 workers", "dask", 2))

@@ -26,10 +26,10 @@ from drake_entry.scenario import load_scenario
 n, seed = int(sys.argv[1]), int(sys.argv[2])
 try:  # the guidance-method interface
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup
-    from drake_entry.diagrams.sample import run_sample
+    from drake_entry.campaign.sample import run_sample
     args = (ClosedLoopSetup.from_scenario(load_scenario("horus2b")),)
 except ImportError:  # before it (the planner's module path of that time)
-    from drake_entry.diagrams.montecarlo import run_sample
+    from drake_entry.campaign.montecarlo import run_sample
     from drake_entry.planning.drag_energy import DragEnergyPlanner
     s = load_scenario("horus2b")
     args = (s, DragEnergyPlanner.from_scenario(s))

@@ -28,11 +28,11 @@ import tempfile
 
 from interface_cost import _checkout, _installed_layout
 
-from drake_entry.cli import closed_loop_scenarios
+from drake_entry.scenario import closed_loop_scenarios
 
 #: paper 004 with sigma_0 re-solved on board every 100 s: the variant the PIO target is about
 #: (a scenario variant is NAME:field=value[,field=value]: the packaged scenario with those overrides)
-PIO_ON_BOARD = "cav_h_paper004:guidance.resolve_period_s=100"
+PIO_ON_BOARD = "cav_h_paper004:guidance.replan_period_s=100"
 #: the targets of the speed work [s of one core per sample] by scenario
 TARGET_S = {"horus2b": 1 / 3, "shefex3_ampi": 1 / 3, "sphynx_paper001": 6.0, PIO_ON_BOARD: 6.0}
 CATEGORIES = ("plant", "planning", "rest")
@@ -42,7 +42,7 @@ import json, sys, time
 import numpy as np
 from drake_entry.scenario import load_scenario
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup
-from drake_entry.diagrams.sample import run_sample
+from drake_entry.campaign.sample import run_sample
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.vehicle import EntryVehicle
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
@@ -54,7 +54,7 @@ name, _, variant = name.partition(":")  # NAME:field=value[,field=value]: a vari
 t0 = time.process_time()
 scenario = load_scenario(name)
 if variant:  # read as --set FIELD=VALUE is, through the CLI's parser and the typed loader
-    from drake_entry.cli import parse_overrides
+    from drake_entry.cli.common import parse_overrides
     from drake_entry.scenario import apply_overrides
 
     apply_overrides(scenario, parse_overrides(variant.split(",")))

@@ -7,6 +7,9 @@ cheapest setting of each that meets it is reported, and the ratio Drake / scipy.
 """
 from __future__ import annotations
 
+import os
+import sys
+
 T_FINAL = 1500.0
 
 
@@ -37,7 +40,8 @@ def open_loop_benchmark(*, repeats: int = 3, scenario_name: str = "horus2b") -> 
 
 def _open_loop_benchmark(scenario, repeats: int) -> dict:
     from drake_entry.diagrams.open_loop import simulate
-    from drake_entry.scipy_open_loop import solve_ivp_open_loop
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tests"))
+    from reference_open_loop import solve_ivp_open_loop  # the tests' independent scipy integration
 
     scenario.simulation.max_time_s = T_FINAL
     scenario.terminal.altitude_km, scenario.terminal.mach = 5.0, None  # fly the full T_FINAL

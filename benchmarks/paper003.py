@@ -1,7 +1,7 @@
 """Benchmark: paper 003 (AMPI on SHEFEX-3) with the packaged database, measured side by side:
 
 1. Storage and reconstruction: the database's MB and the LD->HD reconstruction (eq. 11) of
-   stored cases against the Drake flight of their own bank (diagrams.ampi_accuracy).
+   stored cases against the Drake flight of their own bank (guidance.ampi.accuracy_study).
 2. CPU time (Fig. 6 form): AMPI synthesis (Algorithms 1-2 + eq. 11 to N_HD = 600), NTT's
    lookup, the TVLQR gains the guidance adds, one cold OCP solve and the warm-started ones;
    ratios OCP / synthesis against the paper's 26.5 s / 116 ms.
@@ -34,7 +34,8 @@ def _timed(f, repeats):
 
 
 def paper003_benchmark(cases: int = 100, out_dir: str | None = None, workers: int | None = None) -> dict:
-    from drake_entry.diagrams.ampi_accuracy import (
+    from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.guidance.ampi.accuracy_study import (
         COMPARED,
         UNITS,
         AccuracyStudy,
@@ -44,8 +45,7 @@ def paper003_benchmark(cases: int = 100, out_dir: str | None = None, workers: in
         reconstruction_error,
         summarise,
     )
-    from drake_entry.diagrams.ampi_database import offset_problem
-    from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.guidance.ampi.database_study import offset_problem
     from drake_entry.guidance.ampi.reference import DatabaseReference
     from drake_entry.planning import nlp
     from drake_entry.planning.tracking import tvlqr

@@ -55,7 +55,7 @@ if __name__ == "__main__":
     parser.add_argument("--write", action="store_true", help="examples: write the measured times into the docs")
     parser.add_argument("--scenarios", nargs="*", default=None,
                         help="method-cost: packaged scenarios to cost, or variants NAME:field=value[,field=value] "
-                        "(e.g. cav_h_paper004:guidance.resolve_period_s=100)")
+                        "(e.g. cav_h_paper004:guidance.replan_period_s=100)")
     args = parser.parse_args()
     if args.which == "examples":  # minutes of wall time: on request only
         from example_times import examples_benchmark

@@ -109,9 +109,9 @@ def campaign_solver_benchmark(*, runs: int = 20, seed: int = 2018) -> dict:
     import tempfile
     import time
 
-    from drake_entry.campaign.report import _columns, summary_statistics
+    from drake_entry.campaign.montecarlo import run_campaign
+    from drake_entry.campaign.report import rows_as_columns, summary_statistics
     from drake_entry.campaign.store import read_rows
-    from drake_entry.diagrams.montecarlo import run_campaign
 
     print(f"\nclosed-loop horus2b campaign, the same {runs} samples (seed {seed}), one worker, "
           f"re-planning with each solver")
@@ -124,7 +124,7 @@ def campaign_solver_benchmark(*, runs: int = 20, seed: int = 2018) -> dict:
             run_campaign("horus2b", runs=runs, out_dir=d, seed=seed, workers=1, backend="serial",
                          overrides={"guidance.solver": solver}, progress=False, trajectory_step_s=0)
             wall = (time.perf_counter() - t0) / runs
-            stats = summary_statistics(_columns(list(read_rows(d)[0].values())))
+            stats = summary_statistics(rows_as_columns(list(read_rows(d)[0].values())))
         distance = stats["errors"]["err_distance_m"]
         worst = min(m["worst"] for m in stats["margins"].values())
         out[solver] = {"s_per_sample": wall, "successful": stats["successful"], "distance_m": distance["mean"]}

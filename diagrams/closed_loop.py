@@ -46,6 +46,9 @@ from drake_entry.systems.native_plant import add_plant
 from drake_entry.systems.navigation import Navigation
 from drake_entry.systems.schedule import ScheduleSource
 
+__all__ = ["ALTITUDE_FLOOR_M", "ClosedLoopSetup", "ClosedLoopResult", "ClosedLoopDiagram", "build_closed_loop",
+           "terminal_errors", "acceptance_box", "fly", "summarise"]
+
 ALTITUDE_FLOOR_M = 5000.0
 
 

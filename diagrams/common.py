@@ -14,6 +14,9 @@ from drake_entry.models.trajectory import Trajectory
 from drake_entry.scenario import Scenario
 from drake_entry.systems.native_plant import flight_stop
 
+__all__ = ["configure_integrator", "collect_trajectory", "STEP_SIGNALS", "add_step_loggers", "make_simulator",
+           "stop_reason", "run"]
+
 
 def configure_integrator(simulator: Simulator, scenario: Scenario, *, closed_loop: bool = False):
     """Integrator, accuracy and maximum step from the scenario (RK5 by default; docs/architecture.md, "Integration");

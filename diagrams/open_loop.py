@@ -21,6 +21,8 @@ from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.native_plant import add_plant
 from drake_entry.systems.schedule import make_schedule_source
 
+__all__ = ["build_open_loop", "simulate"]
+
 
 def build_open_loop(scenario: Scenario):
     """Diagram and the handles ``simulate`` needs."""

@@ -45,6 +45,9 @@ from drake_entry.systems.monitors import PlantGuard
 from drake_entry.systems.native_plant import add_plant, flight_stop
 from drake_entry.systems.schedule import ScheduleSource
 
+__all__ = ["ENTRY_STEPS_PER_PERIOD", "ENTRY_ACCURACY", "OCP_ACCURACY", "LOG_POINTS", "FLIGHT_ERRORS", "fly_controls",
+           "first_sentence"]
+
 #: fixed RK5 steps per actuator period (see the module docstring for the measured error)
 ENTRY_STEPS_PER_PERIOD = 2
 #: error-controlled RK5 accuracy of an entry flight without actuators, and of an OCP flight

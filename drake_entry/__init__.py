@@ -6,4 +6,7 @@ or an editable install for development: ``pip install -e .``), so scripts import
 everywhere. That mapping is the only place the names are encoded.
 """
 
+__all__ = ["campaign", "claims", "cli", "comparison", "errors", "figures", "guidance", "models", "planning",
+           "scenario", "schema_doc", "tables", "typed_yaml"]
+
 __version__ = "0.1.0"

@@ -5,11 +5,17 @@ its exit status, not only in its output).
     claims = Claims("example 06: paper 004's bank profile")
     claims.check("the plan reaches TAEM inside the limits", plan.success, plan.message)
     raise SystemExit(claims.report())
+
+``run_example`` is the command line every example shares (``--quick``, ``--out`` and its own
+options): it runs the example's ``main``, checks its claims and returns the exit status.
 """
 from __future__ import annotations
 
+import argparse
 import dataclasses as dc
 import sys
+
+__all__ = ["Claim", "Claims", "run_example"]
 
 
 @dc.dataclass(frozen=True)
@@ -56,3 +62,18 @@ class Claims:
         print(f"{len(self.items) - n_bad} of {len(self.items)} claims hold"
               + (f"; {n_bad} FAILED" if n_bad else ""), file=stream)
         return 1 if n_bad else 0
+
+
+def run_example(doc: str, main, check, *, out: str, quick: str = "", options=(), argv=None) -> int:
+    """An example's command line: ``--quick`` (what it leaves out: ``quick``), ``--out`` (default
+    ``out``) and its own ``options`` ((flag, argparse keywords) pairs, passed to ``main`` by their
+    destination name); runs ``main(quick, out_dir, **options)``, prints ``check(result, quick)``
+    and returns its exit status (1 when a claim fails)."""
+    parser = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help=quick or "the reduced size")
+    parser.add_argument("--out", default=out, help=f"output directory (default: {out})")
+    for flag, keywords in options:
+        parser.add_argument(flag, **keywords)
+    args = vars(parser.parse_args(argv))
+    quick_run, out_dir = args.pop("quick"), args.pop("out")
+    return check(main(quick_run, out_dir, **args), quick_run).report()

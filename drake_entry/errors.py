@@ -2,6 +2,9 @@
 files and overrides into them)."""
 from __future__ import annotations
 
+__all__ = ["DrakeEntryError", "ScenarioError", "FieldError", "NonFiniteStateError", "ModelRangeError",
+           "UnsupportedScalarError", "CampaignError", "Interrupted", "check_range"]
+
 
 class DrakeEntryError(Exception):
     """Base of every user-facing error: the CLI prints it as one line and exits 2. Anything

@@ -23,6 +23,11 @@ from drake_entry.models.vehicles import Vehicle, load_vehicle
 from drake_entry.models.verdict import PathLimit, acceptance_box, vehicle_path_limits
 from drake_entry.typed_yaml import load_packaged_or_file, override, packaged_names
 
+__all__ = ["EntryStateSpec", "TargetSpec", "TerminalSpec", "ScheduleSpec", "PLANTS", "SimulationSpec",
+           "ReferenceResultsSpec", "ERROR_COLUMNS", "Scenario", "INTEGRATORS", "SCHEDULE_VALUES_DEG",
+           "SCHEDULE_BREAKPOINTS", "PACKAGED_SCENARIOS", "closed_loop_scenarios", "load_scenario", "apply_overrides",
+           "load_campaign_scenario"]
+
 
 @dc.dataclass
 class EntryStateSpec:
@@ -340,6 +345,16 @@ SCHEDULE_BREAKPOINTS = {"time": (-1e5, 1e5), "normalized_energy": (-1.0, 2.0), "
 
 #: the scenarios shipped in drake_entry/scenarios (``<name>.yaml``), found in the package
 PACKAGED_SCENARIOS = packaged_names("scenarios")
+
+
+def closed_loop_scenarios() -> list[str]:
+    """The packaged scenarios that declare a guidance method (a ``guidance:`` block): those a
+    campaign can fly (read without building the schema)."""
+    from importlib import resources
+
+    folder = resources.files("drake_entry").joinpath("scenarios")
+    return [n for n in PACKAGED_SCENARIOS if any(line.startswith("guidance:")
+                                                 for line in folder.joinpath(f"{n}.yaml").read_text().splitlines())]
 
 
 def load_scenario(name_or_path: str) -> Scenario:

@@ -14,6 +14,8 @@ import inspect
 import re
 import typing
 
+__all__ = ["field_comments", "schema_markdown"]
+
 _FIELD = re.compile(r"^    (\w+)\s*:\s*([^=#]+?)\s*(?:=\s*(.*?))?\s*(?:#\s*(.*))?$")
 
 

@@ -33,6 +33,9 @@ from pydrake.common.yaml import yaml_load_typed
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["Tagged", "DuplicateKeyError", "parse", "check", "packaged_names", "load_packaged_or_file",
+           "load_yaml_typed", "override"]
+
 
 class Tagged(NamedTuple):
     """A YAML node with a local tag (``!Uniform {min: 0, max: 1}``): the tag without '!'."""

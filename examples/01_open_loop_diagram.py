@@ -13,7 +13,6 @@ a heat-flux plot.
 
     python examples/01_open_loop_diagram.py [--quick] [--out out/examples/01]
 """
-import argparse
 import os
 
 import matplotlib.pyplot as plt
@@ -22,7 +21,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.scenario import load_scenario
 from drake_entry.systems.actuators import BankActuator
@@ -109,8 +108,4 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="fly the first 300 s only")
-    parser.add_argument("--out", default="out/examples/01", help="figure directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/01", quick="fly the first 300 s only"))

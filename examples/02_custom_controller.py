@@ -21,7 +21,6 @@ with it the flight lands inside the 2-km box within every limit (the verdict che
 
     python examples/02_custom_controller.py [--out out/examples/02]
 """
-import argparse
 import math
 import os
 
@@ -29,7 +28,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
 from drake_entry.guidance.drag_energy.method import DragEnergyMethod
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
@@ -129,8 +128,5 @@ def check(results: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="accepted for uniformity; the example is quick")
-    parser.add_argument("--out", default="out/examples/02", help="figure directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/02",
+                                 quick="accepted for uniformity; the example is quick"))

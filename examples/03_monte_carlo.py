@@ -7,7 +7,6 @@ from (seed, sample index): both backends give the same rows.
 
     python examples/03_monte_carlo.py [--quick] [--out out/examples/03]
 """
-import argparse
 import os
 
 import matplotlib.pyplot as plt
@@ -16,8 +15,8 @@ from dask.distributed import LocalCluster
 from pydrake.common.schema import Gaussian, Uniform
 from pydrake.common.yaml import yaml_dump_typed
 
-from drake_entry.claims import Claims
-from drake_entry.diagrams.montecarlo import run_campaign
+from drake_entry.campaign.montecarlo import run_campaign
+from drake_entry.claims import Claims, run_example
 from drake_entry.scenario import Scenario, load_scenario
 
 
@@ -86,8 +85,5 @@ def check(df, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="4 samples per backend instead of 40")
-    parser.add_argument("--out", default="out/examples/03", help="output directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/03",
+                                 quick="4 samples per backend instead of 40"))

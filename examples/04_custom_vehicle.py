@@ -10,13 +10,12 @@ heavier vehicle and an atmosphere 8 % denser than US76 between 20 and 120 km.
 
     python examples/04_custom_vehicle.py [--quick] [--out out/examples/04]
 """
-import argparse
 import math
 import os
 
 import numpy as np
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import fly
 from drake_entry.diagrams.open_loop import simulate
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
@@ -134,8 +133,5 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="400 s of open loop, no closed loop")
-    parser.add_argument("--out", default="out/examples/04", help="output directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/04",
+                                 quick="400 s of open loop, no closed loop"))

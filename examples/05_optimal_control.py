@@ -16,7 +16,6 @@ problem is re-solved from a perturbed state at 500 s with the horizon that remai
 
     python examples/05_optimal_control.py [--quick] [--out out/examples/05]
 """
-import argparse
 import dataclasses as dc
 import math
 import os
@@ -24,7 +23,7 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.models.atmosphere import ExponentialAtmosphere
 from drake_entry.models.planet import Earth
@@ -125,8 +124,5 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="accepted for uniformity: the run is the same")
-    parser.add_argument("--out", default="out/examples/05", help="figure directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/05",
+                                 quick="accepted for uniformity: the run is the same"))

@@ -8,13 +8,12 @@ reversal sampling), so the Drake flight ends where the plan does. The scenario
 
     python examples/06_swarm_bank.py [--quick] [--out out/examples/06]
 """
-import argparse
 import os
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import fly
 from drake_entry.guidance.swarm_bank.evaluator import range_error
 from drake_entry.guidance.swarm_bank.search import problem_from_scenario, search
@@ -85,8 +84,5 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="the bracketed search only (no PIO run)")
-    parser.add_argument("--out", default="out/examples/06", help="figure directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/06",
+                                 quick="the bracketed search only (no PIO run)"))

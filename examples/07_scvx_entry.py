@@ -13,10 +13,9 @@ radius with a labelled representative aerodynamic model (drake_entry/vehicles/sp
 
     python examples/07_scvx_entry.py [--quick] [--out out/examples/07]
 """
-import argparse
 import math
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.guidance.scvx.as_ocp import nlp_form
 from drake_entry.guidance.scvx.mission import ScvxMission
@@ -90,10 +89,5 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--out", default="out/examples/07")
-    parser.add_argument("--formulation", default="direct", choices=list(FORMULATIONS))
-    args = parser.parse_args()
-    raise SystemExit(check(main(quick=args.quick, out_dir=args.out, formulation=args.formulation),
-                           args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/07",
+                                 options=[("--formulation", {"default": "direct", "choices": list(FORMULATIONS)})]))

@@ -8,21 +8,20 @@ engine (local processes; resumable: run it again and only missing cases run):
    attitude to Ben Guerir (minimum miss, as the paper), each flown.
 
 The EIP states of the grid and the alternative site's coordinates are labelled substitutes
-(drake_entry.guidance.scvx.aborts); SPHYNX's aerodynamics are the representative model.
+(drake_entry.guidance.scvx.aborts.cases); SPHYNX's aerodynamics are the representative model.
 
     python examples/08_abort_maps.py [--quick] [--out out/examples/08]
 
 The full run takes about 10 minutes on 2 cores; --quick plans a 1 x 3 row of EIPs and two
 descent aborts.
 """
-import argparse
 import os
 
 from drake_entry.campaign.store import read_rows
-from drake_entry.claims import Claims
-from drake_entry.diagrams.aborts import run_descent_aborts, run_orbital_aborts
-from drake_entry.guidance.scvx.abort_report import write_abort_report
-from drake_entry.guidance.scvx.aborts import FEASIBLE_RADII_M, feasible
+from drake_entry.claims import Claims, run_example
+from drake_entry.guidance.scvx.aborts.cases import FEASIBLE_RADII_M, feasible
+from drake_entry.guidance.scvx.aborts.report import write_abort_report
+from drake_entry.guidance.scvx.aborts.study import run_descent_aborts, run_orbital_aborts
 
 
 def main(quick: bool = False, out_dir: str = "out/examples/08") -> dict:
@@ -61,8 +60,4 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--out", default="out/examples/08")
-    args = parser.parse_args()
-    raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/08"))

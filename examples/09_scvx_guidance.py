@@ -12,7 +12,6 @@ no Monte-Carlo).
 
     python examples/09_scvx_guidance.py [--quick] [--out out/examples/09]
 """
-import argparse
 import dataclasses as dc
 import json
 import os
@@ -20,10 +19,10 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
+from drake_entry.campaign.montecarlo import run_campaign
 from drake_entry.campaign.report import write_report
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
-from drake_entry.diagrams.montecarlo import run_campaign
 from drake_entry.scenario import load_scenario
 
 
@@ -92,8 +91,5 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--quick", action="store_true", help="two campaign samples instead of twenty")
-    ap.add_argument("--out", default="out/examples/09")
-    a = ap.parse_args()
-    raise SystemExit(check(main(a.quick, a.out), a.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/09",
+                                 quick="two campaign samples instead of twenty"))

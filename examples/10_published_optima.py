@@ -12,14 +12,13 @@ the heating along them.
 
     python examples/10_published_optima.py [--quick] [--out out/examples/10]
 """
-import argparse
 import math
 import os
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.planning import nlp
 from drake_entry.planning.nlp import catalogue
@@ -91,8 +90,4 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--out", default="out/examples/10")
-    args = parser.parse_args()
-    raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/10"))

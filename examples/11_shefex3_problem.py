@@ -16,14 +16,13 @@ trajectory database (Sagliano, Mooij & Theil 2017, Sec. II-III).
 
     python examples/11_shefex3_problem.py [--quick] [--out out/examples/11]
 """
-import argparse
 import dataclasses as dc
 import os
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.open_loop import simulate
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.planning import nlp
@@ -100,8 +99,4 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="60 samples for the eq. 1 solve")
-    parser.add_argument("--out", default="out/examples/11")
-    args = parser.parse_args()
-    raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/11", quick="60 samples for the eq. 1 solve"))

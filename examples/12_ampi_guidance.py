@@ -14,7 +14,6 @@ Secs. IV-VI): AMPI against neighbour-trajectory tracking (NTT).
 
 The vehicle's aerodynamics and the target are labelled substitutes (docs/methods/ampi.md).
 """
-import argparse
 import dataclasses as dc
 import math
 import os
@@ -24,11 +23,11 @@ import numpy as np
 import pandas as pd
 from pydrake.common.yaml import yaml_dump_typed
 
-from drake_entry.claims import Claims
+from drake_entry.campaign.montecarlo import run_campaign
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams import closed_loop as cl
-from drake_entry.diagrams.ampi_database import offset_problem
-from drake_entry.diagrams.montecarlo import run_campaign
 from drake_entry.diagrams.verification import fly_controls
+from drake_entry.guidance.ampi.database_study import offset_problem
 from drake_entry.guidance.ampi.reference import DatabaseReference
 from drake_entry.planning import nlp
 from drake_entry.scenario import Scenario, load_scenario
@@ -135,8 +134,5 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="6 campaign runs per mode instead of 100")
-    parser.add_argument("--out", default="out/examples/12")
-    args = parser.parse_args()
-    raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/12",
+                                 quick="6 campaign runs per mode instead of 100"))

@@ -14,14 +14,13 @@ own code with symbolic scalars, evaluated in C++) or ``python`` (the reference L
 
     python examples/13_native_plant.py [--quick] [--out out/examples/13]
 """
-import argparse
 import os
 import time
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
 from drake_entry.scenario import load_scenario
 from drake_entry.systems.native_plant import PlantProbe
@@ -115,8 +114,5 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="compare at 50 states and fly the first 400 s")
-    parser.add_argument("--out", default="out/examples/13", help="figure directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/13",
+                                 quick="compare at 50 states and fly the first 400 s"))

@@ -18,7 +18,6 @@ warm-started from the solution in use).
 
     python examples/14_lgl_terminal_guidance.py [--quick] [--out out/examples/14]
 """
-import argparse
 import dataclasses as dc
 import math
 import os
@@ -27,9 +26,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 from pydrake.common import RandomGenerator
 
-from drake_entry.claims import Claims
+from drake_entry.campaign.sample import sample_seed
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams import closed_loop as cl
-from drake_entry.diagrams.sample import sample_seed
 from drake_entry.models import dispersions
 from drake_entry.scenario import load_scenario
 
@@ -161,9 +160,5 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true",
-                        help="without the nominal guided flight and the dispersed TVLQR-only flight")
-    parser.add_argument("--out", default="out/examples/14")
-    args = parser.parse_args()
-    raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/14",
+                                 quick="without the nominal guided flight and the dispersed TVLQR-only flight"))

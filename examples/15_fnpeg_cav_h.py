@@ -19,16 +19,15 @@ the peaks are compared in kind (damping lowers them), not to the digit.
 --quick flies the first two cases to 900 s only (through the first pull-out and the first phugoid
 dip, where the unconstrained peaks are) with a correction every 5 s instead of every second.
 """
-import argparse
 import math
 import os
 import time
 
 import matplotlib.pyplot as plt
 
-from drake_entry.claims import Claims
+from drake_entry.campaign.sample import campaign_row
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
-from drake_entry.diagrams.sample import campaign_row
 from drake_entry.scenario import apply_overrides, load_scenario
 
 #: Lu 2014's published CAV-H orbital-case figures (without, with phugoid damping)
@@ -53,7 +52,7 @@ CASES = {
 
 def fly_case(overrides: dict, quick: bool):
     scenario = load_scenario("cav_h_fnpeg")
-    apply_overrides(scenario, {**overrides, **({"guidance.corrector_period_s": 5.0} if quick else {})})
+    apply_overrides(scenario, {**overrides, **({"guidance.replan_period_s": 5.0} if quick else {})})
     if quick:
         scenario.simulation.max_time_s = 900.0
     setup = ClosedLoopSetup.from_scenario(scenario)
@@ -132,8 +131,5 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="fly two cases to 900 s, correcting every 5 s")
-    parser.add_argument("--out", default="out/examples/15", help="figure directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/15",
+                                 quick="fly two cases to 900 s, correcting every 5 s"))

@@ -12,13 +12,12 @@ and core seconds per sample, overlaid footprints.
 The command-line equivalent is ``drake-entry compare horus2b --runs 20 --seed 2026``.
 --quick flies two methods (drag-energy and the fixed bank profile) on 2 samples each.
 """
-import argparse
 import json
 import os
 
-from drake_entry.claims import Claims
-from drake_entry.comparison import load_comparison
-from drake_entry.diagrams.comparison import run_comparison
+from drake_entry.claims import Claims, run_example
+from drake_entry.comparison.runner import run_comparison
+from drake_entry.comparison.spec import load_comparison
 
 SEED = 2026
 
@@ -59,9 +58,6 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="two methods, 2 samples each")
-    parser.add_argument("--runs", type=int, default=20, help="samples per method (default: 20)")
-    parser.add_argument("--out", default="out/examples/16", help="comparison directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out, args.runs), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/16",
+                                 quick="two methods, 2 samples each",
+                                 options=[("--runs", {"type": int, "default": 20, "help": "samples per method (default: 20)"})]))

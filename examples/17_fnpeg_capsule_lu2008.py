@@ -21,16 +21,15 @@ figure of the three miss distributions, and checks what the comparison shows.
 
 Full size (500 runs each) took 42 minutes on 2 cores; ``--quick`` flies 5 runs each.
 """
-import argparse
 import os
 
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from drake_entry.campaign.montecarlo import run_campaign
 from drake_entry.campaign.report import write_report
-from drake_entry.claims import Claims
-from drake_entry.diagrams.montecarlo import run_campaign
+from drake_entry.claims import Claims, run_example
 
 SCENARIO, SEED = "capsule_lu2008", 2008
 #: the three campaigns: label -> (scenario overrides, report title)
@@ -130,10 +129,7 @@ def check(stats: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="5 runs per campaign instead of --runs")
-    parser.add_argument("--runs", type=int, default=500, help="runs per campaign (default: Lu's 500)")
-    parser.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
-    parser.add_argument("--out", default="out/examples/17", help="output directory")
-    args = parser.parse_args()
-    raise SystemExit(check(main(args.quick, args.out, args.runs, args.workers), args.quick).report())
+    raise SystemExit(run_example(
+        __doc__, main, check, out="out/examples/17", quick="5 runs per campaign instead of --runs",
+        options=[("--runs", {"type": int, "default": 500, "help": "runs per campaign (default: Lu's 500)"}),
+                 ("--workers", {"type": int, "default": None, "help": "processes (default: all cores)"})]))

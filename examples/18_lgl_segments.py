@@ -16,14 +16,13 @@ nodes, one polynomial and 4 segments of 32, each from the same 60-node one-polyn
 
     python examples/18_lgl_segments.py [--quick] [--out out/examples/18]
 """
-import argparse
 import os
 import time
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-from drake_entry.claims import Claims
+from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.planning import nlp
 from drake_entry.planning.nlp import catalogue
@@ -127,8 +126,4 @@ def check(r: dict, quick: bool = False) -> Claims:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--out", default="out/examples/18")
-    args = parser.parse_args()
-    raise SystemExit(check(main(quick=args.quick, out_dir=args.out), args.quick).report())
+    raise SystemExit(run_example(__doc__, main, check, out="out/examples/18"))

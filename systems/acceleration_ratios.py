@@ -16,6 +16,8 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 from drake_entry.models.acceleration_ratios import filtered_ratios
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 
+__all__ = ["AccelerationRatioFilter"]
+
 _LIFT, _DRAG = FLIGHT_CONDITION_NAMES.index("lift"), FLIGHT_CONDITION_NAMES.index("drag")
 
 

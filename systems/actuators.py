@@ -28,6 +28,8 @@ from pydrake.trajectories import PiecewisePolynomial
 from drake_entry.errors import ScenarioError
 from drake_entry.models.actuator import BANDWIDTH_RAD_S, SUBSTEP_S, actuator_rates, integrate_actuator
 
+__all__ = ["LimitedActuator", "BankActuator", "AlphaActuator"]
+
 
 class LimitedActuator(LeafSystem):
     def __init__(self, *, name: str, lower: float, upper: float, rate_limit: float, accel_limit: float,

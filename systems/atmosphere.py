@@ -16,6 +16,8 @@ from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.dynamics import air_data
 from drake_entry.models.planet import Earth
 
+__all__ = ["AtmosphereSystem_", "AtmosphereSystem"]
+
 
 @TemplateSystem.define("AtmosphereSystem_")
 def AtmosphereSystem_(T):

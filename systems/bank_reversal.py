@@ -21,6 +21,8 @@ from drake_entry.errors import ScenarioError
 from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle
 from drake_entry.models.geodesy import bearing
 
+__all__ = ["BankReversalLogic"]
+
 
 class BankReversalLogic(LeafSystem):
     def __init__(self, *, target_lon: float, target_lat: float, corridor_deg=(5.0, 15.0),

@@ -13,19 +13,21 @@ Ports:
                                   (EntryVehicle output; the plan starts from the sensed drag)
   - output "reference"        [4]  D_ref [m/s^2], D'_ref [1/m], D''_ref [s^2/m^3] at the
                                  estimate's energy, engaged flag (1 after the first plan)
+  - output "replan_stats"     [4]  the schedule's account (systems/replan_scheduler.py)
 """
 from __future__ import annotations
 
 import copy
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import LeafSystem
 
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner, DragEnergyReference
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.systems.replan_scheduler import ReplanScheduler
+
+__all__ = ["sensed_drag", "GuidanceMemory", "DragEnergyGuidance"]
 
 _DRAG = FLIGHT_CONDITION_NAMES.index("drag")
 
@@ -41,26 +43,23 @@ class GuidanceMemory:
     first_reference: DragEnergyReference | None = None  # the plan at engagement
     engaged_state: object = None  # navigation estimate at engagement
     engaged_at: float | None = None
-    last_plan_at: float = -np.inf
-    plans: int = 0
     failures: list = field(default_factory=list)  # (time, message)
-    planning_wall_s: float = 0.0  # wall-clock time spent planning [s] (cost accounting only)
 
     def __deepcopy__(self, memo):
         # Drake copies abstract state at every update; the reference is never mutated after
         # planning, so copies share it (a deep copy of the corridor each second cost ~1 ms).
         return GuidanceMemory(self.reference, self.first_reference, self.engaged_state, self.engaged_at,
-                              self.last_plan_at, self.plans, list(self.failures), self.planning_wall_s)
+                              list(self.failures))
 
 
-class DragEnergyGuidance(LeafSystem):
+class DragEnergyGuidance(ReplanScheduler):
     def __init__(self, planner: DragEnergyPlanner, *, period: float = 1.0, pre_guidance_min_s: float = 100.0,
                  replan_period_s: float = 0.0, replan_until_e: float = 0.9):
         super().__init__()
         self.planner = planner
         self.pre_min = pre_guidance_min_s
-        self.replan = replan_period_s
         self.replan_until_e = replan_until_e
+        self.DeclareReplanSchedule(replan_period_s=replan_period_s)  # the first plan is at engagement
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self._memory = self.DeclareAbstractState(AbstractValue.Make(GuidanceMemory()))
@@ -76,32 +75,31 @@ class DragEnergyGuidance(LeafSystem):
         t = context.get_time()
         x = self.est_port.Eval(context)
         sensed = sensed_drag(self.fc_port, context)
-        if mem.reference is None:
+        if mem.reference is None:  # engagement: tried at every update until a plan succeeds
             due = t >= self.pre_min and self.planner.drag_state(x, sensed).D_prime >= 0.0
         else:
             E0, Ef = self.planner.E_entry, self.planner.E_final
             e = (E0 - self.planner.energy(x)) / (E0 - Ef)
-            due = self.replan > 0 and t - mem.last_plan_at >= self.replan - 1e-9 and e < self.replan_until_e
+            due = self.replan_due(context) and e < self.replan_until_e
         if not due:
             return
         new = copy.deepcopy(mem)
-        new.last_plan_at = t  # a failed re-plan is retried one re-plan period later
-        t_wall = time.perf_counter()
-        try:
+
+        def solve():
             ref = self.planner.plan_from_state(x, previous=mem.reference, sensed_drag=sensed)
-        except Exception as e:  # a numerical failure in planning must not stop the flight
-            ref = None
-            new.failures.append((t, f"{type(e).__name__}: {e}"))
-        new.planning_wall_s += time.perf_counter() - t_wall
-        if ref is not None and ref.success:
+            ok = ref is not None and bool(ref.success)
+            return ref, ok, "" if ok else ("the planner returned no plan" if ref is None else ref.message)
+
+        outcome = self.attempt(context, state, solve)
+        if outcome.applied:
+            ref = outcome.result
             new.reference = ref
-            new.plans += 1
             if new.engaged_at is None:
                 new.engaged_at = t
                 new.first_reference = ref
                 new.engaged_state = np.array(x)
-        elif ref is not None:
-            new.failures.append((t, ref.message))
+        else:
+            new.failures.append((t, outcome.note))
         state.get_mutable_abstract_state(int(self._memory)).set_value(new)
 
     def _calc(self, context, output):

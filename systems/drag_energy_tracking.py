@@ -29,6 +29,8 @@ from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.systems.drag_energy_guidance import sensed_drag
 
+__all__ = ["DragTrackingController"]
+
 
 class DragTrackingController(LeafSystem):
     def __init__(self, planner: DragEnergyPlanner, *, zeta: float, omega: float, integral_ratio: float = 0.0,

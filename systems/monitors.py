@@ -24,6 +24,8 @@ from drake_entry.models.atmosphere import US76_H_MAX
 from drake_entry.models.dynamics import specific_energy
 from drake_entry.models.planet import Earth
 
+__all__ = ["CEILING_M", "require_finite", "TerminationMonitor", "PlantGuard"]
+
 #: default ceiling [m]: 100 km under the top of the US76 model (1000 km), so that an
 #: integrator's trial stages (10 s steps at several km/s) stay inside the model
 CEILING_M = US76_H_MAX - 100e3

@@ -36,6 +36,9 @@ from drake_entry.scenario import PLANTS
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.vehicle import N_STATE, EntryVehicle
 
+__all__ = ["STATE", "DEVIATION", "BANK", "ALPHA", "RHO", "SPEED_OF_SOUND", "NativeAtmosphere", "NativeEntryVehicle",
+           "SYMBOLIC_DOMAIN_ERROR", "as_flight_error", "flight_stop", "add_plant", "PlantProbe"]
+
 #: the symbols of every native plant (shared, so each nominal model's expression trees are
 #: built once per process and reused by every dispersed copy: Atmosphere.symbolic_profile)
 STATE = [Variable(name) for name in dynamics.STATE_NAMES]

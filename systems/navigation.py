@@ -15,6 +15,8 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["Navigation"]
+
 
 class Navigation(LeafSystem):
     def __init__(self, *, bias=None, noise_sigma=None, period: float = 1.0, seed: int = 0):

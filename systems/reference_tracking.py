@@ -28,6 +28,8 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import DrakeEntryError, ScenarioError
 
+__all__ = ["LAW_STATES", "TrackerMemory", "ReferenceTracker"]
+
 #: the reference problem's state layout the law is written in
 LAW_STATES = ("h", "lon", "lat", "V", "gamma", "psi", "sigma", "t")
 

@@ -8,12 +8,13 @@ alpha samples are None flies ``plan.problem.alpha(V)`` (an alpha(V) law) at the 
 speed. The commands are read at the time since the plan began, ``lead`` seconds ahead (the
 actuators' lag), and held after its end.
 
-With ``replan_period`` > 0, every period (while the plan in use has more than
-``min_time_to_go`` seconds left; with ``time_to_go_fraction`` the period shrinks to that
-fraction of the time to go, never below the guidance period) a new plan is made from the estimate by the method's
-``replan(plan, x, elapsed, bank, alpha)`` callable, holding the bank and alpha being commanded;
-a re-plan that raises or is not a verified success is recorded with its time and reason, and
-the previous plan flies on.
+With ``replan_period`` > 0, re-plans follow the shared schedule (systems/replan_scheduler.py):
+the first at ``first_replan``, then one every ``replan_period`` (with ``time_to_go_fraction`` the
+period shrinks to that fraction of the time to go, never below the guidance period), while the
+plan in use has more than ``min_time_to_go`` seconds left. A new plan is made from the estimate
+by the method's ``replan(plan, x, elapsed, bank, alpha)`` callable, holding the bank and alpha
+being commanded; a re-plan that raises or is not a verified success is recorded with its time
+and reason, and the previous plan flies on.
 
 With ``feedback``, the commands are the plan's plus offsets that a tracking law of the plan in
 use builds up between re-plans: ``feedback(plan)`` gives an object whose ``rates(s, x, offsets)``
@@ -31,17 +32,20 @@ Ports:
   - output "bank_command"     [1]  sigma [rad] (signed: the plan chooses its reversals)
   - output "alpha_command"    [1]  alpha [rad]
   - output "plan_stats"       [3]  re-plans made, re-plans refused, wall time of re-planning [s]
+  - output "replan_stats"     [4]  the schedule's account (systems/replan_scheduler.py)
   - output "command_offsets"  [2]  the feedback's bank and alpha offsets [rad] (zero without feedback)
 """
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import LeafSystem
+
+from drake_entry.systems.replan_scheduler import ReplanScheduler
+
+__all__ = ["FlownPlan", "ReplanMemory", "Replan", "ReplanningGuidance"]
 
 
 @dataclass(frozen=True)
@@ -74,29 +78,25 @@ class FlownPlan:
 
 @dataclass
 class ReplanMemory:
-    """The guidance's state: the plan flown, when the next re-plan is due [s], the re-plans made,
-    the refused ones as (time [s], reason), per re-plan (time [s], wall time [s], accepted), the
-    wall time spent re-planning [s], and the flight times [s] at which a plan began without the
-    feedback law asked for (it could not be made: the plan flies on its own)."""
+    """The guidance's state besides its schedule: the plan flown, the refused re-plans as (time
+    [s], reason), per re-plan (time [s], wall time [s], accepted), and the flight times [s] at
+    which a plan began without the feedback law asked for (it could not be made: the plan flies
+    on its own)."""
 
     flown: FlownPlan
-    next_replan: float
-    replans: int = 0
     refused: list = field(default_factory=list)
     log: list = field(default_factory=list)
-    wall_s: float = 0.0
     unfed: list = field(default_factory=list)
 
     def __deepcopy__(self, memo):  # the plans are never mutated: copies share them
-        return ReplanMemory(self.flown, self.next_replan, self.replans, list(self.refused), list(self.log),
-                            self.wall_s, list(self.unfed))
+        return ReplanMemory(self.flown, list(self.refused), list(self.log), list(self.unfed))
 
 
 #: replan(plan, x [6], elapsed [s since the plan began], bank [rad], alpha [rad]) -> a new plan
 Replan = Callable[[object, np.ndarray, float, float, float], object]
 
 
-class ReplanningGuidance(LeafSystem):
+class ReplanningGuidance(ReplanScheduler):
     def __init__(self, plan, *, replan: Replan | None = None, period: float = 1.0, replan_period: float = 0.0,
                  min_time_to_go: float = 300.0, lead: float = 0.0, first_replan: float | None = None,
                  time_to_go_fraction: float | None = None, model_scales: bool = False,
@@ -121,8 +121,9 @@ class ReplanningGuidance(LeafSystem):
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.scales_port = self.DeclareVectorInputPort("model_scales", 2) if model_scales else None
         first_at = (replan_period if first_replan is None else first_replan) if replan_period > 0 else np.inf
+        self.DeclareReplanSchedule(replan_period_s=replan_period, first_due_s=first_at)
         flown = FlownPlan.of(plan, 0.0, feedback)
-        first = ReplanMemory(flown, first_at, unfed=[0.0] if feedback is not None and flown.feedback is None else [])
+        first = ReplanMemory(flown, unfed=[0.0] if feedback is not None and flown.feedback is None else [])
         self._memory = self.DeclareAbstractState(AbstractValue.Make(first))
         self._offsets = self.DeclareDiscreteState(2)
         if replan_period > 0 or feedback is not None:
@@ -145,8 +146,8 @@ class ReplanningGuidance(LeafSystem):
         return bank + float(d[0]), alpha + float(d[1])
 
     def _stats(self, context, output):
-        mem = self.memory(context)
-        output.SetFromVector([mem.replans, len(mem.refused), mem.wall_s])
+        s = self.replan_stats(context)
+        output.SetFromVector([s.applied, s.refused, s.wall_s])
 
     def _update(self, context, state):
         mem = self.memory(context)
@@ -158,33 +159,34 @@ class ReplanningGuidance(LeafSystem):
             offsets = np.clip(offsets + self.period * flown.feedback.rates(t - flown.start, x, offsets),
                               -self.offset_limits, self.offset_limits)
             state.get_mutable_discrete_state(self._offsets).SetFromVector(offsets)
-        if t < mem.next_replan - 1e-9 or flown.start + flown.plan.final_time - t < self.min_time_to_go:
+        if not self.replan_due(context) or flown.start + flown.plan.final_time - t < self.min_time_to_go:
             return
-        new = ReplanMemory(flown, mem.next_replan + self.replan_period, mem.replans, list(mem.refused),
-                           list(mem.log), mem.wall_s, list(mem.unfed))
+        new = ReplanMemory(flown, list(mem.refused), list(mem.log), list(mem.unfed))
         bank, alpha = flown.commands(t, float(x[3]))  # the commands flown now (not read ahead)
         bank, alpha = bank + float(offsets[0]), alpha + float(offsets[1])
-        t_wall = time.perf_counter()
-        try:
+
+        def solve():
             extra = {} if self.scales_port is None else {"scales": tuple(self.scales_port.Eval(context))}
             plan = self.replan(flown.plan, x, t - flown.start, bank, alpha, **extra)
-            reason = "the re-planner returned no plan" if plan is None else plan.message
             accepted = plan is not None and bool(plan.success)
-            flown_next = FlownPlan.of(plan, t, self.feedback) if accepted else None
-        except Exception as e:  # a failed re-plan must not stop the flight: the previous plan flies on
-            plan, reason, accepted = None, f"{type(e).__name__}: {e}", False
-        wall = time.perf_counter() - t_wall
-        new.wall_s += wall
-        new.log.append((t, wall, accepted))
-        if accepted:
-            new.flown = flown_next
-            new.replans += 1
-            if self.feedback is not None and flown_next.feedback is None:
+            note = "" if accepted else ("the re-planner returned no plan" if plan is None else plan.message)
+            return (FlownPlan.of(plan, t, self.feedback) if accepted else None), accepted, note
+
+        interval = None
+        if self.time_to_go_fraction is not None:  # the plan in use after this attempt sets the next
+            outcome = self.attempt(context, state, solve, interval=0.0)
+            in_use = outcome.result if outcome.applied else flown
+            to_go = in_use.start + in_use.plan.final_time - t
+            interval = min(self.replan_period, max(self.period, self.time_to_go_fraction * to_go))
+            self.due_now(state, t + interval)
+        else:
+            outcome = self.attempt(context, state, solve)
+        new.log.append((t, outcome.wall_s, outcome.applied))
+        if outcome.applied:
+            new.flown = outcome.result
+            if self.feedback is not None and outcome.result.feedback is None:
                 new.unfed.append(t)
             state.get_mutable_discrete_state(self._offsets).SetFromVector(np.zeros(2))  # it starts where we are
         else:
-            new.refused.append((t, reason))
-        if self.time_to_go_fraction is not None:
-            to_go = new.flown.start + new.flown.plan.final_time - t
-            new.next_replan = t + min(self.replan_period, max(self.period, self.time_to_go_fraction * to_go))
+            new.refused.append((t, outcome.note))
         state.get_mutable_abstract_state(int(self._memory)).set_value(new)

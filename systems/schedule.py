@@ -17,6 +17,8 @@ from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, specific_energy
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
 
+__all__ = ["make_schedule_source", "ScheduleSource"]
+
 
 def make_schedule_source(schedule: Schedule, planet: Earth | None = None):
     """The cheapest source for a schedule: a native TrajectorySource (first-order hold,

@@ -3,11 +3,12 @@
 Every ``period`` seconds the law gives |sigma| (eq. 17 from sigma_0 with the QEG compensation,
 eqs. 46-48) and the alpha command (eq. 31, or eq. 21 until Mach_shift) from the navigation
 estimate and the sensed flight conditions; the shared reversal logic signs |sigma| and the
-shared actuators fly both. With ``resolve_period`` > 0, sigma_0 is re-solved on board from
+shared actuators fly both. With ``replan_period`` > 0, sigma_0 is re-solved on board from
 the estimate (guidance.swarm_bank.search.resolve_sigma0: predicted trajectories of the same law)
-until the normalised energy ``resolve_until_e``. The predictions fly the nominal models with
-the lift and drag scaled by the ratios of the sensed to the modelled accelerations, low-passed
-over 30 s (``resolve_scaling``): a density or aerodynamic error the flight has shown is then
+on the shared schedule (systems/replan_scheduler.py: the first one ``replan_period`` after
+entry) until the normalised energy ``replan_until_e`` (a re-solution due past it is skipped).
+The predictions fly the nominal models with the lift and drag scaled by the ratios of the
+sensed to the modelled accelerations, low-passed over 30 s (``acceleration_scaling``): a density or aerodynamic error the flight has shown is then
 predicted for the rest of it (with the nominal models the 1-sigma range miss of 100 dispersed
 flights was 31 km; scaled, see docs/methods/swarm-bank.md).
 
@@ -21,6 +22,7 @@ Ports:
   - output "sigma0"             [1]  the sigma_0 in use [rad]
   - output "plan_stats"         [3]  re-solutions, re-solutions without a bracketed root (or that
                                    raised: the sigma_0 in use flies on), wall time [s]
+  - output "replan_stats"       [4]  the schedule's account (systems/replan_scheduler.py)
 
 The commands are computed from the inputs and the law's memory (previous alpha command, Case 2
 switch) at each sample: the actuators sample them at the same instant, as the planner's
@@ -30,10 +32,9 @@ from __future__ import annotations
 
 import dataclasses as dc
 import math
-import time
 
 import numpy as np
-from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.systems.framework import BasicVector
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.swarm_bank.evaluator import SwarmProblem
@@ -42,20 +43,22 @@ from drake_entry.guidance.swarm_bank.search import resolve_sigma0
 from drake_entry.models.acceleration_ratios import filtered_ratios
 from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.systems.replan_scheduler import ReplanScheduler
+
+__all__ = ["SwarmBankGuidance"]
 
 _FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
-# discrete state: law memory (3), sigma_0, re-solutions, failed ones, wall time, next re-solution
-# time, filtered sensed/modelled lift and drag ratios
-_ALPHA, _ABOVE, _SWITCHED, _SIGMA0, _PLANS, _FAILED, _WALL, _NEXT, _KL, _KD = range(10)
+# discrete state: law memory (3), sigma_0, filtered sensed/modelled lift and drag ratios
+_ALPHA, _ABOVE, _SWITCHED, _SIGMA0, _KL, _KD = range(6)
 
 
-class SwarmBankGuidance(LeafSystem):
-    def __init__(self, problem: SwarmProblem, sigma0: float, *, period: float = 1.0, resolve_period: float = 0.0,
-                 resolve_until_e: float = 0.95, bounds_deg=(0.0, 89.0), resolve_scaling: bool = True):
+class SwarmBankGuidance(ReplanScheduler):
+    def __init__(self, problem: SwarmProblem, sigma0: float, *, period: float = 1.0, replan_period: float = 0.0,
+                 replan_until_e: float = 0.95, bounds_deg=(0.0, 89.0), acceleration_scaling: bool = True):
         """Args: problem (the mission and law, nominal models); sigma0 [rad] planned; period [s];
-        resolve_period [s] (0 = fly sigma0); resolve_until_e: last normalised energy of a
+        replan_period [s] (0 = fly sigma0); replan_until_e: last normalised energy of a
         re-solution; bounds_deg: sigma_0 bounds of a re-solution (eq. 17 stays anchored at the
-        entry energy); resolve_scaling: the predictions fly the nominal lift and drag times the
+        entry energy); acceleration_scaling: the predictions fly the nominal lift and drag times the
         filtered ratios of the sensed to the modelled accelerations (a density or aerodynamic
         error the flight has shown), instead of the nominal models."""
         super().__init__()
@@ -64,15 +67,15 @@ class SwarmBankGuidance(LeafSystem):
         if not math.isfinite(sigma0):
             raise ScenarioError(f"SwarmBankGuidance.sigma0 = {sigma0} must be finite (the plan found no sigma_0)")
         self.problem, self.law = problem, problem.law()
-        self.resolve_period, self.resolve_until_e, self.bounds_deg = resolve_period, resolve_until_e, bounds_deg
-        self.resolve_scaling, self.period = resolve_scaling, period
+        self.replan_until_e, self.bounds_deg = replan_until_e, bounds_deg
+        self.acceleration_scaling, self.period = acceleration_scaling, period
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self.bank_port = self.DeclareVectorInputPort("bank_command", 1)
         alpha0 = problem.alpha_max if problem.initial_alpha is None else problem.initial_alpha
-        start = [alpha0, 0.0, 0.0, sigma0, 0.0, 0.0, 0.0, resolve_period if resolve_period > 0 else math.inf,
-                 1.0, 1.0]
-        self._state = self.DeclareDiscreteState(BasicVector(start))
+        self._state = self.DeclareDiscreteState(BasicVector([alpha0, 0.0, 0.0, sigma0, 1.0, 1.0]))
+        self.DeclareReplanSchedule(replan_period_s=replan_period,
+                                   first_due_s=replan_period if replan_period > 0 else math.inf)
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
         deps = {self.xd_ticket(), self.est_port.ticket(), self.fc_port.ticket()}
         self.DeclareVectorOutputPort("bank_magnitude", 1, lambda c, o: o.SetAtIndex(0, self.commands(c)[0]),
@@ -81,8 +84,11 @@ class SwarmBankGuidance(LeafSystem):
                                      prerequisites_of_calc=deps)
         self.DeclareVectorOutputPort("sigma0", 1, lambda c, o: o.SetAtIndex(0, self._memory(c)[_SIGMA0]),
                                      prerequisites_of_calc={self.xd_ticket()})
-        self.DeclareVectorOutputPort("plan_stats", 3, lambda c, o: o.SetFromVector(self._memory(c)[_PLANS:_NEXT]),
-                                     prerequisites_of_calc={self.xd_ticket()})
+        self.DeclareVectorOutputPort("plan_stats", 3, self._plan_stats, prerequisites_of_calc={self.xd_ticket()})
+
+    def _plan_stats(self, context, output):
+        s = self.replan_stats(context)
+        output.SetFromVector([s.attempts, s.flawed, s.wall_s])
 
     def _memory(self, context) -> np.ndarray:
         return context.get_discrete_state(self._state).get_value()
@@ -104,34 +110,35 @@ class SwarmBankGuidance(LeafSystem):
         m = self._memory(context).copy()
         _, alpha, nxt = self.commands(context)
         m[_ALPHA], m[_ABOVE], m[_SWITCHED] = alpha, float(nxt.mach_was_above[0]), float(nxt.switched[0])
-        if self.resolve_scaling and self.resolve_period > 0:  # only re-solutions read the ratios
+        if self.acceleration_scaling and self.replan_period_s > 0:  # only re-solutions read the ratios
             self._update_ratios(context, m)
         t = context.get_time()
-        if t >= m[_NEXT] - 1e-9:
-            m[_NEXT] += self.resolve_period
+        if self.replan_due(context):
             x = np.asarray(self.est_port.Eval(context), float)
             p = self.problem
             e = p.energy(x[0], x[3])
-            if (e - p.start_energy) / (p.ef - p.start_energy) <= self.resolve_until_e:
-                t0 = time.perf_counter()
+            if (e - p.start_energy) / (p.ef - p.start_energy) > self.replan_until_e:
+                self.skip(discrete_state, t)
+            else:
                 bank = float(self.bank_port.Eval(context)[0])
-                vehicle = p.vehicle
-                if self.resolve_scaling:
-                    vehicle = dc.replace(vehicle, aero=ScaledAero(vehicle.aero, lift_scale=float(m[_KL]),
-                                                                  drag_scale=float(m[_KD])))
-                here = dc.replace(p, vehicle=vehicle, x0=x, e0=p.start_energy, origin=(p.x0[1], p.x0[2]),
-                                  initial_alpha=alpha, initial_bank=bank, initial_sign=1.0 if bank >= 0 else -1.0,
-                                  memory=(bool(nxt.mach_was_above[0]), bool(nxt.switched[0])),
-                                  max_time_s=max(p.max_time_s - t, p.guidance_step_s))
-                try:
+
+                def solve():
+                    vehicle = p.vehicle
+                    if self.acceleration_scaling:
+                        vehicle = dc.replace(vehicle, aero=ScaledAero(vehicle.aero, lift_scale=float(m[_KL]),
+                                                                      drag_scale=float(m[_KD])))
+                    here = dc.replace(p, vehicle=vehicle, x0=x, e0=p.start_energy, origin=(p.x0[1], p.x0[2]),
+                                      initial_alpha=alpha, initial_bank=bank,
+                                      initial_sign=1.0 if bank >= 0 else -1.0,
+                                      memory=(bool(nxt.mach_was_above[0]), bool(nxt.switched[0])),
+                                      max_time_s=max(p.max_time_s - t, p.guidance_step_s))
                     r = resolve_sigma0(here, math.degrees(m[_SIGMA0]), self.bounds_deg)
-                except Exception:  # a failed re-solution must not stop the flight: sigma_0 flies on
-                    r = None
-                if r is not None and math.isfinite(r.sigma0_deg):
-                    m[_SIGMA0] = math.radians(r.sigma0_deg)
-                m[_PLANS] += 1
-                m[_FAILED] += r is None or not r.bracketed or not math.isfinite(r.sigma0_deg)
-                m[_WALL] += time.perf_counter() - t0
+                    finite = math.isfinite(r.sigma0_deg)
+                    return r, finite, "" if finite and r.bracketed else "no bracketed root"
+
+                outcome = self.attempt(context, discrete_state, solve)
+                if outcome.applied:
+                    m[_SIGMA0] = math.radians(outcome.result.sigma0_deg)
         discrete_state.get_mutable_vector(self._state).SetFromVector(m)
 
     def _update_ratios(self, context, m):

@@ -21,6 +21,8 @@ from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 
+__all__ = ["N_STATE", "N_CONDITIONS", "EntryVehicle_", "EntryVehicle"]
+
 N_STATE = 6
 N_CONDITIONS = len(dynamics.FLIGHT_CONDITION_NAMES)
 

@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
+from drake_entry.campaign.backends import Task
+from drake_entry.campaign.engine import run_cases, task_manifest
 from drake_entry.campaign.store import read_rows
-from drake_entry.diagrams.backends import Task
-from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.errors import CampaignError, ScenarioError
-from drake_entry.guidance.scvx.aborts import (
+from drake_entry.guidance.scvx.aborts.cases import (
     PAPER_TABLES,
     abort_statistics,
     case_mission,
@@ -137,8 +137,8 @@ def test_one_orbital_abort_is_planned_flown_and_reported(tmp_path):
     """The nominal EIP as a 1 x 1 map through the campaign engine: the plan succeeds and its
     Drake flight ends inside the 10-km radius (measured 9.97 km flown, 476 MJ/m^2); the report
     carries the Tables 4-7 form and the maps."""
-    from drake_entry.diagrams.aborts import run_orbital_aborts
-    from drake_entry.guidance.scvx.abort_report import write_abort_report
+    from drake_entry.guidance.scvx.aborts.report import write_abort_report
+    from drake_entry.guidance.scvx.aborts.study import run_orbital_aborts
 
     out = run_orbital_aborts(str(tmp_path), shape=(1, 1), backend="serial", progress=False)
     rows, _ = read_rows(out)
@@ -159,7 +159,7 @@ def test_descent_aborts_stop_where_the_planner_cannot_start():
     nominal's 33 used to raise 'entry_speed_m_s out of range')."""
     import numpy as np
 
-    from drake_entry.guidance.scvx.aborts import descent_abort_cases
+    from drake_entry.guidance.scvx.aborts.cases import descent_abort_cases
     from drake_entry.models.planet import Earth
 
     t = np.linspace(0.0, 1600.0, 161)

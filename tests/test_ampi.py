@@ -115,7 +115,7 @@ def test_inconsistent_cases_are_named_with_their_reason():
 def test_case_problem_offsets_the_entry_and_keeps_the_geodetic_altitude():
     """Eq. 6: x(t0) = x*(t0) + offsets; an altitude offset is geodetic, and a latitude offset
     keeps the geodetic entry altitude (100.1 km + dh) on the oblate Earth."""
-    from drake_entry.diagrams.ampi_database import case_problem
+    from drake_entry.guidance.ampi.database_study import case_problem
     from drake_entry.planning.ocp_yaml import load_problem
 
     problem, _ = load_problem("shefex3")
@@ -136,7 +136,7 @@ def test_database_build_by_continuation_is_verified_resumable_and_stored(tmp_pat
     """A reduced database (V at -35, 0, +35 m/s) through the campaign engine: every case
     verified, the off-nominal ones warm-started from the nominal, consistent, stored at the LD
     nodes; a rerun solves nothing again; the stored LD samples rebuild the solution."""
-    from drake_entry.diagrams.ampi_database import DATABASE_FILE, DatabaseStudy, build_database
+    from drake_entry.guidance.ampi.database_study import DATABASE_FILE, DatabaseStudy, build_database
 
     grid = ParameterGrid.from_steps({"V": 35.0})
     study = DatabaseStudy(grid=grid.as_dict(), ld_nodes=60)

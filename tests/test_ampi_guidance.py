@@ -186,7 +186,7 @@ def test_reduced_campaign_ampi_against_ntt_table_3_form(tmp_path):
     import pandas as pd
     from pydrake.common.yaml import yaml_dump_typed
 
-    from drake_entry.diagrams.montecarlo import run_campaign
+    from drake_entry.campaign.montecarlo import run_campaign
     from drake_entry.scenario import Scenario, load_scenario
 
     s = load_scenario("shefex3_ampi")
@@ -210,7 +210,7 @@ def test_accuracy_study_and_reconstruction_error(tmp_path):
     """Eq. 13 on 6 entries: every entry's own OCP verified, AMPI's references nearer to it
     than NTT's on average; the nominal's LD-60 reconstruction against its own flown bank
     within the figures docs/methods/ampi.md gives (156 m, 5.7 km at the end)."""
-    from drake_entry.diagrams.ampi_accuracy import AccuracyStudy, accuracy_study, reconstruction_error, summarise
+    from drake_entry.guidance.ampi.accuracy_study import AccuracyStudy, accuracy_study, reconstruction_error, summarise
 
     rows = accuracy_study(str(tmp_path / "acc"), AccuracyStudy(cases=6), workers=2, progress=False)
     s = summarise(rows)

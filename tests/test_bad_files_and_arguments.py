@@ -163,9 +163,9 @@ def test_optimize_refuses_a_node_cap_below_the_nodes_before_solving(capsys):
 
 
 @pytest.mark.parametrize("call", [
-    lambda: __import__("drake_entry.diagrams.montecarlo", fromlist=["x"]).run_campaign("horus2b", runs=1, out_dir=None),
-    lambda: __import__("drake_entry.diagrams.montecarlo", fromlist=["x"]).run_campaign(None, runs=1, out_dir="x"),
-    lambda: __import__("drake_entry.diagrams.montecarlo", fromlist=["x"]).run_campaign(
+    lambda: __import__("drake_entry.campaign.montecarlo", fromlist=["x"]).run_campaign("horus2b", runs=1, out_dir=None),
+    lambda: __import__("drake_entry.campaign.montecarlo", fromlist=["x"]).run_campaign(None, runs=1, out_dir="x"),
+    lambda: __import__("drake_entry.campaign.montecarlo", fromlist=["x"]).run_campaign(
         "horus2b", runs=1, out_dir="x", overrides="guidance.period_s=2"),
     lambda: __import__("drake_entry.diagrams.closed_loop", fromlist=["x"]).ClosedLoopSetup.from_scenario(3),
     lambda: load_scenario(None),

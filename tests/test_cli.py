@@ -80,7 +80,7 @@ def test_results_of_every_closed_loop_scenario_in_reduced_size(tmp_path):
     others' campaigns and reports run in their own slow tests (cav_h_paper004 in test_swarm_bank,
     shefex3_ampi in test_ampi_guidance; marv_guidance closed loop in example 14): running them here
     as well cost CI's 30-minute budget about 3 minutes."""
-    from drake_entry.cli import closed_loop_scenarios
+    from drake_entry.scenario import closed_loop_scenarios
 
     out = tmp_path / "results"
     names = ["horus2b", "sphynx_paper001"]

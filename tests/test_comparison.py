@@ -7,8 +7,8 @@ import pytest
 from pydrake.common.yaml import yaml_dump_typed
 from scipy import stats
 
-from drake_entry.campaign.comparison_report import clopper_pearson, dispersion_check, method_summary
-from drake_entry.comparison import (
+from drake_entry.comparison.report import clopper_pearson, dispersion_check, method_summary
+from drake_entry.comparison.spec import (
     PACKAGED_COMPARISONS,
     ComparedMethod,
     Comparison,
@@ -22,11 +22,24 @@ from drake_entry.scenario import load_scenario
 
 
 @pytest.mark.parametrize("name", PACKAGED_COMPARISONS)
-def test_a_packaged_comparison_lists_every_registered_method(name):
+def test_a_packaged_comparison_accounts_for_every_registered_method(name):
+    """Each listed method says how the mission maps to it or why it is not flown; a registered
+    method the file does not list is a not-flown entry 'not configured' (no hand-written line)."""
     comp = load_comparison(name)
-    assert {m.method for m in comp.methods} == {spec.__name__ for spec in REGISTRY}
     for m in comp.methods:
         assert m.mapping or m.not_flown, f"{m.label}: say how the mission maps to it, or why it is not flown"
+    unlisted = comp.not_configured()
+    assert {m.method for m in comp.methods + unlisted} == {spec.__name__ for spec in REGISTRY}
+    assert all(m.not_flown.startswith("not configured") for m in unlisted)
+
+
+def test_a_method_the_comparison_does_not_list_is_reported_not_configured():
+    comp = Comparison(name="one", mission="horus2b", methods=[
+        ComparedMethod(label="bank_profile", method="BankProfile", mapping="m")]).validate()
+    unlisted = {m.method: m for m in comp.not_configured()}
+    assert set(unlisted) == {spec.__name__ for spec in REGISTRY} - {"BankProfile"}
+    assert unlisted["DragEnergy"].label == "drag_energy" and not unlisted["DragEnergy"].guidance
+    assert "not configured: this comparison gives no settings for !DragEnergy" in unlisted["DragEnergy"].not_flown
 
 
 @pytest.mark.parametrize("name", PACKAGED_COMPARISONS)
@@ -132,8 +145,8 @@ def test_the_method_summary_counts_and_measures_the_rows():
 
 @pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
 def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path, monkeypatch):
+    from drake_entry.comparison.runner import run_comparison
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup
-    from drake_entry.diagrams.comparison import run_comparison
 
     built = []  # pre-flight plans made in this process (workers=1 runs the samples here too)
     from_scenario = ClosedLoopSetup.from_scenario
@@ -152,8 +165,11 @@ def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path, m
     de, bp = summary["methods"]["drag_energy"], summary["methods"]["bank_profile"]
     assert de["successful"] == 2 and bp["successful"] == 0  # the fixed profile misses the 2-km box
     assert bp["miss_km"]["median"] > 2.0 > de["miss_km"]["max"]
-    assert summary["not_flown"] == {"ampi": "no database of this vehicle"}
-    assert "| ampi (!Ampi) | — | not flown |" in text and "Same dispersions: sample i drew the same" in text
+    assert summary["not_flown"]["ampi"] == "no database of this vehicle"
+    unlisted = {spec.__name__ for spec in REGISTRY} - {"DragEnergy", "BankProfile", "Ampi"}
+    assert {k for k, v in summary["not_flown"].items() if v.startswith("not configured")} == {
+        m.label for m in comp.not_configured()} and {m.method for m in comp.not_configured()} == unlisted
+    assert "| ampi (!Ampi) | — | not flown |" in text and "| fnpeg (!Fnpeg) | — | not flown |" in text and "Same dispersions: sample i drew the same" in text
     assert "| [drag_energy](drag_energy/report.md) (!DragEnergy) | 2 | 2 [" in text
     for fig in ("comparison_footprints.png", "comparison_success.png", "comparison_miss.png"):
         assert (tmp_path / "cmp" / fig).stat().st_size > 10_000 and fig in text

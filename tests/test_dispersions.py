@@ -69,3 +69,34 @@ def test_density_bias_is_absorbed_by_sensed_drag_feedback(scale, miss_km):
     assert res.success == (res.errors["distance_m"] <= 2e3) and res.box["distance"]["inside"] == res.success
     tr = res.trajectory
     assert tr.column("heat_flux").max() <= 530e3 and tr.column("normal_load").max() <= 2.5
+
+
+@pytest.mark.parametrize("field, edge, outside", [
+    ("density_scale", 1e-3, 0.0), ("density_scale", 50.0, None),
+    ("density_wave_amplitude", -0.999, -1.0), ("density_wave_amplitude", 0.999, 1.0),
+    ("lift_scale", 1e-3, 0.0), ("drag_scale", 1e-3, 0.0), ("mass_scale", 1e-3, 0.0), ("mass_scale", 50.0, None),
+])
+def test_a_dispersion_the_scenario_accepts_at_its_bound_the_models_accept(field, edge, outside):
+    """One validation per input: a value at the edge of what the scenario check accepts is drawn,
+    built into the sample's closed loop (dispersed atmosphere, aerodynamics, mass) and gives finite
+    equations of motion at the entry state; the value just outside is refused by the scenario
+    check, naming the field, before any sample."""
+    import dataclasses as dc
+
+    from drake_entry.diagrams.closed_loop import ClosedLoopSetup, build_closed_loop
+    from drake_entry.guidance.bank_profile.spec import BankProfile
+
+    scenario = load_scenario("horus2b")
+    scenario.guidance = BankProfile(terminal_altitude_km=26.5, bank_start_deg=60.0, bank_end_deg=50.0)
+    scenario.simulation = dc.replace(scenario.simulation, plant="python")
+    setattr(scenario.dispersions, field, edge)
+    scenario.validate()
+    d = draw(scenario.dispersions, RandomGenerator(3))
+    built = build_closed_loop(ClosedLoopSetup.from_scenario(scenario), draw=d)
+    context = built.diagram.CreateDefaultContext()
+    derivatives = built.diagram.EvalTimeDerivatives(context).CopyToVector()
+    assert derivatives.size >= 6 and np.all(np.isfinite(derivatives))
+    if outside is not None:
+        setattr(scenario.dispersions, field, outside)
+        with pytest.raises(ScenarioError, match=f"dispersions.{field}"):
+            scenario.validate()

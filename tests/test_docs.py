@@ -42,7 +42,7 @@ def _schemas(root):
 
 @pytest.mark.parametrize("module, name", [("drake_entry.scenario", "Scenario"), ("drake_entry.models.vehicles", "VehicleSpec"),
                                           ("drake_entry.planning.ocp_yaml", "ProblemSpec"),
-                                          ("drake_entry.comparison", "Comparison")])
+                                          ("drake_entry.comparison.spec", "Comparison")])
 def test_yaml_reference_has_every_schema_field(module, name):
     import importlib
 

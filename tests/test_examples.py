@@ -63,7 +63,7 @@ def test_every_example_is_tested():
 def test_example_01(tmp_path):
     """The hand-wired diagram flies what an independent scipy DOP853 integration of the same
     equations, schedules and bank actuator gives (0.24 mm and 3e-6 m/s apart after 300 s)."""
-    from drake_entry.scipy_open_loop import solve_ivp_open_loop
+    from reference_open_loop import solve_ivp_open_loop
 
     r = _run("01_open_loop_diagram", tmp_path)
     sol, _ = solve_ivp_open_loop(load_scenario("horus2b"), 300.0, method="DOP853", rtol=1e-11)
@@ -303,3 +303,28 @@ def test_example_18(tmp_path):
     assert one.segments == 1 and seg.segments == 4 and one.nodes == seg.nodes == 81
     assert seg.objective == pytest.approx(-0.5345158, rel=1e-4) and t_seg < t_one
     assert os.path.exists(tmp_path / "segments.png")
+
+
+def test_the_examples_command_line_passes_quick_out_and_options_and_exits_by_the_claims(tmp_path, capsys):
+    """run_example: --quick, --out and an example's own options reach main; the exit status is
+    the claims' (1 when one fails)."""
+    from drake_entry.claims import Claims, run_example
+
+    seen = {}
+
+    def main(quick, out_dir, runs=20):
+        seen.update(quick=quick, out_dir=out_dir, runs=runs)
+        return runs
+
+    def check(result, quick):
+        c = Claims("stub")
+        c.check("runs is 3", result == 3, str(result))
+        return c
+
+    options = [("--runs", {"type": int, "default": 20})]
+    code = run_example("doc", main, check, out="out/x", options=options,
+                       argv=["--quick", "--out", str(tmp_path), "--runs", "3"])
+    assert code == 0 and seen == {"quick": True, "out_dir": str(tmp_path), "runs": 3}
+    assert run_example("doc", main, check, out="out/x", options=options, argv=[]) == 1
+    assert seen == {"quick": False, "out_dir": "out/x", "runs": 20}
+    assert "FAILED" in capsys.readouterr().out

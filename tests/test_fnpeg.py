@@ -179,7 +179,7 @@ def _scenario(overrides, name="cav_h_fnpeg"):
 @pytest.mark.parametrize("overrides, field", [
     ({"guidance.alpha_deg": [10.0, 12.0], "guidance.alpha_velocity_m_s": [1000.0]}, "guidance.alpha_deg"),
     ({"guidance.alpha_velocity_m_s": [7000.0, 2000.0]}, "guidance.alpha_velocity_m_s"),
-    ({"guidance.corrector_period_s": 0.5}, "guidance.corrector_period_s"),
+    ({"guidance.replan_period_s": 0.5}, "guidance.replan_period_s"),
     ({"guidance.bank_end_deg": 95.0}, "guidance.bank_end_deg"),
     ({"guidance.predictor_step_s": 0.0}, "guidance.predictor_step_s"),
     ({"vehicle_limits": {"mass_kg": 1.0}}, "vehicle_limits"),

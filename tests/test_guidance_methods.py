@@ -10,9 +10,9 @@ import pyarrow.parquet as pq
 import pytest
 from pydrake.common.yaml import yaml_dump_typed
 
+from drake_entry.campaign.montecarlo import TIMING_COLUMNS, run_campaign
 from drake_entry.campaign.report import summary_statistics, write_report
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
-from drake_entry.diagrams.montecarlo import TIMING_COLUMNS, run_campaign
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance import REGISTRY, method_for
 from drake_entry.guidance.bank_profile.spec import BankProfile

@@ -95,7 +95,7 @@ def test_skip_out_and_ground_impact_end_with_a_terminal_reason():
 
 # -- campaign store -------------------------------------------------------------------------
 def _run(tmp_path, scenario="horus2b", runs=2, out="c", **kw):
-    from drake_entry.diagrams.montecarlo import run_campaign
+    from drake_entry.campaign.montecarlo import run_campaign
 
     kw.setdefault("workers", 1)
     return run_campaign(scenario, runs=runs, out_dir=str(tmp_path / out), seed=kw.pop("seed", 3), progress=False,
@@ -200,7 +200,7 @@ def test_repeated_kills_lose_and_repeat_no_sample(tmp_path):
     """SIGKILL three times, each once the campaign has written 1, 3 and 4 rows (asserted: every
     kill landed mid-campaign), then resume: every sample once, each trajectory once."""
     out = tmp_path / "killed"
-    code = ("from drake_entry.diagrams.montecarlo import run_campaign; "
+    code = ("from drake_entry.campaign.montecarlo import run_campaign; "
             f"run_campaign('horus2b', runs=6, out_dir={str(out)!r}, seed=5, workers=1, progress=False)")
     def rows_done() -> int:
         try:

@@ -12,9 +12,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from drake_entry.campaign.montecarlo import MAX_RUNS, run_campaign
 from drake_entry.campaign.store import done_indices
-from drake_entry.cli import check_output_dir, main, os_error_line
-from drake_entry.diagrams.montecarlo import MAX_RUNS, run_campaign
+from drake_entry.cli import main
+from drake_entry.cli.common import check_output_dir, os_error_line
 from drake_entry.errors import ScenarioError
 
 
@@ -119,12 +120,12 @@ def test_out_below_a_regular_file_is_one_line_before_any_work(tmp_path, capsys, 
 
 def test_an_os_error_from_any_command_is_one_line_naming_the_path(tmp_path, capsys, monkeypatch):
     """A read-only file system (simulated: os.makedirs refused with EROFS) in the report."""
-    import drake_entry.cli as cli
+    import drake_entry.cli.campaigns as campaigns
 
     def refuse(*a, **k):
         raise OSError(errno.EROFS, "Read-only file system", str(tmp_path / "r"))
 
-    monkeypatch.setattr(cli, "_write_and_print_report", refuse)
+    monkeypatch.setattr(campaigns, "write_and_print_report", refuse)
     (tmp_path / "r").mkdir()
     code = main(["report", str(tmp_path / "r")])
     err = capsys.readouterr().err
@@ -142,7 +143,7 @@ def test_a_runaway_campaign_size_is_refused_at_once(tmp_path):
 
 def test_an_unreachable_dask_scheduler_is_one_line(tmp_path, monkeypatch):
     pytest.importorskip("dask.distributed")
-    import drake_entry.diagrams.backends as backends
+    import drake_entry.campaign.backends as backends
 
     monkeypatch.setattr(backends, "SCHEDULER_TIMEOUT_S", 1)
     with pytest.raises(ScenarioError, match=r"--scheduler tcp://127\.0\.0\.1:9: no Dask scheduler answered within 1 s"):

@@ -70,7 +70,7 @@ def test_a_plan_flight_is_ok_only_inside_every_criterion_with_every_limit_held()
     ("replan_nodes", [30, 20], "guidance.replan_nodes = [30, 20]; allowed [min, max]"),
     ("path_margin", 0.7, "guidance.path_margin"),
     ("final_flight_path_deg", -95.0, "guidance.final_flight_path_deg"),
-    ("replan_period_s", 0.5, "must be 0 or >= guidance.period_s"),
+    ("replan_period_s", 0.5, "replan_period_s = 0.5 is out of range; allowed: 0 "),
     ("problem", "no_such_problem", "no_such_problem"),
     ("feedback", "pid", "guidance.feedback = 'pid' is unknown; allowed: tvlqr, costate, none"),
     ("feedback_state_weight", 0.0, "guidance.feedback_state_weight"),

@@ -8,7 +8,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from drake_entry.diagrams.montecarlo import run_campaign
+from drake_entry.campaign.montecarlo import run_campaign
 from drake_entry.scenario import load_scenario
 
 #: the path limits as the papers state them (peak column: limit, SI)

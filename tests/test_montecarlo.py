@@ -6,10 +6,10 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from drake_entry.campaign.montecarlo import TIMING_COLUMNS, done_indices, run_campaign, run_sample, sample_seed
 from drake_entry.campaign.report import summary_statistics, write_report
+from drake_entry.campaign.sample import DETAILED_SAMPLES, DETAILED_STEP_S
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup
-from drake_entry.diagrams.montecarlo import TIMING_COLUMNS, done_indices, run_campaign, run_sample, sample_seed
-from drake_entry.diagrams.sample import DETAILED_SAMPLES, DETAILED_STEP_S
 from drake_entry.errors import CampaignError
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
 from drake_entry.scenario import load_scenario

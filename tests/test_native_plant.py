@@ -144,8 +144,8 @@ def test_a_model_without_symbolic_form_flies_the_python_plant_unless_native_is_d
 
 
 def test_a_campaign_row_names_the_plant_it_flew(tmp_path):
+    from drake_entry.campaign.sample import run_sample
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup
-    from drake_entry.diagrams.sample import run_sample
     from drake_entry.scenario import load_scenario
 
     scenario = load_scenario("horus2b")

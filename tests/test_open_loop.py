@@ -1,10 +1,10 @@
 """The Drake open-loop diagram against an independent scipy integration of the same equations."""
 import numpy as np
 import pytest
+from reference_open_loop import solve_ivp_open_loop
 
 from drake_entry.diagrams.open_loop import simulate
 from drake_entry.scenario import load_scenario
-from drake_entry.scipy_open_loop import solve_ivp_open_loop
 
 
 @pytest.fixture(scope="module")
@@ -45,8 +45,8 @@ def test_cli_simulate_writes_table_summary_and_plots(tmp_path):
     says; six PNG figures."""
     import json
 
-    from drake_entry.campaign.tables import read_table
     from drake_entry.cli import main
+    from drake_entry.tables import read_table
 
     assert main(["simulate", "horus2b", "--out", str(tmp_path), "--format", "csv"]) == 0
     t = read_table(str(tmp_path / "trajectory.csv"))

@@ -53,24 +53,25 @@ def _fly(planner, until_s: float, replan_s: float = 10.0):
         simulator.AdvanceTo(t)
         context = guidance.GetMyContextFromRoot(simulator.get_context())
         served.append(guidance.GetOutputPort("reference").Eval(context)[0])
-    return np.array(served), guidance.memory(guidance.GetMyContextFromRoot(simulator.get_context()))
+    context = guidance.GetMyContextFromRoot(simulator.get_context())
+    return np.array(served), guidance.memory(context), guidance.replan_stats(context)
 
 
 def test_a_failed_replan_keeps_the_previous_reference_and_is_retried_a_period_later():
     planner = ScriptedPlanner({2: "raise", 3: "unsuccessful"})
-    served, memory = _fly(planner, 45.0)
+    served, memory, stats = _fly(planner, 45.0)
     # plans at t = 0 (1), 10 (raises), 20 (unsuccessful), 30 (drag 4), 40 (drag 5)
     assert planner.calls == 5
     expected = np.repeat([1.0, 1.0, 1.0, 4.0, 5.0], 10)[: len(served)]
     assert np.array_equal(served, expected)
-    assert memory.plans == 3 and memory.engaged_at == 0.0
+    assert stats.applied == 3 and stats.attempts == 5 and memory.engaged_at == 0.0
     assert [(t, m) for t, m in memory.failures] == [(10.0, "FloatingPointError: forced solver failure"),
                                                     (20.0, "forced: not converged")]
 
 
 def test_a_failed_first_plan_stays_in_pre_guidance_until_one_succeeds():
     planner = ScriptedPlanner({1: "raise", 2: "unsuccessful"})
-    served, memory = _fly(planner, 35.0)
+    served, memory, _ = _fly(planner, 35.0)
     # without a reference the guidance serves zeros (not engaged); the first plan is retried at
     # the next guidance update (no re-plan period applies before engagement)
     assert np.array_equal(served[:2], [0.0, 0.0]) and served[2] == 3.0
@@ -149,7 +150,7 @@ def test_a_swarm_resolution_that_raises_keeps_sigma0_and_is_counted(monkeypatch)
     monkeypatch.setattr(swarm, "resolve_sigma0", scripted)
     builder = DiagramBuilder()
     guidance = builder.AddSystem(swarm.SwarmBankGuidance(problem, math.radians(58.0), period=1.0,
-                                                         resolve_period=10.0, resolve_scaling=False))
+                                                         replan_period=10.0, acceleration_scaling=False))
     for port, value in (("estimated_state", problem.x0), ("flight_conditions", np.ones(len(FLIGHT_CONDITION_NAMES))),
                         ("bank_command", [0.5])):
         builder.Connect(builder.AddSystem(ConstantVectorSource(np.asarray(value, float))).get_output_port(),

@@ -107,7 +107,7 @@ def test_plan_names_violated_path_limits():
     ("alpha_law", "drag", "allowed: 'load'"),
     ("bank_start_bounds_deg", [50.0, 40.0], "lower < upper"),
     ("landmark_iteration", 30, "guidance.landmark_iteration = 30 is out of range"),
-    ("resolve_period_s", 0.5, "must be 0 or >= guidance.period_s"),
+    ("replan_period_s", 0.5, "replan_period_s = 0.5 is out of range; allowed: 0 "),
 ])
 def test_bad_spec_fields_are_one_line_errors(field, value, match):
     s = load_scenario("cav_h_paper004")
@@ -140,13 +140,13 @@ def test_campaign_rows_and_report_for_fixed_and_on_board_sigma0(tmp_path):
     and, on the same draws, misses by less (seed 3, fixed: 105 and 832 km)."""
     import pyarrow.parquet as pq
 
+    from drake_entry.campaign.montecarlo import run_campaign
     from drake_entry.campaign.report import write_report
-    from drake_entry.diagrams.montecarlo import run_campaign
 
     rows = {}
     for name, period in (("fixed", 0.0), ("onboard", 400.0)):
         out = run_campaign("cav_h_paper004", runs=2, out_dir=str(tmp_path / name), seed=3, workers=1, progress=False,
-                           overrides={"guidance.bank_start_deg": SIGMA0_CASE1, "guidance.resolve_period_s": period})
+                           overrides={"guidance.bank_start_deg": SIGMA0_CASE1, "guidance.replan_period_s": period})
         rows[name] = pq.read_table(f"{out}/samples.parquet").to_pydict()
         assert rows[name]["method"] == ["swarm_bank"] * 2 and rows[name]["stop"] == ["reached energy"] * 2
         text = open(write_report(out)).read()
@@ -187,7 +187,7 @@ def test_on_board_predictions_learn_the_lift_and_drag_the_flight_shows():
     from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
 
     p = problem_from_scenario(_scenario())
-    system = SwarmBankGuidance(p, math.radians(SIGMA0_CASE1), resolve_period=1e4)  # no re-solution within 300 s
+    system = SwarmBankGuidance(p, math.radians(SIGMA0_CASE1), replan_period=1e4)  # no re-solution within 300 s
     context = system.CreateDefaultContext()
     x = np.array([50e3, p.x0[1], p.x0[2], 5000.0, 0.0, p.x0[5]])
     rho, a = p.atmosphere.air_data(50e3)

@@ -49,8 +49,7 @@ def test_packaged_scenarios_validate(name):
     guidance's terminal interface (closed-loop scenarios), and the target is a point on Earth."""
     from pydrake.common.yaml import yaml_dump_typed
 
-    from drake_entry.cli import closed_loop_scenarios
-    from drake_entry.scenario import Scenario
+    from drake_entry.scenario import Scenario, closed_loop_scenarios
     from drake_entry.typed_yaml import load_yaml_typed
 
     s = load_scenario(name)

@@ -76,8 +76,8 @@ def test_a_closed_loop_flight_that_breaks_a_limit_is_not_a_success():
     limit is 500 kW/m^2: it reaches E_f inside the acceptance box, but the verdict says breached,
     with the peak and margin in the row and the message; with a 4 % tolerance in the scenario it
     is a success again. (At 3dec588 the box alone made ``success``.)"""
+    from drake_entry.campaign.sample import campaign_row
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
-    from drake_entry.diagrams.sample import campaign_row
     from drake_entry.scenario import load_scenario
 
     scenario = load_scenario("horus2b")

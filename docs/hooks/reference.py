@@ -38,7 +38,23 @@ def on_config(config):
         os.symlink(os.path.join(ROOT, directory), os.path.join(package, name))
     handlers = config["plugins"]["mkdocstrings"].config["handlers"]
     handlers.setdefault("python", {})["paths"] = [tree]
+    for section in config["nav"]:
+        if isinstance(section, dict) and "Methods" in section:
+            section["Methods"] = methods_nav()
     return config
+
+
+def methods_nav() -> list:
+    """The Methods section: every page of docs/methods/, titled by its first heading, the papers'
+    in paper order first (a new method's page needs no line in mkdocs.yml)."""
+    folder = os.path.join(ROOT, "docs", "methods")
+    pages = []
+    for name in os.listdir(folder):
+        if name.endswith(".md"):
+            with open(os.path.join(folder, name)) as f:
+                title = f.readline().lstrip("#").strip()
+            pages.append({title: f"methods/{name}"})
+    return sorted(pages, key=lambda page: (not next(iter(page)).startswith("Paper"), next(iter(page))))
 
 PAGES = {
     "reference/scenario.md": ("drake_entry.scenario", "Scenario", "Scenario YAML",
@@ -49,7 +65,7 @@ PAGES = {
                              "A vehicle file (`vehicle: path/to/file.yaml` in a scenario; packaged vehicles live "
                              "in `drake_entry/vehicles/`). `aero` maps model names to aerodynamic models; "
                              "`default_aero` picks one."),
-    "reference/comparison.md": ("drake_entry.comparison", "Comparison", "Comparison YAML",
+    "reference/comparison.md": ("drake_entry.comparison.spec", "Comparison", "Comparison YAML",
                                 "A comparison file (`drake-entry compare FILE.yaml`, `load_comparison(path)`): one "
                                 "mission and every guidance method's settings for it, or why it cannot fly it. "
                                 "Packaged comparisons live in `drake_entry/comparisons/`; see "
@@ -65,29 +81,34 @@ PAGES = {
 API_PAGES = (
     ("api/models.md", "Models",
      "The physics layer: plain Python and numpy (float, array, AutoDiffXd and, where noted, symbolic "
-     "`Expression` inputs), SI units inside. It imports nothing else of the project but its errors.",
-     ("models",), ("drake_entry.errors",)),
+     "`Expression` inputs), SI units inside. It imports nothing else of the project but its errors and the "
+     "typed YAML reader.",
+     ("models",), ("drake_entry.errors", "drake_entry.typed_yaml")),
     ("api/planning.md", "Shared planning",
      "What several methods share: the plan result, the optimal-control problem and its YAML form, the "
-     "LGL operators, the NLP transcriptions and solver, time-varying LQR tracking.",
-     ("planning",), ()),
+     "LGL operators, the NLP transcriptions and solver, time-varying LQR tracking; the shared figures and "
+     "trajectory tables.",
+     ("planning",), ("drake_entry.figures", "drake_entry.tables")),
     ("api/guidance.md", "Guidance methods",
      "The guidance-method interface and registry, then one section per method folder: its spec, "
-     "planner, plots and wiring (see [Architecture](../architecture.md) for how to add a method).",
+     "planner, plots, wiring and studies (see [Architecture](../architecture.md) for how to add a method).",
      ("guidance",), ()),
     ("api/systems.md", "Drake systems",
      "The Drake `LeafSystem`s of the plant, guidance and control (import them as "
      "`drake_entry.systems.<module>`). Each docstring lists the system's ports with their units.",
      ("systems",), ()),
-    ("api/diagrams.md", "Diagrams and campaigns",
-     "Diagram builders, the verification flights and the campaign engine (import them as "
-     "`drake_entry.diagrams.<module>`).",
+    ("api/diagrams.md", "Diagrams",
+     "Diagram builders (open and closed loop) and the plan verifier, the one Drake flight of a plan's "
+     "controls (import them as `drake_entry.diagrams.<module>`).",
      ("diagrams",), ()),
-    ("api/campaign.md", "Scenarios, reports and outputs",
-     "The scenario and comparison files, the campaign directory, the reports and their figures, the examples' "
-     "claims.",
-     ("campaign",), ("drake_entry.scenario", "drake_entry.comparison", "drake_entry.claims",
-                     "drake_entry.scipy_open_loop")),
+    ("api/campaign.md", "Scenarios, campaigns, comparisons and reports",
+     "The scenario file; the campaign engine (backends, Monte-Carlo samples), the campaign directory, the "
+     "reports and their figures; comparisons of several methods on one mission; the examples' claims.",
+     ("campaign", "comparison"), ("drake_entry.scenario", "drake_entry.claims")),
+    ("api/cli.md", "Command line",
+     "The `drake-entry` command: one module per command family, and the methods' own commands in "
+     "`drake_entry.cli.methods`, found through the registry.",
+     ("cli",), ()),
 )
 
 

@@ -41,6 +41,12 @@ from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario
 from drake_entry.typed_yaml import load_yaml_typed
 
+__all__ = ["ERROR_COLUMNS", "MARGIN_COLUMNS", "failure_categories", "finite_column", "reached_terminal",
+           "summary_statistics", "counts_sentence", "errors_markdown", "flown_scenario", "rows_as_columns",
+           "write_report", "write_markdown_report", "PEAK_QUANTITIES", "OTHER_QUANTITIES", "CONTROL_QUANTITIES",
+           "DISPERSION_FIELDS", "NAV_UNITS", "DISPERSION_LABELS", "NAV_NAMES", "table_cell", "format_number",
+           "drake_entry_version", "MAX_FAILED_LISTED", "miss_contributors", "figure_list", "write_html"]
+
 # (row column, label, unit) of the terminal errors, in the scenario schema's order
 ERROR_COLUMNS = tuple(zip(ERROR_COLUMN_NAMES,
                           ("Δh", "Δθ", "Δφ", "ΔV", "ΔR (range to go)", "cross-range", "distance to target"),
@@ -69,7 +75,7 @@ def failure_categories(row: dict) -> list[str]:
     return out or [message.split(":")[0][:80]]
 
 
-def _finite(rows: dict, col: str, n: int) -> np.ndarray:
+def finite_column(rows: dict, col: str, n: int) -> np.ndarray:
     """A column as floats (missing column or entry = nan)."""
     v = rows.get(col)
     return np.full(n, np.nan) if v is None else np.array([np.nan if x is None else x for x in v], float)
@@ -85,7 +91,7 @@ def reached_terminal(rows: dict) -> np.ndarray:
     flag = rows.get("reached_terminal") or [None] * n
     reached = [bool(f) if f is not None else (bool(s) and str(s).startswith("reached energy"))
                for f, s in zip(flag, stop)]
-    return np.array(reached, bool) & np.isfinite(_finite(rows, "err_distance_m", n))
+    return np.array(reached, bool) & np.isfinite(finite_column(rows, "err_distance_m", n))
 
 
 def summary_statistics(rows: dict) -> dict:
@@ -114,28 +120,28 @@ def summary_statistics(rows: dict) -> dict:
             reasons[key] = reasons.get(key, 0) + 1
     out["failure_reasons"] = reasons
     for col, _, _ in ERROR_COLUMNS:
-        v = _finite(rows, col, n)[reached]
+        v = finite_column(rows, col, n)[reached]
         if v.size == 0:
             continue
         out["errors"][col] = {"mean": float(v.mean()), "std": float(v.std(ddof=1)) if v.size > 1 else 0.0,
                               "p5": float(np.percentile(v, 5)), "p50": float(np.percentile(v, 50)),
                               "p95": float(np.percentile(v, 95)), "max_abs": float(np.abs(v).max())}
     if reached.any():
-        d = _finite(rows, "err_distance_m", n)[reached]
+        d = finite_column(rows, "err_distance_m", n)[reached]
         out["inside_km"] = {str(r): int((d <= r * 1e3).sum()) for r in (2, 25, 50, 75)}
     for col in [c for c in rows if c.startswith("inside_") and c.endswith("_box") and c != "inside_box"]:
         out["inside_box"][col[len("inside_"):-len("_box")]] = int(sum(bool(v) for v in rows[col] if v is not None))
     for col in [c for c in MARGIN_COLUMNS if c in rows] + sorted(c for c in rows if c.startswith("margin_")
                                                                   and c not in MARGIN_COLUMNS):
-        m = _finite(rows, col, n)
+        m = finite_column(rows, col, n)
         flew = np.isfinite(m)
         if flew.any():
             out["margins"][col] = {"worst": float(m[flew].min()), "violations": int((m[flew] < 0).sum()),
                                    "worst_sample": int(np.asarray(rows["index"])[flew][m[flew].argmin()])}
     if "wall_time_s" in rows:
-        w = _finite(rows, "wall_time_s", n)
+        w = finite_column(rows, "wall_time_s", n)
         out["wall_time_s"] = {"mean": float(np.nanmean(w)), "total": float(np.nansum(w))}
-        cost = {k: _finite(rows, k, n)[reached] for k in ("planning_wall_s", "plans", "derivative_evaluations")}
+        cost = {k: finite_column(rows, k, n)[reached] for k in ("planning_wall_s", "plans", "derivative_evaluations")}
         if reached.any() and all(np.isfinite(v).all() for v in cost.values()):
             out["cost"] = {"wall_s_per_sample": float(w[reached].mean()),
                            "planning_share": float(cost["planning_wall_s"].sum() / w[reached].sum()),
@@ -185,7 +191,7 @@ def flown_scenario(manifest: dict | None):
         return None
 
 
-def _columns(records: list) -> dict:
+def rows_as_columns(records: list) -> dict:
     keys = sorted({k for r in records for k in r if k != "traceback"})
     return {k: [r.get(k) for r in records] for k in keys}
 
@@ -208,7 +214,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     records = [cov["rows"][k] for k in sorted(cov["rows"])]
     if not records:
         raise CampaignError(f"{out_dir} holds a campaign without any finished sample yet: nothing to report")
-    rows = _columns(records)
+    rows = rows_as_columns(records)
     trajs = read_trajectories(out_dir, set(cov["rows"]))
     traj = None
     if trajs:
@@ -237,7 +243,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     sections = [_header(meta, stats, title, rows), _provenance(meta, stats), _dispersions(scenario),
                 _requirements(rows, reached, stats, scenario), _outcome(rows, stats, traj),
                 _distributions(rows, quantities, reached, stats, reference), _contributors(stats), _cost(stats),
-                _figure_list(figs)]
+                figure_list(figs)]
     return write_markdown_report(sections, out_dir, title=name)
 
 
@@ -333,19 +339,19 @@ def _quantities(rows: dict, reached) -> dict:
     out = {}
     for col, label, unit in ERROR_COLUMNS:
         if col in rows:
-            out[col] = (label, unit, _finite(rows, col, n)[reached])
+            out[col] = (label, unit, finite_column(rows, col, n)[reached])
     for col, label, unit, scale, *_ in PEAK_QUANTITIES + OTHER_QUANTITIES + CONTROL_QUANTITIES:
         if col in rows:
-            out[col] = (label, unit, _finite(rows, col, n) * scale)
+            out[col] = (label, unit, finite_column(rows, col, n) * scale)
     return out
 
 
-def _cell(text) -> str:
+def table_cell(text) -> str:
     """A Markdown table cell: a '|' in the text is escaped."""
     return str(text).replace("|", "\\|")
 
 
-def _fmt(x, digits: int = 4) -> str:
+def format_number(x, digits: int = 4) -> str:
     if x is None:
         return "—"
     if isinstance(x, float) and not math.isfinite(x):
@@ -483,12 +489,12 @@ def _requirements(rows: dict, reached, stats: dict, scenario) -> str:
         tol = getattr(term, c.tolerance)
         unit = f" {c.unit}" if c.unit else ""
         inside = int(sum(bool(v) for v, r in zip(rows[flag], reached) if r and v is not None))
-        e = _finite(rows, col, n)[reached] / c.si if col in rows else np.array([])
+        e = finite_column(rows, col, n)[reached] / c.si if col in rows else np.array([])
         e = e[np.isfinite(e)]
         worst = float(np.abs(e).max()) if e.size else math.nan
         centre = "" if c.centre is None or getattr(term, c.centre) is None else f" about {getattr(term, c.centre):g}{unit}"
         lines.append(f"| {c.label}{centre} | ≤ {tol:g}{unit} | largest absolute error of {nr} | "
-                     f"{_fmt(worst)}{unit} | {_fmt(tol - worst)}{unit} | "
+                     f"{format_number(worst)}{unit} | {format_number(tol - worst)}{unit} | "
                      f"{'PASS' if inside == nr == n else 'FAIL'} ({inside} of {n} inside) |")
     limits = []
     if scenario is not None:
@@ -503,15 +509,15 @@ def _requirements(rows: dict, reached, stats: dict, scenario) -> str:
         m = stats["margins"].get(f"margin_{lim.name}")
         if m is None:
             continue
-        flew = int(np.isfinite(_finite(rows, f"margin_{lim.name}", n)).sum())
+        flew = int(np.isfinite(finite_column(rows, f"margin_{lim.name}", n)).sum())
         peak = ""
         if lim.name in peaks and peaks[lim.name] in rows:
-            worst = float(np.nanmax(_finite(rows, peaks[lim.name], n))) * lim.scale
+            worst = float(np.nanmax(finite_column(rows, peaks[lim.name], n))) * lim.scale
             peak = f"{worst:.4g} {lim.unit}"
         else:
             peak = "—"
         ok = m["violations"] == 0
-        lines.append(f"| {lim.name} | {_cell(lim.bound_text())} | worst flown sample of {flew} | {peak} | "
+        lines.append(f"| {lim.name} | {table_cell(lim.bound_text())} | worst flown sample of {flew} | {peak} | "
                      f"{100 * m['worst']:.2f} % (sample {m['worst_sample']}) | "
                      f"{'PASS' if ok else 'FAIL'} ({flew - m['violations']} of {flew} held) |")
     note = (f"A limit counts as held up to its value plus {100 * tolerance:g} % of it (the scenario's "
@@ -544,7 +550,7 @@ def _outcome(rows: dict, stats: dict, traj) -> str:
             out.append(f"| {rows['index'][i]} | {rows.get('seed', ['?'] * len(rows['index']))[i]} | {reason} |")
         if len(failed) > MAX_FAILED_LISTED:
             out.append(f"| … | | {len(failed) - MAX_FAILED_LISTED} more in samples.parquet |")
-        out += ["", "Each sample re-runs alone and reproduces its row: `drake_entry.diagrams.sample.run_sample("
+        out += ["", "Each sample re-runs alone and reproduces its row: `drake_entry.campaign.sample.run_sample("
                 "ClosedLoopSetup.from_scenario(scenario), master_seed, index)`."]
     if stats.get("inside_km"):
         out += ["", "Samples within a distance of the target: " + ", ".join(
@@ -576,8 +582,8 @@ def _distributions(rows: dict, quantities: dict, reached, stats: dict, reference
             signed = key.startswith("err_") and key != "err_distance_m"
             bound = order_statistic_bound(np.abs(values) if signed else values)
             cells = [label + (" (bound on the absolute value)" if signed else ""), unit, str(d["n"])]
-            cells += [_fmt(d.get(k)) for k in ("min", "p0.13", "p1", "p50", "mean", "sigma", "p99", "p99.87", "max")]
-            cells.append(_fmt(bound) if bound is not None else f"— (needs {runs_for_bound()} runs)")
+            cells += [format_number(d.get(k)) for k in ("min", "p0.13", "p1", "p50", "mean", "sigma", "p99", "p99.87", "max")]
+            cells.append(format_number(bound) if bound is not None else f"— (needs {runs_for_bound()} runs)")
             lines.append("| " + " | ".join(cells) + " |")
         return "\n".join(lines)
 
@@ -613,12 +619,12 @@ def miss_contributors(rows: dict, reached, top: int = 5) -> list:
     with the miss distance over the reached samples: [{input, rho, p_value}] (empty below 8
     samples)."""
     n = len(rows["index"])
-    miss = _finite(rows, "err_distance_m", n)[reached]
+    miss = finite_column(rows, "err_distance_m", n)[reached]
     if miss.size < 8 or not np.isfinite(miss).all():
         return []
     out = []
     for col in sorted(c for c in rows if c.startswith("disp_")):
-        x = _finite(rows, col, n)[reached]
+        x = finite_column(rows, col, n)[reached]
         if not np.isfinite(x).all() or np.ptp(x) == 0.0:
             continue
         rho, p = sps.spearmanr(x, miss)
@@ -656,12 +662,12 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
     n = len(rows["index"])
     figs = []
     if reached.any():
-        errors = {f"{label} [{unit}]": _finite(rows, col, n)[reached] for col, label, unit in ERROR_COLUMNS if col in rows}
+        errors = {f"{label} [{unit}]": finite_column(rows, col, n)[reached] for col, label, unit in ERROR_COLUMNS if col in rows}
         figs.append(figures.error_histograms(errors, out_dir, title))
         radius = getattr(getattr(scenario, "terminal", None), "distance_tolerance_km", None)
-        figs.append(figures.footprint(_finite(rows, "err_crossrange_m", n)[reached] / 1e3,
-                                      _finite(rows, "err_range_m", n)[reached] / 1e3, out_dir, title, radius_km=radius))
-    peaks = {f"{label} [{unit}]": (_finite(rows, col, n) * scale,
+        figs.append(figures.footprint(finite_column(rows, "err_crossrange_m", n)[reached] / 1e3,
+                                      finite_column(rows, "err_range_m", n)[reached] / 1e3, out_dir, title, radius_km=radius))
+    peaks = {f"{label} [{unit}]": (finite_column(rows, col, n) * scale,
                                    getattr(limits, lim) * scale if limits is not None else None)
              for col, label, unit, scale, lim in PEAK_QUANTITIES if col in rows}
     figs.append(figures.peak_histograms(peaks, out_dir, title))
@@ -678,7 +684,7 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
 
 def _detailed_samples(traj: dict, step_s: float) -> list:
     """Samples stored finer than half the campaign's storage step ``step_s`` [s] (the first few
-    of a campaign, at the detailed step or the scenario's log period: diagrams.sample)."""
+    of a campaign, at the detailed step or the scenario's log period: campaign.sample)."""
     sample, t = np.asarray(traj["sample"]), np.asarray(traj["time_s"], float)
     out = []
     for s in np.unique(sample):
@@ -688,7 +694,7 @@ def _detailed_samples(traj: dict, step_s: float) -> list:
     return out[:5]
 
 
-def _figure_list(figs: list) -> str:
+def figure_list(figs: list) -> str:
     out = ["## Figures"]
     for k, (path, caption) in enumerate(figs, 1):
         name = os.path.basename(path)

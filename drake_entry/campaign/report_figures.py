@@ -12,8 +12,11 @@ import math
 import numpy as np
 from scipy import stats
 
-from drake_entry.campaign import plots  # sets the Agg backend before pyplot is imported
-from drake_entry.campaign.plots import plt
+from drake_entry.figures import plt, save_figure  # sets the Agg backend before pyplot is imported
+
+__all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "error_histograms",
+           "footprint", "peak_histograms", "envelopes", "OFF_SCALE", "path_quantities", "drag_profiles",
+           "ground_tracks", "bank_histories", "energy_range", "normalised_energy"]
 
 #: k of the 99 % probability ellipse of a 2-D normal: sqrt(chi2.ppf(0.99, 2)) = 3.035
 ELLIPSE_99_K = math.sqrt(stats.chi2.ppf(0.99, 2))
@@ -38,7 +41,7 @@ def fd_bins(values) -> np.ndarray | int:
 
 def _save(fig, out_dir: str, name: str, title: str) -> str:
     paths = []
-    plots.save_figure(fig, out_dir, name, paths, title)
+    save_figure(fig, out_dir, name, paths, title)
     return paths[0]
 
 

@@ -22,6 +22,9 @@ from scipy import stats
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["PERCENTILES", "COVERAGE", "CONFIDENCE", "SUCCESS_LEVELS", "success_lower_bound", "runs_for_bound",
+           "order_statistic_rank", "order_statistic_bound", "describe", "percentile_key"]
+
 #: the percentiles of the report [%] (P0.13 and P99.87: the normal distribution's 3-sigma levels)
 PERCENTILES = (0.13, 1.0, 50.0, 99.0, 99.87)
 #: the default coverage and confidence of the order-statistic bound

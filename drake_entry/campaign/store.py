@@ -30,6 +30,11 @@ import os
 
 from drake_entry.errors import CampaignError
 
+__all__ = ["FORMAT", "ROWS", "TRAJECTORIES", "QUARANTINE", "MANIFEST", "LOCK", "MANIFEST_COPY", "MANIFEST_TYPES",
+           "NOMINAL", "IDENTITY", "OPTIONAL_IDENTITY", "fingerprint", "CampaignStore", "write_atomic",
+           "read_manifest", "read_rows", "write_nominal", "read_nominal", "read_trajectories", "repair", "finalise",
+           "done_indices", "coverage"]
+
 FORMAT = 2
 ROWS, TRAJECTORIES, QUARANTINE, MANIFEST, LOCK = ("samples.jsonl", "trajectories.jsonl", "quarantine.jsonl",
                                                   "campaign.json", "campaign.lock")
@@ -46,7 +51,7 @@ IDENTITY = {"scenario_yaml": "scenario content", "vehicle_file_sha256": "vehicle
             "atmosphere_file_sha256": "atmosphere table content", "task": "task settings",
             "cases_sha256": "case list"}
 #: identity keys that count only when set (added after campaigns were written without them;
-#: 'task' and 'cases_sha256' belong to campaigns of generic cases, diagrams.campaign)
+#: 'task' and 'cases_sha256' belong to campaigns of generic cases, campaign.engine)
 OPTIONAL_IDENTITY = ("atmosphere_file_sha256", "task", "cases_sha256")
 
 
@@ -119,8 +124,8 @@ class CampaignStore:
             manifest["runs"] = max(int(old.get("runs", 0)), int(manifest["runs"]))
             manifest["sessions"] = list(old.get("sessions", [])) + list(manifest.get("sessions", []))
         data = json.dumps(manifest, indent=2).encode()
-        _write_atomic(self.path(MANIFEST), data)
-        _write_atomic(self.path(MANIFEST_COPY), data)
+        write_atomic(self.path(MANIFEST), data)
+        write_atomic(self.path(MANIFEST_COPY), data)
         return manifest
 
     def path(self, name: str) -> str:
@@ -175,7 +180,7 @@ def _append(fd: int, line: str, path: str):
     os.fsync(fd)
 
 
-def _write_atomic(path: str, data: bytes):
+def write_atomic(path: str, data: bytes):
     """Replace ``path`` by ``data`` atomically (write a temporary file, fsync, rename)."""
     tmp = f"{path}.tmp{os.getpid()}"
     with open(tmp, "wb") as f:
@@ -219,7 +224,7 @@ def read_manifest(out_dir: str) -> dict | None:
     backup, _ = _manifest_problem(copy) if os.path.exists(copy) else (None, "")
     if backup is not None:
         try:
-            _write_atomic(path, json.dumps(backup, indent=2).encode())
+            write_atomic(path, json.dumps(backup, indent=2).encode())
         except OSError:
             pass  # read-only: the copy serves this time
         return backup
@@ -278,7 +283,7 @@ def read_rows(out_dir: str) -> tuple[dict, dict]:
 
 def write_nominal(out_dir: str, columns: dict) -> None:
     """Keep the campaign's nominal flight (trajectory columns; atomically)."""
-    _write_atomic(os.path.join(out_dir, NOMINAL), json.dumps(columns).encode())
+    write_atomic(os.path.join(out_dir, NOMINAL), json.dumps(columns).encode())
 
 
 def read_nominal(out_dir: str) -> dict | None:
@@ -320,7 +325,7 @@ def repair(out_dir: str) -> dict:
             with open(os.path.join(out_dir, QUARANTINE), "ab") as q:
                 for raw in bad:
                     q.write(json.dumps({"file": name, "line": raw.decode("utf-8", "replace")}).encode() + b"\n")
-        _write_atomic(path, b"".join(line + b"\n" for line in keep))
+        write_atomic(path, b"".join(line + b"\n" for line in keep))
     return report
 
 

@@ -20,6 +20,8 @@ from drake_entry.guidance.lgl_terminal.spec import LglTerminal
 from drake_entry.guidance.scvx.spec import Scvx
 from drake_entry.guidance.swarm_bank.spec import SwarmBank
 
+__all__ = ["REGISTRY", "GuidanceSpec", "known_tags", "folder_of", "method_for"]
+
 REGISTRY = {
     DragEnergy: "drake_entry.guidance.drag_energy.method",
     BankProfile: "drake_entry.guidance.bank_profile.method",
@@ -36,6 +38,11 @@ GuidanceSpec = Union[tuple(REGISTRY)]
 
 def known_tags() -> str:
     return ", ".join(f"!{spec.__name__}" for spec in REGISTRY)
+
+
+def folder_of(spec_type) -> str:
+    """The method folder (``drake_entry/guidance/<folder>/``) of a registered spec type."""
+    return REGISTRY[spec_type].split(".")[2]
 
 
 def method_for(spec):

@@ -8,7 +8,7 @@ A method is one package under ``drake_entry/guidance/`` registered in
 - a ``GuidanceMethod`` (``method.py``): a planner factory, ``add_systems`` that adds its
   Drake systems to the closed-loop ``DiagramBuilder`` and returns its command ports, and
   ``summarise`` that reads its systems after a flight into per-sample fields;
-- optionally ``commands.py`` (CLI layer) with ``plan_report(scenario, out_dir) -> int`` for
+- optionally ``drake_entry/cli/methods/<folder>.py`` (CLI layer) with ``plan_report(scenario, out_dir) -> int`` for
   ``drake-entry plan``.
 
 The closed loop (``drake_entry.diagrams.closed_loop``) builds only the shared parts:
@@ -20,6 +20,8 @@ from __future__ import annotations
 import dataclasses as dc
 
 from pydrake.systems.framework import OutputPort
+
+__all__ = ["PlantPorts", "LoggedSignal", "ActuatorLimits", "GuidanceCommands", "GuidanceSummary", "GuidanceMethod"]
 
 
 @dc.dataclass(frozen=True)

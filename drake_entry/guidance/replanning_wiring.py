@@ -8,7 +8,10 @@ import math
 import numpy as np
 
 from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, LoggedSignal, PlantPorts
+from drake_entry.systems.replan_scheduler import ReplanStats
 from drake_entry.systems.replanning_guidance import ReplanMemory, ReplanningGuidance
+
+__all__ = ["add_replanning_guidance", "replanning_commands", "replanning_record"]
 
 
 def add_replanning_guidance(builder, name: str, plan, replan, spec, plant: PlantPorts, **options):
@@ -34,14 +37,15 @@ def replanning_commands(system, alpha_limits: ActuatorLimits, initial_bank: floa
                                            ("replans", "replans_refused", "replan_wall_s"))})
 
 
-def replanning_record(diagram, context, name: str) -> tuple[ReplanMemory, dict]:
-    """(memory, row fields) of the ReplanningGuidance ``name`` after a flight: re-plans tried and
-    refused, the median and largest wall time of one [s] (nan without any), and when the last
-    plan flown began and ends [s of the flight]."""
+def replanning_record(diagram, context, name: str) -> tuple[ReplanMemory, ReplanStats, dict]:
+    """(memory, the schedule's account, row fields) of the ReplanningGuidance ``name`` after a
+    flight: re-plans tried and refused, the median and largest wall time of one [s] (nan without
+    any), and when the last plan flown began and ends [s of the flight]."""
     system = diagram.GetSubsystemByName(name)
-    mem = system.memory(system.GetMyContextFromRoot(context))
+    own = system.GetMyContextFromRoot(context)
+    mem, stats = system.memory(own), system.replan_stats(own)
     walls = np.array([w for _, w, _ in mem.log]) if mem.log else np.array([math.nan])
-    return mem, {"replans_tried": len(mem.log), "replans_refused": len(mem.refused),
+    return mem, stats, {"replans_tried": len(mem.log), "replans_refused": len(mem.refused),
                  "replan_wall_median_s": float(np.median(walls)), "replan_wall_max_s": float(np.max(walls)),
                  "last_plan_start_s": mem.flown.start,
                  "last_plan_final_time_s": mem.flown.start + mem.flown.plan.final_time}

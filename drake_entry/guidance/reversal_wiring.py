@@ -7,6 +7,8 @@ import math
 from drake_entry.guidance.interface import PlantPorts
 from drake_entry.systems.bank_reversal import BankReversalLogic
 
+__all__ = ["REVERSAL_SYSTEM", "add_bank_reversal", "reversal_count"]
+
 REVERSAL_SYSTEM = "bank_reversal"
 
 

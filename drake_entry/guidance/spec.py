@@ -6,8 +6,25 @@ scenario's ``guidance:`` field selects it with the YAML tag ``!ClassName``.
 """
 
 import dataclasses as dc
+import math
 
 from drake_entry.errors import ScenarioError, check_range
+
+__all__ = ["MAX_REPLAN_PERIOD_S", "check_replan_period", "GuidanceSpecBase", "ReversingBankSpec", "ReplanningSpec"]
+
+#: the longest on-board re-planning period [s]
+MAX_REPLAN_PERIOD_S = 1e4
+
+
+def check_replan_period(spec) -> None:
+    """The one rule of ``guidance.replan_period_s``, the on-board re-planning period of every method
+    that plans on board (systems/replan_scheduler.py): 0 (no re-plan after the first plan) or
+    from the guidance period ``period_s`` to MAX_REPLAN_PERIOD_S seconds."""
+    value, period = spec.replan_period_s, spec.period_s
+    if not (isinstance(value, (int, float)) and (value == 0 or period <= value <= MAX_REPLAN_PERIOD_S)):
+        shown = value if not isinstance(value, float) or math.isfinite(value) else str(value)
+        raise ScenarioError(f"guidance.replan_period_s = {shown} is out of range; allowed: 0 (no re-plan after the "
+                            f"first plan) or from guidance.period_s = {period} to {MAX_REPLAN_PERIOD_S:g} s")
 
 
 @dc.dataclass
@@ -68,7 +85,7 @@ class ReplanningSpec(GuidanceSpecBase):
     002's LGL)."""
 
     # each command is read this far ahead on the plan [s]: the actuators' lag (half the guidance
-    # period for the hold, 1/bandwidth for the loop: 1.0 s at 1 s; drake_entry.models.actuator.command_lag)
+    # period for the hold, 1/bandwidth for the loop: 1.0 s at 1 s with the 2 rad/s loop)
     command_lead_s: float = 1.0
     # on-board re-planning from the navigation estimate every replan_period_s [s] (0 = fly the
     # pre-flight plan), while the plan in use has more than replan_min_time_to_go_s [s] to go
@@ -78,8 +95,5 @@ class ReplanningSpec(GuidanceSpecBase):
     def validate(self, scenario) -> None:
         super().validate(scenario)
         check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
-        check_range("guidance.replan_period_s", self.replan_period_s, 0.0, 1e4)
-        if self.replan_period_s and self.replan_period_s < self.period_s:
-            raise ScenarioError(f"guidance.replan_period_s = {self.replan_period_s} must be 0 or >= guidance.period_s "
-                                f"= {self.period_s}")
+        check_replan_period(self)
         check_range("guidance.replan_min_time_to_go_s", self.replan_min_time_to_go_s, 0.0, 1e4)

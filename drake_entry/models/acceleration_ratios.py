@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from drake_entry.models.dynamics import aero_accelerations
 
+__all__ = ["RATIO_TIME_CONSTANT_S", "RATIO_MIN_DRAG", "filtered_ratios"]
+
 #: time constant [s] of the low-pass, and the modelled drag [m/s^2] below which the ratios are
 #: not updated (thin air: the ratio is noise)
 RATIO_TIME_CONSTANT_S, RATIO_MIN_DRAG = 30.0, 0.5

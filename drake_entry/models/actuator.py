@@ -7,6 +7,9 @@ import math
 
 import numpy as np
 
+__all__ = ["BANDWIDTH_RAD_S", "SUBSTEP_S", "FEW_LIMITED", "actuator_rates", "integrate_actuator",
+           "integrate_actuators"]
+
 #: the position loop's bandwidth omega [rad/s] of the closed loop's actuators (systems/actuators.py)
 BANDWIDTH_RAD_S = 2.0
 #: the sampled actuators' integration sub-step [s]
@@ -14,13 +17,6 @@ SUBSTEP_S = 0.02
 #: up to this many rate- or acceleration-limited members, ``integrate_actuators`` steps them one by
 #: one on floats (faster than NumPy's per-call cost on a few elements; the same numbers)
 FEW_LIMITED = 4
-
-
-def command_lag(period: float, bandwidth: float = BANDWIDTH_RAD_S) -> float:
-    """Low-frequency lag [s] of a command sampled and held every ``period`` [s] and tracked by
-    the linear law: period / 2 for the hold plus 1 / omega, the group delay of the critically
-    damped loop 4 omega^2 / (s + 2 omega)^2 (1.0 s at a 1-s period and omega = 2 rad/s)."""
-    return 0.5 * period + 1.0 / bandwidth
 
 
 def _clip(v: float, lower: float, upper: float) -> float:

@@ -31,6 +31,11 @@ from drake_entry.errors import ScenarioError
 from drake_entry.models.data_tables import read_csv_rows
 from drake_entry.models.scalar import clamp, is_autodiff, lift, value_of
 
+__all__ = ["DEG", "CoefficientDerivatives", "AeroDerivatives", "AeroModel", "TableAero", "read_wide_table",
+           "packaged_data", "horus2b_table", "HorusFitAero", "horus_cd_form", "horus_cl_form", "FitReport",
+           "fit_horus_forms", "CavHAero", "DragPolarAero", "PolynomialAero", "NewtonianLiftingBodyAero",
+           "CallableAero", "ScaledAero"]
+
 DEG = np.pi / 180.0
 
 

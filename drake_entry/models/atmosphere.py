@@ -35,6 +35,11 @@ from drake_entry.errors import ModelRangeError, ScenarioError, UnsupportedScalar
 from drake_entry.models.data_tables import read_csv_rows
 from drake_entry.models.scalar import clamp, is_autodiff, is_symbolic, lift, promote, value_of
 
+__all__ = ["G0_US76", "R_STAR", "M0_AIR", "R_AIR", "R0_GEOPOTENTIAL", "GAMMA_AIR", "P0_SEA_LEVEL", "US76_H_MIN",
+           "US76_H_MAX", "US76_LOWER_TOP", "AtmosphereProperties", "Derivatives", "piecewise", "Atmosphere",
+           "US76Atmosphere", "ExponentialAtmosphere", "TableAtmosphere", "DENSITY_WAVE_AMPLITUDE_BOUND",
+           "DispersedAtmosphere", "make_atmosphere", "write_upper_table"]
+
 # U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
 G0_US76 = 9.80665  # m/s^2
 R_STAR = 8314.32  # J/(kmol K)
@@ -420,11 +425,6 @@ class US76Atmosphere(Atmosphere):
         rho = np.exp(ln_rho) if isinstance(ln_rho, np.ndarray) else math.exp(ln_rho)
         return Derivatives(rho, rho * l1, rho * (l2 + l1 * l1)), Derivatives(T, T1, T2)
 
-    def pressure(self, h):
-        """Pressure p = rho R T [Pa] (float / ndarray; M0 air above 86 km as an approximation)."""
-        rho = self.density(h)
-        return rho * R_AIR * self.temperature(h)
-
 
 @dataclass(frozen=True)
 class ExponentialAtmosphere(Atmosphere):
@@ -550,18 +550,24 @@ class TableAtmosphere(Atmosphere):
         return Derivatives(T, T1, T2)
 
 
+#: |A| < DENSITY_WAVE_AMPLITUDE_BOUND keeps a dispersed density positive (DispersedAtmosphere; the
+#: scenario's dispersions are checked against the same bound)
+DENSITY_WAVE_AMPLITUDE_BOUND = 1.0
+
+
 class DispersedAtmosphere(Atmosphere):
     """A Monte-Carlo sample's true atmosphere: rho = rho_nominal * scale * (1 + A sin(2 pi h /
     wavelength + phase)) (bias plus an altitude-correlated perturbation); temperature nominal.
 
-    Args: base atmosphere, scale (> 0), amplitude A in [0, 1), wavelength [m], phase [rad].
+    Args: base atmosphere, scale (> 0), amplitude A with |A| < 1 (a negative A is the same wave
+    half a wavelength along), wavelength [m] (> 0), phase [rad].
     """
 
     def __init__(self, base: Atmosphere, *, scale: float = 1.0, amplitude: float = 0.0,
                  wavelength: float = 8000.0, phase: float = 0.0):
-        if not scale > 0 or not 0 <= amplitude < 1 or not wavelength > 0:
-            raise ScenarioError(f"DispersedAtmosphere needs scale > 0, 0 <= amplitude < 1, wavelength > 0 "
-                             f"(got {scale}, {amplitude}, {wavelength})")
+        if not scale > 0 or not abs(amplitude) < DENSITY_WAVE_AMPLITUDE_BOUND or not wavelength > 0:
+            raise ScenarioError(f"DispersedAtmosphere needs scale > 0, |amplitude| < {DENSITY_WAVE_AMPLITUDE_BOUND:g}, "
+                                f"wavelength > 0 (got {scale}, {amplitude}, {wavelength})")
         self.base, self.scale, self.amplitude = base, scale, amplitude
         self.k, self.phase = 2.0 * math.pi / wavelength, phase
         self.name = f"dispersed {base.name}"

@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 
+__all__ = ["wrap_angle", "corridor_half_width", "reversal_sign"]
+
 
 def wrap_angle(a):
     """a wrapped to [-pi, pi) [rad]."""

@@ -14,6 +14,9 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["FT", "SLUG", "BTU_FT2_S", "HeatFlux", "make_heat_flux", "dynamic_pressure", "normal_load_factor",
+           "total_load_factor", "equilibrium_glide_lift", "PathLimits"]
+
 # US customary units (exact SI conversions) for forms published in them
 FT = 0.3048  # m
 SLUG = 14.593902937  # kg

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import csv
 
+__all__ = ["read_csv_rows"]
+
 
 def read_csv_rows(path_or_file) -> list[list[str]]:
     """The rows of a CSV file (a path or an open text file) as lists of cells (strings)."""

@@ -28,6 +28,9 @@ import numpy as np
 import pydrake.common.schema as schema
 
 from drake_entry.errors import ScenarioError
+from drake_entry.models.atmosphere import DENSITY_WAVE_AMPLITUDE_BOUND
+
+__all__ = ["Scalar", "Vector", "EntryDispersionSpec", "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate"]
 
 Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
 Vector = typing.Union[schema.DeterministicVectorX, schema.GaussianVectorX, schema.UniformVectorX]
@@ -185,9 +188,9 @@ def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
                                 f"(the value, a Uniform's min, a Gaussian's mean - {GAUSSIAN_REACH:g} stddev)")
     amplitude = spec.density_wave_amplitude
     reach = max(abs(_support_floor(amplitude)), abs(_support_ceiling(amplitude)))
-    if not reach < 1:
-        raise ScenarioError(f"{where}.density_wave_amplitude reaches {reach:g}; allowed: |amplitude| < 1 over its "
-                            f"whole distribution (density stays positive)")
+    if not reach < DENSITY_WAVE_AMPLITUDE_BOUND:
+        raise ScenarioError(f"{where}.density_wave_amplitude reaches {reach:g}; allowed: |amplitude| < "
+                            f"{DENSITY_WAVE_AMPLITUDE_BOUND:g} over its whole distribution (density stays positive)")
     if np.asarray(spec.nav_bias.Mean()).size != 6:
         raise ScenarioError(f"{where}.nav_bias needs 6 entries [h, lon, lat, V, gamma, psi]")
     if len(spec.nav_noise_sigma) != 6 or not all(0 <= v < math.inf for v in spec.nav_noise_sigma):

@@ -26,6 +26,10 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.scalar import promote
 from drake_entry.models.vehicles import Vehicle
 
+__all__ = ["STATE_NAMES", "STATE_UNITS", "FlightConditions", "FLIGHT_CONDITION_NAMES", "air_data",
+           "aero_accelerations", "state_derivatives", "equations_of_motion", "equations_of_motion_lift_components",
+           "flight_conditions", "conditions_from", "specific_energy", "energy_rate", "energy_domain_derivatives"]
+
 STATE_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
 STATE_UNITS = ("m", "rad", "rad", "m/s", "rad", "rad")
 

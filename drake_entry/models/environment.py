@@ -10,6 +10,8 @@ from drake_entry.errors import ScenarioError
 from drake_entry.models.atmosphere import Atmosphere, ExponentialAtmosphere, TableAtmosphere, US76Atmosphere
 from drake_entry.models.planet import Earth
 
+__all__ = ["PlanetSpec", "AtmosphereSpec", "planet_from_spec", "atmosphere_from_spec"]
+
 
 @dc.dataclass
 class PlanetSpec:

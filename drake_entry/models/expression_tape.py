@@ -36,6 +36,8 @@ from pydrake.symbolic import Expression, ExpressionKind, Formula, FormulaKind, V
 from drake_entry.errors import UnsupportedScalarError
 from drake_entry.models.atmosphere import Atmosphere
 
+__all__ = ["ExpressionTape", "TracedAtmosphere"]
+
 _UNARY = {  # kind -> (value, derivative d f / d a as a function of (a, f))
     ExpressionKind.Log: (np.log, lambda a, f: 1.0 / a),
     ExpressionKind.Exp: (np.exp, lambda a, f: f),

@@ -10,6 +10,9 @@ import math
 
 import numpy as np
 
+__all__ = ["central_angle", "central_angle_smooth", "bearing", "bearings", "range_and_crossrange",
+           "downtrack_crosstrack", "crossrange_from_great_circle", "destination"]
+
 
 def central_angle(lon1, lat1, lon2, lat2):
     """Central angle [rad] between two points (haversine form; floats or arrays)."""

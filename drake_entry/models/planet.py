@@ -13,6 +13,8 @@ import numpy as np
 from drake_entry.errors import ScenarioError
 from drake_entry.models import geodesy
 
+__all__ = ["MU_EARTH", "R_EQUATOR", "J2_EARTH", "OMEGA_EARTH", "FLATTENING_WGS84", "G0", "Earth"]
+
 # WGS-84 / EGM constants.
 MU_EARTH = 3.986004418e14  # m^3/s^2 (paper 000 eq. 28, corrected units)
 R_EQUATOR = 6378137.0  # m

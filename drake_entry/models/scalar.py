@@ -14,6 +14,8 @@ from pydrake.symbolic import Expression, Variable
 
 from drake_entry.errors import UnsupportedScalarError
 
+__all__ = ["is_autodiff", "is_symbolic", "value_of", "lift", "clamp", "promote"]
+
 
 def is_autodiff(x) -> bool:
     """True when x is a pydrake AutoDiffXd scalar."""

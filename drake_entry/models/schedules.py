@@ -15,6 +15,8 @@ import numpy as np
 from drake_entry.errors import ScenarioError
 from drake_entry.models.scalar import is_autodiff, lift, value_of
 
+__all__ = ["VARIABLES", "Schedule", "linear_bank"]
+
 VARIABLES = ("time", "energy", "mach", "velocity")
 
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 from pydrake.symbolic import Expression, Variable
 from pydrake.systems.primitives import SymbolicVectorSystem
 
+__all__ = ["stateless"]
+
 _CONSTANT = Variable("constant")
 
 

@@ -11,6 +11,8 @@ import numpy as np
 from drake_entry.models.constraints import PathLimits
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, STATE_NAMES
 
+__all__ = ["Trajectory", "metrics", "REVERSAL_THRESHOLD", "control_activity"]
+
 
 @dc.dataclass
 class Trajectory:

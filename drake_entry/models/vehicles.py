@@ -18,6 +18,9 @@ from drake_entry.models import aerodynamics as aero_mod
 from drake_entry.models.constraints import HeatFlux, PathLimits, make_heat_flux
 from drake_entry.typed_yaml import load_packaged_or_file, packaged_names
 
+__all__ = ["AeroSpec", "HeatFluxSpec", "VehicleSpec", "Vehicle", "build_aero", "vehicle_from_spec",
+           "PACKAGED_VEHICLES", "vehicle_spec", "LIMIT_FIELDS", "load_vehicle"]
+
 
 @dc.dataclass
 class AeroSpec:

@@ -23,6 +23,9 @@ import numpy as np
 
 from drake_entry.models.constraints import PathLimits
 
+__all__ = ["PathLimit", "vehicle_path_limits", "LimitCheck", "check_limits", "breaches_text", "ROUNDING",
+           "BoxCriterion", "BOX_CRITERIA", "acceptance_box", "box_text", "Verdict", "judge"]
+
 
 @dc.dataclass(frozen=True)
 class PathLimit:

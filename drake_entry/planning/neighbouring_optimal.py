@@ -31,6 +31,9 @@ from scipy.integrate import solve_ivp
 from drake_entry.errors import ScenarioError
 from drake_entry.planning.tracking import TrackingLaw, TrackingWeights, lerp, resample, scaled_linearisation
 
+__all__ = ["HESSIAN_STEP", "DIVERGED", "hamiltonian_gradient", "hamiltonian_hessian", "without_odd_even_mode",
+           "neighbouring_optimal"]
+
 #: relative step of the central differences of H's gradient (of each variable's scale)
 HESSIAN_STEP = 1.0e-5
 #: S beyond this (scaled units) is a diverging Riccati solution: a conjugate point

@@ -30,6 +30,9 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
 from drake_entry.models.vehicles import Vehicle
 
+__all__ = ["PATH_QUANTITIES", "LAGRANGE_KINDS", "MAYER_KINDS", "CONTROL_LAYOUTS", "DEVIATION_STATES",
+           "PathConstraint", "ObjectiveTerm", "CustomProblem", "OptimalControlProblem"]
+
 PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
     "dynamic_pressure": ("dynamic_pressure", "Pa"), "heat_flux": ("heat_flux", "W/m^2"),
     "normal_load": ("normal_load", "g"), "total_load": ("total_load", "g"),

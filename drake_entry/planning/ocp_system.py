@@ -18,6 +18,8 @@ from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drake_entry.errors import DrakeEntryError
 
+__all__ = ["OptimalControlPlant_", "OptimalControlPlant"]
+
 
 @TemplateSystem.define("OptimalControlPlant_")
 def OptimalControlPlant_(T):

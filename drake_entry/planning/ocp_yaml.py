@@ -40,6 +40,10 @@ from drake_entry.planning.ocp import (
 )
 from drake_entry.typed_yaml import load_yaml_typed
 
+__all__ = ["STATE_FIELDS", "CONTROL_FIELDS", "PACKAGED_PROBLEMS", "BoundSpec", "PathSpec", "AlphaScheduleSpec",
+           "ObjectiveSpec", "SolveSpec", "ProblemSpec", "problem_from_spec", "load_problem_spec", "validate_solve",
+           "load_problem"]
+
 # YAML field -> (state or control name, factor to SI)
 STATE_FIELDS = {"altitude_km": ("h", 1e3), "longitude_deg": ("lon", math.pi / 180), "latitude_deg": ("lat", math.pi / 180),
                 "velocity_m_s": ("V", 1.0), "flight_path_deg": ("gamma", math.pi / 180),

@@ -7,6 +7,8 @@ import math
 import sys
 import time
 
+__all__ = ["PROGRESS_AFTER_S", "PROGRESS_INTERVAL_S", "wanted", "ProgressLine"]
+
 #: a computation prints progress once it has run this long [s], then at this interval [s]
 PROGRESS_AFTER_S, PROGRESS_INTERVAL_S = 5.0, 5.0
 

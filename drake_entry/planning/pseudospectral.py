@@ -19,6 +19,9 @@ from numpy.polynomial import legendre
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["lgl_nodes", "barycentric_weights", "interpolation_matrix", "LGL", "lobatto_integration_matrix",
+           "INTEGRATION_MAX_NODES", "SEGMENT_MAX_NODES", "SegmentMesh"]
+
 
 def lgl_nodes(n_nodes: int) -> np.ndarray:
     """LGL nodes on [-1, 1], increasing (Newton iteration from Chebyshev-Lobatto points)."""

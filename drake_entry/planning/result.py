@@ -8,6 +8,8 @@ import dataclasses as dc
 import math
 from typing import ClassVar
 
+__all__ = ["PlanResult"]
+
 
 @dc.dataclass(kw_only=True)
 class PlanResult:

@@ -35,6 +35,9 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["RICCATI_ACCURACY", "RICCATI_MAX_STEP_S", "TrackingWeights", "TrackingLaw", "CommandFeedback", "lerp",
+           "resample", "scaled_linearisation", "linearise", "tvlqr"]
+
 #: Riccati integration (Drake's RK3 with error control): 1e-3 changes K by < 1e-3 of its
 #: largest entry against 1e-4 on the SHEFEX-3 nominal, at 60 % of the cost
 RICCATI_ACCURACY = 1.0e-3

@@ -24,6 +24,8 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["Actuation", "EntryControls", "OcpControls", "FlownControls", "Verifier", "require_verifier"]
+
 
 @dc.dataclass(frozen=True)
 class Actuation:

@@ -25,6 +25,9 @@ from drake_entry.guidance.ampi.spec import MODES
 from drake_entry.guidance.ampi.synthesis import interpolate_corners, nearest_case, select_subspace
 from drake_entry.planning.pseudospectral import interpolation_matrix, lgl_nodes
 
+__all__ = ["OBJECTIVE_FACTOR", "FINAL_TIME_JUMP_S", "BANK_JUMP_DEG", "Synthesis", "hd_matrix", "FILE_FORMAT",
+           "FILE_VERSION", "ARRAYS", "TrajectoryDatabase"]
+
 #: consistency with the neighbours (``TrajectoryDatabase.inconsistent``): a case whose
 #: objective exceeds this factor times the median of its neighbours' (a worse local branch:
 #: a pre-implementation prototype found J = 70-143 among neighbours at 19-26), whose t_f differs from

@@ -19,6 +19,8 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["PARAMETERS", "DISPLAY_UNITS", "ParameterGrid"]
+
 #: the entry-state components a parameter may offset (the canonical state order)
 PARAMETERS = ("h", "lon", "lat", "V", "gamma", "psi")
 #: the unit each parameter's levels are given in by ``ParameterGrid.from_steps`` / YAML

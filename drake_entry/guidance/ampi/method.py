@@ -16,6 +16,8 @@ from drake_entry.guidance.ampi.reference import DatabaseReference
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
 from drake_entry.systems.reference_tracking import ReferenceTracker
 
+__all__ = ["GUIDANCE_SYSTEM", "AmpiMethod", "METHOD"]
+
 GUIDANCE_SYSTEM = "reference_tracker"
 
 

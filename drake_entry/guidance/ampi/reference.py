@@ -25,6 +25,8 @@ from drake_entry.planning.ocp_yaml import load_problem
 from drake_entry.planning.result import PlanResult
 from drake_entry.planning.tracking import TrackingLaw, TrackingWeights, tvlqr
 
+__all__ = ["TrackedReference", "DatabaseReference"]
+
 
 @dc.dataclass(frozen=True)
 class TrackedReference:
@@ -86,7 +88,7 @@ class DatabaseReference(PlanResult):
         study = db.provenance.get("study", {})
         if "problem" not in study:
             raise ScenarioError(f"database '{database}' does not record its problem (provenance.study.problem); "
-                                "rebuild it with diagrams.ampi_database.build_database")
+                                "rebuild it with guidance.ampi.database_study.build_database")
         problem, _ = load_problem(study["problem"])
         bad = db.inconsistent()
         ok = not bad

@@ -8,13 +8,15 @@ from importlib import resources
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import GuidanceSpecBase
 
+__all__ = ["MODES", "packaged_databases", "database_path", "Ampi"]
+
 #: how the on-board reference is made: AMPI synthesis or the nearest entry (NTT)
 MODES = ("ampi", "ntt")
 
 
 def packaged_databases() -> tuple:
     """Names of the trajectory databases shipped in drake_entry/data/ampi (``<name>.npz``, built by
-    diagrams/ampi_database.py)."""
+    guidance/ampi/database_study.py)."""
     folder = resources.files("drake_entry").joinpath("data/ampi")
     return tuple(sorted(p.name[:-4] for p in folder.iterdir() if p.name.endswith(".npz")))
 
@@ -45,7 +47,7 @@ class Ampi(GuidanceSpecBase):
     terminal_altitude_km: float = 21.1
     terminal_velocity_m_s: float = 620.0
     period_s: float = 0.5
-    # packaged database name or .npz path (diagrams/ampi_database.py builds one)
+    # packaged database name or .npz path (guidance/ampi/database_study.py builds one)
     database: str = "shefex3"
     reference: str = "ampi"
     # eq. 11's N_HD: equally spaced reference samples the tracker interpolates linearly

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = ["select_subspace", "interpolate_corners", "interpolate", "nearest_case"]
+
 #: how a reference is made from the database: AMPI (Algorithms 1-2) or the nearest entry (NTT)
 
 

@@ -19,6 +19,8 @@ from drake_entry.models.schedules import Schedule
 from drake_entry.planning.result import PlanResult
 from drake_entry.systems.schedule import ScheduleSource
 
+__all__ = ["BankProfilePlan", "BankProfileMethod", "METHOD"]
+
 
 @dc.dataclass
 class BankProfilePlan(PlanResult):

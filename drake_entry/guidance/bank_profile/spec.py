@@ -6,6 +6,8 @@ import math
 from drake_entry.errors import check_range
 from drake_entry.guidance.spec import ReversingBankSpec
 
+__all__ = ["BankProfile"]
+
 
 @dc.dataclass
 class BankProfile(ReversingBankSpec):

@@ -22,6 +22,8 @@ from drake_entry.models.constraints import PathLimits
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 
+__all__ = ["BOUND_NAMES", "Corridor", "compute_corridor"]
+
 BOUND_NAMES = ("heat_flux", "normal_load", "dynamic_pressure", "total_load")
 
 

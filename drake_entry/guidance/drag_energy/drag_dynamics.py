@@ -22,6 +22,8 @@ from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 
+__all__ = ["AlphaProfile", "DragDynamics", "gamma_correction", "drag_acceleration", "DragTerms", "drag_dynamics"]
+
 
 @dataclass(frozen=True)
 class AlphaProfile:

@@ -18,6 +18,8 @@ from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_cou
 from drake_entry.systems.drag_energy_guidance import DragEnergyGuidance
 from drake_entry.systems.drag_energy_tracking import DragTrackingController
 
+__all__ = ["REFERENCE_COLUMNS", "DragEnergyMethod", "METHOD"]
+
 REFERENCE_COLUMNS = ("reference_drag_m_s2", "reference_drag_slope_1_m", "reference_drag_curvature_s2_m3",
                      "guidance_engaged")
 
@@ -59,7 +61,8 @@ class DragEnergyMethod(GuidanceMethod):
 
     def summarise(self, diagram, context, planner) -> GuidanceSummary:
         guidance = diagram.GetSubsystemByName("drag_energy_guidance")
-        mem = guidance.memory(guidance.GetMyContextFromRoot(context))
+        own = guidance.GetMyContextFromRoot(context)
+        mem, stats = guidance.memory(own), guidance.replan_stats(own)
         active = mem.engaged_at is not None
         message = ""
         if not active:
@@ -67,7 +70,7 @@ class DragEnergyMethod(GuidanceMethod):
                                                     else "engagement condition never met")
         fields = {"engaged_at_s": mem.engaged_at if active else np.nan, "planning_failures": len(mem.failures),
                   "reversals": reversal_count(diagram, context)}
-        return GuidanceSummary(active, message, plans=mem.plans, planning_wall_s=mem.planning_wall_s, fields=fields,
+        return GuidanceSummary(active, message, plans=stats.applied, planning_wall_s=stats.wall_s, fields=fields,
                                details=mem)
 
     def flight_plots(self, result, out_dir: str, *, title: str = "") -> list[str]:

@@ -48,6 +48,9 @@ from drake_entry.models.vehicles import Vehicle
 from drake_entry.planning.pseudospectral import LGL
 from drake_entry.planning.result import PlanResult
 
+__all__ = ["SOLVERS", "DragEnergyProblem", "Extraction", "DragEnergyReference", "plan", "SCS_OPTIONS", "solve_socp",
+           "extract", "altitude_speed_from_drag", "DragEnergyPlanner"]
+
 SOLVERS = {"clarabel": ClarabelSolver, "scs": ScsSolver}
 
 

@@ -6,7 +6,9 @@ import os
 
 import numpy as np
 
-from drake_entry.campaign.plots import plt, save_figure  # the Agg backend is set there
+from drake_entry.figures import plt, save_figure  # the Agg backend is set there
+
+__all__ = ["corridor_plot", "extraction_plot", "tracking_plot"]
 
 
 def corridor_plot(corridor, E0: float, Ef: float, out_dir: str, *, reference=None, title: str = "") -> list[str]:

@@ -4,7 +4,9 @@
 import dataclasses as dc
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance.spec import ReversingBankSpec
+from drake_entry.guidance.spec import ReversingBankSpec, check_replan_period
+
+__all__ = ["DragEnergy"]
 
 
 @dc.dataclass
@@ -47,7 +49,7 @@ class DragEnergy(ReversingBankSpec):
         check_range("guidance.replan_until_e", self.replan_until_e, 0.0, 1.0)
         check_range("guidance.corridor_margin", self.corridor_margin, 0.0, 0.49)
         check_range("guidance.corridor_points", self.corridor_points, 20, 100000)
-        check_range("guidance.replan_period_s", self.replan_period_s, 0.0, 1e4)
+        check_replan_period(self)
         check_range("guidance.pre_guidance_min_s", self.pre_guidance_min_s, 0.0, 1e5)
         check_range("guidance.pre_guidance_bank_deg", self.pre_guidance_bank_deg, -180.0, 180.0)
         if self.solver not in ("clarabel", "scs"):

@@ -12,6 +12,8 @@ from __future__ import annotations
 import dataclasses as dc
 import math
 
+__all__ = ["SIGMA0_BOUNDS", "CorrectorSettings", "Correction", "correct"]
+
 SIGMA0_BOUNDS = (0.0, math.radians(90.0))
 
 

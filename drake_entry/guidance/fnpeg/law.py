@@ -28,6 +28,9 @@ from pydrake.symbolic import max as symbolic_max
 
 from drake_entry.models.scalar import clamp, is_symbolic
 
+__all__ = ["HEAT_RATE_VELOCITY_EXPONENT", "FeedbackSettings", "qegc_sin_flight_path", "path_limit_sin_flight_path",
+           "commanded_bank"]
+
 #: exponent of V in the heat-rate law the path-limit reference assumes (Lu 2014: 3.15)
 HEAT_RATE_VELOCITY_EXPONENT = 3.15
 

@@ -29,6 +29,8 @@ from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_cou
 from drake_entry.planning.result import PlanResult
 from drake_entry.systems.fnpeg_guidance import FnpegGuidance
 
+__all__ = ["GUIDANCE_SYSTEM", "FnpegPlan", "FnpegMethod", "METHOD"]
+
 GUIDANCE_SYSTEM = "fnpeg_guidance"
 
 
@@ -60,7 +62,7 @@ class FnpegMethod(GuidanceMethod):
         guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, FnpegGuidance(
             s, sigma0_guess=math.radians(g.bank_start_guess_deg), bank_before=math.radians(g.bank_before_engagement_deg),
             initial_alpha=alpha0, engage_acceleration=g.engage_acceleration_m_s2, period=g.period_s,
-            corrector_period=g.corrector_period_s, scaling=g.acceleration_scaling))
+            replan_period=g.replan_period_s, scaling=g.acceleration_scaling))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
         reversal = add_bank_reversal(builder, scenario, plant, guidance.GetOutputPort("bank_magnitude"))

@@ -14,6 +14,8 @@ from drake_entry.guidance.fnpeg.law import FeedbackSettings, commanded_bank
 from drake_entry.guidance.fnpeg.predictor import Prediction, Predictor
 from drake_entry.models.schedules import Schedule, linear_bank
 
+__all__ = ["FnpegSetup"]
+
 
 @dc.dataclass
 class FnpegSetup:

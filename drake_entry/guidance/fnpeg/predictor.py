@@ -41,6 +41,8 @@ from drake_entry.models.atmosphere import piecewise
 from drake_entry.models.schedules import Schedule, linear_bank
 from drake_entry.models.symbolic_system import stateless
 
+__all__ = ["STAGED_SIZE_RATIO", "Prediction", "alpha_expression", "Predictor"]
+
 _STATE = [Variable(n) for n in ("h", "lon", "lat", "V", "gamma", "psi", "s")]
 _INPUT = [Variable(n) for n in ("sigma0", "e0", "sign", "lift_scale", "drag_scale")]
 #: the aerodynamic stage's outputs (scaled lift and drag accelerations [m/s^2], density [kg/m^3])

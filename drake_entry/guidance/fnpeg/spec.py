@@ -4,13 +4,15 @@ import dataclasses as dc
 import math
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance.spec import ReversingBankSpec
+from drake_entry.guidance.spec import ReversingBankSpec, check_replan_period
+
+__all__ = ["Fnpeg"]
 
 
 @dc.dataclass
 class Fnpeg(ReversingBankSpec):
     """|sigma| linear in e = mu/r - V^2/2 from sigma_0 (solved on board every
-    ``corrector_period_s`` by the damped secant on the predicted range error) to
+    ``replan_period_s`` by the damped secant on the predicted range error) to
     ``bank_end_deg`` at the terminal energy (or held at sigma_0: ``bank_profile: constant``),
     with Lu's altitude-rate feedback for phugoid damping and path limits; bank sign from the
     shared reversal logic; alpha a profile in velocity. Engages when the sensed aerodynamic acceleration reaches
@@ -35,7 +37,8 @@ class Fnpeg(ReversingBankSpec):
     alpha_rate_deg_s: float = 5.0
     alpha_accel_deg_s2: float = 10.0
     # corrector (Lu 2014; first difference, halvings and cap as in a public implementation)
-    corrector_period_s: float = 1.0
+    # the corrector runs at engagement and then every replan_period_s [s] (0: at engagement only)
+    replan_period_s: float = 1.0
     range_tolerance_km: float = 0.1
     max_iterations: int = 15
     max_halvings: int = 10
@@ -83,7 +86,7 @@ class Fnpeg(ReversingBankSpec):
             check_range("guidance.alpha_deg", a, -10.0, 60.0)
         check_range("guidance.alpha_rate_deg_s", self.alpha_rate_deg_s, 1e-3, 100.0)
         check_range("guidance.alpha_accel_deg_s2", self.alpha_accel_deg_s2, 1e-3, 1000.0)
-        check_range("guidance.corrector_period_s", self.corrector_period_s, self.period_s, 600.0)
+        check_replan_period(self)
         check_range("guidance.range_tolerance_km", self.range_tolerance_km, 1e-4, 100.0)
         check_range("guidance.max_iterations", self.max_iterations, 1, 100)
         check_range("guidance.max_halvings", self.max_halvings, 0, 30)

@@ -28,6 +28,8 @@ from drake_entry.guidance.lgl_terminal.planner import LglPlan, actuation, feedba
 from drake_entry.guidance.replanning_wiring import add_replanning_guidance, replanning_commands, replanning_record
 from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 
+__all__ = ["GUIDANCE_SYSTEM", "RATIO_SYSTEM", "LglTerminalMethod", "METHOD"]
+
 GUIDANCE_SYSTEM, RATIO_SYSTEM = "lgl_terminal_guidance", "acceleration_ratios"
 
 
@@ -63,10 +65,10 @@ class LglTerminalMethod(GuidanceMethod):
         return commands
 
     def summarise(self, diagram, context, planner: LglPlan) -> GuidanceSummary:
-        mem, fields = replanning_record(diagram, context, GUIDANCE_SYSTEM)
+        mem, stats, fields = replanning_record(diagram, context, GUIDANCE_SYSTEM)
         return GuidanceSummary(
             planner.success, "" if planner.success else f"the pre-flight plan is not verified: {planner.message}",
-            plans=mem.replans, planning_wall_s=mem.wall_s,
+            plans=stats.applied, planning_wall_s=stats.wall_s,
             fields={**fields, "plan_objective": float(planner.result.objective), "plan_final_time_s": planner.final_time,
                     "plans_without_feedback": len(mem.unfed)},
             details={"plan": planner, "last_plan": mem.flown.plan, "refused": mem.refused, "replans": mem.log})

@@ -11,6 +11,8 @@ from drake_entry.models.verdict import PathLimit
 from drake_entry.planning.ocp import PATH_QUANTITIES
 from drake_entry.planning.ocp_yaml import load_problem
 
+__all__ = ["load_guidance_problem", "problem_for_scenario", "mission_path_limits"]
+
 
 def load_guidance_problem(spec):
     """The spec's OptimalControlProblem as its file states it (controls must be 'rates')."""

@@ -26,6 +26,9 @@ from drake_entry.planning.neighbouring_optimal import neighbouring_optimal, with
 from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlqr
 from drake_entry.planning.verification import Actuation, EntryControls, require_verifier
 
+__all__ = ["SAMPLES_PER_S", "PlanFlight", "LglPlan", "feedback_weights", "feedback_maker", "actuation", "fly_plan",
+           "judged", "plan_terminal", "replan_nodes", "final_windows", "replan"]
+
 #: command samples per second of a plan (linear interpolation between them by the guidance)
 SAMPLES_PER_S = 4.0
 

@@ -6,6 +6,8 @@ from typing import Optional
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import ReplanningSpec
 
+__all__ = ["SOLVERS", "FEEDBACKS", "LglTerminal"]
+
 SOLVERS = ("snopt", "ipopt")
 FEEDBACKS = ("tvlqr", "costate", "none")
 

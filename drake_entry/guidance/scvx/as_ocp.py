@@ -24,6 +24,8 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.planning.ocp import ObjectiveTerm, OptimalControlProblem, PathConstraint
 
+__all__ = ["NLP_OBJECTIVES", "mission_problem", "nlp_guess", "nlp_form"]
+
 #: OptimalControlProblem objective kind of each SCvx objective the NLP path can pose
 NLP_OBJECTIVES = {"heat_load": "heat_load", "time": "final_time"}
 

@@ -45,6 +45,12 @@ from pydrake.solvers import ClarabelSolver, LorentzConeConstraint, MathematicalP
 
 from drake_entry.guidance.scvx.settings import ScvxSettings
 
+__all__ = ["GOLDEN", "FLOOR_DECREASE_FACTOR", "PROJECTION_STEPS", "Evaluation", "Linearisation",
+           "ConvexifiableProblem", "CLARABEL_DEFAULTS", "SCS_DEFAULTS", "SCS_REFINE_FACTOR", "SCS_EPS_FLOOR",
+           "STEP_FORM", "IterationRecord", "ScvxOutcome", "merit", "max_defect", "max_violation",
+           "within_tolerances", "diagnose", "ShiftedCone", "ScvxSubproblem", "defect_correction",
+           "constraint_correction", "project_accepted", "restore_feasibility", "golden_section", "solve_scvx"]
+
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0  # Phi of eq. 29
 #: a feasible point where the trust region reaches its floor is converged when the predicted
 #: decrease is within this factor of ``decrease_tolerance`` (said so in the message)

@@ -75,6 +75,10 @@ from drake_entry.models.scalar import is_symbolic, lift, value_of
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.planning.pseudospectral import SegmentMesh
 
+__all__ = ["POSITION_SCALE", "SIGMA_SCALE", "ALPHA_SCALE", "SIGMA_RATE_SCALE", "ALPHA_RATE_SCALE", "TIME_SCALE",
+           "HEAT_LOAD_SCALE", "GAMMA_RATE_SCALE", "MISS_SCALE", "PATH_NAMES", "EVENT_NAMES",
+           "heading_regulariser_sign", "EntryProblem"]
+
 POSITION_SCALE = np.array([1e5, 1.0, 0.1, 7e3, 0.1, 0.5])  # m, rad, rad, m/s, rad, rad
 SIGMA_SCALE, ALPHA_SCALE = 1.0, 0.5  # rad
 SIGMA_RATE_SCALE, ALPHA_RATE_SCALE = 0.1, 0.02  # rad/s

@@ -30,6 +30,9 @@ from drake_entry.models.dynamics import aero_accelerations, air_data, equations_
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 
+__all__ = ["GlideGuess", "glide_bank_magnitude", "heading_error", "reversal_deadband", "propagate_glide",
+           "glide_guess"]
+
 
 @dc.dataclass(frozen=True)
 class GlideGuess:

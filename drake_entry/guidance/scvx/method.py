@@ -19,6 +19,8 @@ from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, Gui
 from drake_entry.guidance.replanning_wiring import add_replanning_guidance, replanning_commands, replanning_record
 from drake_entry.guidance.scvx.planner import ScvxPlan, plan_entry, replan_from
 
+__all__ = ["GUIDANCE_SYSTEM", "ScvxMethod", "METHOD"]
+
 GUIDANCE_SYSTEM = "scvx_guidance"
 
 
@@ -41,10 +43,10 @@ class ScvxMethod(GuidanceMethod):
                                    planner.bank[0], planner.alpha[0])
 
     def summarise(self, diagram, context, planner: ScvxPlan) -> GuidanceSummary:
-        mem, fields = replanning_record(diagram, context, GUIDANCE_SYSTEM)
+        mem, stats, fields = replanning_record(diagram, context, GUIDANCE_SYSTEM)
         return GuidanceSummary(
             planner.success, "" if planner.success else f"the pre-flight plan is not verified: {planner.message}",
-            plans=mem.replans, planning_wall_s=mem.wall_s,
+            plans=stats.applied, planning_wall_s=stats.wall_s,
             fields={**fields, "plan_heat_load_MJ_m2": planner.metrics["heat_load_MJ_m2"],
                     "plan_final_time_s": planner.final_time, "plan_iterations": planner.iterations},
             details={"plan": planner, "last_plan": mem.flown.plan, "refused": mem.refused, "replans": mem.log})

@@ -18,6 +18,8 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
 from drake_entry.models.verdict import PathLimit
 
+__all__ = ["SITE_RADIUS_MAX_M", "ENTRY_SPEED_RANGE_M_S", "DEFAULT_DRS_ALTITUDE_MARGIN_M", "ScvxMission"]
+
 #: the largest site radius a mission accepts [m] (a minimum-miss abort opens its cone to it)
 SITE_RADIUS_MAX_M = 5e6
 #: the entry speeds a mission accepts [m/s] (a plan from below 500 m/s has nowhere to glide)

@@ -27,6 +27,11 @@ from drake_entry.models.verdict import PathLimit, breaches_text, check_limits, v
 from drake_entry.planning.result import PlanResult
 from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, Verifier, require_verifier
 
+__all__ = ["GAP_LIFT_FRACTION", "BETWEEN_NODE_TOLERANCE", "POINTS_PER_SEGMENT", "PROPAGATION_TOLERANCE_M",
+           "OBJECTIVE_METRIC", "ScvxPlan", "decision_from_trajectory", "initial_decision", "plan_metrics",
+           "plan_controls", "PlanFlight", "flown_check", "drs_point", "plan_path_limits", "terminal_distance",
+           "plan_entry", "replan_from"]
+
 #: the lossless gap is judged where the lift can act: L >= this fraction of g0
 GAP_LIFT_FRACTION = 0.05
 #: between-node re-check: relative tolerance on heat flux and load, absolute on gamma [rad]

@@ -7,7 +7,9 @@ import os
 
 import numpy as np
 
-from drake_entry.campaign.plots import plt, save_figure
+from drake_entry.figures import plt, save_figure
+
+__all__ = ["plan_figure"]
 
 
 def plan_figure(plan, flight, site_rad: tuple[float, float], out_dir: str, *, title: str,

@@ -9,6 +9,9 @@ import math
 
 from drake_entry.errors import FieldError, ScenarioError
 
+__all__ = ["SOLVER_TOLERANCES", "ScvxSettings", "Formulation", "FORMULATIONS", "OBJECTIVES", "RATE_OBJECTIVES",
+           "EntryProblemSettings", "DEFAULT_PATH_MARGIN", "PAPER_LOSSLESS", "FlightCheck"]
+
 #: convergence tolerances by solver where they differ from ScvxSettings' (``for_solver``)
 SOLVER_TOLERANCES = {"scs": {"defect_tolerance": 1e-5, "constraint_tolerance": 1e-5, "decrease_tolerance": 1e-3}}
 
@@ -222,8 +225,8 @@ class FlightCheck:
       period_s: the guidance period [s]: the plan's bank and alpha are sampled and held this
         long and tracked by the closed loop's actuator law (drake_entry.models.actuator); None flies
         the plan's own bank and alpha directly (no actuator).
-      lead_s: each command is read this far ahead on the plan [s] (the actuators' lag,
-        ``actuator.command_lag``: 1.0 s at a 1-s period), as the SCvx guidance does.
+      lead_s: each command is read this far ahead on the plan [s] (the actuators' lag: half
+        the period for the hold plus 1/omega of the 2 rad/s position loop, 1.0 s at a 1-s period), as the SCvx guidance does.
       alpha_acceleration_deg_s2: the alpha actuator's acceleration limit (not in paper 001: a
         labelled choice well above what a 1 deg/s planned alpha rate needs).
     """

@@ -9,6 +9,8 @@ from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
 from drake_entry.guidance.spec import ReplanningSpec
 
+__all__ = ["Scvx", "shared_fields"]
+
 
 @dc.dataclass
 class Scvx(ReplanningSpec):

@@ -30,6 +30,9 @@ from drake_entry.models.constraints import dynamic_pressure
 from drake_entry.models.dynamics import aero_accelerations, equations_of_motion, state_derivatives
 from drake_entry.models.geodesy import bearings, downtrack_crosstrack
 
+__all__ = ["RANGE_UNIT_M", "ALTITUDE_UNIT_M", "SPEED_UNIT_M_S", "SwarmProblem", "Evaluation", "HISTORY_COLUMNS",
+           "CONTROL_COLUMNS", "evaluate", "range_error"]
+
 #: J of eq. 32: range error over 100 nmi, altitude error over 1 km, speed error over 100 m/s
 RANGE_UNIT_M, ALTITUDE_UNIT_M, SPEED_UNIT_M_S = 1.852e5, 1e3, 100.0
 

@@ -18,6 +18,9 @@ import numpy as np
 from drake_entry.errors import ScenarioError
 from drake_entry.models.schedules import linear_bank
 
+__all__ = ["equilibrium_glide_radius", "qeg_sin_flight_path", "qeg_bank", "alpha_for_load_factor",
+           "alpha_for_heat_rate", "LawMemory", "LawSettings", "law_commands"]
+
 
 def equilibrium_glide_radius(V, lift_coefficient_term, beta: float):
     """r_eq(V) of paper 004 eq. 46, nondimensional: the radius where lift balances gravity

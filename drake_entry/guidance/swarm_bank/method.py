@@ -38,6 +38,9 @@ from drake_entry.planning.result import PlanResult
 from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, require_verifier
 from drake_entry.systems.swarm_bank_guidance import SwarmBankGuidance
 
+__all__ = ["GUIDANCE_SYSTEM", "FLOWN_TOLERANCE_M", "SwarmPlan", "plan_controls", "verify", "terminal_box", "plan",
+           "SwarmBankMethod", "METHOD"]
+
 GUIDANCE_SYSTEM = "swarm_bank_guidance"
 #: the plan's commands flown by Drake must end this close to the replica's TAEM point [m]
 #: (great circle and altitude; measured on paper 004's Case 1 optimum: see docs/methods/swarm-bank.md)
@@ -177,9 +180,9 @@ class SwarmBankMethod(GuidanceMethod):
     def add_systems(self, builder, scenario, planner: SwarmPlan, plant: PlantPorts) -> GuidanceCommands:
         g, p = scenario.guidance, planner.problem
         guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, SwarmBankGuidance(
-            p, math.radians(planner.sigma0_deg), period=g.period_s, resolve_period=g.resolve_period_s,
-            resolve_until_e=g.resolve_until_e, bounds_deg=tuple(g.bank_start_bounds_deg),
-            resolve_scaling=g.resolve_scaling))
+            p, math.radians(planner.sigma0_deg), period=g.period_s, replan_period=g.replan_period_s,
+            replan_until_e=g.replan_until_e, bounds_deg=tuple(g.bank_start_bounds_deg),
+            acceleration_scaling=g.acceleration_scaling))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
         reversal = add_bank_reversal(builder, scenario, plant, guidance.GetOutputPort("bank_magnitude"),

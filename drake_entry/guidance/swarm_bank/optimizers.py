@@ -26,6 +26,8 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["PSO_PAPER", "PSO_CONSTRICTION", "SwarmResult", "pio_search", "pso_search", "minimise", "pio", "pso"]
+
 PSO_PAPER = dict(c1=1.4, c2=2.6, w_start=1.0, w_end=0.4)
 PSO_CONSTRICTION = dict(c1=1.494, c2=1.494, w_start=0.729, w_end=0.729)
 

@@ -6,7 +6,9 @@ import os
 
 import numpy as np
 
-from drake_entry.campaign.plots import limit_line, plt, save_figure  # the Agg backend is set there
+from drake_entry.figures import limit_line, plt, save_figure  # the Agg backend is set there
+
+__all__ = ["swarm_case_plots", "swarm_convergence_plot"]
 
 
 def swarm_case_plots(histories: dict, columns, out_dir: str, *, limits=None, flown=None, title: str = "") -> list[str]:

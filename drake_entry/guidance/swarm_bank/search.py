@@ -34,8 +34,10 @@ from drake_entry.guidance.swarm_bank.optimizers import (
     pso_search,
 )
 from drake_entry.guidance.swarm_bank.spec import SWARMS, swarm_trajectories
-from drake_entry.models.geodesy import destination
 from drake_entry.planning.progress import ProgressLine, wanted
+
+__all__ = ["BASELINES", "Objective", "SearchResult", "swarm_searches", "search", "Resolution", "resolve_sigma0",
+           "problem_from_scenario"]
 
 BASELINES = ("grid", "brentq", "secant", "bounded", "differential_evolution")
 
@@ -262,11 +264,3 @@ def problem_from_scenario(scenario) -> SwarmProblem:
         mach_shift=g.mach_shift, k2=g.qeg_gain, beta=g.qeg_beta,
         reversal_heading=tuple(np.radians(g.reversal_heading_deg)), reversal_velocity=tuple(g.reversal_velocity_m_s),
         guidance_step_s=g.period_s, max_time_s=scenario.simulation.max_time_s)
-
-
-def target_on_entry_great_circle(scenario, distance_m: float) -> tuple[float, float]:
-    """(lon, lat) [deg] at ``distance_m`` along the entry heading's great circle (how the
-    paper-004 substitute target is placed; the paper does not print its target)."""
-    x0 = scenario.initial_state()
-    lon, lat = destination(x0[1], x0[2], x0[5], distance_m, scenario.make_planet().reference_radius)
-    return math.degrees(lon), math.degrees(lat)

@@ -5,7 +5,9 @@ import math
 import typing
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance.spec import ReversingBankSpec
+from drake_entry.guidance.spec import ReversingBankSpec, check_replan_period
+
+__all__ = ["SWARMS", "OPTIMIZERS", "swarm_trajectories", "MAX_SEARCH_TRAJECTORIES", "SwarmBank"]
 
 #: sigma_0 searches: the paper's swarms and the scipy baselines (guidance/swarm_bank/search.py)
 #: the swarm optimizers (paper 004's PIO and PSO; their budget: swarm_trajectories)
@@ -29,7 +31,7 @@ class SwarmBank(ReversingBankSpec):
     TAEM energy (paper 004 eq. 17) with the QEG compensation (eqs. 46-48); alpha from the load
     factor (Case 1, eq. 31) or the heat rate until Mach_shift (Case 2, eq. 21); bank sign from
     the shared reversal logic. bank_start_deg is searched before flight (``optimizer``) unless
-    given, and re-solved on board every ``resolve_period_s`` when > 0."""
+    given, and re-solved on board every ``replan_period_s`` when > 0."""
 
     # the TAEM interface of eq. 32 (r*, V*); the flight stops at its energy
     terminal_altitude_km: float = 30.0
@@ -57,13 +59,14 @@ class SwarmBank(ReversingBankSpec):
     landmark_iteration: int = 14
     map_compass_factor: float = 0.2
     seed: int = 0
-    # on-board re-solution of sigma_0 from the navigation estimate [s] (0 = fly the plan)
-    resolve_period_s: float = 0.0
+    # on-board re-solution of sigma_0 from the navigation estimate every replan_period_s [s] (0 =
+    # fly the plan)
+    replan_period_s: float = 0.0
     # no re-solution past this normalised energy (little range is left to correct)
-    resolve_until_e: float = 0.95
+    replan_until_e: float = 0.95
     # the predictions fly the nominal lift and drag scaled by the filtered sensed/modelled
     # ratios (what the flight has shown of a density or aerodynamic error)
-    resolve_scaling: bool = True
+    acceleration_scaling: bool = True
 
     def terminal_speed(self, speed_of_sound: float) -> float:
         return self.terminal_velocity_m_s
@@ -102,8 +105,5 @@ class SwarmBank(ReversingBankSpec):
                 f"{MAX_SEARCH_TRAJECTORIES:,} (paper 004: 10 x 21 = 210)")
         check_range("guidance.seed", self.seed, 0, 2**32 - 1)
         check_range("guidance.map_compass_factor", self.map_compass_factor, 0.0, 10.0)
-        check_range("guidance.resolve_period_s", self.resolve_period_s, 0.0, 1e4)
-        if self.resolve_period_s and self.resolve_period_s < self.period_s:
-            raise ScenarioError(f"guidance.resolve_period_s = {self.resolve_period_s} must be 0 or >= guidance.period_s "
-                                f"= {self.period_s}")
-        check_range("guidance.resolve_until_e", self.resolve_until_e, 0.0, 1.0)
+        check_replan_period(self)
+        check_range("guidance.replan_until_e", self.replan_until_e, 0.0, 1.0)

@@ -1,6 +1,6 @@
 """Paper 004's study on a mission: Table 1 (swarm statistics over seeds), the optimum per case
 (Case 1 and Case 2 at Mach_shift 20, 16, 10), the scipy baselines and the two-parameter
-search. Used by ``benchmarks/run.py paper004`` and the method's ``drake-entry plan`` report.
+search, as ``benchmarks/run.py paper004`` prints them beside the paper's.
 
 ``PAPER`` holds the figures paper 004 prints, for side-by-side tables (Case 1 unless named).
 """
@@ -14,6 +14,9 @@ import numpy as np
 from drake_entry.guidance.swarm_bank.evaluator import Evaluation, SwarmProblem, evaluate
 from drake_entry.guidance.swarm_bank.optimizers import minimise
 from drake_entry.guidance.swarm_bank.search import BASELINES, Objective, SearchResult, search, swarm_searches
+
+__all__ = ["PAPER", "CASES", "SwarmStatistics", "swarm_statistics", "case_problem", "CaseOptimum", "case_optima",
+           "baselines", "two_parameter"]
 
 #: paper 004's printed figures (Table 1: Case 1, 5 runs; Sec. 5 per case)
 PAPER = {

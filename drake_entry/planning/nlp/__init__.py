@@ -69,7 +69,7 @@ from drake_entry.planning.nlp.result import (  # noqa: F401 (API)
     summary,
 )
 from drake_entry.planning.nlp.scaling import Scaling  # noqa: F401 (API)
-from drake_entry.planning.nlp.scaling import resolve as resolve_scaling
+from drake_entry.planning.nlp.scaling import resolve as acceleration_scaling
 from drake_entry.planning.nlp.status import restartable, verdict
 from drake_entry.planning.nlp.transcription import COSTATE_SIGN  # noqa: F401 (API)
 from drake_entry.planning.nlp.verify import (  # noqa: F401 (API)
@@ -81,6 +81,11 @@ from drake_entry.planning.nlp.verify import (  # noqa: F401 (API)
 )
 from drake_entry.planning.nlp.verify import verify as verify_solution
 from drake_entry.planning.progress import wanted
+
+__all__ = ["MAX_NODES", "MeshStep", "mesh_error", "next_nodes", "TRANSCRIPTION_LABELS", "NlpError", "NlpResult",
+           "extremal_controls", "segment_words", "summary", "Scaling", "COSTATE_SIGN", "DYNAMICS_TOLERANCE",
+           "PROPAGATION_TOLERANCE", "PropagationCheck", "Verification", "propagate", "TRANSCRIPTIONS",
+           "RESTART_VIOLATION", "SOLVERS", "solve", "check_options", "auto_solvers", "default_solver"]
 
 TRANSCRIPTIONS = ("lgl", "dircol", "hermite_simpson")
 #: a solver stopped near an optimum (status.restartable) at a point this feasible (largest
@@ -289,7 +294,7 @@ def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, o
     with ``converged`` and this mesh's build and solve times, the solver's verdict in words, the
     violation diagnosis when not converged); ``show``: progress lines on stderr (SolveProgress)."""
     t_build = _time.perf_counter()
-    scales = resolve_scaling(problem, guess, scaling)
+    scales = acceleration_scaling(problem, guess, scaling)
     tx = (_LglTranscription(problem, nodes, scales, segments) if transcription == "lgl"
           else _HermiteSimpsonTranscription(problem, nodes, scales) if transcription == "hermite_simpson"
           else _DircolTranscription(problem, nodes, scales, float(guess[0][-1])))

@@ -16,6 +16,8 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.planning.ocp import CustomProblem, ObjectiveTerm, OptimalControlProblem, PathConstraint
 
+__all__ = ["G_BRACHISTOCHRONE", "brachistochrone", "goddard_rocket", "shuttle_crossrange"]
+
 G_BRACHISTOCHRONE = 9.81  # m/s^2
 
 

@@ -7,6 +7,8 @@ import numpy as np
 from drake_entry.planning.nlp.result import NlpResult
 from drake_entry.planning.nlp.transcription import _Transcription
 
+__all__ = ["DIRCOL_COSTATE_FACTOR"]
+
 DIRCOL_COSTATE_FACTOR = 1.5
 
 

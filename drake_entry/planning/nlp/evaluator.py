@@ -10,6 +10,8 @@ from pydrake.autodiffutils import ExtractValue
 
 from drake_entry.planning.progress import ProgressLine
 
+__all__ = ["SolveProgress", "CallbackTimer", "CACHED_EVALUATIONS", "model_values"]
+
 
 class SolveProgress(ProgressLine):
     """Console progress of a long solve (planning.progress): the solver's evaluations of the

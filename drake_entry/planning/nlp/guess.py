@@ -9,6 +9,9 @@ import numpy as np
 from drake_entry.models.geodesy import bearing, central_angle_smooth, crossrange_from_great_circle
 from drake_entry.planning.ocp import OptimalControlProblem
 
+__all__ = ["initial_guess", "REVERSAL_TRIGGER_M", "REVERSAL_MIN_TURN", "REVERSAL_STEPS", "GUESS_MAX_STEP_S",
+           "GUESS_SAMPLE_STEP_S", "GUESS_MISS_TOL_RAD", "GUESS_LATERAL_TOL_M", "MEET_FINAL_SHARE"]
+
 
 def initial_guess(problem, samples: int = 200):
     """(t, states, controls) SI: a propagated guess.

@@ -22,6 +22,8 @@ from drake_entry.planning.nlp.evaluator import _NodeEvaluator
 from drake_entry.planning.nlp.node_program import _NodeProgram, _Part
 from drake_entry.planning.nlp.result import NlpResult
 
+__all__ = ["MIN_FINAL_TIME", "PART_INTERVALS", "interval_parts"]
+
 MIN_FINAL_TIME = 1e-6  # [time scales]
 #: intervals per part (one constraint each, node_program): Drake packs a Python constraint's
 #: Jacobian as AutoDiff over all its variables, so parts of this size cost far less than one

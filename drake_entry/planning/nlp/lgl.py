@@ -9,6 +9,8 @@ from drake_entry.planning.nlp.node_program import _NodeProgram, _Part
 from drake_entry.planning.nlp.result import NlpResult
 from drake_entry.planning.pseudospectral import SegmentMesh
 
+__all__ = ["nodes_per_segment", "segment_compatible"]
+
 
 def nodes_per_segment(nodes: int, segments: int) -> int:
     """LGL nodes of each of ``segments`` equal segments sharing their end nodes, for ``nodes``

@@ -26,6 +26,8 @@ import numpy as np
 from drake_entry.errors import DrakeEntryError
 from drake_entry.planning.nlp.verify import interval_errors
 
+__all__ = ["MAX_NODES", "TARGET_SHARE", "MeshStep", "mesh_error", "next_nodes"]
+
 #: default node caps: one LGL polynomial of 150 nodes already resolves minutes-long entry
 #: flights to 1e-4; Hermite-Simpson needs more samples for the same error
 MAX_NODES = {"lgl": 150, "dircol": 400, "hermite_simpson": 400}

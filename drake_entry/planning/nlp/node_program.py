@@ -19,6 +19,8 @@ from pydrake.solvers import MathematicalProgram
 from drake_entry.planning.nlp.evaluator import _chain, _NodeEvaluator
 from drake_entry.planning.nlp.transcription import _Transcription
 
+__all__ = []
+
 
 @dc.dataclass(frozen=True)
 class _Part:

@@ -5,8 +5,10 @@ import os
 
 import numpy as np
 
-from drake_entry.campaign.plots import plt, save_figure  # the Agg backend is set there
+from drake_entry.figures import plt, save_figure  # the Agg backend is set there
 from drake_entry.planning.nlp.result import TRANSCRIPTION_LABELS
+
+__all__ = ["nlp_solution_plots"]
 
 
 def nlp_solution_plots(problem, result, out_dir: str, *, propagated=None, extremal=None, title: str = "") -> list[str]:

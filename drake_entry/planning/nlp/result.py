@@ -12,6 +12,8 @@ from drake_entry.planning.ocp import OptimalControlProblem
 from drake_entry.planning.pseudospectral import SegmentMesh
 from drake_entry.planning.result import PlanResult
 
+__all__ = ["NlpResult", "TRANSCRIPTION_LABELS", "segment_words", "NlpError", "extremal_controls", "summary"]
+
 
 @dc.dataclass
 class NlpResult(PlanResult):

@@ -22,6 +22,8 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["FIELDS", "Scaling", "resolve", "objective_factor"]
+
 FIELDS = ("states", "controls", "time", "objective")
 
 

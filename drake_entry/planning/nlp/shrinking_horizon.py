@@ -22,6 +22,8 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["MIN_HORIZON_S", "GUESS_SAMPLES", "remaining_problem", "shifted_guess", "resolve_from"]
+
 #: the shortest horizon worth re-solving [s of the problem's clock]
 MIN_HORIZON_S = 1e-3
 #: samples of the previous solution in the warm start

@@ -4,6 +4,8 @@ not converged here. The meanings are the SNOPT 7 user guide's (section 8.6, INFO
 Ipopt's SolverReturn (Drake's ``IpoptSolverDetails.ConvertStatusToString``)."""
 from __future__ import annotations
 
+__all__ = ["SNOPT_INFO", "SNOPT_CONVERGED", "SNOPT_RESTARTABLE", "IPOPT_RESTARTABLE_WORDS", "verdict", "restartable"]
+
 SNOPT_INFO = {
     1: "optimality conditions satisfied", 2: "feasible point found", 3: "requested accuracy could not be achieved",
     5: "elastic objective minimized", 6: "elastic infeasibilities minimized",

@@ -8,6 +8,8 @@ from drake_entry.planning.nlp.evaluator import CallbackTimer, model_values
 from drake_entry.planning.nlp.result import NlpResult
 from drake_entry.planning.nlp.scaling import objective_factor
 
+__all__ = ["COSTATE_SIGN"]
+
 COSTATE_SIGN = 1.0  # Drake's multiplier sign convention, checked on analytic problems (tests)
 
 

@@ -30,6 +30,9 @@ from drake_entry.planning.nlp.evaluator import model_values
 from drake_entry.planning.ocp import OptimalControlProblem
 from drake_entry.planning.verification import OcpControls, require_verifier
 
+__all__ = ["QUADRATURE_POINTS", "DYNAMICS_TOLERANCE", "PROPAGATION_TOLERANCE", "Verification", "state_magnitudes",
+           "interval_errors", "verify", "PropagationCheck", "propagate", "terminal_error"]
+
 QUADRATURE_POINTS = 8
 #: default tolerances (relative, GPOPS-II form). 1e-3 between nodes is GPOPS-II's default
 #: mesh tolerance. The open-loop flight accumulates and amplifies those errors over the whole

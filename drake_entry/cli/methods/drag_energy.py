@@ -9,7 +9,9 @@ import sys
 
 import numpy as np
 
-from drake_entry.cli import Command
+from drake_entry.cli.common import Command
+
+__all__ = ["plan_report", "propagate_extracted_bank", "fit_horus", "COMMANDS"]
 
 
 def plan_report(scenario, out_dir: str) -> int:

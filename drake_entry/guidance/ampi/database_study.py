@@ -21,9 +21,9 @@ import time
 
 import numpy as np
 
+from drake_entry.campaign.backends import Task
+from drake_entry.campaign.engine import run_cases, task_manifest
 from drake_entry.campaign.store import read_rows, read_trajectories
-from drake_entry.diagrams.backends import Task
-from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.ampi.database import TrajectoryDatabase
@@ -31,6 +31,9 @@ from drake_entry.guidance.ampi.grid import ParameterGrid
 from drake_entry.planning import nlp
 from drake_entry.planning.ocp_yaml import load_problem
 from drake_entry.planning.pseudospectral import lgl_nodes
+
+__all__ = ["DATABASE_FILE", "DatabaseStudy", "setup_worker", "case_problem", "offset_problem", "solve_case",
+           "build_database"]
 
 DATABASE_FILE = "database.npz"
 
@@ -162,7 +165,7 @@ def build_database(out_dir: str, study: DatabaseStudy | None = None, *, backend:
     config = study.config()
     state = setup_worker(config)
     problem, grid = state["problem"], state["grid"]
-    task = Task("drake_entry.diagrams.ampi_database:setup_worker", "drake_entry.diagrams.ampi_database:solve_case",
+    task = Task("drake_entry.guidance.ampi.database_study:setup_worker", "drake_entry.guidance.ampi.database_study:solve_case",
                 config)
     manifest = task_manifest(task, [{"index": i} for i in range(grid.size)], kind="ampi_database")
     campaign = dict(backend=backend, workers=workers, scheduler=scheduler, progress=progress)

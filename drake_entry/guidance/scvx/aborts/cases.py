@@ -30,6 +30,11 @@ from drake_entry.guidance.scvx.mission import ENTRY_SPEED_RANGE_M_S, SITE_RADIUS
 from drake_entry.models import geodesy
 from drake_entry.models.planet import Earth
 
+__all__ = ["GRID_SPACING_DEG", "GRID_SHAPE", "FEASIBLE_RADII_M", "DESCENT_ABORT_SPACING_S", "OPEN_SITE_RADIUS_M",
+           "ALTERNATIVE_SITES", "PAPER_TABLES", "COLUMN_NOTES", "heading_offset", "orbital_abort_cases",
+           "CASE_FIELDS", "case_mission", "descent_abort_cases", "feasible", "abort_statistics",
+           "statistics_markdown"]
+
 #: the paper's grid spacing [deg] and the smallest map the issue asks for
 GRID_SPACING_DEG = 5.0
 GRID_SHAPE = (9, 9)

@@ -20,9 +20,11 @@ import sys
 import numpy as np
 
 import drake_entry
+from drake_entry.campaign.backends import BACKENDS, Task, run_backend
 from drake_entry.campaign.store import CampaignStore
-from drake_entry.diagrams.backends import BACKENDS, Task, run_backend
 from drake_entry.errors import Interrupted, ScenarioError
+
+__all__ = ["versions", "session", "source_commit", "task_manifest", "check_backend", "run_cases", "SampleCases"]
 
 
 def versions() -> dict:

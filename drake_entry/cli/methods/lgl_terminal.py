@@ -11,6 +11,8 @@ import sys
 
 from drake_entry.models.verdict import box_text
 
+__all__ = ["plan_report"]
+
 
 def plan_report(scenario, out_dir: str) -> int:
     """Exit 0 when the plan is a success (solver converged, verified, and its bank and alpha,

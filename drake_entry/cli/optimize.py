@@ -8,8 +8,10 @@ import os
 import sys
 import time
 
-from drake_entry.cli import Command
+from drake_entry.cli.common import Command
 from drake_entry.errors import ScenarioError
+
+__all__ = ["add_arguments", "run", "COMMANDS"]
 
 
 def add_arguments(parser) -> None:
@@ -59,11 +61,11 @@ def run(args) -> int:
 
 
 def _solve_and_write(args) -> int:
-    from drake_entry.campaign.tables import write_table
     from drake_entry.diagrams.verification import fly_controls
     from drake_entry.planning import nlp
     from drake_entry.planning.nlp.plots import nlp_solution_plots
     from drake_entry.planning.ocp_yaml import load_problem
+    from drake_entry.tables import write_table
 
     problem, settings = load_problem(args.problem)
     nodes = settings.nodes if args.nodes is None else args.nodes

@@ -32,18 +32,22 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from drake_entry.campaign.backends import Task
+from drake_entry.campaign.engine import run_cases, task_manifest
 from drake_entry.campaign.store import read_rows
-from drake_entry.diagrams.ampi_database import offset_problem
-from drake_entry.diagrams.ampi_database import setup_worker as database_worker
-from drake_entry.diagrams.backends import Task
-from drake_entry.diagrams.campaign import run_cases, task_manifest
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.ampi.database import TrajectoryDatabase
+from drake_entry.guidance.ampi.database_study import offset_problem
+from drake_entry.guidance.ampi.database_study import setup_worker as database_worker
 from drake_entry.guidance.ampi.spec import MODES, database_path
 from drake_entry.models.geodesy import central_angle
 from drake_entry.planning import nlp
 from drake_entry.planning.pseudospectral import LGL
+
+__all__ = ["COMPARED", "UNITS", "AccuracyStudy", "entry_offsets", "setup_worker", "flown_controls", "fly_ld",
+           "fly_reference", "reference_errors", "accuracy_case", "accuracy_study", "summarise", "format_summary",
+           "reconstruction_error"]
 
 #: the states compared (eq. 13 shows h, lon, lat, V and t_f; gamma, psi and the bank too)
 COMPARED = ("h", "lon", "lat", "V", "gamma", "psi", "sigma")
@@ -184,7 +188,7 @@ def accuracy_study(out_dir: str, study: AccuracyStudy | None = None, *, backend:
     config = study.config()
     db = TrajectoryDatabase.load(config["database"])
     offsets = entry_offsets(db, study.cases, study.seed)
-    task = Task("drake_entry.diagrams.ampi_accuracy:setup_worker", "drake_entry.diagrams.ampi_accuracy:accuracy_case",
+    task = Task("drake_entry.guidance.ampi.accuracy_study:setup_worker", "drake_entry.guidance.ampi.accuracy_study:accuracy_case",
                 config)
     cases = [{"index": i, "offsets": o.tolist()} for i, o in enumerate(offsets)]
     run_cases(task, cases, out_dir, task_manifest(task, cases, kind="ampi_accuracy"), backend=backend, workers=workers,

@@ -7,13 +7,15 @@ import json
 import os
 import sys
 
+__all__ = ["plan_report"]
+
 
 def plan_report(scenario, out_dir: str) -> int:
     """Plan, fly the plan's controls, print, plot and write ``plan.json``; exit 0 when the plan
     is verified (converged, its flight within PROPAGATION_TOLERANCE_M of it, inside the DRS box,
     every path limit held), 1 otherwise."""
-    from drake_entry.campaign.plots import trajectory_plots
     from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.figures import trajectory_plots
     from drake_entry.guidance.scvx.method import METHOD
     from drake_entry.guidance.scvx.plots import plan_figure
 

@@ -24,6 +24,9 @@ from drake_entry.scenario import Scenario
 from drake_entry.systems.native_plant import as_flight_error
 from drake_entry.typed_yaml import load_yaml_typed
 
+__all__ = ["TRAJECTORY_STEP_S", "DETAILED_SAMPLES", "DETAILED_STEP_S", "TIMING_COLUMNS", "sample_seed",
+           "setup_worker", "run_case", "run_sample", "campaign_row", "downsample"]
+
 TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
 #: the first samples are stored at this finer step [s] (the report's bank histories), when the
 #: campaign keeps trajectories at all

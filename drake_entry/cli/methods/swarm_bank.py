@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import sys
 
+__all__ = ["plan_report"]
+
 
 def plan_report(scenario, out_dir: str) -> int:
     """Plan, fly once (nominal), print the comparison and write the figures; exit code 0 when
     the plan is verified and the flight agrees with it (2 km along-track, 20 m altitude)."""
-    from drake_entry.campaign.plots import trajectory_plots
     from drake_entry.diagrams.closed_loop import fly
+    from drake_entry.figures import trajectory_plots
     from drake_entry.guidance.swarm_bank.evaluator import HISTORY_COLUMNS, range_error
     from drake_entry.guidance.swarm_bank.plots import swarm_case_plots
 

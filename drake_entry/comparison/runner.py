@@ -1,12 +1,12 @@
 """Several guidance methods flown on one mission with the same dispersions and seeds.
 
-``run_comparison`` takes a comparison (drake_entry.comparison: the mission and each method's
+``run_comparison`` takes a comparison (drake_entry.comparison.spec: the mission and each method's
 settings, or why a method cannot fly it) and, for every method that flies, writes the
 scenario it flies (``scenarios/<label>.yaml``), times its pre-flight planning once, and runs
 an ordinary Monte-Carlo campaign of it (``montecarlo.run_campaign``, resumable) into
 ``<label>/`` with the same seed: sample i of every method draws the same dispersions, because
-a sample's draws come first from a generator seeded by (seed, i) alone (diagrams.sample).
-Then each campaign's report and the comparison's report (campaign.comparison_report).
+a sample's draws come first from a generator seeded by (seed, i) alone (campaign.sample).
+Then each campaign's report and the comparison's report (comparison.report).
 """
 from __future__ import annotations
 
@@ -16,12 +16,14 @@ import time
 
 from pydrake.common.yaml import yaml_dump_typed
 
-from drake_entry.campaign.comparison_report import MANIFEST, read_comparison_manifest, write_comparison_report
-from drake_entry.campaign.store import _write_atomic
-from drake_entry.comparison import Comparison, load_comparison, method_scenario
-from drake_entry.diagrams.campaign import session, versions
-from drake_entry.diagrams.montecarlo import TRAJECTORY_STEP_S, run_campaign
+from drake_entry.campaign.engine import session, versions
+from drake_entry.campaign.montecarlo import TRAJECTORY_STEP_S, run_campaign
+from drake_entry.campaign.store import write_atomic
+from drake_entry.comparison.report import MANIFEST, read_comparison_manifest, write_comparison_report
+from drake_entry.comparison.spec import Comparison, load_comparison, method_scenario
 from drake_entry.errors import DrakeEntryError, ScenarioError
+
+__all__ = ["SCENARIOS", "run_comparison"]
 
 #: the folder of a comparison directory that holds the scenario each method flew
 SCENARIOS = "scenarios"
@@ -51,7 +53,7 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
         raise ScenarioError(f"{out_dir} holds comparison {manifest.get('comparison')!r} with seed "
                             f"{manifest.get('seed')}; use another --out")
     methods = dict(manifest.get("methods", {}))
-    for entry in comp.methods:
+    for entry in comp.methods + comp.not_configured():
         if entry.not_flown:
             methods[entry.label] = {"method": entry.method, "flown": False, "reason": entry.not_flown,
                                     "mapping": entry.mapping}
@@ -62,7 +64,7 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
             continue
         scenario = scenarios[entry.label]
         path = os.path.join(out_dir, SCENARIOS, f"{entry.label}.yaml")
-        _write_atomic(path, yaml_dump_typed(scenario).encode())
+        write_atomic(path, yaml_dump_typed(scenario).encode())
         record = {"method": entry.method, "flown": True, "mapping": entry.mapping,
                   "scenario": os.path.join(SCENARIOS, f"{entry.label}.yaml")}
         if progress:
@@ -84,11 +86,11 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
         del setup
         write_report(campaign_dir, title=f"{comp.name}: {entry.label}")
         methods[entry.label] = {**record, "campaign": entry.label}
-    order = {label: i for i, label in enumerate(labels)}
+    order = {label: i for i, label in enumerate(labels + [m.label for m in comp.not_configured()])}
     manifest = {"comparison": comp.name, "description": comp.description, "mission": comp.mission,
                 "comparison_yaml": yaml_dump_typed(comp), "runs": max(int(runs), int(manifest.get("runs", 0))),
                 "seed": int(seed), "versions": versions(),
                 "sessions": list(manifest.get("sessions", [])) + [session()],
                 "methods": dict(sorted(methods.items(), key=lambda kv: order.get(kv[0], len(order))))}
-    _write_atomic(os.path.join(out_dir, MANIFEST), json.dumps(manifest, indent=2).encode())
+    write_atomic(os.path.join(out_dir, MANIFEST), json.dumps(manifest, indent=2).encode())
     return write_comparison_report(out_dir)

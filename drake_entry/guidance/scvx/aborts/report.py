@@ -1,4 +1,4 @@
-"""Report of an abort campaign directory (``diagrams.aborts``): counts of feasible aborts at
+"""Report of an abort campaign directory (``guidance.scvx.aborts.study``): counts of feasible aborts at
 10 and 40 km, the Tables 4-7 statistics beside paper 001's, and the figures of its Sec. VI
 (reachability map coloured by heat load as its Fig. 8, flown miss as its Fig. 13, attitude
 as Fig. 7, altitude-speed as Fig. 9; descent aborts: ground tracks as Fig. 14 and the miss by
@@ -11,10 +11,12 @@ import textwrap
 
 import numpy as np
 
-from drake_entry.campaign.plots import plt, save_figure
 from drake_entry.campaign.store import coverage, read_trajectories
-from drake_entry.guidance.scvx.aborts import FEASIBLE_RADII_M, abort_statistics, feasible, statistics_markdown
+from drake_entry.figures import plt, save_figure
+from drake_entry.guidance.scvx.aborts.cases import FEASIBLE_RADII_M, abort_statistics, feasible, statistics_markdown
 from drake_entry.models.planet import Earth
+
+__all__ = ["write_abort_report"]
 
 
 def _geodetic_track(traj: dict, planet: Earth):

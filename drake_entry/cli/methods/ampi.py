@@ -11,9 +11,11 @@ import sys
 
 import numpy as np
 
-from drake_entry.diagrams.ampi_accuracy import flown_controls, fly_ld, reference_errors
+from drake_entry.guidance.ampi.accuracy_study import flown_controls, fly_ld, reference_errors
 from drake_entry.models.verdict import box_text
 from drake_entry.planning.nlp.evaluator import model_values
+
+__all__ = ["plan_report"]
 
 
 def plan_report(scenario, out_dir: str) -> int:
@@ -86,7 +88,7 @@ def _path_peaks(problem, syn, n_ld: int, check) -> dict:
 
 
 def _figure(scenario, problem, syn, check, out_dir: str) -> str:
-    from drake_entry.campaign.plots import plt, save_figure
+    from drake_entry.figures import plt, save_figure
 
     names = problem.state_names
     i_lon, i_lat, i_v, i_s = (names.index(n) for n in ("lon", "lat", "V", "sigma"))

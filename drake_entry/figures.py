@@ -1,5 +1,7 @@
 """Standard entry plots shared by every command: altitude-velocity, groundtrack, heat
-flux, dynamic pressure and load factors against their limits. Headless (Agg)."""
+flux, dynamic pressure and load factors against their limits; ``save_figure``, the one way a
+figure is titled and written. Headless: ``plt`` is pyplot with the Agg backend set, so every
+module that draws imports it from here."""
 from __future__ import annotations
 
 import os
@@ -9,6 +11,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+__all__ = ["plt", "limit_line", "trajectory_plots", "save_figure"]
 
 
 def limit_line(ax, value, label):

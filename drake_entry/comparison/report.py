@@ -18,22 +18,25 @@ import os
 import numpy as np
 from scipy import stats as scipy_stats
 
-from drake_entry.campaign.plots import plt, save_figure
 from drake_entry.campaign.report import (
     MARGIN_COLUMNS,
-    _cell,
-    _columns,
-    _figure_list,
-    _finite,
-    _fmt,
     drake_entry_version,
+    figure_list,
+    finite_column,
     flown_scenario,
+    format_number,
     reached_terminal,
+    rows_as_columns,
     summary_statistics,
+    table_cell,
     write_markdown_report,
 )
 from drake_entry.campaign.store import coverage, read_manifest
 from drake_entry.errors import CampaignError
+from drake_entry.figures import plt, save_figure
+
+__all__ = ["MANIFEST", "LEVEL", "MARGIN_NAMES", "read_comparison_manifest", "clopper_pearson", "method_summary",
+           "dispersion_check", "write_comparison_report", "footprints", "success_intervals", "miss_distributions"]
 
 #: the file a comparison directory is identified by
 MANIFEST = "comparison.json"
@@ -62,7 +65,7 @@ def clopper_pearson(successes: int, runs: int, level: float = LEVEL) -> tuple[fl
 def _method_rows(out_dir: str, label: str) -> dict | None:
     cov = coverage(os.path.join(out_dir, label))
     records = [cov["rows"][k] for k in sorted(cov["rows"])]
-    return _columns(records) if records else None
+    return rows_as_columns(records) if records else None
 
 
 def method_summary(rows: dict) -> dict:
@@ -75,22 +78,22 @@ def method_summary(rows: dict) -> dict:
            "failure_reasons": s["failure_reasons"]}
     for key in ("successful", "inside_box", "within_limits"):
         out[f"{key}_interval"] = clopper_pearson(out[key], n)
-    d = _finite(rows, "err_distance_m", n)[reached] / 1e3
+    d = finite_column(rows, "err_distance_m", n)[reached] / 1e3
     if d.size:
         out["miss_km"] = {"median": float(np.median(d)), "p95": float(np.percentile(d, 95)), "max": float(d.max())}
     for col in ("err_range_m", "err_crossrange_m", "err_altitude_m", "err_velocity_m_s"):
-        v = _finite(rows, col, n)[reached]
+        v = finite_column(rows, col, n)[reached]
         if v.size:
             out[col] = {"mean": float(v.mean()), "std": float(v.std(ddof=1)) if v.size > 1 else 0.0}
     out["margins"] = {}
     for col in [c for c in MARGIN_COLUMNS if c in rows] + (["margin_bank"] if "margin_bank" in rows else []):
-        m = _finite(rows, col, n)
+        m = finite_column(rows, col, n)
         m = m[np.isfinite(m)]
         if m.size:
             out["margins"][col] = {"worst": float(m.min()), "breached": int((m < 0).sum())}
     for col in ("bank_reversals", "bank_travel_deg", "time_at_bank_limit_s", "time_at_bank_rate_limit_s",
                 "plans", "planning_wall_s", "wall_time_s"):
-        v = _finite(rows, col, n)
+        v = finite_column(rows, col, n)
         v = v[np.isfinite(v)]
         if v.size:
             out[col] = {"mean": float(v.mean()), "max": float(v.max())}
@@ -144,7 +147,7 @@ def write_comparison_report(out_dir: str) -> str:
     figs = _figures(all_rows, summaries, out_dir, title, radius)
     sections = [_header(meta, summaries, same, compared, worst, scenario), _verdict_table(meta, summaries),
                 _error_table(summaries), _margin_table(summaries), _activity_table(meta, summaries),
-                _mapping_table(meta), _figure_list(figs) if figs else ""]
+                _mapping_table(meta), figure_list(figs) if figs else ""]
     return write_markdown_report(sections, out_dir, title=title)
 
 
@@ -152,7 +155,7 @@ def _num(x) -> str:
     """A table number: whole units from 100 up, else 3 significant digits."""
     if x is None or not np.isfinite(x):
         return "—"
-    return f"{x:.0f}" if abs(x) >= 100 else _fmt(x, 3)
+    return f"{x:.0f}" if abs(x) >= 100 else format_number(x, 3)
 
 
 def _pct(x: float) -> str:
@@ -206,13 +209,13 @@ def _verdict_table(meta, summaries) -> str:
             cells.append(f"{s[key]} [{_pct(lo)}, {_pct(hi)}]")
         reasons = "; ".join(f"{k}: {v}" for k, v in sorted(s["failure_reasons"].items(), key=lambda kv: -kv[1]))
         out.append(f"| [{label}]({label}/report.md) (!{info['method']}) | {s['samples']} | {' | '.join(cells)} | "
-                   f"{_cell(reasons) or '—'} |")
+                   f"{table_cell(reasons) or '—'} |")
     return "\n".join(out)
 
 
 def _ms(s: dict, col: str, scale: float = 1.0, digits: int = 3) -> str:
     v = s.get(col)
-    return "—" if v is None else f"{_fmt(v['mean'] * scale, digits)} ± {_fmt(v['std'] * scale, 2)}"
+    return "—" if v is None else f"{format_number(v['mean'] * scale, digits)} ± {format_number(v['std'] * scale, 2)}"
 
 
 def _error_table(summaries) -> str:
@@ -225,8 +228,8 @@ def _error_table(summaries) -> str:
            "| altitude [m] | speed [m/s] |", "|---|---|---|---|---|---|---|---|---|"]
     for label, s in summaries.items():
         miss = s.get("miss_km") or {}
-        out.append(f"| {label} | {s['reached']} of {s['samples']} | {_fmt(miss.get('median'), 3)} | "
-                   f"{_fmt(miss.get('p95'), 3)} | {_fmt(miss.get('max'), 3)} | {_ms(s, 'err_range_m', 1e-3)} | "
+        out.append(f"| {label} | {s['reached']} of {s['samples']} | {format_number(miss.get('median'), 3)} | "
+                   f"{format_number(miss.get('p95'), 3)} | {format_number(miss.get('max'), 3)} | {_ms(s, 'err_range_m', 1e-3)} | "
                    f"{_ms(s, 'err_crossrange_m', 1e-3)} | {_ms(s, 'err_altitude_m')} | {_ms(s, 'err_velocity_m_s')} |")
     return "\n".join(out)
 
@@ -284,7 +287,7 @@ def _mapping_table(meta) -> str:
                     else f"{text} (not flown yet: not selected in any run so far)").strip()
         where = f" ([scenario]({info['scenario']}))" if info.get("flown") and info.get("scenario") else ""
         out.append(f"| {label} (!{info['method']}) | {'yes' if info.get('flown') else 'no'} | "
-                   f"{_cell(text)}{where} |")
+                   f"{table_cell(text)}{where} |")
     return "\n".join(out)
 
 
@@ -304,8 +307,8 @@ def footprints(all_rows: dict, out_dir: str, title: str, radius_km) -> tuple[str
     for k, (label, rows) in enumerate(all_rows.items()):
         n = len(rows["index"])
         reached = reached_terminal(rows)
-        x = _finite(rows, "err_crossrange_m", n)[reached] / 1e3
-        y = _finite(rows, "err_range_m", n)[reached] / 1e3
+        x = finite_column(rows, "err_crossrange_m", n)[reached] / 1e3
+        y = finite_column(rows, "err_range_m", n)[reached] / 1e3
         ok = np.array([bool(v) for v in rows["success"]])[reached]
         color = f"C{k % 10}"
         for ax in axes:
@@ -376,7 +379,7 @@ def miss_distributions(all_rows: dict, out_dir: str, title: str, radius_km) -> t
     fig, ax = plt.subplots(figsize=(9.5, 4.2))
     for k, (label, rows) in enumerate(all_rows.items()):
         n = len(rows["index"])
-        d = np.sort(_finite(rows, "err_distance_m", n)[reached_terminal(rows)] / 1e3)
+        d = np.sort(finite_column(rows, "err_distance_m", n)[reached_terminal(rows)] / 1e3)
         if d.size:
             ax.step(np.maximum(d, 1e-3), np.arange(1, d.size + 1) / n, where="post", color=f"C{k % 10}",
                     label=f"{label} ({d.size} of {n} reached)")

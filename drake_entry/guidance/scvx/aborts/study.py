@@ -8,7 +8,7 @@ Dask), resumable.
     run_descent_aborts(out_dir)   the nominal flown, re-planned to an alternative site every 50 s
 
 The cases and the Tables 4-7 statistics are ``guidance.scvx.aborts``; the report and
-figures ``guidance.scvx.abort_report``.
+figures ``guidance.scvx.aborts.report``.
 """
 from __future__ import annotations
 
@@ -18,11 +18,11 @@ import time
 
 import numpy as np
 
-from drake_entry.diagrams.backends import Task
-from drake_entry.diagrams.campaign import run_cases, task_manifest
+from drake_entry.campaign.backends import Task
+from drake_entry.campaign.engine import run_cases, task_manifest
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.scvx.aborts import (
+from drake_entry.guidance.scvx.aborts.cases import (
     ALTERNATIVE_SITES,
     DESCENT_ABORT_SPACING_S,
     FEASIBLE_RADII_M,
@@ -40,6 +40,9 @@ from drake_entry.guidance.scvx.settings import EntryProblemSettings, ScvxSetting
 from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import load_vehicle
+
+__all__ = ["TRAJECTORY_STEP_S", "AbortStudy", "setup_worker", "abort_row", "plan_trajectory", "run_case",
+           "run_orbital_aborts", "fly_nominal", "run_descent_aborts"]
 
 #: spacing [s] of the planned trajectory kept per case for the figures
 TRAJECTORY_STEP_S = 20.0
@@ -121,7 +124,7 @@ def run_case(models: tuple, case: dict):
 
 
 def _run(study: AbortStudy, cases: list, out_dir: str, kind: str, extra: dict, **campaign) -> str:
-    task = Task("drake_entry.diagrams.aborts:setup_worker", "drake_entry.diagrams.aborts:run_case", study.config())
+    task = Task("drake_entry.guidance.scvx.aborts.study:setup_worker", "drake_entry.guidance.scvx.aborts.study:run_case", study.config())
     manifest = task_manifest(task, cases, kind=kind, **extra)
     return run_cases(task, cases, out_dir, manifest, desc=kind.replace("_", " "), **campaign)
 

@@ -8,7 +8,7 @@ dispersions, simulation) is the same for every method: an override may touch onl
 method's settings, ``guidance.*`` and the open-loop ``alpha`` schedule (flown by the methods
 that do not command alpha). ``method_scenario`` makes the scenario one method flies; the
 campaign engine flies them all with the same seed, so sample i of every method draws the same
-dispersions (``drake_entry.diagrams.comparison``). Pure data: loading one imports no solver.
+dispersions (``drake_entry.comparison.runner``). Pure data: loading one imports no solver.
 """
 import dataclasses as dc
 import re
@@ -18,6 +18,9 @@ from drake_entry.errors import ScenarioError
 from drake_entry.guidance import REGISTRY, GuidanceSpec, known_tags
 from drake_entry.scenario import Scenario, apply_overrides, load_scenario
 from drake_entry.typed_yaml import load_packaged_or_file, packaged_names
+
+__all__ = ["METHOD_FIELDS", "LABEL", "ComparedMethod", "Comparison", "PACKAGED_COMPARISONS", "load_comparison",
+           "method_scenario"]
 
 #: the scenario fields an entry may override: the method's settings, never the mission
 METHOD_FIELDS = ("guidance", "alpha")
@@ -86,6 +89,25 @@ class Comparison:
 
     def flown(self) -> list[ComparedMethod]:
         return [m for m in self.methods if not m.not_flown]
+
+    def not_configured(self) -> list[ComparedMethod]:
+        """Every registered method this comparison does not list, as a not-flown entry with the
+        reason (labelled by its folder's name): a new method shows in every comparison without a
+        hand-written entry."""
+        from drake_entry.guidance import folder_of
+
+        listed = {m.method for m in self.methods}
+        labels = {m.label for m in self.methods}
+        out = []
+        for spec in REGISTRY:
+            if spec.__name__ in listed:
+                continue
+            label = folder_of(spec)
+            label = label if label not in labels else f"{label}_not_configured"
+            out.append(ComparedMethod(label=label, method=spec.__name__, not_flown=(
+                f"not configured: this comparison gives no settings for !{spec.__name__} (add an entry with its "
+                f"guidance block and a mapping, or not_flown with the reason)")))
+        return out
 
 
 #: the comparisons shipped in drake_entry/comparisons (``<name>.yaml``)

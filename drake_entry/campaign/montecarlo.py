@@ -1,9 +1,9 @@
 """Monte-Carlo campaigns of the closed loop of any guidance method.
 
 ``run_campaign`` runs (or resumes) ``runs`` samples of a scenario's dispersions on a
-backend as a campaign of cases (diagrams.campaign: serial, local processes, Dask), each
+backend as a campaign of cases (campaign.engine: serial, local processes, Dask), each
 finished row streamed into the campaign directory (campaign_store); one sample is one
-Drake RandomSimulation (diagrams.sample). The report is drake_entry.campaign.report.
+Drake RandomSimulation (campaign.sample). The report is drake_entry.campaign.report.
 """
 from __future__ import annotations
 
@@ -14,10 +14,9 @@ import os
 import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
 
-from drake_entry.campaign.store import done_indices, finalise, read_nominal, write_nominal  # noqa: F401 (API)
-from drake_entry.diagrams.backends import Task
-from drake_entry.diagrams.campaign import SampleCases, check_backend, run_cases, session, versions
-from drake_entry.diagrams.sample import (  # noqa: F401 (API)
+from drake_entry.campaign.backends import Task
+from drake_entry.campaign.engine import SampleCases, check_backend, run_cases, session, versions
+from drake_entry.campaign.sample import (  # noqa: F401 (API)
     DETAILED_STEP_S,
     TIMING_COLUMNS,
     TRAJECTORY_STEP_S,
@@ -26,9 +25,15 @@ from drake_entry.diagrams.sample import (  # noqa: F401 (API)
     run_sample,
     sample_seed,
 )
+from drake_entry.campaign.store import done_indices, finalise, read_nominal, write_nominal  # noqa: F401 (API)
 from drake_entry.errors import ScenarioError
 from drake_entry.models.vehicles import PACKAGED_VEHICLES
 from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
+
+__all__ = ["DETAILED_STEP_S", "TIMING_COLUMNS", "TRAJECTORY_STEP_S", "campaign_row", "downsample", "run_sample",
+           "sample_seed", "done_indices", "finalise", "read_nominal", "write_nominal", "PACKAGED_SCENARIOS",
+           "apply_overrides", "load_campaign_scenario", "MAX_RUNS", "RUNS_NOTE", "campaign_manifest", "run_campaign",
+           "fly_nominal"]
 
 #: the largest campaign accepted: 10^7 samples at 0.5-40 s of a core each are 2-4600 core-days
 MAX_RUNS = 10_000_000
@@ -96,7 +101,7 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
                             f"(0 = no trajectories)")
     manifest = campaign_manifest(scenario_path, seed=seed, trajectory_step_s=trajectory_step_s, overrides=overrides,
                                  runs=runs)
-    task = Task("drake_entry.diagrams.sample:setup_worker", "drake_entry.diagrams.sample:run_case",
+    task = Task("drake_entry.campaign.sample:setup_worker", "drake_entry.campaign.sample:run_case",
                 {"scenario_yaml": manifest["scenario_yaml"], "seed": int(seed),
                  "trajectory_step_s": float(trajectory_step_s)})
     cases = SampleCases(runs, lambda i: sample_seed(seed, i))

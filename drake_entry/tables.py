@@ -7,6 +7,8 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 
+__all__ = ["write_table", "read_table"]
+
 
 def write_table(columns: dict, path: str) -> str:
     """Write {name: 1-D array} to ``path``; the suffix picks the format (.parquet or .csv)."""

@@ -20,6 +20,10 @@ import os
 import signal
 import traceback
 
+__all__ = ["BACKENDS", "SCHEDULER_TIMEOUT_S", "IN_FLIGHT_PER_WORKER", "DASK_QUIET_WORKERS", "Task",
+           "init_pool_worker", "init_worker", "failed_row", "work", "run_serial", "run_processes", "run_dask",
+           "run_backend"]
+
 BACKENDS = ("serial", "processes", "dask")
 
 #: how long a Dask scheduler address is tried before the campaign is refused [s]

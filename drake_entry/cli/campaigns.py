@@ -1,0 +1,129 @@
+"""The campaign commands: ``campaign`` (a closed-loop Monte-Carlo campaign of one scenario with
+its report), ``report`` (rewrite a campaign directory's report) and ``results`` (every packaged
+closed-loop scenario as a campaign, with an index: the documentation's docs/results/)."""
+from __future__ import annotations
+
+import json
+import os
+import sys
+
+from drake_entry.cli.common import Command, add_overrides_argument, add_scenario_argument, parse_overrides
+
+__all__ = ["COMMANDS", "write_and_print_report"]
+
+
+def campaign(args) -> int:
+    from drake_entry.campaign.montecarlo import run_campaign
+
+    backend = "dask" if args.scheduler else args.backend
+    out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
+                       overrides=parse_overrides(args.overrides), backend=backend, scheduler=args.scheduler,
+                       trajectory_step_s=args.trajectory_step)
+    stats = write_and_print_report(out)
+    if stats["successful"] < stats["samples"]:  # a campaign that shows a failure exits non-zero
+        print(f"drake-entry: {stats['samples'] - stats['successful']} of {stats['samples']} samples are not "
+              f"successful (see {os.path.join(out, 'report.md')})", file=sys.stderr)
+        return 1
+    return 0
+
+
+def report(args) -> int:
+    write_and_print_report(args.dir)
+    return 0
+
+
+def write_and_print_report(out_dir: str) -> dict:
+    """Write the report of ``out_dir`` (its scenario as flown, from the manifest), print its
+    terminal errors, margins and counts, and return its statistics (summary.json)."""
+    from drake_entry.campaign.report import counts_sentence, errors_markdown, flown_scenario, write_report
+    from drake_entry.campaign.store import read_manifest
+
+    path = write_report(out_dir)
+    with open(os.path.join(out_dir, "summary.json")) as f:
+        stats = json.load(f)
+    scenario = flown_scenario(read_manifest(out_dir))
+    print(errors_markdown(stats, getattr(scenario, "reference_results", None)))
+    for k, m in stats["margins"].items():
+        print(f"worst {k}: {100 * m['worst']:.2f} % ({m['violations']} violations)")
+    c = stats["coverage"]
+    print(f"{c['done']}/{c['requested']} samples done: {counts_sentence(stats)}; report: {path}")
+    return stats
+
+
+def _add_campaign_arguments(parser) -> None:
+    add_scenario_argument(parser)
+    parser.add_argument("--runs", type=int, default=100, help="samples (a larger value extends a finished campaign)")
+    parser.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    parser.add_argument("--seed", type=int, default=0, help="campaign seed; sample i is reproducible from (seed, i)")
+    parser.add_argument("--out", default="out/campaign", help="campaign directory (re-running resumes it)")
+    parser.add_argument("--backend", choices=("processes", "serial", "dask"), default="processes",
+                        help="local processes (default), one process, or Dask distributed")
+    parser.add_argument("--scheduler", default=None,
+                        help="Dask scheduler address (implies --backend dask); a LocalCluster when omitted")
+    parser.add_argument("--trajectory-step", type=float, default=10.0, metavar="SECONDS",
+                        help="keep each sample's trajectory every SECONDS (0 = none, rows only; the first 5 samples "
+                             "every 1 s for the report's bank histories)")
+    add_overrides_argument(parser, "guidance.replan_period_s=100")
+
+
+def _add_report_arguments(parser) -> None:
+    parser.add_argument("dir", help="a campaign directory (finished, running, killed or partial)")
+
+
+def _add_results_arguments(parser) -> None:
+    parser.add_argument("--runs", type=int, default=100, help="samples per scenario (default: 100)")
+    parser.add_argument("--only", nargs="*", default=None, metavar="SCENARIO",
+                        help="these packaged scenarios only (default: every closed-loop one)")
+    parser.add_argument("--seed", type=int, default=2018, help="master seed of every campaign (default: 2018)")
+    parser.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    parser.add_argument("--trajectory-step", type=float, default=10.0, metavar="SECONDS",
+                        help="trajectory storage step of the campaigns (default: 10)")
+    parser.add_argument("--out", default="out/results", help="one campaign directory per scenario below it "
+                        "(default: out/results); index.md lists them")
+
+
+def results(args) -> int:
+    from drake_entry.campaign.montecarlo import run_campaign
+    from drake_entry.campaign.report import write_report
+    from drake_entry.errors import ScenarioError
+    from drake_entry.scenario import closed_loop_scenarios
+
+    names = closed_loop_scenarios()
+    chosen = names if not args.only else args.only
+    unknown = [n for n in chosen if n not in names]
+    if unknown:
+        raise ScenarioError(f"--only {' '.join(unknown)}: not a packaged closed-loop scenario; "
+                            f"allowed: {', '.join(names)}")
+    os.makedirs(args.out, exist_ok=True)
+    lines = ["# Campaign results", "",
+             f"Every packaged closed-loop scenario flown as a Monte-Carlo campaign ({args.runs} runs, seed "
+             f"{args.seed}) by `drake-entry results --runs {args.runs} --seed {args.seed}`; each directory holds "
+             "report.md (and report.html, self-contained), its figures, summary.json and campaign.json.", "",
+             "| scenario | successful | success probability, 90 % lower bound | report |", "|---|---|---|---|"]
+    failed = 0
+    for name in chosen:
+        print(f"== {name}: {args.runs} runs", flush=True)
+        out = run_campaign(name, runs=args.runs, out_dir=os.path.join(args.out, name), seed=args.seed,
+                           workers=args.workers, trajectory_step_s=args.trajectory_step)
+        path = write_report(out)
+        with open(os.path.join(out, "summary.json")) as f:
+            stats = json.load(f)
+        ok, n = stats["successful"], stats["samples"]
+        failed += ok < n
+        lines.append(f"| `{name}` | {ok} of {n} | {100 * stats['success_lower_bound']['0.9']:.2f} % | "
+                     f"[report]({name}/report.md) |")
+        print(f"   {ok} of {n} successful; report: {path}", flush=True)
+    with open(os.path.join(args.out, "index.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print(f"wrote {os.path.join(args.out, 'index.md')}")
+    if failed:
+        print(f"drake-entry: {failed} scenario(s) with samples that are not successful (see their reports)",
+              file=sys.stderr)
+    return 1 if failed else 0
+
+
+COMMANDS = (Command("campaign", "closed-loop Monte-Carlo campaign with a report", _add_campaign_arguments, campaign),
+            Command("report", "write the report (report.md, report.html) of a campaign directory",
+                    _add_report_arguments, report),
+            Command("results", "every packaged closed-loop scenario as a Monte-Carlo campaign with its report",
+                    _add_results_arguments, results))

@@ -1,0 +1,154 @@
+"""ReplanScheduler: the one on-board re-planning schedule, shared by every guidance method that
+plans on board (paper 000's drag-energy SOCP, paper 001's SCvx and paper 002's LGL plans, paper
+004's sigma_0 re-solved on board, FNPEG's corrector).
+
+A method's guidance system derives from ``ReplanScheduler`` (a ``LeafSystem``), declares its
+schedule once with ``DeclareReplanSchedule`` and, in its own periodic update at flight time t,
+asks ``replan_due`` and re-plans through ``attempt``:
+
+    if self.replan_due(context) and <the method's own condition>:
+        outcome = self.attempt(context, values, solve)
+
+The rule, the same for every method (``replan_period_s`` in every spec, checked by
+``drake_entry.guidance.spec.check_replan_period``):
+
+- the first re-plan is due at ``first_due_s``, or, for a method that plans when it engages,
+  from the flight time given to ``due_now``;
+- after an attempt at t the next is due at t + ``replan_period_s`` (or the method's own interval
+  for that attempt, e.g. a horizon that shrinks); ``replan_period_s`` = 0: none after it;
+- a due re-plan that the method declines is either kept due (its condition is checked again at
+  the next sample) or skipped to one period later (``skip``), as the method says;
+- ``attempt`` times the solve (wall-clock, for cost accounting only), catches what it raises
+  (the plan in use flies on: a failed re-plan never stops a flight) and counts the attempt, the
+  plans applied and the clean ones (applied without a caveat such as "not converged").
+
+The schedule is a discrete-state group of the system (a periodic discrete update and an
+unrestricted one both write it), so the order of events in the diagram is the method's own.
+Guidance computing latency, when it is added, is applied here, once.
+
+Ports added by ``DeclareReplanSchedule``:
+  - output "replan_stats" [4]  attempts, plans applied, clean plans, wall time of the attempts [s]
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+import time
+from typing import Callable
+
+from pydrake.systems.framework import BasicVector, DiscreteValues, LeafSystem
+
+__all__ = ["DUE_TOLERANCE_S", "ReplanOutcome", "Solve", "ReplanStats", "ReplanScheduler"]
+
+#: the schedule's discrete state: next due time [s], attempts, applied, clean, wall time [s]
+_NEXT, _ATTEMPTS, _APPLIED, _CLEAN, _WALL = range(5)
+#: a re-plan is due from this much before its time [s] (periodic samples land on k * period)
+DUE_TOLERANCE_S = 1e-9
+
+
+@dc.dataclass(frozen=True)
+class ReplanOutcome:
+    """One attempt: the method's result (None when the solve raised), whether it was applied,
+    whether it was clean (applied without a caveat), why not (or the caveat), and its wall time [s]."""
+
+    result: object
+    applied: bool
+    clean: bool
+    note: str
+    wall_s: float
+
+
+#: solve() -> (result, applied, note): the method's re-plan; note is '' for a clean plan, else why
+#: it was not applied or the caveat it was applied with
+Solve = Callable[[], tuple]
+
+
+@dc.dataclass(frozen=True)
+class ReplanStats:
+    """The schedule's account after a flight: attempts, plans applied, clean plans, wall time [s]."""
+
+    attempts: int
+    applied: int
+    clean: int
+    wall_s: float
+
+    @property
+    def refused(self) -> int:
+        """Attempts whose result was not applied (the previous plan flew on)."""
+        return self.attempts - self.applied
+
+    @property
+    def flawed(self) -> int:
+        """Attempts not applied or applied with a caveat."""
+        return self.attempts - self.clean
+
+
+class ReplanScheduler(LeafSystem):
+    """Base of the guidance systems that re-plan on board (module docstring)."""
+
+    def DeclareReplanSchedule(self, *, replan_period_s: float, first_due_s: float = math.inf):
+        """Declare the schedule: re-plans every ``replan_period_s`` [s] (0: none after the first),
+        the first due at ``first_due_s`` [s] (inf: when the method calls ``due_now``)."""
+        if not (replan_period_s == 0 or 0 < replan_period_s < math.inf):
+            raise ValueError(f"{type(self).__name__}: replan_period_s must be 0 or > 0, got {replan_period_s}")
+        self.replan_period_s = float(replan_period_s)
+        self._schedule = self.DeclareDiscreteState(BasicVector([first_due_s, 0.0, 0.0, 0.0, 0.0]))
+        self.DeclareVectorOutputPort("replan_stats", 4,
+                                     lambda c, o: o.SetFromVector(self._schedule_of(c)[_ATTEMPTS:]),
+                                     prerequisites_of_calc={self.xd_ticket()})
+
+    def _schedule_of(self, context):
+        return context.get_discrete_state(self._schedule).get_value()
+
+    def _mutable(self, values):
+        """The schedule's vector in an update's output: a DiscreteValues or a State."""
+        if isinstance(values, DiscreteValues):
+            return values.get_mutable_vector(self._schedule)
+        return values.get_mutable_discrete_state(self._schedule)
+
+    def replan_due(self, context) -> bool:
+        """A re-plan is due at this sample."""
+        return context.get_time() >= self._schedule_of(context)[_NEXT] - DUE_TOLERANCE_S
+
+    def next_due(self, context) -> float:
+        """When the next re-plan is due [s] (inf: none)."""
+        return float(self._schedule_of(context)[_NEXT])
+
+    def due_now(self, values, t: float) -> None:
+        """Make a re-plan due at flight time ``t`` [s] (a method that engages plans at once)."""
+        self._mutable(values).SetAtIndex(_NEXT, t)
+
+    def skip(self, values, t: float) -> None:
+        """Decline the re-plan due at ``t`` [s]: the next is due one period later."""
+        self._mutable(values).SetAtIndex(_NEXT, self._after(t, self.replan_period_s))
+
+    @staticmethod
+    def _after(t: float, interval: float) -> float:
+        return t + interval if interval > 0 else math.inf
+
+    def attempt(self, context, values, solve: Solve, *, interval: float | None = None) -> ReplanOutcome:
+        """Re-plan now: run ``solve`` (timed; what it raises becomes a refused attempt with its
+        reason), count the attempt, and make the next due ``interval`` [s] after now
+        (default ``replan_period_s``; 0: none)."""
+        t = context.get_time()
+        t_wall = time.perf_counter()
+        try:
+            result, applied, note = solve()
+        except Exception as e:  # a failed re-plan must not stop the flight: the plan in use flies on
+            result, applied, note = None, False, f"{type(e).__name__}: {e}"
+        wall = time.perf_counter() - t_wall
+        applied = bool(applied)
+        clean = applied and not note
+        v = self._mutable(values)
+        old = self._schedule_of(context)
+        v.SetAtIndex(_NEXT, self._after(t, self.replan_period_s if interval is None else interval))
+        v.SetAtIndex(_ATTEMPTS, old[_ATTEMPTS] + 1)
+        v.SetAtIndex(_APPLIED, old[_APPLIED] + applied)
+        v.SetAtIndex(_CLEAN, old[_CLEAN] + clean)
+        v.SetAtIndex(_WALL, old[_WALL] + wall)
+        return ReplanOutcome(result, applied, clean, note, wall)
+
+    def replan_stats(self, context) -> ReplanStats:
+        """The schedule's account in this system's ``context``."""
+        s = self._schedule_of(context)
+        return ReplanStats(int(s[_ATTEMPTS]), int(s[_APPLIED]), int(s[_CLEAN]), float(s[_WALL]))

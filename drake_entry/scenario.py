@@ -12,8 +12,7 @@ from typing import Optional
 import numpy as np
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance import GuidanceSpec, known_tags
-from drake_entry.guidance.drag_energy.spec import DragEnergy
+from drake_entry.guidance import REGISTRY, GuidanceSpec, known_tags
 from drake_entry.models import dispersions as disp
 from drake_entry.models.atmosphere import US76_H_MAX, US76_H_MIN, Atmosphere
 from drake_entry.models.environment import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
@@ -165,7 +164,7 @@ class Scenario:
     simulation: SimulationSpec = dc.field(default_factory=SimulationSpec)  # integrator, stop time and logging
     # the guidance method, selected by YAML tag (!DragEnergy, !BankProfile, ...; the
     # registry in drake_entry/guidance); untagged = drag-energy
-    guidance: GuidanceSpec = dc.field(default_factory=DragEnergy)
+    guidance: GuidanceSpec = dc.field(default_factory=next(iter(REGISTRY)))
     # published campaign statistics for the report to compare with (optional)
     reference_results: ReferenceResultsSpec = dc.field(default_factory=ReferenceResultsSpec)
     # Monte-Carlo dispersions (Drake schema distributions: !Uniform, !Gaussian, ...)

@@ -29,7 +29,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 ORDER = ("base", "planning", "systems", "methods", "diagrams", "campaign", "comparison", "cli")
 SHARED = ("drake_entry.models", "drake_entry.planning", "drake_entry.campaign", "drake_entry.errors",
-          "drake_entry.typed_yaml", "drake_entry.figures", "drake_entry.tables")
+          "drake_entry.typed_yaml", "drake_entry.figures", "drake_entry.tables", "drake_entry.scenario",
+          "drake_entry.comparison", "drake_entry.diagrams")
 
 
 def setuptools_config() -> dict:

@@ -1,10 +1,11 @@
 """Guidance methods, registered in one place.
 
-``REGISTRY`` maps each method's scenario spec (a dataclass; YAML tag ``!ClassName``) to
-the module that holds its ``GuidanceMethod`` as ``METHOD``. The spec modules are pure data
-and imported here; method modules (which import Drake systems) are imported on first use.
-Add a method: a new package beside ``drag_energy``, its spec import and one entry below
-(docs/architecture.md).
+``METHODS`` lists each method once: its folder (``drake_entry/guidance/<folder>/``) and the
+class name of its scenario spec (a dataclass in ``<folder>/spec.py``; YAML tag ``!ClassName``).
+``REGISTRY`` maps each spec class to the module that holds its ``GuidanceMethod`` as ``METHOD``
+(``<folder>/method.py``). The spec modules are pure data and imported here; method modules
+(which import Drake systems) are imported on first use. Add a method: a new folder beside
+``drag_energy`` and one line below (docs/architecture.md, "Adding a method").
 """
 from __future__ import annotations
 
@@ -12,25 +13,23 @@ import importlib
 from typing import Union
 
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.ampi.spec import Ampi
-from drake_entry.guidance.bank_profile.spec import BankProfile
-from drake_entry.guidance.drag_energy.spec import DragEnergy
-from drake_entry.guidance.fnpeg.spec import Fnpeg
-from drake_entry.guidance.lgl_terminal.spec import LglTerminal
-from drake_entry.guidance.scvx.spec import Scvx
-from drake_entry.guidance.swarm_bank.spec import SwarmBank
 
-__all__ = ["REGISTRY", "GuidanceSpec", "known_tags", "folder_of", "method_for"]
+__all__ = ["METHODS", "REGISTRY", "GuidanceSpec", "known_tags", "folder_of", "method_for"]
 
-REGISTRY = {
-    DragEnergy: "drake_entry.guidance.drag_energy.method",
-    BankProfile: "drake_entry.guidance.bank_profile.method",
-    SwarmBank: "drake_entry.guidance.swarm_bank.method",
-    Scvx: "drake_entry.guidance.scvx.method",
-    Ampi: "drake_entry.guidance.ampi.method",
-    LglTerminal: "drake_entry.guidance.lgl_terminal.method",
-    Fnpeg: "drake_entry.guidance.fnpeg.method",
-}
+#: (folder, spec class) of every method; the first is the default of an untagged ``guidance:``
+METHODS = (
+    ("drag_energy", "DragEnergy"),  # paper 000
+    ("bank_profile", "BankProfile"),  # the worked example of adding a method
+    ("swarm_bank", "SwarmBank"),  # paper 004
+    ("scvx", "Scvx"),  # paper 001
+    ("ampi", "Ampi"),  # paper 003
+    ("lgl_terminal", "LglTerminal"),  # paper 002 as guidance
+    ("fnpeg", "Fnpeg"),  # Lu 2014, the field's baseline
+)
+
+#: {spec class: the module of its GuidanceMethod}
+REGISTRY = {getattr(importlib.import_module(f"drake_entry.guidance.{folder}.spec"), spec):
+            f"drake_entry.guidance.{folder}.method" for folder, spec in METHODS}
 
 #: the scenario's ``guidance:`` field type (the first is the default when untagged)
 GuidanceSpec = Union[tuple(REGISTRY)]

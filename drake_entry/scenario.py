@@ -22,7 +22,7 @@ from drake_entry.models.vehicles import Vehicle, load_vehicle
 from drake_entry.models.verdict import PathLimit, acceptance_box, vehicle_path_limits
 from drake_entry.typed_yaml import load_packaged_or_file, override, packaged_names
 
-__all__ = ["EntryStateSpec", "TargetSpec", "TerminalSpec", "ScheduleSpec", "PLANTS", "SimulationSpec",
+__all__ = ["scenario_from_dump", "EntryStateSpec", "TargetSpec", "TerminalSpec", "ScheduleSpec", "PLANTS", "SimulationSpec",
            "ReferenceResultsSpec", "ERROR_COLUMNS", "Scenario", "INTEGRATORS", "SCHEDULE_VALUES_DEG",
            "SCHEDULE_BREAKPOINTS", "PACKAGED_SCENARIOS", "closed_loop_scenarios", "load_scenario", "apply_overrides",
            "load_campaign_scenario"]
@@ -383,6 +383,15 @@ def apply_overrides(scenario: Scenario, overrides: dict | None):
     for key, value in overrides.items():
         override(scenario, key, value, where="override")
     scenario.validate()
+
+
+def scenario_from_dump(text: str) -> Scenario:
+    """A scenario this library wrote (``yaml_dump_typed`` of a validated Scenario: a campaign's
+    ``scenario_yaml``, sent to every worker process as text because pydrake's schema distributions
+    do not pickle), read back by Drake's loader alone: it was checked once, where it entered."""
+    from pydrake.common.yaml import yaml_load_typed
+
+    return yaml_load_typed(schema=Scenario, data=text)
 
 
 def load_campaign_scenario(scenario_path: str, overrides: dict | None) -> Scenario:

@@ -119,12 +119,10 @@ def fly_nominal(out_dir: str, scenario_yaml: str, *, setup=None) -> None:
     A flight that raises is not kept: the report then shows the campaign alone."""
     from drake_entry.diagrams.closed_loop import fly
     from drake_entry.errors import DrakeEntryError
-    from drake_entry.scenario import Scenario
-    from drake_entry.typed_yaml import load_yaml_typed
+    from drake_entry.scenario import scenario_from_dump
 
     try:
-        flown = setup if setup is not None else load_yaml_typed(Scenario, text=scenario_yaml,
-                                                                where="campaign scenario").validate()
+        flown = setup if setup is not None else scenario_from_dump(scenario_yaml)
         tr = fly(flown).trajectory
     except (DrakeEntryError, RuntimeError) as e:
         print(f"drake-entry: the nominal flight of the campaign failed ({e}); the report shows the campaign alone")

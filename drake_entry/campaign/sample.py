@@ -20,9 +20,8 @@ from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, 
 from drake_entry.diagrams.common import collect_trajectory, make_simulator
 from drake_entry.models.dispersions import draw
 from drake_entry.models.trajectory import control_activity, metrics
-from drake_entry.scenario import Scenario
+from drake_entry.scenario import scenario_from_dump
 from drake_entry.systems.native_plant import as_flight_error
-from drake_entry.typed_yaml import load_yaml_typed
 
 __all__ = ["TRAJECTORY_STEP_S", "DETAILED_SAMPLES", "DETAILED_STEP_S", "TIMING_COLUMNS", "sample_seed",
            "setup_worker", "run_case", "run_sample", "campaign_row", "downsample"]
@@ -44,7 +43,7 @@ def setup_worker(config: dict) -> dict:
     """A campaign worker's state (backends.Task.setup): the ClosedLoopSetup (models, guidance
     method and its planner) built once from config['scenario_yaml'], the campaign seed and
     the trajectory step."""
-    scenario = load_yaml_typed(Scenario, text=config["scenario_yaml"], where="campaign scenario").validate()
+    scenario = scenario_from_dump(config["scenario_yaml"])  # validated once, when the campaign began
     return {"setup": ClosedLoopSetup.from_scenario(scenario), "seed": int(config["seed"]),
             "trajectory_step_s": float(config["trajectory_step_s"])}
 

@@ -4,12 +4,14 @@ one-line account of an operating-system error."""
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import sys
 from typing import Callable, NamedTuple
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["Command", "HelpWithDefaults", "add_scenario_argument", "add_overrides_argument", "check_output_dir",
+__all__ = ["write_plan_report", "Command", "HelpWithDefaults", "add_scenario_argument", "add_overrides_argument", "check_output_dir",
            "parse_overrides", "os_error_line"]
 
 
@@ -98,3 +100,15 @@ def os_error_line(e: OSError, where: str | None = None) -> str:
             errno.EISDIR: "a directory is in the way of a file",
             errno.ENOENT: "check the path"}.get(e.errno, "")
     return f"cannot use {path}: {cause}" + (f"; {hint}" if hint else "")
+
+
+def write_plan_report(out_dir: str, summary: dict, figures: list, verified: bool, why: str) -> int:
+    """The end of every method's plan report: ``plan.json`` written, the files named, and the exit
+    status (0 when the plan is verified; else 1 with ``why`` on stderr)."""
+    os.makedirs(out_dir, exist_ok=True)
+    with open(os.path.join(out_dir, "plan.json"), "w") as f:
+        json.dump(summary, f, indent=2, default=float)
+    print(f"wrote plan.json and {len(figures)} plot(s) to {out_dir}")
+    if not verified:
+        print(f"drake-entry: {why}", file=sys.stderr)
+    return 0 if verified else 1

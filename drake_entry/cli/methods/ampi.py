@@ -4,16 +4,14 @@ reference's controls flown open loop by the Drake Simulator, printed, plotted an
 ``plan.json``. CLI layer (it flies diagrams)."""
 from __future__ import annotations
 
-import json
 import math
 import os
 import sys
 
 import numpy as np
 
-from drake_entry.guidance.ampi.accuracy_study import flown_controls, fly_ld, reference_errors
+from drake_entry.cli.common import write_plan_report
 from drake_entry.models.verdict import box_text
-from drake_entry.planning.nlp.evaluator import model_values
 
 __all__ = ["plan_report"]
 
@@ -22,6 +20,7 @@ def plan_report(scenario, out_dir: str) -> int:
     """Exit 0 when the database is verified and consistent and the reference, flown open loop,
     ends inside the scenario's acceptance box (Scenario.acceptance_box) with every path
     constraint of the database's problem (eq. 3) held; 1 otherwise."""
+    from drake_entry.guidance.ampi.accuracy_study import fly_ld, reference_errors
     from drake_entry.guidance.ampi.method import METHOD
 
     planner = METHOD.make_planner(scenario, verifier=None)
@@ -70,17 +69,15 @@ def plan_report(scenario, out_dir: str) -> int:
         print("path constraints (eq. 3): " + "; ".join(
             f"{n} peak {p['peak']:.4g} of {p['max']:.4g}{'' if p['held'] else ' EXCEEDED'}" for n, p in peaks.items()))
         paths.append(_figure(scenario, problem, syn, check, out_dir))
-    with open(os.path.join(out_dir, "plan.json"), "w") as f:
-        json.dump(summary, f, indent=2, default=float)
-    print(f"wrote plan.json and {len(paths)} plot(s) to {out_dir}")
-    if not ok:
-        print("drake-entry: the reference is not verified (see above)", file=sys.stderr)
-    return 0 if ok else 1
+    return write_plan_report(out_dir, summary, paths, ok, "the reference is not verified (see above)")
 
 
 def _path_peaks(problem, syn, n_ld: int, check) -> dict:
     """Each path constraint's peak along the flown states (the flown controls at the log
     times), with its upper bound and whether it held."""
+    from drake_entry.guidance.ampi.accuracy_study import flown_controls
+    from drake_entry.planning.nlp.evaluator import model_values
+
     controls = flown_controls(problem, syn, n_ld)
     g = model_values(problem, check.states.T, controls(check.time).T)[1]
     return {c.label: {"peak": float(row.max()), "max": float(c.max),

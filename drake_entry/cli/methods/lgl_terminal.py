@@ -4,11 +4,9 @@ closed loop's actuators into the acceptance box; printed, plotted (paper 002 Fig
 Drake propagation) and written to ``plan.json``. CLI layer (it flies diagrams)."""
 from __future__ import annotations
 
-import json
 import math
-import os
-import sys
 
+from drake_entry.cli.common import write_plan_report
 from drake_entry.models.verdict import box_text
 
 __all__ = ["plan_report"]
@@ -49,13 +47,7 @@ def plan_report(scenario, out_dir: str) -> int:
     if r.verification is not None and r.verification.flight is not None:
         paths = nlp_solution_plots(r.problem, r, out_dir, propagated=r.verification.flight,
                                    title=f"{scenario.name}: pre-flight LGL plan")
-    os.makedirs(out_dir, exist_ok=True)
-    with open(os.path.join(out_dir, "plan.json"), "w") as fh:
-        json.dump(summary, fh, indent=2, default=float)
-    print(f"wrote plan.json and {len(paths)} plot(s) to {out_dir}")
-    if not plan.success:
-        print(f"drake-entry: the plan is not a success: {plan.message}", file=sys.stderr)
-    return 0 if plan.success else 1
+    return write_plan_report(out_dir, summary, paths, plan.success, f"the plan is not a success: {plan.message}")
 
 
 def _unit(name: str) -> float:

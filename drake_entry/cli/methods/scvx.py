@@ -3,9 +3,7 @@ state to its site, its bank and alpha flown by the Drake Simulator through the c
 actuators, the comparison printed and plotted, and ``plan.json`` written. CLI layer."""
 from __future__ import annotations
 
-import json
-import os
-import sys
+from drake_entry.cli.common import write_plan_report
 
 __all__ = ["plan_report"]
 
@@ -46,10 +44,4 @@ def plan_report(scenario, out_dir: str) -> int:
         paths += trajectory_plots(flight.trajectory, out_dir, limits=plan.problem.vehicle.limits,
                                   target=(scenario.target.longitude_deg, scenario.target.latitude_deg),
                                   title=f"{scenario.name}: the plan's controls flown")
-    os.makedirs(out_dir, exist_ok=True)
-    with open(os.path.join(out_dir, "plan.json"), "w") as f:
-        json.dump(summary, f, indent=2, default=float)
-    print(f"wrote plan.json and {len(paths)} plots to {out_dir}")
-    if not plan.success:
-        print(f"drake-entry: the plan is not verified: {plan.message}", file=sys.stderr)
-    return 0 if plan.success else 1
+    return write_plan_report(out_dir, summary, paths, plan.success, f"the plan is not verified: {plan.message}")

@@ -94,12 +94,17 @@ def trajectory_plots(tr, out_dir: str, *, limits=None, target=None, title: str =
     return paths
 
 
-def save_figure(fig, out_dir, name, paths, title=""):
-    """Save fig as out_dir/name (PNG), append the path to ``paths``, close it."""
+def save_figure(fig, out_dir, name, paths=None, title="", rect=None) -> str:
+    """Save fig as out_dir/name (PNG; the directory made), titled ``title`` when given, laid out
+    tight (inside ``rect`` when given), closed; append the path to ``paths`` when given and
+    return it."""
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=rect)
+    os.makedirs(out_dir, exist_ok=True)
     p = os.path.join(out_dir, name)
     fig.savefig(p, dpi=110)
     plt.close(fig)
-    paths.append(p)
+    if paths is not None:
+        paths.append(p)
+    return p

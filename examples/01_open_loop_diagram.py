@@ -15,13 +15,13 @@ a heat-flux plot.
 """
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from drake_entry.claims import Claims, run_example
+from drake_entry.figures import plt, save_figure
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.scenario import load_scenario
 from drake_entry.systems.actuators import BankActuator
@@ -86,10 +86,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/01") -> dict:
     ax2.axhline(vehicle.limits.heat_flux_max / 1e3, color="r", ls="--", label="limit")
     ax2.set(xlabel="time [s]", ylabel="heat flux [kW/m^2]", title="stagnation-point heat flux")
     ax2.legend()
-    fig.tight_layout()
-    path = os.path.join(out_dir, "open_loop.png")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    path = save_figure(fig, out_dir, "open_loop.png")
     print(f"wrote {path}")
     return {"time_s": float(context.get_time()), "final_state": x[:, -1], "peak_heat_flux_W_m2": float(heat.max()),
             "stop": status.message() or "time limit",

@@ -24,12 +24,12 @@ with it the flight lands inside the 2-km box within every limit (the verdict che
 import math
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
+from drake_entry.figures import plt, save_figure
 from drake_entry.guidance.drag_energy.method import DragEnergyMethod
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.scenario import load_scenario
@@ -111,10 +111,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/02") -> dict:
     ax1.set(xlabel="time [s]", ylabel="(D - D_ref) / D_ref [%]", title="drag tracking error")
     ax2.set(xlabel="time [s]", ylabel="bank [deg]", title="bank angle flown")
     ax1.legend()
-    fig.tight_layout()
-    path = os.path.join(out_dir, "controllers.png")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    path = save_figure(fig, out_dir, "controllers.png")
     print(f"wrote {path}")
     return results
 

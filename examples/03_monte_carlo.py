@@ -9,7 +9,6 @@ from (seed, sample index): both backends give the same rows.
 """
 import os
 
-import matplotlib.pyplot as plt
 import pandas as pd
 from dask.distributed import LocalCluster
 from pydrake.common.schema import Gaussian, Uniform
@@ -17,6 +16,7 @@ from pydrake.common.yaml import yaml_dump_typed
 
 from drake_entry.campaign.montecarlo import run_campaign
 from drake_entry.claims import Claims, run_example
+from drake_entry.figures import plt, save_figure
 from drake_entry.scenario import Scenario, load_scenario
 
 
@@ -58,10 +58,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/03") -> pd.DataFrame:
     ax.set(xlabel="density scale drawn", ylabel="range-to-go error [km]",
            title=f"{scenario.name}: {runs} closed-loop samples")
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    figure = os.path.join(out_dir, "range_vs_density.png")
-    fig.savefig(figure, dpi=100)
-    plt.close(fig)
+    figure = save_figure(fig, out_dir, "range_vs_density.png")
     print(f"wrote {figure}; the full report: drake-entry report {os.path.join(out_dir, 'processes')}")
     return df
 

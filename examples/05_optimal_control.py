@@ -20,11 +20,11 @@ import dataclasses as dc
 import math
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.verification import fly_controls
+from drake_entry.figures import plt, save_figure
 from drake_entry.models.atmosphere import ExponentialAtmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import load_vehicle
@@ -99,10 +99,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/05") -> dict:
         ax.set(xlabel="time [s]", ylabel="costate [J per unit state]")
         ax.legend()
     fig.suptitle(f"{problem.name}: {result.nodes} LGL nodes, J = {result.objective:.3f}")
-    fig.tight_layout()
-    path = os.path.join(out_dir, "ocp.png")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    path = save_figure(fig, out_dir, "ocp.png")
     print(f"wrote {path}")
     return {"result": result, "flown": flown, "resolved": again, "x_now": x_now}
 

@@ -10,11 +10,11 @@ reversal sampling), so the Drake flight ends where the plan does. The scenario
 """
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import fly
+from drake_entry.figures import plt, save_figure
 from drake_entry.guidance.swarm_bank.evaluator import range_error
 from drake_entry.guidance.swarm_bank.search import problem_from_scenario, search
 from drake_entry.scenario import load_scenario
@@ -58,10 +58,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/06") -> dict:
     ax2.set(xlabel="time [s]", ylabel="[deg]")
     ax2.legend()
     fig.suptitle(f"{scenario.name}: sigma_0 = {best.x[0]:.3f} deg by {best.method}")
-    fig.tight_layout()
-    path = os.path.join(out_dir, "swarm_bank.png")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    path = save_figure(fig, out_dir, "swarm_bank.png")
     print(f"wrote {path}")
     return {"searches": found, "flight": result}
 

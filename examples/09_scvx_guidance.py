@@ -16,13 +16,13 @@ import dataclasses as dc
 import json
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.campaign.montecarlo import run_campaign
 from drake_entry.campaign.report import write_report
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
+from drake_entry.figures import plt, save_figure
 from drake_entry.scenario import load_scenario
 
 
@@ -55,10 +55,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/09") -> dict:
     ax2.plot(t, np.degrees(ref["bank"]), "k:", label="pre-flight plan")
     ax2.set(xlabel="t [s]", ylabel="bank [deg]", title="bank flown")
     ax1.legend(fontsize=8)
-    fig.tight_layout()
-    plot = os.path.join(out_dir, "scvx_closed_loop.png")
-    fig.savefig(plot, dpi=110)
-    plt.close(fig)
+    plot = save_figure(fig, out_dir, "scvx_closed_loop.png")
 
     # 2. a Monte-Carlo campaign of the guidance through the shared engine (resumable directory)
     runs = 2 if quick else 20

@@ -15,11 +15,11 @@ the heating along them.
 import math
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.verification import fly_controls
+from drake_entry.figures import plt, save_figure
 from drake_entry.planning import nlp
 from drake_entry.planning.nlp import catalogue
 
@@ -65,10 +65,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/10") -> dict:
     ax2.set(xlabel="time [s]", ylabel="wing heating [BTU/ft^2/s]", title="q = q_a(alpha) q_r")
     ax1.legend(fontsize=8)
     ax2.legend(fontsize=8)
-    fig.tight_layout()
-    out["plot"] = os.path.join(out_dir, "shuttle.png")
-    fig.savefig(out["plot"], dpi=120)
-    plt.close(fig)
+    out["plot"] = save_figure(fig, out_dir, "shuttle.png")
     print(f"wrote {out['plot']}; max crossrange {math.degrees(-out['shuttle_crossrange']['result'].objective):.4f} deg")
     return out
 

@@ -19,12 +19,12 @@ trajectory database (Sagliano, Mooij & Theil 2017, Sec. II-III).
 import dataclasses as dc
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.open_loop import simulate
 from drake_entry.diagrams.verification import fly_controls
+from drake_entry.figures import plt, save_figure
 from drake_entry.planning import nlp
 from drake_entry.planning.ocp import ObjectiveTerm
 from drake_entry.planning.ocp_yaml import load_problem
@@ -76,10 +76,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/11") -> dict:
     ax[2].plot(-45.75, 66.40, "kx", ms=8, label="Table 1 target")
     ax[2].legend()
     ax[2].set(xlabel="longitude [deg]", ylabel="latitude [deg]")
-    fig.tight_layout()
-    plot = os.path.join(out_dir, "shefex3_problem.png")
-    fig.savefig(plot, dpi=110)
-    plt.close(fig)
+    plot = save_figure(fig, out_dir, "shefex3_problem.png")
     print(f"wrote {plot}")
     return {"open_loop": flight, "result": result, "eq1": eq1_result, "eq1_miss_m": miss, "eq1_bank_gap_deg": bank_gap,
             "plot": plot}

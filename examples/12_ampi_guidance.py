@@ -18,7 +18,6 @@ import dataclasses as dc
 import math
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from pydrake.common.yaml import yaml_dump_typed
@@ -27,6 +26,7 @@ from drake_entry.campaign.montecarlo import run_campaign
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams import closed_loop as cl
 from drake_entry.diagrams.verification import fly_controls
+from drake_entry.figures import plt, save_figure
 from drake_entry.guidance.ampi.database_study import offset_problem
 from drake_entry.guidance.ampi.reference import DatabaseReference
 from drake_entry.planning import nlp
@@ -105,10 +105,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/12") -> dict:
     ax[1].legend(fontsize=7)
     ax[2].set(xlabel="cross-range [km]", ylabel="range to go [km]", title="campaign footprint")
     ax[2].legend(fontsize=7)
-    fig.tight_layout()
-    plot = os.path.join(out_dir, "ampi_guidance.png")
-    fig.savefig(plot, dpi=110)
-    plt.close(fig)
+    plot = save_figure(fig, out_dir, "ampi_guidance.png")
     print(f"wrote {plot}")
     return {"references": refs, "optimum": optimum, "errors": errors, "flights": flights, "table": table, "plot": plot}
 

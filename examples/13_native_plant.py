@@ -17,11 +17,11 @@ own code with symbolic scalars, evaluated in C++) or ``python`` (the reference L
 import os
 import time
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
+from drake_entry.figures import plt, save_figure
 from drake_entry.scenario import load_scenario
 from drake_entry.systems.native_plant import PlantProbe
 
@@ -84,10 +84,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/13") -> dict:
             title="difference (rounding, amplified by the guidance)")
     fig.text(0.01, 0.01, "Look at: the curves coincide; the difference stays below the integrator's own error "
                          "(RK3 at 0.5 s against RK5 at 1e-10: 2.7 m rms in range, 22 m in cross-range).", fontsize=8)
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
-    path = os.path.join(out_dir, "native_plant.png")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    path = save_figure(fig, out_dir, "native_plant.png", rect=(0, 0.04, 1, 1))
     print(f"wrote {path}")
     return {"worst_relative": worst, "end_gap_m": end_gap, "sensitivity_m": sensitivity,
             "altitude_gap_m": float(abs(py.state[-1, 0] - nat.state[-1, 0])),

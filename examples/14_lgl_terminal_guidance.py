@@ -22,13 +22,13 @@ import dataclasses as dc
 import math
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 from pydrake.common import RandomGenerator
 
 from drake_entry.campaign.sample import sample_seed
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams import closed_loop as cl
+from drake_entry.figures import plt, save_figure
 from drake_entry.models import dispersions
 from drake_entry.scenario import load_scenario
 
@@ -130,10 +130,7 @@ def _figure(plan, flights: dict, path: str) -> str:
     fig.suptitle("Paper 002 MaRV, shrinking-horizon LGL terminal guidance in the Drake closed loop\n"
                  "Look at: the re-solved flights end at the planned impact, the dispersed plan alone drifts; "
                  "without the TVLQR the dispersed draw's q dips under 12 kPa (lower left)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, os.path.dirname(path), os.path.basename(path))
 
 
 def check(r: dict, quick: bool = False) -> Claims:

@@ -23,11 +23,10 @@ import math
 import os
 import time
 
-import matplotlib.pyplot as plt
-
 from drake_entry.campaign.sample import campaign_row
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
+from drake_entry.figures import plt, save_figure
 from drake_entry.scenario import apply_overrides, load_scenario
 
 #: Lu 2014's published CAV-H orbital-case figures (without, with phugoid damping)
@@ -103,10 +102,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/15") -> dict:
     fig.suptitle("FNPEG on Lu (2014)'s CAV-H orbital case" + (" (first 900 s, corrections every 5 s)" if quick else ""))
     fig.text(0.01, 0.01, "Look at: without damping the glide oscillates (phugoid) and the first pull-out peaks higher"
              + ("." if quick else "; the constrained flight stays under its red limits."), fontsize=8)
-    fig.tight_layout(rect=(0, 0.04, 1, 0.95))
-    path = os.path.join(out_dir, "fnpeg_cav_h.png")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    path = save_figure(fig, out_dir, "fnpeg_cav_h.png", rect=(0, 0.04, 1, 0.95))
     print(f"wrote {path}")
     return {"rows": rows, "peaks": peaks, "success": {k: f.success for k, f in flights.items()}, "plot": path}
 

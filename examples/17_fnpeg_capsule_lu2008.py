@@ -23,13 +23,13 @@ Full size (500 runs each) took 42 minutes on 2 cores; ``--quick`` flies 5 runs e
 """
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
 from drake_entry.campaign.montecarlo import run_campaign
 from drake_entry.campaign.report import write_report
 from drake_entry.claims import Claims, run_example
+from drake_entry.figures import plt, save_figure
 
 SCENARIO, SEED = "capsule_lu2008", 2008
 #: the three campaigns: label -> (scenario overrides, report title)
@@ -87,10 +87,7 @@ def figure(stats: dict, path: str) -> str:
            title=f"{SCENARIO}: FNPEG miss distance, same dispersions per sample")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8, loc="lower right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, os.path.dirname(path), os.path.basename(path))
 
 
 def main(quick: bool = False, out_dir: str = "out/examples/17", runs: int = 500, workers: int | None = None) -> dict:

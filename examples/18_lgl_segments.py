@@ -19,11 +19,11 @@ nodes, one polynomial and 4 segments of 32, each from the same 60-node one-polyn
 import os
 import time
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from drake_entry.claims import Claims, run_example
 from drake_entry.diagrams.verification import fly_controls
+from drake_entry.figures import plt, save_figure
 from drake_entry.planning import nlp
 from drake_entry.planning.nlp import catalogue
 from drake_entry.planning.nlp.evaluator import model_values
@@ -97,10 +97,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/18") -> dict:
                    title=f"{name}: costate of {case['state']} (eq. 15)")
     fig.suptitle("LGL on one polynomial and in segments: the same controls; in segments the costates oscillate "
                  "node to node on much of the arc where a path limit is active (shaded)", fontsize=10)
-    fig.tight_layout()
-    plot = os.path.join(out_dir, "segments.png")
-    fig.savefig(plot, dpi=120)
-    plt.close(fig)
+    plot = save_figure(fig, out_dir, "segments.png")
     print(f"wrote {plot}")
     return {"cases": cases, "plot": plot}
 

@@ -100,3 +100,13 @@ def test_fly_takes_overrides_through_the_typed_checks(tmp_path, capsys):
     assert main(["fly", "horus2b", "--set", "guidance=!BankProfile {terminal_altitude_km: 26.5, bank_start_deg: 66.0, "
                  "bank_end_deg: 50.0}", "--out", str(tmp_path), "--format", "csv"]) == 1  # misses the 2-km box
     assert "method                       bank_profile" in capsys.readouterr().out
+
+
+def test_python_dash_m_runs_the_command(tmp_path):
+    """``python -m drake_entry.cli`` is the drake-entry command (what the interrupt tests start)."""
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-m", "drake_entry.cli", "--version"], capture_output=True, text=True,
+                         cwd=str(tmp_path), timeout=120)
+    assert out.returncode == 0 and out.stdout.startswith("drake-entry "), out.stderr

@@ -38,7 +38,9 @@ def main(quick: bool = False, out_dir: str = "out/examples/03") -> pd.DataFrame:
     # 2. the same campaign on local processes and on a Dask cluster (here a LocalCluster; pass
     #    the address of any running Dask scheduler the same way)
     run_campaign(path, runs=runs, seed=7, workers=2, out_dir=os.path.join(out_dir, "processes"), progress=False)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+    # (no dashboard, and the scheduler's own HTTP server on a free port: 8787 may be taken)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      scheduler_kwargs={"dashboard_address": ":0"}) as cluster:
         run_campaign(path, runs=runs, seed=7, backend="dask", scheduler=cluster.scheduler_address,
                      out_dir=os.path.join(out_dir, "dask"), progress=False)
 

@@ -22,7 +22,7 @@ from drake_entry.models.vehicles import Vehicle, load_vehicle
 from drake_entry.models.verdict import PathLimit, acceptance_box, vehicle_path_limits
 from drake_entry.typed_yaml import load_packaged_or_file, override, packaged_names
 
-__all__ = ["scenario_from_dump", "EntryStateSpec", "TargetSpec", "TerminalSpec", "ScheduleSpec", "PLANTS", "SimulationSpec",
+__all__ = ["RENAMED_GUIDANCE_FIELDS", "upgrade_scenario_yaml", "scenario_from_dump", "EntryStateSpec", "TargetSpec", "TerminalSpec", "ScheduleSpec", "PLANTS", "SimulationSpec",
            "ReferenceResultsSpec", "ERROR_COLUMNS", "Scenario", "INTEGRATORS", "SCHEDULE_VALUES_DEG",
            "SCHEDULE_BREAKPOINTS", "PACKAGED_SCENARIOS", "closed_loop_scenarios", "load_scenario", "apply_overrides",
            "load_campaign_scenario"]
@@ -383,6 +383,22 @@ def apply_overrides(scenario: Scenario, overrides: dict | None):
     for key, value in overrides.items():
         override(scenario, key, value, where="override")
     scenario.validate()
+
+
+#: guidance fields renamed when every method that re-plans on board got one re-plan concept
+#: ({old name: today's}); a scenario stored before (a campaign manifest) is read with today's names
+RENAMED_GUIDANCE_FIELDS = {"resolve_period_s": "replan_period_s", "corrector_period_s": "replan_period_s",
+                           "resolve_until_e": "replan_until_e", "resolve_scaling": "acceleration_scaling"}
+
+
+def upgrade_scenario_yaml(text: str) -> str:
+    """A stored scenario's YAML (a campaign manifest's ``scenario_yaml``) with the guidance fields
+    renamed since it was written (RENAMED_GUIDANCE_FIELDS) under today's names."""
+    import re
+
+    for old, new in RENAMED_GUIDANCE_FIELDS.items():
+        text = re.sub(rf"^(\s+){old}:", rf"\g<1>{new}:", text, flags=re.MULTILINE)
+    return text
 
 
 def scenario_from_dump(text: str) -> Scenario:

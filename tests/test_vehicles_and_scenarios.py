@@ -132,3 +132,20 @@ def test_closed_loop_runs_fixed_steps_and_open_loop_keeps_error_control():
     assert closed.get_fixed_step_mode() and closed.get_maximum_step_size() == sc.simulation.closed_loop_step_s == 0.5
     opened = make_simulator(diagram, sc).get_integrator()
     assert not opened.get_fixed_step_mode() and opened.get_target_accuracy() == sc.simulation.accuracy
+
+
+@pytest.mark.parametrize("name, old, new", [("capsule_lu2008", "corrector_period_s", "replan_period_s"),
+                                            ("cav_h_paper004", "resolve_until_e", "replan_until_e"),
+                                            ("cav_h_paper004", "resolve_scaling", "acceleration_scaling")])
+def test_a_campaign_stored_before_the_replan_renames_reports_its_scenario(name, old, new):
+    """A manifest written with a guidance field's old name (before one re-plan concept) is read
+    with today's name: the report keeps the flown scenario instead of losing it."""
+    from pydrake.common.yaml import yaml_dump_typed
+
+    from drake_entry.campaign.report import flown_scenario
+
+    scenario = load_scenario(name)
+    stored = yaml_dump_typed(scenario).replace(f"{new}:", f"{old}:")
+    assert f"  {old}:" in stored
+    flown = flown_scenario({"scenario_yaml": stored})
+    assert flown is not None and getattr(flown.guidance, new) == getattr(scenario.guidance, new)

@@ -38,7 +38,7 @@ from drake_entry.campaign.store import coverage, read_nominal, read_trajectories
 from drake_entry.errors import CampaignError, DrakeEntryError
 from drake_entry.models.verdict import BOX_CRITERIA
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
-from drake_entry.scenario import Scenario
+from drake_entry.scenario import Scenario, upgrade_scenario_yaml
 from drake_entry.typed_yaml import load_yaml_typed
 
 __all__ = ["ERROR_COLUMNS", "MARGIN_COLUMNS", "failure_categories", "finite_column", "reached_terminal",
@@ -186,7 +186,7 @@ def flown_scenario(manifest: dict | None):
     if not text:
         return None
     try:
-        return load_yaml_typed(Scenario, text=text, where="campaign manifest")
+        return load_yaml_typed(Scenario, text=upgrade_scenario_yaml(text), where="campaign manifest")
     except DrakeEntryError:  # a manifest of another version: report without what it would give
         return None
 

@@ -54,12 +54,17 @@ class GuidanceMemory:
 
 class DragEnergyGuidance(ReplanScheduler):
     def __init__(self, planner: DragEnergyPlanner, *, period: float = 1.0, pre_guidance_min_s: float = 100.0,
-                 replan_period_s: float = 0.0, replan_until_e: float = 0.9):
+                 replan_period_s: float = 0.0, replan_until_e: float = 0.9, latency_s: float = 0.0,
+                 latency_factor: float = 0.0):
+        """Args: planner; period [s]; pre_guidance_min_s [s]; replan_period_s [s] (0: plan once);
+        replan_until_e: no re-plan past this normalised energy; latency_s [s], latency_factor: the
+        computing latency of each plan (systems/replan_scheduler.py)."""
         super().__init__()
         self.planner = planner
         self.pre_min = pre_guidance_min_s
         self.replan_until_e = replan_until_e
-        self.DeclareReplanSchedule(replan_period_s=replan_period_s)  # the first plan is at engagement
+        self.DeclareReplanSchedule(replan_period_s=replan_period_s, latency_s=latency_s,  # the first at engagement
+                                   latency_factor=latency_factor)
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self._memory = self.DeclareAbstractState(AbstractValue.Make(GuidanceMemory()))
@@ -73,10 +78,16 @@ class DragEnergyGuidance(ReplanScheduler):
     def _update(self, context, state):
         mem = self.memory(context)
         t = context.get_time()
+        held = self.take_held(context, state)
+        if held is not None:  # a plan computed one latency ago: it flies from now
+            mem = copy.deepcopy(mem)
+            self._apply(mem, *held, t)
+            state.get_mutable_abstract_state(int(self._memory)).set_value(mem)
         x = self.est_port.Eval(context)
         sensed = sensed_drag(self.fc_port, context)
         if mem.reference is None:  # engagement: tried at every update until a plan succeeds
-            due = t >= self.pre_min and self.planner.drag_state(x, sensed).D_prime >= 0.0
+            due = (not self.holding(context) and t >= self.pre_min
+                   and self.planner.drag_state(x, sensed).D_prime >= 0.0)
         else:
             E0, Ef = self.planner.E_entry, self.planner.E_final
             e = (E0 - self.planner.energy(x)) / (E0 - Ef)
@@ -88,19 +99,23 @@ class DragEnergyGuidance(ReplanScheduler):
         def solve():
             ref = self.planner.plan_from_state(x, previous=mem.reference, sensed_drag=sensed)
             ok = ref is not None and bool(ref.success)
-            return ref, ok, "" if ok else ("the planner returned no plan" if ref is None else ref.message)
+            return (ref, np.array(x)), ok, "" if ok else ("the planner returned no plan" if ref is None else ref.message)
 
         outcome = self.attempt(context, state, solve)
-        if outcome.applied:
-            ref = outcome.result
-            new.reference = ref
-            if new.engaged_at is None:
-                new.engaged_at = t
-                new.first_reference = ref
-                new.engaged_state = np.array(x)
-        else:
+        if outcome.apply_now:
+            self._apply(new, *outcome.result, t)
+        elif not outcome.applied:
             new.failures.append((t, outcome.note))
         state.get_mutable_abstract_state(int(self._memory)).set_value(new)
+
+    @staticmethod
+    def _apply(mem: GuidanceMemory, ref: DragEnergyReference, x_planned: np.ndarray, t: float) -> None:
+        """Fly ``ref`` (planned from the estimate ``x_planned``) from flight time ``t`` [s]."""
+        mem.reference = ref
+        if mem.engaged_at is None:
+            mem.engaged_at = t
+            mem.first_reference = ref
+            mem.engaged_state = x_planned
 
     def _calc(self, context, output):
         mem = self.memory(context)

@@ -45,13 +45,14 @@ _FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
 class FnpegGuidance(ReplanScheduler):
     def __init__(self, setup: FnpegSetup, *, sigma0_guess: float, bank_before: float, initial_alpha: float,
                  engage_acceleration: float, period: float = 1.0, replan_period: float = 1.0,
-                 scaling: bool = True):
+                 scaling: bool = True, latency_s: float = 0.0, latency_factor: float = 0.0):
         """Args: setup (the mission's predictor, corrector and law); sigma0_guess [rad] (the first
         corrector's start); bank_before [rad] (|sigma| before engagement); initial_alpha [rad] (the
         alpha command before the first sample); engage_acceleration [m/s^2]; period [s];
         replan_period [s] of the corrector (0: at engagement only); scaling: the
         predictions fly the nominal lift and drag times the low-passed ratios of the sensed to the
-        modelled accelerations (models.acceleration_ratios), else the nominal models."""
+        modelled accelerations (models.acceleration_ratios), else the nominal models; latency_s [s],
+        latency_factor: each correction's computing latency (systems/replan_scheduler.py)."""
         super().__init__()
         if not period > 0 or not (replan_period == 0 or replan_period >= period):
             raise ScenarioError(f"FnpegGuidance: period = {period} s must be > 0 and replan_period = "
@@ -67,7 +68,8 @@ class FnpegGuidance(ReplanScheduler):
         start[_SIGMA0], start[_MAGNITUDE] = sigma0_guess, bank_before
         start[_ALPHA] = initial_alpha
         self._state = self.DeclareDiscreteState(BasicVector(start))
-        self.DeclareReplanSchedule(replan_period_s=replan_period)  # the first correction is at engagement
+        self.DeclareReplanSchedule(replan_period_s=replan_period, latency_s=latency_s,  # the first: at engagement
+                                   latency_factor=latency_factor, pending_size=3)
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
         deps = {self.xd_ticket()}
         for name, index in (("bank_magnitude", _MAGNITUDE), ("alpha_command", _ALPHA), ("sigma0", _SIGMA0),
@@ -93,6 +95,9 @@ class FnpegGuidance(ReplanScheduler):
         if self.scaling:
             m[_KL], m[_KD] = filtered_ratios((m[_KL], m[_KD]), x, float(m[_ALPHA]), L, D, s.vehicle, s.planet,
                                              s.atmosphere, self.period)
+        held = self.take_held(context, discrete_state)
+        if held is not None:  # a correction computed one latency ago flies from now
+            m[_SIGMA0], m[_SLOPE], m[_Z] = held
         if not m[_ENGAGED] and math.hypot(L, D) >= self.engage_acceleration:
             m[_ENGAGED], m[_T_ENGAGE] = 1.0, t
             self.due_now(discrete_state, t)
@@ -117,8 +122,8 @@ class FnpegGuidance(ReplanScheduler):
             finite = math.isfinite(c.z)
             return c, finite, "" if finite and c.converged else "not converged"
 
-        outcome = self.attempt(context, discrete_state, solve)
+        outcome = self.attempt(context, discrete_state, solve, encode=lambda c: [c.sigma0, c.slope, c.z])
         m[_PREDICTIONS] += self.setup.predictor.predictions - n0
-        if outcome.applied:
+        if outcome.apply_now:
             c = outcome.result
             m[_SIGMA0], m[_SLOPE], m[_Z] = c.sigma0, c.slope, c.z

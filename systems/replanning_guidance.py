@@ -100,7 +100,8 @@ class ReplanningGuidance(ReplanScheduler):
     def __init__(self, plan, *, replan: Replan | None = None, period: float = 1.0, replan_period: float = 0.0,
                  min_time_to_go: float = 300.0, lead: float = 0.0, first_replan: float | None = None,
                  time_to_go_fraction: float | None = None, model_scales: bool = False,
-                 feedback: Callable[[object], object] | None = None, offset_limits=(0.0, 0.0)):
+                 feedback: Callable[[object], object] | None = None, offset_limits=(0.0, 0.0),
+                 latency_s: float = 0.0, latency_factor: float = 0.0):
         """Args: plan (the pre-flight plan, flown from t = 0); replan: the method's re-planner
         (needed when replan_period > 0); period [s] of the re-plan check; replan_period [s] (0: no
         re-planning); min_time_to_go [s]: no re-plan with less left; lead [s]: the commands are
@@ -111,7 +112,8 @@ class ReplanningGuidance(ReplanScheduler):
         (the time to go of the plan in use after the re-plan); model_scales: declare the
         "model_scales" input and pass its value to ``replan`` as ``scales``; feedback: the
         tracking law maker of a plan and offset_limits (bank, alpha) [rad] its offsets' bounds
-        (module docstring)."""
+        (module docstring); latency_s [s], latency_factor: each re-plan's computing latency
+        (systems/replan_scheduler.py: it flies from then, read at its own time since it began)."""
         super().__init__()
         if replan_period > 0 and replan is None:
             raise ValueError("ReplanningGuidance: replan_period > 0 needs a replan callable")
@@ -121,7 +123,8 @@ class ReplanningGuidance(ReplanScheduler):
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.scales_port = self.DeclareVectorInputPort("model_scales", 2) if model_scales else None
         first_at = (replan_period if first_replan is None else first_replan) if replan_period > 0 else np.inf
-        self.DeclareReplanSchedule(replan_period_s=replan_period, first_due_s=first_at)
+        self.DeclareReplanSchedule(replan_period_s=replan_period, first_due_s=first_at, latency_s=latency_s,
+                                   latency_factor=latency_factor)
         flown = FlownPlan.of(plan, 0.0, feedback)
         first = ReplanMemory(flown, unfed=[0.0] if feedback is not None and flown.feedback is None else [])
         self._memory = self.DeclareAbstractState(AbstractValue.Make(first))
@@ -152,10 +155,15 @@ class ReplanningGuidance(ReplanScheduler):
     def _update(self, context, state):
         mem = self.memory(context)
         t = context.get_time()
+        held = self.take_held(context, state)
+        if held is not None:  # a re-plan computed one latency ago flies from now
+            mem = ReplanMemory(held, list(mem.refused), list(mem.log), list(mem.unfed))
+            self._start(mem, state, t)
+            state.get_mutable_abstract_state(int(self._memory)).set_value(mem)
         flown = mem.flown
         x = np.asarray(self.est_port.Eval(context), float)
-        offsets = context.get_discrete_state(self._offsets).value().copy()
-        if flown.feedback is not None and t - flown.start < flown.plan.final_time:
+        offsets = np.zeros(2) if held is not None else context.get_discrete_state(self._offsets).value().copy()
+        if held is None and flown.feedback is not None and t - flown.start < flown.plan.final_time:
             offsets = np.clip(offsets + self.period * flown.feedback.rates(t - flown.start, x, offsets),
                               -self.offset_limits, self.offset_limits)
             state.get_mutable_discrete_state(self._offsets).SetFromVector(offsets)
@@ -182,11 +190,16 @@ class ReplanningGuidance(ReplanScheduler):
         else:
             outcome = self.attempt(context, state, solve)
         new.log.append((t, outcome.wall_s, outcome.applied))
-        if outcome.applied:
+        if outcome.apply_now:
             new.flown = outcome.result
-            if self.feedback is not None and outcome.result.feedback is None:
-                new.unfed.append(t)
-            state.get_mutable_discrete_state(self._offsets).SetFromVector(np.zeros(2))  # it starts where we are
-        else:
+            self._start(new, state, t)
+        elif not outcome.applied:
             new.refused.append((t, outcome.note))
         state.get_mutable_abstract_state(int(self._memory)).set_value(new)
+
+    def _start(self, mem: ReplanMemory, state, t: float) -> None:
+        """``mem.flown`` (just accepted) flies from flight time ``t`` [s]: its feedback, if asked
+        for and not made, is recorded, and the offsets restart at zero (it starts where we are)."""
+        if self.feedback is not None and mem.flown.feedback is None:
+            mem.unfed.append(t)
+        state.get_mutable_discrete_state(self._offsets).SetFromVector(np.zeros(2))

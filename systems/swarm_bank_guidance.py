@@ -54,13 +54,15 @@ _ALPHA, _ABOVE, _SWITCHED, _SIGMA0, _KL, _KD = range(6)
 
 class SwarmBankGuidance(ReplanScheduler):
     def __init__(self, problem: SwarmProblem, sigma0: float, *, period: float = 1.0, replan_period: float = 0.0,
-                 replan_until_e: float = 0.95, bounds_deg=(0.0, 89.0), acceleration_scaling: bool = True):
+                 replan_until_e: float = 0.95, bounds_deg=(0.0, 89.0), acceleration_scaling: bool = True,
+                 latency_s: float = 0.0, latency_factor: float = 0.0):
         """Args: problem (the mission and law, nominal models); sigma0 [rad] planned; period [s];
         replan_period [s] (0 = fly sigma0); replan_until_e: last normalised energy of a
         re-solution; bounds_deg: sigma_0 bounds of a re-solution (eq. 17 stays anchored at the
         entry energy); acceleration_scaling: the predictions fly the nominal lift and drag times the
         filtered ratios of the sensed to the modelled accelerations (a density or aerodynamic
-        error the flight has shown), instead of the nominal models."""
+        error the flight has shown), instead of the nominal models; latency_s [s], latency_factor:
+        each re-solution's computing latency (systems/replan_scheduler.py)."""
         super().__init__()
         if not period > 0:
             raise ScenarioError(f"SwarmBankGuidance.period must be > 0 s, got {period}")
@@ -75,7 +77,8 @@ class SwarmBankGuidance(ReplanScheduler):
         alpha0 = problem.alpha_max if problem.initial_alpha is None else problem.initial_alpha
         self._state = self.DeclareDiscreteState(BasicVector([alpha0, 0.0, 0.0, sigma0, 1.0, 1.0]))
         self.DeclareReplanSchedule(replan_period_s=replan_period,
-                                   first_due_s=replan_period if replan_period > 0 else math.inf)
+                                   first_due_s=replan_period if replan_period > 0 else math.inf,
+                                   latency_s=latency_s, latency_factor=latency_factor, pending_size=1)
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
         deps = {self.xd_ticket(), self.est_port.ticket(), self.fc_port.ticket()}
         self.DeclareVectorOutputPort("bank_magnitude", 1, lambda c, o: o.SetAtIndex(0, self.commands(c)[0]),
@@ -113,6 +116,9 @@ class SwarmBankGuidance(ReplanScheduler):
         if self.acceleration_scaling and self.replan_period_s > 0:  # only re-solutions read the ratios
             self._update_ratios(context, m)
         t = context.get_time()
+        held = self.take_held(context, discrete_state)
+        if held is not None:  # a sigma_0 solved one latency ago flies from now
+            m[_SIGMA0] = held[0]
         if self.replan_due(context):
             x = np.asarray(self.est_port.Eval(context), float)
             p = self.problem
@@ -136,8 +142,9 @@ class SwarmBankGuidance(ReplanScheduler):
                     finite = math.isfinite(r.sigma0_deg)
                     return r, finite, "" if finite and r.bracketed else "no bracketed root"
 
-                outcome = self.attempt(context, discrete_state, solve)
-                if outcome.applied:
+                outcome = self.attempt(context, discrete_state, solve,
+                                       encode=lambda r: [math.radians(r.sigma0_deg)])
+                if outcome.apply_now:
                     m[_SIGMA0] = math.radians(outcome.result.sigma0_deg)
         discrete_state.get_mutable_vector(self._state).SetFromVector(m)
 

@@ -127,10 +127,40 @@ def test_a_refused_scvx_replan_keeps_the_plan_in_flight(monkeypatch):
     assert [(t, ok) for t, _, ok in memory.log] == [(100.0, False), (200.0, False), (300.0, True), (400.0, True)]
 
 
-def test_a_swarm_resolution_that_raises_keeps_sigma0_and_is_counted(monkeypatch):
+def test_a_replan_held_for_its_latency_flies_from_then_read_at_its_own_time():
+    """ReplanningGuidance with a 30-s computing latency: the re-plan computed at 100 s flies from
+    130 s (the pre-flight plan until then), its start stays 100 s (it is read 30 s into itself), and
+    the next re-plan is due 100 s after the attempt, at 200 s."""
+    from drake_entry.systems.replanning_guidance import ReplanningGuidance
+
+    calls = []
+
+    def replan(plan, x, t_plan, bank, alpha):
+        calls.append(t_plan)
+        return _StubPlan(2.0 + len(calls))
+
+    builder = DiagramBuilder()
+    guidance = builder.AddSystem(ReplanningGuidance(_StubPlan(1.0), replan=replan, period=1.0, replan_period=100.0,
+                                                    min_time_to_go=300.0, latency_s=30.0))
+    estimate = builder.AddSystem(ConstantVectorSource(np.array([60e3, 0.1, 0.2, 6000.0, -0.01, 1.0])))
+    builder.Connect(estimate.get_output_port(), guidance.GetInputPort("estimated_state"))
+    simulator = Simulator(builder.Build())
+    bank = {}
+    for t in (129.5, 130.5, 229.5, 230.5):
+        simulator.AdvanceTo(t)
+        context = guidance.GetMyContextFromRoot(simulator.get_context())
+        bank[t] = guidance.GetOutputPort("bank_command").Eval(context)[0]
+    assert bank == {129.5: 1.0, 130.5: 3.0, 229.5: 3.0, 230.5: 4.0}
+    assert calls == [100.0, 100.0]  # the second at 200 s, 100 s into the plan that began at 100 s
+    assert guidance.memory(context).flown.start == 200.0
+
+
+@pytest.mark.parametrize("latency_s", [0.0, 4.0])
+def test_a_swarm_resolution_that_raises_keeps_sigma0_and_is_counted(monkeypatch, latency_s):
     """SwarmBankGuidance re-solves sigma_0 every 10 s; a re-solution that raises (the first) or
     returns a non-finite sigma_0 (the second) leaves the sigma_0 in use, and plan_stats counts
-    both as failed; the third re-solution's bracketed root is taken."""
+    both as failed; the third re-solution's bracketed root is taken (at 30 s, or with a 4-s
+    computing latency at 34 s)."""
     import math
 
     import drake_entry.systems.swarm_bank_guidance as swarm
@@ -150,18 +180,20 @@ def test_a_swarm_resolution_that_raises_keeps_sigma0_and_is_counted(monkeypatch)
     monkeypatch.setattr(swarm, "resolve_sigma0", scripted)
     builder = DiagramBuilder()
     guidance = builder.AddSystem(swarm.SwarmBankGuidance(problem, math.radians(58.0), period=1.0,
-                                                         replan_period=10.0, acceleration_scaling=False))
+                                                         replan_period=10.0, acceleration_scaling=False,
+                                                         latency_s=latency_s))
     for port, value in (("estimated_state", problem.x0), ("flight_conditions", np.ones(len(FLIGHT_CONDITION_NAMES))),
                         ("bank_command", [0.5])):
         builder.Connect(builder.AddSystem(ConstantVectorSource(np.asarray(value, float))).get_output_port(),
                         guidance.GetInputPort(port))
     simulator = Simulator(builder.Build())
     sigma0 = []
-    for t in (5.5, 15.5, 25.5, 35.5):
+    for t in (5.5, 15.5, 25.5, 32.5, 35.5):
         simulator.AdvanceTo(t)
         context = guidance.GetMyContextFromRoot(simulator.get_context())
         sigma0.append(math.degrees(guidance.GetOutputPort("sigma0").Eval(context)[0]))
-    assert sigma0 == pytest.approx([58.0, 58.0, 58.0, 61.0], abs=1e-12)
+    at_32 = 61.0 if latency_s == 0 else 58.0
+    assert sigma0 == pytest.approx([58.0, 58.0, 58.0, at_32, 61.0], abs=1e-12)
     stats = guidance.GetOutputPort("plan_stats").Eval(context)
     assert stats[0] == 3 and stats[1] == 2
 

@@ -20,7 +20,7 @@ def add_replanning_guidance(builder, name: str, plan, replan, spec, plant: Plant
     arguments), connected to the navigation estimate; return it."""
     system = builder.AddNamedSystem(name, ReplanningGuidance(
         plan, replan=replan, period=spec.period_s, replan_period=spec.replan_period_s,
-        min_time_to_go=spec.replan_min_time_to_go_s, lead=spec.command_lead_s, **options))
+        min_time_to_go=spec.replan_min_time_to_go_s, lead=spec.command_lead_s, **spec.latency(), **options))
     builder.Connect(plant.estimated_state, system.GetInputPort("estimated_state"))
     return system
 

@@ -10,21 +10,27 @@ import math
 
 from drake_entry.errors import ScenarioError, check_range
 
-__all__ = ["MAX_REPLAN_PERIOD_S", "check_replan_period", "GuidanceSpecBase", "ReversingBankSpec", "ReplanningSpec"]
+__all__ = ["MAX_REPLAN_PERIOD_S", "MAX_REPLAN_LATENCY_S", "MAX_REPLAN_LATENCY_FACTOR", "check_replanning",
+           "GuidanceSpecBase", "ReplansOnBoard", "ReversingBankSpec", "ReplanningSpec"]
 
 #: the longest on-board re-planning period [s]
 MAX_REPLAN_PERIOD_S = 1e4
+#: the longest guidance computing latency [s] and latency factor (x the measured wall time)
+MAX_REPLAN_LATENCY_S, MAX_REPLAN_LATENCY_FACTOR = 600.0, 1e3
 
 
-def check_replan_period(spec) -> None:
-    """The one rule of ``guidance.replan_period_s``, the on-board re-planning period of every method
-    that plans on board (systems/replan_scheduler.py): 0 (no re-plan after the first plan) or
-    from the guidance period ``period_s`` to MAX_REPLAN_PERIOD_S seconds."""
+def check_replanning(spec) -> None:
+    """The one rule of the on-board re-planning fields of every method that plans on board
+    (``ReplansOnBoard``; systems/replan_scheduler.py): ``replan_period_s`` is 0 (no re-plan after
+    the first plan) or from the guidance period ``period_s`` to MAX_REPLAN_PERIOD_S seconds;
+    ``replan_latency_s`` and ``replan_latency_factor`` are finite and >= 0."""
     value, period = spec.replan_period_s, spec.period_s
     if not (isinstance(value, (int, float)) and (value == 0 or period <= value <= MAX_REPLAN_PERIOD_S)):
         shown = value if not isinstance(value, float) or math.isfinite(value) else str(value)
         raise ScenarioError(f"guidance.replan_period_s = {shown} is out of range; allowed: 0 (no re-plan after the "
                             f"first plan) or from guidance.period_s = {period} to {MAX_REPLAN_PERIOD_S:g} s")
+    check_range("guidance.replan_latency_s", spec.replan_latency_s, 0.0, MAX_REPLAN_LATENCY_S)
+    check_range("guidance.replan_latency_factor", spec.replan_latency_factor, 0.0, MAX_REPLAN_LATENCY_FACTOR)
 
 
 @dc.dataclass
@@ -60,6 +66,30 @@ class GuidanceSpecBase:
 
 
 @dc.dataclass
+class ReplansOnBoard(GuidanceSpecBase):
+    """A method that plans on board (systems/replan_scheduler.py: drag-energy, SCvx, LGL terminal,
+    the swarm bank re-solved on board, FNPEG's corrector): one re-plan concept, one rule
+    (``check_replanning``)."""
+
+    # on-board re-planning from the navigation estimate every replan_period_s [s] (0: no re-plan
+    # after the first plan)
+    replan_period_s: float = 0.0
+    # guidance computing latency: a plan computed from the estimate at t flies from t +
+    # replan_latency_s [s] (a flight computer's stated time) + replan_latency_factor x its measured
+    # wall time on this machine (which makes rows depend on the machine; 0 = applied at once)
+    replan_latency_s: float = 0.0
+    replan_latency_factor: float = 0.0
+
+    def validate(self, scenario) -> None:
+        super().validate(scenario)
+        check_replanning(self)
+
+    def latency(self) -> dict:
+        """The latency arguments of the method's guidance system."""
+        return {"latency_s": self.replan_latency_s, "latency_factor": self.replan_latency_factor}
+
+
+@dc.dataclass
 class ReversingBankSpec(GuidanceSpecBase):
     """A method that commands |sigma| and flies it with the shared bank-reversal logic
     (heading-error corridor, paper 000 Sec. VI.D; systems.bank_reversal)."""
@@ -79,7 +109,7 @@ class ReversingBankSpec(GuidanceSpecBase):
 
 
 @dc.dataclass
-class ReplanningSpec(GuidanceSpecBase):
+class ReplanningSpec(ReplansOnBoard):
     """A method whose plans are flown in time through the shared actuators and re-planned on
     board from the navigation estimate (systems/replanning_guidance.py: paper 001's SCvx, paper
     002's LGL)."""
@@ -87,13 +117,11 @@ class ReplanningSpec(GuidanceSpecBase):
     # each command is read this far ahead on the plan [s]: the actuators' lag (half the guidance
     # period for the hold, 1/bandwidth for the loop: 1.0 s at 1 s with the 2 rad/s loop)
     command_lead_s: float = 1.0
-    # on-board re-planning from the navigation estimate every replan_period_s [s] (0 = fly the
-    # pre-flight plan), while the plan in use has more than replan_min_time_to_go_s [s] to go
-    replan_period_s: float = 0.0
+    # on-board re-planning (replan_period_s) only while the plan in use has more than
+    # replan_min_time_to_go_s [s] to go
     replan_min_time_to_go_s: float = 300.0
 
     def validate(self, scenario) -> None:
         super().validate(scenario)
         check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
-        check_replan_period(self)
         check_range("guidance.replan_min_time_to_go_s", self.replan_min_time_to_go_s, 0.0, 1e4)

@@ -34,7 +34,7 @@ class DragEnergyMethod(GuidanceMethod):
         g = scenario.guidance
         guidance = builder.AddNamedSystem("drag_energy_guidance", DragEnergyGuidance(
             planner, period=g.period_s, pre_guidance_min_s=g.pre_guidance_min_s, replan_period_s=g.replan_period_s,
-            replan_until_e=g.replan_until_e))
+            replan_until_e=g.replan_until_e, **g.latency()))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         # the accelerometer's drag: guidance and feedback act on the drag actually felt
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))

@@ -4,13 +4,13 @@
 import dataclasses as dc
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance.spec import ReversingBankSpec, check_replan_period
+from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
 
 __all__ = ["DragEnergy"]
 
 
 @dc.dataclass
-class DragEnergy(ReversingBankSpec):
+class DragEnergy(ReversingBankSpec, ReplansOnBoard):
     """Drag-energy reference by a pseudospectral SOCP, drag tracking and bank reversals."""
 
     n_nodes: int = 40
@@ -24,8 +24,6 @@ class DragEnergy(ReversingBankSpec):
     # pre-guidance: this bank until the drag stops rising (D' >= 0) after pre_guidance_min_s
     pre_guidance_bank_deg: float = 0.0
     pre_guidance_min_s: float = 100.0
-    # re-planning period [s] (0 = plan once)
-    replan_period_s: float = 0.0
     # no re-planning past this normalised energy (little range is left to correct)
     replan_until_e: float = 0.9
     # drag tracking (eq. 101), energy domain: zeta < 0 because E decreases (paper 000 Sec. VI.D)
@@ -49,7 +47,6 @@ class DragEnergy(ReversingBankSpec):
         check_range("guidance.replan_until_e", self.replan_until_e, 0.0, 1.0)
         check_range("guidance.corridor_margin", self.corridor_margin, 0.0, 0.49)
         check_range("guidance.corridor_points", self.corridor_points, 20, 100000)
-        check_replan_period(self)
         check_range("guidance.pre_guidance_min_s", self.pre_guidance_min_s, 0.0, 1e5)
         check_range("guidance.pre_guidance_bank_deg", self.pre_guidance_bank_deg, -180.0, 180.0)
         if self.solver not in ("clarabel", "scs"):

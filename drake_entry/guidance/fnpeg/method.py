@@ -62,7 +62,7 @@ class FnpegMethod(GuidanceMethod):
         guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, FnpegGuidance(
             s, sigma0_guess=math.radians(g.bank_start_guess_deg), bank_before=math.radians(g.bank_before_engagement_deg),
             initial_alpha=alpha0, engage_acceleration=g.engage_acceleration_m_s2, period=g.period_s,
-            replan_period=g.replan_period_s, scaling=g.acceleration_scaling))
+            replan_period=g.replan_period_s, scaling=g.acceleration_scaling, **g.latency()))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
         reversal = add_bank_reversal(builder, scenario, plant, guidance.GetOutputPort("bank_magnitude"))

@@ -4,13 +4,13 @@ import dataclasses as dc
 import math
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance.spec import ReversingBankSpec, check_replan_period
+from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
 
 __all__ = ["Fnpeg"]
 
 
 @dc.dataclass
-class Fnpeg(ReversingBankSpec):
+class Fnpeg(ReversingBankSpec, ReplansOnBoard):
     """|sigma| linear in e = mu/r - V^2/2 from sigma_0 (solved on board every
     ``replan_period_s`` by the damped secant on the predicted range error) to
     ``bank_end_deg`` at the terminal energy (or held at sigma_0: ``bank_profile: constant``),
@@ -86,7 +86,6 @@ class Fnpeg(ReversingBankSpec):
             check_range("guidance.alpha_deg", a, -10.0, 60.0)
         check_range("guidance.alpha_rate_deg_s", self.alpha_rate_deg_s, 1e-3, 100.0)
         check_range("guidance.alpha_accel_deg_s2", self.alpha_accel_deg_s2, 1e-3, 1000.0)
-        check_replan_period(self)
         check_range("guidance.range_tolerance_km", self.range_tolerance_km, 1e-4, 100.0)
         check_range("guidance.max_iterations", self.max_iterations, 1, 100)
         check_range("guidance.max_halvings", self.max_halvings, 0, 30)

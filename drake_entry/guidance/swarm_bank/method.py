@@ -182,7 +182,7 @@ class SwarmBankMethod(GuidanceMethod):
         guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, SwarmBankGuidance(
             p, math.radians(planner.sigma0_deg), period=g.period_s, replan_period=g.replan_period_s,
             replan_until_e=g.replan_until_e, bounds_deg=tuple(g.bank_start_bounds_deg),
-            acceleration_scaling=g.acceleration_scaling))
+            acceleration_scaling=g.acceleration_scaling, **g.latency()))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
         reversal = add_bank_reversal(builder, scenario, plant, guidance.GetOutputPort("bank_magnitude"),

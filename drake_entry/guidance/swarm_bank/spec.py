@@ -5,7 +5,7 @@ import math
 import typing
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance.spec import ReversingBankSpec, check_replan_period
+from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
 
 __all__ = ["SWARMS", "OPTIMIZERS", "swarm_trajectories", "MAX_SEARCH_TRAJECTORIES", "SwarmBank"]
 
@@ -26,7 +26,7 @@ MAX_SEARCH_TRAJECTORIES = 100_000
 
 
 @dc.dataclass
-class SwarmBank(ReversingBankSpec):
+class SwarmBank(ReversingBankSpec, ReplansOnBoard):
     """|sigma| linear in e = mu/r - V^2/2 from bank_start_deg at entry to bank_end_deg at the
     TAEM energy (paper 004 eq. 17) with the QEG compensation (eqs. 46-48); alpha from the load
     factor (Case 1, eq. 31) or the heat rate until Mach_shift (Case 2, eq. 21); bank sign from
@@ -59,9 +59,6 @@ class SwarmBank(ReversingBankSpec):
     landmark_iteration: int = 14
     map_compass_factor: float = 0.2
     seed: int = 0
-    # on-board re-solution of sigma_0 from the navigation estimate every replan_period_s [s] (0 =
-    # fly the plan)
-    replan_period_s: float = 0.0
     # no re-solution past this normalised energy (little range is left to correct)
     replan_until_e: float = 0.95
     # the predictions fly the nominal lift and drag scaled by the filtered sensed/modelled
@@ -105,5 +102,4 @@ class SwarmBank(ReversingBankSpec):
                 f"{MAX_SEARCH_TRAJECTORIES:,} (paper 004: 10 x 21 = 210)")
         check_range("guidance.seed", self.seed, 0, 2**32 - 1)
         check_range("guidance.map_compass_factor", self.map_compass_factor, 0.0, 10.0)
-        check_replan_period(self)
         check_range("guidance.replan_until_e", self.replan_until_e, 0.0, 1.0)

@@ -25,7 +25,8 @@ The rule, the same for every method (``replan_period_s`` in every spec, checked 
   t + ``latency_s`` + ``latency_factor`` x its measured wall time (a flight computer's stated
   time, or what this machine took scaled to one), at the first update at or after that instant
   (exactly then when the latency is a whole number of update periods); until then it is held
-  (``take_held``), the plan in use flies on, and no other re-plan starts (the computer is busy).
+  (``take_held``), the plan in use flies on, and no other re-plan starts before it flies (the
+  computer is busy); the next may start at the update where it does.
 
 The schedule is a discrete-state group of the system (a periodic discrete update and an
 unrestricted one both write it), so the order of events in the diagram is the method's own
@@ -139,9 +140,12 @@ class ReplanScheduler(LeafSystem):
         return values.get_mutable_discrete_state(index)
 
     def replan_due(self, context) -> bool:
-        """A re-plan is due at this sample (and no plan is held for its latency)."""
+        """A re-plan is due at this sample, and no plan is held for its latency beyond it (a plan
+        whose time has come is taken at this update, and the computer is free again)."""
         s = self._schedule_of(context)
-        return context.get_time() >= s[_NEXT] - DUE_TOLERANCE_S and s[_HELD_UNTIL] == math.inf
+        t = context.get_time()
+        return t >= s[_NEXT] - DUE_TOLERANCE_S and (s[_HELD_UNTIL] == math.inf
+                                                    or t >= s[_HELD_UNTIL] - DUE_TOLERANCE_S)
 
     def holding(self, context) -> bool:
         """A computed plan is held for its latency."""

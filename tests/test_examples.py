@@ -305,6 +305,16 @@ def test_example_18(tmp_path):
     assert os.path.exists(tmp_path / "segments.png")
 
 
+def test_example_19(tmp_path):
+    """Computing latency, quick run (latencies 0 and 5 s on the HORUS-2B nominal): engagement's plan
+    flies exactly 5 s later, both flights reach E_f, and the 0-s flight is the scenario's own."""
+    r = _run("19_computing_latency", tmp_path)
+    f0, f5 = r["flights"][0.0], r["flights"][5.0]
+    assert f5.guidance.fields["engaged_at_s"] == f0.guidance.fields["engaged_at_s"] + 5.0
+    assert f0.reached and f5.reached and f0.trajectory.time[-1] != f5.trajectory.time[-1]
+    assert os.path.exists(tmp_path / "computing_latency.png")
+
+
 def test_the_examples_command_line_passes_quick_out_and_options_and_exits_by_the_claims(tmp_path, capsys):
     """run_example: --quick, --out and an example's own options reach main; the exit status is
     the claims' (1 when one fails)."""

@@ -91,13 +91,24 @@ def test_a_latency_between_updates_applies_at_the_first_update_after_it(numbers)
     assert [used[t] for t in (12, 13)] == [-1.0, 10.0]
 
 
-def test_no_re_plan_starts_while_one_is_held():
-    """A latency longer than the period: the computer is busy; the next attempt comes once the held
-    plan flies (at 5), at the next update (6), and the period counts from each attempt."""
-    system = _Counter(numbers=False, replan_period_s=2.0, latency_s=3.0)
+@pytest.mark.parametrize("numbers", [False, True], ids=["object held", "numbers held"])
+def test_no_re_plan_starts_while_one_is_held(numbers):
+    """A latency longer than the period: the computer is busy; the next attempt starts at the
+    update where the held plan flies (5 s, then 8 s), and the period counts from each attempt."""
+    system = _Counter(numbers=numbers, replan_period_s=2.0, latency_s=3.0)
     used = _plans_in_use(system, 13.0)
-    assert system.computed[:3] == [2.0, 6.0, 10.0]
-    assert [used[t] for t in (4, 5, 8, 9)] == [-1.0, 2.0, 2.0, 6.0]
+    assert system.computed[:3] == [2.0, 5.0, 8.0]
+    assert [used[t] for t in (4, 5, 7, 8, 11)] == [-1.0, 2.0, 2.0, 5.0, 8.0]
+
+
+@pytest.mark.parametrize("numbers", [False, True], ids=["object held", "numbers held"])
+def test_a_latency_of_one_period_keeps_the_re_plan_rate(numbers):
+    """Re-plans every update, each computed in one period: every update applies the plan of the
+    update before and starts the next (FNPEG's 1-Hz corrector on a computer that needs 1 s)."""
+    system = _Counter(numbers=numbers, replan_period_s=1.0, latency_s=1.0)
+    used = _plans_in_use(system, 8.0)
+    assert system.computed[:5] == [1.0, 2.0, 3.0, 4.0, 5.0]
+    assert [used[t] for t in (1, 2, 3, 6)] == [-1.0, 1.0, 2.0, 5.0]
 
 
 def test_the_latency_factor_scales_the_measured_computing_time():

@@ -30,7 +30,6 @@ from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance import method_for
 from drake_entry.guidance.interface import GuidanceMethod, GuidanceSummary, PlantPorts
-from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.atmosphere import Atmosphere, DispersedAtmosphere
 from drake_entry.models.dispersions import Draw
 from drake_entry.models.geodesy import range_and_crossrange
@@ -150,13 +149,13 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
 
     ``initial_state`` becomes the vehicle's default state (what SetRandomContext keeps).
     ``draw`` (a Monte-Carlo sample) disperses the plant: entry state, density, aerodynamic
-    scale factors, mass and navigation errors; the guidance keeps the nominal models.
+    scale factors and errors by Mach regime with the trim error, mass and navigation errors; the
+    guidance keeps the nominal models.
     """
     scenario, g = setup.scenario, setup.scenario.guidance
     vehicle, atmosphere = setup.vehicle, setup.atmosphere
     if draw is not None:
-        vehicle = dc.replace(vehicle, mass=vehicle.mass * draw.mass_scale,
-                             aero=ScaledAero(vehicle.aero, draw.lift_scale, draw.drag_scale))
+        vehicle = dc.replace(vehicle, mass=vehicle.mass * draw.mass_scale, aero=draw.aerodynamics(vehicle.aero))
         atmosphere = DispersedAtmosphere(atmosphere, scale=draw.density_scale, amplitude=draw.density_wave_amplitude,
                                          wavelength=draw.density_wave_length, phase=draw.density_wave_phase)
         initial_state = scenario.initial_state() + draw.entry_delta

@@ -1,6 +1,7 @@
 """Example 3: a Monte-Carlo campaign from Python.
 
-Load a packaged scenario, edit its dispersions in code (Drake's schema distributions), save
+Load a packaged scenario, edit its dispersions in code (Drake's schema distributions; the
+aerodynamic errors by Mach regime with a trim error, and an entry delivery covariance), save
 it, run the same campaign on local processes and on a Dask LocalCluster, read the rows back
 with pandas and make a plot of your own. Each sample is a Drake ``RandomSimulation`` seeded
 from (seed, sample index): both backends give the same rows.
@@ -17,6 +18,7 @@ from pydrake.common.yaml import yaml_dump_typed
 from drake_entry.campaign.montecarlo import run_campaign
 from drake_entry.claims import Claims, run_example
 from drake_entry.figures import plt, save_figure
+from drake_entry.models.dispersions import AeroRegimeDispersionSpec
 from drake_entry.scenario import Scenario, load_scenario
 
 
@@ -30,6 +32,17 @@ def main(quick: bool = False, out_dir: str = "out/examples/03") -> pd.DataFrame:
     scenario.name = "horus2b_wider_density"
     scenario.dispersions.density_scale = Gaussian(mean=1.0, stddev=0.10)
     scenario.dispersions.entry.flight_path_deg = Uniform(min=-0.05, max=0.05)
+    #    C_L and C_D errors per Mach regime (subsonic, transonic, supersonic, hypersonic; an
+    #    illustration, not a vehicle's database uncertainty) and a trim error of 0.5 deg (1-sigma)
+    scenario.dispersions.aero_regimes = AeroRegimeDispersionSpec(
+        lift_sigma=[0.05, 0.10, 0.05, 0.03], drag_sigma=[0.05, 0.10, 0.05, 0.03], correlation=[0.0, 0.5, 0.5, 0.5],
+        trim_alpha_sigma_deg=0.5)
+    #    a delivery covariance on top of Table 2's box: altitude 100 m and speed 5 m/s (1-sigma),
+    #    correlated -0.8 (table units: m, deg, deg, m/s, deg, deg)
+    cov = [[0.0] * 6 for _ in range(6)]
+    cov[0][0], cov[3][3], cov[0][3] = 100.0**2, 5.0**2, -0.8 * 100.0 * 5.0
+    cov[3][0] = cov[0][3]
+    scenario.dispersions.entry_covariance = cov
     scenario.validate()  # bad values raise a one-line ScenarioError naming the field
     path = os.path.join(out_dir, "horus2b_wider_density.yaml")
     with open(path, "w") as f:
@@ -80,6 +93,10 @@ def check(df, quick: bool = False) -> Claims:
             f"{int(df['within_limits'].sum())} within the limits")
     c.check("the edited density dispersion was drawn", float(df["disp_density_scale"].std()) > 0.01,
             f"sigma {df['disp_density_scale'].std():.3f}")
+    c.check("every sample drew its own hypersonic C_D error and trim error",
+            bool((df["disp_dCD_hypersonic"] != 0).all() and df["disp_trim_alpha_deg"].nunique() == len(df)),
+            f"C_D hypersonic {df['disp_dCD_hypersonic'].min():+.3f} to {df['disp_dCD_hypersonic'].max():+.3f}, trim "
+            f"{df['disp_trim_alpha_deg'].min():+.2f} to {df['disp_trim_alpha_deg'].max():+.2f} deg")
     return c
 
 

@@ -36,6 +36,7 @@ from drake_entry.campaign.statistics import (
 )
 from drake_entry.campaign.store import coverage, read_nominal, read_trajectories
 from drake_entry.errors import CampaignError, DrakeEntryError
+from drake_entry.models.aerodynamics import AERO_REGIMES
 from drake_entry.models.verdict import BOX_CRITERIA
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario, upgrade_scenario_yaml
@@ -317,7 +318,9 @@ DISPERSION_LABELS = {"disp_dh_m": "entry altitude deviation [m]", "disp_dlon_deg
                      "disp_dpsi_deg": "entry heading deviation [deg]", "disp_density_scale": "density factor",
                      "disp_density_wave": "density wave amplitude", "disp_lift_scale": "lift-coefficient factor",
                      "disp_drag_scale": "drag-coefficient factor", "disp_mass_scale": "mass factor",
-                     **{f"disp_nav_bias_{k}": f"navigation bias, {k}" for k in ("h", "lon", "lat", "V", "gamma", "psi")}}
+                     **{f"disp_nav_bias_{k}": f"navigation bias, {k}" for k in ("h", "lon", "lat", "V", "gamma", "psi")},
+                     **{f"disp_d{c}_{r}": f"{c} error, {r}" for c in ("CL", "CD") for r in AERO_REGIMES},
+                     "disp_trim_alpha_deg": "trim angle-of-attack error [deg]"}
 NAV_NAMES = ("altitude", "longitude", "latitude", "speed", "flight-path angle", "heading")
 
 
@@ -433,6 +436,39 @@ def _distribution_text(d) -> tuple[str, str]:
     return name, str(d)
 
 
+def _regime_rows(a) -> list:
+    """Dispersion-table rows of the aerodynamic errors by Mach regime and the trim error."""
+    if a is None:
+        return []
+    edges = [0.0, *a.mach_boundaries, math.inf]
+    rows = [f"| C_L and C_D relative errors, {r} (Mach {lo:g} to {hi:g}) | 0 | Gaussian, correlation {rho:g} | "
+            f"1σ {sl:g} and {sd:g} | - |"
+            for r, lo, hi, sl, sd, rho in zip(AERO_REGIMES, edges, edges[1:], a.lift_sigma, a.drag_sigma, a.correlation)
+            if sl or sd]
+    if rows:
+        rows.append(f"| regime blend width | — | fixed | {a.blend_mach:g} | Mach |")
+    if a.trim_alpha_sigma_deg:
+        rows.append(f"| trim angle-of-attack error | 0 | Gaussian | 1σ {a.trim_alpha_sigma_deg:g} | deg |")
+    return rows
+
+
+def _covariance_rows(covariance) -> list:
+    """Dispersion-table rows of an entry delivery covariance: each 1-sigma, then the correlations."""
+    if covariance is None:
+        return []
+    c = np.asarray(covariance, float)
+    sd = np.sqrt(np.clip(np.diag(c), 0.0, None))
+    names = ("altitude", "longitude", "latitude", "speed", "flight-path angle", "heading")
+    units = ("m", "deg", "deg", "m/s", "deg", "deg")
+    rows = [f"| entry {n} (delivery covariance) | 0 | Gaussian, correlated | 1σ {s:g} | {u} |"
+            for n, s, u in zip(names, sd, units) if s]
+    pairs = [f"{names[i]}-{names[j]} {c[i, j] / (sd[i] * sd[j]):+.2f}" for i in range(6) for j in range(i + 1, 6)
+             if sd[i] and sd[j] and c[i, j]]
+    if pairs:
+        rows.append(f"| entry delivery correlations | — | — | {'; '.join(pairs)} | - |")
+    return rows
+
+
 def _dispersions(scenario) -> str:
     if scenario is None:
         return ("## Dispersions\n\nThe flown scenario could not be read from the manifest (a campaign of another "
@@ -467,6 +503,7 @@ def _dispersions(scenario) -> str:
         if s:
             lines.append(f"| navigation white noise, {NAV_NAMES[i]} | 0 | Gaussian per step | 1σ {s:g} | "
                          f"{NAV_UNITS[i]} |")
+    lines += _regime_rows(spec.aero_regimes) + _covariance_rows(spec.entry_covariance)
     head = "## Dispersions\n\n"
     source = f"Source: {spec.source}." if spec.source else "Source: not stated in the scenario (`dispersions.source`)."
     if not lines:

@@ -34,7 +34,7 @@ from drake_entry.models.scalar import clamp, is_autodiff, lift, value_of
 __all__ = ["DEG", "CoefficientDerivatives", "AeroDerivatives", "AeroModel", "TableAero", "read_wide_table",
            "packaged_data", "horus2b_table", "HorusFitAero", "horus_cd_form", "horus_cl_form", "FitReport",
            "fit_horus_forms", "CavHAero", "DragPolarAero", "PolynomialAero", "NewtonianLiftingBodyAero",
-           "CallableAero", "ScaledAero"]
+           "CallableAero", "ScaledAero", "AERO_REGIMES", "RegimeAero"]
 
 DEG = np.pi / 180.0
 
@@ -572,3 +572,58 @@ class ScaledAero(AeroModel):
     def drag_derivatives(self, alpha: float, mach: float):
         cd, cl = self.base.drag_derivatives(alpha, mach)
         return CoefficientDerivatives(*(self.drag_scale * v for v in cd)), cl * self.lift_scale
+
+
+#: the Mach regimes of aerodynamic uncertainty, slowest first (RegimeAero)
+AERO_REGIMES = ("subsonic", "transonic", "supersonic", "hypersonic")
+
+
+@dataclass
+class RegimeAero(AeroModel):
+    """A dispersed vehicle's aerodynamics with errors by Mach regime and a trim error:
+    C_L = C_L,base(alpha + trim_alpha, M) (1 + dC_L(M)) and likewise C_D, where dC_L(M) is the
+    relative error of the regime M lies in (AERO_REGIMES, split at ``boundaries``), changing
+    linearly from one regime's to the next over ``blend_mach`` centred on each boundary (so the
+    coefficients stay continuous in Mach). Float, array, AutoDiffXd and symbolic inputs.
+
+    Args: base; lift_errors, drag_errors: one relative error per regime (> -1); boundaries:
+    increasing Mach numbers between the regimes; blend_mach: the width of each blend (> 0, at
+    most the narrowest regime); trim_alpha [rad]: the angle-of-attack error of the trim.
+    """
+
+    base: AeroModel
+    lift_errors: tuple = (0.0, 0.0, 0.0, 0.0)
+    drag_errors: tuple = (0.0, 0.0, 0.0, 0.0)
+    boundaries: tuple = (0.8, 1.2, 5.0)
+    blend_mach: float = 0.2
+    trim_alpha: float = 0.0
+
+    def __post_init__(self):
+        self.trim_alpha, self.blend_mach = float(self.trim_alpha), float(self.blend_mach)
+        self.lift_errors, self.drag_errors = tuple(map(float, self.lift_errors)), tuple(map(float, self.drag_errors))
+        self.boundaries = tuple(map(float, self.boundaries))
+        n = len(self.boundaries) + 1
+        if len(self.lift_errors) != n or len(self.drag_errors) != n:
+            raise ScenarioError(f"RegimeAero needs one lift and one drag error per regime ({n}), got "
+                                f"{len(self.lift_errors)} and {len(self.drag_errors)}")
+        if not all(math.isfinite(e) and e > -1.0 for e in (*self.lift_errors, *self.drag_errors)):
+            raise ScenarioError(f"RegimeAero errors must be finite and > -1 (a coefficient stays positive), got "
+                                f"{self.lift_errors}, {self.drag_errors}")
+        gaps = np.diff((0.0, *self.boundaries))
+        if not (np.all(gaps > 0) and 0 < self.blend_mach <= gaps.min() and math.isfinite(self.trim_alpha)):
+            raise ScenarioError(f"RegimeAero needs increasing positive boundaries {self.boundaries}, a blend width "
+                                f"0 < {self.blend_mach} <= the narrowest regime, and a finite trim error")
+
+    def factors(self, mach):
+        """(1 + dC_L, 1 + dC_D) at Mach ``mach`` (the regimes' errors blended at the boundaries)."""
+        kl, kd = 1.0 + self.lift_errors[0], 1.0 + self.drag_errors[0]
+        for i, b in enumerate(self.boundaries):
+            w = clamp((mach - (b - 0.5 * self.blend_mach)) / self.blend_mach, 0.0, 1.0)
+            kl = kl + w * (self.lift_errors[i + 1] - self.lift_errors[i])
+            kd = kd + w * (self.drag_errors[i + 1] - self.drag_errors[i])
+        return kl, kd
+
+    def coefficients(self, alpha, mach):
+        cl, cd = self.base.coefficients(alpha + self.trim_alpha, mach)
+        kl, kd = self.factors(mach)
+        return cl * kl, cd * kd

@@ -28,9 +28,11 @@ import numpy as np
 import pydrake.common.schema as schema
 
 from drake_entry.errors import ScenarioError
+from drake_entry.models.aerodynamics import AERO_REGIMES
 from drake_entry.models.atmosphere import DENSITY_WAVE_AMPLITUDE_BOUND
 
-__all__ = ["Scalar", "Vector", "EntryDispersionSpec", "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate"]
+__all__ = ["Scalar", "Vector", "EntryDispersionSpec", "AeroRegimeDispersionSpec", "ENTRY_TABLE_TO_SI", "MAX_AERO_SIGMA",
+           "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate"]
 
 Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
 Vector = typing.Union[schema.DeterministicVectorX, schema.GaussianVectorX, schema.UniformVectorX]
@@ -46,6 +48,25 @@ class EntryDispersionSpec:
     velocity_m_s: Scalar = 0.0
     flight_path_deg: Scalar = 0.0
     heading_deg: Scalar = 0.0
+
+
+@dc.dataclass
+class AeroRegimeDispersionSpec:
+    """Aerodynamic uncertainty by Mach regime (models.aerodynamics.RegimeAero): per regime a
+    relative C_L and C_D error, drawn jointly Gaussian with their correlation, blended across the
+    regime boundaries; and a trim angle-of-attack error."""
+
+    # Mach numbers between the regimes subsonic | transonic | supersonic | hypersonic
+    mach_boundaries: list[float] = dc.field(default_factory=lambda: [0.8, 1.2, 5.0])
+    # the errors change linearly from one regime's to the next over this Mach width at each boundary
+    blend_mach: float = 0.2
+    # 1-sigma of the relative C_L and C_D errors per regime (subsonic, transonic, supersonic,
+    # hypersonic) and the correlation of the two within a regime
+    lift_sigma: list[float] = dc.field(default_factory=lambda: [0.0, 0.0, 0.0, 0.0])
+    drag_sigma: list[float] = dc.field(default_factory=lambda: [0.0, 0.0, 0.0, 0.0])
+    correlation: list[float] = dc.field(default_factory=lambda: [0.0, 0.0, 0.0, 0.0])
+    # 1-sigma of the trim angle-of-attack error [deg] (Gaussian, mean 0)
+    trim_alpha_sigma_deg: float = 0.0
 
 
 @dc.dataclass
@@ -67,6 +88,12 @@ class DispersionSpec:
     # navigation: constant bias [state units, SI / rad] and white-noise sigma
     nav_bias: Vector = dc.field(default_factory=lambda: schema.DeterministicVectorX(value=[0.0] * 6))
     nav_noise_sigma: list[float] = dc.field(default_factory=lambda: [0.0] * 6)
+    # aerodynamic errors by Mach regime and a trim error (none when absent)
+    aero_regimes: typing.Optional[AeroRegimeDispersionSpec] = None
+    # entry delivery covariance: a zero-mean Gaussian deviation of [altitude m, longitude deg,
+    # latitude deg, speed m/s, flight-path deg, heading deg] with this 6 x 6 covariance (symmetric,
+    # positive semi-definite), added to the ``entry`` deviations (none when absent)
+    entry_covariance: typing.Optional[list[list[float]]] = None
 
     @staticmethod
     def paper000_table2() -> "DispersionSpec":
@@ -90,6 +117,13 @@ class Draw:
     nav_bias: np.ndarray = dc.field(default_factory=lambda: np.zeros(6))
     nav_noise_sigma: np.ndarray = dc.field(default_factory=lambda: np.zeros(6))
     nav_seed: int = 0
+    #: aerodynamic errors by Mach regime (relative, per regime of AERO_REGIMES), the boundaries
+    #: and blend width of the regimes, and the trim error [rad] (empty: none)
+    aero_lift_errors: tuple = ()
+    aero_drag_errors: tuple = ()
+    aero_boundaries: tuple = ()
+    aero_blend_mach: float = 0.2
+    trim_alpha: float = 0.0
 
     def columns(self) -> dict:
         """Flat record for result tables (entry deviations in table units)."""
@@ -101,7 +135,22 @@ class Draw:
                "disp_mass_scale": self.mass_scale}
         for k, v in zip(("h", "lon", "lat", "V", "gamma", "psi"), self.nav_bias):
             out[f"disp_nav_bias_{k}"] = v
+        if self.aero_lift_errors:
+            for regime, dl, dd in zip(AERO_REGIMES, self.aero_lift_errors, self.aero_drag_errors):
+                out[f"disp_dCL_{regime}"], out[f"disp_dCD_{regime}"] = dl, dd
+            out["disp_trim_alpha_deg"] = math.degrees(self.trim_alpha)
         return {k: float(v) for k, v in out.items()}
+
+    def aerodynamics(self, base):
+        """The sample's true aerodynamics over the nominal ``base``: the scale factors, then the
+        errors by Mach regime and the trim error when drawn."""
+        from drake_entry.models.aerodynamics import RegimeAero, ScaledAero
+
+        aero = ScaledAero(base, self.lift_scale, self.drag_scale)
+        if not self.aero_lift_errors:
+            return aero
+        return RegimeAero(aero, tuple(self.aero_lift_errors), tuple(self.aero_drag_errors), tuple(self.aero_boundaries),
+                          self.aero_blend_mach, self.trim_alpha)
 
 
 def _sample(x, generator) -> float:
@@ -122,9 +171,43 @@ def draw(spec: DispersionSpec, generator) -> Draw:
     for k in ("density_scale", "lift_scale", "drag_scale", "mass_scale"):
         if not scales[k] > 0:
             raise ScenarioError(f"dispersions.{k} drew {scales[k]:g}; it must stay > 0 (narrow its distribution)")
+    aero = {}
+    if spec.aero_regimes is not None:  # drawn after the rest, so a scenario without it draws as before
+        a = spec.aero_regimes
+        lift, drag = [], []
+        for sl, sd, rho in zip(a.lift_sigma, a.drag_sigma, a.correlation):
+            z1, z2 = _normal(generator), _normal(generator)
+            lift.append(sl * z1)
+            drag.append(sd * (rho * z1 + math.sqrt(max(0.0, 1.0 - rho * rho)) * z2))
+        aero = {"aero_lift_errors": tuple(lift), "aero_drag_errors": tuple(drag),
+                "aero_boundaries": tuple(a.mach_boundaries), "aero_blend_mach": float(a.blend_mach),
+                "trim_alpha": math.radians(a.trim_alpha_sigma_deg * _normal(generator))}
+        too_low = [e for e in (*lift, *drag) if not e > -1.0]
+        if too_low:
+            raise ScenarioError(f"dispersions.aero_regimes drew a relative error of {too_low[0]:g}; a coefficient must "
+                                f"stay positive (narrow lift_sigma / drag_sigma)")
+    if spec.entry_covariance is not None:  # after the rest, for the same reason
+        delivered = _covariance_root(spec.entry_covariance) @ np.array([_normal(generator) for _ in range(6)])
+        delta = delta + delivered * ENTRY_TABLE_TO_SI
     return Draw(delta, scales["density_scale"], scales["density_wave_amplitude"],
                 spec.density_wave_length_km * 1e3, phase, scales["lift_scale"], scales["drag_scale"],
-                scales["mass_scale"], bias, np.asarray(spec.nav_noise_sigma, float), nav_seed)
+                scales["mass_scale"], bias, np.asarray(spec.nav_noise_sigma, float), nav_seed, **aero)
+
+
+#: the entry deviations' table units [m, deg, deg, m/s, deg, deg] to SI [m, rad, rad, m/s, rad, rad]
+ENTRY_TABLE_TO_SI = np.array([1.0, math.pi / 180, math.pi / 180, 1.0, math.pi / 180, math.pi / 180])
+
+
+def _normal(generator) -> float:
+    """One standard normal draw from the sample's generator."""
+    return float(schema.Gaussian(mean=0.0, stddev=1.0).Sample(generator))
+
+
+def _covariance_root(covariance) -> np.ndarray:
+    """L with L L^T = covariance (symmetric positive semi-definite; eigen-decomposition, so a
+    singular covariance, e.g. one correlated pair, is fine)."""
+    values, vectors = np.linalg.eigh(np.asarray(covariance, float))
+    return vectors * np.sqrt(np.clip(values, 0.0, None))
 
 
 def _check_distribution(where: str, d) -> None:
@@ -197,3 +280,54 @@ def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
         raise ScenarioError(f"{where}.nav_noise_sigma needs 6 entries >= 0")
     if not spec.density_wave_length_km > 0:
         raise ScenarioError(f"{where}.density_wave_length_km must be > 0, got {spec.density_wave_length_km}")
+    if spec.aero_regimes is not None:
+        _validate_aero_regimes(spec.aero_regimes, f"{where}.aero_regimes")
+    if spec.entry_covariance is not None:
+        _validate_covariance(spec.entry_covariance, f"{where}.entry_covariance")
+
+
+#: a relative aerodynamic error's 1-sigma is below this, so the coefficient stays positive to 5 sigma
+MAX_AERO_SIGMA = 1.0 / GAUSSIAN_REACH
+
+
+def _validate_aero_regimes(a: AeroRegimeDispersionSpec, where: str) -> None:
+    n = len(AERO_REGIMES)
+    if len(a.mach_boundaries) != n - 1:
+        raise ScenarioError(f"{where}.mach_boundaries needs {n - 1} Mach numbers (between {', '.join(AERO_REGIMES)}), "
+                            f"got {len(a.mach_boundaries)}")
+    gaps = np.diff([0.0, *a.mach_boundaries])
+    if not all(math.isfinite(b) for b in a.mach_boundaries) or not np.all(gaps > 0):
+        raise ScenarioError(f"{where}.mach_boundaries = {a.mach_boundaries} must be finite, positive and increasing")
+    if not (math.isfinite(a.blend_mach) and 0 < a.blend_mach <= gaps.min()):
+        raise ScenarioError(f"{where}.blend_mach = {a.blend_mach} is out of range; allowed: > 0 and at most the "
+                            f"narrowest regime ({gaps.min():g})")
+    for name in ("lift_sigma", "drag_sigma", "correlation"):
+        values = getattr(a, name)
+        if len(values) != n:
+            raise ScenarioError(f"{where}.{name} needs {n} values (one per regime: {', '.join(AERO_REGIMES)}), "
+                                f"got {len(values)}")
+        lo, hi = (-1.0, 1.0) if name == "correlation" else (0.0, MAX_AERO_SIGMA)
+        for i, v in enumerate(values):
+            if not (math.isfinite(v) and lo <= v <= hi) or (name != "correlation" and v >= hi):
+                allowed = "[-1, 1]" if name == "correlation" else f"[0, {hi:g}) (a coefficient stays positive to " \
+                                                                    f"{GAUSSIAN_REACH:g} sigma)"
+                raise ScenarioError(f"{where}.{name}[{i}] ({AERO_REGIMES[i]}) = {v} is out of range; allowed: {allowed}")
+    if not (math.isfinite(a.trim_alpha_sigma_deg) and 0 <= a.trim_alpha_sigma_deg <= 10):
+        raise ScenarioError(f"{where}.trim_alpha_sigma_deg = {a.trim_alpha_sigma_deg} is out of range; allowed: "
+                            f"[0, 10] deg")
+
+
+def _validate_covariance(c, where: str) -> None:
+    m = np.asarray(c, float) if all(len(row) == 6 for row in c) and len(c) == 6 else None
+    if m is None:
+        raise ScenarioError(f"{where} needs 6 rows of 6 values [altitude m, longitude deg, latitude deg, speed m/s, "
+                            f"flight-path deg, heading deg]")
+    if not np.all(np.isfinite(m)):
+        raise ScenarioError(f"{where} has a value that is not finite")
+    if not np.allclose(m, m.T, rtol=1e-9, atol=0.0):
+        i, j = np.unravel_index(np.argmax(np.abs(m - m.T)), m.shape)
+        raise ScenarioError(f"{where} is not symmetric: [{i}][{j}] = {m[i, j]:g} but [{j}][{i}] = {m[j, i]:g}")
+    lowest = float(np.linalg.eigvalsh(m).min())
+    if lowest < -1e-9 * max(1.0, float(np.abs(m).max())):
+        raise ScenarioError(f"{where} is not positive semi-definite (its smallest eigenvalue is {lowest:g}); a "
+                            f"covariance needs variances >= 0 and correlations in [-1, 1]")

@@ -30,7 +30,7 @@ from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance import method_for
 from drake_entry.guidance.interface import GuidanceMethod, GuidanceSummary, PlantPorts
-from drake_entry.models.atmosphere import Atmosphere, DispersedAtmosphere
+from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.dispersions import Draw
 from drake_entry.models.geodesy import range_and_crossrange
 from drake_entry.models.planet import Earth
@@ -156,8 +156,7 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
     vehicle, atmosphere = setup.vehicle, setup.atmosphere
     if draw is not None:
         vehicle = dc.replace(vehicle, mass=vehicle.mass * draw.mass_scale, aero=draw.aerodynamics(vehicle.aero))
-        atmosphere = DispersedAtmosphere(atmosphere, scale=draw.density_scale, amplitude=draw.density_wave_amplitude,
-                                         wavelength=draw.density_wave_length, phase=draw.density_wave_phase)
+        atmosphere = draw.atmosphere(atmosphere)
         initial_state = scenario.initial_state() + draw.entry_delta
         nav_bias, nav_noise, nav_seed = draw.nav_bias, draw.nav_noise_sigma, draw.nav_seed
     builder = DiagramBuilder()

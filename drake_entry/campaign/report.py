@@ -37,6 +37,7 @@ from drake_entry.campaign.statistics import (
 from drake_entry.campaign.store import coverage, read_nominal, read_trajectories
 from drake_entry.errors import CampaignError, DrakeEntryError
 from drake_entry.models.aerodynamics import AERO_REGIMES
+from drake_entry.models.dispersions import PERTURBATION_COLUMNS_KM
 from drake_entry.models.verdict import BOX_CRITERIA
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario, upgrade_scenario_yaml
@@ -320,7 +321,9 @@ DISPERSION_LABELS = {"disp_dh_m": "entry altitude deviation [m]", "disp_dlon_deg
                      "disp_drag_scale": "drag-coefficient factor", "disp_mass_scale": "mass factor",
                      **{f"disp_nav_bias_{k}": f"navigation bias, {k}" for k in ("h", "lon", "lat", "V", "gamma", "psi")},
                      **{f"disp_d{c}_{r}": f"{c} error, {r}" for c in ("CL", "CD") for r in AERO_REGIMES},
-                     "disp_trim_alpha_deg": "trim angle-of-attack error [deg]"}
+                     "disp_trim_alpha_deg": "trim angle-of-attack error [deg]",
+                     **{f"disp_d{q}_{km}km": f"{name} perturbation at {km} km" for km in PERTURBATION_COLUMNS_KM
+                        for q, name in (("rho", "density"), ("T", "temperature"))}}
 NAV_NAMES = ("altitude", "longitude", "latitude", "speed", "flight-path angle", "heading")
 
 
@@ -452,6 +455,18 @@ def _regime_rows(a) -> list:
     return rows
 
 
+def _perturbation_rows(p) -> list:
+    """Dispersion-table rows of the density and temperature perturbation profiles."""
+    if p is None:
+        return []
+    profile = lambda sigma: ", ".join(f"{s:g} at {h:g} km" for h, s in zip(p.altitude_km, sigma))  # noqa: E731
+    return [f"| density perturbation along the flight | 0 | per-flight part {100 * p.large_scale_fraction:g} % of the "
+            f"variance, the rest correlated over {p.vertical_scale_km:g} km of altitude | 1σ {profile(p.density_sigma)} "
+            f"| fraction |",
+            f"| temperature perturbation along the flight | 0 | the same process, correlation with density "
+            f"{p.density_temperature_correlation:g} | 1σ {profile(p.temperature_sigma)} | fraction |"]
+
+
 def _covariance_rows(covariance) -> list:
     """Dispersion-table rows of an entry delivery covariance: each 1-sigma, then the correlations."""
     if covariance is None:
@@ -503,7 +518,8 @@ def _dispersions(scenario) -> str:
         if s:
             lines.append(f"| navigation white noise, {NAV_NAMES[i]} | 0 | Gaussian per step | 1σ {s:g} | "
                          f"{NAV_UNITS[i]} |")
-    lines += _regime_rows(spec.aero_regimes) + _covariance_rows(spec.entry_covariance)
+    lines += (_regime_rows(spec.aero_regimes) + _covariance_rows(spec.entry_covariance)
+              + _perturbation_rows(spec.atmosphere_perturbations))
     head = "## Dispersions\n\n"
     source = f"Source: {spec.source}." if spec.source else "Source: not stated in the scenario (`dispersions.source`)."
     if not lines:

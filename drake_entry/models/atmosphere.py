@@ -28,7 +28,7 @@ from importlib import resources
 from typing import NamedTuple
 
 import numpy as np
-from pydrake.symbolic import if_then_else
+from pydrake.symbolic import Expression, if_then_else
 from scipy.interpolate import CubicSpline
 
 from drake_entry.errors import ModelRangeError, ScenarioError, UnsupportedScalarError
@@ -38,7 +38,7 @@ from drake_entry.models.scalar import clamp, is_autodiff, is_symbolic, lift, pro
 __all__ = ["G0_US76", "R_STAR", "M0_AIR", "R_AIR", "R0_GEOPOTENTIAL", "GAMMA_AIR", "P0_SEA_LEVEL", "US76_H_MIN",
            "US76_H_MAX", "US76_LOWER_TOP", "AtmosphereProperties", "Derivatives", "piecewise", "Atmosphere",
            "US76Atmosphere", "ExponentialAtmosphere", "TableAtmosphere", "DENSITY_WAVE_AMPLITUDE_BOUND",
-           "DispersedAtmosphere", "make_atmosphere", "write_upper_table"]
+           "DispersedAtmosphere", "make_atmosphere", "write_upper_table", "PerturbedAtmosphere"]
 
 # U.S. Standard Atmosphere 1976 constants (NASA-TM-X-74335).
 G0_US76 = 9.80665  # m/s^2
@@ -606,6 +606,77 @@ class DispersedAtmosphere(Atmosphere):
         if np.ndim(h) == 0:
             f, f1, f2 = float(f), float(f1), float(f2)
         return Derivatives(d.value * f, d.d_h * f + d.value * f1, d.d_hh * f + 2 * d.d_h * f1 + d.value * f2), t
+
+
+class PerturbedAtmosphere(Atmosphere):
+    """A Monte-Carlo sample's atmosphere with its density and temperature perturbation profiles:
+    rho = rho_base(h) (1 + d_rho(h)), T = T_base(h) (1 + d_T(h)) (so the speed of sound and the
+    Mach number change with T), d_rho and d_T linear between the nodes of ``altitude_m`` and held
+    beyond its ends (models.atmosphere_perturbations draws them). Float, ndarray, AutoDiffXd and
+    symbolic altitude (the native plant flies it).
+
+    Args: base atmosphere; altitude_m (increasing nodes [m]); density_perturbation and
+    temperature_perturbation (fractions at the nodes, each > -1).
+    """
+
+    def __init__(self, base: Atmosphere, altitude_m, density_perturbation, temperature_perturbation):
+        h, dr, dt = (np.asarray(v, float) for v in (altitude_m, density_perturbation, temperature_perturbation))
+        if not (h.ndim == 1 and h.size >= 2 and dr.shape == h.shape and dt.shape == h.shape
+                and np.all(np.diff(h) > 0) and np.all(np.isfinite(dr)) and np.all(np.isfinite(dt))
+                and np.all(dr > -1.0) and np.all(dt > -1.0)):
+            raise ScenarioError("PerturbedAtmosphere needs increasing altitude nodes and finite perturbations > -1 at "
+                                "each of them")
+        self.base, self.nodes, self.d_rho, self.d_T = base, h, dr, dt
+        self.name = f"perturbed {base.name}"
+        self.h_min, self.h_max = base.h_min, base.h_max
+        self.gas_constant, self.gamma = base.gas_constant, base.gamma
+
+    def factors(self, h):
+        """((1 + d_rho, slope), (1 + d_T, slope)) at altitude h [m] (float or ndarray; slopes per m,
+        zero beyond the nodes)."""
+        hv = np.asarray(h, float)
+        k = np.clip(np.searchsorted(self.nodes, hv, side="right") - 1, 0, self.nodes.size - 2)
+        inside = (hv >= self.nodes[0]) & (hv <= self.nodes[-1])
+        width = self.nodes[k + 1] - self.nodes[k]
+        out = []
+        for d in (self.d_rho, self.d_T):
+            slope = (d[k + 1] - d[k]) / width
+            out.append((1.0 + np.interp(hv, self.nodes, d), np.where(inside, slope, 0.0)))
+        if np.ndim(h) == 0:
+            out = [(float(f), float(s)) for f, s in out]
+        return out
+
+    def _air_data_float(self, h: float) -> tuple[float, float]:
+        rho, a = self.base.air_data(h)
+        (fr, _), (ft, _) = self.factors(h)
+        return rho * fr, a * math.sqrt(ft)
+
+    def _symbolic_profile(self, h):
+        rho, T = self.base.symbolic_profile(h)
+        nodes = self.nodes
+
+        def linear(d):
+            def piece(i):
+                s = (d[i + 1] - d[i]) / (nodes[i + 1] - nodes[i])
+                return 1.0 + d[i] + s * (h - nodes[i])
+            inner = piecewise(h, list(nodes), piece)
+            return if_then_else(h < nodes[0], Expression(1.0 + d[0]), if_then_else(h > nodes[-1], Expression(
+                1.0 + d[-1]), inner))
+
+        return rho * linear(self.d_rho), T * linear(self.d_T)
+
+    def density_derivatives(self, h) -> Derivatives:
+        return self.derivatives(h)[0]
+
+    def temperature_derivatives(self, h) -> Derivatives:
+        return self.derivatives(h)[1]
+
+    def derivatives(self, h):
+        """Product rule on base x factor (the factor piecewise linear: no second derivative)."""
+        d, t = self.base.derivatives(h)
+        (fr, sr), (ft, st) = self.factors(value_of(h))
+        return (Derivatives(d.value * fr, d.d_h * fr + d.value * sr, d.d_hh * fr + 2 * d.d_h * sr),
+                Derivatives(t.value * ft, t.d_h * ft + t.value * st, t.d_hh * ft + 2 * t.d_h * st))
 
 
 def make_atmosphere(name: str, **kwargs) -> Atmosphere:

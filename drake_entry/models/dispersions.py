@@ -30,8 +30,14 @@ import pydrake.common.schema as schema
 from drake_entry.errors import ScenarioError
 from drake_entry.models.aerodynamics import AERO_REGIMES
 from drake_entry.models.atmosphere import DENSITY_WAVE_AMPLITUDE_BOUND
+from drake_entry.models.atmosphere_perturbations import (
+    AtmospherePerturbationSpec,
+    draw_profiles,
+    validate_perturbations,
+)
 
 __all__ = ["Scalar", "Vector", "EntryDispersionSpec", "AeroRegimeDispersionSpec", "ENTRY_TABLE_TO_SI", "MAX_AERO_SIGMA",
+           "PERTURBATION_COLUMNS_KM", "AtmospherePerturbationSpec",
            "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate"]
 
 Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
@@ -94,6 +100,10 @@ class DispersionSpec:
     # latitude deg, speed m/s, flight-path deg, heading deg] with this 6 x 6 covariance (symmetric,
     # positive semi-definite), added to the ``entry`` deviations (none when absent)
     entry_covariance: typing.Optional[list[list[float]]] = None
+    # density and temperature perturbations along the flight: a per-flight part and a part
+    # correlated over a vertical scale length, 1-sigma by altitude (models.atmosphere_perturbations;
+    # none when absent)
+    atmosphere_perturbations: typing.Optional[AtmospherePerturbationSpec] = None
 
     @staticmethod
     def paper000_table2() -> "DispersionSpec":
@@ -124,6 +134,11 @@ class Draw:
     aero_boundaries: tuple = ()
     aero_blend_mach: float = 0.2
     trim_alpha: float = 0.0
+    #: the atmosphere perturbation profile: altitude nodes [m] and the density and temperature
+    #: perturbations (fractions) there (empty: none)
+    perturbation_altitude_m: tuple = ()
+    density_perturbation: tuple = ()
+    temperature_perturbation: tuple = ()
 
     def columns(self) -> dict:
         """Flat record for result tables (entry deviations in table units)."""
@@ -139,7 +154,24 @@ class Draw:
             for regime, dl, dd in zip(AERO_REGIMES, self.aero_lift_errors, self.aero_drag_errors):
                 out[f"disp_dCL_{regime}"], out[f"disp_dCD_{regime}"] = dl, dd
             out["disp_trim_alpha_deg"] = math.degrees(self.trim_alpha)
+        if self.perturbation_altitude_m:
+            for km in PERTURBATION_COLUMNS_KM:
+                out[f"disp_drho_{km}km"] = np.interp(km * 1e3, self.perturbation_altitude_m, self.density_perturbation)
+                out[f"disp_dT_{km}km"] = np.interp(km * 1e3, self.perturbation_altitude_m,
+                                                   self.temperature_perturbation)
         return {k: float(v) for k, v in out.items()}
+
+    def atmosphere(self, base):
+        """The sample's true atmosphere over the nominal ``base``: the density factor and wave,
+        then the perturbation profiles when drawn."""
+        from drake_entry.models.atmosphere import DispersedAtmosphere, PerturbedAtmosphere
+
+        air = DispersedAtmosphere(base, scale=self.density_scale, amplitude=self.density_wave_amplitude,
+                                  wavelength=self.density_wave_length, phase=self.density_wave_phase)
+        if not self.perturbation_altitude_m:
+            return air
+        return PerturbedAtmosphere(air, self.perturbation_altitude_m, self.density_perturbation,
+                                   self.temperature_perturbation)
 
     def aerodynamics(self, base):
         """The sample's true aerodynamics over the nominal ``base``: the scale factors, then the
@@ -189,10 +221,21 @@ def draw(spec: DispersionSpec, generator) -> Draw:
     if spec.entry_covariance is not None:  # after the rest, for the same reason
         delivered = _covariance_root(spec.entry_covariance) @ np.array([_normal(generator) for _ in range(6)])
         delta = delta + delivered * ENTRY_TABLE_TO_SI
+    profile = {}
+    if spec.atmosphere_perturbations is not None:  # after the rest, for the same reason
+        h, d_rho, d_T = draw_profiles(spec.atmosphere_perturbations, generator)
+        profile = {"perturbation_altitude_m": tuple(h), "density_perturbation": tuple(d_rho),
+                   "temperature_perturbation": tuple(d_T)}
+        if not (d_rho.min() > -1.0 and d_T.min() > -1.0):
+            raise ScenarioError("dispersions.atmosphere_perturbations drew a perturbation of -100 % or less; narrow "
+                                "density_sigma / temperature_sigma")
     return Draw(delta, scales["density_scale"], scales["density_wave_amplitude"],
                 spec.density_wave_length_km * 1e3, phase, scales["lift_scale"], scales["drag_scale"],
-                scales["mass_scale"], bias, np.asarray(spec.nav_noise_sigma, float), nav_seed, **aero)
+                scales["mass_scale"], bias, np.asarray(spec.nav_noise_sigma, float), nav_seed, **aero, **profile)
 
+
+#: altitudes [km] at which a row records the drawn density and temperature perturbations
+PERTURBATION_COLUMNS_KM = (30, 50, 70)
 
 #: the entry deviations' table units [m, deg, deg, m/s, deg, deg] to SI [m, rad, rad, m/s, rad, rad]
 ENTRY_TABLE_TO_SI = np.array([1.0, math.pi / 180, math.pi / 180, 1.0, math.pi / 180, math.pi / 180])
@@ -284,6 +327,8 @@ def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
         _validate_aero_regimes(spec.aero_regimes, f"{where}.aero_regimes")
     if spec.entry_covariance is not None:
         _validate_covariance(spec.entry_covariance, f"{where}.entry_covariance")
+    if spec.atmosphere_perturbations is not None:
+        validate_perturbations(spec.atmosphere_perturbations, f"{where}.atmosphere_perturbations")
 
 
 #: a relative aerodynamic error's 1-sigma is below this, so the coefficient stays positive to 5 sigma

@@ -88,6 +88,7 @@ def test_example_03(tmp_path):
     assert len(df) == 4 and df["stop"].eq("reached energy").all()
     assert df["disp_density_scale"].std() > 0.01  # the edited dispersion was drawn
     assert df["disp_dCL_transonic"].std() > 0 and df["disp_trim_alpha_deg"].std() > 0  # regime and trim errors
+    assert df["disp_drho_50km"].std() > 0  # the perturbation profiles
     assert (tmp_path / "range_vs_density.png").exists() and (tmp_path / "dask" / "samples.parquet").exists()
 
 

@@ -317,6 +317,14 @@ def test_example_19(tmp_path):
     assert os.path.exists(tmp_path / "computing_latency.png")
 
 
+def test_example_20(tmp_path):
+    """NRLMSIS at HORUS-2B's entry point: both nominal flights succeed, the density ratio stays
+    within 35 % of US76 below 90 km, and the source names the model, place, date and indices."""
+    r = _run("20_nrlmsis_atmosphere", tmp_path)
+    assert all(f.success for f in r["flights"].values())
+    assert "F10.7 150" in r["source"] and os.path.exists(tmp_path / "nrlmsis_atmosphere.png")
+
+
 def test_the_examples_command_line_passes_quick_out_and_options_and_exits_by_the_claims(tmp_path, capsys):
     """run_example: --quick, --out and an example's own options reach main; the exit status is
     the claims' (1 when one fails)."""

@@ -69,7 +69,7 @@ def test_field_descriptions_come_from_the_comments_beside_the_fields():
     from drake_entry.schema_doc import field_comments
 
     assert field_comments(SimulationSpec)["max_time_s"] == "hard stop [s] if no terminal condition triggers"
-    assert field_comments(AtmosphereSpec)["model"] == "us76 | exponential | table"
+    assert field_comments(AtmosphereSpec)["model"] == "us76 | exponential | table | nrlmsis"
     assert "eq. 17" in field_comments(SwarmBank)["bank_start_deg"]
 
 

@@ -94,13 +94,15 @@ def trajectory_plots(tr, out_dir: str, *, limits=None, target=None, title: str =
     return paths
 
 
-def save_figure(fig, out_dir, name, paths=None, title="", rect=None) -> str:
-    """Save fig as out_dir/name (PNG; the directory made), titled ``title`` when given, laid out
-    tight (inside ``rect`` when given), closed; append the path to ``paths`` when given and
-    return it."""
+def save_figure(fig, out_dir, name, paths=None, title="", caption="") -> str:
+    """Save fig as out_dir/name (PNG; the directory made), titled ``title`` and captioned
+    ``caption`` (what to look at, in a band along the bottom) when given, laid out tight, closed;
+    append the path to ``paths`` when given and return it."""
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.tight_layout(rect=rect)
+    if caption:
+        fig.text(0.01, 0.01, caption, fontsize=8)
+    fig.tight_layout(rect=(0, 0.04, 1, 1) if caption else None)
     os.makedirs(out_dir, exist_ok=True)
     p = os.path.join(out_dir, name)
     fig.savefig(p, dpi=110)

@@ -82,9 +82,9 @@ def main(quick: bool = False, out_dir: str = "out/examples/13") -> dict:
     ax2.plot(py.time[:n], py.state[:n, 0] - nat.state[:n, 0])
     ax2.set(xlabel="time [s]", ylabel="altitude, Python - native [m]",
             title="difference (rounding, amplified by the guidance)")
-    fig.text(0.01, 0.01, "Look at: the curves coincide; the difference stays below the integrator's own error "
-                         "(RK3 at 0.5 s against RK5 at 1e-10: 2.7 m rms in range, 22 m in cross-range).", fontsize=8)
-    path = save_figure(fig, out_dir, "native_plant.png", rect=(0, 0.04, 1, 1))
+    path = save_figure(fig, out_dir, "native_plant.png",
+                       caption="Look at: the curves coincide; the difference stays below the integrator's own error "
+                               "(RK3 at 0.5 s against RK5 at 1e-10: 2.7 m rms in range, 22 m in cross-range).")
     print(f"wrote {path}")
     return {"worst_relative": worst, "end_gap_m": end_gap, "sensitivity_m": sensitivity,
             "altitude_gap_m": float(abs(py.state[-1, 0] - nat.state[-1, 0])),

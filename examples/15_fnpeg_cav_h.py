@@ -100,9 +100,9 @@ def main(quick: bool = False, out_dir: str = "out/examples/15") -> dict:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle("FNPEG on Lu (2014)'s CAV-H orbital case" + (" (first 900 s, corrections every 5 s)" if quick else ""))
-    fig.text(0.01, 0.01, "Look at: without damping the glide oscillates (phugoid) and the first pull-out peaks higher"
-             + ("." if quick else "; the constrained flight stays under its red limits."), fontsize=8)
-    path = save_figure(fig, out_dir, "fnpeg_cav_h.png", rect=(0, 0.04, 1, 0.95))
+    path = save_figure(fig, out_dir, "fnpeg_cav_h.png",
+                       caption="Look at: without damping the glide oscillates (phugoid) and the first pull-out peaks "
+                               "higher" + ("." if quick else "; the constrained flight stays under its red limits."))
     print(f"wrote {path}")
     return {"rows": rows, "peaks": peaks, "success": {k: f.success for k, f in flights.items()}, "plot": path}
 

@@ -45,10 +45,10 @@ def main(quick: bool = False, out_dir: str = "out/examples/19") -> dict:
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    fig.text(0.01, 0.01, "Look at: engagement and every re-planned profile arrive one latency later; the "
-                         "plan in use flies on meanwhile.", fontsize=8)
-    path = save_figure(fig, out_dir, "computing_latency.png", rect=(0, 0.04, 1, 1),
-                       title="HORUS-2B nominal, drag-energy guidance re-planned every 20 s: computing latency")
+    path = save_figure(fig, out_dir, "computing_latency.png",
+                       title="HORUS-2B nominal, drag-energy guidance re-planned every 20 s: computing latency",
+                       caption="Look at: engagement and every re-planned profile arrive one latency later; the plan "
+                               "in use flies on meanwhile.")
     return {"flights": flights, "plot": path}
 
 

@@ -46,10 +46,10 @@ def main(quick: bool = False, out_dir: str = "out/examples/20") -> dict:
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    fig.text(0.01, 0.01, "Look at: where NRLMSIS departs from US76 for this place and season, and that the guidance "
-                         "flies either nominal atmosphere to its target.", fontsize=8)
-    path = save_figure(fig, out_dir, "nrlmsis_atmosphere.png", rect=(0, 0.04, 1, 1),
-                       title="An empirical nominal atmosphere (NRLMSIS 2.1 through pymsis) beside US76")
+    path = save_figure(fig, out_dir, "nrlmsis_atmosphere.png",
+                       title="An empirical nominal atmosphere (NRLMSIS 2.1 through pymsis) beside US76",
+                       caption="Look at: where NRLMSIS departs from US76 for this place and season, and that the "
+                               "guidance flies either nominal atmosphere to its target.")
     return {"flights": flights, "ratio_density": ratio_rho, "altitude_m": h, "source": a_msis.source, "plot": path}
 
 

@@ -151,10 +151,6 @@ class ReplanScheduler(LeafSystem):
         """A computed plan is held for its latency."""
         return self._schedule_of(context)[_HELD_UNTIL] < math.inf
 
-    def next_due(self, context) -> float:
-        """When the next re-plan is due [s] (inf: none)."""
-        return float(self._schedule_of(context)[_NEXT])
-
     def due_now(self, values, t: float) -> None:
         """Make a re-plan due at flight time ``t`` [s] (a method that engages plans at once)."""
         self._mutable(values).SetAtIndex(_NEXT, t)

@@ -118,7 +118,7 @@ class ReplanningGuidance(ReplanScheduler):
         if replan_period > 0 and replan is None:
             raise ValueError("ReplanningGuidance: replan_period > 0 needs a replan callable")
         self.lead, self.replan, self.period, self.time_to_go_fraction = lead, replan, period, time_to_go_fraction
-        self.replan_period, self.min_time_to_go = replan_period, min_time_to_go
+        self.min_time_to_go = min_time_to_go
         self.feedback, self.offset_limits = feedback, np.asarray(offset_limits, float)
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.scales_port = self.DeclareVectorInputPort("model_scales", 2) if model_scales else None
@@ -185,7 +185,7 @@ class ReplanningGuidance(ReplanScheduler):
             outcome = self.attempt(context, state, solve, interval=0.0)
             in_use = outcome.result if outcome.applied else flown
             to_go = in_use.start + in_use.plan.final_time - t
-            interval = min(self.replan_period, max(self.period, self.time_to_go_fraction * to_go))
+            interval = min(self.replan_period_s, max(self.period, self.time_to_go_fraction * to_go))
             self.due_now(state, t + interval)
         else:
             outcome = self.attempt(context, state, solve)

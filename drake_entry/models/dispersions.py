@@ -28,8 +28,8 @@ import numpy as np
 import pydrake.common.schema as schema
 
 from drake_entry.errors import ScenarioError
-from drake_entry.models.aerodynamics import AERO_REGIMES
-from drake_entry.models.atmosphere import DENSITY_WAVE_AMPLITUDE_BOUND
+from drake_entry.models.aerodynamics import AERO_REGIMES, RegimeAero, ScaledAero
+from drake_entry.models.atmosphere import DENSITY_WAVE_AMPLITUDE_BOUND, DispersedAtmosphere, PerturbedAtmosphere
 from drake_entry.models.atmosphere_perturbations import (
     AtmospherePerturbationSpec,
     draw_profiles,
@@ -164,8 +164,6 @@ class Draw:
     def atmosphere(self, base):
         """The sample's true atmosphere over the nominal ``base``: the density factor and wave,
         then the perturbation profiles when drawn."""
-        from drake_entry.models.atmosphere import DispersedAtmosphere, PerturbedAtmosphere
-
         air = DispersedAtmosphere(base, scale=self.density_scale, amplitude=self.density_wave_amplitude,
                                   wavelength=self.density_wave_length, phase=self.density_wave_phase)
         if not self.perturbation_altitude_m:
@@ -176,8 +174,6 @@ class Draw:
     def aerodynamics(self, base):
         """The sample's true aerodynamics over the nominal ``base``: the scale factors, then the
         errors by Mach regime and the trim error when drawn."""
-        from drake_entry.models.aerodynamics import RegimeAero, ScaledAero
-
         aero = ScaledAero(base, self.lift_scale, self.drag_scale)
         if not self.aero_lift_errors:
             return aero
@@ -351,11 +347,13 @@ def _validate_aero_regimes(a: AeroRegimeDispersionSpec, where: str) -> None:
         if len(values) != n:
             raise ScenarioError(f"{where}.{name} needs {n} values (one per regime: {', '.join(AERO_REGIMES)}), "
                                 f"got {len(values)}")
-        lo, hi = (-1.0, 1.0) if name == "correlation" else (0.0, MAX_AERO_SIGMA)
+        if name == "correlation":
+            inside, allowed = (lambda v: -1.0 <= v <= 1.0), "[-1, 1]"
+        else:
+            inside = (lambda v: 0.0 <= v < MAX_AERO_SIGMA)
+            allowed = f"[0, {MAX_AERO_SIGMA:g}) (a coefficient stays positive to {GAUSSIAN_REACH:g} sigma)"
         for i, v in enumerate(values):
-            if not (math.isfinite(v) and lo <= v <= hi) or (name != "correlation" and v >= hi):
-                allowed = "[-1, 1]" if name == "correlation" else f"[0, {hi:g}) (a coefficient stays positive to " \
-                                                                    f"{GAUSSIAN_REACH:g} sigma)"
+            if not (math.isfinite(v) and inside(v)):
                 raise ScenarioError(f"{where}.{name}[{i}] ({AERO_REGIMES[i]}) = {v} is out of range; allowed: {allowed}")
     if not (math.isfinite(a.trim_alpha_sigma_deg) and 0 <= a.trim_alpha_sigma_deg <= 10):
         raise ScenarioError(f"{where}.trim_alpha_sigma_deg = {a.trim_alpha_sigma_deg} is out of range; allowed: "

@@ -37,6 +37,7 @@ Ports:
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -157,7 +158,8 @@ class ReplanningGuidance(ReplanScheduler):
         t = context.get_time()
         held = self.take_held(context, state)
         if held is not None:  # a re-plan computed one latency ago flies from now
-            mem = ReplanMemory(held, list(mem.refused), list(mem.log), list(mem.unfed))
+            mem = copy.deepcopy(mem)  # the plans are shared, the records copied (ReplanMemory.__deepcopy__)
+            mem.flown = held
             self._start(mem, state, t)
             state.get_mutable_abstract_state(int(self._memory)).set_value(mem)
         flown = mem.flown
@@ -169,7 +171,7 @@ class ReplanningGuidance(ReplanScheduler):
             state.get_mutable_discrete_state(self._offsets).SetFromVector(offsets)
         if not self.replan_due(context) or flown.start + flown.plan.final_time - t < self.min_time_to_go:
             return
-        new = ReplanMemory(flown, list(mem.refused), list(mem.log), list(mem.unfed))
+        new = copy.deepcopy(mem)
         bank, alpha = flown.commands(t, float(x[3]))  # the commands flown now (not read ahead)
         bank, alpha = bank + float(offsets[0]), alpha + float(offsets[1])
 
@@ -180,7 +182,6 @@ class ReplanningGuidance(ReplanScheduler):
             note = "" if accepted else ("the re-planner returned no plan" if plan is None else plan.message)
             return (FlownPlan.of(plan, t, self.feedback) if accepted else None), accepted, note
 
-        interval = None
         if self.time_to_go_fraction is not None:  # the plan in use after this attempt sets the next
             outcome = self.attempt(context, state, solve, interval=0.0)
             in_use = outcome.result if outcome.applied else flown

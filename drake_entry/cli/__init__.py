@@ -8,7 +8,7 @@ Commands:
   report DIR          (re)write the report (report.md, report.html) of a campaign directory
   fly SCENARIO        one closed-loop guided flight with plots
   plan SCENARIO       the guidance method's reference plan, flown by Drake, with its figures
-                      (drag-energy, SCvx, AMPI and swarm-bank methods)
+                      (drag-energy, SCvx, AMPI, swarm-bank and LGL terminal methods)
   simulate SCENARIO   fly the open-loop diagram; write the trajectory and PNG plots
   results             every packaged closed-loop scenario as a campaign with its report
   compare COMPARISON  several guidance methods on one mission, the same dispersions and seeds

@@ -40,15 +40,18 @@ from drake_entry.models.vehicles import Vehicle
 from drake_entry.models.verdict import Verdict, box_text, judge
 from drake_entry.scenario import Scenario, load_scenario
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
+from drake_entry.systems.inertial_navigation import InertialNavigation
 from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.native_plant import add_plant
 from drake_entry.systems.navigation import Navigation
 from drake_entry.systems.schedule import ScheduleSource
 
-__all__ = ["ALTITUDE_FLOOR_M", "ClosedLoopSetup", "ClosedLoopResult", "ClosedLoopDiagram", "build_closed_loop",
+__all__ = ["ALTITUDE_FLOOR_M", "NAVIGATION_ERROR_COLUMNS", "ClosedLoopSetup", "ClosedLoopResult", "ClosedLoopDiagram", "build_closed_loop",
            "terminal_errors", "acceptance_box", "fly", "summarise"]
 
 ALTITUDE_FLOOR_M = 5000.0
+#: the logged columns of an INS flight's navigation error (InertialNavigation "navigation_error")
+NAVIGATION_ERROR_COLUMNS = ("nav_position_error_m", "nav_velocity_error_m_s")
 
 
 @dc.dataclass
@@ -163,23 +166,32 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
     x0 = scenario.initial_state() if initial_state is None else np.asarray(initial_state, float)
     plant, air, used = add_plant(builder, vehicle, setup.planet, atmosphere, initial_state=x0,
                            plant=scenario.simulation.plant)
-    nav = builder.AddNamedSystem("navigation", Navigation(bias=nav_bias, noise_sigma=nav_noise,
-                                                          period=g.period_s, seed=nav_seed))
     state, conditions = plant.GetOutputPort("state"), plant.GetOutputPort("flight_conditions")
+    inertial = draw.inertial if draw is not None else None
+    if inertial is None:
+        nav = builder.AddNamedSystem("navigation", Navigation(bias=nav_bias, noise_sigma=nav_noise,
+                                                              period=g.period_s, seed=nav_seed))
+        sensed = conditions
+    else:  # the INS: its state, and the accelerometers' drag and lift
+        nav = builder.AddNamedSystem("navigation", InertialNavigation(inertial, setup.planet, period=g.period_s))
+        builder.Connect(conditions, nav.GetInputPort("flight_conditions"))
+        sensed = nav.GetOutputPort("sensed_conditions")
     builder.Connect(state, nav.GetInputPort("true_state"))
     estimate = nav.GetOutputPort("estimated_state")
 
-    commands = setup.method.add_systems(builder, scenario, setup.planner, PlantPorts(estimate, conditions))
+    commands = setup.method.add_systems(builder, scenario, setup.planner, PlantPorts(estimate, sensed))
 
     bank = builder.AddNamedSystem("bank_actuator", BankActuator(
         bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit, accel_limit=vehicle.bank_accel_limit,
         initial_bank=commands.initial_bank, period=g.period_s))
     builder.Connect(commands.bank, bank.get_input_port())
     builder.Connect(bank.GetOutputPort("bank"), plant.GetInputPort("bank"))
+    if inertial is not None:
+        builder.Connect(bank.GetOutputPort("bank"), nav.GetInputPort("bank"))
     if commands.alpha is None:  # the scenario's alpha schedule, sampled at the guidance period
         alpha = builder.AddNamedSystem("alpha_schedule", ScheduleSource(
             setup.alpha, setup.energy_planet, period=g.period_s, initial_value=setup.alpha(setup.entry_energy)))
-        for port, source in (("state", estimate), ("flight_conditions", conditions)):
+        for port, source in (("state", estimate), ("flight_conditions", sensed)):
             if alpha.HasInputPort(port):
                 builder.Connect(source, alpha.GetInputPort(port))
         alpha_out = alpha.get_output_port()
@@ -204,11 +216,15 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
     signals = {"state": state, "conditions": conditions, "bank": bank.GetOutputPort("bank"), "alpha": alpha_out,
                "bank_command": commands.bank}
     signals.update({name: logged.port for name, logged in commands.logged.items()})
+    if inertial is not None:
+        signals["navigation_error"] = nav.GetOutputPort("navigation_error")
     period = scenario.simulation.log_period_s
     loggers = {name: LogVectorOutput(port, builder, period) for name, port in signals.items()}
     step_loggers = add_step_loggers(builder, signals)
     sources = {name: (port.get_system().get_name(), port.get_name()) for name, port in signals.items()}
     columns = {"bank_command": ("bank_command_rad",), **{n: s.columns for n, s in commands.logged.items()}}
+    if inertial is not None:
+        columns["navigation_error"] = NAVIGATION_ERROR_COLUMNS
     diagram = builder.Build()
     diagram.set_name(f"closed_loop_{scenario.name}_{setup.method.name}")
     return ClosedLoopDiagram(diagram, loggers, sources, columns, step_loggers, used)

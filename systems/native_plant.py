@@ -6,14 +6,16 @@ per integrator stage. The Python systems (``EntryVehicle``, ``AtmosphereSystem``
 reference; tests hold the two to each other (derivatives, conditions, a flight's end).
 
 NativeEntryVehicle (a Diagram named like the vehicle it replaces, the same ports):
-  - input  "bank" [1] and "alpha" [1] in rad, "air_data" [2] (density kg/m^3, speed of sound m/s)
+  - input  "bank" [1] and "alpha" [1] in rad, "air_data" [2] (density kg/m^3, speed of sound m/s),
+    "wind" [2] (only with winds=True: east, north wind m/s)
   - output "state"             [6]  [h m, lon rad, lat rad, V m/s, gamma rad, psi rad]
   - output "flight_conditions" [9]  drake_entry.models.dynamics.FlightConditions
   inside: "equations_of_motion", a SymbolicVectorSystem whose continuous state is the
   deviation from the entry state (a SymbolicVectorSystem's default state is zero, and
   Drake's RandomSimulation resets every context to its defaults), and "flight_conditions",
   an algebraic one fed by state, alpha and air data (``stateless``).
-NativeAtmosphere: input "state" [6] -> output "air_data" [2], as AtmosphereSystem.
+NativeAtmosphere: input "state" [6] -> output "air_data" [2] (and "wind" [2] when the atmosphere
+has a wind), as AtmosphereSystem.
 
 ``add_plant`` builds either realisation into a diagram; the scenario's
 ``simulation.plant`` chooses ("auto" by default: native when every model has a symbolic form,
@@ -36,7 +38,7 @@ from drake_entry.scenario import PLANTS
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.vehicle import N_STATE, EntryVehicle
 
-__all__ = ["STATE", "DEVIATION", "BANK", "ALPHA", "RHO", "SPEED_OF_SOUND", "NativeAtmosphere", "NativeEntryVehicle",
+__all__ = ["STATE", "DEVIATION", "BANK", "ALPHA", "RHO", "SPEED_OF_SOUND", "WIND", "NativeAtmosphere", "NativeEntryVehicle",
            "SYMBOLIC_DOMAIN_ERROR", "as_flight_error", "flight_stop", "add_plant", "PlantProbe"]
 
 #: the symbols of every native plant (shared, so each nominal model's expression trees are
@@ -44,6 +46,7 @@ __all__ = ["STATE", "DEVIATION", "BANK", "ALPHA", "RHO", "SPEED_OF_SOUND", "Nati
 STATE = [Variable(name) for name in dynamics.STATE_NAMES]
 DEVIATION = [Variable(f"d{name}") for name in dynamics.STATE_NAMES]
 BANK, ALPHA, RHO, SPEED_OF_SOUND = (Variable(n) for n in ("bank", "alpha", "rho", "speed_of_sound"))
+WIND = [Variable("wind_east"), Variable("wind_north")]
 
 
 
@@ -59,6 +62,12 @@ class NativeAtmosphere(Diagram):
         leaf = builder.AddNamedSystem("air_data", stateless(STATE, [rho, a]))
         builder.ExportInput(leaf.get_input_port(), "state")
         builder.ExportOutput(leaf.get_output_port(), "air_data")
+        if atmosphere.has_wind:
+            with np.errstate(all="ignore"):
+                wind = dynamics.wind_at(x, planet, atmosphere)
+            moving = builder.AddNamedSystem("wind", stateless(STATE, list(wind)))
+            builder.ConnectInput("state", moving.get_input_port())
+            builder.ExportOutput(moving.get_output_port(), "wind")
         builder.BuildInto(self)
 
 
@@ -66,33 +75,37 @@ class NativeEntryVehicle(Diagram):
     """The 3-DOF entry plant of ``vehicle`` on ``planet``, evaluated natively (module
     docstring); air data come in on "air_data" (a NativeAtmosphere or AtmosphereSystem).
 
-    Args: vehicle, planet; initial_state [6] SI (the default state, what a context reset keeps).
+    Args: vehicle, planet; initial_state [6] SI (the default state, what a context reset keeps);
+    winds: take the wind on input "wind" (the air-relative velocity sets the aerodynamics).
     """
 
-    def __init__(self, vehicle: Vehicle, planet: Earth, *, initial_state=None):
+    def __init__(self, vehicle: Vehicle, planet: Earth, *, initial_state=None, winds: bool = False):
         Diagram.__init__(self)
         self.x0 = np.zeros(N_STATE) if initial_state is None else np.asarray(initial_state, float).copy()
         x = [Expression(d) + float(x0) for d, x0 in zip(DEVIATION, self.x0)]
         bank, alpha, rho, a = (Expression(v) for v in (BANK, ALPHA, RHO, SPEED_OF_SOUND))
         state = [Expression(v) for v in STATE]
+        wind = [Expression(v) for v in WIND] if winds else None
+        air = [RHO, SPEED_OF_SOUND, *(WIND if winds else [])]
         with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
-            _, L, D = dynamics.aero_accelerations(x, alpha, rho, a, vehicle)
-            xdot = dynamics.equations_of_motion(x, bank, L, D, planet)
+            _, L, D = dynamics.aero_accelerations(x, alpha, rho, a, vehicle, wind)
+            xdot = dynamics.equations_of_motion(x, bank, L, D, planet, wind)
             conditions = dynamics.conditions_from(state, alpha, rho,
-                                                  *dynamics.aero_accelerations(state, alpha, rho, a, vehicle),
-                                                  vehicle, planet)
+                                                  *dynamics.aero_accelerations(state, alpha, rho, a, vehicle, wind),
+                                                  vehicle, planet, dynamics.airspeed(state, wind))
         builder = DiagramBuilder()
         motion = builder.AddNamedSystem("equations_of_motion", SymbolicVectorSystem(
-            state=DEVIATION, input=[BANK, ALPHA, RHO, SPEED_OF_SOUND], dynamics=list(xdot), output=x))
-        cond = builder.AddNamedSystem("flight_conditions", stateless([*STATE, ALPHA, RHO, SPEED_OF_SOUND],
+            state=DEVIATION, input=[BANK, ALPHA, *air], dynamics=list(xdot), output=x))
+        cond = builder.AddNamedSystem("flight_conditions", stateless([*STATE, ALPHA, *air],
                                                                      [_expression(c) for c in conditions]))
-        controls = builder.AddNamedSystem("controls", Multiplexer([1, 1, 2]))
-        flight = builder.AddNamedSystem("state_alpha_air", Multiplexer([N_STATE, 1, 2]))
+        inputs = [("alpha", 1), ("air_data", 2)] + ([("wind", 2)] if winds else [])
+        controls = builder.AddNamedSystem("controls", Multiplexer([1] + [n for _, n in inputs]))
+        flight = builder.AddNamedSystem("state_alpha_air", Multiplexer([N_STATE] + [n for _, n in inputs]))
         builder.Connect(controls.get_output_port(), motion.get_input_port())
         builder.Connect(motion.get_output_port(), flight.get_input_port(0))
         builder.Connect(flight.get_output_port(), cond.get_input_port())
         builder.ExportInput(controls.get_input_port(0), "bank")
-        for name, k in (("alpha", 1), ("air_data", 2)):  # each input feeds both systems
+        for k, (name, _) in enumerate(inputs, start=1):  # each input feeds both systems
             builder.ExportInput(controls.get_input_port(k), name)
             builder.ConnectInput(name, flight.get_input_port(k))
         builder.ExportOutput(motion.get_output_port(), "state")
@@ -152,7 +165,7 @@ def add_plant(builder, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, 
     systems, used = None, "python"
     if plant != "python":
         try:
-            systems = (NativeEntryVehicle(vehicle, planet, initial_state=initial_state),
+            systems = (NativeEntryVehicle(vehicle, planet, initial_state=initial_state, winds=atmosphere.has_wind),
                        NativeAtmosphere(atmosphere, planet))
             used = "native"
         except (UnsupportedScalarError, TypeError) as e:
@@ -160,12 +173,15 @@ def add_plant(builder, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, 
                 raise ScenarioError(f"simulation.plant = 'native' needs models with a symbolic form: {e} "
                                     f"(use plant 'auto' or 'python')") from None
     if systems is None:
-        systems = (EntryVehicle(vehicle, planet, atmosphere, initial_state=initial_state, air_data_input=True),
+        systems = (EntryVehicle(vehicle, planet, atmosphere, initial_state=initial_state, air_data_input=True,
+                                wind_input=atmosphere.has_wind),
                    AtmosphereSystem(atmosphere, planet))
     body = builder.AddNamedSystem("vehicle", systems[0])
     air = builder.AddNamedSystem("atmosphere", systems[1])
     builder.Connect(body.GetOutputPort("state"), air.GetInputPort("state"))
     builder.Connect(air.GetOutputPort("air_data"), body.GetInputPort("air_data"))
+    if atmosphere.has_wind:
+        builder.Connect(air.GetOutputPort("wind"), body.GetInputPort("wind"))
     return body, air, used
 
 

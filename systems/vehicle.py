@@ -6,6 +6,8 @@ Ports:
   - input  "alpha"              [1]  angle of attack [rad]
   - input  "air_data"           [2]  (only with air_data_input=True) density [kg/m^3] and
                                    speed of sound [m/s] from an ``AtmosphereSystem``
+  - input  "wind"               [2]  (only with air_data_input=True and wind_input=True) east and
+                                   north wind [m/s] (the air-relative velocity sets the aerodynamics)
   - output "state"              [6]  [h m, lon rad, lat rad, V m/s, gamma rad, psi rad]
   - output "flight_conditions"  [9]  rho kg/m^3, Mach, q Pa, heat flux W/m^2, n_z g, n g,
                                    L m/s^2, D m/s^2, E J/kg (drake_entry.models.dynamics.FlightConditions)
@@ -31,29 +33,33 @@ N_CONDITIONS = len(dynamics.FLIGHT_CONDITION_NAMES)
 def EntryVehicle_(T):
     class Impl(LeafSystem_[T]):
         def _construct(self, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, *,
-                       initial_state=None, air_data_input: bool = False, converter=None):
+                       initial_state=None, air_data_input: bool = False, wind_input: bool = False,
+                       converter=None):
             LeafSystem_[T].__init__(self, converter)
             self.vehicle = vehicle
             self.planet = planet
             self.atmosphere = atmosphere
             self.air_data_input = air_data_input
+            self.wind_input = wind_input and air_data_input
             x0 = np.zeros(N_STATE) if initial_state is None else np.asarray(initial_state, float)
             self._x0 = x0
             self.DeclareContinuousState(BasicVector_[T](x0))
             self.bank_port = self.DeclareVectorInputPort("bank", 1)
             self.alpha_port = self.DeclareVectorInputPort("alpha", 1)
             self.air_port = self.DeclareVectorInputPort("air_data", 2) if air_data_input else None
+            self.wind_port = self.DeclareVectorInputPort("wind", 2) if self.wind_input else None
             self.DeclareStateOutputPort("state", ContinuousStateIndex(0))  # native copy, no Python call
             deps = {self.all_state_ticket(), self.alpha_port.ticket()}
-            if self.air_port is not None:
-                deps.add(self.air_port.ticket())
+            for port in (self.air_port, self.wind_port):
+                if port is not None:
+                    deps.add(port.ticket())
             self.DeclareVectorOutputPort("flight_conditions", N_CONDITIONS, self._calc_conditions,
                                          prerequisites_of_calc=deps)
 
         def _construct_copy(self, other, converter=None):
             Impl._construct(self, other.vehicle, other.planet, other.atmosphere,
                             initial_state=other._x0, air_data_input=other.air_data_input,
-                            converter=converter)
+                            wind_input=other.wind_input, converter=converter)
 
         # -- helpers ----------------------------------------------------------------
         def _inputs(self, context):
@@ -65,22 +71,26 @@ def EntryVehicle_(T):
             return x, bank, alpha
 
         def _aero(self, context, x, alpha):
+            """(rho, Mach, L, D, wind or None) at state x."""
             if self.air_port is not None:
                 rho, a = self.air_port.Eval(context).tolist()
+                wind = None if self.wind_port is None else tuple(self.wind_port.Eval(context).tolist())
             else:
                 rho, a = dynamics.air_data(x, self.planet, self.atmosphere)
-            return (rho, *dynamics.aero_accelerations(x, alpha, rho, a, self.vehicle))
+                wind = dynamics.wind_at(x, self.planet, self.atmosphere)
+            return (rho, *dynamics.aero_accelerations(x, alpha, rho, a, self.vehicle, wind), wind)
 
         # -- Drake callbacks --------------------------------------------------------
         def DoCalcTimeDerivatives(self, context, derivatives):
             x, bank, alpha = self._inputs(context)
-            _, _, L, D = self._aero(context, x, alpha)
-            derivatives.get_mutable_vector().SetFromVector(dynamics.equations_of_motion(x, bank, L, D, self.planet))
+            _, _, L, D, wind = self._aero(context, x, alpha)
+            derivatives.get_mutable_vector().SetFromVector(dynamics.equations_of_motion(x, bank, L, D, self.planet, wind))
 
         def _calc_conditions(self, context, output):
             x, _, alpha = self._inputs(context)
-            rho, mach, L, D = self._aero(context, x, alpha)
-            output.SetFromVector(np.array(dynamics.conditions_from(x, alpha, rho, mach, L, D, self.vehicle, self.planet)))
+            rho, mach, L, D, wind = self._aero(context, x, alpha)
+            output.SetFromVector(np.array(dynamics.conditions_from(x, alpha, rho, mach, L, D, self.vehicle, self.planet,
+                                                                   dynamics.airspeed(x, wind))))
 
         def state_derivatives(self, context) -> np.ndarray:
             """dx/dt [6] (SI per s) at this plant's ``context`` (as NativeEntryVehicle's)."""

@@ -467,6 +467,18 @@ def _perturbation_rows(p) -> list:
             f"{p.density_temperature_correlation:g} | 1σ {profile(p.temperature_sigma)} | fraction |"]
 
 
+def _wind_rows(w) -> list:
+    """Dispersion-table rows of the horizontal wind: its mean profile and its perturbation."""
+    if w is None:
+        return []
+    profile = lambda values: ", ".join(f"{v:g} at {h:g} km" for h, v in zip(w.altitude_km, values))  # noqa: E731
+    return [f"| wind towards the east, mean | {profile(w.east_mean_m_s)} | fixed | — | m/s |",
+            f"| wind towards the north, mean | {profile(w.north_mean_m_s)} | fixed | — | m/s |",
+            f"| wind perturbation, each horizontal component | 0 | per-flight part {100 * w.large_scale_fraction:g} % of "
+            f"the variance, the rest correlated over {w.vertical_scale_km:g} km of altitude | 1σ "
+            f"{profile(w.sigma_m_s)} | m/s |"]
+
+
 def _covariance_rows(covariance) -> list:
     """Dispersion-table rows of an entry delivery covariance: each 1-sigma, then the correlations."""
     if covariance is None:
@@ -519,7 +531,7 @@ def _dispersions(scenario) -> str:
             lines.append(f"| navigation white noise, {NAV_NAMES[i]} | 0 | Gaussian per step | 1σ {s:g} | "
                          f"{NAV_UNITS[i]} |")
     lines += (_regime_rows(spec.aero_regimes) + _covariance_rows(spec.entry_covariance)
-              + _perturbation_rows(spec.atmosphere_perturbations))
+              + _perturbation_rows(spec.atmosphere_perturbations) + _wind_rows(spec.winds))
     head = "## Dispersions\n\n"
     source = f"Source: {spec.source}." if spec.source else "Source: not stated in the scenario (`dispersions.source`)."
     if not lines:

@@ -19,7 +19,7 @@ from pydrake.systems.analysis import RandomSimulation
 from drake_entry.diagrams.closed_loop import ClosedLoopResult, ClosedLoopSetup, build_closed_loop, summarise
 from drake_entry.diagrams.common import collect_trajectory, make_simulator
 from drake_entry.models.dispersions import draw
-from drake_entry.models.trajectory import control_activity, metrics
+from drake_entry.models.trajectory import control_activity, metrics, navigation_errors
 from drake_entry.scenario import scenario_from_dump
 from drake_entry.systems.native_plant import as_flight_error
 
@@ -120,7 +120,7 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
         "err_latitude_deg": res.errors["latitude_deg"], "err_velocity_m_s": res.errors["velocity_m_s"],
         "err_range_m": res.errors["range_to_go_m"], "err_crossrange_m": res.errors["crossrange_m"],
         "err_distance_m": res.errors["distance_m"],
-        **metrics(tr), **v.margins(),
+        **metrics(tr), **navigation_errors(tr), **v.margins(),
         **control_activity(tr, setup.vehicle.bank_limit, setup.vehicle.bank_rate_limit),
         **{f"inside_{k}_box": b["inside"] for k, b in res.box.items()},
         **{f"box_{k}_error": b["error"] for k, b in res.box.items()},

@@ -114,6 +114,16 @@ class Atmosphere:
         raise NotImplementedError
 
     # -- generic ---------------------------------------------------------------------
+    def wind(self, h):
+        """(east, north) horizontal wind [m/s] at altitude h [m], or None in still air (every
+        model here; models.winds.WindyAtmosphere adds a wind)."""
+        return None
+
+    @property
+    def has_wind(self) -> bool:
+        """True when ``wind`` gives a wind (the plant then takes a wind input)."""
+        return False
+
     def check(self, h):
         _check_range(type(self).__name__, h, self.h_min, self.h_max)
 

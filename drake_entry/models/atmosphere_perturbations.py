@@ -27,7 +27,8 @@ from scipy.signal import lfilter
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["MAX_PERTURBATION_SIGMA", "AtmospherePerturbationSpec", "validate_perturbations", "draw_profiles"]
+__all__ = ["MAX_PERTURBATION_SIGMA", "AtmospherePerturbationSpec", "validate_perturbations", "unit_profiles",
+           "draw_profiles"]
 
 #: a perturbation's 1-sigma is below this, so the density and temperature stay positive to 5 sigma
 MAX_PERTURBATION_SIGMA = 0.2
@@ -75,25 +76,34 @@ def validate_perturbations(p: AtmospherePerturbationSpec, where: str) -> None:
             raise ScenarioError(f"{where}.{name} = {v} is out of range; allowed: [{lo:g}, {hi:g}]")
 
 
+def unit_profiles(rng, nodes_km: np.ndarray, large_scale_fraction: float, vertical_scale_km: float,
+                  correlation: float) -> np.ndarray:
+    """Two unit-variance profiles [n x 2] on the altitude grid ``nodes_km`` (evenly spaced): per
+    column sqrt(f) B + sqrt(1 - f) S(h) (module docstring), the two columns correlated by
+    ``correlation`` in both parts; every normal draw from the numpy generator ``rng``."""
+    n = nodes_km.size
+    step = float(nodes_km[1] - nodes_km[0]) if n > 1 else 1.0
+    mix = math.sqrt(max(0.0, 1.0 - correlation * correlation))
+    b = rng.standard_normal(2)
+    bias = np.array([b[0], correlation * b[0] + mix * b[1]])
+    e = rng.standard_normal((n, 2))
+    e[:, 1] = correlation * e[:, 0] + mix * e[:, 1]
+    phi = math.exp(-step / vertical_scale_km)
+    root = math.sqrt(1.0 - phi * phi)
+    # s[0] = e[0], s[k] = phi s[k-1] + root e[k]: the exact discretisation of corr exp(-dh / L)
+    e[0] /= root
+    s = lfilter([root], [1.0, -phi], e, axis=0)
+    f = large_scale_fraction
+    return math.sqrt(f) * bias + math.sqrt(1.0 - f) * s
+
+
 def draw_profiles(p: AtmospherePerturbationSpec, generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(altitude nodes [m], density perturbation, temperature perturbation) of one sample: one
     draw of the sample's generator seeds the profile's normal draws."""
     rng = np.random.default_rng(int(generator()))
     nodes_km = np.arange(0.0, p.top_km + 0.5 * p.step_km, p.step_km)
-    n = nodes_km.size
-    rho = p.density_temperature_correlation
-    mix = math.sqrt(max(0.0, 1.0 - rho * rho))
-    b = rng.standard_normal(2)
-    bias = np.array([b[0], rho * b[0] + mix * b[1]])
-    e = rng.standard_normal((n, 2))
-    e[:, 1] = rho * e[:, 0] + mix * e[:, 1]
-    phi = math.exp(-p.step_km / p.vertical_scale_km)
-    root = math.sqrt(1.0 - phi * phi)
-    # s[0] = e[0], s[k] = phi s[k-1] + root e[k]: the exact discretisation of corr exp(-dh / L)
-    e[0] /= root
-    s = lfilter([root], [1.0, -phi], e, axis=0)
-    f = p.large_scale_fraction
-    unit = math.sqrt(f) * bias + math.sqrt(1.0 - f) * s
+    unit = unit_profiles(rng, nodes_km, p.large_scale_fraction, p.vertical_scale_km,
+                         p.density_temperature_correlation)
     sigma = np.column_stack([np.interp(nodes_km, p.altitude_km, p.density_sigma),
                              np.interp(nodes_km, p.altitude_km, p.temperature_sigma)])
     d = sigma * unit

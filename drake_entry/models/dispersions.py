@@ -35,9 +35,16 @@ from drake_entry.models.atmosphere_perturbations import (
     draw_profiles,
     validate_perturbations,
 )
+from drake_entry.models.inertial_navigation import (
+    InertialNavigationSpec,
+    draw_inertial_errors,
+    validate_inertial_navigation,
+)
+from drake_entry.models.winds import WindProfile, WindSpec, WindyAtmosphere, draw_wind, validate_winds
 
 __all__ = ["Scalar", "Vector", "EntryDispersionSpec", "AeroRegimeDispersionSpec", "ENTRY_TABLE_TO_SI", "MAX_AERO_SIGMA",
-           "PERTURBATION_COLUMNS_KM", "AtmospherePerturbationSpec",
+           "PERTURBATION_COLUMNS_KM", "AtmospherePerturbationSpec", "WindSpec",
+           "InertialNavigationSpec",
            "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate"]
 
 Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
@@ -104,6 +111,12 @@ class DispersionSpec:
     # correlated over a vertical scale length, 1-sigma by altitude (models.atmosphere_perturbations;
     # none when absent)
     atmosphere_perturbations: typing.Optional[AtmospherePerturbationSpec] = None
+    # horizontal wind: a mean profile by altitude plus perturbations correlated in altitude
+    # (models.winds; still air when absent)
+    winds: typing.Optional[WindSpec] = None
+    # navigation from an inertial error model (models.inertial_navigation) instead of nav_bias and
+    # nav_noise_sigma (none when absent)
+    inertial_navigation: typing.Optional[InertialNavigationSpec] = None
 
     @staticmethod
     def paper000_table2() -> "DispersionSpec":
@@ -139,6 +152,13 @@ class Draw:
     perturbation_altitude_m: tuple = ()
     density_perturbation: tuple = ()
     temperature_perturbation: tuple = ()
+    #: the wind profile: altitude nodes [m] and the east and north wind there [m/s] (empty: still air)
+    wind_altitude_m: tuple = ()
+    wind_east_m_s: tuple = ()
+    wind_north_m_s: tuple = ()
+    #: the flight's inertial navigation errors (models.inertial_navigation.InertialErrors; None:
+    #: nav_bias and nav_noise_sigma)
+    inertial: typing.Any = None
 
     def columns(self) -> dict:
         """Flat record for result tables (entry deviations in table units)."""
@@ -159,17 +179,25 @@ class Draw:
                 out[f"disp_drho_{km}km"] = np.interp(km * 1e3, self.perturbation_altitude_m, self.density_perturbation)
                 out[f"disp_dT_{km}km"] = np.interp(km * 1e3, self.perturbation_altitude_m,
                                                    self.temperature_perturbation)
+        if self.wind_altitude_m:
+            for km in PERTURBATION_COLUMNS_KM:
+                out[f"disp_wind_east_{km}km"] = np.interp(km * 1e3, self.wind_altitude_m, self.wind_east_m_s)
+                out[f"disp_wind_north_{km}km"] = np.interp(km * 1e3, self.wind_altitude_m, self.wind_north_m_s)
+        if self.inertial is not None:
+            out.update(self.inertial.columns())
         return {k: float(v) for k, v in out.items()}
 
     def atmosphere(self, base):
         """The sample's true atmosphere over the nominal ``base``: the density factor and wave,
-        then the perturbation profiles when drawn."""
+        then the perturbation profiles and the wind when drawn."""
         air = DispersedAtmosphere(base, scale=self.density_scale, amplitude=self.density_wave_amplitude,
                                   wavelength=self.density_wave_length, phase=self.density_wave_phase)
-        if not self.perturbation_altitude_m:
-            return air
-        return PerturbedAtmosphere(air, self.perturbation_altitude_m, self.density_perturbation,
-                                   self.temperature_perturbation)
+        if self.perturbation_altitude_m:
+            air = PerturbedAtmosphere(air, self.perturbation_altitude_m, self.density_perturbation,
+                                      self.temperature_perturbation)
+        if self.wind_altitude_m:
+            air = WindyAtmosphere(air, WindProfile(self.wind_altitude_m, self.wind_east_m_s, self.wind_north_m_s))
+        return air
 
     def aerodynamics(self, base):
         """The sample's true aerodynamics over the nominal ``base``: the scale factors, then the
@@ -225,6 +253,12 @@ def draw(spec: DispersionSpec, generator) -> Draw:
         if not (d_rho.min() > -1.0 and d_T.min() > -1.0):
             raise ScenarioError("dispersions.atmosphere_perturbations drew a perturbation of -100 % or less; narrow "
                                 "density_sigma / temperature_sigma")
+    if spec.winds is not None:  # after the rest, for the same reason
+        wind = draw_wind(spec.winds, generator)
+        profile.update(wind_altitude_m=tuple(wind.nodes), wind_east_m_s=tuple(wind.east),
+                       wind_north_m_s=tuple(wind.north))
+    if spec.inertial_navigation is not None:  # after the rest, for the same reason
+        profile["inertial"] = draw_inertial_errors(spec.inertial_navigation, lambda: _normal(generator))
     return Draw(delta, scales["density_scale"], scales["density_wave_amplitude"],
                 spec.density_wave_length_km * 1e3, phase, scales["lift_scale"], scales["drag_scale"],
                 scales["mass_scale"], bias, np.asarray(spec.nav_noise_sigma, float), nav_seed, **aero, **profile)
@@ -325,6 +359,14 @@ def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
         _validate_covariance(spec.entry_covariance, f"{where}.entry_covariance")
     if spec.atmosphere_perturbations is not None:
         validate_perturbations(spec.atmosphere_perturbations, f"{where}.atmosphere_perturbations")
+    if spec.winds is not None:
+        validate_winds(spec.winds, f"{where}.winds")
+    if spec.inertial_navigation is not None:
+        validate_inertial_navigation(spec.inertial_navigation, f"{where}.inertial_navigation")
+        fixed_bias = isinstance(spec.nav_bias, schema.DeterministicVectorX) and not any(spec.nav_bias.value)
+        if not fixed_bias or any(spec.nav_noise_sigma):
+            raise ScenarioError(f"{where}: nav_bias / nav_noise_sigma and inertial_navigation are two navigation "
+                                f"models; give one")
 
 
 #: a relative aerodynamic error's 1-sigma is below this, so the coefficient stays positive to 5 sigma

@@ -11,6 +11,13 @@ derived from the potential here (paper 001 eqs. 4-6 mix heading conventions): th
 component g_n adds g_n cos(gamma) cos(psi) to V', -g_n sin(gamma) cos(psi) / V to gamma'
 and -g_n sin(psi) / (V cos gamma) to psi'. On an oblate planet the atmosphere is
 evaluated at the geodetic altitude (paper 001 Sec. II.A).
+
+With a horizontal wind (the atmosphere's ``wind``: east and north components W_e, W_n) the
+state stays Earth-relative; the air-relative velocity v_a = v - W sets the Mach number, the
+dynamic pressure, the heat flux and the aerodynamic force: drag along -v_a, lift normal to v_a
+and banked about it. That force's components along the Earth-relative velocity, its normal in
+the vertical plane and the horizontal normal replace -D, L cos(sigma) and L sin(sigma) in
+paper 000 eq. 102 (in still air they are equal).
 """
 from __future__ import annotations
 
@@ -27,7 +34,7 @@ from drake_entry.models.scalar import promote
 from drake_entry.models.vehicles import Vehicle
 
 __all__ = ["STATE_NAMES", "STATE_UNITS", "FlightConditions", "FLIGHT_CONDITION_NAMES", "air_data",
-           "aero_accelerations", "state_derivatives", "equations_of_motion", "equations_of_motion_lift_components",
+           "wind_at", "airspeed", "aero_accelerations", "air_relative_force_components", "state_derivatives", "equations_of_motion", "equations_of_motion_lift_components",
            "flight_conditions", "conditions_from", "specific_energy", "energy_rate", "energy_domain_derivatives"]
 
 STATE_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
@@ -56,13 +63,56 @@ def air_data(x, planet: Earth, atmosphere: Atmosphere):
     return atmosphere.air_data(planet.atmospheric_altitude(x[0], x[2]))
 
 
-def aero_accelerations(x, alpha, rho, speed_of_sound, vehicle: Vehicle):
-    """Mach, lift and drag accelerations L, D [m/s^2] (paper 001 eq. 8 divided by m)."""
-    V = x[3]
+def wind_at(x, planet: Earth, atmosphere: Atmosphere):
+    """(east, north) wind [m/s] at state x, or None in still air."""
+    return atmosphere.wind(planet.atmospheric_altitude(x[0], x[2]))
+
+
+def _air_relative_velocity(x, wind):
+    """Air-relative velocity (east, north, up) [m/s] and its horizontal and total magnitudes."""
+    V, gamma, psi = x[3], x[4], x[5]
+    fn = math if isinstance(gamma, float) and isinstance(wind[0], float) else np
+    horizontal = V * fn.cos(gamma)
+    ve = horizontal * fn.sin(psi) - wind[0]
+    vn = horizontal * fn.cos(psi) - wind[1]
+    vu = V * fn.sin(gamma)
+    vh = fn.sqrt(ve * ve + vn * vn)
+    return (ve, vn, vu), vh, fn.sqrt(vh * vh + vu * vu)
+
+
+def airspeed(x, wind):
+    """Air-relative speed V_a [m/s] at state x in the wind (east, north) [m/s]; V in still air."""
+    return x[3] if wind is None else _air_relative_velocity(x, wind)[2]
+
+
+def aero_accelerations(x, alpha, rho, speed_of_sound, vehicle: Vehicle, wind=None):
+    """Mach, lift and drag accelerations L, D [m/s^2] (paper 001 eq. 8 divided by m), at the
+    air-relative speed in the wind (east, north) [m/s] when one is given."""
+    V = airspeed(x, wind)
     mach = V / speed_of_sound
     cl, cd = vehicle.aero.coefficients(alpha, mach)
     qS_m = 0.5 * rho * V * V * vehicle.area_over_mass
     return mach, qS_m * cl, qS_m * cd
+
+
+def air_relative_force_components(x, bank, L, D, wind):
+    """The aerodynamic acceleration's components (L_vertical, L_horizontal, D_along) [m/s^2] in the
+    Earth-relative velocity frame, for ``equations_of_motion_lift_components``: drag D along the
+    air-relative velocity, lift L normal to it at bank sigma (module docstring); in still air
+    exactly (L cos sigma, L sin sigma, D)."""
+    (ve, vn, vu), vh, va = _air_relative_velocity(x, wind)
+    gamma, psi = x[4], x[5]
+    fn = math if isinstance(gamma, float) and isinstance(vh, float) and isinstance(bank, float) else np
+    lc, ls = L * fn.cos(bank), L * fn.sin(bank)
+    # force in (east, north, up): -D v_a/|v_a| + L cos(sigma) (lift-up normal) + L sin(sigma) (right normal)
+    fe = -D * ve / va - lc * vu * ve / (va * vh) + ls * vn / vh
+    fnorth = -D * vn / va - lc * vu * vn / (va * vh) - ls * ve / vh
+    fu = -D * vu / va + lc * vh / va
+    sg, cg, sp, cp = fn.sin(gamma), fn.cos(gamma), fn.sin(psi), fn.cos(psi)
+    along = fe * cg * sp + fnorth * cg * cp + fu * sg
+    vertical = -fe * sg * sp - fnorth * sg * cp + fu * cg
+    horizontal = fe * cp - fnorth * sp
+    return vertical, horizontal, -along
 
 
 def state_derivatives(x, bank, alpha, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere):
@@ -77,12 +127,16 @@ def state_derivatives(x, bank, alpha, vehicle: Vehicle, planet: Earth, atmospher
     x = [promote(v) for v in x]
     bank, alpha = promote(bank), promote(alpha)
     rho, a = air_data(x, planet, atmosphere)
-    _, L, D = aero_accelerations(x, alpha, rho, a, vehicle)
-    return equations_of_motion(x, bank, L, D, planet)
+    wind = wind_at(x, planet, atmosphere)
+    _, L, D = aero_accelerations(x, alpha, rho, a, vehicle, wind)
+    return equations_of_motion(x, bank, L, D, planet, wind)
 
 
-def equations_of_motion(x, bank, L, D, planet: Earth):
-    """xdot given the lift and drag accelerations L, D [m/s^2] (paper 000 eq. 102)."""
+def equations_of_motion(x, bank, L, D, planet: Earth, wind=None):
+    """xdot given the lift and drag accelerations L, D [m/s^2] (paper 000 eq. 102), in the wind
+    (east, north) [m/s] when one is given (module docstring)."""
+    if wind is not None:
+        return equations_of_motion_lift_components(x, *air_relative_force_components(x, bank, L, D, wind), planet)
     fn = math if isinstance(x[4], float) and isinstance(bank, float) else np  # float fast path
     return equations_of_motion_lift_components(x, L * fn.cos(bank), L * fn.sin(bank), D, planet)
 
@@ -129,15 +183,18 @@ def equations_of_motion_lift_components(x, L_vertical, L_horizontal, D, planet: 
 
 
 def flight_conditions(x, bank, alpha, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere) -> FlightConditions:
-    """Density, Mach, q, heat flux, load factors, L, D and energy at state x."""
+    """Density, Mach, q, heat flux, load factors, L, D and energy at state x (Mach, q and heat flux
+    at the air-relative speed in a wind)."""
     rho, a = air_data(x, planet, atmosphere)
-    mach, L, D = aero_accelerations(x, alpha, rho, a, vehicle)
-    return conditions_from(x, alpha, rho, mach, L, D, vehicle, planet)
+    wind = wind_at(x, planet, atmosphere)
+    mach, L, D = aero_accelerations(x, alpha, rho, a, vehicle, wind)
+    return conditions_from(x, alpha, rho, mach, L, D, vehicle, planet, airspeed(x, wind))
 
 
-def conditions_from(x, alpha, rho, mach, L, D, vehicle: Vehicle, planet: Earth) -> FlightConditions:
-    """FlightConditions from already computed air data and aerodynamic accelerations."""
-    V = x[3]
+def conditions_from(x, alpha, rho, mach, L, D, vehicle: Vehicle, planet: Earth, speed=None) -> FlightConditions:
+    """FlightConditions from already computed air data and aerodynamic accelerations; ``speed``
+    is the air-relative speed [m/s] (None: the state's speed, still air)."""
+    V = x[3] if speed is None else speed
     return FlightConditions(
         rho=rho,
         mach=mach,

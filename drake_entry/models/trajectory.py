@@ -11,7 +11,7 @@ import numpy as np
 from drake_entry.models.constraints import PathLimits
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, STATE_NAMES
 
-__all__ = ["Trajectory", "metrics", "REVERSAL_THRESHOLD", "control_activity"]
+__all__ = ["Trajectory", "metrics", "navigation_errors", "REVERSAL_THRESHOLD", "control_activity"]
 
 
 @dc.dataclass
@@ -95,6 +95,17 @@ def metrics(tr: Trajectory, limits: PathLimits | None = None) -> dict:
                            normal_load=out["peak_normal_load_g"], total_load=out["peak_total_load_g"])
         out.update({f"margin_{k}": float(v) for k, v in m.items() if np.isfinite(getattr(limits, f"{k}_max"))})
     return out
+
+
+def navigation_errors(tr: Trajectory) -> dict:
+    """The INS flight's navigation error (the logged "navigation_error" signal: |position error|
+    [m], |velocity error| [m/s]) at the end and its largest over the flight; {} when the flight
+    had no inertial navigation."""
+    e = tr.extra.get("navigation_error")
+    if e is None or len(e) == 0:
+        return {}
+    return {"nav_position_error_end_m": float(e[-1, 0]), "nav_velocity_error_end_m_s": float(e[-1, 1]),
+            "nav_position_error_max_m": float(e[:, 0].max()), "nav_velocity_error_max_m_s": float(e[:, 1].max())}
 
 
 #: a bank reversal is a sign change of the flown bank between excursions beyond this [rad]

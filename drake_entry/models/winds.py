@@ -1,0 +1,162 @@
+"""Horizontal winds: a profile by altitude (east and north components), a Monte-Carlo sample's
+wind (a mean profile plus perturbations correlated in altitude, in the manner of Earth-GRAM:
+Leslie & Justus, NASA/TM-2011-216467), and the atmosphere that carries it.
+
+The wind moves the air, not the vehicle: the equations of motion keep the Earth-relative state
+and take the aerodynamic force from the air-relative velocity (models.dynamics). Each component's
+perturbation is sigma(h) [sqrt(f) B + sqrt(1 - f) S(h)] as the density's
+(models.atmosphere_perturbations), the east and north components independent. Altitude only: a
+long glide at nearly constant altitude sees one wind (no horizontal correlation).
+(No ``from __future__ import annotations``: pydrake's YAML reads the spec's field types.)
+"""
+import dataclasses as dc
+import math
+
+import numpy as np
+from pydrake.symbolic import Expression, if_then_else
+
+from drake_entry.errors import ScenarioError
+from drake_entry.models.atmosphere import Atmosphere, piecewise
+from drake_entry.models.atmosphere_perturbations import unit_profiles
+from drake_entry.models.scalar import is_autodiff, is_symbolic, lift
+
+__all__ = ["MAX_WIND_M_S", "WindSpec", "validate_winds", "draw_wind", "WindProfile", "WindyAtmosphere"]
+
+#: no mean wind or 5-sigma wind beyond this speed [m/s] is accepted (the strongest measured
+#: jets are below 200 m/s)
+MAX_WIND_M_S = 300.0
+
+
+@dc.dataclass
+class WindSpec:
+    """A Monte-Carlo sample's horizontal wind (module docstring)."""
+
+    # altitudes [km] of the profiles below (increasing); the profiles hold beyond the ends
+    altitude_km: list[float] = dc.field(default_factory=lambda: [0.0, 150.0])
+    # mean wind towards the east and towards the north [m/s] at those altitudes
+    east_mean_m_s: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
+    north_mean_m_s: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
+    # 1-sigma of each horizontal component's perturbation [m/s] at those altitudes
+    sigma_m_s: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
+    # share of the variance in the large-scale part (one value per flight), 0..1
+    large_scale_fraction: float = 0.5
+    # vertical correlation length of the small-scale part [km]
+    vertical_scale_km: float = 5.0
+    # the grid the small-scale process is drawn on [km] (linear between its nodes)
+    step_km: float = 0.5
+    # the altitude span of the drawn profile [km]; beyond it the end values hold
+    top_km: float = 150.0
+
+
+def validate_winds(w: WindSpec, where: str) -> None:
+    """One-line ScenarioErrors naming the field."""
+    h = np.asarray(w.altitude_km, float)
+    if h.ndim != 1 or h.size < 1 or not np.all(np.isfinite(h)) or np.any(np.diff(h) <= 0):
+        raise ScenarioError(f"{where}.altitude_km = {w.altitude_km} must be finite and sorted increasing")
+    for name in ("east_mean_m_s", "north_mean_m_s", "sigma_m_s"):
+        values = getattr(w, name)
+        if len(values) != h.size:
+            raise ScenarioError(f"{where}.{name} needs one value per altitude ({h.size}), got {len(values)}")
+        low = 0.0 if name == "sigma_m_s" else -MAX_WIND_M_S
+        high = MAX_WIND_M_S / 5.0 if name == "sigma_m_s" else MAX_WIND_M_S
+        for i, v in enumerate(values):
+            if not (math.isfinite(v) and low <= v <= high):
+                raise ScenarioError(f"{where}.{name}[{i}] = {v} is out of range; allowed: [{low:g}, {high:g}] m/s")
+    checks = (("large_scale_fraction", 0.0, 1.0), ("vertical_scale_km", 1e-3, 1e3), ("step_km", 1e-2, 10.0),
+              ("top_km", 1.0, 1e3))
+    for name, lo, hi in checks:
+        v = getattr(w, name)
+        if not (math.isfinite(v) and lo <= v <= hi):
+            raise ScenarioError(f"{where}.{name} = {v} is out of range; allowed: [{lo:g}, {hi:g}]")
+
+
+def draw_wind(w: WindSpec, generator) -> "WindProfile":
+    """One sample's wind profile: one draw of the sample's generator seeds its normal draws."""
+    rng = np.random.default_rng(int(generator()))
+    nodes_km = np.arange(0.0, w.top_km + 0.5 * w.step_km, w.step_km)
+    unit = unit_profiles(rng, nodes_km, w.large_scale_fraction, w.vertical_scale_km, 0.0)
+    sigma = np.interp(nodes_km, w.altitude_km, w.sigma_m_s)
+    east = np.interp(nodes_km, w.altitude_km, w.east_mean_m_s) + sigma * unit[:, 0]
+    north = np.interp(nodes_km, w.altitude_km, w.north_mean_m_s) + sigma * unit[:, 1]
+    return WindProfile(nodes_km * 1e3, east, north)
+
+
+class WindProfile:
+    """Wind towards the east and the north [m/s], linear in altitude between the nodes and held
+    beyond the ends; evaluated at a float, AutoDiffXd or symbolic altitude [m].
+
+    Args: altitude_m (increasing nodes [m]), east_m_s and north_m_s (the components there).
+    """
+
+    def __init__(self, altitude_m, east_m_s, north_m_s):
+        h, e, n = (np.asarray(v, float) for v in (altitude_m, east_m_s, north_m_s))
+        if not (h.ndim == 1 and h.size >= 2 and e.shape == h.shape and n.shape == h.shape
+                and np.all(np.diff(h) > 0) and np.all(np.isfinite(e)) and np.all(np.isfinite(n))):
+            raise ScenarioError("WindProfile needs increasing altitude nodes and finite east and north winds at each")
+        self.nodes, self.east, self.north = h, e, n
+
+    def __call__(self, h):
+        """(east, north) wind [m/s] at altitude h [m] (the scalar type of h)."""
+        if is_symbolic(h):
+            return self._symbolic(h, self.east), self._symbolic(h, self.north)
+        hv = float(h.value()) if is_autodiff(h) else float(h)
+        k = min(max(int(np.searchsorted(self.nodes, hv, side="right")) - 1, 0), self.nodes.size - 2)
+        inside = self.nodes[0] <= hv <= self.nodes[-1]
+        width = self.nodes[k + 1] - self.nodes[k]
+        out = []
+        for d in (self.east, self.north):
+            slope = (d[k + 1] - d[k]) / width if inside else 0.0
+            value = float(np.interp(hv, self.nodes, d))
+            out.append(lift([h], value, [slope]) if is_autodiff(h) else value)
+        return tuple(out)
+
+    def _symbolic(self, h, d):
+        nodes = self.nodes
+
+        def piece(i):
+            s = float((d[i + 1] - d[i]) / (nodes[i + 1] - nodes[i]))
+            return float(d[i]) + s * (h - float(nodes[i]))
+
+        inner = piecewise(h, [float(v) for v in nodes], piece)
+        return if_then_else(h < float(nodes[0]), Expression(float(d[0])),
+                            if_then_else(h > float(nodes[-1]), Expression(float(d[-1])), inner))
+
+    def at(self, altitude_m) -> tuple[np.ndarray, np.ndarray]:
+        """(east, north) [m/s] at an array of altitudes [m]."""
+        return np.interp(altitude_m, self.nodes, self.east), np.interp(altitude_m, self.nodes, self.north)
+
+
+class WindyAtmosphere(Atmosphere):
+    """``base``'s density and temperature with the horizontal wind ``winds`` (a WindProfile):
+    every air-data call goes to ``base``; ``wind(h)`` gives the wind."""
+
+    def __init__(self, base: Atmosphere, winds: WindProfile):
+        self.base, self.winds = base, winds
+        self.name = f"{base.name} with winds"
+        self.h_min, self.h_max = base.h_min, base.h_max
+        self.gas_constant, self.gamma = base.gas_constant, base.gamma
+
+    def wind(self, h):
+        return self.winds(h)
+
+    @property
+    def has_wind(self) -> bool:
+        return True
+
+    def air_data(self, h):
+        return self.base.air_data(h)
+
+    def properties(self, h):
+        return self.base.properties(h)
+
+    def symbolic_profile(self, h) -> tuple:
+        return self.base.symbolic_profile(h)
+
+    def density_derivatives(self, h):
+        return self.base.density_derivatives(h)
+
+    def temperature_derivatives(self, h):
+        return self.base.temperature_derivatives(h)
+
+    def derivatives(self, h):
+        return self.base.derivatives(h)

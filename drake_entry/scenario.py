@@ -138,6 +138,9 @@ class Scenario:
     """A mission: vehicle, environment, entry interface, target, terminal interface,
     open-loop command schedules and simulation settings."""
 
+    # a packaged scenario name, or a YAML path (relative to this file), whose every field this
+    # file starts from: the file then states only what it changes (blocks merge field by field)
+    based_on: str = ""
     name: str = ""  # short identifier, used in file names and reports
     description: str = ""  # one line for humans
     source: str = ""  # where the numbers come from (papers, data files)
@@ -352,8 +355,14 @@ def closed_loop_scenarios() -> list[str]:
     from importlib import resources
 
     folder = resources.files("drake_entry").joinpath("scenarios")
-    return [n for n in PACKAGED_SCENARIOS if any(line.startswith("guidance:")
-                                                 for line in folder.joinpath(f"{n}.yaml").read_text().splitlines())]
+
+    def flies(name: str) -> bool:
+        lines = folder.joinpath(f"{name}.yaml").read_text().splitlines()
+        base = [line.split(":", 1)[1].split("#")[0].strip() for line in lines if line.startswith("based_on:")]
+        return any(line.startswith("guidance:") for line in lines) or bool(base and base[0] in PACKAGED_SCENARIOS
+                                                                          and flies(base[0]))
+
+    return [n for n in PACKAGED_SCENARIOS if flies(n)]
 
 
 def load_scenario(name_or_path: str) -> Scenario:

@@ -267,31 +267,45 @@ def packaged_names(folder: str) -> tuple:
                         if p.name.endswith(".yaml")))
 
 
-def load_packaged_or_file(schema, name_or_path, *, kind: str, folder: str):
+def load_packaged_or_file(schema, name_or_path, *, kind: str, folder: str, _chain: tuple = ()):
     """``schema`` read from a packaged file by name (drake_entry/<folder>/<name>.yaml) or from a
     YAML file path (``load_yaml_typed``); anything else is one ScenarioError naming the packaged
-    ones. ``kind`` names the file in messages ('scenario', 'comparison')."""
+    ones. ``kind`` names the file in messages ('scenario', 'comparison'). A schema with a
+    ``based_on`` field starts from the file it names (read the same way) when one is given."""
     from importlib import resources
 
     packaged = packaged_names(folder)
+    chain = _chain + (os.fspath(name_or_path),) if isinstance(name_or_path, (str, os.PathLike)) else _chain
+
+    def base_of(base: str, path: str | None):
+        """The schema a ``based_on: base`` starts from (a packaged name, or a path relative to ``path``)."""
+        if base not in packaged and path is not None and not os.path.isabs(base):
+            base = os.path.join(os.path.dirname(os.path.abspath(path)), base)
+        if base in chain or len(chain) > 8:
+            raise ScenarioError(f"{kind} '{chain[0]}': based_on makes a loop ({' -> '.join(chain)} -> {base})")
+        return load_packaged_or_file(schema, base, kind=kind, folder=folder, _chain=chain)
+
     if not isinstance(name_or_path, (str, os.PathLike)):
         raise ScenarioError(f"a {kind} is a packaged name ({', '.join(packaged)}) or a YAML file path; got "
                             f"{type(name_or_path).__name__}")
     name_or_path = os.fspath(name_or_path)
     if name_or_path in packaged:
         text = resources.files("drake_entry").joinpath(f"{folder}/{name_or_path}.yaml").read_text()
-        return load_yaml_typed(schema, text=text, where=f"{kind} '{name_or_path}'")
+        return load_yaml_typed(schema, text=text, where=f"{kind} '{name_or_path}'", base_of=base_of)
     if os.path.isdir(name_or_path):
         raise ScenarioError(f"{kind} '{name_or_path}' is a directory, not a YAML file")
     if os.path.exists(name_or_path):
-        return load_yaml_typed(schema, path=name_or_path)
+        return load_yaml_typed(schema, path=name_or_path, base_of=base_of)
     raise ScenarioError(f"{kind} '{name_or_path}' is neither a packaged {kind} ({', '.join(packaged)}) nor a file")
 
 
-def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None, where: str | None = None):
+def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None, where: str | None = None,
+                    base_of=None):
     """Read ``schema`` from a YAML file (``path``) or ``text``: checked field by field
     (``check``), then built by Drake's ``yaml_load_typed``; every problem is one
-    ScenarioError naming the file (``where``) and the field path."""
+    ScenarioError naming the file (``where``) and the field path. ``base_of(name, path)``, when
+    given, loads the schema a ``based_on: name`` field starts from (the file's fields then
+    replace the base's, blocks merged field by field)."""
     where = where or path or "YAML"
     if path is not None:
         if not isinstance(path, (str, os.PathLike)):
@@ -317,6 +331,20 @@ def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None,
         check(schema, data, "")
     except ScenarioError as e:
         raise ScenarioError(f"{where}: {e}") from None
+    base = data.get("based_on") if isinstance(data, dict) and base_of is not None else None
+    if base:
+        try:
+            defaults = base_of(base, path)
+        except ScenarioError as e:
+            raise ScenarioError(f"{where}: based_on '{base}': {e}") from None
+        hints = _hints(schema)
+        for name, value in data.items():  # an untagged block of a tagged field would replace the base's
+            variants = _union_args(hints.get(name))
+            if isinstance(value, dict) and variants and all(dc.is_dataclass(v) for v in variants):
+                raise ScenarioError(f"{where}: {name}: write the tag of the block it changes (the base '{base}' "
+                                    f"has !{_tag_name(type(getattr(defaults, name)))}); an untagged block "
+                                    f"starts from the default")
+        return _drake_load(schema, text, where, defaults=defaults)
     return _drake_load(schema, text, where)
 
 

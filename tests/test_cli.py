@@ -30,7 +30,7 @@ def test_scenarios_name_prints_the_file_with_its_comments(capsys):
     assert text == resources.files("drake_entry").joinpath("scenarios/horus2b.yaml").read_text()
     assert "#" in text and "paper 000 Table 2" in text
     assert main(["scenarios", "no_such"]) == 2
-    assert "is not packaged; packaged: capsule_lu2008, cav_h" in capsys.readouterr().err
+    assert "is not packaged; packaged: capsule_lu2008, capsule_lu2008_flight, cav_h" in capsys.readouterr().err
 
 
 def test_version_names_the_package_and_drake(capsys):

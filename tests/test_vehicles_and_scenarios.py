@@ -149,3 +149,44 @@ def test_a_campaign_stored_before_the_replan_renames_reports_its_scenario(name, 
     assert f"  {old}:" in stored
     flown = flown_scenario({"scenario_yaml": stored})
     assert flown is not None and getattr(flown.guidance, new) == getattr(scenario.guidance, new)
+
+
+def test_a_flight_twin_is_its_paper_scenario_plus_the_flight_environment():
+    """Every closed-loop NAME has NAME_flight: the same mission and method settings (but the
+    stated latency), the paper's dispersions kept, every flight-like model added."""
+    import dataclasses as dc
+
+    from pydrake.common.yaml import yaml_dump_typed
+
+    from drake_entry.scenario import closed_loop_scenarios
+
+    names = closed_loop_scenarios()
+    for name in [n for n in names if not n.endswith("_flight")]:
+        assert f"{name}_flight" in names
+        paper, twin = load_scenario(name), load_scenario(f"{name}_flight")
+        assert twin.based_on == name and twin.name == f"{name}_flight"
+        assert (twin.vehicle, twin.aero, twin.vehicle_limits) == (paper.vehicle, paper.aero, paper.vehicle_limits)
+        for field in ("entry", "target", "terminal", "alpha", "planet", "atmosphere", "simulation"):
+            assert yaml_dump_typed(getattr(twin, field)) == yaml_dump_typed(getattr(paper, field)), (name, field)
+        guidance = dc.replace(twin.guidance, replan_latency_s=getattr(paper.guidance, "replan_latency_s", 0.0)) \
+            if hasattr(paper.guidance, "replan_latency_s") else twin.guidance
+        assert yaml_dump_typed(guidance) == yaml_dump_typed(paper.guidance), name
+        assert yaml_dump_typed(twin.dispersions.entry) == yaml_dump_typed(paper.dispersions.entry)
+        d = twin.dispersions
+        assert None not in (d.aero_regimes, d.atmosphere_perturbations, d.winds, d.inertial_navigation), name
+
+
+def test_based_on_resolves_relative_to_the_file_and_refuses_loops_and_untagged_method_blocks(tmp_path):
+    (tmp_path / "a.yaml").write_text("based_on: horus2b\nname: a\nguidance: !DragEnergy\n  replan_period_s: 40.0\n")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "b.yaml").write_text("based_on: ../a.yaml\nname: b\n")
+    b = load_scenario(str(tmp_path / "sub" / "b.yaml"))
+    assert b.name == "b" and b.guidance.replan_period_s == 40.0 and b.guidance.terminal_altitude_km == 26.5
+    (tmp_path / "c.yaml").write_text("based_on: d.yaml\nname: c\n")
+    (tmp_path / "d.yaml").write_text("based_on: c.yaml\nname: d\n")
+    with pytest.raises(ScenarioError, match="based_on makes a loop"):
+        load_scenario(str(tmp_path / "c.yaml"))
+    (tmp_path / "e.yaml").write_text("based_on: capsule_lu2008\nname: e\nguidance:\n  period_s: 2.0\n")
+    with pytest.raises(ScenarioError, match=r"guidance: write the tag of the block it changes \(the base "
+                                            r"'capsule_lu2008' has !Fnpeg\)"):
+        load_scenario(str(tmp_path / "e.yaml"))

@@ -6,8 +6,9 @@ NASA/TP-2010-216447; docs/references.md).
 and percentiles (paper 000 Table 3; paper 003 Table 3 counts inside 25/50/75 km) and the worst
 path-limit margins. ``write_report(out_dir)`` reads a campaign directory's streams
 (drake_entry.campaign.store) and writes report.md and report.html: verdict, provenance,
-dispersions, requirements, outcome, statistics (drake_entry.campaign.statistics), contributors
-to the miss, cost and captioned figures (drake_entry.campaign.report_figures).
+dispersions, requirements, outcome, statistics (drake_entry.campaign.statistics), what drives the
+misses and failures (drake_entry.campaign.drivers), cost and captioned figures
+(drake_entry.campaign.report_figures).
 """
 from __future__ import annotations
 
@@ -22,14 +23,15 @@ import re
 import shlex
 
 import numpy as np
-from scipy import stats as sps
 
 from drake_entry.campaign import report_figures as figures
+from drake_entry.campaign.drivers import failure_drivers
 from drake_entry.campaign.statistics import (
     CONFIDENCE,
     COVERAGE,
     SUCCESS_LEVELS,
     describe,
+    finite_column,
     order_statistic_bound,
     runs_for_bound,
     success_lower_bound,
@@ -43,11 +45,11 @@ from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario, upgrade_scenario_yaml
 from drake_entry.typed_yaml import load_yaml_typed
 
-__all__ = ["ERROR_COLUMNS", "MARGIN_COLUMNS", "failure_categories", "finite_column", "reached_terminal",
+__all__ = ["ERROR_COLUMNS", "MARGIN_COLUMNS", "failure_categories", "reached_terminal",
            "summary_statistics", "counts_sentence", "errors_markdown", "flown_scenario", "rows_as_columns",
            "write_report", "write_markdown_report", "PEAK_QUANTITIES", "OTHER_QUANTITIES", "CONTROL_QUANTITIES",
            "DISPERSION_FIELDS", "NAV_UNITS", "DISPERSION_LABELS", "NAV_NAMES", "table_cell", "format_number",
-           "drake_entry_version", "MAX_FAILED_LISTED", "miss_contributors", "figure_list", "write_html"]
+           "drake_entry_version", "MAX_FAILED_LISTED", "figure_list", "write_html"]
 
 # (row column, label, unit) of the terminal errors, in the scenario schema's order
 ERROR_COLUMNS = tuple(zip(ERROR_COLUMN_NAMES,
@@ -75,12 +77,6 @@ def failure_categories(row: dict) -> list[str]:
     out = [] if inside else ["outside the acceptance box"]
     out += [f"{part.split()[0]} limit breached" for part in str(row.get("violations") or "").split("; ") if part]
     return out or [message.split(":")[0][:80]]
-
-
-def finite_column(rows: dict, col: str, n: int) -> np.ndarray:
-    """A column as floats (missing column or entry = nan)."""
-    v = rows.get(col)
-    return np.full(n, np.nan) if v is None else np.array([np.nan if x is None else x for x in v], float)
 
 
 def reached_terminal(rows: dict) -> np.ndarray:
@@ -206,7 +202,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     killed or running campaign) and the scenario as flown (its manifest). The report: the
     verdict with Clopper-Pearson bounds, provenance, the dispersion table, the requirements
     table, the outcome and the failed samples, statistics of every terminal error, peak, heat
-    load, flight time and control-activity figure, the largest contributors to the miss, and
+    load, flight time and control-activity figure, what drives the misses and failures, and
     captioned figures. ``limits``: the vehicle's path limits drawn on the figures (default: the
     flown scenario's vehicle); ``reference``: published results put beside the terminal errors
     (default: the flown scenario's ``reference_results``). Raises CampaignError when out_dir
@@ -237,14 +233,14 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     reached = reached_terminal(rows)
     quantities = _quantities(rows, reached)
     stats["distributions"] = {key: describe(values) for key, (_, _, values) in quantities.items()}
-    stats["contributors"] = miss_contributors(rows, reached)
+    stats["drivers"] = failure_drivers(rows)
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
         json.dump(stats, f, indent=2)
     name = title or _name(meta)
     figs = _figures(rows, reached, traj, out_dir, scenario, limits, name, meta)
     sections = [_header(meta, stats, title, rows), _provenance(meta, stats), _dispersions(scenario),
                 _requirements(rows, reached, stats, scenario), _outcome(rows, stats, traj),
-                _distributions(rows, quantities, reached, stats, reference), _contributors(stats), _cost(stats),
+                _distributions(rows, quantities, reached, stats, reference), _drivers(stats), _cost(stats),
                 figure_list(figs)]
     return write_markdown_report(sections, out_dir, title=name)
 
@@ -323,7 +319,14 @@ DISPERSION_LABELS = {"disp_dh_m": "entry altitude deviation [m]", "disp_dlon_deg
                      **{f"disp_d{c}_{r}": f"{c} error, {r}" for c in ("CL", "CD") for r in AERO_REGIMES},
                      "disp_trim_alpha_deg": "trim angle-of-attack error [deg]",
                      **{f"disp_d{q}_{km}km": f"{name} perturbation at {km} km" for km in PERTURBATION_COLUMNS_KM
-                        for q, name in (("rho", "density"), ("T", "temperature"))}}
+                        for q, name in (("rho", "density"), ("T", "temperature"))},
+                     **{f"disp_wind_{d}_{km}km": f"wind towards the {d} at {km} km [m/s]" for km in PERTURBATION_COLUMNS_KM
+                        for d in ("east", "north")},
+                     "disp_ins_dr0_m": "INS position error at entry [m]", "disp_ins_dv0_m_s": "INS velocity error at entry [m/s]",
+                     **{f"disp_ins_accel_bias_{a}_m_s2": f"accelerometer bias, {a} axis [m/s²]" for a in "xyz"},
+                     **{f"disp_ins_scale_factor_{a}_ppm": f"accelerometer scale factor, {a} axis [ppm]" for a in "xyz"},
+                     **{f"disp_ins_gyro_drift_{a}_deg_h": f"gyro drift, {w} [deg/h]" for a, w in
+                        (("e", "east"), ("n", "north"), ("u", "up"))}}
 NAV_NAMES = ("altitude", "longitude", "latitude", "speed", "flight-path angle", "heading")
 
 
@@ -679,35 +682,32 @@ def _distributions(rows: dict, quantities: dict, reached, stats: dict, reference
     return "\n".join(out)
 
 
-def miss_contributors(rows: dict, reached, top: int = 5) -> list:
-    """The dispersed inputs (``disp_*`` columns that vary) ranked by |Spearman rank correlation|
-    with the miss distance over the reached samples: [{input, rho, p_value}] (empty below 8
-    samples)."""
-    n = len(rows["index"])
-    miss = finite_column(rows, "err_distance_m", n)[reached]
-    if miss.size < 8 or not np.isfinite(miss).all():
-        return []
-    out = []
-    for col in sorted(c for c in rows if c.startswith("disp_")):
-        x = finite_column(rows, col, n)[reached]
-        if not np.isfinite(x).all() or np.ptp(x) == 0.0:
-            continue
-        rho, p = sps.spearmanr(x, miss)
-        out.append({"input": col, "rho": float(rho), "p_value": float(p)})
-    return sorted(out, key=lambda c: -abs(c["rho"]))[:top]
-
-
-def _contributors(stats_: dict) -> str:
-    c = stats_.get("contributors") or []
-    if not c:
+def _drivers(stats_: dict) -> str:
+    d = stats_.get("drivers") or {}
+    if not d.get("inputs"):
         return ""
-    lines = ["## Largest contributors to the miss", "",
-             "Dispersed inputs ranked by the magnitude of their Spearman rank correlation with the distance to the "
-             "target over the samples that reached the terminal interface (a monotonic association, not a causal "
-             "share; |ρ| below about 0.2 explains little, and a p-value above 0.05 is indistinguishable from none).", "",
-             "| input | Spearman ρ | p-value |", "|---|---|---|"]
-    lines += [f"| {DISPERSION_LABELS.get(x['input'], x['input'].removeprefix('disp_'))} | {x['rho']:+.3f} | "
-              f"{x['p_value']:.2g} |" for x in c]
+    outcomes = d["outcomes"]
+    label = lambda col: DISPERSION_LABELS.get(col, col.removeprefix("disp_"))  # noqa: E731
+    lines = ["## What drives the misses and the failures", "",
+             "Every dispersed input against every outcome by Spearman rank correlation ρ over the samples where both "
+             "are finite (success counts 1, failure 0; a margin is 1 - peak / limit, so a negative ρ means the input "
+             "eats the margin). The inputs with the largest |ρ| in any column are listed. A monotonic association, "
+             "not a causal share: with many inputs some ρ are large by chance, so only the bold cells pass the "
+             f"Bonferroni level p < {d['level']:.2g} (0.05 over the number of cells).", "",
+             "| input | " + " | ".join(w for _, w in outcomes) + " |", "|---" * (len(outcomes) + 1) + "|"]
+    for r in d["inputs"]:
+        cells = []
+        for col, _ in outcomes:
+            c = r["cells"].get(col)
+            text = "—" if c is None else f"{c[0]:+.2f}"
+            cells.append(f"**{text}**" if c is not None and c[1] < d["level"] else text)
+        lines.append(f"| {label(r['input'])} | " + " | ".join(cells) + " |")
+    if d.get("failures"):
+        lines += ["", "Failed against successful samples (the inputs most associated with success; medians and the "
+                      "Mann-Whitney U test's p-value):", ""]
+        lines += [f"- {label(f['input'])}: median {format_number(f['median_failed'])} in the failed samples, "
+                  f"{format_number(f['median_successful'])} in the successful ones (ρ with success {f['rho']:+.2f}, "
+                  f"Mann-Whitney p = {f['mann_whitney_p']:.2g})" for f in d["failures"]]
     return "\n".join(lines)
 
 

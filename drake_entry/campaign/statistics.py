@@ -23,7 +23,7 @@ from scipy import stats
 from drake_entry.errors import ScenarioError
 
 __all__ = ["PERCENTILES", "COVERAGE", "CONFIDENCE", "SUCCESS_LEVELS", "success_lower_bound", "runs_for_bound",
-           "order_statistic_rank", "order_statistic_bound", "describe", "percentile_key"]
+           "order_statistic_rank", "order_statistic_bound", "finite_column", "describe", "percentile_key"]
 
 #: the percentiles of the report [%] (P0.13 and P99.87: the normal distribution's 3-sigma levels)
 PERCENTILES = (0.13, 1.0, 50.0, 99.0, 99.87)
@@ -81,6 +81,12 @@ def order_statistic_bound(values, coverage: float = COVERAGE, confidence: float 
     if r == 0:
         return None
     return float(v[-r] if upper else v[r - 1])
+
+
+def finite_column(rows: dict, col: str, n: int) -> np.ndarray:
+    """A column as floats (missing column or entry = nan)."""
+    v = rows.get(col)
+    return np.full(n, np.nan) if v is None else np.array([np.nan if x is None else x for x in v], float)
 
 
 def describe(values) -> dict:

@@ -22,7 +22,6 @@ from drake_entry.campaign.report import (
     MARGIN_COLUMNS,
     drake_entry_version,
     figure_list,
-    finite_column,
     flown_scenario,
     format_number,
     reached_terminal,
@@ -31,6 +30,7 @@ from drake_entry.campaign.report import (
     table_cell,
     write_markdown_report,
 )
+from drake_entry.campaign.statistics import finite_column
 from drake_entry.campaign.store import coverage, read_manifest
 from drake_entry.errors import CampaignError
 from drake_entry.figures import plt, save_figure

@@ -325,6 +325,17 @@ def test_example_20(tmp_path):
     assert "F10.7 150" in r["source"] and os.path.exists(tmp_path / "nrlmsis_atmosphere.png")
 
 
+@pytest.mark.slow
+def test_example_21(tmp_path):
+    """A flight-like twin's sample with the INS and with perfect navigation: both succeed, the INS
+    error grows and changes the miss, perfect navigation has none."""
+    r = _run("21_flight_environment", tmp_path)
+    flights = r["flights"]
+    assert all(f.success for f in flights.values())
+    assert r["error"][-1, 0] > 100.0 and flights["perfect navigation"].trajectory.extra["navigation_error"].max() == 0
+    assert os.path.exists(tmp_path / "flight_environment.png")
+
+
 def test_the_examples_command_line_passes_quick_out_and_options_and_exits_by_the_claims(tmp_path, capsys):
     """run_example: --quick, --out and an example's own options reach main; the exit status is
     the claims' (1 when one fails)."""

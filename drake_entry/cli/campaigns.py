@@ -96,9 +96,10 @@ def results(args) -> int:
                             f"allowed: {', '.join(names)}")
     os.makedirs(args.out, exist_ok=True)
     lines = ["# Campaign results", "",
-             f"Every packaged closed-loop scenario flown as a Monte-Carlo campaign ({args.runs} runs, seed "
-             f"{args.seed}) by `drake-entry results --runs {args.runs} --seed {args.seed}`; each directory holds "
-             "report.md (and report.html, self-contained), its figures, summary.json and campaign.json.", "",
+             f"Packaged closed-loop scenarios flown as Monte-Carlo campaigns by `drake-entry results --runs {args.runs} "
+             f"--seed {args.seed}` (every campaign directory below this one is listed, also those of an earlier run "
+             "with `--only`; each report states its runs, seed and commit); each directory holds report.md (and "
+             "report.html, self-contained), its figures, summary.json and campaign.json.", "",
              "| scenario | successful | success probability, 90 % lower bound | report |", "|---|---|---|---|"]
     failed = 0
     for name in chosen:
@@ -108,11 +109,16 @@ def results(args) -> int:
         path = write_report(out)
         with open(os.path.join(out, "summary.json")) as f:
             stats = json.load(f)
-        ok, n = stats["successful"], stats["samples"]
-        failed += ok < n
-        lines.append(f"| `{name}` | {ok} of {n} | {100 * stats['success_lower_bound']['0.9']:.2f} % | "
-                     f"[report]({name}/report.md) |")
-        print(f"   {ok} of {n} successful; report: {path}", flush=True)
+        failed += stats["successful"] < stats["samples"]
+        print(f"   {stats['successful']} of {stats['samples']} successful; report: {path}", flush=True)
+    for name in names:  # every campaign below --out, also those of an earlier run (--only)
+        summary = os.path.join(args.out, name, "summary.json")
+        if not os.path.isfile(summary):
+            continue
+        with open(summary) as f:
+            stats = json.load(f)
+        lines.append(f"| `{name}` | {stats['successful']} of {stats['samples']} | "
+                     f"{100 * stats['success_lower_bound']['0.9']:.2f} % | [report]({name}/report.md) |")
     with open(os.path.join(args.out, "index.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print(f"wrote {os.path.join(args.out, 'index.md')}")

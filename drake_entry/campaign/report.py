@@ -482,6 +482,27 @@ def _wind_rows(w) -> list:
             f"{profile(w.sigma_m_s)} | m/s |"]
 
 
+def _inertial_rows(n) -> list:
+    """Dispersion-table rows of the inertial navigation errors."""
+    if n is None:
+        return []
+    rows = []
+    if not n.enabled:
+        rows.append("| inertial navigation | switched off | — | perfect navigation (the errors drawn, not flown) | — |")
+    if n.initial_covariance is not None:
+        sd = np.sqrt(np.clip(np.diag(np.asarray(n.initial_covariance, float)), 0.0, None))
+        rows.append(f"| INS error at entry, position (east, north, up) | 0 | Gaussian (covariance) | 1σ "
+                    f"{sd[0]:g}, {sd[1]:g}, {sd[2]:g} | m |")
+        rows.append(f"| INS error at entry, velocity (east, north, up) | 0 | Gaussian (covariance) | 1σ "
+                    f"{sd[3]:g}, {sd[4]:g}, {sd[5]:g} | m/s |")
+    rows += [f"| accelerometer bias, each axis | 0 | Gaussian | 1σ {n.accelerometer_bias_sigma_m_s2:g} | m/s² |",
+             f"| accelerometer scale factor, each axis | 0 | Gaussian | 1σ {n.accelerometer_scale_factor_sigma_ppm:g} "
+             f"| ppm |",
+             f"| gyro drift, each axis | 0 | Gaussian | 1σ {n.gyro_drift_sigma_deg_h:g} | deg/h |",
+             f"| INS gravity feedback (Schuler, vertical channel) | {'on' if n.gravity_feedback else 'off'} | — | — | — |"]
+    return rows
+
+
 def _covariance_rows(covariance) -> list:
     """Dispersion-table rows of an entry delivery covariance: each 1-sigma, then the correlations."""
     if covariance is None:
@@ -534,7 +555,8 @@ def _dispersions(scenario) -> str:
             lines.append(f"| navigation white noise, {NAV_NAMES[i]} | 0 | Gaussian per step | 1σ {s:g} | "
                          f"{NAV_UNITS[i]} |")
     lines += (_regime_rows(spec.aero_regimes) + _covariance_rows(spec.entry_covariance)
-              + _perturbation_rows(spec.atmosphere_perturbations) + _wind_rows(spec.winds))
+              + _perturbation_rows(spec.atmosphere_perturbations) + _wind_rows(spec.winds)
+              + _inertial_rows(spec.inertial_navigation))
     head = "## Dispersions\n\n"
     source = f"Source: {spec.source}." if spec.source else "Source: not stated in the scenario (`dispersions.source`)."
     if not lines:

@@ -28,7 +28,7 @@ import tempfile
 
 from interface_cost import _checkout, _installed_layout
 
-from drake_entry.scenario import closed_loop_scenarios
+from drake_entry.scenario import closed_loop_scenarios, load_scenario
 
 #: paper 004 with sigma_0 re-solved on board every 100 s: the variant the PIO target is about
 #: (a scenario variant is NAME:field=value[,field=value]: the packaged scenario with those overrides)
@@ -115,10 +115,11 @@ def method_cost_benchmark(*, baseline: str = "HEAD~1", samples: dict | None = No
                           seed: int = 7, only: list | None = None) -> dict:
     """Print and return {scenario: {side: {setup_s, sample_s, shares}}, ...}; ``only``: packaged
     scenarios or variants NAME:field=value[,field=value] (default: every packaged closed-loop
-    scenario and PIO_ON_BOARD); ``samples`` per scenario (default: 10 for the fast methods, 4 for
+    scenario but the flight-like twins, and PIO_ON_BOARD); ``samples`` per scenario (default: 10 for the fast methods, 4 for
     PIO with sigma_0 fixed, 2 for SCvx and PIO re-solved on board)."""
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    names = only or [*closed_loop_scenarios(), PIO_ON_BOARD]
+    # the flight-like twins (based_on a paper scenario) only by --scenarios: a baseline before them has none
+    names = only or [*(n for n in closed_loop_scenarios() if not load_scenario(n).based_on), PIO_ON_BOARD]
     counts = {"horus2b": 10, "shefex3_ampi": 10, "sphynx_paper001": 2, "cav_h_paper004": 4, PIO_ON_BOARD: 2,
               **(samples or {})}
     out = {}

@@ -27,53 +27,75 @@ from scipy.signal import lfilter
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["MAX_PERTURBATION_SIGMA", "AtmospherePerturbationSpec", "validate_perturbations", "unit_profiles",
-           "draw_profiles"]
+__all__ = ["MAX_PERTURBATION_SIGMA", "AltitudeProcessSpec", "AtmospherePerturbationSpec", "validate_process",
+           "process_nodes_km", "validate_perturbations", "unit_profiles", "draw_profiles"]
 
 #: a perturbation's 1-sigma is below this, so the density and temperature stay positive to 5 sigma
 MAX_PERTURBATION_SIGMA = 0.2
 
 
 @dc.dataclass
-class AtmospherePerturbationSpec:
-    """Density and temperature perturbation profiles of a Monte-Carlo sample (module docstring)."""
+class AltitudeProcessSpec:
+    """The altitude grid of a perturbation profile and the process it is drawn with (module
+    docstring): shared by the density and temperature perturbations and the winds."""
 
-    # altitudes [km] of the 1-sigma profiles (increasing); the profiles hold beyond the ends
+    # altitudes [km] of the profiles below (increasing); the profiles hold beyond the ends
     altitude_km: list[float] = dc.field(default_factory=lambda: [0.0, 150.0])
-    # 1-sigma of the density and of the temperature perturbation [fraction] at those altitudes
-    density_sigma: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
-    temperature_sigma: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
     # share of the variance in the large-scale part (one value per flight), 0..1
     large_scale_fraction: float = 0.5
     # vertical correlation length of the small-scale part [km]
     vertical_scale_km: float = 5.0
-    # correlation of the density and temperature perturbations (both parts)
-    density_temperature_correlation: float = 0.0
     # the grid the small-scale process is drawn on [km] (linear between its nodes)
     step_km: float = 0.5
     # the altitude span of the drawn profile [km]; beyond it the end values hold
     top_km: float = 150.0
 
 
-def validate_perturbations(p: AtmospherePerturbationSpec, where: str) -> None:
-    """One-line ScenarioErrors naming the field."""
+@dc.dataclass
+class AtmospherePerturbationSpec(AltitudeProcessSpec):
+    """Density and temperature perturbation profiles of a Monte-Carlo sample (module docstring)."""
+
+    # 1-sigma of the density and of the temperature perturbation [fraction] at altitude_km
+    density_sigma: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
+    temperature_sigma: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
+    # correlation of the density and temperature perturbations (both parts)
+    density_temperature_correlation: float = 0.0
+
+
+def validate_process(p: AltitudeProcessSpec, where: str, profiles) -> None:
+    """One-line ScenarioErrors naming the field: the altitudes, the process, and each of
+    ``profiles`` ((field name, lowest, highest, unit text)) one value per altitude in range."""
     h = np.asarray(p.altitude_km, float)
     if h.ndim != 1 or h.size < 1 or not np.all(np.isfinite(h)) or np.any(np.diff(h) <= 0):
-        raise ScenarioError(f"{where}.altitude_km = {p.altitude_km} must be finite and increasing")
-    for name in ("density_sigma", "temperature_sigma"):
-        v = getattr(p, name)
-        if len(v) != h.size:
-            raise ScenarioError(f"{where}.{name} needs one value per altitude ({h.size}), got {len(v)}")
-        for i, s in enumerate(v):
-            if not (math.isfinite(s) and 0.0 <= s < MAX_PERTURBATION_SIGMA):
-                raise ScenarioError(f"{where}.{name}[{i}] = {s} is out of range; allowed: [0, {MAX_PERTURBATION_SIGMA:g}) "
-                                    f"(the quantity stays positive to 5 sigma)")
-    checks = (("large_scale_fraction", 0.0, 1.0), ("density_temperature_correlation", -1.0, 1.0),
-              ("vertical_scale_km", 1e-3, 1e3), ("step_km", 1e-2, 10.0), ("top_km", 1.0, 1e3))
+        raise ScenarioError(f"{where}.altitude_km = {p.altitude_km} must be finite and sorted increasing")
+    for name, lo, hi, unit in profiles:
+        values = getattr(p, name)
+        if len(values) != h.size:
+            raise ScenarioError(f"{where}.{name} needs one value per altitude ({h.size}), got {len(values)}")
+        for i, v in enumerate(values):
+            if not (math.isfinite(v) and lo <= v <= hi):
+                raise ScenarioError(f"{where}.{name}[{i}] = {v} is out of range; allowed: {unit}")
+    checks = (("large_scale_fraction", 0.0, 1.0), ("vertical_scale_km", 1e-3, 1e3), ("step_km", 1e-2, 10.0),
+              ("top_km", 1.0, 1e3))
     for name, lo, hi in checks:
         v = getattr(p, name)
         if not (math.isfinite(v) and lo <= v <= hi):
             raise ScenarioError(f"{where}.{name} = {v} is out of range; allowed: [{lo:g}, {hi:g}]")
+
+
+def process_nodes_km(p: AltitudeProcessSpec) -> np.ndarray:
+    """The altitude grid [km] a profile of ``p`` is drawn on."""
+    return np.arange(0.0, p.top_km + 0.5 * p.step_km, p.step_km)
+
+
+def validate_perturbations(p: AtmospherePerturbationSpec, where: str) -> None:
+    """One-line ScenarioErrors naming the field."""
+    below = MAX_PERTURBATION_SIGMA * (1 - 1e-12)
+    allowed = f"[0, {MAX_PERTURBATION_SIGMA:g}) (the quantity stays positive to 5 sigma)"
+    validate_process(p, where, [("density_sigma", 0.0, below, allowed), ("temperature_sigma", 0.0, below, allowed)])
+    v = p.density_temperature_correlation
+    if not (math.isfinite(v) and -1.0 <= v <= 1.0):
+        raise ScenarioError(f"{where}.density_temperature_correlation = {v} is out of range; allowed: [-1, 1]")
 
 
 def unit_profiles(rng, nodes_km: np.ndarray, large_scale_fraction: float, vertical_scale_km: float,
@@ -101,7 +123,7 @@ def draw_profiles(p: AtmospherePerturbationSpec, generator) -> tuple[np.ndarray,
     """(altitude nodes [m], density perturbation, temperature perturbation) of one sample: one
     draw of the sample's generator seeds the profile's normal draws."""
     rng = np.random.default_rng(int(generator()))
-    nodes_km = np.arange(0.0, p.top_km + 0.5 * p.step_km, p.step_km)
+    nodes_km = process_nodes_km(p)
     unit = unit_profiles(rng, nodes_km, p.large_scale_fraction, p.vertical_scale_km,
                          p.density_temperature_correlation)
     sigma = np.column_stack([np.interp(nodes_km, p.altitude_km, p.density_sigma),

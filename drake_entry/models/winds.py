@@ -10,14 +10,18 @@ long glide at nearly constant altitude sees one wind (no horizontal correlation)
 (No ``from __future__ import annotations``: pydrake's YAML reads the spec's field types.)
 """
 import dataclasses as dc
-import math
 
 import numpy as np
 from pydrake.symbolic import Expression, if_then_else
 
 from drake_entry.errors import ScenarioError
 from drake_entry.models.atmosphere import Atmosphere, piecewise
-from drake_entry.models.atmosphere_perturbations import unit_profiles
+from drake_entry.models.atmosphere_perturbations import (
+    AltitudeProcessSpec,
+    process_nodes_km,
+    unit_profiles,
+    validate_process,
+)
 from drake_entry.models.scalar import is_autodiff, is_symbolic, lift
 
 __all__ = ["MAX_WIND_M_S", "WindSpec", "validate_winds", "draw_wind", "WindProfile", "WindyAtmosphere"]
@@ -28,52 +32,28 @@ MAX_WIND_M_S = 300.0
 
 
 @dc.dataclass
-class WindSpec:
+class WindSpec(AltitudeProcessSpec):
     """A Monte-Carlo sample's horizontal wind (module docstring)."""
 
-    # altitudes [km] of the profiles below (increasing); the profiles hold beyond the ends
-    altitude_km: list[float] = dc.field(default_factory=lambda: [0.0, 150.0])
-    # mean wind towards the east and towards the north [m/s] at those altitudes
+    # mean wind towards the east and towards the north [m/s] at altitude_km
     east_mean_m_s: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
     north_mean_m_s: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
-    # 1-sigma of each horizontal component's perturbation [m/s] at those altitudes
+    # 1-sigma of each horizontal component's perturbation [m/s] at altitude_km
     sigma_m_s: list[float] = dc.field(default_factory=lambda: [0.0, 0.0])
-    # share of the variance in the large-scale part (one value per flight), 0..1
-    large_scale_fraction: float = 0.5
-    # vertical correlation length of the small-scale part [km]
-    vertical_scale_km: float = 5.0
-    # the grid the small-scale process is drawn on [km] (linear between its nodes)
-    step_km: float = 0.5
-    # the altitude span of the drawn profile [km]; beyond it the end values hold
-    top_km: float = 150.0
 
 
 def validate_winds(w: WindSpec, where: str) -> None:
     """One-line ScenarioErrors naming the field."""
-    h = np.asarray(w.altitude_km, float)
-    if h.ndim != 1 or h.size < 1 or not np.all(np.isfinite(h)) or np.any(np.diff(h) <= 0):
-        raise ScenarioError(f"{where}.altitude_km = {w.altitude_km} must be finite and sorted increasing")
-    for name in ("east_mean_m_s", "north_mean_m_s", "sigma_m_s"):
-        values = getattr(w, name)
-        if len(values) != h.size:
-            raise ScenarioError(f"{where}.{name} needs one value per altitude ({h.size}), got {len(values)}")
-        low = 0.0 if name == "sigma_m_s" else -MAX_WIND_M_S
-        high = MAX_WIND_M_S / 5.0 if name == "sigma_m_s" else MAX_WIND_M_S
-        for i, v in enumerate(values):
-            if not (math.isfinite(v) and low <= v <= high):
-                raise ScenarioError(f"{where}.{name}[{i}] = {v} is out of range; allowed: [{low:g}, {high:g}] m/s")
-    checks = (("large_scale_fraction", 0.0, 1.0), ("vertical_scale_km", 1e-3, 1e3), ("step_km", 1e-2, 10.0),
-              ("top_km", 1.0, 1e3))
-    for name, lo, hi in checks:
-        v = getattr(w, name)
-        if not (math.isfinite(v) and lo <= v <= hi):
-            raise ScenarioError(f"{where}.{name} = {v} is out of range; allowed: [{lo:g}, {hi:g}]")
+    mean = f"[{-MAX_WIND_M_S:g}, {MAX_WIND_M_S:g}] m/s"
+    validate_process(w, where, [("east_mean_m_s", -MAX_WIND_M_S, MAX_WIND_M_S, mean),
+                                ("north_mean_m_s", -MAX_WIND_M_S, MAX_WIND_M_S, mean),
+                                ("sigma_m_s", 0.0, MAX_WIND_M_S / 5.0, f"[0, {MAX_WIND_M_S / 5.0:g}] m/s")])
 
 
 def draw_wind(w: WindSpec, generator) -> "WindProfile":
     """One sample's wind profile: one draw of the sample's generator seeds its normal draws."""
     rng = np.random.default_rng(int(generator()))
-    nodes_km = np.arange(0.0, w.top_km + 0.5 * w.step_km, w.step_km)
+    nodes_km = process_nodes_km(w)
     unit = unit_profiles(rng, nodes_km, w.large_scale_fraction, w.vertical_scale_km, 0.0)
     sigma = np.interp(nodes_km, w.altitude_km, w.sigma_m_s)
     east = np.interp(nodes_km, w.altitude_km, w.east_mean_m_s) + sigma * unit[:, 0]

@@ -3,8 +3,8 @@ by a bad or extreme value. Every case ends in one of two ways: a one-line error 
 traceback), or a finished run with a named stop reason and no NaN in a result called a
 success. Never a hang: each case runs under a time limit.
 
-CI runs a bounded, derandomised number of examples (DRAKE_ENTRY_FUZZ_EXAMPLES, default 25
-per test); set it higher for a longer search. With DRAKE_ENTRY_FUZZ_LOG=path each case's
+Both tests are marked slow (about 25 s of one core each): CI runs them in its slow set, a
+bounded, derandomised number of examples (DRAKE_ENTRY_FUZZ_EXAMPLES, default 25 per test); set it higher for a longer search. With DRAKE_ENTRY_FUZZ_LOG=path each case's
 outcome is appended there as a JSON line (for the tally in the issue's closing note).
 """
 import contextlib
@@ -100,6 +100,7 @@ def _finite(v) -> bool:
     return not isinstance(v, float) or math.isfinite(v)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(k=st.integers(0, 10_000), value=BAD, command=st.sampled_from(["simulate", "fly"]))
 def test_scenario_with_a_bad_number_gives_one_line_or_a_named_stop(tmp_path, capsys, k, value, command):
@@ -119,6 +120,7 @@ def test_scenario_with_a_bad_number_gives_one_line_or_a_named_stop(tmp_path, cap
         assert code == 0
 
 
+@pytest.mark.slow
 @FUZZ
 @given(k=st.integers(0, 10_000), value=BAD)
 def test_problem_with_a_bad_number_gives_one_line_or_a_checked_result(tmp_path, capsys, k, value):

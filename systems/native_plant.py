@@ -38,7 +38,7 @@ from drake_entry.scenario import PLANTS
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.vehicle import N_STATE, EntryVehicle
 
-__all__ = ["STATE", "DEVIATION", "BANK", "ALPHA", "RHO", "SPEED_OF_SOUND", "WIND", "NativeAtmosphere", "NativeEntryVehicle",
+__all__ = ["STATE", "DEVIATION", "BANK", "ALPHA", "RHO", "SPEED_OF_SOUND", "WIND", "AIR_VELOCITY", "NativeAtmosphere", "NativeEntryVehicle",
            "SYMBOLIC_DOMAIN_ERROR", "as_flight_error", "flight_stop", "add_plant", "PlantProbe"]
 
 #: the symbols of every native plant (shared, so each nominal model's expression trees are
@@ -47,6 +47,7 @@ STATE = [Variable(name) for name in dynamics.STATE_NAMES]
 DEVIATION = [Variable(f"d{name}") for name in dynamics.STATE_NAMES]
 BANK, ALPHA, RHO, SPEED_OF_SOUND = (Variable(n) for n in ("bank", "alpha", "rho", "speed_of_sound"))
 WIND = [Variable("wind_east"), Variable("wind_north")]
+AIR_VELOCITY = [Variable(n) for n in ("air_east", "air_north", "air_up", "air_horizontal", "airspeed")]
 
 
 
@@ -85,22 +86,30 @@ class NativeEntryVehicle(Diagram):
         x = [Expression(d) + float(x0) for d, x0 in zip(DEVIATION, self.x0)]
         bank, alpha, rho, a = (Expression(v) for v in (BANK, ALPHA, RHO, SPEED_OF_SOUND))
         state = [Expression(v) for v in STATE]
+        # in a wind the air-relative velocity is an input (computed once by "air_velocity" from the
+        # state and the wind), since Drake evaluates an expression tree without sharing repeated parts
         wind = [Expression(v) for v in WIND] if winds else None
-        air = [RHO, SPEED_OF_SOUND, *(WIND if winds else [])]
+        velocity = [Expression(v) for v in AIR_VELOCITY] if winds else None
+        speed = velocity[4] if winds else None
+        relative = (velocity[:3], velocity[3], velocity[4]) if winds else None
+        air = [RHO, SPEED_OF_SOUND, *(WIND + AIR_VELOCITY if winds else [])]
         with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
-            _, L, D = dynamics.aero_accelerations(x, alpha, rho, a, vehicle, wind)
-            xdot = dynamics.equations_of_motion(x, bank, L, D, planet, wind)
+            _, L, D = dynamics.aero_accelerations(x, alpha, rho, a, vehicle, wind, speed)
+            xdot = dynamics.equations_of_motion(x, bank, L, D, planet, wind, relative)
             conditions = dynamics.conditions_from(state, alpha, rho,
-                                                  *dynamics.aero_accelerations(state, alpha, rho, a, vehicle, wind),
-                                                  vehicle, planet, dynamics.airspeed(state, wind))
+                                                  *dynamics.aero_accelerations(state, alpha, rho, a, vehicle, wind, speed),
+                                                  vehicle, planet, speed)
+            if winds:
+                (ve, vn, vu), vh, va = dynamics.air_relative_velocity(state, [Expression(v) for v in WIND])
         builder = DiagramBuilder()
         motion = builder.AddNamedSystem("equations_of_motion", SymbolicVectorSystem(
             state=DEVIATION, input=[BANK, ALPHA, *air], dynamics=list(xdot), output=x))
         cond = builder.AddNamedSystem("flight_conditions", stateless([*STATE, ALPHA, *air],
                                                                      [_expression(c) for c in conditions]))
         inputs = [("alpha", 1), ("air_data", 2)] + ([("wind", 2)] if winds else [])
-        controls = builder.AddNamedSystem("controls", Multiplexer([1] + [n for _, n in inputs]))
-        flight = builder.AddNamedSystem("state_alpha_air", Multiplexer([N_STATE] + [n for _, n in inputs]))
+        sizes = [n for _, n in inputs] + ([len(AIR_VELOCITY)] if winds else [])
+        controls = builder.AddNamedSystem("controls", Multiplexer([1] + sizes))
+        flight = builder.AddNamedSystem("state_alpha_air", Multiplexer([N_STATE] + sizes))
         builder.Connect(controls.get_output_port(), motion.get_input_port())
         builder.Connect(motion.get_output_port(), flight.get_input_port(0))
         builder.Connect(flight.get_output_port(), cond.get_input_port())
@@ -108,6 +117,14 @@ class NativeEntryVehicle(Diagram):
         for k, (name, _) in enumerate(inputs, start=1):  # each input feeds both systems
             builder.ExportInput(controls.get_input_port(k), name)
             builder.ConnectInput(name, flight.get_input_port(k))
+        if winds:  # the air-relative velocity of the state in the wind, into both systems
+            speed_of = builder.AddNamedSystem("air_velocity", stateless([*STATE, *WIND], [ve, vn, vu, vh, va]))
+            state_wind = builder.AddNamedSystem("state_wind", Multiplexer([N_STATE, 2]))
+            builder.Connect(motion.get_output_port(), state_wind.get_input_port(0))
+            builder.ConnectInput("wind", state_wind.get_input_port(1))
+            builder.Connect(state_wind.get_output_port(), speed_of.get_input_port())
+            builder.Connect(speed_of.get_output_port(), controls.get_input_port(len(inputs) + 1))
+            builder.Connect(speed_of.get_output_port(), flight.get_input_port(len(inputs) + 1))
         builder.ExportOutput(motion.get_output_port(), "state")
         builder.ExportOutput(cond.get_output_port(), "flight_conditions")
         builder.BuildInto(self)

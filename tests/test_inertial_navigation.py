@@ -166,3 +166,14 @@ def test_the_perfect_navigation_switch_flies_the_flight_without_an_ins():
     assert rows[1]["err_distance_m"] == rows[0]["err_distance_m"]
     assert rows[1]["nav_position_error_max_m"] == 0.0
     assert rows[2]["err_distance_m"] != rows[0]["err_distance_m"] and rows[2]["nav_position_error_max_m"] > 1.0
+
+
+def test_the_stability_axes_are_a_right_handed_orthonormal_triad_with_z_along_the_banked_lift():
+    rng = np.random.default_rng(2)
+    for gamma, psi, bank in rng.uniform([-0.5, -4.0, -1.6], [0.3, 4.0, 1.6], (20, 3)):
+        r = ins.stability_to_local_level(gamma, psi, bank)
+        assert r.T @ r == pytest.approx(np.eye(3), abs=1e-14) and np.linalg.det(r) == pytest.approx(1.0, abs=1e-14)
+        assert r[:, 1] == pytest.approx(np.cross(r[:, 2], r[:, 0]), abs=1e-14)
+        assert r[:, 0] == pytest.approx([math.cos(gamma) * math.sin(psi), math.cos(gamma) * math.cos(psi),
+                                         math.sin(gamma)], abs=1e-14)
+        assert r[2, 2] == pytest.approx(math.cos(gamma) * math.cos(bank), abs=1e-14)  # the lift's vertical share

@@ -34,7 +34,7 @@ from drake_entry.models.scalar import promote
 from drake_entry.models.vehicles import Vehicle
 
 __all__ = ["STATE_NAMES", "STATE_UNITS", "FlightConditions", "FLIGHT_CONDITION_NAMES", "air_data",
-           "wind_at", "airspeed", "aero_accelerations", "air_relative_force_components", "state_derivatives", "equations_of_motion", "equations_of_motion_lift_components",
+           "wind_at", "air_relative_velocity", "airspeed", "aero_accelerations", "air_relative_force_components", "state_derivatives", "equations_of_motion", "equations_of_motion_lift_components",
            "flight_conditions", "conditions_from", "specific_energy", "energy_rate", "energy_domain_derivatives"]
 
 STATE_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
@@ -68,7 +68,7 @@ def wind_at(x, planet: Earth, atmosphere: Atmosphere):
     return atmosphere.wind(planet.atmospheric_altitude(x[0], x[2]))
 
 
-def _air_relative_velocity(x, wind):
+def air_relative_velocity(x, wind):
     """Air-relative velocity (east, north, up) [m/s] and its horizontal and total magnitudes."""
     V, gamma, psi = x[3], x[4], x[5]
     fn = math if isinstance(gamma, float) and isinstance(wind[0], float) else np
@@ -82,25 +82,28 @@ def _air_relative_velocity(x, wind):
 
 def airspeed(x, wind):
     """Air-relative speed V_a [m/s] at state x in the wind (east, north) [m/s]; V in still air."""
-    return x[3] if wind is None else _air_relative_velocity(x, wind)[2]
+    return x[3] if wind is None else air_relative_velocity(x, wind)[2]
 
 
-def aero_accelerations(x, alpha, rho, speed_of_sound, vehicle: Vehicle, wind=None):
+def aero_accelerations(x, alpha, rho, speed_of_sound, vehicle: Vehicle, wind=None, speed=None):
     """Mach, lift and drag accelerations L, D [m/s^2] (paper 001 eq. 8 divided by m), at the
-    air-relative speed in the wind (east, north) [m/s] when one is given."""
-    V = airspeed(x, wind)
+    air-relative speed in the wind (east, north) [m/s] when one is given; ``speed``: that speed
+    [m/s] when already computed (the native plant takes it as an input, so its expression is not
+    repeated wherever the aerodynamic model uses the Mach number)."""
+    V = airspeed(x, wind) if speed is None else speed
     mach = V / speed_of_sound
     cl, cd = vehicle.aero.coefficients(alpha, mach)
     qS_m = 0.5 * rho * V * V * vehicle.area_over_mass
     return mach, qS_m * cl, qS_m * cd
 
 
-def air_relative_force_components(x, bank, L, D, wind):
+def air_relative_force_components(x, bank, L, D, wind, velocity=None):
     """The aerodynamic acceleration's components (L_vertical, L_horizontal, D_along) [m/s^2] in the
     Earth-relative velocity frame, for ``equations_of_motion_lift_components``: drag D along the
     air-relative velocity, lift L normal to it at bank sigma (module docstring); in still air
-    exactly (L cos sigma, L sin sigma, D)."""
-    (ve, vn, vu), vh, va = _air_relative_velocity(x, wind)
+    exactly (L cos sigma, L sin sigma, D). ``velocity``: ``air_relative_velocity(x, wind)`` when
+    already computed."""
+    (ve, vn, vu), vh, va = air_relative_velocity(x, wind) if velocity is None else velocity
     gamma, psi = x[4], x[5]
     fn = math if isinstance(gamma, float) and isinstance(vh, float) and isinstance(bank, float) else np
     lc, ls = L * fn.cos(bank), L * fn.sin(bank)
@@ -132,11 +135,13 @@ def state_derivatives(x, bank, alpha, vehicle: Vehicle, planet: Earth, atmospher
     return equations_of_motion(x, bank, L, D, planet, wind)
 
 
-def equations_of_motion(x, bank, L, D, planet: Earth, wind=None):
+def equations_of_motion(x, bank, L, D, planet: Earth, wind=None, air_velocity=None):
     """xdot given the lift and drag accelerations L, D [m/s^2] (paper 000 eq. 102), in the wind
-    (east, north) [m/s] when one is given (module docstring)."""
+    (east, north) [m/s] when one is given (module docstring; ``air_velocity``: its
+    ``air_relative_velocity`` when already computed)."""
     if wind is not None:
-        return equations_of_motion_lift_components(x, *air_relative_force_components(x, bank, L, D, wind), planet)
+        components = air_relative_force_components(x, bank, L, D, wind, air_velocity)
+        return equations_of_motion_lift_components(x, *components, planet)
     fn = math if isinstance(x[4], float) and isinstance(bank, float) else np  # float fast path
     return equations_of_motion_lift_components(x, L * fn.cos(bank), L * fn.sin(bank), D, planet)
 

@@ -123,21 +123,23 @@ def stability_to_local_level(gamma: float, psi: float, bank: float) -> np.ndarra
     """The rotation [3 x 3] from stability axes (x along the velocity, z along the lift at bank
     sigma, y = z x x) to (east, north, up), at flight-path angle gamma and heading psi [rad]."""
     sg, cg, sp, cp = math.sin(gamma), math.cos(gamma), math.sin(psi), math.cos(psi)
-    t = np.array([cg * sp, cg * cp, sg])  # along the velocity
-    n = np.array([-sg * sp, -sg * cp, cg])  # lift-up normal
-    h = np.array([cp, -sp, 0.0])  # right normal
     cb, sb = math.cos(bank), math.sin(bank)
-    z = cb * n + sb * h
-    y = np.cross(z, t)
-    return np.column_stack([t, y, z])
+    # t along the velocity, n the lift-up normal, h the right normal; z = cb n + sb h, y = z x t
+    # = cb (n x t) + sb (h x t) = -cb h + sb n
+    t = (cg * sp, cg * cp, sg)
+    n = (-sg * sp, -sg * cp, cg)
+    h = (cp, -sp, 0.0)
+    return np.array([[t[k], sb * n[k] - cb * h[k], cb * n[k] + sb * h[k]] for k in range(3)])
 
 
 def error_acceleration(e: np.ndarray, errors: InertialErrors, rotation: np.ndarray, drag: float, lift: float,
                        gravity: float, radius: float) -> np.ndarray:
     """dv' [3] m/s^2 (local level) at error state e [9] (module docstring)."""
     f_stab = np.array([-drag, 0.0, lift])
-    force = rotation @ f_stab
-    a = rotation @ (errors.accelerometer_bias + errors.scale_factor * f_stab) + np.cross(e[6:9], force)
+    fe, fn, fu = rotation @ f_stab
+    pe, pn, pu = e[6:9]
+    tilt = np.array([pn * fu - pu * fn, pu * fe - pe * fu, pe * fn - pn * fe])  # phi x f
+    a = rotation @ (errors.accelerometer_bias + errors.scale_factor * f_stab) + tilt
     if errors.gravity_feedback:
         k = gravity / radius
         a = a + np.array([-k * e[0], -k * e[1], 2.0 * k * e[2]])

@@ -60,7 +60,11 @@ PAGES = {
     "reference/scenario.md": ("drake_entry.scenario", "Scenario", "Scenario YAML",
                               "A mission file (`drake-entry fly FILE.yaml`, `load_scenario(path)`). Packaged "
                               "scenarios live in `drake_entry/scenarios/`. Fields not in SI carry their unit in "
-                              "the name; a bad value is a one-line error naming the field and the allowed range."),
+                              "the name; a bad value is a one-line error naming the field and the allowed range. "
+                              "A file with `based_on: NAME` starts from that scenario (a packaged name, or a path "
+                              "relative to the file) and states only what it changes; blocks merge field by field, "
+                              "and a guidance block there carries the base's tag (`guidance: !Fnpeg`), as in the "
+                              "packaged flight-like twins (`horus2b_flight.yaml`)."),
     "reference/vehicle.md": ("drake_entry.models.vehicles", "VehicleSpec", "Vehicle YAML",
                              "A vehicle file (`vehicle: path/to/file.yaml` in a scenario; packaged vehicles live "
                              "in `drake_entry/vehicles/`). `aero` maps model names to aerodynamic models; "

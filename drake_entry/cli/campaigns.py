@@ -9,7 +9,7 @@ import sys
 
 from drake_entry.cli.common import Command, add_overrides_argument, add_scenario_argument, parse_overrides
 
-__all__ = ["COMMANDS", "write_and_print_report"]
+__all__ = ["write_results_index", "COMMANDS", "write_and_print_report"]
 
 
 def campaign(args) -> int:
@@ -82,6 +82,32 @@ def _add_results_arguments(parser) -> None:
                         "(default: out/results); index.md lists them")
 
 
+def write_results_index(out_dir: str, *, runs: int, seed: int) -> str:
+    """index.md of every packaged closed-loop scenario's campaign directory below ``out_dir`` (those
+    of earlier runs with --only too): successes and the 90 % bound, a link to each report;
+    returns its path."""
+    from drake_entry.scenario import closed_loop_scenarios
+
+    lines = ["# Campaign results", "",
+             f"Packaged closed-loop scenarios flown as Monte-Carlo campaigns by `drake-entry results --runs {runs} "
+             f"--seed {seed}` (every campaign directory below this one is listed, also those of an earlier run "
+             "with `--only`; each report states its runs, seed and commit); each directory holds report.md (and "
+             "report.html, self-contained), its figures, summary.json and campaign.json.", "",
+             "| scenario | successful | success probability, 90 % lower bound | report |", "|---|---|---|---|"]
+    for name in closed_loop_scenarios():
+        summary = os.path.join(out_dir, name, "summary.json")
+        if not os.path.isfile(summary):
+            continue
+        with open(summary) as f:
+            stats = json.load(f)
+        lines.append(f"| `{name}` | {stats['successful']} of {stats['samples']} | "
+                     f"{100 * stats['success_lower_bound']['0.9']:.2f} % | [report]({name}/report.md) |")
+    path = os.path.join(out_dir, "index.md")
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return path
+
+
 def results(args) -> int:
     from drake_entry.campaign.montecarlo import run_campaign
     from drake_entry.campaign.report import write_report
@@ -95,12 +121,6 @@ def results(args) -> int:
         raise ScenarioError(f"--only {' '.join(unknown)}: not a packaged closed-loop scenario; "
                             f"allowed: {', '.join(names)}")
     os.makedirs(args.out, exist_ok=True)
-    lines = ["# Campaign results", "",
-             f"Packaged closed-loop scenarios flown as Monte-Carlo campaigns by `drake-entry results --runs {args.runs} "
-             f"--seed {args.seed}` (every campaign directory below this one is listed, also those of an earlier run "
-             "with `--only`; each report states its runs, seed and commit); each directory holds report.md (and "
-             "report.html, self-contained), its figures, summary.json and campaign.json.", "",
-             "| scenario | successful | success probability, 90 % lower bound | report |", "|---|---|---|---|"]
     failed = 0
     for name in chosen:
         print(f"== {name}: {args.runs} runs", flush=True)
@@ -111,17 +131,7 @@ def results(args) -> int:
             stats = json.load(f)
         failed += stats["successful"] < stats["samples"]
         print(f"   {stats['successful']} of {stats['samples']} successful; report: {path}", flush=True)
-    for name in names:  # every campaign below --out, also those of an earlier run (--only)
-        summary = os.path.join(args.out, name, "summary.json")
-        if not os.path.isfile(summary):
-            continue
-        with open(summary) as f:
-            stats = json.load(f)
-        lines.append(f"| `{name}` | {stats['successful']} of {stats['samples']} | "
-                     f"{100 * stats['success_lower_bound']['0.9']:.2f} % | [report]({name}/report.md) |")
-    with open(os.path.join(args.out, "index.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print(f"wrote {os.path.join(args.out, 'index.md')}")
+    print(f"wrote {write_results_index(args.out, runs=args.runs, seed=args.seed)}")
     if failed:
         print(f"drake-entry: {failed} scenario(s) with samples that are not successful (see their reports)",
               file=sys.stderr)

@@ -35,6 +35,7 @@ from drake_entry.models.atmosphere_perturbations import (
     draw_profiles,
     validate_perturbations,
 )
+from drake_entry.models.covariance import check_covariance, covariance_root
 from drake_entry.models.inertial_navigation import (
     InertialNavigationSpec,
     draw_inertial_errors,
@@ -243,7 +244,7 @@ def draw(spec: DispersionSpec, generator) -> Draw:
             raise ScenarioError(f"dispersions.aero_regimes drew a relative error of {too_low[0]:g}; a coefficient must "
                                 f"stay positive (narrow lift_sigma / drag_sigma)")
     if spec.entry_covariance is not None:  # after the rest, for the same reason
-        delivered = _covariance_root(spec.entry_covariance) @ np.array([_normal(generator) for _ in range(6)])
+        delivered = covariance_root(spec.entry_covariance) @ np.array([_normal(generator) for _ in range(6)])
         delta = delta + delivered * ENTRY_TABLE_TO_SI
     profile = {}
     if spec.atmosphere_perturbations is not None:  # after the rest, for the same reason
@@ -274,13 +275,6 @@ ENTRY_TABLE_TO_SI = np.array([1.0, math.pi / 180, math.pi / 180, 1.0, math.pi / 
 def _normal(generator) -> float:
     """One standard normal draw from the sample's generator."""
     return float(schema.Gaussian(mean=0.0, stddev=1.0).Sample(generator))
-
-
-def _covariance_root(covariance) -> np.ndarray:
-    """L with L L^T = covariance (symmetric positive semi-definite; eigen-decomposition, so a
-    singular covariance, e.g. one correlated pair, is fine)."""
-    values, vectors = np.linalg.eigh(np.asarray(covariance, float))
-    return vectors * np.sqrt(np.clip(values, 0.0, None))
 
 
 def _check_distribution(where: str, d) -> None:
@@ -356,7 +350,8 @@ def validate(spec: DispersionSpec, where: str = "dispersions") -> None:
     if spec.aero_regimes is not None:
         _validate_aero_regimes(spec.aero_regimes, f"{where}.aero_regimes")
     if spec.entry_covariance is not None:
-        _validate_covariance(spec.entry_covariance, f"{where}.entry_covariance")
+        check_covariance(spec.entry_covariance, f"{where}.entry_covariance",
+                         "[altitude m, longitude deg, latitude deg, speed m/s, flight-path deg, heading deg]")
     if spec.atmosphere_perturbations is not None:
         validate_perturbations(spec.atmosphere_perturbations, f"{where}.atmosphere_perturbations")
     if spec.winds is not None:
@@ -400,19 +395,3 @@ def _validate_aero_regimes(a: AeroRegimeDispersionSpec, where: str) -> None:
     if not (math.isfinite(a.trim_alpha_sigma_deg) and 0 <= a.trim_alpha_sigma_deg <= 10):
         raise ScenarioError(f"{where}.trim_alpha_sigma_deg = {a.trim_alpha_sigma_deg} is out of range; allowed: "
                             f"[0, 10] deg")
-
-
-def _validate_covariance(c, where: str) -> None:
-    m = np.asarray(c, float) if all(len(row) == 6 for row in c) and len(c) == 6 else None
-    if m is None:
-        raise ScenarioError(f"{where} needs 6 rows of 6 values [altitude m, longitude deg, latitude deg, speed m/s, "
-                            f"flight-path deg, heading deg]")
-    if not np.all(np.isfinite(m)):
-        raise ScenarioError(f"{where} has a value that is not finite")
-    if not np.allclose(m, m.T, rtol=1e-9, atol=0.0):
-        i, j = np.unravel_index(np.argmax(np.abs(m - m.T)), m.shape)
-        raise ScenarioError(f"{where} is not symmetric: [{i}][{j}] = {m[i, j]:g} but [{j}][{i}] = {m[j, i]:g}")
-    lowest = float(np.linalg.eigvalsh(m).min())
-    if lowest < -1e-9 * max(1.0, float(np.abs(m).max())):
-        raise ScenarioError(f"{where} is not positive semi-definite (its smallest eigenvalue is {lowest:g}); a "
-                            f"covariance needs variances >= 0 and correlations in [-1, 1]")

@@ -30,6 +30,7 @@ import typing
 import numpy as np
 
 from drake_entry.errors import ScenarioError
+from drake_entry.models.covariance import check_covariance, covariance_root
 
 __all__ = ["InertialNavigationSpec", "validate_inertial_navigation", "InertialErrors", "draw_inertial_errors",
            "stability_to_local_level", "error_acceleration", "propagate", "navigated_state", "sensed_drag_lift"]
@@ -63,23 +64,9 @@ def validate_inertial_navigation(n: InertialNavigationSpec, where: str) -> None:
         v = getattr(n, name)
         if not (math.isfinite(v) and 0.0 <= v <= hi):
             raise ScenarioError(f"{where}.{name} = {v} is out of range; allowed: [0, {hi:g}]")
-    c = n.initial_covariance
-    if c is None:
-        return
-    if not (len(c) == 6 and all(len(row) == 6 for row in c)):
-        raise ScenarioError(f"{where}.initial_covariance needs 6 rows of 6 values [east m, north m, up m, east m/s, "
-                            f"north m/s, up m/s]")
-    m = np.asarray(c, float)
-    if not np.all(np.isfinite(m)):
-        raise ScenarioError(f"{where}.initial_covariance has a value that is not finite")
-    if not np.allclose(m, m.T, rtol=1e-9, atol=0.0):
-        i, j = np.unravel_index(np.argmax(np.abs(m - m.T)), m.shape)
-        raise ScenarioError(f"{where}.initial_covariance is not symmetric: [{i}][{j}] = {m[i, j]:g} but "
-                            f"[{j}][{i}] = {m[j, i]:g}")
-    lowest = float(np.linalg.eigvalsh(m).min())
-    if lowest < -1e-9 * max(1.0, float(np.abs(m).max())):
-        raise ScenarioError(f"{where}.initial_covariance is not positive semi-definite (its smallest eigenvalue is "
-                            f"{lowest:g})")
+    if n.initial_covariance is not None:
+        check_covariance(n.initial_covariance, f"{where}.initial_covariance",
+                         "[east m, north m, up m, east m/s, north m/s, up m/s]")
 
 
 @dc.dataclass(frozen=True)
@@ -110,10 +97,7 @@ class InertialErrors:
 def draw_inertial_errors(n: InertialNavigationSpec, normal) -> InertialErrors:
     """One flight's errors; ``normal()`` gives one standard normal draw (the sample's generator)."""
     z = np.array([normal() for _ in range(15)])
-    initial = np.zeros(6)
-    if n.initial_covariance is not None:
-        values, vectors = np.linalg.eigh(np.asarray(n.initial_covariance, float))
-        initial = (vectors * np.sqrt(np.clip(values, 0.0, None))) @ z[:6]
+    initial = np.zeros(6) if n.initial_covariance is None else covariance_root(n.initial_covariance) @ z[:6]
     return InertialErrors(initial, n.accelerometer_bias_sigma_m_s2 * z[6:9],
                           n.accelerometer_scale_factor_sigma_ppm * 1e-6 * z[9:12],
                           math.radians(n.gyro_drift_sigma_deg_h) / 3600.0 * z[12:15], n.gravity_feedback, n.enabled)

@@ -36,7 +36,8 @@ from drake_entry.models.data_tables import read_csv_rows
 from drake_entry.models.scalar import clamp, is_autodiff, is_symbolic, lift, promote, value_of
 
 __all__ = ["G0_US76", "R_STAR", "M0_AIR", "R_AIR", "R0_GEOPOTENTIAL", "GAMMA_AIR", "P0_SEA_LEVEL", "US76_H_MIN",
-           "US76_H_MAX", "US76_LOWER_TOP", "AtmosphereProperties", "Derivatives", "piecewise", "Atmosphere",
+           "US76_H_MAX", "US76_LOWER_TOP", "AtmosphereProperties", "Derivatives", "piecewise", "held_linear",
+           "held_linear_expression", "Atmosphere",
            "US76Atmosphere", "ExponentialAtmosphere", "TableAtmosphere", "DENSITY_WAVE_AMPLITUDE_BOUND",
            "DispersedAtmosphere", "make_atmosphere", "write_upper_table", "PerturbedAtmosphere"]
 
@@ -84,6 +85,28 @@ def piecewise(x, breaks, piece):
         return if_then_else(x < breaks[mid], build(lo, mid), build(mid, hi))
 
     return build(0, len(breaks) - 1)
+
+
+def held_linear(h, nodes: np.ndarray, values: np.ndarray):
+    """(value, slope per m) of the profile linear between ``nodes`` (increasing) through
+    ``values`` and held beyond its ends (slope 0 there), at a float or ndarray h."""
+    hv = np.asarray(h, float)
+    k = np.clip(np.searchsorted(nodes, hv, side="right") - 1, 0, nodes.size - 2)
+    inside = (hv >= nodes[0]) & (hv <= nodes[-1])
+    slope = (values[k + 1] - values[k]) / (nodes[k + 1] - nodes[k])
+    return np.interp(hv, nodes, values), np.where(inside, slope, 0.0)
+
+
+def held_linear_expression(h, nodes: np.ndarray, values: np.ndarray, offset: float = 0.0):
+    """``offset`` plus that profile (``held_linear``) as a symbolic Expression of the altitude
+    Expression h: one linear piece per interval (``piecewise``), the end values beyond the ends."""
+    def piece(i):
+        s = (values[i + 1] - values[i]) / (nodes[i + 1] - nodes[i])
+        return offset + values[i] + s * (h - nodes[i])
+
+    inner = piecewise(h, list(nodes), piece)
+    return if_then_else(h < nodes[0], Expression(offset + values[0]),
+                        if_then_else(h > nodes[-1], Expression(offset + values[-1]), inner))
 
 
 def _check_range(name: str, h, lo: float, hi: float):
@@ -644,14 +667,10 @@ class PerturbedAtmosphere(Atmosphere):
     def factors(self, h):
         """((1 + d_rho, slope), (1 + d_T, slope)) at altitude h [m] (float or ndarray; slopes per m,
         zero beyond the nodes)."""
-        hv = np.asarray(h, float)
-        k = np.clip(np.searchsorted(self.nodes, hv, side="right") - 1, 0, self.nodes.size - 2)
-        inside = (hv >= self.nodes[0]) & (hv <= self.nodes[-1])
-        width = self.nodes[k + 1] - self.nodes[k]
         out = []
         for d in (self.d_rho, self.d_T):
-            slope = (d[k + 1] - d[k]) / width
-            out.append((1.0 + np.interp(hv, self.nodes, d), np.where(inside, slope, 0.0)))
+            value, slope = held_linear(h, self.nodes, d)
+            out.append((1.0 + value, slope))
         if np.ndim(h) == 0:
             out = [(float(f), float(s)) for f, s in out]
         return out
@@ -663,17 +682,8 @@ class PerturbedAtmosphere(Atmosphere):
 
     def _symbolic_profile(self, h):
         rho, T = self.base.symbolic_profile(h)
-        nodes = self.nodes
-
-        def linear(d):
-            def piece(i):
-                s = (d[i + 1] - d[i]) / (nodes[i + 1] - nodes[i])
-                return 1.0 + d[i] + s * (h - nodes[i])
-            inner = piecewise(h, list(nodes), piece)
-            return if_then_else(h < nodes[0], Expression(1.0 + d[0]), if_then_else(h > nodes[-1], Expression(
-                1.0 + d[-1]), inner))
-
-        return rho * linear(self.d_rho), T * linear(self.d_T)
+        return (rho * held_linear_expression(h, self.nodes, self.d_rho, 1.0),
+                T * held_linear_expression(h, self.nodes, self.d_T, 1.0))
 
     def density_derivatives(self, h) -> Derivatives:
         return self.derivatives(h)[0]

@@ -64,17 +64,18 @@ class AtmospherePerturbationSpec(AltitudeProcessSpec):
 
 def validate_process(p: AltitudeProcessSpec, where: str, profiles) -> None:
     """One-line ScenarioErrors naming the field: the altitudes, the process, and each of
-    ``profiles`` ((field name, lowest, highest, unit text)) one value per altitude in range."""
+    ``profiles`` ((field name, inside(value) -> bool, the allowed range in words)) one finite
+    value per altitude inside its range."""
     h = np.asarray(p.altitude_km, float)
     if h.ndim != 1 or h.size < 1 or not np.all(np.isfinite(h)) or np.any(np.diff(h) <= 0):
         raise ScenarioError(f"{where}.altitude_km = {p.altitude_km} must be finite and sorted increasing")
-    for name, lo, hi, unit in profiles:
+    for name, inside, allowed in profiles:
         values = getattr(p, name)
         if len(values) != h.size:
             raise ScenarioError(f"{where}.{name} needs one value per altitude ({h.size}), got {len(values)}")
         for i, v in enumerate(values):
-            if not (math.isfinite(v) and lo <= v <= hi):
-                raise ScenarioError(f"{where}.{name}[{i}] = {v} is out of range; allowed: {unit}")
+            if not (math.isfinite(v) and inside(v)):
+                raise ScenarioError(f"{where}.{name}[{i}] = {v} is out of range; allowed: {allowed}")
     checks = (("large_scale_fraction", 0.0, 1.0), ("vertical_scale_km", 1e-3, 1e3), ("step_km", 1e-2, 10.0),
               ("top_km", 1.0, 1e3))
     for name, lo, hi in checks:
@@ -90,9 +91,9 @@ def process_nodes_km(p: AltitudeProcessSpec) -> np.ndarray:
 
 def validate_perturbations(p: AtmospherePerturbationSpec, where: str) -> None:
     """One-line ScenarioErrors naming the field."""
-    below = MAX_PERTURBATION_SIGMA * (1 - 1e-12)
+    inside = lambda v: 0.0 <= v < MAX_PERTURBATION_SIGMA  # noqa: E731
     allowed = f"[0, {MAX_PERTURBATION_SIGMA:g}) (the quantity stays positive to 5 sigma)"
-    validate_process(p, where, [("density_sigma", 0.0, below, allowed), ("temperature_sigma", 0.0, below, allowed)])
+    validate_process(p, where, [("density_sigma", inside, allowed), ("temperature_sigma", inside, allowed)])
     v = p.density_temperature_correlation
     if not (math.isfinite(v) and -1.0 <= v <= 1.0):
         raise ScenarioError(f"{where}.density_temperature_correlation = {v} is out of range; allowed: [-1, 1]")

@@ -12,10 +12,9 @@ long glide at nearly constant altitude sees one wind (no horizontal correlation)
 import dataclasses as dc
 
 import numpy as np
-from pydrake.symbolic import Expression, if_then_else
 
 from drake_entry.errors import ScenarioError
-from drake_entry.models.atmosphere import Atmosphere, piecewise
+from drake_entry.models.atmosphere import Atmosphere, held_linear, held_linear_expression
 from drake_entry.models.atmosphere_perturbations import (
     AltitudeProcessSpec,
     process_nodes_km,
@@ -44,10 +43,10 @@ class WindSpec(AltitudeProcessSpec):
 
 def validate_winds(w: WindSpec, where: str) -> None:
     """One-line ScenarioErrors naming the field."""
-    mean = f"[{-MAX_WIND_M_S:g}, {MAX_WIND_M_S:g}] m/s"
-    validate_process(w, where, [("east_mean_m_s", -MAX_WIND_M_S, MAX_WIND_M_S, mean),
-                                ("north_mean_m_s", -MAX_WIND_M_S, MAX_WIND_M_S, mean),
-                                ("sigma_m_s", 0.0, MAX_WIND_M_S / 5.0, f"[0, {MAX_WIND_M_S / 5.0:g}] m/s")])
+    mean, mean_text = (lambda v: -MAX_WIND_M_S <= v <= MAX_WIND_M_S), f"[{-MAX_WIND_M_S:g}, {MAX_WIND_M_S:g}] m/s"
+    validate_process(w, where, [("east_mean_m_s", mean, mean_text), ("north_mean_m_s", mean, mean_text),
+                                ("sigma_m_s", lambda v: 0.0 <= v <= MAX_WIND_M_S / 5.0,
+                                 f"[0, {MAX_WIND_M_S / 5.0:g}] m/s")])
 
 
 def draw_wind(w: WindSpec, generator) -> "WindProfile":
@@ -78,32 +77,13 @@ class WindProfile:
     def __call__(self, h):
         """(east, north) wind [m/s] at altitude h [m] (the scalar type of h)."""
         if is_symbolic(h):
-            return self._symbolic(h, self.east), self._symbolic(h, self.north)
+            return tuple(held_linear_expression(h, self.nodes, d) for d in (self.east, self.north))
         hv = float(h.value()) if is_autodiff(h) else float(h)
-        k = min(max(int(np.searchsorted(self.nodes, hv, side="right")) - 1, 0), self.nodes.size - 2)
-        inside = self.nodes[0] <= hv <= self.nodes[-1]
-        width = self.nodes[k + 1] - self.nodes[k]
         out = []
         for d in (self.east, self.north):
-            slope = (d[k + 1] - d[k]) / width if inside else 0.0
-            value = float(np.interp(hv, self.nodes, d))
+            value, slope = (float(v) for v in held_linear(hv, self.nodes, d))
             out.append(lift([h], value, [slope]) if is_autodiff(h) else value)
         return tuple(out)
-
-    def _symbolic(self, h, d):
-        nodes = self.nodes
-
-        def piece(i):
-            s = float((d[i + 1] - d[i]) / (nodes[i + 1] - nodes[i]))
-            return float(d[i]) + s * (h - float(nodes[i]))
-
-        inner = piecewise(h, [float(v) for v in nodes], piece)
-        return if_then_else(h < float(nodes[0]), Expression(float(d[0])),
-                            if_then_else(h > float(nodes[-1]), Expression(float(d[-1])), inner))
-
-    def at(self, altitude_m) -> tuple[np.ndarray, np.ndarray]:
-        """(east, north) [m/s] at an array of altitudes [m]."""
-        return np.interp(altitude_m, self.nodes, self.east), np.interp(altitude_m, self.nodes, self.north)
 
 
 class WindyAtmosphere(Atmosphere):

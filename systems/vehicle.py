@@ -71,26 +71,30 @@ def EntryVehicle_(T):
             return x, bank, alpha
 
         def _aero(self, context, x, alpha):
-            """(rho, Mach, L, D, wind or None) at state x."""
+            """(rho, Mach, L, D, wind or None, air-relative velocity or None) at state x (the
+            air-relative velocity computed once, for the aerodynamics and the equations)."""
             if self.air_port is not None:
                 rho, a = self.air_port.Eval(context).tolist()
                 wind = None if self.wind_port is None else tuple(self.wind_port.Eval(context).tolist())
             else:
                 rho, a = dynamics.air_data(x, self.planet, self.atmosphere)
                 wind = dynamics.wind_at(x, self.planet, self.atmosphere)
-            return (rho, *dynamics.aero_accelerations(x, alpha, rho, a, self.vehicle, wind), wind)
+            velocity = None if wind is None else dynamics.air_relative_velocity(x, wind)
+            speed = None if velocity is None else velocity[2]
+            return (rho, *dynamics.aero_accelerations(x, alpha, rho, a, self.vehicle, wind, speed), wind, velocity)
 
         # -- Drake callbacks --------------------------------------------------------
         def DoCalcTimeDerivatives(self, context, derivatives):
             x, bank, alpha = self._inputs(context)
-            _, _, L, D, wind = self._aero(context, x, alpha)
-            derivatives.get_mutable_vector().SetFromVector(dynamics.equations_of_motion(x, bank, L, D, self.planet, wind))
+            _, _, L, D, wind, velocity = self._aero(context, x, alpha)
+            derivatives.get_mutable_vector().SetFromVector(dynamics.equations_of_motion(x, bank, L, D, self.planet, wind,
+                                                                                        velocity))
 
         def _calc_conditions(self, context, output):
             x, _, alpha = self._inputs(context)
-            rho, mach, L, D, wind = self._aero(context, x, alpha)
+            rho, mach, L, D, _, velocity = self._aero(context, x, alpha)
             output.SetFromVector(np.array(dynamics.conditions_from(x, alpha, rho, mach, L, D, self.vehicle, self.planet,
-                                                                   dynamics.airspeed(x, wind))))
+                                                                   None if velocity is None else velocity[2])))
 
         def state_derivatives(self, context) -> np.ndarray:
             """dx/dt [6] (SI per s) at this plant's ``context`` (as NativeEntryVehicle's)."""

@@ -458,11 +458,16 @@ def _regime_rows(a) -> list:
     return rows
 
 
+def _profile_text(altitude_km, values) -> str:
+    """A profile by altitude in words: 'v at h km, ...'."""
+    return ", ".join(f"{v:g} at {h:g} km" for h, v in zip(altitude_km, values))
+
+
 def _perturbation_rows(p) -> list:
     """Dispersion-table rows of the density and temperature perturbation profiles."""
     if p is None:
         return []
-    profile = lambda sigma: ", ".join(f"{s:g} at {h:g} km" for h, s in zip(p.altitude_km, sigma))  # noqa: E731
+    profile = lambda sigma: _profile_text(p.altitude_km, sigma)  # noqa: E731
     return [f"| density perturbation along the flight | 0 | per-flight part {100 * p.large_scale_fraction:g} % of the "
             f"variance, the rest correlated over {p.vertical_scale_km:g} km of altitude | 1σ {profile(p.density_sigma)} "
             f"| fraction |",
@@ -474,7 +479,7 @@ def _wind_rows(w) -> list:
     """Dispersion-table rows of the horizontal wind: its mean profile and its perturbation."""
     if w is None:
         return []
-    profile = lambda values: ", ".join(f"{v:g} at {h:g} km" for h, v in zip(w.altitude_km, values))  # noqa: E731
+    profile = lambda values: _profile_text(w.altitude_km, values)  # noqa: E731
     return [f"| wind towards the east, mean | {profile(w.east_mean_m_s)} | fixed | — | m/s |",
             f"| wind towards the north, mean | {profile(w.north_mean_m_s)} | fixed | — | m/s |",
             f"| wind perturbation, each horizontal component | 0 | per-flight part {100 * w.large_scale_fraction:g} % of "

@@ -35,13 +35,15 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import SymbolicVectorSystem
 
 from drake_entry.errors import ScenarioError
+from drake_entry.guidance.fnpeg import predicted_flight
 from drake_entry.guidance.fnpeg.law import FeedbackSettings, commanded_bank
 from drake_entry.models import dynamics
 from drake_entry.models.atmosphere import piecewise
+from drake_entry.models.kernels import Kernel, compile_kernels
 from drake_entry.models.schedules import Schedule, linear_bank
 from drake_entry.models.symbolic_system import stateless
 
-__all__ = ["STAGED_SIZE_RATIO", "Prediction", "alpha_expression", "Predictor"]
+__all__ = ["STAGED_SIZE_RATIO", "ENGINES", "Prediction", "alpha_expression", "Predictor"]
 
 _STATE = [Variable(n) for n in ("h", "lon", "lat", "V", "gamma", "psi", "s")]
 _INPUT = [Variable(n) for n in ("sigma0", "e0", "sign", "lift_scale", "drag_scale")]
@@ -49,6 +51,10 @@ _INPUT = [Variable(n) for n in ("sigma0", "e0", "sign", "lift_scale", "drag_scal
 _AERO = [Variable(n) for n in ("L", "D", "rho")]
 #: two stages when one system's expanded expressions are at least this many times the stages'
 STAGED_SIZE_RATIO = 2.0
+#: how a prediction is computed: "compiled" (the default: the whole flight in one compiled call of
+#: kernels generated from the same expressions, models.kernels) or "drake" (Drake's Simulator
+#: integrating the SymbolicVectorSystems: the reference the compiled flight is tested against)
+ENGINES = ("compiled", "drake")
 #: prediction steps advanced per Simulator call (the energy is checked between calls)
 _STEPS_PER_CALL = 10
 
@@ -106,32 +112,27 @@ class Predictor:
 
     def __init__(self, vehicle, planet, atmosphere, law: FeedbackSettings, *, sigma_f: float, e_f: float,
                  alpha: Schedule, step_s: float = 2.0, floor_m: float = 0.0, ceiling_m: float = 200e3,
-                 max_time_s: float = 10000.0, constant: bool = False):
+                 max_time_s: float = 10000.0, constant: bool = False, engine: str = "compiled"):
         if not step_s > 0:
             raise ScenarioError(f"FNPEG predictor step_s = {step_s}; allowed > 0 s")
-        self.planet, self.mu, self.e_f = planet, planet.mu, e_f
+        if engine not in ENGINES:
+            raise ScenarioError(f"FNPEG predictor engine = {engine!r}; allowed: {', '.join(ENGINES)}")
+        self.planet, self.mu, self.e_f, self.engine = planet, planet.mu, e_f, engine
         self.step_s, self.floor_m, self.ceiling_m, self.max_time_s = step_s, floor_m, ceiling_m, max_time_s
-        x = [Expression(v) for v in _STATE[:6]]
-        sigma0, e0, sign, k_lift, k_drag = (Expression(u) for u in _INPUT)
-        L, D, rho = (Expression(v) for v in _AERO)  # the aerodynamic stage's outputs
-        h, V, gamma = x[0], x[3], x[4]
-        r = planet.radius(h)
-        with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
-            a = alpha_expression(alpha, V)
-            air = dynamics.air_data(x, planet, atmosphere)
-            _, lift, drag = dynamics.aero_accelerations(x, a, *air, vehicle)
-            aero = [k_lift * lift, k_drag * drag, air[0]]
-            e = self.mu / r - 0.5 * V * V
-            base = sigma0 if constant else linear_bank(e, e0, e_f, sigma0, sigma_f)
-            load = np.sqrt(L * L + D * D)
-            q = dynamics.dynamic_pressure(rho, V)
-            heat = vehicle.heat_flux(rho, V, a)
-            bank = sign * commanded_bank(base, V, gamma, L, D, load, heat, q, law)
-            xdot = dynamics.equations_of_motion(x, bank, L, D, planet)
-            sdot = V * np.cos(gamma) * planet.reference_radius / r
-        motion = [*xdot, sdot]
+        aero, motion = _equations(vehicle, planet, atmosphere, law, sigma_f, e_f, alpha, constant)
         one = [f.Substitute(dict(zip(_AERO, aero))) for f in motion]
         self.staged = _size(one) >= STAGED_SIZE_RATIO * (_size(aero) + _size(motion))
+        self.evaluations = 0
+        self.predictions = 0
+        if engine == "compiled":
+            h, V = (Expression(v) for v in (_STATE[0], _STATE[3]))
+            e = self.mu / planet.radius(h) - 0.5 * V * V
+            rate = e.Differentiate(_STATE[0]) * one[0] + e.Differentiate(_STATE[3]) * one[3]
+            variables = (*_STATE, *_INPUT)
+            self.kernels = compile_kernels([Kernel("rhs", tuple(one), variables),
+                                            Kernel("energy_rate", (e, rate), variables)],
+                                           predicted_flight, tag="fnpeg_prediction")
+            return
         self.system, self._motion = _build(aero, motion) if self.staged else _build(None, one)
         self.simulator = Simulator(self.system)
         integrator = ResetIntegratorFromFlags(self.simulator, "runge_kutta3", step_s)
@@ -139,8 +140,6 @@ class Predictor:
         integrator.set_maximum_step_size(step_s)
         self.context = self.simulator.get_mutable_context()
         self._motion_context = self._motion.GetMyMutableContextFromRoot(self.context)
-        self.evaluations = 0
-        self.predictions = 0
 
     def energy(self, x) -> float:
         """e = mu/r - V^2/2 [J/kg] of a state."""
@@ -154,8 +153,13 @@ class Predictor:
 
     def derivatives(self, y, params) -> np.ndarray:
         """d/dt of the 7 states [h, lon, lat, V, gamma, psi, s] (SI) at ``y`` with the inputs
-        ``params`` = [sigma_0 rad, e_0 J/kg, sign, k_L, k_D], evaluated natively."""
-        self._set_state([*map(float, y), *map(float, params)])
+        ``params`` = [sigma_0 rad, e_0 J/kg, sign, k_L, k_D], by the predictor's engine."""
+        v = np.array([*map(float, y), *map(float, params)])
+        if self.engine == "compiled":
+            out = np.empty(len(_STATE))
+            self.kernels["rhs"](v, out)
+            return out
+        self._set_state(v)
         return self._xdot()
 
     def _xdot(self) -> np.ndarray:
@@ -166,12 +170,14 @@ class Predictor:
         sign ``sign`` held and the modelled lift and drag times ``scales`` (k_L, k_D: what the
         flight has shown, models.acceleration_ratios), until e_f or another stop (class docstring)."""
         x = np.asarray(x, float)
+        self.predictions += 1
+        if self.engine == "compiled":
+            return self._predict_compiled(x, sigma0, sign, scales)
         ctx = self.context
         ctx.SetTime(0.0)
         self._set_state([*x, 0.0, float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0, *map(float, scales)])
         integrator = self.simulator.get_mutable_integrator()
         n0 = integrator.get_num_derivative_evaluations()
-        self.predictions += 1
         self.simulator.Initialize()
         try:
             return self._fly()
@@ -180,6 +186,19 @@ class Predictor:
                               f"the prediction left the models' domain ({str(err).splitlines()[0]})")
         finally:
             self.evaluations += integrator.get_num_derivative_evaluations() - n0
+
+    def _predict_compiled(self, x, sigma0, sign, scales) -> Prediction:
+        v0 = np.array([*x, 0.0, float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0, *map(float, scales)])
+        code, t, v, evaluations = self.kernels["predict_flight"](
+            v0, self.step_s, self.e_f, self.floor_m, self.ceiling_m, self.max_time_s, _STEPS_PER_CALL)
+        self.evaluations += evaluations
+        if code == predicted_flight.REACHED:
+            return Prediction(v[6], v[:6].copy(), t, True)
+        if code == predicted_flight.NOT_FINITE:
+            return Prediction(math.nan, v[:6].copy(), t, False,
+                              "the prediction left the models' domain (a state became NaN or infinite)")
+        flown = v[6] if code == predicted_flight.FLOOR else math.nan
+        return Prediction(flown, v[:6].copy(), t, False, self._stop(v, t))
 
     def _fly(self) -> Prediction:
         ctx, sim, e_f = self.context, self.simulator, self.e_f
@@ -230,6 +249,30 @@ class Predictor:
             sim.AdvanceTo(ctx.get_time() + dt)
         y = self._state()
         return Prediction(y[6], y[:6], ctx.get_time(), True)
+
+
+def _equations(vehicle, planet, atmosphere, law, sigma_f, e_f, alpha, constant):
+    """(aerodynamics, motion): [k_L L, k_D D, rho] of the 7 states and 5 inputs, and the 7
+    derivatives of the states reading those three as the Variables _AERO (module docstring)."""
+    x = [Expression(v) for v in _STATE[:6]]
+    sigma0, e0, sign, k_lift, k_drag = (Expression(u) for u in _INPUT)
+    L, D, rho = (Expression(v) for v in _AERO)  # the aerodynamic stage's outputs
+    h, V, gamma = x[0], x[3], x[4]
+    r = planet.radius(h)
+    with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
+        a = alpha_expression(alpha, V)
+        air = dynamics.air_data(x, planet, atmosphere)
+        _, lift, drag = dynamics.aero_accelerations(x, a, *air, vehicle)
+        aero = [k_lift * lift, k_drag * drag, air[0]]
+        e = planet.mu / r - 0.5 * V * V
+        base = sigma0 if constant else linear_bank(e, e0, e_f, sigma0, sigma_f)
+        load = np.sqrt(L * L + D * D)
+        q = dynamics.dynamic_pressure(rho, V)
+        heat = vehicle.heat_flux(rho, V, a)
+        bank = sign * commanded_bank(base, V, gamma, L, D, load, heat, q, law)
+        xdot = dynamics.equations_of_motion(x, bank, L, D, planet)
+        sdot = V * np.cos(gamma) * planet.reference_radius / r
+    return aero, [*xdot, sdot]
 
 
 def _size(expressions) -> int:

@@ -42,7 +42,10 @@ import json, sys, time
 import numpy as np
 from drake_entry.scenario import load_scenario
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup
-from drake_entry.campaign.sample import run_sample
+try:
+    from drake_entry.campaign.sample import run_sample
+except ImportError:  # a baseline before the campaign package held the sample (diagrams/sample.py)
+    from drake_entry.diagrams.sample import run_sample
 from drake_entry.systems.atmosphere import AtmosphereSystem
 from drake_entry.systems.vehicle import EntryVehicle
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator

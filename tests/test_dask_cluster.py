@@ -41,14 +41,12 @@ def test_a_killed_worker_loses_no_sample_and_changes_no_row(tmp_path):
             assert time.monotonic() < deadline and campaign.is_alive(), "the campaign did not start on the cluster"
             time.sleep(0.1)
         finished_before_kill = len(_rows(out))
-        cluster.kill_worker("worker-0")  # dies holding cases
+        cluster.kill_worker("worker-0")  # dies holding cases; returns once the scheduler has removed it
+        assert cluster.worker_names() == {"worker-1"} and campaign.is_alive()
         cluster.add_worker()
         campaign.join(timeout=600)
         assert not campaign.is_alive() and "out" in done
     assert finished_before_kill < RUNS
-    with open(log) as f:
-        text = f.read()
-    assert "remove worker" in text.lower(), text[-2000:]  # the scheduler saw worker-0 go
     cluster_rows = _rows(out)
     assert sorted(r["index"] for r in cluster_rows) == list(range(RUNS))  # every row once
     local = str(tmp_path / "local")

@@ -336,6 +336,14 @@ def test_example_21(tmp_path):
     assert os.path.exists(tmp_path / "flight_environment.png")
 
 
+@pytest.mark.slow
+def test_example_22(tmp_path):
+    """A campaign on a Dask cluster of separate processes (one worker, two, and workers submitted
+    by dask-jobqueue's local runner): every way, the rows equal the serial run's."""
+    r = _run("22_dask_cluster", tmp_path)
+    assert set(r["rows"]) == {"1 worker", "2 workers", "dask-jobqueue"} and set(r["throughput"]) == {1, 2}
+
+
 def test_the_examples_command_line_passes_quick_out_and_options_and_exits_by_the_claims(tmp_path, capsys):
     """run_example: --quick, --out and an example's own options reach main; the exit status is
     the claims' (1 when one fails)."""

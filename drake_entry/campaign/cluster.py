@@ -68,21 +68,29 @@ class ProcessCluster:
                                          "--no-dashboard", "--death-timeout", "60")
         return name
 
-    def kill_worker(self, name: str) -> None:
-        """SIGKILL a worker process, as a node lost mid-campaign."""
+    def kill_worker(self, name: str, timeout_s: float = 60.0) -> None:
+        """SIGKILL a worker process, as a node lost mid-campaign, and wait until the scheduler
+        has removed it (TimeoutError otherwise)."""
         os.kill(self.workers.pop(name).pid, signal.SIGKILL)
+        self._wait(lambda names: name not in names, f"the scheduler still lists {name}", timeout_s)
+
+    def worker_names(self) -> set:
+        """The names of the workers the scheduler counts now."""
+        from dask.distributed import Client
+
+        with Client(self.address, timeout=10) as client:
+            return {w.get("name") for w in client.scheduler_info().get("workers", {}).values()}
 
     def wait_for_workers(self, n: int, timeout_s: float = 60.0) -> None:
         """Block until the scheduler counts ``n`` workers (TimeoutError naming the count)."""
-        from dask.distributed import Client
+        self._wait(lambda names: len(names) >= n, f"fewer than {n} workers joined", timeout_s)
 
+    def _wait(self, done, what: str, timeout_s: float) -> None:
         deadline = time.monotonic() + timeout_s
-        with Client(self.address, timeout=timeout_s) as client:
-            while len(client.scheduler_info().get("workers", {})) < n:
-                if time.monotonic() > deadline:
-                    got = len(client.scheduler_info().get("workers", {}))
-                    raise TimeoutError(f"ProcessCluster: {got} of {n} workers joined within {timeout_s:.0f} s")
-                time.sleep(0.1)
+        while not done(self.worker_names()):
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"ProcessCluster: {what} within {timeout_s:.0f} s")
+            time.sleep(0.1)
 
     def close(self) -> None:
         procs = [*self.workers.values(), self.scheduler]

@@ -6,7 +6,8 @@ call by name:
 
   ``rhs(v, out)``           out[0:7] = d/dt [h, lon, lat, V, gamma, psi, s] at v (12: the 7
                             states, then sigma_0, e_0, sign, k_L, k_D)
-  ``energy_rate(v, out)``   out[0] = e = mu/r - V^2/2, out[1] = de/dt
+  ``energy(v, out)``        out[0] = e = mu/r - V^2/2 [J/kg]
+  ``energy_rate(v, out)``   out[0] = e, out[1] = de/dt (the right-hand side's h and V rates)
 
 So the driver holds no physics: only Drake's fixed-step Runge-Kutta 3 (the native predictor's
 integrator: k1 at t, k2 at t + h/2 from y + h/2 k1, k3 at t + h from y - h k1 + 2 h k2,
@@ -14,7 +15,7 @@ y + h/6 (k1 + 4 k2 + k3)) and the stops of ``Predictor`` (the energy checked eve
 ``steps_per_check`` steps, as the native predictor's Simulator calls do; the step that
 crosses e_f found again and Newton on time to e_f).
 """
-# ruff: noqa: F821  (rhs and energy_rate are the generated kernels of the compiled module)
+# ruff: noqa: F821  (rhs, energy and energy_rate are the generated kernels of the compiled module)
 import math
 
 import numpy as np
@@ -61,13 +62,13 @@ def predict_flight(v0, step, e_f, floor, ceiling, max_time, steps_per_check):
             for i in range(7):
                 if not math.isfinite(nxt[i]):
                     return NOT_FINITE, t, v, evaluations
-            energy_rate(nxt, e)
+            energy(nxt, e)
             if crossing < 0 and e[0] >= e_f:
                 crossing, t_cross = k, t
                 cross_from[:] = v
             v[:] = nxt
             t = t0 + (k + 1) * step
-        energy_rate(v, e)
+        energy(v, e)
         if e[0] >= e_f:
             return _newton_to_energy(cross_from, t_cross, step, e_f, nxt, k1, k2, k3, work, e, evaluations)
         if v[0] < floor:

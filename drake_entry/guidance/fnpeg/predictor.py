@@ -130,6 +130,7 @@ class Predictor:
             rate = e.Differentiate(_STATE[0]) * one[0] + e.Differentiate(_STATE[3]) * one[3]
             variables = (*_STATE, *_INPUT)
             self.kernels = compile_kernels([Kernel("rhs", tuple(one), variables),
+                                            Kernel("energy", (e,), variables),
                                             Kernel("energy_rate", (e, rate), variables)],
                                            predicted_flight, tag="fnpeg_prediction")
             return

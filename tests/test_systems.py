@@ -323,3 +323,20 @@ def test_acceleration_ratio_filter_low_passes_sensed_over_modelled_lift_and_drag
     assert far == pytest.approx((1.05, 0.97), rel=1e-12)
     thin = np.array([90e3, 0.1, 0.0, 7000.0, 0.0, 1.5])
     assert filtered_ratios((1.2, 0.8), thin, alpha, 1.0, 1.0, vehicle, planet, atmosphere, 1.0) == (1.2, 0.8)
+
+
+def test_compiled_actuator_path_is_the_actuator_law():
+    """actuator_path (the form numba kernels call, compiled inline) gives integrate_actuator's
+    positions and rates: a limited reversal, linear tracking, a settled actuator and a command
+    beyond the position limit; run as Python here and compiled in the swarm evaluator's tests."""
+    from drake_entry.models.actuator import actuator_path, integrate_actuator
+
+    lim = dict(lower=-math.radians(80), upper=math.radians(80), rate_limit=math.radians(10),
+               accel_limit=math.radians(5), bandwidth=2.0)
+    for sigma, rate, command, steps in ((math.radians(60), 0.0, math.radians(-70), 300), (0.30, 0.0, 0.303, 100),
+                                        (0.3, 0.0, 0.3, 5), (0.2, 0.05, math.radians(120), 50)):
+        want = np.array(integrate_actuator(sigma, rate, command, 0.01, steps, **lim))
+        got = np.empty((2, steps + 1))
+        actuator_path(sigma, rate, command, 0.01, steps, lim["lower"], lim["upper"], lim["rate_limit"],
+                      lim["accel_limit"], lim["bandwidth"], got[0], got[1])
+        np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-15)

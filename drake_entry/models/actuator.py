@@ -6,9 +6,10 @@ import functools
 import math
 
 import numpy as np
+from numba.extending import register_jitable
 
 __all__ = ["BANDWIDTH_RAD_S", "SUBSTEP_S", "FEW_LIMITED", "actuator_rates", "integrate_actuator",
-           "integrate_actuators"]
+           "integrate_actuators", "actuator_path"]
 
 #: the position loop's bandwidth omega [rad/s] of the closed loop's actuators (systems/actuators.py)
 BANDWIDTH_RAD_S = 2.0
@@ -19,10 +20,12 @@ SUBSTEP_S = 0.02
 FEW_LIMITED = 4
 
 
+@register_jitable  # plain Python when called from Python; compiled inline into numba kernels
 def _clip(v: float, lower: float, upper: float) -> float:
     return lower if v < lower else (upper if v > upper else v)
 
 
+@register_jitable
 def _accel(e: float, rate: float, omega: float, rate_limit: float, accel_limit: float) -> float:
     """x_ddot for the position error e = clipped command - x (see actuator_rates)."""
     ae = e if e >= 0.0 else -e
@@ -93,6 +96,40 @@ def _limited_path(sigma: float, rate: float, c: float, step: float, steps: int, 
         s_out.append(s)
         r_out.append(r)
     return s_out, r_out
+
+
+@register_jitable
+def actuator_path(sigma: float, rate: float, command: float, step: float, steps: int, lower: float, upper: float,
+                  rate_limit: float, accel_limit: float, bandwidth: float, positions, rates) -> None:
+    """``integrate_actuator`` written for compiled code (numba; models.kernels drivers): the
+    positions and rates at 0, step, ..., steps * step into the arrays ``positions`` and ``rates``
+    (at least steps + 1 long): the same exact solution where no limit is active, the same
+    midpoint-RK2 steps of ``_accel`` where one is (tests hold the two equal)."""
+    c = _clip(command, lower, upper)
+    w = bandwidth
+    x0 = sigma - c
+    B = rate + 2.0 * w * x0
+    bound = min(rate_limit / w, accel_limit / (w * w))
+    linear = True
+    for k in range(steps + 1):
+        t = k * step
+        decay = math.exp(-2.0 * w * t)
+        x = (x0 + B * t) * decay
+        v = (rate - 2.0 * w * B * t) * decay
+        positions[k], rates[k] = x + c, v
+        if abs(x) > bound or abs(4.0 * w * (w * x + v)) > accel_limit:
+            linear = False
+    if linear:
+        return
+    s, r, hh = sigma, rate, 0.5 * step
+    positions[0], rates[0] = s, r
+    for k in range(steps):
+        a1 = _accel(c - s, r, w, rate_limit, accel_limit)
+        r_mid = r + hh * a1
+        a2 = _accel(c - (s + hh * r), r_mid, w, rate_limit, accel_limit)
+        s += step * r_mid
+        r += step * a2
+        positions[k + 1], rates[k + 1] = s, r
 
 
 def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upper, rate_limit,

@@ -29,7 +29,7 @@ from scipy.interpolate import CubicSpline
 
 from drake_entry.errors import ScenarioError
 from drake_entry.models.data_tables import read_csv_rows
-from drake_entry.models.scalar import clamp, is_autodiff, lift, value_of
+from drake_entry.models.scalar import clamp, is_autodiff, is_symbolic, lift, value_of
 
 __all__ = ["DEG", "CoefficientDerivatives", "AeroDerivatives", "AeroModel", "TableAero", "read_wide_table",
            "packaged_data", "horus2b_table", "HorusFitAero", "horus_cd_form", "horus_cl_form", "FitReport",
@@ -562,6 +562,8 @@ class ScaledAero(AeroModel):
     drag_scale: float = 1.0
 
     def __post_init__(self):
+        if is_symbolic(self.lift_scale) or is_symbolic(self.drag_scale):  # a trace: scales are inputs
+            return
         if not self.lift_scale > 0 or not self.drag_scale > 0:
             raise ScenarioError(f"ScaledAero scales must be > 0, got {self.lift_scale}, {self.drag_scale}")
 

@@ -26,6 +26,7 @@ import dataclasses as dc
 import hashlib
 import importlib.util
 import inspect
+import math
 import os
 import sys
 import time
@@ -56,6 +57,13 @@ class Kernel:
     name: str
     outputs: tuple
     variables: tuple
+
+
+def _literal(c: float) -> str:
+    """A float as Python source (infinities and NaN as math's names)."""
+    if math.isfinite(c):
+        return repr(c)
+    return "math.nan" if math.isnan(c) else ("math.inf" if c > 0 else "-math.inf")
 
 
 class _Writer:
@@ -98,10 +106,10 @@ class _Writer:
         if isinstance(e, Variable):
             e = Expression(e)
         if not isinstance(e, Expression):
-            return repr(float(e))
+            return _literal(float(e))
         kind = e.get_kind()
         if kind == ExpressionKind.Constant:
-            return repr(float(e.Evaluate()))
+            return _literal(float(e.Evaluate()))
         found = self._lookup(e)
         if found is not None:
             return found
@@ -119,11 +127,11 @@ class _Writer:
         if kind == ExpressionKind.Add:  # constant + sum of terms
             terms = [self.value(a) for a in args[1:]]
             c = float(args[0])
-            return " + ".join(([repr(c)] if c != 0.0 else []) + terms)
+            return " + ".join(([_literal(c)] if c != 0.0 else []) + terms)
         if kind == ExpressionKind.Mul:  # constant * product of factors
             factors = [self.value(a) for a in args[1:]]
             c = float(args[0])
-            return " * ".join(([repr(c)] if c != 1.0 else []) + factors)
+            return " * ".join(([_literal(c)] if c != 1.0 else []) + factors)
         if kind == ExpressionKind.Div:
             return f"{self.value(args[0])} / {self.value(args[1])}"
         if kind == ExpressionKind.Pow:
@@ -171,7 +179,7 @@ class _Writer:
             return None
         table = f"{self.prefix}_table{self.tables}"
         self.tables += 1
-        self.globals.append(f"{table}_breaks = np.array({[float(b) for b in breaks]!r})")
+        self.globals.append(f"{table}_breaks = np.array([{', '.join(_literal(float(b)) for b in breaks)}])")
         index = self._emit(f"np.searchsorted({table}_breaks, {self.value(x)}, side='right')")
         name = f"t{self.count}"
         self.count += 1
@@ -184,12 +192,13 @@ class _Writer:
             columns = [[rows[i][1][k] if rows[i][0] == g else 0.0 for k in range(width)] for i in range(len(rows))]
             varying = [len({rows[i][1][k] for i in members}) > 1 for k in range(width)]
             if any(varying):
-                self.globals.append(f"{table}_constants{g} = np.array({columns!r})")
+                rows_text = ", ".join("[" + ", ".join(_literal(float(c)) for c in row) + "]" for row in columns)
+                self.globals.append(f"{table}_constants{g} = np.array([{rows_text}])")
             constants = iter(range(width))
 
             def constant(g=g, constants=constants, varying=varying, first=rows[members[0]][1]) -> str:
                 k = next(constants)
-                return f"{table}_constants{g}[{index}, {k}]" if varying[k] else repr(float(first[k]))
+                return f"{table}_constants{g}[{index}, {k}]" if varying[k] else _literal(float(first[k]))
 
             text = self._template(leaves[members[0]], constant)
             if len(shapes) == 1:

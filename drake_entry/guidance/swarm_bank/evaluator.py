@@ -21,17 +21,28 @@ import dataclasses as dc
 import math
 
 import numpy as np
+from pydrake.symbolic import Expression, Variable
 
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, LawSettings, law_commands
+from drake_entry.guidance.swarm_bank import population_flight
+from drake_entry.guidance.swarm_bank.guidance_law import (
+    LawMemory,
+    LawSettings,
+    bank_magnitude,
+    heat_drag_target,
+    law_commands,
+    load_coefficient_target,
+)
 from drake_entry.models.actuator import integrate_actuators
+from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle
 from drake_entry.models.constraints import dynamic_pressure
-from drake_entry.models.dynamics import aero_accelerations, equations_of_motion, state_derivatives
+from drake_entry.models.dynamics import aero_accelerations, air_data, equations_of_motion, state_derivatives
 from drake_entry.models.geodesy import bearings, downtrack_crosstrack
+from drake_entry.models.kernels import Kernel, compile_kernels
 
 __all__ = ["RANGE_UNIT_M", "ALTITUDE_UNIT_M", "SPEED_UNIT_M_S", "SwarmProblem", "Evaluation", "HISTORY_COLUMNS",
-           "CONTROL_COLUMNS", "evaluate", "range_error"]
+           "CONTROL_COLUMNS", "ENGINES", "evaluate", "range_error"]
 
 #: J of eq. 32: range error over 100 nmi, altitude error over 1 km, speed error over 100 m/s
 RANGE_UNIT_M, ALTITUDE_UNIT_M, SPEED_UNIT_M_S = 1.852e5, 1e3, 100.0
@@ -102,7 +113,8 @@ class SwarmProblem:
         return self.energy(self.h_f, self.V_f)
 
     def energy(self, h, V):
-        return self.planet.mu / self.planet.radius(h) - 0.5 * np.asarray(V) ** 2
+        """e = mu/r - V^2/2 [J/kg] (eq. 10): any scalar type or numpy arrays."""
+        return self.planet.mu / self.planet.radius(h) - 0.5 * V * V
 
     def law(self) -> LawSettings:
         pl = self.planet
@@ -158,15 +170,40 @@ HISTORY_COLUMNS = ("time_s", "altitude_m", "longitude_rad", "latitude_rad", "vel
 CONTROL_COLUMNS = ("time_s", "alpha_rad", "bank_rad")
 
 
-def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = False) -> Evaluation:
+def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = False,
+             engine: str = "compiled") -> Evaluation:
     """Fly every sigma0 [rad] of the population (array) and return its Evaluation; ``sigma_f``
     [rad]: per-member eq. 17 end banks (the two-parameter search; default the problem's); with
     ``record`` each member's step-by-step history (HISTORY_COLUMNS) and its actuators' path at
-    every sub-step (CONTROL_COLUMNS) are kept."""
-    p, pl, veh = problem, problem.planet, problem.vehicle
+    every sub-step (CONTROL_COLUMNS) are kept. ``engine``: "compiled" (the default; one compiled
+    call for the population, population_flight) or "numpy" (this function's vectorised loop, the
+    reference the compiled flight is tested against); a recorded evaluation is always "numpy"."""
+    if engine not in ENGINES:
+        raise ScenarioError(f"swarm evaluator engine = {engine!r}; allowed: {', '.join(ENGINES)}")
+    p = problem
     sigma0 = np.atleast_1d(np.asarray(sigma0, float))
     n = sigma0.size
     sigma_f = None if sigma_f is None else np.broadcast_to(np.asarray(sigma_f, float), (n,))
+    if engine == "compiled" and not record:
+        final, t_end, reached, peaks, reversals = _fly_compiled(p, sigma0, sigma_f)
+        return _evaluation(p, final, t_end, reached, peaks, reversals, n)
+    return _fly_numpy(p, sigma0, sigma_f, record)
+
+
+def _evaluation(p: SwarmProblem, final, t_end, reached, peaks, reversals, n, history=None, controls=None):
+    """The Evaluation of final states (6, n) and the rest (eq. 32)."""
+    ds, c = range_error(p, final[1], final[2])
+    dh, dV = final[0] - p.h_f, final[3] - p.V_f
+    J = np.abs(ds) / RANGE_UNIT_M + np.abs(dh) / ALTITUDE_UNIT_M + np.abs(dV) / SPEED_UNIT_M_S  # eq. 32
+    J = np.where(reached, J, np.inf)
+    return Evaluation(J, ds, c, dh, dV, final.T.copy(), t_end, reached, peaks[0], peaks[1], peaks[2], reversals, n,
+                      history, controls)
+
+
+def _fly_numpy(p: SwarmProblem, sigma0, sigma_f, record: bool) -> Evaluation:
+    """The population flown on numpy arrays, every member a column (module docstring)."""
+    pl, veh = p.planet, p.vehicle
+    n = sigma0.size
     law = p.law()
     x = np.tile(np.asarray(p.x0, float)[:, None], (1, n))
     alpha0 = p.alpha_max if p.initial_alpha is None else p.initial_alpha
@@ -247,15 +284,93 @@ def evaluate(problem: SwarmProblem, sigma0, *, sigma_f=None, record: bool = Fals
         active[idx[done | low]] = False
     final[:, active] = x[:, active]
     t_end[active] = t
-    ds, c = range_error(p, final[1], final[2])
-    dh, dV = final[0] - p.h_f, final[3] - p.V_f
-    J = np.abs(ds) / RANGE_UNIT_M + np.abs(dh) / ALTITUDE_UNIT_M + np.abs(dV) / SPEED_UNIT_M_S  # eq. 32
-    J = np.where(reached, J, np.inf)
     if record:
         history = [np.array(h) for h in history]
         controls = [np.vstack(c_i) for c_i in controls]
-    return Evaluation(J, ds, c, dh, dV, final.T.copy(), t_end, reached, peaks[0], peaks[1], peaks[2], reversals, n,
-                      history, controls)
+    return _evaluation(p, final, t_end, reached, peaks, reversals, n, history, controls)
+
+
+#: how a population is flown: "compiled" (population_flight with kernels generated from the
+#: models, models.kernels) or "numpy" (the vectorised loop: the reference)
+ENGINES = ("compiled", "numpy")
+_COMPILED: dict = {}  # the compiled module per (vehicle, planet, atmosphere, law) in this process
+
+
+def _unscaled(vehicle):
+    """(vehicle with its base aerodynamics, k_L, k_D) of a vehicle whose aerodynamics may be
+    ScaledAero (the on-board re-solution's acceleration ratios): the scales are kernel inputs."""
+    if isinstance(vehicle.aero, ScaledAero):
+        return dc.replace(vehicle, aero=vehicle.aero.base), vehicle.aero.lift_scale, vehicle.aero.drag_scale
+    return vehicle, 1.0, 1.0
+
+
+def _population_module(p: SwarmProblem, vehicle):
+    """The compiled population flight of ``p``'s models and law constants (cached per process;
+    the generated text is cached per machine by models.kernels)."""
+    law = p.law()
+    key = (id(vehicle), id(p.planet), id(p.atmosphere), p.load_max, p.heat_max, law.k2, law.beta, law.bank_limit)
+    found = _COMPILED.get(key)
+    if found is not None and found[0] is vehicle and found[1] is p.planet and found[2] is p.atmosphere:
+        return found[3]
+    pl, atm = p.planet, p.atmosphere
+    names = ("h", "lon", "lat", "V", "gamma", "psi", "alpha", "bank", "L", "D", "kL", "kD", "sigma0", "sigmaf",
+             "e0", "ef", "mach", "q", "cd", "heat", "tlon", "tlat")
+    v = {n: Variable(n) for n in names}
+    e = {n: Expression(var) for n, var in v.items()}
+    x = [e[n] for n in names[:6]]
+    traced = dc.replace(vehicle, aero=ScaledAero(vehicle.aero, e["kL"], e["kD"]))
+    with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
+        rho, a = air_data(x, pl, atm)
+        mach, L, D = aero_accelerations(x, e["alpha"], rho, a, traced)
+        aero = (rho, a, mach, L, D, dynamic_pressure(rho, e["V"]), traced.heat_flux(rho, e["V"]),
+                np.sqrt(L * L + D * D) / pl.g0)
+        magnitude = bank_magnitude(law, e["sigma0"], e["V"], e["gamma"], pl.radius(e["h"]), e["L"], e["D"],
+                                   e["sigmaf"], e["e0"], e["ef"])
+        kernels = [
+            Kernel("aero", aero, tuple(v[n] for n in (*names[:7], "kL", "kD"))),
+            Kernel("motion", tuple(equations_of_motion(x, e["bank"], e["L"], e["D"], pl)),
+                   tuple(v[n] for n in (*names[:6], "bank", "L", "D"))),
+            Kernel("derivatives", tuple(state_derivatives(x, e["bank"], e["alpha"], traced, pl, atm)),
+                   tuple(v[n] for n in (*names[:6], "bank", "alpha", "kL", "kD"))),
+            Kernel("bank_magnitude", (magnitude,),
+                   tuple(v[n] for n in ("h", "V", "gamma", "L", "D", "sigma0", "sigmaf", "e0", "ef"))),
+            Kernel("coefficients", tuple(traced.aero.coefficients(e["alpha"], e["mach"])),
+                   tuple(v[n] for n in ("alpha", "mach", "kL", "kD"))),
+            Kernel("load_target", (load_coefficient_target(e["q"], vehicle.area_over_mass, pl.g0, p.load_max),),
+                   (v["q"],)),
+            Kernel("heat_target", (heat_drag_target(e["cd"], e["heat"] / p.heat_max),), (v["cd"], v["heat"])),
+            Kernel("heading_error", (e["psi"] - bearings(e["lon"], e["lat"], e["tlon"], e["tlat"]),),
+                   tuple(v[n] for n in ("lon", "lat", "psi", "tlon", "tlat"))),
+            Kernel("energy", (p.energy(e["h"], e["V"]),), (v["h"], v["V"])),
+        ]
+    module = compile_kernels(kernels, population_flight, tag="swarm_population")
+    _COMPILED[key] = (vehicle, p.planet, p.atmosphere, module)
+    return module
+
+
+def _fly_compiled(p: SwarmProblem, sigma0, sigma_f):
+    """(final (6, n), t_end, reached, peaks (3, n), reversals) of the population, compiled."""
+    vehicle, kl, kd = _unscaled(p.vehicle)
+    module = _population_module(p, vehicle)
+    n = sigma0.size
+    alpha0 = p.alpha_max if p.initial_alpha is None else p.initial_alpha
+    values = dict(e0=p.start_energy, ef=p.ef, target_lon=p.target[0], target_lat=p.target[1], lift_scale=kl,
+                  drag_scale=kd, alpha0=alpha0, bank0=p.initial_bank, sign0=p.initial_sign,
+                  mach_was_above=float(p.memory[0]), switched=float(p.memory[1]), step_s=p.guidance_step_s,
+                  substeps=max(1, int(round(p.guidance_step_s / p.actuator_substep_s))),
+                  altitude_floor_m=p.altitude_floor_m, max_time_s=p.max_time_s, alpha_min=p.alpha_min,
+                  alpha_max=p.alpha_max, bank_limit=p.vehicle.bank_limit, alpha_rate=p.alpha_rate,
+                  bank_rate=p.vehicle.bank_rate_limit, alpha_accel=p.alpha_accel,
+                  bank_accel=p.vehicle.bank_accel_limit, bandwidth=2.0, heat_case=float(p.case == "heat"),
+                  mach_shift=p.mach_shift)
+    settings = np.array([float(values[k]) for k in population_flight.SETTINGS])
+    sf = np.full(n, p.sigma_f) if sigma_f is None else np.ascontiguousarray(sigma_f, float)
+    final, t_end = np.zeros((n, 6)), np.zeros(n)
+    reached, peaks, reversals = np.zeros(n, bool), np.zeros((n, 3)), np.zeros(n, np.int64)
+    module["fly_population"](np.asarray(p.x0, float), np.ascontiguousarray(sigma0), sf, settings,
+                             np.asarray(p.reversal_velocity, float), np.asarray(p.reversal_heading, float),
+                             final, t_end, reached, peaks, reversals)
+    return final.T, t_end, reached, peaks.T, reversals
 
 
 def range_error(problem: SwarmProblem, lon, lat):

@@ -16,10 +16,12 @@ import math
 import numpy as np
 
 from drake_entry.errors import ScenarioError
+from drake_entry.models.scalar import clamp
 from drake_entry.models.schedules import linear_bank
 
-__all__ = ["equilibrium_glide_radius", "qeg_sin_flight_path", "qeg_bank", "alpha_for_load_factor",
-           "alpha_for_heat_rate", "LawMemory", "LawSettings", "law_commands"]
+__all__ = ["equilibrium_glide_radius", "qeg_sin_flight_path", "qeg_bank", "SOLVE_RTOL", "SOLVE_MAX_ITERATIONS",
+           "load_coefficient_target", "heat_drag_target", "alpha_for_load_factor", "alpha_for_heat_rate",
+           "LawMemory", "LawSettings", "law_commands", "bank_magnitude"]
 
 
 def equilibrium_glide_radius(V, lift_coefficient_term, beta: float):
@@ -39,7 +41,6 @@ def qeg_sin_flight_path(r, V, D, beta: float):
     sin gamma = -2 D / (beta V^2 (1 - V^2) + 2 / r^2).
     The paper prints -D / (beta V^3 (1 - V^2) + 1/r^2), which is off by x0.56 to x1.25
     (docs/methods/swarm-bank.md); tests check this form against eq. 46's derivative."""
-    r, V, D = (np.asarray(v, float) for v in (r, V, D))
     return -2.0 * D / (beta * V * V * (1.0 - V * V) + 2.0 / (r * r))
 
 
@@ -48,12 +49,28 @@ def qeg_bank(sigma_base, L, D, sin_gamma, sin_gamma_qeg, k2: float):
     L cos(sigma_cmd) = L cos(sigma_base) - k2 (dr/de - dr_QEGC/de), with dr/de = sin gamma / D
     (eq. 11: de/dt = D V). Climbing faster than the glide (dr/de above) lowers the vertical
     lift. cos(sigma_cmd) is clipped to [-1, 1] (the compensation saturates)."""
-    drde = (np.asarray(sin_gamma) - np.asarray(sin_gamma_qeg)) / np.asarray(D)
-    c = np.cos(sigma_base) - k2 * drde / np.asarray(L)
-    return np.arccos(np.clip(c, -1.0, 1.0))
+    drde = (sin_gamma - sin_gamma_qeg) / D
+    c = np.cos(sigma_base) - k2 * drde / L
+    return np.arccos(clamp(c, -1.0, 1.0))
 
 
-def _solve_increasing(f, target, lo: float, hi: float, rtol: float = 1e-13, max_iterations: int = 60):
+#: the alpha laws' root finder: relative tolerance on the target, most iterations
+SOLVE_RTOL, SOLVE_MAX_ITERATIONS = 1e-13, 60
+
+
+def load_coefficient_target(dynamic_pressure, area_over_mass: float, g0: float, load_max: float):
+    """sqrt(C_L^2 + C_D^2) at which the total aerodynamic load is ``load_max`` [g] (eq. 31:
+    q S sqrt(C_L^2 + C_D^2) / (m g0) = a_max). Any scalar type or numpy arrays."""
+    return load_max * g0 / (dynamic_pressure * area_over_mass)
+
+
+def heat_drag_target(drag_coefficient_previous, heat_ratio):
+    """C_DQ of eq. 21: C_D(alpha_previous) (Qdot / Qdot_max)^2 (alpha_for_heat_rate)."""
+    return drag_coefficient_previous * heat_ratio * heat_ratio
+
+
+def _solve_increasing(f, target, lo: float, hi: float, rtol: float = SOLVE_RTOL,
+                      max_iterations: int = SOLVE_MAX_ITERATIONS):
     """x in [lo, hi] with f(x) = target for f increasing in x, vectorised: the Illinois
     variant of false position (superlinear; about 8 evaluations instead of bisection's 40).
     Targets outside [f(lo), f(hi)] give the bound (the constraint cannot be met exactly:
@@ -100,7 +117,7 @@ def alpha_for_load_factor(dynamic_pressure, mach, aero, area_over_mass: float, g
         cl, cd = aero.coefficients(alpha, mach)
         return np.hypot(cl, cd)
 
-    return _solve_increasing(coefficient, load_max * g0 / (q * area_over_mass), lo, hi)
+    return _solve_increasing(coefficient, load_coefficient_target(q, area_over_mass, g0, load_max), lo, hi)
 
 
 def alpha_for_heat_rate(alpha_previous, heat_ratio, mach, aero, lo: float, hi: float):
@@ -112,7 +129,7 @@ def alpha_for_heat_rate(alpha_previous, heat_ratio, mach, aero, lo: float, hi: f
     result depends on the guidance step (document it with the scenario)."""
     _check_bounds(lo, hi)
     a_prev, ratio, mach = np.broadcast_arrays(*(np.asarray(v, float) for v in (alpha_previous, heat_ratio, mach)))
-    target = aero.coefficients(a_prev, mach)[1] * ratio * ratio
+    target = heat_drag_target(aero.coefficients(a_prev, mach)[1], ratio)
     return _solve_increasing(lambda alpha: aero.coefficients(alpha, mach)[1], target, lo, hi)
 
 
@@ -171,12 +188,7 @@ def law_commands(s: LawSettings, sigma0, x, r, rho, mach, L, D, heat, q, aero, a
     to bank_limit. alpha: eq. 31 (Case 1); Case 2: eq. 21 until Mach has fallen below
     Mach_shift after exceeding it, then eq. 31. ``sigma_f``: per-member eq. 17 end banks
     (default: the settings')."""
-    V, gamma = x[3], x[4]
-    e = s.mu / r - 0.5 * V * V
-    base = linear_bank(e, s.e0, s.ef, sigma0, s.sigma_f if sigma_f is None else sigma_f)
-    v_scale = math.sqrt(s.g0 * s.R0)
-    s_qeg = qeg_sin_flight_path(r / s.R0, V / v_scale, D / s.g0, s.beta)
-    magnitude = np.minimum(qeg_bank(base, L / s.g0, D / s.g0, np.sin(gamma), s_qeg, s.k2), s.bank_limit)
+    magnitude = bank_magnitude(s, sigma0, x[3], x[4], r, L, D, s.sigma_f if sigma_f is None else sigma_f)
     alpha = alpha_for_load_factor(q, mach, aero, area_over_mass, s.g0, s.load_max, s.alpha_min, s.alpha_max)
     above, switched = memory.mach_was_above, memory.switched
     if s.case == "heat":
@@ -185,3 +197,18 @@ def law_commands(s: LawSettings, sigma0, x, r, rho, mach, L, D, heat, q, aero, a
         heat_alpha = alpha_for_heat_rate(memory.alpha_command, heat / s.heat_max, mach, aero, s.alpha_min, s.alpha_max)
         alpha = np.where(switched, alpha, heat_alpha)
     return magnitude, alpha, LawMemory(alpha, above, switched)
+
+
+def bank_magnitude(s: LawSettings, sigma0, V, gamma, r, L, D, sigma_f, e0=None, ef=None):
+    """|sigma| [rad] of eq. 17 (linear in e from sigma0 at e0 to sigma_f at ef; default the
+    settings' energies) with the QEG compensation (eqs. 46-48), limited to bank_limit, at speed V
+    [m/s], flight-path angle gamma [rad], radius r [m] and lift and drag L, D [m/s^2]. Any
+    scalar type or numpy arrays (the compiled population flight traces it)."""
+    e = s.mu / r - 0.5 * V * V
+    base = linear_bank(e, s.e0 if e0 is None else e0, s.ef if ef is None else ef, sigma0, sigma_f)
+    v_scale = math.sqrt(s.g0 * s.R0)
+    s_qeg = qeg_sin_flight_path(r / s.R0, V / v_scale, D / s.g0, s.beta)
+    command = qeg_bank(base, L / s.g0, D / s.g0, np.sin(gamma), s_qeg, s.k2)
+    if isinstance(command, np.ndarray):
+        return np.minimum(command, s.bank_limit)
+    return clamp(command, -math.inf, s.bank_limit)

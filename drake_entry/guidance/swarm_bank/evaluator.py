@@ -308,10 +308,14 @@ def _population_module(p: SwarmProblem, vehicle):
     """The compiled population flight of ``p``'s models and law constants (cached per process;
     the generated text is cached per machine by models.kernels)."""
     law = p.law()
-    key = (id(vehicle), id(p.planet), id(p.atmosphere), p.load_max, p.heat_max, law.k2, law.beta, law.bank_limit)
+    # what the trace reads: the objects by identity (an on-board re-solution rebuilds the vehicle
+    # around the same aerodynamics each time), the numbers by value
+    objects = (vehicle.aero, vehicle.heat_flux, p.planet, p.atmosphere)
+    key = (*map(id, objects), vehicle.mass, vehicle.reference_area, vehicle.nose_radius, p.load_max, p.heat_max,
+           law.k2, law.beta, law.bank_limit)
     found = _COMPILED.get(key)
-    if found is not None and found[0] is vehicle and found[1] is p.planet and found[2] is p.atmosphere:
-        return found[3]
+    if found is not None and all(a is b for a, b in zip(found[0], objects)):
+        return found[1]
     pl, atm = p.planet, p.atmosphere
     names = ("h", "lon", "lat", "V", "gamma", "psi", "alpha", "bank", "L", "D", "kL", "kD", "sigma0", "sigmaf",
              "e0", "ef", "mach", "q", "cd", "heat", "tlon", "tlat")
@@ -344,7 +348,7 @@ def _population_module(p: SwarmProblem, vehicle):
             Kernel("energy", (p.energy(e["h"], e["V"]),), (v["h"], v["V"])),
         ]
     module = compile_kernels(kernels, population_flight, tag="swarm_population")
-    _COMPILED[key] = (vehicle, p.planet, p.atmosphere, module)
+    _COMPILED[key] = (objects, module)  # the objects held, so their ids stay theirs
     return module
 
 

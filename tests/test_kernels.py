@@ -129,3 +129,17 @@ def test_the_cache_directory_follows_the_environment(monkeypatch, tmp_path):
     monkeypatch.delenv("DRAKE_ENTRY_KERNEL_CACHE")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     assert kernels.kernel_cache_dir() == tmp_path / "xdg" / "drake_entry" / "kernels"
+
+
+def test_a_read_only_cache_falls_back_to_a_temporary_directory(tmp_path, monkeypatch):
+    """A cache directory that cannot be written (a read-only home on a cluster node) does not stop
+    the work: the module is written and compiled in this user's temporary directory."""
+    blocked = tmp_path / "file"
+    blocked.write_text("a file, not a directory")
+    monkeypatch.setenv("DRAKE_ENTRY_KERNEL_CACHE", str(blocked / "kernels"))
+    monkeypatch.setattr(kernels, "_scratch_dir", lambda: tmp_path / "scratch")
+    k = compile_kernels([Kernel("f", (Expression(X) * 5.0,), (X,))], tag="fallback")
+    assert k.path.parent == tmp_path / "scratch"
+    out = np.empty(1)
+    k["f"](np.array([2.0]), out)
+    assert out[0] == 10.0

@@ -14,7 +14,8 @@ no physics), so the driver and its kernels compile as one unit. The module is wr
 kernel cache directory under the SHA-256 of its text and compiled with ``cache=True``: the
 machine code is kept on disk and a later process (a campaign worker) loads it instead of
 compiling. ``DRAKE_ENTRY_KERNEL_CACHE`` sets the directory (default
-``$XDG_CACHE_HOME/drake_entry/kernels`` or ``~/.cache/drake_entry/kernels``).
+``$XDG_CACHE_HOME/drake_entry/kernels`` or ``~/.cache/drake_entry/kernels``; where it cannot be
+written, a directory of this user's under the system's temporary one).
 
 Semantics are the float model's: ``min``/``max``, ``abs``, comparisons and logic as in Python;
 numba's NumPy error model (a sqrt of a negative or a 0/0 gives NaN, not an exception), so a
@@ -29,6 +30,7 @@ import inspect
 import math
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -373,6 +375,11 @@ def kernel_cache_dir() -> Path:
     return Path(base) / "drake_entry" / "kernels"
 
 
+def _scratch_dir() -> Path:
+    """The fallback when the cache directory cannot be written: this user's temporary one."""
+    return Path(tempfile.gettempdir()) / f"drake_entry_kernels_{os.getuid()}"
+
+
 @dc.dataclass
 class CompiledModule:
     """A generated module: ``functions`` name -> numba dispatcher (kernels and drivers);
@@ -416,15 +423,23 @@ def compile_kernels(kernels: list, driver=None, *, tag: str = "kernels") -> Comp
         names += [n for n, f in inspect.getmembers(driver, inspect.isfunction) if f.__module__ == driver.__name__]
     text = "\n\n".join(parts)
     digest = hashlib.sha256(text.encode()).hexdigest()[:20]
-    directory = kernel_cache_dir()
-    path = directory / f"{tag}_{digest}.py"
-    if path in _LOADED:
-        return _LOADED[path]
-    if not path.exists():
-        directory.mkdir(parents=True, exist_ok=True)
-        scratch = path.with_suffix(f".{os.getpid()}.tmp")
-        scratch.write_text(text)
-        os.replace(scratch, path)  # atomic: campaign workers may write the same module at once
+    name = f"{tag}_{digest}.py"
+    for directory in (kernel_cache_dir(), _scratch_dir()):
+        path = directory / name
+        if path in _LOADED:
+            return _LOADED[path]
+        try:
+            if not path.exists():
+                directory.mkdir(parents=True, exist_ok=True)
+                scratch = path.with_suffix(f".{os.getpid()}.tmp")
+                scratch.write_text(text)
+                os.replace(scratch, path)  # atomic: campaign workers may write the same module at once
+            break
+        except OSError:  # a read-only or full cache directory: compile in a temporary one
+            continue
+    else:
+        raise OSError(f"compiled kernels: neither {kernel_cache_dir()} nor {_scratch_dir()} is writable; "
+                      f"set DRAKE_ENTRY_KERNEL_CACHE to a writable directory")
     generate_s = time.perf_counter() - t0
     spec = importlib.util.spec_from_file_location(f"drake_entry_kernels_{digest}", path)
     module = importlib.util.module_from_spec(spec)

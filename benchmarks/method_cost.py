@@ -21,6 +21,7 @@ drag-energy and AMPI >= 3 runs/s/core, SCvx and PIO with on-board re-solution <=
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -57,7 +58,10 @@ name, _, variant = name.partition(":")  # NAME:field=value[,field=value]: a vari
 t0 = time.process_time()
 scenario = load_scenario(name)
 if variant:  # read as --set FIELD=VALUE is, through the CLI's parser and the typed loader
-    from drake_entry.cli.common import parse_overrides
+    try:
+        from drake_entry.cli.common import parse_overrides
+    except ImportError:  # a baseline whose command line was one module (drake_entry/cli.py)
+        from drake_entry.cli import parse_overrides
     from drake_entry.scenario import apply_overrides
 
     apply_overrides(scenario, parse_overrides(variant.split(",")))
@@ -103,6 +107,20 @@ planning = float(np.mean([r.get("planning_wall_s", 0.0) or 0.0 for r in rows]))
 print(json.dumps({"setup_s": setup_s, "sample_s": min(walls), "per_eval_s": per_eval, "evaluations": evaluations,
                   "planning_s": planning, "rows": rows}, default=float))
 """
+
+
+def final_point_difference(a: dict, b: dict, radius_m: float = 6378137.0) -> tuple[float, float]:
+    """(distance [m] between two rows' final points: great circle at the mean radius and altitude,
+    |speed difference| [m/s]); nan where a row has no final point."""
+    try:
+        lon1, lat1, lon2, lat2 = (math.radians(r[k]) for r, k in ((a, "final_longitude_deg"), (a, "final_latitude_deg"),
+                                                                  (b, "final_longitude_deg"), (b, "final_latitude_deg")))
+        h1, h2, v1, v2 = a["final_altitude_m"], b["final_altitude_m"], a["final_velocity_m_s"], b["final_velocity_m_s"]
+    except (KeyError, TypeError):
+        return math.nan, math.nan
+    s = math.sin((lat2 - lat1) / 2) ** 2 + math.cos(lat1) * math.cos(lat2) * math.sin((lon2 - lon1) / 2) ** 2
+    across = 2.0 * (radius_m + 0.5 * (h1 + h2)) * math.asin(min(1.0, math.sqrt(s)))
+    return math.hypot(across, h2 - h1), abs(v2 - v1)
 
 
 def _run(site: str, scenario: str, samples: int, seed: int, rounds: int) -> dict:
@@ -153,7 +171,11 @@ def method_cost_benchmark(*, baseline: str = "HEAD~1", samples: dict | None = No
             diffs = [abs(x.get("err_distance_m", 0.0) - y.get("err_distance_m", 0.0))
                      for x, y in zip(a["rows"], b["rows"])]
             same = [x.get("success") == y.get("success") for x, y in zip(a["rows"], b["rows"])]
+            point = [final_point_difference(x, y) for x, y in zip(a["rows"], b["rows"])]
+            position, speed = max((p[0] for p in point), default=0.0), max((p[1] for p in point), default=0.0)
             print(f"{'':{width}s} ratio this/baseline {ratio:.3f}; verdicts equal: {all(same)}; largest terminal-distance "
-                  f"difference {max(diffs, default=0.0):.3g} m over {n} samples")
-            out[name] = {**res, "ratio": ratio, "max_distance_difference_m": max(diffs, default=0.0)}
+                  f"difference {max(diffs, default=0.0):.3g} m, final points within {position:.3g} m and "
+                  f"{speed:.3g} m/s over {n} samples")
+            out[name] = {**res, "ratio": ratio, "max_distance_difference_m": max(diffs, default=0.0),
+                         "max_final_position_difference_m": position, "max_final_speed_difference_m_s": speed}
     return out

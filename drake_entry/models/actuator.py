@@ -85,17 +85,25 @@ def _limited_path(sigma: float, rate: float, c: float, step: float, steps: int, 
     """(x, x_dot) lists at 0, step, ..., steps * step of midpoint-RK2 steps of ``_accel``
     towards the clipped command ``c`` (Python floats: for one member this is several times
     faster than the same steps on NumPy arrays)."""
-    s_out, r_out = [sigma], [rate]
+    s_out, r_out = [0.0] * (steps + 1), [0.0] * (steps + 1)
+    _limited_steps(sigma, rate, c, step, steps, omega, rate_limit, accel_limit, s_out, r_out)
+    return s_out, r_out
+
+
+@register_jitable
+def _limited_steps(sigma: float, rate: float, c: float, step: float, steps: int, omega: float, rate_limit: float,
+                   accel_limit: float, positions, rates) -> None:
+    """The midpoint-RK2 steps of ``_accel`` towards ``c``: positions and rates at 0, step, ...,
+    steps * step written into ``positions`` and ``rates`` (lists in Python, arrays when compiled)."""
     s, r, hh = sigma, rate, 0.5 * step
-    for _ in range(steps):
+    positions[0], rates[0] = s, r
+    for k in range(steps):
         a1 = _accel(c - s, r, omega, rate_limit, accel_limit)
         r_mid = r + hh * a1
         a2 = _accel(c - (s + hh * r), r_mid, omega, rate_limit, accel_limit)
         s += step * r_mid
         r += step * a2
-        s_out.append(s)
-        r_out.append(r)
-    return s_out, r_out
+        positions[k + 1], rates[k + 1] = s, r
 
 
 @register_jitable
@@ -119,17 +127,8 @@ def actuator_path(sigma: float, rate: float, command: float, step: float, steps:
         positions[k], rates[k] = x + c, v
         if abs(x) > bound or abs(4.0 * w * (w * x + v)) > accel_limit:
             linear = False
-    if linear:
-        return
-    s, r, hh = sigma, rate, 0.5 * step
-    positions[0], rates[0] = s, r
-    for k in range(steps):
-        a1 = _accel(c - s, r, w, rate_limit, accel_limit)
-        r_mid = r + hh * a1
-        a2 = _accel(c - (s + hh * r), r_mid, w, rate_limit, accel_limit)
-        s += step * r_mid
-        r += step * a2
-        positions[k + 1], rates[k + 1] = s, r
+    if not linear:
+        _limited_steps(sigma, rate, c, step, steps, w, rate_limit, accel_limit, positions, rates)
 
 
 def integrate_actuators(x, rate, command, step: float, steps: int, *, lower, upper, rate_limit,

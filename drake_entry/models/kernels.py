@@ -94,6 +94,13 @@ class _Writer:
                 return scope[key]
         return None
 
+    def _known(self, e):
+        """The name of ``e`` if it is computed already (a variable always is), else None."""
+        found = self._lookup(e)
+        if found is None and e.get_kind() == ExpressionKind.Var:
+            raise UnsupportedScalarError(f"compiled kernel: variable {e} is not among the kernel's variables")
+        return found
+
     def _bind(self, e, name):
         self.scopes[-1][self._key(e)] = name
 
@@ -112,11 +119,9 @@ class _Writer:
         kind = e.get_kind()
         if kind == ExpressionKind.Constant:
             return _literal(float(e.Evaluate()))
-        found = self._lookup(e)
+        found = self._known(e)
         if found is not None:
             return found
-        if kind == ExpressionKind.Var:
-            raise UnsupportedScalarError(f"compiled kernel: variable {e} is not among the kernel's variables")
         _, args = e.Unapply()
         if kind == ExpressionKind.IfThenElse:
             name = self._table(e) or self._branch(args)
@@ -226,11 +231,9 @@ class _Writer:
             if kind == ExpressionKind.Constant:
                 constants.append(float(e.Evaluate()))
                 return "c"
-            found = self._lookup(e)
+            found = self._known(e)
             if found is not None:
                 return found
-            if kind == ExpressionKind.Var:
-                raise UnsupportedScalarError(f"compiled kernel: variable {e} is not among the kernel's variables")
             _, args = e.Unapply()
             if kind in (ExpressionKind.Add, ExpressionKind.Mul):
                 constants.append(float(args[0]))

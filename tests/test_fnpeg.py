@@ -252,6 +252,7 @@ def test_apollo_cm_is_the_apollo10_compilation():
     assert cl / cd == pytest.approx(0.3247, abs=1e-4)
 
 
+@pytest.mark.slow  # two more compiled predictors (about 10 s of a core on a new machine): CI's slow set
 def test_constant_profile_predicts_the_linear_profile_with_sigma_f_equal_to_sigma_0(capsule):
     """guidance.bank_profile: constant flies |sigma| = sigma_0 to e_f: the same prediction as the
     linear profile whose sigma_f is sigma_0, and a different one from the packaged sigma_f."""

@@ -710,6 +710,7 @@ def test_model_values_dynamics_only_gives_the_same_dynamics_and_skips_the_rest()
         assert not np.any(L_only)
 
 
+@pytest.mark.slow  # two NLP solves, about 13 s of a core: CI's slow set
 def test_hermite_simpson_is_drakes_direct_collocation_nlp():
     """The vectorised transcription poses the NLP of Drake's DirectCollocation (same rows,
     trapezoid cost, first-order-hold controls): Betts' shuttle at 40 samples, SNOPT from the

@@ -30,6 +30,7 @@ import tempfile
 
 from interface_cost import _checkout, _installed_layout
 
+from drake_entry.models.geodesy import central_angle
 from drake_entry.scenario import closed_loop_scenarios, load_scenario
 
 #: paper 004 with sigma_0 re-solved on board every 100 s: the variant the PIO target is about
@@ -127,8 +128,7 @@ def final_point_difference(a: dict, b: dict, radius_m: float = 6378137.0) -> tup
         h1, h2, v1, v2 = a["final_altitude_m"], b["final_altitude_m"], a["final_velocity_m_s"], b["final_velocity_m_s"]
     except (KeyError, TypeError):
         return math.nan, math.nan
-    s = math.sin((lat2 - lat1) / 2) ** 2 + math.cos(lat1) * math.cos(lat2) * math.sin((lon2 - lon1) / 2) ** 2
-    across = 2.0 * (radius_m + 0.5 * (h1 + h2)) * math.asin(min(1.0, math.sqrt(s)))
+    across = (radius_m + 0.5 * (h1 + h2)) * float(central_angle(lon1, lat1, lon2, lat2))
     return math.hypot(across, h2 - h1), abs(v2 - v1)
 
 

@@ -47,15 +47,14 @@ def predict_flight(v0, step, e_f, floor, ceiling, max_time, steps_per_check):
     the energy e_f [J/kg] or a stop checked every ``steps_per_check`` steps: below ``floor`` [m],
     above ``ceiling`` [m], at ``max_time`` [s]. Returns (stop code, time [s], the final v, the
     number of right-hand sides evaluated)."""
-    v, nxt, before = v0.copy(), v0.copy(), v0.copy()
+    v, nxt = v0.copy(), v0.copy()
     k1, k2, k3, work = np.empty(7), np.empty(7), np.empty(7), np.empty(v0.size)
     e = np.empty(2)
     cross_from = v0.copy()
     t, evaluations = 0.0, 0
     while True:
         t0 = t
-        before[:] = v
-        crossing, t_cross = -1, 0.0
+        crossed, t_cross = False, 0.0
         for k in range(steps_per_check):
             rk3_step(v, step, nxt, k1, k2, k3, work)
             evaluations += 3
@@ -63,13 +62,12 @@ def predict_flight(v0, step, e_f, floor, ceiling, max_time, steps_per_check):
                 if not math.isfinite(nxt[i]):
                     return NOT_FINITE, t, v, evaluations
             energy(nxt, e)
-            if crossing < 0 and e[0] >= e_f:
-                crossing, t_cross = k, t
+            if not crossed and e[0] >= e_f:
+                crossed, t_cross = True, t
                 cross_from[:] = v
             v[:] = nxt
             t = t0 + (k + 1) * step
-        energy(v, e)
-        if e[0] >= e_f:
+        if e[0] >= e_f:  # e holds the energy after the chunk's last step
             return _newton_to_energy(cross_from, t_cross, step, e_f, nxt, k1, k2, k3, work, e, evaluations)
         if v[0] < floor:
             return FLOOR, t, v, evaluations

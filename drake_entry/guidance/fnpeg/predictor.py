@@ -125,8 +125,7 @@ class Predictor:
         self.evaluations = 0
         self.predictions = 0
         if engine == "compiled":
-            h, V = (Expression(v) for v in (_STATE[0], _STATE[3]))
-            e = self.mu / planet.radius(h) - 0.5 * V * V
+            e = self.energy([Expression(v) for v in _STATE])
             rate = e.Differentiate(_STATE[0]) * one[0] + e.Differentiate(_STATE[3]) * one[3]
             variables = (*_STATE, *_INPUT)
             self.kernels = compile_kernels([Kernel("rhs", tuple(one), variables),

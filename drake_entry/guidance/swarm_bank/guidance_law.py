@@ -208,7 +208,4 @@ def bank_magnitude(s: LawSettings, sigma0, V, gamma, r, L, D, sigma_f, e0=None, 
     base = linear_bank(e, s.e0 if e0 is None else e0, s.ef if ef is None else ef, sigma0, sigma_f)
     v_scale = math.sqrt(s.g0 * s.R0)
     s_qeg = qeg_sin_flight_path(r / s.R0, V / v_scale, D / s.g0, s.beta)
-    command = qeg_bank(base, L / s.g0, D / s.g0, np.sin(gamma), s_qeg, s.k2)
-    if isinstance(command, np.ndarray):
-        return np.minimum(command, s.bank_limit)
-    return clamp(command, -math.inf, s.bank_limit)
+    return clamp(qeg_bank(base, L / s.g0, D / s.g0, np.sin(gamma), s_qeg, s.k2), -math.inf, s.bank_limit)

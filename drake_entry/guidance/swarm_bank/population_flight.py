@@ -89,7 +89,7 @@ def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_he
     one, two = np.empty(1), np.empty(2)
     a_path, b_path = np.empty(steps + 1), np.empty(steps + 1)
     a_rates, b_rates = np.empty(steps + 1), np.empty(steps + 1)
-    x, xs, xn = np.empty(6), np.empty(6), np.empty(6)
+    x, xn = np.empty(6), np.empty(6)
     half = steps // 2
     for i in range(sigma0.size):
         x[:] = x0
@@ -98,6 +98,9 @@ def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_he
         alpha_command, above, switched = settings[6], settings[9] > 0.5, settings[10] > 0.5
         n_rev, p0, p1, p2 = 0, 0.0, 0.0, 0.0
         stopped, t = False, 0.0
+        two[0], two[1] = x[0], x[3]
+        energy(two, one)
+        e = one[0]  # the energy at x, carried from step to step
         while t < max_time:
             for k in range(6):
                 va[k] = x[k]
@@ -143,15 +146,12 @@ def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_he
                 va[k] = x[k]
             va[6], va[7], va[8] = b_path[0], L, D
             motion(va, k1)
-            _stage(x, k1, 0.5 * dt, b_mid, a_mid, kl, kd, xs, va, k2)
-            _stage(x, k2, 0.5 * dt, b_mid, a_mid, kl, kd, xs, va, k3)
-            _stage(x, k3, dt, b_path[steps], a_path[steps], kl, kd, xs, va, k4)
+            _stage(x, k1, 0.5 * dt, b_mid, a_mid, kl, kd, va, k2)
+            _stage(x, k2, 0.5 * dt, b_mid, a_mid, kl, kd, va, k3)
+            _stage(x, k3, dt, b_path[steps], a_path[steps], kl, kd, va, k4)
             for k in range(6):
                 xn[k] = x[k] + dt / 6.0 * (k1[k] + 2.0 * k2[k] + 2.0 * k3[k] + k4[k])
             t += dt
-            two[0], two[1] = x[0], x[3]
-            energy(two, one)
-            e = one[0]
             two[0], two[1] = xn[0], xn[3]
             energy(two, one)
             e_new = one[0]
@@ -166,13 +166,14 @@ def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_he
                 t_end[i], stopped = t, True
                 break
             x[:] = xn
+            e = e_new
         if not stopped:
             final[i, :] = x
             t_end[i] = t
         peaks[i, 0], peaks[i, 1], peaks[i, 2], reversals[i] = p0, p1, p2, n_rev
 
 
-def _stage(x, k, h, bank, alpha, kl, kd, xs, v, out):
+def _stage(x, k, h, bank, alpha, kl, kd, v, out):
     """The state rates at x + h k with the actuators at (bank, alpha)."""
     for j in range(6):
         v[j] = x[j] + h * k[j]

@@ -246,6 +246,23 @@ def test_initial_decision_respects_the_rate_limits_and_sets_the_epigraph_to_the_
     assert problem.evaluate(z).objective == pytest.approx(max(loads) / 3.0, rel=1e-12)
 
 
+def test_initial_decision_follows_a_guess_s_own_alpha(sphynx_case):
+    """A re-plan's guess carries the previous plan's alpha: the direct start flies it (within
+    the alpha bounds and rate limit), not the mission's alpha(V) schedule it replaced."""
+    vehicle, planet, atmosphere, mission, guess = sphynx_case
+    problem = EntryProblem(vehicle, planet, atmosphere, mission,
+                           EntryProblemSettings(formulation="direct", objective="heat_load"), guess.final_time)
+    lo, hi = np.radians(mission.alpha_bounds_deg)
+    own = lo + 0.25 * (hi - lo) * (1.0 + np.cos(guess.time / guess.final_time * math.pi))  # slow: within the rate limit
+    X, _, _ = problem.unpack(initial_decision(problem, dc.replace(guess, alpha=own)))
+    t = problem.mesh.s * guess.final_time
+    assert X[1:, 7] == pytest.approx(np.interp(t, guess.time, own)[1:], abs=1e-9)
+    scheduled = np.array([problem.alpha(float(V)) for V in X[:, 3]])
+    X0, _, _ = problem.unpack(initial_decision(problem, guess))
+    assert X0[1:, 7] == pytest.approx(scheduled[1:], abs=1e-9)
+    assert np.abs(X[1:, 7] - scheduled[1:]).max() > math.radians(1.0)
+
+
 def test_settings_name_the_formulation_an_objective_needs():
     with pytest.raises(ScenarioError, match="formulation"):
         EntryProblemSettings(formulation="polar")

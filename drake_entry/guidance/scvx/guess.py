@@ -37,8 +37,10 @@ __all__ = ["GlideGuess", "glide_bank_magnitude", "heading_error", "reversal_dead
 @dc.dataclass(frozen=True)
 class GlideGuess:
     """A propagated guess: times [s], states (n, 6), bank [rad] at those times, the
-    reference bank sigma_g [rad], the distance of its end from the site [m], and whether it
-    reached the middle of the DRS altitude window (it may stop earlier by speed or time)."""
+    reference bank sigma_g [rad], the distance of its end from the site [m], whether it
+    reached the middle of the DRS altitude window (it may stop earlier by speed or time), and
+    the angle of attack [rad] at those times where the guess has its own (a re-plan's, from the
+    previous plan; None: the mission's alpha(V) schedule)."""
 
     time: np.ndarray
     states: np.ndarray
@@ -46,6 +48,7 @@ class GlideGuess:
     reference_bank: float
     miss: float
     reached_drs_altitude: bool
+    alpha: np.ndarray | None = None
 
     @property
     def final_time(self) -> float:

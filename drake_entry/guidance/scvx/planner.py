@@ -178,12 +178,16 @@ def decision_from_trajectory(problem: EntryProblem, states, bank, alpha, tf: flo
 
 
 def initial_decision(problem: EntryProblem, guess: GlideGuess) -> np.ndarray:
-    """z from a glide guess: states by cubic spline at the mesh times, its bank and alpha(V)."""
+    """z from a glide guess: states by cubic spline at the mesh times, its bank, and its alpha
+    where it has one (a re-plan's) else the mission's alpha(V)."""
     t = problem.mesh.s * guess.final_time
     T, idx = np.unique(guess.time, return_index=True)
     X = CubicSpline(T, guess.states[idx])(t)
     bank = np.interp(t, T, guess.bank[idx])
-    alpha = np.array([problem.alpha(float(V)) for V in X[:, 3]])
+    if guess.alpha is not None:
+        alpha = np.interp(t, T, guess.alpha[idx])
+    else:
+        alpha = np.array([problem.alpha(float(V)) for V in X[:, 3]])
     return decision_from_trajectory(problem, X, bank, alpha, guess.final_time)
 
 
@@ -467,7 +471,7 @@ def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float
     ref = previous.evaluate(rest)
     states = np.stack([ref[k] for k in STATE_NAMES], axis=1)
     states[0] = x
-    guess = GlideGuess(rest - rest[0], states, ref["bank"], math.nan, math.nan, True)
+    guess = GlideGuess(rest - rest[0], states, ref["bank"], math.nan, math.nan, True, alpha=ref["alpha"])
     if guess.final_time <= 0.0:
         raise ValueError(f"the previous plan has no time left at {elapsed:.1f} s (t_f {previous.final_time:.1f} s)")
     return plan_entry(p.vehicle, p.planet, p.atmosphere, mission, problem_settings=p.settings,

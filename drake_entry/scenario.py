@@ -138,13 +138,16 @@ class Scenario:
     """A mission: vehicle, environment, entry interface, target, terminal interface,
     open-loop command schedules and simulation settings."""
 
+    #: fields naming a file: a relative path is read beside the scenario file (typed_yaml.resolve_file_fields)
+    FILE_FIELDS = ('vehicle',)
+
     # a packaged scenario name, or a YAML path (relative to this file), whose every field this
     # file starts from: the file then states only what it changes (blocks merge field by field)
     based_on: str = ""
     name: str = ""  # short identifier, used in file names and reports
     description: str = ""  # one line for humans
     source: str = ""  # where the numbers come from (papers, data files)
-    vehicle: str = ""  # packaged vehicle name or a vehicle YAML path
+    vehicle: str = ""  # packaged vehicle name or a vehicle YAML path (relative: beside this file)
     # which aero model of the vehicle file ('' = its default)
     aero: str = ""
     # the mission's path and bank limits where they differ from the vehicle file's (keys:

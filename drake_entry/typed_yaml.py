@@ -34,7 +34,7 @@ from pydrake.common.yaml import yaml_load_typed
 from drake_entry.errors import ScenarioError
 
 __all__ = ["Tagged", "DuplicateKeyError", "parse", "check", "packaged_names", "load_packaged_or_file",
-           "load_yaml_typed", "override"]
+           "load_yaml_typed", "resolve_file_fields", "override"]
 
 
 class Tagged(NamedTuple):
@@ -296,7 +296,8 @@ def load_packaged_or_file(schema, name_or_path, *, kind: str, folder: str, _chai
         raise ScenarioError(f"{kind} '{name_or_path}' is a directory, not a YAML file")
     if os.path.exists(name_or_path):
         return load_yaml_typed(schema, path=name_or_path, base_of=base_of)
-    raise ScenarioError(f"{kind} '{name_or_path}' is neither a packaged {kind} ({', '.join(packaged)}) nor a file")
+    raise ScenarioError(f"{kind} '{name_or_path}' is neither a packaged {kind} ({', '.join(packaged)}) nor a file "
+                        f"(a relative path written in a YAML file is read beside that file, then here)")
 
 
 def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None, where: str | None = None,
@@ -344,8 +345,37 @@ def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None,
                 raise ScenarioError(f"{where}: {name}: write the tag of the block it changes (the base '{base}' "
                                     f"has !{_tag_name(type(getattr(defaults, name)))}); an untagged block "
                                     f"starts from the default")
-        return _drake_load(schema, text, where, defaults=defaults)
-    return _drake_load(schema, text, where)
+        loaded = _drake_load(schema, text, where, defaults=defaults)
+    else:
+        loaded = _drake_load(schema, text, where)
+    if path is not None:
+        resolve_file_fields(loaded, os.path.dirname(os.path.abspath(path)))
+    return loaded
+
+
+def resolve_file_fields(root, folder: str) -> None:
+    """Read the relative file names of a loaded tree beside the file that names them: in every
+    block of ``root`` (a dataclass tree, its lists and dicts included), each field its class lists
+    in ``FILE_FIELDS`` that names a file relative to ``folder`` becomes that file's absolute path.
+    Other values (packaged names, absolute paths, files not there) are left for the field's own
+    loader, which then tries the packaged names and the working directory."""
+    if dc.is_dataclass(root) and not isinstance(root, type):
+        for name in getattr(type(root), "FILE_FIELDS", ()):
+            value = getattr(root, name)
+            if isinstance(value, str) and value and not os.path.isabs(value):
+                beside = os.path.join(folder, value)
+                if os.path.isfile(beside):
+                    setattr(root, name, os.path.abspath(beside))
+        children = [getattr(root, f.name) for f in dc.fields(root)]
+    elif isinstance(root, dict):
+        children = list(root.values())
+    elif isinstance(root, (list, tuple)):
+        children = list(root)
+    else:
+        return
+    for child in children:
+        if dc.is_dataclass(child) or isinstance(child, (dict, list, tuple)):
+            resolve_file_fields(child, folder)
 
 
 def _as_yaml_text(value) -> str:

@@ -2,6 +2,7 @@
 accepted or refused the same way from a scenario file, from ``--set`` and from the API, and
 every refusal is one ScenarioError naming the full field path."""
 import dataclasses as dc
+import math
 import re
 
 import pytest
@@ -151,3 +152,46 @@ def test_check_reports_nested_list_positions():
 def _packaged_text(name: str) -> str:
     from importlib import resources
     return resources.files("drake_entry").joinpath(f"scenarios/{name}.yaml").read_text()
+
+
+def test_relative_files_are_read_beside_the_file_that_names_them(tmp_path, monkeypatch):
+    """A user's mission folder (vehicle with its own aero tables, scenario, comparison), loaded
+    from another working directory: every relative file name is read beside the YAML file that
+    writes it; a file that is not there is refused naming where relative paths are read."""
+    from importlib import resources
+
+    from drake_entry.comparison.spec import load_comparison
+    from drake_entry.models.vehicles import load_vehicle
+
+    mission = tmp_path / "mission"
+    (mission / "aero").mkdir(parents=True)
+    data = resources.files("drake_entry").joinpath("data")
+    for name in ("horus2b_clean_aero_m692.csv", "horus2b_clean_aero_fill_2024.csv"):
+        (mission / "aero" / name).write_text(data.joinpath(name).read_text())
+    vehicle = resources.files("drake_entry").joinpath("vehicles/horus2b.yaml").read_text()
+    vehicle = vehicle.replace("table_csv: horus2b_clean_aero_m692.csv", "table_csv: aero/horus2b_clean_aero_m692.csv")
+    vehicle = vehicle.replace("fill_csv: horus2b_clean_aero_fill_2024.csv",
+                              "fill_csv: aero/horus2b_clean_aero_fill_2024.csv")
+    assert vehicle.count("aero/") == 2
+    (mission / "glider.yaml").write_text(vehicle.replace("name: horus2b", "name: glider"))
+    (mission / "entry.yaml").write_text("based_on: horus2b\nvehicle: glider.yaml\naero: table\n")
+    (mission / "compare.yaml").write_text("name: mine\nmission: entry.yaml\nmethods:\n"
+                                          "  - {label: drag_energy, method: DragEnergy}\n")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+
+    scenario = load_scenario(str(mission / "entry.yaml"))
+    assert scenario.vehicle == str(mission / "glider.yaml")
+    v = scenario.make_vehicle()
+    packaged = load_vehicle("horus2b", aero="table")
+    for alpha, mach in ((20.0, 5.0), (40.0, 15.0)):
+        assert v.aero.coefficients(math.radians(alpha), mach) == pytest.approx(
+            packaged.aero.coefficients(math.radians(alpha), mach), rel=1e-14)
+    comparison = load_comparison(str(mission / "compare.yaml"))
+    assert comparison.mission == str(mission / "entry.yaml")
+    assert load_scenario(comparison.mission).vehicle == str(mission / "glider.yaml")
+
+    (mission / "lost.yaml").write_text("based_on: horus2b\nvehicle: nowhere/glider.yaml\n")
+    with pytest.raises(ScenarioError, match=r"vehicle 'nowhere/glider.yaml' is neither .* read beside that file"):
+        load_scenario(str(mission / "lost.yaml"))

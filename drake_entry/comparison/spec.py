@@ -51,9 +51,12 @@ class ComparedMethod:
 class Comparison:
     """Several guidance methods on one mission, with the same dispersions and seeds."""
 
+    #: fields naming a file: a relative path is read beside the comparison file (typed_yaml.resolve_file_fields)
+    FILE_FIELDS = ('mission',)
+
     name: str = ""  # short identifier, used in file names and reports
     description: str = ""  # one line for humans
-    # the mission: a packaged scenario name or a scenario file (its guidance block is the
+    # the mission: a packaged scenario name or a scenario file (relative: beside this file; its guidance block is the
     # default settings of the entry that gives none)
     mission: str = ""
     methods: list[ComparedMethod] = dc.field(default_factory=list)  # every method, flown or not

@@ -26,6 +26,9 @@ __all__ = ["AeroSpec", "HeatFluxSpec", "VehicleSpec", "Vehicle", "build_aero", "
 class AeroSpec:
     """One aerodynamic model of a vehicle file."""
 
+    #: fields naming a file: a relative path is read beside the vehicle file (typed_yaml.resolve_file_fields)
+    FILE_FIELDS = ('table_csv', 'fill_csv')
+
     # table | horus_fit | cav_h | drag_polar | polynomial | newtonian
     model: str = ""
     # table: wide CSV (packaged data name or path) and optional long-format fill CSV
@@ -149,7 +152,8 @@ def _resolve_data(path: str):
     try:
         return aero_mod.packaged_data(path)
     except FileNotFoundError:
-        raise ScenarioError(f"aero table '{path}' is neither a file nor a packaged data file") from None
+        raise ScenarioError(f"aero table '{path}' is neither a file nor a packaged data file (a relative path is "
+                            f"read beside the vehicle file, then here)") from None
 
 
 def build_aero(spec: AeroSpec, where: str = "aero") -> aero_mod.AeroModel:

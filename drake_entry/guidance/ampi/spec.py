@@ -44,6 +44,9 @@ class Ampi(GuidanceSpecBase):
     The defaults are where the packaged database's references end (bank-effort optimum: the
     corner h 21.0-21.4 km, V 620 m/s of Table 1's window)."""
 
+    #: fields naming a file: a relative path is read beside the scenario file (typed_yaml.resolve_file_fields)
+    FILE_FIELDS = ('database',)
+
     terminal_altitude_km: float = 21.1
     terminal_velocity_m_s: float = 620.0
     period_s: float = 0.5

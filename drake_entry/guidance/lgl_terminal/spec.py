@@ -22,6 +22,9 @@ class LglTerminal(ReplanningSpec):
     the navigation estimate every ``replan_period_s`` with the horizon that remains, warm-started
     from the solution in use (drake_entry.planning.nlp.shrinking_horizon)."""
 
+    #: fields naming a file: a relative path is read beside the scenario file (typed_yaml.resolve_file_fields)
+    FILE_FIELDS = ('problem',)
+
     # the closed loop stops at impact
     stops_at_altitude = True
     terminal_altitude_km: float = 0.0

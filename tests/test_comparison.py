@@ -14,6 +14,7 @@ from drake_entry.comparison.spec import (
     Comparison,
     load_comparison,
     method_scenario,
+    needs_derivation,
 )
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance import REGISTRY
@@ -39,7 +40,7 @@ def test_a_method_the_comparison_does_not_list_is_reported_not_configured():
     unlisted = {m.method: m for m in comp.not_configured()}
     assert set(unlisted) == {spec.__name__ for spec in REGISTRY} - {"BankProfile"}
     assert unlisted["DragEnergy"].label == "drag_energy" and not unlisted["DragEnergy"].guidance
-    assert "not configured: this comparison gives no settings for !DragEnergy" in unlisted["DragEnergy"].not_flown
+    assert "not configured: this comparison does not list !DragEnergy (list it without a guidance block to derive" in unlisted["DragEnergy"].not_flown
 
 
 @pytest.mark.parametrize("name", PACKAGED_COMPARISONS)
@@ -82,9 +83,10 @@ def test_a_label_given_twice_and_an_entry_whose_settings_do_not_fit_are_refused(
     bad = _comparison(overrides={"guidance.terminal_mach": "99"}).validate()
     with pytest.raises(ScenarioError, match=r"comparison t, method a: .*guidance.terminal_mach = 99"):
         method_scenario(bad, bad.methods[0])
-    wrong = _comparison(method="Fnpeg").validate()  # the mission flies !DragEnergy: a block is needed
-    with pytest.raises(ScenarioError, match="give this entry a guidance: !Fnpeg block"):
-        method_scenario(wrong, wrong.methods[0])
+    derived = _comparison(method="Fnpeg").validate()  # the mission flies !DragEnergy: settings derived
+    assert needs_derivation(derived, derived.methods[0]) and not needs_derivation(comp, comp.methods[0])
+    with pytest.raises(ScenarioError, match="gives no guidance: !Fnpeg block: its settings are derived from the mission"):
+        method_scenario(derived, derived.methods[0])
 
 
 def test_a_comparison_file_is_read_and_checked_like_a_scenario(tmp_path):

@@ -14,8 +14,9 @@ __all__ = ["COMMANDS"]
 def _add_compare_arguments(parser) -> None:
     from drake_entry.comparison.spec import PACKAGED_COMPARISONS
 
-    parser.add_argument("comparison", help=f"a packaged comparison ({', '.join(PACKAGED_COMPARISONS)}) or a comparison "
-                        "YAML file (docs/campaigns.md, 'Comparing methods')")
+    parser.add_argument("comparison", help=f"a packaged comparison ({', '.join(PACKAGED_COMPARISONS)}), a comparison "
+                        "YAML file (docs/comparisons.md), or a mission alone (a packaged scenario or a scenario file): "
+                        "every method, its settings derived from the mission")
     parser.add_argument("--runs", type=int, default=20, help="dispersed samples per method (default: 20)")
     parser.add_argument("--seed", type=int, default=2026, help="seed of every method's campaign (default: 2026)")
     parser.add_argument("--only", nargs="*", default=None, metavar="LABEL",
@@ -28,9 +29,9 @@ def _add_compare_arguments(parser) -> None:
 
 def compare(args) -> int:
     from drake_entry.comparison.runner import run_comparison
-    from drake_entry.comparison.spec import load_comparison
+    from drake_entry.comparison.spec import load_comparison_or_mission
 
-    comparison = load_comparison(args.comparison)
+    comparison = load_comparison_or_mission(args.comparison)
     out = args.out or os.path.join("out", "compare", comparison.name)
     path = run_comparison(comparison, runs=args.runs, out_dir=out, seed=args.seed, workers=args.workers,
                           only=args.only, trajectory_step_s=args.trajectory_step)

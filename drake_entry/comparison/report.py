@@ -147,7 +147,7 @@ def write_comparison_report(out_dir: str) -> str:
     figs = _figures(all_rows, summaries, out_dir, title, radius)
     sections = [_header(meta, summaries, same, compared, worst, scenario), _verdict_table(meta, summaries),
                 _error_table(summaries), _margin_table(summaries), _activity_table(meta, summaries),
-                _mapping_table(meta), figure_list(figs) if figs else ""]
+                _mapping_table(meta), _derivation_tables(meta), figure_list(figs) if figs else ""]
     return write_markdown_report(sections, out_dir, title=title)
 
 
@@ -288,6 +288,32 @@ def _mapping_table(meta) -> str:
         where = f" ([scenario]({info['scenario']}))" if info.get("flown") and info.get("scenario") else ""
         out.append(f"| {label} (!{info['method']}) | {'yes' if info.get('flown') else 'no'} | "
                    f"{table_cell(text)}{where} |")
+    return "\n".join(out)
+
+
+def _derivation_tables(meta) -> str:
+    """Each derived method's search: every candidate flown, its successes of the search's flights
+    and mean box ratio, and which were kept ('' when no method's settings were derived)."""
+    derived = {label: info["derivation"] for label, info in meta["methods"].items() if info.get("derivation")}
+    if not derived:
+        return ""
+    out = ["## Settings derived from the mission", "",
+           "A method listed without settings (or every method, when the comparison names only its mission) takes "
+           "them from the mission (drake_entry.guidance.derivation) and chooses its free ones by flying them: each "
+           "candidate on the nominal entry and dispersed draws of a seed no campaign uses, kept when every flight "
+           "succeeds within three quarters of each box tolerance, else the best (most successes, then the smallest "
+           "mean box ratio |error| / tolerance, a limit breach counting 10 more, a flight stopped short 100 more). "
+           "Steps run in order, each at the values kept before it."]
+    for label, d in derived.items():
+        out += ["", f"**{label}**: kept {', '.join(f'{k} = {v:g}' for k, v in d['chosen'].items()) or 'nothing searched'}",
+                "", "| step | candidate | successful | mean box ratio | s | why not (first flights) |",
+                "|---|---|---|---|---|---|"]
+        for t in d["trials"]:
+            values = ", ".join(f"{k.replace('guidance.', '')} {v:g}" for k, v in t["values"].items())
+            ratio = "—" if t["mean_box_ratio"] is None else f"{t['mean_box_ratio']:.2f}"
+            why = t["setup_failure"] or "; ".join(t["why"])
+            out.append(f"| {t['step']} | {values} | {t['successes']} of {t['flights']} | {ratio} | {t['wall_s']:.1f} | "
+                       f"{table_cell(why[:300])} |")
     return "\n".join(out)
 
 

@@ -20,10 +20,15 @@ from drake_entry.campaign.engine import session, versions
 from drake_entry.campaign.montecarlo import TRAJECTORY_STEP_S, run_campaign
 from drake_entry.campaign.store import write_atomic
 from drake_entry.comparison.report import MANIFEST, read_comparison_manifest, write_comparison_report
-from drake_entry.comparison.spec import Comparison, load_comparison, method_scenario
+from drake_entry.comparison.spec import Comparison, load_comparison, method_scenario, needs_derivation
 from drake_entry.errors import DrakeEntryError, ScenarioError
+from drake_entry.guidance.derivation import CannotFly
+from drake_entry.scenario import load_scenario
 
 __all__ = ["SCENARIOS", "run_comparison"]
+
+#: how the search flies each candidate, in words
+SEARCH_DRAWS_TEXT = "a few dispersed draws of another seed"
 
 #: the folder of a comparison directory that holds the scenario each method flew
 SCENARIOS = "scenarios"
@@ -42,18 +47,32 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
 
     comp = comparison if isinstance(comparison, Comparison) else load_comparison(comparison)
     comp.validate()
-    labels = [m.label for m in comp.methods]
+    entries = comp.entries()
+    labels = [m.label for m in entries]
     unknown = [x for x in (only or []) if x not in labels]
     if unknown:
         raise ScenarioError(f"only: {', '.join(unknown)} not in comparison {comp.name}; allowed: {', '.join(labels)}")
-    scenarios = {m.label: method_scenario(comp, m) for m in comp.flown()}  # every bad entry before any flight
+    mission = load_scenario(comp.mission)
+    derived = {m.label for m in comp.flown() if needs_derivation(comp, m, mission)}
+    scenarios = {m.label: method_scenario(comp, m) for m in comp.flown()
+                 if m.label not in derived}  # every bad entry before any flight
     os.makedirs(os.path.join(out_dir, SCENARIOS), exist_ok=True)
     manifest = read_comparison_manifest(out_dir) or {}
     if manifest and (manifest.get("comparison") != comp.name or manifest.get("seed") != seed):
         raise ScenarioError(f"{out_dir} holds comparison {manifest.get('comparison')!r} with seed "
                             f"{manifest.get('seed')}; use another --out")
     methods = dict(manifest.get("methods", {}))
-    for entry in comp.methods + comp.not_configured():
+    order = {label: i for i, label in enumerate(labels + [m.label for m in comp.not_configured()])}
+    earlier_runs, sessions = int(manifest.get("runs", 0)), list(manifest.get("sessions", [])) + [session()]
+
+    def save(methods: dict) -> None:
+        record = {"comparison": comp.name, "description": comp.description, "mission": comp.mission,
+                  "comparison_yaml": yaml_dump_typed(comp), "runs": max(int(runs), earlier_runs),
+                  "seed": int(seed), "versions": versions(), "sessions": sessions,
+                  "methods": dict(sorted(methods.items(), key=lambda kv: order.get(kv[0], len(order))))}
+        write_atomic(os.path.join(out_dir, MANIFEST), json.dumps(record, indent=2).encode())
+
+    for entry in entries + comp.not_configured():
         if entry.not_flown:
             methods[entry.label] = {"method": entry.method, "flown": False, "reason": entry.not_flown,
                                     "mapping": entry.mapping}
@@ -62,11 +81,24 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
             methods.setdefault(entry.label, {"method": entry.method, "flown": False, "mapping": entry.mapping,
                                              "reason": ""})  # not in this run; an earlier run's record stays
             continue
-        scenario = scenarios[entry.label]
         path = os.path.join(out_dir, SCENARIOS, f"{entry.label}.yaml")
-        write_atomic(path, yaml_dump_typed(scenario).encode())
         record = {"method": entry.method, "flown": True, "mapping": entry.mapping,
                   "scenario": os.path.join(SCENARIOS, f"{entry.label}.yaml")}
+        if entry.label in derived:
+            try:
+                scenario, derivation = _derived_scenario(comp, entry, mission, path, methods.get(entry.label),
+                                                         progress)
+            except CannotFly as e:
+                methods[entry.label] = {"method": entry.method, "flown": False, "mapping": entry.mapping,
+                                        "reason": f"cannot fly this mission: {e}"}
+                if progress:
+                    print(f"== {entry.label} (!{entry.method}): not flown: {e}", flush=True)
+                continue
+            record["derivation"] = derivation
+            record["mapping"] = (entry.mapping + " " if entry.mapping else "") + _derivation_text(derivation)
+        else:
+            scenario = scenarios[entry.label]
+        write_atomic(path, yaml_dump_typed(scenario).encode())
         if progress:
             print(f"== {entry.label} (!{entry.method}): pre-flight planning", flush=True)
         t = time.perf_counter()
@@ -86,11 +118,39 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
         del setup
         write_report(campaign_dir, title=f"{comp.name}: {entry.label}")
         methods[entry.label] = {**record, "campaign": entry.label}
-    order = {label: i for i, label in enumerate(labels + [m.label for m in comp.not_configured()])}
-    manifest = {"comparison": comp.name, "description": comp.description, "mission": comp.mission,
-                "comparison_yaml": yaml_dump_typed(comp), "runs": max(int(runs), int(manifest.get("runs", 0))),
-                "seed": int(seed), "versions": versions(),
-                "sessions": list(manifest.get("sessions", [])) + [session()],
-                "methods": dict(sorted(methods.items(), key=lambda kv: order.get(kv[0], len(order))))}
-    write_atomic(os.path.join(out_dir, MANIFEST), json.dumps(manifest, indent=2).encode())
+        save(methods)  # each method's record (its derivation) kept as soon as it is flown
+    save(methods)
     return write_comparison_report(out_dir)
+
+
+def _derived_scenario(comp: Comparison, entry, mission, path: str, earlier: dict | None, progress: bool):
+    """The scenario ``entry`` flies with its settings derived from the mission, and the
+    derivation's record: an earlier run's (its scenario file and record, when both are there:
+    derivation is deterministic), else derived and searched now (CannotFly when the method cannot
+    fly the mission)."""
+    from drake_entry.comparison.derive import derive_settings
+    from drake_entry.guidance import REGISTRY
+    from drake_entry.guidance.derivation import derivation_for
+
+    if earlier and earlier.get("derivation") and os.path.exists(path):
+        return method_scenario(comp, entry, load_scenario(path)), earlier["derivation"]
+    spec_type = next(spec for spec in REGISTRY if spec.__name__ == entry.method)
+    derivation = derivation_for(mission, spec_type)
+    if progress:
+        print(f"== {entry.label} (!{entry.method}): settings derived from the mission"
+              + (", searched on the nominal flight and dispersed draws" if derivation.search else ""), flush=True)
+    chosen = derive_settings(mission, derivation, progress=(lambda text: print(f"   {text}", flush=True))
+                             if progress else None)
+    return method_scenario(comp, entry, chosen.scenario), chosen.record()
+
+
+def _derivation_text(record: dict) -> str:
+    """One paragraph for the mapping table: each setting taken from the mission, and the search's choices."""
+    taken = "; ".join(f"{c['field'].replace('guidance.', '')} {c['value']} ({c['how']})" for c in record["choices"])
+    chosen = ", ".join(f"{k.replace('guidance.', '')} {v:g}" for k, v in record["chosen"].items())
+    tried = len(record["trials"])
+    text = f"Derived from the mission: {taken}."
+    if tried:
+        text += (f" Searched ({tried} candidates flown on the nominal entry and {SEARCH_DRAWS_TEXT}): {chosen}"
+                 f" (table: 'Settings derived from the mission').")
+    return text

@@ -1,9 +1,12 @@
 """Comparison files: one mission and the settings each guidance method flies it with.
 
 A comparison (``drake_entry/comparisons/*.yaml`` or a user file) names a mission scenario and
-lists every guidance method with either the settings it flies that mission with (its
-``guidance:`` block and ``overrides`` of the method's own fields) or the reason it cannot fly
-it (``not_flown``). The mission (vehicle, environment, entry state, target, terminal box,
+lists guidance methods with the settings each flies that mission with (its ``guidance:`` block
+and ``overrides`` of the method's own fields), or none: the mission's own method flies the
+mission's settings, another method derives its settings from the mission
+(drake_entry.guidance.derivation, searched by drake_entry.comparison.derive), or the reason it
+cannot fly it (``not_flown``). A comparison that lists no method flies every registered one,
+each with derived settings (``mission_comparison``: a mission alone). The mission (vehicle, environment, entry state, target, terminal box,
 dispersions, simulation) is the same for every method: an override may touch only the
 method's settings, ``guidance.*`` and the open-loop ``alpha`` schedule (flown by the methods
 that do not command alpha). ``method_scenario`` makes the scenario one method flies; the
@@ -11,6 +14,7 @@ campaign engine flies them all with the same seed, so sample i of every method d
 dispersions (``drake_entry.comparison.runner``). Pure data: loading one imports no solver.
 """
 import dataclasses as dc
+import os
 import re
 from typing import Optional
 
@@ -20,7 +24,8 @@ from drake_entry.scenario import Scenario, apply_overrides, load_scenario
 from drake_entry.typed_yaml import load_packaged_or_file, packaged_names
 
 __all__ = ["METHOD_FIELDS", "LABEL", "ComparedMethod", "Comparison", "PACKAGED_COMPARISONS", "load_comparison",
-           "method_scenario"]
+           "needs_derivation", "method_scenario", "mission_comparison",
+           "load_comparison_or_mission"]
 
 #: the scenario fields an entry may override: the method's settings, never the mission
 METHOD_FIELDS = ("guidance", "alpha")
@@ -59,13 +64,14 @@ class Comparison:
     # the mission: a packaged scenario name or a scenario file (relative: beside this file; its guidance block is the
     # default settings of the entry that gives none)
     mission: str = ""
-    methods: list[ComparedMethod] = dc.field(default_factory=list)  # every method, flown or not
+    # the methods, flown or not; none: every registered method, its settings derived from the mission
+    methods: list[ComparedMethod] = dc.field(default_factory=list)
 
     def validate(self) -> "Comparison":
-        """One-line ScenarioErrors for unknown methods, duplicate or bad labels, an entry both
-        flown and not flown, and overrides of the mission's own fields."""
-        if not self.methods:
-            raise ScenarioError("methods: a comparison needs at least one method")
+        """One-line ScenarioErrors for a missing mission, unknown methods, duplicate or bad labels,
+        an entry both flown and not flown, and overrides of the mission's own fields."""
+        if not isinstance(self.mission, str) or not self.mission:
+            raise ScenarioError("mission: missing; give a packaged scenario name or a scenario file")
         tags = {spec.__name__: spec for spec in REGISTRY}
         seen = set()
         for i, m in enumerate(self.methods):
@@ -90,15 +96,27 @@ class Comparison:
                                         f"(vehicle, entry, target, terminal box, dispersions, simulation) is shared")
         return self
 
-    def flown(self) -> list[ComparedMethod]:
-        return [m for m in self.methods if not m.not_flown]
-
-    def not_configured(self) -> list[ComparedMethod]:
-        """Every registered method this comparison does not list, as a not-flown entry with the
-        reason (labelled by its folder's name): a new method shows in every comparison without a
-        hand-written entry."""
+    def entries(self) -> list[ComparedMethod]:
+        """The methods of this comparison: the file's list, or, when it names none (a comparison
+        of the mission alone), every registered method, each with its settings derived from the
+        mission (labelled by its folder's name)."""
         from drake_entry.guidance import folder_of
 
+        if self.methods:
+            return list(self.methods)
+        return [ComparedMethod(label=folder_of(spec), method=spec.__name__) for spec in REGISTRY]
+
+    def flown(self) -> list[ComparedMethod]:
+        return [m for m in self.entries() if not m.not_flown]
+
+    def not_configured(self) -> list[ComparedMethod]:
+        """Every registered method a comparison that lists methods does not list, as a not-flown
+        entry with the reason (labelled by its folder's name): a new method shows in every
+        comparison without a hand-written entry."""
+        from drake_entry.guidance import folder_of
+
+        if not self.methods:
+            return []
         listed = {m.method for m in self.methods}
         labels = {m.label for m in self.methods}
         out = []
@@ -108,8 +126,9 @@ class Comparison:
             label = folder_of(spec)
             label = label if label not in labels else f"{label}_not_configured"
             out.append(ComparedMethod(label=label, method=spec.__name__, not_flown=(
-                f"not configured: this comparison gives no settings for !{spec.__name__} (add an entry with its "
-                f"guidance block and a mapping, or not_flown with the reason)")))
+                f"not configured: this comparison does not list !{spec.__name__} (list it without a guidance "
+                f"block to derive its settings from the mission, with one to set them, or with not_flown and the "
+                f"reason)")))
         return out
 
 
@@ -122,23 +141,73 @@ def load_comparison(name_or_path) -> Comparison:
     return load_packaged_or_file(Comparison, name_or_path, kind="comparison", folder="comparisons").validate()
 
 
-def method_scenario(comparison: Comparison, entry: ComparedMethod) -> Scenario:
-    """The scenario ``entry`` flies: the comparison's mission with the entry's guidance block
-    (or the mission's own) and its overrides, named ``<mission>-<label>``. A ScenarioError names
-    the entry when its settings do not fit the mission."""
+def needs_derivation(comparison: Comparison, entry: ComparedMethod, mission: Scenario | None = None) -> bool:
+    """Whether ``entry``'s settings are derived from the mission: it is flown, gives no guidance
+    block, and the mission flies another method (``mission``: the loaded mission, else loaded)."""
+    if entry.not_flown or entry.guidance is not None:
+        return False
+    mission = mission if mission is not None else load_scenario(comparison.mission)
+    return type(mission.guidance).__name__ != entry.method
+
+
+def method_scenario(comparison: Comparison, entry: ComparedMethod, guidance_scenario: Scenario | None = None) -> Scenario:
+    """The scenario ``entry`` flies: the comparison's mission with the entry's guidance block (or
+    the mission's own, or ``guidance_scenario``'s guidance and alpha: the settings derived from the
+    mission, drake_entry.comparison.derive) and its overrides, named ``<mission>-<label>``. A
+    ScenarioError names the entry when its settings do not fit the mission."""
     if entry.not_flown:
         raise ScenarioError(f"{entry.label} is not flown on this mission: {entry.not_flown}")
     scenario = load_scenario(comparison.mission)
     mission_name = scenario.name
     try:
-        if entry.guidance is not None:
+        if guidance_scenario is not None:
+            scenario.guidance, scenario.alpha = dc.replace(guidance_scenario.guidance), dc.replace(guidance_scenario.alpha)
+        elif entry.guidance is not None:
             scenario.guidance = dc.replace(entry.guidance)
         if type(scenario.guidance).__name__ != entry.method:
-            raise ScenarioError(f"the mission flies !{type(scenario.guidance).__name__}; give this entry a "
-                                f"guidance: !{entry.method} block")
+            raise ScenarioError(f"the mission flies !{type(scenario.guidance).__name__} and this entry gives no "
+                                f"guidance: !{entry.method} block: its settings are derived from the mission when the "
+                                f"comparison runs (drake_entry.comparison.derive), or give the block")
         apply_overrides(scenario, dict(entry.overrides))
         scenario.validate()
     except ScenarioError as e:
         raise ScenarioError(f"comparison {comparison.name}, method {entry.label}: {e}") from None
     scenario.name = f"{mission_name}-{entry.label}"
     return scenario
+
+
+def mission_comparison(mission: str) -> Comparison:
+    """The comparison of a mission alone (a packaged scenario name or a scenario file): every
+    registered method, each with its settings derived from the mission; named after it."""
+    scenario = load_scenario(mission)
+    return Comparison(name=scenario.name, description=f"every guidance method on {scenario.name}, settings derived "
+                      f"from the mission", mission=mission).validate()
+
+
+def load_comparison_or_mission(name_or_path: str) -> Comparison:
+    """A comparison (a packaged name or a comparison file), or the comparison of a mission alone
+    (a packaged scenario name or a scenario file: ``mission_comparison``). A packaged comparison
+    wins over a packaged scenario of the same name; a file is a comparison when it has a
+    ``mission`` field."""
+    from drake_entry.scenario import PACKAGED_SCENARIOS
+    from drake_entry.typed_yaml import parse
+
+    if name_or_path in PACKAGED_COMPARISONS:
+        return load_comparison(name_or_path)
+    if name_or_path in PACKAGED_SCENARIOS:
+        return mission_comparison(name_or_path)
+    if isinstance(name_or_path, str) and os.path.isfile(name_or_path):
+        try:
+            with open(name_or_path, encoding="utf-8") as f:
+                data = parse(f.read(), name_or_path)
+        except (OSError, UnicodeDecodeError):
+            data = None
+        if isinstance(data, dict) and "mission" not in data and ("entry" in data or "based_on" in data):
+            return mission_comparison(name_or_path)
+    try:
+        return load_comparison(name_or_path)
+    except ScenarioError as e:
+        if "is neither a packaged" in str(e):
+            raise ScenarioError(f"'{name_or_path}' is neither a packaged comparison ({', '.join(PACKAGED_COMPARISONS)}), "
+                                f"a packaged scenario ({', '.join(PACKAGED_SCENARIOS)}) nor a file") from None
+        raise

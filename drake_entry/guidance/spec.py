@@ -53,6 +53,13 @@ class GuidanceSpecBase:
         whose mission gives V_f rather than Mach overrides this)."""
         return self.terminal_mach * speed_of_sound
 
+    def alpha_profile(self) -> tuple[str, list[float], list[float]] | None:
+        """The angle-of-attack profile this method flies when it is a fixed schedule of its own
+        (variable, breakpoints, values [deg]; the scenario's ``alpha`` block's variables), else
+        None: another method flying this mission takes it as the mission's alpha
+        (drake_entry.guidance.derivation)."""
+        return None
+
     def path_limits(self, scenario) -> list:
         """The mission's own path limits (drake_entry.models.verdict.PathLimit) that every flight must
         hold besides the vehicle's; none by default."""

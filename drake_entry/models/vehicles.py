@@ -140,6 +140,12 @@ class Vehicle:
             self.heat_flux = HeatFlux.chapman(self.nose_radius)
 
     @property
+    def bank_limit_deg(self) -> float:
+        """The bank limit [deg] as the vehicle file states it (the radian round trip's last-bit
+        error removed, so a setting equal to the stated limit is within it)."""
+        return round(math.degrees(self.bank_limit), 9)
+
+    @property
     def area_over_mass(self) -> float:
         """S_ref / m [m^2/kg]."""
         return self.reference_area / self.mass

@@ -1,7 +1,6 @@
 """Scenario spec of the bank-profile guidance; YAML tag ``guidance: !BankProfile``."""
 
 import dataclasses as dc
-import math
 
 from drake_entry.errors import check_range
 from drake_entry.guidance.spec import ReversingBankSpec
@@ -20,6 +19,6 @@ class BankProfile(ReversingBankSpec):
 
     def validate(self, scenario) -> None:
         super().validate(scenario)
-        limit = scenario.make_vehicle().bank_limit
+        limit = scenario.make_vehicle().bank_limit_deg
         for name in ("bank_start_deg", "bank_end_deg"):
-            check_range(f"guidance.{name}", getattr(self, name), 0.0, math.degrees(limit))
+            check_range(f"guidance.{name}", getattr(self, name), 0.0, limit)

@@ -1,7 +1,6 @@
 """Scenario spec of FNPEG (Lu 2014's predictor-corrector); YAML tag ``guidance: !Fnpeg``."""
 
 import dataclasses as dc
-import math
 
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
@@ -66,11 +65,14 @@ class Fnpeg(ReversingBankSpec, ReplansOnBoard):
     def terminal_speed(self, speed_of_sound: float) -> float:
         return self.terminal_velocity_m_s
 
+    def alpha_profile(self) -> tuple[str, list[float], list[float]]:
+        return "velocity", list(self.alpha_velocity_m_s), list(self.alpha_deg)
+
     def validate(self, scenario) -> None:
         super().validate(scenario)
         check_range("guidance.terminal_velocity_m_s", self.terminal_velocity_m_s, 1.0, scenario.entry.velocity_m_s)
         check_range("guidance.final_range_km", self.final_range_km, 0.0, 1e4)
-        limit = math.degrees(scenario.make_vehicle().bank_limit)
+        limit = scenario.make_vehicle().bank_limit_deg
         check_range("guidance.bank_end_deg", self.bank_end_deg, 0.0, limit)
         if self.bank_profile not in ("linear", "constant"):
             raise ScenarioError(f"guidance.bank_profile = '{self.bank_profile}'; allowed: 'linear' or 'constant'")

@@ -1,7 +1,6 @@
 """Scenario spec of paper 004's guidance; YAML tag ``guidance: !SwarmBank``."""
 
 import dataclasses as dc
-import math
 import typing
 
 from drake_entry.errors import ScenarioError, check_range
@@ -71,7 +70,7 @@ class SwarmBank(ReversingBankSpec, ReplansOnBoard):
     def validate(self, scenario) -> None:
         super().validate(scenario)
         check_range("guidance.terminal_velocity_m_s", self.terminal_velocity_m_s, 1.0, scenario.entry.velocity_m_s)
-        bank_limit = math.degrees(scenario.make_vehicle().bank_limit)
+        bank_limit = scenario.make_vehicle().bank_limit_deg
         if len(self.bank_start_bounds_deg) != 2 or not self.bank_start_bounds_deg[0] < self.bank_start_bounds_deg[1]:
             raise ScenarioError(f"guidance.bank_start_bounds_deg = {self.bank_start_bounds_deg} needs [lower, upper] "
                                 "with lower < upper")

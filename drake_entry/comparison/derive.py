@@ -1,0 +1,174 @@
+"""A method's settings for a mission, chosen by flying: a method's Derivation
+(drake_entry.guidance.derivation: what it takes from the mission, and its free settings with
+their candidates) searched on the nominal flight and a few dispersed draws.
+
+The search runs its steps one after the other. In a step, each candidate (in the derivation's
+order) is flown by the Drake closed loop: the nominal entry and ``draws`` dispersed samples of
+the mission's own dispersions, drawn with SEARCH_SEED (never a campaign's seed: the campaign is
+not tuned on its own samples). The first candidate whose every flight succeeds within
+GOOD_ENOUGH of every box tolerance is kept; when none does, the best: most successes, then the
+smallest mean box ratio (a flight's largest |error| / tolerance; one that breaches a limit or
+stops short counts LIMIT_PENALTY or SHORT_PENALTY more). The same mission gives the same
+settings.
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import math
+import time
+
+from drake_entry.errors import DrakeEntryError
+from drake_entry.guidance.derivation import Choice, Derivation
+from drake_entry.models.verdict import acceptance_box
+
+__all__ = ["SEARCH_SEED", "SEARCH_DRAWS", "GOOD_ENOUGH", "Flight", "Trial", "DerivedSettings", "derive_settings",
+           "apply_derivation"]
+
+#: the campaign seed of a search's dispersed draws (apart from the seeds campaigns use)
+SEARCH_SEED = 918_273_645
+#: dispersed draws per candidate, besides the nominal flight
+SEARCH_DRAWS = 2
+#: a candidate whose every flight succeeds with a box ratio at most this is kept at once
+GOOD_ENOUGH = 0.75
+#: added to a flight's box ratio when it breaches a path limit / does not reach its interface
+LIMIT_PENALTY, SHORT_PENALTY = 10.0, 100.0
+
+
+@dc.dataclass
+class Flight:
+    """One search flight: 'nominal' or the draw's index, its verdict, box ratio and why not a success."""
+
+    sample: str
+    success: bool
+    box_ratio: float
+    why: str = ""
+
+    @property
+    def merit(self) -> float:
+        return self.box_ratio if math.isfinite(self.box_ratio) else SHORT_PENALTY * 10
+
+
+@dc.dataclass
+class Trial:
+    """One candidate of a search step: the step's name, the fields it set, its flights and its
+    wall time [s]."""
+
+    step: str
+    values: dict
+    flights: list[Flight]
+    wall_s: float
+    setup_failure: str = ""
+
+    @property
+    def successes(self) -> int:
+        return sum(f.success for f in self.flights)
+
+    @property
+    def mean_ratio(self) -> float:
+        return sum(f.merit for f in self.flights) / len(self.flights) if self.flights else math.inf
+
+    def score(self) -> tuple:
+        return (-self.successes, self.mean_ratio)
+
+    def good_enough(self) -> bool:
+        return bool(self.flights) and all(f.success and f.box_ratio <= GOOD_ENOUGH for f in self.flights)
+
+
+@dc.dataclass
+class DerivedSettings:
+    """A method's settings for a mission: the scenario it flies (the mission with the derived
+    guidance block and alpha), what it took from the mission, and the search that chose the rest."""
+
+    scenario: object
+    choices: list[Choice]
+    trials: list[Trial]
+    chosen: dict
+
+    def record(self) -> dict:
+        """JSON-ready: the choices, the chosen values and every trial with its flights."""
+        return {"choices": [dc.asdict(c) | {"value": str(c.value)} for c in self.choices],
+                "chosen": {k: v for k, v in self.chosen.items()},
+                "trials": [{"step": t.step, "values": t.values, "successes": t.successes, "flights": len(t.flights),
+                            "mean_box_ratio": t.mean_ratio if math.isfinite(t.mean_ratio) else None,
+                            "wall_s": round(t.wall_s, 2), "setup_failure": t.setup_failure,
+                            "why": [f.why for f in t.flights if f.why][:3]} for t in self.trials]}
+
+
+def apply_derivation(mission, derivation: Derivation, values: dict | None = None):
+    """The mission scenario flying ``derivation``'s spec (and its alpha) with ``values``
+    ({'guidance.<field>': value}) set on it."""
+    scenario = dc.replace(mission)
+    spec = derivation.spec
+    fields = {k.split(".", 1)[1]: v for k, v in (values or {}).items()}
+    scenario.guidance = dc.replace(spec, **fields)
+    if derivation.alpha is not None:
+        scenario.alpha = dc.replace(derivation.alpha)
+    scenario.validate()
+    return scenario
+
+
+def _box_ratio(box: dict) -> float:
+    """The largest |error| / tolerance of an acceptance box ({criterion: {error, tolerance}})."""
+    ratios = [abs(b["error"]) / b["tolerance"] for b in box.values() if b["tolerance"] > 0]
+    return max(ratios) if ratios and all(math.isfinite(r) for r in ratios) else math.inf
+
+
+def _fly_candidate(scenario, draws: int) -> tuple[list[Flight], str]:
+    """The nominal flight and ``draws`` dispersed samples of ``scenario``; ('', flights) or the
+    pre-flight failure."""
+    from drake_entry.campaign.sample import run_sample
+    from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
+
+    try:
+        setup = ClosedLoopSetup.from_scenario(scenario)
+    except DrakeEntryError as e:
+        return [], f"pre-flight planning failed: {str(e).splitlines()[0][:300]}"
+    flights = []
+    try:
+        res = fly(setup)
+        ratio = _box_ratio(res.box) + (0.0 if res.verdict.within_limits else LIMIT_PENALTY)
+        flights.append(Flight("nominal", bool(res.success), ratio if res.reached else ratio + SHORT_PENALTY,
+                              "" if res.success else res.message.splitlines()[0][:200]))
+    except (DrakeEntryError, RuntimeError) as e:
+        flights.append(Flight("nominal", False, math.inf, str(e).splitlines()[0][:200]))
+    tolerances = acceptance_box(scenario.terminal, altitude_m=math.nan, mach=math.nan, distance_m=math.nan)
+    for i in range(draws):
+        row, _ = run_sample(setup, SEARCH_SEED, i, trajectory_step_s=0)
+        box = {k: {"error": row.get(f"box_{k}_error", math.nan), "tolerance": b["tolerance"]}
+               for k, b in tolerances.items()}
+        ratio = _box_ratio(box) + (0.0 if row.get("within_limits", False) else LIMIT_PENALTY)
+        if not row.get("reached_terminal", False):
+            ratio += SHORT_PENALTY
+        flights.append(Flight(str(i), bool(row.get("success", False)), ratio,
+                              "" if row.get("success") else str(row.get("message", ""))[:200]))
+    return flights, ""
+
+
+def derive_settings(mission, derivation: Derivation, *, draws: int = SEARCH_DRAWS, progress=None) -> DerivedSettings:
+    """Choose ``derivation``'s free settings on ``mission`` (module doc); ``progress(text)``
+    is told each trial."""
+    chosen, trials = {}, []
+    for step in derivation.search:
+        step_trials = []
+        for values in step.candidates:
+            t0 = time.perf_counter()
+            try:
+                scenario = apply_derivation(mission, derivation, {**chosen, **values})
+            except DrakeEntryError as e:
+                step_trials.append(Trial(step.name, values, [], time.perf_counter() - t0,
+                                         f"refused: {str(e).splitlines()[0][:300]}"))
+                continue
+            flights, failure = _fly_candidate(scenario, draws)
+            trial = Trial(step.name, values, flights, time.perf_counter() - t0, failure)
+            step_trials.append(trial)
+            if progress:
+                shown = ", ".join(f"{k.split('.')[-1]} {v:g}" for k, v in values.items())
+                progress(f"{step.name}: {shown}: {trial.successes}/{len(flights)} successful, mean box ratio "
+                         f"{trial.mean_ratio:.2f} ({trial.wall_s:.1f} s){' ' + failure if failure else ''}")
+            if trial.good_enough():
+                break
+        trials += step_trials
+        flown = [t for t in step_trials if t.flights]
+        best = min(flown, key=Trial.score) if flown else step_trials[0]
+        chosen.update(best.values)
+    return DerivedSettings(apply_derivation(mission, derivation, chosen), list(derivation.choices), trials, chosen)

@@ -1,0 +1,219 @@
+"""Settings a guidance method derives from a mission: every method on any mission.
+
+A method's folder may hold ``derive.py`` with ``derive(scenario) -> Derivation``: pure
+computation from the mission (the vehicle and its limits, the entry, the target, the terminal
+box, the mission's alpha schedule), no flight and no solver. A ``Derivation`` is the method's
+spec with each setting it took from the mission (a ``Choice`` saying how), plus its free
+settings as a ``search``: candidates the comparison layer flies in order on the nominal flight
+and a few dispersed draws, keeping the best (drake_entry.comparison.derive). Derivation is
+deterministic: the same mission gives the same settings. A method that cannot fly a mission
+raises ``CannotFly`` with the figures that show why.
+
+The mission facts every method shares are here: the terminal interface (the box centre),
+the mission's alpha schedule rewritten in speed, the vehicle's limits with a margin, and the
+reversal corridor.
+"""
+import dataclasses as dc
+import importlib
+import math
+
+import numpy as np
+
+from drake_entry.errors import ScenarioError
+from drake_entry.guidance.spec import ReversingBankSpec
+
+__all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for", "terminal_interface",
+           "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY", "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN"]
+
+#: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
+#: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
+LIMIT_MARGIN = 0.93
+
+
+@dc.dataclass
+class Choice:
+    """One setting taken from the mission: the dotted field, its value, and how it was chosen."""
+
+    field: str
+    value: object
+    how: str
+
+
+@dc.dataclass
+class SearchStep:
+    """One free setting: ``name`` (what is searched), ``candidates`` tried in order, each the
+    dotted fields it sets ({'guidance.bank_end_deg': 45.0}; the first is the derivation's own
+    value), and why it is free. ``over`` builds the step of one field."""
+
+    name: str
+    candidates: tuple
+    why: str
+
+    @classmethod
+    def over(cls, field: str, values, why: str) -> "SearchStep":
+        return cls(field, tuple({field: v} for v in values), why)
+
+
+@dc.dataclass
+class Derivation:
+    """A method's settings for a mission: ``spec`` (its guidance block, the search's fields at
+    their first candidates), the ``choices`` taken from the mission, the ``search`` steps
+    (flown one after the other, each at the best values of the ones before), and ``alpha``: the
+    mission's open-loop alpha schedule rewritten for a method that flies it (a ScheduleSpec;
+    None: the mission's as it is)."""
+
+    spec: object
+    choices: list[Choice]
+    search: list[SearchStep] = dc.field(default_factory=list)
+    alpha: object = None
+
+
+class CannotFly(ScenarioError):
+    """A method cannot fly a mission; the message says why, with its figures."""
+
+
+@dc.dataclass(frozen=True)
+class Interface:
+    """The mission's terminal interface, the centre of its acceptance box: geodetic altitude
+    [km], speed [m/s] and its Mach number there (None when the mission gives a speed)."""
+
+    altitude_km: float
+    speed_m_s: float
+    mach: float | None
+
+
+def derivation_for(scenario, spec_type) -> Derivation:
+    """The Derivation of method ``spec_type`` (a registered spec class) for ``scenario``'s
+    mission, from ``guidance/<folder>/derive.py``; CannotFly when the method has none."""
+    from drake_entry.guidance import folder_of
+
+    folder = folder_of(spec_type)
+    name = f"drake_entry.guidance.{folder}.derive"
+    try:
+        module = importlib.import_module(name)
+    except ModuleNotFoundError as e:
+        if e.name != name:
+            raise
+        raise CannotFly(f"!{spec_type.__name__} derives no settings from a mission (guidance/{folder}/derive.py "
+                        f"is not written): give its guidance block in the comparison") from None
+    derivation = module.derive(scenario)
+    if type(derivation.spec) is not spec_type:
+        raise TypeError(f"{name}.derive returned a {type(derivation.spec).__name__}, not a {spec_type.__name__}")
+    return derivation
+
+
+def terminal_interface(scenario) -> Interface:
+    """The centre of the mission's acceptance box (terminal.altitude_km and its mach or
+    velocity_m_s); CannotFly when the mission gives no altitude or no speed."""
+    t = scenario.terminal
+    if t.altitude_km is None:
+        raise CannotFly("the mission's terminal block gives no altitude_km: no terminal interface to aim at")
+    h = t.altitude_km * 1e3
+    if t.mach is not None:
+        return Interface(t.altitude_km, float(t.mach * scenario.make_atmosphere().speed_of_sound(h)), float(t.mach))
+    if t.velocity_m_s is not None:
+        return Interface(t.altitude_km, float(t.velocity_m_s), None)
+    raise CannotFly("the mission's terminal block gives neither mach nor velocity_m_s: no terminal speed to aim at")
+
+
+def _altitude_at_energy(E: float, E0: float, h0: float, Ef: float, hf: float) -> float:
+    """The altitude [m] at specific energy E [J/kg], linear in energy between the entry (E0, h0)
+    and the terminal interface (Ef, hf) (``alpha_in_speed``'s approximation)."""
+    return hf + (h0 - hf) * (E - Ef) / (E0 - Ef)
+
+
+def mission_alpha(scenario):
+    """The mission's alpha schedule (a ScheduleSpec) and whose it is: the mission's own method's
+    profile when it flies a fixed one of its own (``alpha_profile``), else the scenario's
+    ``alpha`` block."""
+    own = scenario.guidance.alpha_profile()
+    if own is None:
+        return scenario.alpha, "the mission's"
+    variable, breakpoints, values = own
+    return (dc.replace(scenario.alpha, variable=variable, breakpoints=list(breakpoints), values_deg=list(values)),
+            f"the mission's own method's (!{type(scenario.guidance).__name__})")
+
+
+def alpha_rewritten(scenario, interface: Interface, variable: str) -> tuple[list[float], list[float], str]:
+    """The mission's alpha schedule as values [deg] at increasing breakpoints of ``variable``
+    ('velocity' [m/s]: FNPEG's profile; 'normalized_energy': e = (E0 - E)/(E0 - Ef) with Ef at
+    ``interface``, the drag-energy planner's), and how it was rewritten.
+
+    A schedule already in ``variable`` is taken as it is. Otherwise each breakpoint is mapped
+    with the altitude taken linear in specific energy between the entry and the interface: the
+    kinetic energy dominates, so the speeds are close (an altitude 5 km off moves a speed of
+    2.5 km/s by 0.8 %); between breakpoints the profile stays linear (a smooth schedule keeps its
+    blend only where it is not rewritten). A schedule in time has no equivalent before a flight:
+    CannotFly."""
+    s, source = mission_alpha(scenario)
+    values = [float(v) for v in s.values_deg]
+    if len(set(values)) == 1:
+        return [0.0], values[:1], f"{source} alpha, constant"
+    if s.variable == variable:
+        return [float(b) for b in s.breakpoints], values, f"{source} alpha schedule in {variable}, as it is"
+    if s.variable == "time":
+        raise CannotFly(f"the mission's alpha schedule is in time; this method needs it in {variable} (write the "
+                        f"mission's schedule in speed, energy, normalised energy or Mach)")
+    planet = scenario.make_planet().with_(j2=0.0)
+    atmosphere = scenario.make_atmosphere()
+    x0 = scenario.initial_state()
+    h0, E0 = float(x0[0]), float(planet.specific_energy(x0[0], x0[3]))
+    hf = interface.altitude_km * 1e3
+    Ef = float(planet.specific_energy(hf, interface.speed_m_s))
+
+    def state_at_energy(E: float) -> tuple[float, float]:
+        h = _altitude_at_energy(E, E0, h0, Ef, hf)
+        return E, math.sqrt(max(2.0 * (E - float(planet.specific_energy(h, 0.0))), 0.0))
+
+    points = []  # (E [J/kg], V [m/s]) of each breakpoint
+    for b in s.breakpoints:
+        if s.variable == "normalized_energy":
+            points.append(state_at_energy(E0 - b * (E0 - Ef)))
+        elif s.variable == "energy":
+            points.append(state_at_energy(b))
+        else:  # speed or Mach: the altitude on the energy line at that speed (fixed-point passes)
+            h = hf
+            for _ in range(30):
+                a = float(atmosphere.speed_of_sound(min(max(h, atmosphere.h_min), atmosphere.h_max)))
+                V = b * a if s.variable == "mach" else float(b)
+                h = _altitude_at_energy(float(planet.specific_energy(h, V)), E0, h0, Ef, hf)
+            points.append((float(planet.specific_energy(h, V)), V))
+    new = [V for _, V in points] if variable == "velocity" else [(E0 - E) / (E0 - Ef) for E, _ in points]
+    order = np.argsort(new)
+    new, values = [float(new[i]) for i in order], [values[i] for i in order]
+    if any(b <= a for a, b in zip(new, new[1:])):
+        raise CannotFly(f"the mission's alpha schedule in {s.variable} does not map to increasing {variable} "
+                        f"({', '.join(f'{v:.4g}' for v in new)})")
+    return new, values, (f"{source} alpha schedule in {s.variable} rewritten in {variable} at its breakpoints "
+                         f"(altitude linear in energy from the entry to the interface)")
+
+
+#: terminal altitudes a method tries, as fractions of the box's altitude tolerance above its
+#: centre (a lower interface meets the dynamic-pressure limit first: HORUS-2B's 25 km at Mach 2.5
+#: breaches 10 kPa; 26.5 km, three quarters up, is where paper 000's guidance aims)
+ALTITUDE_STEPS = (0.0, 0.25, 0.5, 0.75, -0.25, -0.5)
+
+
+#: why the terminal altitude is searched
+ALTITUDE_WHY = "the interface inside the box where the path limits hold to the end"
+
+
+def interface_altitudes(scenario, interface: Interface) -> tuple[float, ...]:
+    """The terminal altitudes [km] to try inside the mission's box (ALTITUDE_STEPS; the centre
+    alone when the box has no altitude tolerance), never below the ground."""
+    tol = scenario.terminal.altitude_tolerance_km
+    if not tol:
+        return (interface.altitude_km,)
+    return tuple(h for h in (round(interface.altitude_km + k * tol, 4) for k in ALTITUDE_STEPS) if h >= 0.0)
+
+
+def reversal_corridor(scenario) -> tuple[list[float], list[float], str]:
+    """The bank-reversal corridor (half-widths [deg] at speeds [m/s]): the mission's own method's
+    when it reverses the bank, else the shared default (paper 000 Sec. VI.D)."""
+    own = scenario.guidance
+    if isinstance(own, ReversingBankSpec):
+        return (list(own.reversal_heading_deg), list(own.reversal_velocity_m_s),
+                f"the corridor of the mission's own method (!{type(own).__name__})")
+    default = ReversingBankSpec()
+    return (list(default.reversal_heading_deg), list(default.reversal_velocity_m_s),
+            "the shared default corridor (paper 000 Sec. VI.D)")

@@ -1,0 +1,74 @@
+"""FNPEG's settings from a mission (drake_entry.guidance.derivation): Lu 2014's terminal
+interface e_f at the mission's box centre, the mission's alpha schedule in speed, its reversal
+corridor, the path-limit feedback on the vehicle's limits with a margin; sigma_f searched."""
+import dataclasses as dc
+import math
+
+from drake_entry.guidance.derivation import (
+    ALTITUDE_WHY,
+    Choice,
+    Derivation,
+    SearchStep,
+    alpha_rewritten,
+    interface_altitudes,
+    reversal_corridor,
+    terminal_interface,
+)
+from drake_entry.guidance.fnpeg.spec import Fnpeg
+
+__all__ = ["derive", "BANK_END_CANDIDATES_DEG", "PATH_GAIN", "LIMIT_MARGINS"]
+
+#: sigma_f tried on the nominal flight and the search's draws, in order [deg] (Lu 2008: 60-70;
+#: the hand-tuned HORUS-2B value was 45)
+BANK_END_CANDIDATES_DEG = (45.0, 30.0, 60.0, 20.0, 70.0)
+#: fractions of the vehicle's limits the path feedback enforces, tried in order (the hand-tuned
+#: HORUS-2B values were 0.90-0.94)
+LIMIT_MARGINS = (0.93, 0.9, 0.85, 0.8)
+#: Lu 2014's path-limit feedback gain when the vehicle has a limit (the hand-tuned HORUS-2B value)
+PATH_GAIN = 40.0
+
+
+def derive(scenario) -> Derivation:
+    """Fnpeg settings for ``scenario``'s mission (module doc); the mission's own block when it flies FNPEG."""
+    if isinstance(scenario.guidance, Fnpeg):
+        return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!Fnpeg", "the mission's own settings")])
+    interface = terminal_interface(scenario)
+    speeds, alphas, alpha_how = alpha_rewritten(scenario, interface, "velocity")
+    heading, velocity, corridor_how = reversal_corridor(scenario)
+    v = scenario.make_vehicle()
+    lim = v.limits
+    limits = {"heat_rate_limit_kW_m2": lim.heat_flux_max / 1e3,
+              "load_limit_g": min(lim.normal_load_max, lim.total_load_max),
+              "dynamic_pressure_limit_kPa": lim.dynamic_pressure_max / 1e3}
+
+    def enforced(margin: float) -> dict:
+        return {f"guidance.{k}": (round(margin * x, 4) if math.isfinite(x) else 0.0) for k, x in limits.items()}
+
+    gain = PATH_GAIN if any(math.isfinite(x) for x in limits.values()) else 0.0
+    candidates = tuple(b for b in BANK_END_CANDIDATES_DEG if b <= v.bank_limit_deg)
+    first = {k.split(".", 1)[1]: x for k, x in enforced(LIMIT_MARGINS[0]).items()}
+    spec = Fnpeg(terminal_altitude_km=interface.altitude_km, terminal_velocity_m_s=round(interface.speed_m_s, 3),
+                 final_range_km=0.0, bank_end_deg=candidates[0], alpha_deg=alphas,
+                 alpha_velocity_m_s=[round(x, 3) for x in speeds], reversal_heading_deg=heading,
+                 reversal_velocity_m_s=velocity, path_gain=gain, **first)
+    choices = [
+        Choice("guidance.terminal_velocity_m_s", round(interface.speed_m_s, 3),
+               "Lu's e_f at the speed of the mission's acceptance box"
+               + (f" (Mach {interface.mach:g} at its centre, as a speed)" if interface.mach is not None else "")),
+        Choice("guidance.final_range_km", 0.0, "the target is the box's distance centre"),
+        Choice("guidance.alpha_deg, alpha_velocity_m_s",
+               ", ".join(f"{a:g} deg at {s:.0f} m/s" for a, s in zip(alphas, speeds)), alpha_how),
+        Choice("guidance.reversal_heading_deg, reversal_velocity_m_s", f"{heading} deg at {velocity} m/s",
+               corridor_how),
+        Choice("guidance.path_gain", gain, "Lu 2014's path-limit feedback, on where the vehicle has a limit (the "
+               "load enforced is the lower of its normal and total load limits: the total bounds the normal)"),
+    ]
+    search = [
+        SearchStep("limit margin", tuple(enforced(m) for m in LIMIT_MARGINS),
+                   f"the fraction of the vehicle's limits the feedback enforces ({', '.join(map(str, LIMIT_MARGINS))})"
+                   f": the rest is the predictor's and the actuators' lag"),
+        SearchStep.over("guidance.terminal_altitude_km", interface_altitudes(scenario, interface), ALTITUDE_WHY),
+        SearchStep.over("guidance.bank_end_deg", candidates,
+                        "sigma_f sets how much lift is left for the range at the end (Lu: chosen per vehicle)"),
+    ]
+    return Derivation(spec, choices, search)

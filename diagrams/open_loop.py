@@ -45,10 +45,11 @@ def build_open_loop(scenario: Scenario):
         geodetic=scenario.altitude_datum == "ellipsoid"))
     state = plant.GetOutputPort("state")
     conditions = plant.GetOutputPort("flight_conditions")
+    sources = {"state": state, "flight_conditions": conditions, "air_data": air.GetOutputPort("air_data")}
     for src in (alpha, bank):
-        for port in ("state", "flight_conditions"):
+        for port, source in sources.items():
             if src.HasInputPort(port):
-                builder.Connect(state if port == "state" else conditions, src.GetInputPort(port))
+                builder.Connect(source, src.GetInputPort(port))
     builder.Connect(alpha.get_output_port(), plant.GetInputPort("alpha"))
     builder.Connect(bank.get_output_port(), actuator.get_input_port())
     builder.Connect(actuator.GetOutputPort("bank"), plant.GetInputPort("bank"))

@@ -1,9 +1,14 @@
 """ScheduleSource: an open-loop command (bank or angle of attack) from a ``Schedule``.
 
 Ports:
-  - input  "state"              [6]  (energy-, Mach- or velocity-scheduled only) vehicle state
-  - input  "flight_conditions"  [9]  (Mach-scheduled only) EntryVehicle flight conditions
+  - input  "state"              [6]  (energy- or velocity-scheduled, or Mach from air data) vehicle state
+  - input  "flight_conditions"  [9]  (Mach-scheduled, mach_from 'flight_conditions') EntryVehicle flight conditions
+  - input  "air_data"           [2]  (Mach-scheduled, mach_from 'air_data') density, speed of sound: Mach = V / a
   - output "command"            [1]  the scheduled value (rad for angles)
+
+A continuous alpha schedule in Mach reads Mach from the state and the air data (as the
+termination monitor does): the flight conditions depend on alpha, so reading them would close an
+algebraic loop; a sampled source (``period``) may read them.
 """
 from __future__ import annotations
 
@@ -31,7 +36,7 @@ def make_schedule_source(schedule: Schedule, planet: Earth | None = None):
         times = np.concatenate([[min(bp[0], 0.0) - far], bp, [bp[-1] + far]])
         values = np.concatenate([[v[0]], v, [v[-1]]])
         return TrajectorySource(PiecewisePolynomial.FirstOrderHold(times, values.reshape(1, -1)))
-    return ScheduleSource(schedule, planet)
+    return ScheduleSource(schedule, planet, mach_from="air_data")
 
 
 class ScheduleSource(LeafSystem):
@@ -40,15 +45,18 @@ class ScheduleSource(LeafSystem):
     starting from ``initial_value``; otherwise it is evaluated continuously."""
 
     def __init__(self, schedule: Schedule, planet: Earth | None = None, period: float | None = None,
-                 initial_value: float = 0.0):
+                 initial_value: float = 0.0, mach_from: str = "flight_conditions"):
         super().__init__()
         self.schedule = schedule
         self.planet = planet or Earth()
         var = schedule.variable
-        self.state_port = self.DeclareVectorInputPort("state", 6) if var in ("energy", "velocity") else None
-        self.conditions_port = (
-            self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES)) if var == "mach" else None
-        )
+        if mach_from not in ("flight_conditions", "air_data"):
+            raise ScenarioError(f"ScheduleSource.mach_from = {mach_from!r}; allowed: 'flight_conditions', 'air_data'")
+        air = var == "mach" and mach_from == "air_data"
+        self.state_port = self.DeclareVectorInputPort("state", 6) if var in ("energy", "velocity") or air else None
+        self.conditions_port = (self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
+                                if var == "mach" and not air else None)
+        self.air_port = self.DeclareVectorInputPort("air_data", 2) if air else None
         if period is not None:
             if not period > 0:
                 raise ScenarioError(f"ScheduleSource.period must be > 0 s, got {period}")
@@ -74,6 +82,8 @@ class ScheduleSource(LeafSystem):
             s = specific_energy(self.state_port.Eval(context), self.planet)
         elif var == "velocity":
             s = self.state_port.Eval(context)[3]
+        elif self.air_port is not None:
+            s = self.state_port.Eval(context)[3] / self.air_port.Eval(context)[1]
         else:
             s = self.conditions_port.Eval(context)[FLIGHT_CONDITION_NAMES.index("mach")]
         return self.schedule(float(s))

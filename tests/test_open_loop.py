@@ -36,6 +36,23 @@ def test_run_stops_exactly_on_the_terminal_interface():
     assert np.all(np.diff(tr.time) > 0)
 
 
+def test_an_alpha_schedule_in_mach_flies_open_loop():
+    """A continuous alpha schedule in Mach reads Mach from the state and the air data (the flight
+    conditions depend on alpha: reading them closed an algebraic loop the diagram refused); the
+    flown alpha is the schedule at the logged V / a."""
+    import dataclasses as dc
+    import math
+
+    s = load_scenario("horus2b")
+    s.alpha = dc.replace(s.alpha, variable="mach", breakpoints=[3.0, 10.0], values_deg=[15.0, 40.0], smooth=False)
+    tr = simulate(s)
+    mach = tr.column("mach")
+    alpha = np.degrees(tr.alpha)
+    expected = np.interp(mach, [3.0, 10.0], [15.0, 40.0])
+    assert np.abs(alpha - expected).max() < 1e-6
+    assert alpha.min() < 20.0 and alpha.max() == pytest.approx(40.0) and math.isfinite(tr.time[-1])
+
+
 def test_cli_simulate_writes_table_summary_and_plots(tmp_path):
     """The written table (CSV, 10 significant digits) recomputes from first principles: dynamic
     pressure 0.5 rho V^2, the Chapman heat flux of paper 000 eq. 34 (R_N 0.8 m), the specific

@@ -22,7 +22,7 @@ from drake_entry.models.vehicles import Vehicle, load_vehicle
 from drake_entry.models.verdict import PathLimit, acceptance_box, vehicle_path_limits
 from drake_entry.typed_yaml import load_packaged_or_file, override, packaged_names
 
-__all__ = ["RENAMED_GUIDANCE_FIELDS", "upgrade_scenario_yaml", "scenario_from_dump", "EntryStateSpec", "TargetSpec", "TerminalSpec", "ScheduleSpec", "PLANTS", "SimulationSpec",
+__all__ = ["RENAMED_GUIDANCE_FIELDS", "upgrade_scenario_yaml", "scenario_from_dump", "EntryStateSpec", "TargetSpec", "TerminalSpec", "ScheduleSpec", "unstated_guidance", "stated_guidance", "PLANTS", "SimulationSpec",
            "ReferenceResultsSpec", "ERROR_COLUMNS", "Scenario", "INTEGRATORS", "SCHEDULE_VALUES_DEG",
            "SCHEDULE_BREAKPOINTS", "PACKAGED_SCENARIOS", "closed_loop_scenarios", "load_scenario", "apply_overrides",
            "load_campaign_scenario"]
@@ -133,6 +133,21 @@ ERROR_COLUMNS = ("err_altitude_m", "err_longitude_deg", "err_latitude_deg", "err
                  "err_crossrange_m", "err_distance_m")
 
 
+def unstated_guidance():
+    """The guidance of a scenario that states no ``guidance:`` block: the first registered
+    method's defaults, marked as not stated (``stated_guidance``)."""
+    spec = next(iter(REGISTRY))()
+    spec.unstated = True  # an attribute, not a field: never written to YAML
+    return spec
+
+
+def stated_guidance(scenario):
+    """The guidance block ``scenario`` states, or None when its file states none (it flies the
+    first registered method's defaults; a dumped scenario states what it flies)."""
+    g = scenario.guidance
+    return None if g is None or getattr(g, "unstated", False) else g
+
+
 @dc.dataclass
 class Scenario:
     """A mission: vehicle, environment, entry interface, target, terminal interface,
@@ -170,13 +185,19 @@ class Scenario:
     simulation: SimulationSpec = dc.field(default_factory=SimulationSpec)  # integrator, stop time and logging
     # the guidance method, selected by YAML tag (!DragEnergy, !BankProfile, ...; the
     # registry in drake_entry/guidance); untagged = drag-energy
-    guidance: GuidanceSpec = dc.field(default_factory=next(iter(REGISTRY)))
+    guidance: GuidanceSpec = dc.field(default_factory=unstated_guidance)
     # published campaign statistics for the report to compare with (optional)
     reference_results: ReferenceResultsSpec = dc.field(default_factory=ReferenceResultsSpec)
     # Monte-Carlo dispersions (Drake schema distributions: !Uniform, !Gaussian, ...)
     dispersions: disp.DispersionSpec = dc.field(default_factory=disp.DispersionSpec)
 
     # -- models ----------------------------------------------------------------------
+    def loaded_from(self, data: dict) -> None:
+        """After loading a file: a ``guidance:`` block it states is stated, even when it names the
+        default method (the loader then fills the default in place: ``stated_guidance``)."""
+        if isinstance(data, dict) and data.get("guidance") is not None:
+            vars(self.guidance).pop("unstated", None)
+
     def make_vehicle(self) -> Vehicle:
         return load_vehicle(self.vehicle, aero=self.aero or None, limits=self.vehicle_limits)
 

@@ -350,6 +350,8 @@ def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None,
         loaded = _drake_load(schema, text, where)
     if path is not None:
         resolve_file_fields(loaded, os.path.dirname(os.path.abspath(path)))
+    if callable(getattr(loaded, "loaded_from", None)):
+        loaded.loaded_from(data)  # what the file stated (e.g. a scenario's guidance block)
     return loaded
 
 

@@ -21,14 +21,13 @@ from drake_entry.guidance.derivation import (
     alpha_rewritten,
     derivation_for,
     interface_altitudes,
+    own_guidance,
     terminal_interface,
 )
 from drake_entry.scenario import PACKAGED_SCENARIOS, load_scenario
 
-CLOSED_LOOP = [n for n in PACKAGED_SCENARIOS if load_scenario(n).guidance is not None]
 
-
-@pytest.mark.parametrize("mission", CLOSED_LOOP)
+@pytest.mark.parametrize("mission", PACKAGED_SCENARIOS)
 def test_every_method_derives_settings_that_fit_the_mission_or_says_why_not(mission):
     """On every packaged mission each registered method gives settings the mission accepts (its own
     method: the mission's block as it is), every search candidate accepted too, or one line
@@ -45,13 +44,25 @@ def test_every_method_derives_settings_that_fit_the_mission_or_says_why_not(miss
         assert type(d.spec) is spec
         flown = apply_derivation(scenario, d)
         assert type(flown.guidance) is spec and flown.vehicle == scenario.vehicle and flown.entry == scenario.entry
-        if type(scenario.guidance) is spec:
+        if type(own_guidance(scenario)) is spec:
             assert d.spec == scenario.guidance and not d.search
         for step in d.search:
             assert step.candidates and all(isinstance(c, dict) and c for c in step.candidates), step.name
             for candidate in step.candidates:
                 apply_derivation(scenario, d, candidate)  # validates
     assert flyable >= 1
+
+
+def test_a_mission_without_a_guidance_block_states_no_method():
+    """A mission file without a guidance block gets the first method's defaults, which state
+    nothing: every method, that one included, derives its settings (closed_loop_scenarios agrees)."""
+    from drake_entry.guidance.drag_energy.spec import DragEnergy
+    from drake_entry.scenario import closed_loop_scenarios
+
+    for name in PACKAGED_SCENARIOS:
+        assert (own_guidance(load_scenario(name)) is not None) == (name in closed_loop_scenarios()), name
+    cav_h = load_scenario("cav_h")  # open loop: no guidance block
+    assert own_guidance(cav_h) is None and derivation_for(cav_h, DragEnergy).search
 
 
 def test_derivation_is_deterministic():

@@ -143,11 +143,14 @@ def load_comparison(name_or_path) -> Comparison:
 
 def needs_derivation(comparison: Comparison, entry: ComparedMethod, mission: Scenario | None = None) -> bool:
     """Whether ``entry``'s settings are derived from the mission: it is flown, gives no guidance
-    block, and the mission flies another method (``mission``: the loaded mission, else loaded)."""
+    block, and the mission states no block of its method (``mission``: the loaded mission, else
+    loaded; guidance.derivation.own_guidance)."""
+    from drake_entry.guidance.derivation import own_guidance
+
     if entry.not_flown or entry.guidance is not None:
         return False
     mission = mission if mission is not None else load_scenario(comparison.mission)
-    return type(mission.guidance).__name__ != entry.method
+    return type(own_guidance(mission)).__name__ != entry.method
 
 
 def method_scenario(comparison: Comparison, entry: ComparedMethod, guidance_scenario: Scenario | None = None) -> Scenario:

@@ -22,7 +22,7 @@ import numpy as np
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.spec import ReversingBankSpec
 
-__all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for", "terminal_interface",
+__all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "own_guidance", "derivation_for", "terminal_interface",
            "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY", "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
@@ -82,6 +82,14 @@ class Interface:
     mach: float | None
 
 
+def own_guidance(scenario):
+    """The guidance block the mission states, or None (drake_entry.scenario.stated_guidance: a
+    mission file without one flies the first registered method's defaults, which state nothing)."""
+    from drake_entry.scenario import stated_guidance
+
+    return stated_guidance(scenario)
+
+
 def derivation_for(scenario, spec_type) -> Derivation:
     """The Derivation of method ``spec_type`` (a registered spec class) for ``scenario``'s
     mission, from ``guidance/<folder>/derive.py``; CannotFly when the method has none."""
@@ -126,7 +134,8 @@ def mission_alpha(scenario):
     """The mission's alpha schedule (a ScheduleSpec) and whose it is: the mission's own method's
     profile when it flies a fixed one of its own (``alpha_profile``), else the scenario's
     ``alpha`` block."""
-    own = scenario.guidance.alpha_profile()
+    stated = own_guidance(scenario)
+    own = stated.alpha_profile() if stated is not None else None
     if own is None:
         return scenario.alpha, "the mission's"
     variable, breakpoints, values = own
@@ -210,7 +219,7 @@ def interface_altitudes(scenario, interface: Interface) -> tuple[float, ...]:
 def reversal_corridor(scenario) -> tuple[list[float], list[float], str]:
     """The bank-reversal corridor (half-widths [deg] at speeds [m/s]): the mission's own method's
     when it reverses the bank, else the shared default (paper 000 Sec. VI.D)."""
-    own = scenario.guidance
+    own = own_guidance(scenario)
     if isinstance(own, ReversingBankSpec):
         return (list(own.reversal_heading_deg), list(own.reversal_velocity_m_s),
                 f"the corridor of the mission's own method (!{type(own).__name__})")

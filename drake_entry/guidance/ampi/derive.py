@@ -4,14 +4,14 @@ vehicle and entry). Building a database for a mission on demand is future work."
 import dataclasses as dc
 
 from drake_entry.guidance.ampi.spec import Ampi, packaged_databases
-from drake_entry.guidance.derivation import CannotFly, Choice, Derivation
+from drake_entry.guidance.derivation import CannotFly, Choice, Derivation, own_guidance
 
 __all__ = ["derive"]
 
 
 def derive(scenario) -> Derivation:
     """Ampi settings for ``scenario``'s mission; CannotFly for another method's mission."""
-    if isinstance(scenario.guidance, Ampi):
+    if isinstance(own_guidance(scenario), Ampi):
         return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!Ampi", "the mission's own settings")])
     e = scenario.entry
     raise CannotFly(f"AMPI interpolates references from a database of optimal trajectories of one vehicle and "

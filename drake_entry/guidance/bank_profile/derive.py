@@ -9,6 +9,7 @@ from drake_entry.guidance.derivation import (
     Derivation,
     SearchStep,
     interface_altitudes,
+    own_guidance,
     reversal_corridor,
     terminal_interface,
 )
@@ -21,7 +22,7 @@ BANK_CANDIDATES_DEG = (60.0, 45.0, 75.0, 30.0, 85.0, 15.0)
 
 def derive(scenario) -> Derivation:
     """BankProfile settings for ``scenario``'s mission; the mission's own block when it flies this method."""
-    if isinstance(scenario.guidance, BankProfile):
+    if isinstance(own_guidance(scenario), BankProfile):
         return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!BankProfile", "the mission's own settings")])
     interface = terminal_interface(scenario)
     mach = interface.mach if interface.mach is not None else interface.speed_m_s / float(

@@ -12,6 +12,7 @@ from drake_entry.guidance.derivation import (
     SearchStep,
     alpha_rewritten,
     interface_altitudes,
+    own_guidance,
     reversal_corridor,
     terminal_interface,
 )
@@ -28,7 +29,7 @@ REPLAN_PERIOD_S = 20.0
 
 def derive(scenario) -> Derivation:
     """DragEnergy settings for ``scenario``'s mission; the mission's own block when it flies this method."""
-    if isinstance(scenario.guidance, DragEnergy):
+    if isinstance(own_guidance(scenario), DragEnergy):
         return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!DragEnergy", "the mission's own settings")])
     interface = terminal_interface(scenario)
     a = float(scenario.make_atmosphere().speed_of_sound(interface.altitude_km * 1e3))

@@ -11,6 +11,7 @@ from drake_entry.guidance.derivation import (
     SearchStep,
     alpha_rewritten,
     interface_altitudes,
+    own_guidance,
     reversal_corridor,
     terminal_interface,
 )
@@ -30,7 +31,7 @@ PATH_GAIN = 40.0
 
 def derive(scenario) -> Derivation:
     """Fnpeg settings for ``scenario``'s mission (module doc); the mission's own block when it flies FNPEG."""
-    if isinstance(scenario.guidance, Fnpeg):
+    if isinstance(own_guidance(scenario), Fnpeg):
         return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!Fnpeg", "the mission's own settings")])
     interface = terminal_interface(scenario)
     speeds, alphas, alpha_how = alpha_rewritten(scenario, interface, "velocity")

@@ -4,7 +4,7 @@ mission's own block when it flies it; any other mission is refused with the figu
 interface is future work."""
 import dataclasses as dc
 
-from drake_entry.guidance.derivation import CannotFly, Choice, Derivation, terminal_interface
+from drake_entry.guidance.derivation import CannotFly, Choice, Derivation, own_guidance, terminal_interface
 from drake_entry.guidance.lgl_terminal.spec import LglTerminal
 
 __all__ = ["derive"]
@@ -12,7 +12,7 @@ __all__ = ["derive"]
 
 def derive(scenario) -> Derivation:
     """LglTerminal settings for ``scenario``'s mission; CannotFly for another method's mission."""
-    if isinstance(scenario.guidance, LglTerminal):
+    if isinstance(own_guidance(scenario), LglTerminal):
         return Derivation(dc.replace(scenario.guidance),
                           [Choice("guidance", "!LglTerminal", "the mission's own settings")])
     interface = terminal_interface(scenario)

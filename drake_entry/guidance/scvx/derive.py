@@ -5,7 +5,7 @@ is future work."""
 import dataclasses as dc
 import math
 
-from drake_entry.guidance.derivation import CannotFly, Choice, Derivation, terminal_interface
+from drake_entry.guidance.derivation import CannotFly, Choice, Derivation, own_guidance, terminal_interface
 from drake_entry.guidance.scvx.spec import Scvx
 
 __all__ = ["derive"]
@@ -13,7 +13,7 @@ __all__ = ["derive"]
 
 def derive(scenario) -> Derivation:
     """Scvx settings for ``scenario``'s mission; CannotFly (with its figures) for another method's mission."""
-    if isinstance(scenario.guidance, Scvx):
+    if isinstance(own_guidance(scenario), Scvx):
         return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!Scvx", "the mission's own settings")])
     lim = scenario.make_vehicle().limits
     interface = terminal_interface(scenario)

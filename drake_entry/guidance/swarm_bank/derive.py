@@ -11,6 +11,7 @@ from drake_entry.guidance.derivation import (
     SearchStep,
     interface_altitudes,
     mission_alpha,
+    own_guidance,
     reversal_corridor,
     terminal_interface,
 )
@@ -27,7 +28,7 @@ REPLAN_PERIOD_S = 100.0
 
 def derive(scenario) -> Derivation:
     """SwarmBank settings for ``scenario``'s mission; the mission's own block when it flies this method."""
-    if isinstance(scenario.guidance, SwarmBank):
+    if isinstance(own_guidance(scenario), SwarmBank):
         return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!SwarmBank", "the mission's own settings")])
     interface = terminal_interface(scenario)
     heading, velocity, corridor_how = reversal_corridor(scenario)

@@ -344,6 +344,19 @@ def test_example_22(tmp_path):
     assert set(r["rows"]) == {"1 worker", "2 workers", "dask-jobqueue"} and set(r["throughput"]) == {1, 2}
 
 
+@pytest.mark.slow
+def test_example_23(tmp_path):
+    """A user's vehicle and mission written from scratch, compared in one call: FNPEG derives its
+    settings, searches them by flying and succeeds on every quick sample; SCvx, AMPI and LGL say
+    why they cannot fly the mission; the scenario FNPEG flew names the vehicle by its absolute path."""
+    r = _run("23_your_mission_every_method", tmp_path)
+    m = r["manifest"]["methods"]
+    assert m["fnpeg"]["flown"] and m["fnpeg"]["derivation"]["trials"]
+    assert {k for k, v in m.items() if v.get("reason", "").startswith("cannot fly")} >= {"scvx", "ampi", "lgl_terminal"}
+    flown = (tmp_path / "compare" / "scenarios" / "fnpeg.yaml").read_text()
+    assert f"vehicle: {tmp_path / 'mission' / 'glider.yaml'}" in flown and "guidance: !Fnpeg" in flown
+
+
 def test_the_examples_command_line_passes_quick_out_and_options_and_exits_by_the_claims(tmp_path, capsys):
     """run_example: --quick, --out and an example's own options reach main; the exit status is
     the claims' (1 when one fails)."""

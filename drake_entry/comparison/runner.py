@@ -78,8 +78,13 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
                                     "mapping": entry.mapping}
             continue
         if only and entry.label not in only:
-            methods.setdefault(entry.label, {"method": entry.method, "flown": False, "mapping": entry.mapping,
-                                             "reason": ""})  # not in this run; an earlier run's record stays
+            reason = _cannot_fly(mission, entry) if entry.label in derived else ""
+            if reason:  # known without flying: recorded whatever an earlier run left
+                methods[entry.label] = {"method": entry.method, "flown": False, "mapping": entry.mapping,
+                                        "reason": reason}
+            else:
+                methods.setdefault(entry.label, {"method": entry.method, "flown": False, "mapping": entry.mapping,
+                                                 "reason": ""})  # not in this run; an earlier run's record stays
             continue
         path = os.path.join(out_dir, SCENARIOS, f"{entry.label}.yaml")
         record = {"method": entry.method, "flown": True, "mapping": entry.mapping,
@@ -121,6 +126,18 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
         save(methods)  # each method's record (its derivation) kept as soon as it is flown
     save(methods)
     return write_comparison_report(out_dir)
+
+
+def _cannot_fly(mission, entry) -> str:
+    """Why ``entry``'s method cannot fly the mission, when its derivation says so without flying ('' else)."""
+    from drake_entry.guidance import REGISTRY
+    from drake_entry.guidance.derivation import derivation_for
+
+    try:
+        derivation_for(mission, next(spec for spec in REGISTRY if spec.__name__ == entry.method))
+    except CannotFly as e:
+        return f"cannot fly this mission: {e}"
+    return ""
 
 
 def _derived_scenario(comp: Comparison, entry, mission, path: str, earlier: dict | None, progress: bool):

@@ -134,6 +134,25 @@ def test_infeasible_range_is_diagnosed_not_raised(planner, engagement_state):
     assert not long.success and "lower bound binds" in long.message
 
 
+@pytest.mark.parametrize("margin, limit, first_e", [(0.15, "dynamic_pressure", 0.957), (0.3, "heat_flux", 0.129)])
+def test_an_empty_corridor_names_the_limit_that_closes_it_and_where(scenario, engagement_state, margin, limit,
+                                                                     first_e):
+    """HORUS-2B with a wide corridor margin: the diagnosis names the upper limit that closes the
+    corridor first (15 %: q near the end; 30 %: the heat flux from e = 0.13) and the energy, with
+    both drags, and that limit is the corridor's own smallest upper bound there."""
+    wide = dc.replace(scenario, guidance=dc.replace(scenario.guidance, corridor_margin=margin))
+    planner = DragEnergyPlanner.from_scenario(wide)
+    ref = planner.plan_from_state(engagement_state)
+    assert not ref.success
+    d = ref.binding[0]
+    assert d["bound"] == "corridor" and d["limit"] == limit and d["where_e"] == pytest.approx(first_e, abs=2e-3)
+    assert f"the {limit.replace('_', ' ')} limit caps the drag at" in ref.message and "MJ/kg" in ref.message
+    c = planner.corridor
+    E = c.energy[np.searchsorted(c.energy, c.energy[c.D_min > c.D_max].max())]
+    caps = {name: float(np.interp(E, c.energy, c.upper[name])) for name in c.upper}
+    assert min(caps, key=caps.get) in ("heat_flux", "normal_load", "dynamic_pressure")
+
+
 def test_nominal_terminal_point_violates_q_as_the_notes_say(planner, engagement_state, scenario):
     """A fixed terminal drag at 25 km, Mach 2.5 is above D_max (q limit; notes)."""
     h, V = 25e3, 2.5 * float(planner.atmosphere.speed_of_sound(25e3))

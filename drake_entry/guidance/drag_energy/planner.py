@@ -378,9 +378,15 @@ def _diagnose(p: DragEnergyProblem, op: LGL, D_lo, D_hi) -> list:
     e = (p.E0 - op.x) / (p.E0 - p.Ef)
     empty = D_lo > D_hi
     if empty.any():
-        out.append({"bound": "corridor", "where_e": float(e[empty][0]),
-                    "message": f"corridor empty (D_min > D_max) from e = {e[empty][0]:.3f} "
-                               f"to {e[empty][-1]:.3f}: reduce the margin or change alpha(E)"})
+        k = int(np.flatnonzero(empty)[0])
+        E = float(op.x[k])
+        limit = _binding_limit(p.corridor, E)
+        out.append({"bound": "corridor", "where_e": float(e[k]), "limit": limit,
+                    "message": f"corridor empty (D_min > D_max) from e = {e[k]:.3f} to {e[empty][-1]:.3f}: at "
+                               f"e = {e[k]:.3f} (E = {E / 1e6:.3f} MJ/kg) the {limit.replace('_', ' ')} limit "
+                               f"caps the drag at {D_hi[k]:.3g} m/s^2, below the "
+                               f"{D_lo[k]:.3g} m/s^2 the equilibrium glide needs (margin {p.corridor.margin:g} "
+                               f"included): reduce the margin, change alpha(E) or move the interface"})
         return out
     if not D_lo[0] <= p.D0 <= D_hi[0]:
         side = "above D_max" if p.D0 > D_hi[0] else "below D_min"
@@ -403,6 +409,13 @@ def _diagnose(p: DragEnergyProblem, op: LGL, D_lo, D_hi) -> list:
                     "message": f"range to go {p.range_to_go / 1e3:.1f} km is longer than the corridor allows "
                                f"({R_max / 1e3:.1f} km flying on D_min everywhere): the lower bound binds"})
     return out
+
+
+def _binding_limit(corridor, E: float) -> str:
+    """The upper bound (heat_flux, normal_load, dynamic_pressure, total_load) that sets D_max at E [J/kg]."""
+    names = list(corridor.upper)
+    caps = [float(np.interp(E, corridor.energy, corridor.upper[n])) for n in names]
+    return names[int(np.argmin(caps))]
 
 
 def _binding(ref: DragEnergyReference, D_lo, D_hi, tol: float = 1e-4) -> list:

@@ -198,3 +198,30 @@ def test_compare_takes_a_comparison_or_a_mission_alone(tmp_path):
     with pytest.raises(ScenarioError, match="'nowhere' is neither a packaged comparison .* a packaged scenario"):
         load_comparison_or_mission("nowhere")
     assert isinstance(mission_comparison("capsule_lu2008"), Comparison)
+
+
+def test_the_matrix_reads_comparison_directories(tmp_path):
+    """The mission x method matrix from comparison directories: the one-sided 90 % lower bound
+    (20 of 20: 0.1^(1/20) = 89.1 %; 0 of n: 0), each flown cell's figures, a not-flown method's
+    reason, and a directory that holds no comparison refused in one line."""
+    import json
+
+    from drake_entry.comparison.matrix import matrix_markdown, success_lower_bound, write_matrix
+    from drake_entry.errors import CampaignError
+
+    assert success_lower_bound(20, 20) == pytest.approx(0.1 ** (1 / 20), rel=1e-9)
+    assert success_lower_bound(0, 10) == 0.0 and success_lower_bound(5, 10) < 0.5 < success_lower_bound(9, 10)
+    folder = tmp_path / "c"
+    folder.mkdir()
+    (folder / "comparison.json").write_text(json.dumps({
+        "comparison": "mine", "mission": "x/mine.yaml", "runs": 20, "seed": 3, "sessions": [{"git_commit": "abc"}],
+        "methods": {"fnpeg": {"method": "Fnpeg", "flown": True, "derivation": {"chosen": {}}},
+                    "scvx": {"method": "Scvx", "flown": False, "reason": "cannot fly this mission: no DRS window; x"}}}))
+    (folder / "comparison_summary.json").write_text(json.dumps({"methods": {"fnpeg": {
+        "successful": 20, "samples": 20, "miss_km": {"median": 1.5, "p95": 2.25}, "wall_time_s": {"mean": 0.8}}}}))
+    text = matrix_markdown([str(folder)])
+    assert "| mine (20 runs, seed 3) | **20/20** (>= 89 %), miss 1.5 / 2.25 km, 0.8 s * | not flown: no DRS window |" in text
+    path = write_matrix([str(folder)], str(tmp_path / "m.md"))
+    assert "commit abc" in open(path).read()
+    with pytest.raises(CampaignError, match="holds no comparison report"):
+        matrix_markdown([str(tmp_path)])

@@ -49,5 +49,22 @@ def compare(args) -> int:
     return 1 if failed else 0
 
 
+def _add_matrix_arguments(parser) -> None:
+    parser.add_argument("folders", nargs="+", metavar="DIR", help="comparison directories (drake-entry compare --out)")
+    parser.add_argument("--out", default=os.path.join("out", "compare", "matrix.md"),
+                        help="the Markdown file written (default: out/compare/matrix.md)")
+
+
+def matrix(args) -> int:
+    from drake_entry.comparison.matrix import write_matrix
+
+    path = write_matrix(args.folders, args.out)
+    print(open(path).read())
+    print(f"wrote {path}")
+    return 0
+
+
 COMMANDS = (Command("compare", "several guidance methods on one mission, the same dispersions and seeds: one report",
-                    _add_compare_arguments, compare),)
+                    _add_compare_arguments, compare),
+            Command("matrix", "the mission x method matrix of several comparison directories: one Markdown table",
+                    _add_matrix_arguments, matrix))

@@ -1,0 +1,96 @@
+"""The mission x method matrix: several comparison directories (one mission each) in one table.
+
+Each cell is one method's campaign on one mission: successes of samples with the one-sided 90 %
+lower Clopper-Pearson bound on the success probability, the miss distance's median and 95th
+percentile over the samples that reached the interface, and the core seconds per sample; or why
+the method was not flown (its first clause). Read from each directory's ``comparison.json`` and
+``comparison_summary.json`` (drake_entry.comparison.report), so the matrix is regenerated from
+the directories, never typed.
+"""
+from __future__ import annotations
+
+import json
+import os
+
+from scipy import stats as scipy_stats
+
+from drake_entry.campaign.store import write_atomic
+from drake_entry.errors import CampaignError
+
+__all__ = ["LEVEL", "success_lower_bound", "read_comparison", "matrix_markdown", "write_matrix"]
+
+#: the one-sided confidence of the success bound
+LEVEL = 0.90
+
+
+def success_lower_bound(successes: int, runs: int, level: float = LEVEL) -> float:
+    """The one-sided ``level`` lower Clopper-Pearson bound on a success probability."""
+    if runs <= 0:
+        return 0.0
+    test = scipy_stats.binomtest(int(successes), int(runs), alternative="greater")
+    return float(test.proportion_ci(confidence_level=level, method="exact").low)
+
+
+def read_comparison(folder: str) -> dict:
+    """A comparison directory's manifest and summary: {'mission', 'name', 'runs', 'seed',
+    'methods': {label: {'method', 'flown', 'reason', 'summary'}}}; CampaignError when it holds none."""
+    paths = [os.path.join(folder, name) for name in ("comparison.json", "comparison_summary.json")]
+    if not all(os.path.isfile(p) for p in paths):
+        raise CampaignError(f"{folder} holds no comparison report (comparison.json and comparison_summary.json): "
+                            f"run `drake-entry compare` into it first")
+    with open(paths[0]) as f:
+        manifest = json.load(f)
+    with open(paths[1]) as f:
+        summary = json.load(f)
+    methods = {}
+    for label, info in manifest["methods"].items():
+        methods[label] = {"method": info["method"], "flown": bool(info.get("flown")),
+                          "reason": info.get("reason") or "", "summary": summary["methods"].get(label),
+                          "derived": bool(info.get("derivation"))}
+    return {"mission": os.path.splitext(os.path.basename(manifest["mission"]))[0], "name": manifest["comparison"],
+            "runs": manifest["runs"], "seed": manifest["seed"],
+            "commit": (manifest.get("sessions") or [{}])[-1].get("git_commit"),
+            "methods": methods}
+
+
+def _cell(m: dict) -> str:
+    s = m["summary"]
+    if not m["flown"] or s is None:
+        reason = m["reason"] or "not flown yet"
+        short = reason.split(": ", 1)[1] if reason.startswith("cannot fly this mission: ") else reason
+        return "not flown: " + short.split(";")[0].split(" (")[0][:90]
+    k, n = s["successful"], s["samples"]
+    text = f"**{k}/{n}** (>= {100 * success_lower_bound(k, n):.0f} %)"
+    miss = s.get("miss_km")
+    if miss:
+        text += f", miss {miss['median']:.3g} / {miss['p95']:.3g} km"
+    wall = s.get("wall_time_s")
+    if wall:
+        text += f", {wall['mean']:.2g} s"
+    return text + (" *" if m["derived"] else "")
+
+
+def matrix_markdown(folders: list[str]) -> str:
+    """The matrix of these comparison directories (rows: missions; columns: methods)."""
+    comparisons = [read_comparison(f) for f in folders]
+    labels = []
+    for c in comparisons:
+        labels += [label for label in c["methods"] if label not in labels]
+    out = ["| mission | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]
+    for c in comparisons:
+        cells = [_cell(c["methods"][label]) if label in c["methods"] else "—" for label in labels]
+        out.append(f"| {c['name']} ({c['runs']} runs, seed {c['seed']}) | " + " | ".join(cells) + " |")
+    out += ["", f"Each cell: successful/samples (the one-sided {100 * LEVEL:.0f} % lower Clopper-Pearson bound on the "
+            f"success probability), the miss distance's median / 95th percentile over the samples that reached the "
+            f"interface, core seconds per sample; * settings derived from the mission (the mission's own method "
+            f"flies the mission's settings). Not flown: the method's own reason (its comparison report has it whole)."]
+    return "\n".join(out)
+
+
+def write_matrix(folders: list[str], path: str, *, title: str = "Every method on every mission") -> str:
+    """Write the matrix of ``folders`` to the Markdown file ``path``; returns ``path``."""
+    commits = sorted({str(read_comparison(f)["commit"]) for f in folders})
+    text = (f"# {title}\n\nFrom {len(folders)} comparison directories (`drake-entry compare MISSION`), commit "
+            f"{', '.join(commits)}.\n\n" + matrix_markdown(folders) + "\n")
+    write_atomic(path, text.encode())
+    return path

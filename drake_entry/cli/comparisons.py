@@ -51,14 +51,15 @@ def compare(args) -> int:
 
 def _add_matrix_arguments(parser) -> None:
     parser.add_argument("folders", nargs="+", metavar="DIR", help="comparison directories (drake-entry compare --out)")
-    parser.add_argument("--out", default=os.path.join("out", "compare", "matrix.md"),
-                        help="the Markdown file written (default: out/compare/matrix.md)")
+    parser.add_argument("--out", default=os.path.join("out", "compare"),
+                        help="directory of the Markdown file written, matrix.md (default: out/compare)")
 
 
 def matrix(args) -> int:
     from drake_entry.comparison.matrix import write_matrix
 
-    path = write_matrix(args.folders, args.out)
+    os.makedirs(args.out, exist_ok=True)
+    path = write_matrix(args.folders, os.path.join(args.out, "matrix.md"))
     print(open(path).read())
     print(f"wrote {path}")
     return 0

@@ -305,7 +305,8 @@ def _derivation_tables(meta) -> str:
            "mean box ratio |error| / tolerance, a limit breach counting 10 more, a flight stopped short 100 more). "
            "Steps run in order, each at the values kept before it."]
     for label, d in derived.items():
-        out += ["", f"**{label}**: kept {', '.join(f'{k} = {v:g}' for k, v in d['chosen'].items()) or 'nothing searched'}",
+        kept = ", ".join(f"{k} = {v:g}" for k, v in d["chosen"].items()) or "nothing searched"
+        out += ["", f"**{label}**: kept {kept}",
                 "", "| step | candidate | successful | mean box ratio | s | why not (first flights) |",
                 "|---|---|---|---|---|---|"]
         for t in d["trials"]:

@@ -6,13 +6,13 @@ and ``overrides`` of the method's own fields), or none: the mission's own method
 mission's settings, another method derives its settings from the mission
 (drake_entry.guidance.derivation, searched by drake_entry.comparison.derive), or the reason it
 cannot fly it (``not_flown``). A comparison that lists no method flies every registered one,
-each with derived settings (``mission_comparison``: a mission alone). The mission (vehicle, environment, entry state, target, terminal box,
-dispersions, simulation) is the same for every method: an override may touch only the
-method's settings, ``guidance.*`` and the open-loop ``alpha`` schedule (flown by the methods
-that do not command alpha). ``method_scenario`` makes the scenario one method flies; the
-campaign engine flies them all with the same seed, so sample i of every method draws the same
-dispersions (``drake_entry.comparison.runner``). Pure data: loading one imports no solver.
-"""
+each with derived settings (``mission_comparison``: a mission alone). The mission (vehicle,
+environment, entry state, target, terminal box, dispersions, simulation) is the same for every
+method: an override may touch only the method's settings, ``guidance.*`` and the open-loop
+``alpha`` schedule (flown by the methods that do not command alpha). ``method_scenario`` makes
+the scenario one method flies; the campaign engine flies them all with the same seed, so sample
+i of every method draws the same dispersions (``drake_entry.comparison.runner``). Pure data:
+loading one imports no solver."""
 import dataclasses as dc
 import os
 import re
@@ -153,7 +153,8 @@ def needs_derivation(comparison: Comparison, entry: ComparedMethod, mission: Sce
     return type(own_guidance(mission)).__name__ != entry.method
 
 
-def method_scenario(comparison: Comparison, entry: ComparedMethod, guidance_scenario: Scenario | None = None) -> Scenario:
+def method_scenario(comparison: Comparison, entry: ComparedMethod,
+                    guidance_scenario: Scenario | None = None) -> Scenario:
     """The scenario ``entry`` flies: the comparison's mission with the entry's guidance block (or
     the mission's own, or ``guidance_scenario``'s guidance and alpha: the settings derived from the
     mission, drake_entry.comparison.derive) and its overrides, named ``<mission>-<label>``. A
@@ -164,7 +165,8 @@ def method_scenario(comparison: Comparison, entry: ComparedMethod, guidance_scen
     mission_name = scenario.name
     try:
         if guidance_scenario is not None:
-            scenario.guidance, scenario.alpha = dc.replace(guidance_scenario.guidance), dc.replace(guidance_scenario.alpha)
+            scenario.guidance = dc.replace(guidance_scenario.guidance)
+            scenario.alpha = dc.replace(guidance_scenario.alpha)
         elif entry.guidance is not None:
             scenario.guidance = dc.replace(entry.guidance)
         if type(scenario.guidance).__name__ != entry.method:
@@ -211,6 +213,7 @@ def load_comparison_or_mission(name_or_path: str) -> Comparison:
         return load_comparison(name_or_path)
     except ScenarioError as e:
         if "is neither a packaged" in str(e):
-            raise ScenarioError(f"'{name_or_path}' is neither a packaged comparison ({', '.join(PACKAGED_COMPARISONS)}), "
-                                f"a packaged scenario ({', '.join(PACKAGED_SCENARIOS)}) nor a file") from None
+            raise ScenarioError(f"'{name_or_path}' is neither a packaged comparison "
+                                f"({', '.join(PACKAGED_COMPARISONS)}), a packaged scenario "
+                                f"({', '.join(PACKAGED_SCENARIOS)}) nor a file") from None
         raise

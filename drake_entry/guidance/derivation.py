@@ -22,8 +22,9 @@ import numpy as np
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.spec import ReversingBankSpec
 
-__all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "own_guidance", "derivation_for", "terminal_interface",
-           "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY", "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN"]
+__all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "own_guidance", "derivation_for",
+           "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
+           "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
 #: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
@@ -92,7 +93,9 @@ def own_guidance(scenario):
 
 def derivation_for(scenario, spec_type) -> Derivation:
     """The Derivation of method ``spec_type`` (a registered spec class) for ``scenario``'s
-    mission, from ``guidance/<folder>/derive.py``; CannotFly when the method has none."""
+    mission: the mission's own block when the mission states one of this method, else
+    ``guidance/<folder>/derive.py``'s ``derive`` (another method's mission, or none stated);
+    CannotFly when the method has no derive.py or cannot fly the mission."""
     from drake_entry.guidance import folder_of
 
     folder = folder_of(spec_type)
@@ -104,6 +107,9 @@ def derivation_for(scenario, spec_type) -> Derivation:
             raise
         raise CannotFly(f"!{spec_type.__name__} derives no settings from a mission (guidance/{folder}/derive.py "
                         f"is not written): give its guidance block in the comparison") from None
+    own = own_guidance(scenario)
+    if type(own) is spec_type:  # the mission's own method flies the mission's settings
+        return Derivation(dc.replace(own), [Choice("guidance", f"!{spec_type.__name__}", "the mission's own settings")])
     derivation = module.derive(scenario)
     if type(derivation.spec) is not spec_type:
         raise TypeError(f"{name}.derive returned a {type(derivation.spec).__name__}, not a {spec_type.__name__}")
@@ -216,13 +222,17 @@ def interface_altitudes(scenario, interface: Interface) -> tuple[float, ...]:
     return tuple(h for h in (round(interface.altitude_km + k * tol, 4) for k in ALTITUDE_STEPS) if h >= 0.0)
 
 
-def reversal_corridor(scenario) -> tuple[list[float], list[float], str]:
-    """The bank-reversal corridor (half-widths [deg] at speeds [m/s]): the mission's own method's
-    when it reverses the bank, else the shared default (paper 000 Sec. VI.D)."""
+def reversal_corridor(scenario) -> tuple[list[float], list[float], Choice]:
+    """The bank-reversal corridor (half-widths [deg] at speeds [m/s]) and its Choice: the
+    mission's own method's when it reverses the bank, else the shared default (paper 000
+    Sec. VI.D)."""
     own = own_guidance(scenario)
     if isinstance(own, ReversingBankSpec):
-        return (list(own.reversal_heading_deg), list(own.reversal_velocity_m_s),
-                f"the corridor of the mission's own method (!{type(own).__name__})")
-    default = ReversingBankSpec()
-    return (list(default.reversal_heading_deg), list(default.reversal_velocity_m_s),
-            "the shared default corridor (paper 000 Sec. VI.D)")
+        heading, velocity = list(own.reversal_heading_deg), list(own.reversal_velocity_m_s)
+        how = f"the corridor of the mission's own method (!{type(own).__name__})"
+    else:
+        default = ReversingBankSpec()
+        heading, velocity = list(default.reversal_heading_deg), list(default.reversal_velocity_m_s)
+        how = "the shared default corridor (paper 000 Sec. VI.D)"
+    return heading, velocity, Choice("guidance.reversal_heading_deg, reversal_velocity_m_s",
+                                     f"{heading} deg at {velocity} m/s", how)

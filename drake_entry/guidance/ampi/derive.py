@@ -1,18 +1,16 @@
-"""AMPI's settings from a mission (drake_entry.guidance.derivation). Today: the mission's own block
-when it flies AMPI; any other mission is refused with the figure that stops it (the databases'
-vehicle and entry). Building a database for a mission on demand is future work."""
-import dataclasses as dc
+"""AMPI's settings from a mission (drake_entry.guidance.derivation). Today: only a mission that
+states its !Ampi block flies it (derivation_for); any other mission is refused with the figure
+that stops it (the databases' vehicle and entry). Building a database for a mission on demand is
+future work."""
 
-from drake_entry.guidance.ampi.spec import Ampi, packaged_databases
-from drake_entry.guidance.derivation import CannotFly, Choice, Derivation, own_guidance
+from drake_entry.guidance.ampi.spec import packaged_databases
+from drake_entry.guidance.derivation import CannotFly, Derivation
 
 __all__ = ["derive"]
 
 
 def derive(scenario) -> Derivation:
     """Ampi settings for ``scenario``'s mission; CannotFly for another method's mission."""
-    if isinstance(own_guidance(scenario), Ampi):
-        return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!Ampi", "the mission's own settings")])
     e = scenario.entry
     raise CannotFly(f"AMPI interpolates references from a database of optimal trajectories of one vehicle and "
                     f"entry box (paper 003); the packaged databases ({', '.join(packaged_databases())}) are not of "

@@ -1,6 +1,6 @@
 """The worked example's settings from a mission (drake_entry.guidance.derivation): the mission's
-terminal interface, its reversal corridor; the two bank magnitudes searched on the nominal flight."""
-import dataclasses as dc
+terminal interface, its reversal corridor; the two bank magnitudes searched on the nominal
+flight."""
 
 from drake_entry.guidance.bank_profile.spec import BankProfile
 from drake_entry.guidance.derivation import (
@@ -9,7 +9,6 @@ from drake_entry.guidance.derivation import (
     Derivation,
     SearchStep,
     interface_altitudes,
-    own_guidance,
     reversal_corridor,
     terminal_interface,
 )
@@ -21,20 +20,18 @@ BANK_CANDIDATES_DEG = (60.0, 45.0, 75.0, 30.0, 85.0, 15.0)
 
 
 def derive(scenario) -> Derivation:
-    """BankProfile settings for ``scenario``'s mission; the mission's own block when it flies this method."""
-    if isinstance(own_guidance(scenario), BankProfile):
-        return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!BankProfile", "the mission's own settings")])
+    """BankProfile settings for ``scenario``'s mission stating no
+    block of this method (derivation_for returns a stated one as it is)."""
     interface = terminal_interface(scenario)
     mach = interface.mach if interface.mach is not None else interface.speed_m_s / float(
         scenario.make_atmosphere().speed_of_sound(interface.altitude_km * 1e3))
-    heading, velocity, corridor_how = reversal_corridor(scenario)
+    heading, velocity, corridor = reversal_corridor(scenario)
     spec = BankProfile(terminal_altitude_km=interface.altitude_km, terminal_mach=round(mach, 4),
                        bank_start_deg=BANK_CANDIDATES_DEG[0], bank_end_deg=BANK_CANDIDATES_DEG[0],  # searched
                        reversal_heading_deg=heading, reversal_velocity_m_s=velocity)
     choices = [Choice("guidance.terminal_altitude_km, terminal_mach", f"{interface.altitude_km:g} km, Mach {mach:.3g}",
                       "the centre of the mission's acceptance box"),
-               Choice("guidance.reversal_heading_deg, reversal_velocity_m_s", f"{heading} deg at {velocity} m/s",
-                      corridor_how)]
+               corridor]
     limit = scenario.make_vehicle().bank_limit_deg
     banks = tuple(b for b in BANK_CANDIDATES_DEG if b <= limit)
     search = [SearchStep.over("guidance.terminal_altitude_km", interface_altitudes(scenario, interface), ALTITUDE_WHY),

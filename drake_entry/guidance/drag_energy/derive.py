@@ -1,9 +1,8 @@
 """The drag-energy guidance's settings from a mission (drake_entry.guidance.derivation): the
-terminal interface in the mission's box, the mission's alpha schedule in normalised energy,
-its reversal corridor; the interface's altitude and the corridor margin searched (paper 000's
+terminal interface in the mission's box, the mission's alpha schedule in normalised energy, its
+reversal corridor; the interface's altitude and the corridor margin searched (paper 000's
 corridor closes where the vehicle's limits meet: the altitude that keeps it open is the
 mission's)."""
-import dataclasses as dc
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
@@ -12,7 +11,6 @@ from drake_entry.guidance.derivation import (
     SearchStep,
     alpha_rewritten,
     interface_altitudes,
-    own_guidance,
     reversal_corridor,
     terminal_interface,
 )
@@ -28,13 +26,12 @@ REPLAN_PERIOD_S = 20.0
 
 
 def derive(scenario) -> Derivation:
-    """DragEnergy settings for ``scenario``'s mission; the mission's own block when it flies this method."""
-    if isinstance(own_guidance(scenario), DragEnergy):
-        return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!DragEnergy", "the mission's own settings")])
+    """DragEnergy settings for ``scenario``'s mission stating no
+    block of this method (derivation_for returns a stated one as it is)."""
     interface = terminal_interface(scenario)
     a = float(scenario.make_atmosphere().speed_of_sound(interface.altitude_km * 1e3))
     mach = interface.mach if interface.mach is not None else interface.speed_m_s / a
-    heading, velocity, corridor_how = reversal_corridor(scenario)
+    heading, velocity, corridor = reversal_corridor(scenario)
     breakpoints, values, alpha_how = alpha_rewritten(scenario, interface, "normalized_energy")
     own = scenario.alpha
     alpha = (None if own.variable in ("energy", "normalized_energy")
@@ -49,7 +46,7 @@ def derive(scenario) -> Derivation:
         Choice("alpha", "as the mission's" if alpha is None else
                ", ".join(f"{v:g} deg at e = {b:.3f}" for b, v in zip(breakpoints, values)),
                alpha_how if alpha is not None else "the planner flies alpha(E): the mission's schedule is in energy"),
-        Choice("guidance.reversal_heading_deg, reversal_velocity_m_s", f"{heading} deg at {velocity} m/s", corridor_how),
+        corridor,
         Choice("guidance.replan_period_s, replan_until_e", f"{REPLAN_PERIOD_S:g} s, 0.99",
                "re-planned from the navigation state (paper 000 plans once; a single HORUS-2B plan ends "
                "24.3 +- 4.3 km from the runway)"),

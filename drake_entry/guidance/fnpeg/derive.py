@@ -1,7 +1,6 @@
-"""FNPEG's settings from a mission (drake_entry.guidance.derivation): Lu 2014's terminal
-interface e_f at the mission's box centre, the mission's alpha schedule in speed, its reversal
-corridor, the path-limit feedback on the vehicle's limits with a margin; sigma_f searched."""
-import dataclasses as dc
+"""FNPEG's settings from a mission (drake_entry.guidance.derivation): Lu 2014's terminal interface
+e_f at the mission's box centre, the mission's alpha schedule in speed, its reversal corridor,
+the path-limit feedback on the vehicle's limits with a margin; sigma_f searched."""
 import math
 
 from drake_entry.guidance.derivation import (
@@ -11,7 +10,6 @@ from drake_entry.guidance.derivation import (
     SearchStep,
     alpha_rewritten,
     interface_altitudes,
-    own_guidance,
     reversal_corridor,
     terminal_interface,
 )
@@ -30,12 +28,10 @@ PATH_GAIN = 40.0
 
 
 def derive(scenario) -> Derivation:
-    """Fnpeg settings for ``scenario``'s mission (module doc); the mission's own block when it flies FNPEG."""
-    if isinstance(own_guidance(scenario), Fnpeg):
-        return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!Fnpeg", "the mission's own settings")])
+    """Fnpeg settings for ``scenario``'s mission that states no !Fnpeg block (module doc)."""
     interface = terminal_interface(scenario)
     speeds, alphas, alpha_how = alpha_rewritten(scenario, interface, "velocity")
-    heading, velocity, corridor_how = reversal_corridor(scenario)
+    heading, velocity, corridor = reversal_corridor(scenario)
     v = scenario.make_vehicle()
     lim = v.limits
     limits = {"heat_rate_limit_kW_m2": lim.heat_flux_max / 1e3,
@@ -59,8 +55,7 @@ def derive(scenario) -> Derivation:
         Choice("guidance.final_range_km", 0.0, "the target is the box's distance centre"),
         Choice("guidance.alpha_deg, alpha_velocity_m_s",
                ", ".join(f"{a:g} deg at {s:.0f} m/s" for a, s in zip(alphas, speeds)), alpha_how),
-        Choice("guidance.reversal_heading_deg, reversal_velocity_m_s", f"{heading} deg at {velocity} m/s",
-               corridor_how),
+        corridor,
         Choice("guidance.path_gain", gain, "Lu 2014's path-limit feedback, on where the vehicle has a limit (the "
                "load enforced is the lower of its normal and total load limits: the total bounds the normal)"),
     ]

@@ -1,20 +1,16 @@
-"""SCvx's settings from a mission (drake_entry.guidance.derivation). Today: the mission's own block
-when it flies SCvx; any other mission is refused with the figure that stops it (the planner's
-load limit, the terminal window). Posing paper 001's DRS problem from any mission's interface
-is future work."""
-import dataclasses as dc
+"""SCvx's settings from a mission (drake_entry.guidance.derivation). Today: only a mission that
+states its !Scvx block flies it (derivation_for); any other mission is refused with the figure
+that stops it (the planner's load limit, the terminal window). Posing paper 001's DRS problem
+from any mission's interface is future work."""
 import math
 
-from drake_entry.guidance.derivation import CannotFly, Choice, Derivation, own_guidance, terminal_interface
-from drake_entry.guidance.scvx.spec import Scvx
+from drake_entry.guidance.derivation import CannotFly, Derivation, terminal_interface
 
 __all__ = ["derive"]
 
 
 def derive(scenario) -> Derivation:
     """Scvx settings for ``scenario``'s mission; CannotFly (with its figures) for another method's mission."""
-    if isinstance(own_guidance(scenario), Scvx):
-        return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!Scvx", "the mission's own settings")])
     lim = scenario.make_vehicle().limits
     interface = terminal_interface(scenario)
     reasons = []

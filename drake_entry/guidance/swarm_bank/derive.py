@@ -2,7 +2,6 @@
 mission's box centre, alpha from the load factor (Case 1, eq. 31) between the mission's alpha
 extremes, its reversal corridor, sigma_0 searched before flight and re-solved on board; sigma_f
 searched."""
-import dataclasses as dc
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
@@ -11,7 +10,6 @@ from drake_entry.guidance.derivation import (
     SearchStep,
     interface_altitudes,
     mission_alpha,
-    own_guidance,
     reversal_corridor,
     terminal_interface,
 )
@@ -27,11 +25,10 @@ REPLAN_PERIOD_S = 100.0
 
 
 def derive(scenario) -> Derivation:
-    """SwarmBank settings for ``scenario``'s mission; the mission's own block when it flies this method."""
-    if isinstance(own_guidance(scenario), SwarmBank):
-        return Derivation(dc.replace(scenario.guidance), [Choice("guidance", "!SwarmBank", "the mission's own settings")])
+    """SwarmBank settings for ``scenario``'s mission stating no
+    block of this method (derivation_for returns a stated one as it is)."""
     interface = terminal_interface(scenario)
-    heading, velocity, corridor_how = reversal_corridor(scenario)
+    heading, velocity, corridor = reversal_corridor(scenario)
     alpha, source = mission_alpha(scenario)
     alphas = [float(a) for a in alpha.values_deg]
     lo, hi = min(alphas), max(alphas)
@@ -52,8 +49,9 @@ def derive(scenario) -> Derivation:
         Choice("guidance.bank_start_bounds_deg", f"0-{bank_limit:g} deg", "the vehicle's bank limit"),
         Choice("guidance.replan_period_s", REPLAN_PERIOD_S,
                "sigma_0 re-solved on board (plan-once PIO meets paper 004's own dispersions in 1 of 20 runs)"),
-        Choice("guidance.reversal_heading_deg, reversal_velocity_m_s", f"{heading} deg at {velocity} m/s", corridor_how),
+        corridor,
     ]
     search = [SearchStep.over("guidance.terminal_altitude_km", interface_altitudes(scenario, interface), ALTITUDE_WHY),
-              SearchStep.over("guidance.bank_end_deg", candidates, "eq. 17's sigma_f: the lift left for the range at the end")]
+              SearchStep.over("guidance.bank_end_deg", candidates,
+                              "eq. 17's sigma_f: the lift left for the range at the end")]
     return Derivation(spec, choices, search)

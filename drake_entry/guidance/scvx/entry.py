@@ -24,11 +24,12 @@ nodes; 2 nodes per segment is the paper's trapezoid, Sec. IV.B),
     x_j - x_0 - sum_k I[j, k] t_f f(x_k, u_k) = 0.
 
 Constraints: control bounds (eqs. 36, 43-44, hard), |u| <= 1 (eq. 42, hard cone, lossless);
-buffered (eq. 24) at every node: heat flux <= q_max (eq. 9), total load <= n_max (eq. 10) (both
-less the settings' path_margin),
+buffered (eq. 24) at every node: heat flux <= q_max (eq. 9), total load <= n_max (eq. 10), or
+the normal load (paper 000 eq. 35) for a vehicle that limits only that (both less the settings'
+path_margin),
 flight-path bounds (eq. 70); at the DRS point: geodetic altitude window (eq. 64, narrowed by
-the mission's final_altitude_margin_m), V <= M a
-(eq. 65), V sin(gamma) >= V_v,min (eq. 66), and a cone ||miss|| <= site radius (eqs. 67-68)
+the mission's final_altitude_margin_m), M_min a <= V <= M a
+(eq. 65; M_min 0 in paper 001, a TAEM box's lower Mach otherwise), V sin(gamma) >= V_v,min (eq. 66), and a cone ||miss|| <= site radius (eqs. 67-68)
 with a buffer. Hard bounds on the other states (eq. 70) and the fixed entry state.
 
 Objectives (paper 001 Table 2, ``OBJECTIVES``; the min-max ones through an epigraph variable
@@ -89,7 +90,8 @@ MISS_SCALE = 1e4  # m
 
 
 PATH_NAMES = ("heat flux", "total load", "flight-path lower bound", "flight-path upper bound")
-EVENT_NAMES = ("DRS altitude lower bound", "DRS altitude upper bound", "DRS Mach", "DRS vertical speed")
+EVENT_NAMES = ("DRS altitude lower bound", "DRS altitude upper bound", "DRS Mach", "DRS vertical speed",
+               "DRS Mach lower bound")
 #: |u| below which the bank-norm floor's gradient takes the direction (1, 0)
 _NORM_FLOOR = 1e-3
 
@@ -118,9 +120,13 @@ class EntryProblem(ConvexifiableProblem):
         self.x0 = mission.entry_state(planet)
         self.site_lon, self.site_lat = mission.site(planet)
         limits = vehicle.limits
-        if not (math.isfinite(limits.heat_flux_max) and math.isfinite(limits.total_load_max)):
-            raise ScenarioError(f"vehicle '{vehicle.name}' needs finite heat_flux_max_kW_m2 and total_load_max_g "
-                                f"for the SCvx planner")
+        #: the load the plan bounds: the total (paper 001 eq. 10) where the vehicle limits it, else
+        #: the normal load (L cos(alpha) + D sin(alpha)) / g0 (paper 000 eq. 35)
+        self.load_kind = "total" if math.isfinite(limits.total_load_max) else "normal"
+        self.load_max = limits.total_load_max if self.load_kind == "total" else limits.normal_load_max
+        if not (math.isfinite(limits.heat_flux_max) and math.isfinite(self.load_max)):
+            raise ScenarioError(f"vehicle '{vehicle.name}' needs a finite heat_flux_max_kW_m2 and a finite "
+                                f"total_load_max_g or normal_load_max_g for the SCvx planner")
         # layout of the states and controls per node
         state_scale, control_scale = list(POSITION_SCALE), []
         self.i_sigma = self.i_alpha = None
@@ -147,7 +153,7 @@ class EntryProblem(ConvexifiableProblem):
         objective = settings.objective
         self.n_aux = n if objective == "control_effort" else (0 if objective in ("heat_load", "time") else 1)
         self.aux_scale = {"control_effort": 1.0, "max_control_rate": 0.01, "max_flight_path_rate": GAMMA_RATE_SCALE,
-                          "max_heat_flux": limits.heat_flux_max, "max_load": limits.total_load_max,
+                          "max_heat_flux": limits.heat_flux_max, "max_load": self.load_max,
                           "miss": MISS_SCALE}.get(objective, 1.0)
         self._x = slice(0, n * nx)
         self._u = slice(n * nx, n * (nx + nu))
@@ -177,7 +183,7 @@ class EntryProblem(ConvexifiableProblem):
         t_nodes = self.mesh.s[1:] * final_time_guess
         ramp_s = settings.path_margin_ramp_s
         margin = settings.path_margin * (np.minimum(1.0, t_nodes / ramp_s) if ramp_s > 0 else np.ones_like(t_nodes))
-        self.node_limits = ((1.0 - margin) * limits.heat_flux_max, (1.0 - margin) * limits.total_load_max)
+        self.node_limits = ((1.0 - margin) * limits.heat_flux_max, (1.0 - margin) * self.load_max)
 
     # ----- layout -------------------------------------------------------------------------
     def _set_bounds(self, tf_guess):
@@ -259,7 +265,7 @@ class EntryProblem(ConvexifiableProblem):
         return c, s, alpha
 
     def node_outputs(self, x, u, atmosphere: Atmosphere | None = None):
-        """[xdot (n_x), heat flux W/m^2, total load g, speed of sound m/s, geodetic altitude m]
+        """[xdot (n_x), heat flux W/m^2, load g (total or normal: ``load_kind``), speed of sound m/s, geodetic altitude m]
         at state x and control u (eqs. 1-10, 34-41, 54-57). Any scalar type; ``atmosphere``
         replaces the problem's (the tape's trace)."""
         position = x[:6]
@@ -270,7 +276,8 @@ class EntryProblem(ConvexifiableProblem):
         for control, _state in self.rate_controls:
             xdot.append(u[control])
         q = self.vehicle.heat_flux(rho, x[3])
-        n = total_load_factor(L, D, self.planet.g0)
+        n = (total_load_factor(L, D, self.planet.g0) if self.load_kind == "total"
+             else (L * np.cos(alpha) + D * np.sin(alpha)) / self.planet.g0)  # positive in flight: no abs
         return [*xdot, q, n, a, self.planet.atmospheric_altitude(x[0], x[2])]
 
     @functools.cached_property
@@ -349,7 +356,8 @@ class EntryProblem(ConvexifiableProblem):
         h_lo, h_hi = m.drs_altitude_window(self.formulation.bank)
         events = np.array([(h_lo - hstar[-1]) / 1e3, (hstar[-1] - h_hi) / 1e3,
                            (xf[3] - m.final_mach_max * a[-1]) / 100.0,
-                           (m.final_vertical_speed_min_m_s - xf[3] * math.sin(xf[4])) / 100.0])
+                           (m.final_vertical_speed_min_m_s - xf[3] * math.sin(xf[4])) / 100.0,
+                           (m.final_mach_min * a[-1] - xf[3]) / 100.0])
         floor = (1.0 - self.settings.max_lossless_gap) - np.hypot(U[:, 0], U[:, 1]) if self.n_bank_floor else np.zeros(0)
         w = mesh.weights
         if objective == "heat_load":
@@ -452,12 +460,14 @@ class EntryProblem(ConvexifiableProblem):
         e0 += self.n_epigraph
         xf, jf = X[-1], jac[-1]
         fcols = var_cols[-1]
-        r_idx += [np.full(nv, e0), np.full(nv, e0 + 1), np.full(nv, e0 + 2), np.full(2, e0 + 3)]
-        c_idx += [fcols, fcols, fcols, self._col_x(n - 1, np.array([3, 4]))]
+        r_idx += [np.full(nv, e0), np.full(nv, e0 + 1), np.full(nv, e0 + 2), np.full(2, e0 + 3), np.full(nv, e0 + 4)]
+        c_idx += [fcols, fcols, fcols, self._col_x(n - 1, np.array([3, 4])), fcols]
         d_mach = -mi.final_mach_max * jf[self.out_a, :]
         d_mach[3] += 1.0
+        d_mach_min = mi.final_mach_min * jf[self.out_a, :]
+        d_mach_min[3] -= 1.0
         vals += [-jf[self.out_h, :] / 1e3, jf[self.out_h, :] / 1e3, d_mach / 100.0,
-                 -np.array([math.sin(xf[4]), xf[3] * math.cos(xf[4])]) / 100.0]
+                 -np.array([math.sin(xf[4]), xf[3] * math.cos(xf[4])]) / 100.0, d_mach_min / 100.0]
         if self.n_bank_floor:  # d(1 - gap - |u_k|)/du_k = -u_k / |u_k|
             norm = np.hypot(U[:, 0], U[:, 1])
             direction = np.where(norm[:, None] > _NORM_FLOOR, U[:, :2] / np.maximum(norm, _NORM_FLOOR)[:, None],
@@ -594,7 +604,8 @@ class EntryProblem(ConvexifiableProblem):
             node = (i - self.n_path) % self.n_nodes
             return f"{self.settings.objective} epigraph at {self.node_time(node)}"
         node, c = divmod(i, len(PATH_NAMES))
-        return f"{PATH_NAMES[c]} at {self.node_time(node + 1)}"
+        name = PATH_NAMES[c] if c != 1 else f"{self.load_kind} load"
+        return f"{name} at {self.node_time(node + 1)}"
 
     def describe_convex(self, i: int) -> str:
         if i > 0:

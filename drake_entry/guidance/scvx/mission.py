@@ -48,6 +48,7 @@ class ScvxMission:
         (default): DEFAULT_DRS_ALTITUDE_MARGIN_M of the formulation's bank form
         (``drs_altitude_window``).
       final_mach_max: largest DRS Mach number (eq. 65: subsonic).
+      final_mach_min: smallest DRS Mach number (0 in paper 001; a TAEM box's lower edge).
       final_vertical_speed_min_m_s: lowest V sin(gamma) at the DRS point [m/s] (eq. 66).
       flight_path_bounds_deg: path bounds on gamma [deg] (eq. 70), buffered.
       heading_bounds_deg: hard bounds on the heading [deg] (eq. 70).
@@ -72,6 +73,7 @@ class ScvxMission:
     final_altitude_m: tuple = (10e3, 13e3)
     final_altitude_margin_m: float | None = None
     final_mach_max: float = 1.0
+    final_mach_min: float = 0.0
     final_vertical_speed_min_m_s: float = -140.0
     flight_path_bounds_deg: tuple = (-30.0, 0.5)
     heading_bounds_deg: tuple = (-10.0, 270.0)
@@ -98,6 +100,7 @@ class ScvxMission:
             check(f, getattr(self, f), -360.0, 360.0, "deg")
         check("site_radius_m", self.site_radius_m, 1.0, SITE_RADIUS_MAX_M, "m")
         check("final_mach_max", self.final_mach_max, 0.1, 10.0, "-")
+        check("final_mach_min", self.final_mach_min, 0.0, self.final_mach_max, "- (below final_mach_max)")
         check("final_vertical_speed_min_m_s", self.final_vertical_speed_min_m_s, -2000.0, 0.0, "m/s")
         check("bank_min_deg", self.bank_min_deg, 0.0, 45.0, "deg")
         check("alpha_rate_limit_deg_s", self.alpha_rate_limit_deg_s, 1e-3, 90.0, "deg/s")

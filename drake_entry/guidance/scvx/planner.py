@@ -208,7 +208,7 @@ def _between_nodes(problem: EntryProblem, X, U) -> dict:
     lim = problem.vehicle.limits
     g_lo, g_hi = np.radians(problem.mission.flight_path_bounds_deg)
     return {"heat_flux": float(max(outputs[:, problem.out_q].max() / lim.heat_flux_max - 1.0, 0.0)),
-            "total_load": float(max(outputs[:, problem.out_n].max() / lim.total_load_max - 1.0, 0.0)),
+            "load": float(max(outputs[:, problem.out_n].max() / problem.load_max - 1.0, 0.0)),
             "flight_path_rad": float(max((g_lo - Xd[:, 4]).max(), (Xd[:, 4] - g_hi).max(), 0.0))}
 
 
@@ -398,12 +398,12 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     final = problem.node_outputs(xf, U[-1])
     ev = outcome.evaluation
     tol_q, tol_n, tol_g = BETWEEN_NODE_TOLERANCE
-    checked = (between["heat_flux"] <= tol_q and between["total_load"] <= tol_n
+    checked = (between["heat_flux"] <= tol_q and between["load"] <= tol_n
                and between["flight_path_rad"] <= tol_g)
     message = outcome.message
     if outcome.converged and not checked:
         message += (f"; converged but violated between the nodes (heat flux +{between['heat_flux']:.1%}, "
-                    f"load +{between['total_load']:.1%}, gamma {math.degrees(between['flight_path_rad']):.2f} deg): "
+                    f"{problem.load_kind} load +{between['load']:.1%}, gamma {math.degrees(between['flight_path_rad']):.2f} deg): "
                     f"refine the mesh")
     plan = ScvxPlan(
         success=False, message=message, iterations=outcome.iterations, build_time=build,

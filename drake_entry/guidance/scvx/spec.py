@@ -36,6 +36,8 @@ class Scvx(ReplanningSpec):
     # (None: the formulation's default, 1200 m for the lossless bank, 200 m for a bank state)
     final_altitude_margin_m: Optional[float] = None
     final_mach_max: float = 1.0
+    # the DRS point's lowest Mach (0: paper 001's subsonic DRS has none; a TAEM box's lower edge)
+    final_mach_min: float = 0.0
     final_vertical_speed_min_m_s: float = -140.0
     # path bounds (eq. 70) and the smallest bank magnitude of the lossless bank (eq. 43) [deg]
     flight_path_bounds_deg: list[float] = dc.field(default_factory=lambda: [-30.0, 0.5])

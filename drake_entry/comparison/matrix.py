@@ -58,7 +58,8 @@ def _cell(m: dict) -> str:
     if not m["flown"] or s is None:
         reason = m["reason"] or "not flown yet"
         short = reason.split(": ", 1)[1] if reason.startswith("cannot fly this mission: ") else reason
-        return "not flown: " + short.split(";")[0].split(" (")[0][:90]
+        first = short.split(";")[0].split(" (")[0]
+        return "not flown: " + (first if len(first) <= 90 else first[:90].rsplit(" ", 1)[0] + " ...")
     k, n = s["successful"], s["samples"]
     text = f"**{k}/{n}** (>= {100 * success_lower_bound(k, n):.0f} %)"
     miss = s.get("miss_km")

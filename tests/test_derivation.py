@@ -197,6 +197,10 @@ def test_compare_takes_a_comparison_or_a_mission_alone(tmp_path):
     assert c.name == "c" and c.mission == str(scenario_file) and not c.methods
     with pytest.raises(ScenarioError, match="'nowhere' is neither a packaged comparison .* a packaged scenario"):
         load_comparison_or_mission("nowhere")
+    vehicle = tmp_path / "glider.yaml"
+    vehicle.write_text("name: glider\nmass_kg: 1000.0\n")
+    with pytest.raises(ScenarioError, match="neither a comparison file .* it looks like a vehicle file"):
+        load_comparison_or_mission(str(vehicle))
     assert isinstance(mission_comparison("capsule_lu2008"), Comparison)
 
 

@@ -207,8 +207,13 @@ def load_comparison_or_mission(name_or_path: str) -> Comparison:
                 data = parse(f.read(), name_or_path)
         except (OSError, UnicodeDecodeError):
             data = None
-        if isinstance(data, dict) and "mission" not in data and ("entry" in data or "based_on" in data):
-            return mission_comparison(name_or_path)
+        if isinstance(data, dict) and "mission" not in data:
+            if "entry" in data or "based_on" in data:
+                return mission_comparison(name_or_path)
+            raise ScenarioError(f"{name_or_path} is neither a comparison file (it has no 'mission' field) nor a "
+                                f"scenario file (no 'entry' or 'based_on' field)"
+                                + ("; it looks like a vehicle file: name it in a scenario's 'vehicle' field"
+                                   if "mass_kg" in data or "aero" in data else ""))
     try:
         return load_comparison(name_or_path)
     except ScenarioError as e:

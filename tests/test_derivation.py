@@ -229,3 +229,32 @@ def test_the_matrix_reads_comparison_directories(tmp_path):
     assert "commit abc" in open(path).read()
     with pytest.raises(CampaignError, match="holds no comparison report"):
         matrix_markdown([str(tmp_path)])
+
+
+def test_a_resumed_comparison_reuses_the_derived_scenario(tmp_path, monkeypatch):
+    """Derivation is deterministic, so a comparison run again into its directory flies the
+    scenario the first run derived (its file and record) without searching again."""
+    from pydrake.common.yaml import yaml_dump_typed
+
+    import drake_entry.comparison.derive as derive_module
+    from drake_entry.comparison.runner import _derived_scenario
+    from drake_entry.comparison.spec import ComparedMethod
+    from drake_entry.guidance.fnpeg.spec import Fnpeg
+
+    comp = mission_comparison("horus2b")
+    mission = load_scenario("horus2b")
+    entry = ComparedMethod(label="fnpeg", method="Fnpeg")
+    flown = dc.replace(mission, guidance=Fnpeg(terminal_altitude_km=26.0, terminal_velocity_m_s=750.0,
+                                               bank_end_deg=30.0))
+    path = tmp_path / "fnpeg.yaml"
+    path.write_text(yaml_dump_typed(flown))
+    record = {"choices": [], "chosen": {"guidance.bank_end_deg": 30.0}, "trials": []}
+
+    def refuse(*a, **k):
+        raise AssertionError("searched again")
+
+    monkeypatch.setattr(derive_module, "derive_settings", refuse)
+    scenario, again = _derived_scenario(comp, entry, mission, str(path), {"derivation": record}, progress=False)
+    assert again == record and scenario.guidance.bank_end_deg == 30.0 and scenario.name == "horus2b-fnpeg"
+    with pytest.raises(AssertionError, match="searched again"):  # no record: it derives
+        _derived_scenario(comp, entry, mission, str(path), None, progress=False)

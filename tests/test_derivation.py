@@ -21,10 +21,9 @@ from drake_entry.guidance.derivation import (
     alpha_rewritten,
     derivation_for,
     interface_altitudes,
-    own_guidance,
     terminal_interface,
 )
-from drake_entry.scenario import PACKAGED_SCENARIOS, load_scenario
+from drake_entry.scenario import PACKAGED_SCENARIOS, load_scenario, stated_guidance
 
 
 @pytest.mark.parametrize("mission", PACKAGED_SCENARIOS)
@@ -44,7 +43,7 @@ def test_every_method_derives_settings_that_fit_the_mission_or_says_why_not(miss
         assert type(d.spec) is spec
         flown = apply_derivation(scenario, d)
         assert type(flown.guidance) is spec and flown.vehicle == scenario.vehicle and flown.entry == scenario.entry
-        if type(own_guidance(scenario)) is spec:
+        if type(stated_guidance(scenario)) is spec:
             assert d.spec == scenario.guidance and not d.search
         for step in d.search:
             assert step.candidates and all(isinstance(c, dict) and c for c in step.candidates), step.name
@@ -60,9 +59,9 @@ def test_a_mission_without_a_guidance_block_states_no_method():
     from drake_entry.scenario import closed_loop_scenarios
 
     for name in PACKAGED_SCENARIOS:
-        assert (own_guidance(load_scenario(name)) is not None) == (name in closed_loop_scenarios()), name
+        assert (stated_guidance(load_scenario(name)) is not None) == (name in closed_loop_scenarios()), name
     cav_h = load_scenario("cav_h")  # open loop: no guidance block
-    assert own_guidance(cav_h) is None and derivation_for(cav_h, DragEnergy).search
+    assert stated_guidance(cav_h) is None and derivation_for(cav_h, DragEnergy).search
 
 
 def test_derivation_is_deterministic():

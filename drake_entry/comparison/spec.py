@@ -20,7 +20,7 @@ from typing import Optional
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance import REGISTRY, GuidanceSpec, known_tags
-from drake_entry.scenario import Scenario, apply_overrides, load_scenario
+from drake_entry.scenario import Scenario, apply_overrides, load_scenario, stated_guidance
 from drake_entry.typed_yaml import load_packaged_or_file, packaged_names
 
 __all__ = ["METHOD_FIELDS", "LABEL", "ComparedMethod", "Comparison", "PACKAGED_COMPARISONS", "load_comparison",
@@ -144,13 +144,11 @@ def load_comparison(name_or_path) -> Comparison:
 def needs_derivation(comparison: Comparison, entry: ComparedMethod, mission: Scenario | None = None) -> bool:
     """Whether ``entry``'s settings are derived from the mission: it is flown, gives no guidance
     block, and the mission states no block of its method (``mission``: the loaded mission, else
-    loaded; guidance.derivation.own_guidance)."""
-    from drake_entry.guidance.derivation import own_guidance
-
+    loaded; drake_entry.scenario.stated_guidance)."""
     if entry.not_flown or entry.guidance is not None:
         return False
     mission = mission if mission is not None else load_scenario(comparison.mission)
-    return type(own_guidance(mission)).__name__ != entry.method
+    return type(stated_guidance(mission)).__name__ != entry.method
 
 
 def method_scenario(comparison: Comparison, entry: ComparedMethod,

@@ -21,8 +21,9 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.spec import ReversingBankSpec
+from drake_entry.scenario import stated_guidance
 
-__all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "own_guidance", "derivation_for",
+__all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
            "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN"]
 
@@ -76,19 +77,14 @@ class CannotFly(ScenarioError):
 @dc.dataclass(frozen=True)
 class Interface:
     """The mission's terminal interface, the centre of its acceptance box: geodetic altitude
-    [km], speed [m/s] and its Mach number there (None when the mission gives a speed)."""
+    [km], speed [m/s], its Mach number there, the speed of sound there [m/s], and whether the
+    mission gives the Mach number (else the speed)."""
 
     altitude_km: float
     speed_m_s: float
-    mach: float | None
-
-
-def own_guidance(scenario):
-    """The guidance block the mission states, or None (drake_entry.scenario.stated_guidance: a
-    mission file without one flies the first registered method's defaults, which state nothing)."""
-    from drake_entry.scenario import stated_guidance
-
-    return stated_guidance(scenario)
+    mach: float
+    speed_of_sound: float
+    mach_given: bool
 
 
 def derivation_for(scenario, spec_type) -> Derivation:
@@ -107,7 +103,7 @@ def derivation_for(scenario, spec_type) -> Derivation:
             raise
         raise CannotFly(f"!{spec_type.__name__} derives no settings from a mission (guidance/{folder}/derive.py "
                         f"is not written): give its guidance block in the comparison") from None
-    own = own_guidance(scenario)
+    own = stated_guidance(scenario)  # a mission file's guidance block, None when it states none
     if type(own) is spec_type:  # the mission's own method flies the mission's settings
         return Derivation(dc.replace(own), [Choice("guidance", f"!{spec_type.__name__}", "the mission's own settings")])
     derivation = module.derive(scenario)
@@ -122,17 +118,17 @@ def terminal_interface(scenario) -> Interface:
     t = scenario.terminal
     if t.altitude_km is None:
         raise CannotFly("the mission's terminal block gives no altitude_km: no terminal interface to aim at")
-    h = t.altitude_km * 1e3
+    a = float(scenario.make_atmosphere().speed_of_sound(t.altitude_km * 1e3))
     if t.mach is not None:
-        return Interface(t.altitude_km, float(t.mach * scenario.make_atmosphere().speed_of_sound(h)), float(t.mach))
+        return Interface(t.altitude_km, float(t.mach) * a, float(t.mach), a, True)
     if t.velocity_m_s is not None:
-        return Interface(t.altitude_km, float(t.velocity_m_s), None)
+        return Interface(t.altitude_km, float(t.velocity_m_s), float(t.velocity_m_s) / a, a, False)
     raise CannotFly("the mission's terminal block gives neither mach nor velocity_m_s: no terminal speed to aim at")
 
 
 def _altitude_at_energy(E: float, E0: float, h0: float, Ef: float, hf: float) -> float:
     """The altitude [m] at specific energy E [J/kg], linear in energy between the entry (E0, h0)
-    and the terminal interface (Ef, hf) (``alpha_in_speed``'s approximation)."""
+    and the terminal interface (Ef, hf) (``alpha_rewritten``'s approximation)."""
     return hf + (h0 - hf) * (E - Ef) / (E0 - Ef)
 
 
@@ -140,7 +136,7 @@ def mission_alpha(scenario):
     """The mission's alpha schedule (a ScheduleSpec) and whose it is: the mission's own method's
     profile when it flies a fixed one of its own (``alpha_profile``), else the scenario's
     ``alpha`` block."""
-    stated = own_guidance(scenario)
+    stated = stated_guidance(scenario)
     own = stated.alpha_profile() if stated is not None else None
     if own is None:
         return scenario.alpha, "the mission's"
@@ -226,7 +222,7 @@ def reversal_corridor(scenario) -> tuple[list[float], list[float], Choice]:
     """The bank-reversal corridor (half-widths [deg] at speeds [m/s]) and its Choice: the
     mission's own method's when it reverses the bank, else the shared default (paper 000
     Sec. VI.D)."""
-    own = own_guidance(scenario)
+    own = stated_guidance(scenario)
     if isinstance(own, ReversingBankSpec):
         heading, velocity = list(own.reversal_heading_deg), list(own.reversal_velocity_m_s)
         how = f"the corridor of the mission's own method (!{type(own).__name__})"

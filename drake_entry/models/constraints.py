@@ -14,7 +14,7 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["FT", "SLUG", "BTU_FT2_S", "HeatFlux", "make_heat_flux", "dynamic_pressure", "normal_load_factor",
+__all__ = ["FT", "SLUG", "BTU_FT2_S", "HeatFlux", "make_heat_flux", "dynamic_pressure", "signed_normal_load_factor", "normal_load_factor",
            "total_load_factor", "equilibrium_glide_lift", "PathLimits"]
 
 # US customary units (exact SI conversions) for forms published in them
@@ -161,9 +161,15 @@ def dynamic_pressure(rho, V):
     return 0.5 * rho * V * V
 
 
+def signed_normal_load_factor(lift_acc, drag_acc, alpha, g0: float):
+    """(L cos(alpha) + D sin(alpha)) / g0 (paper 000 eq. 35 before its absolute value), L, D in
+    m/s^2: positive in flight, and smooth where a planner differentiates it."""
+    return (lift_acc * np.cos(alpha) + drag_acc * np.sin(alpha)) / g0
+
+
 def normal_load_factor(lift_acc, drag_acc, alpha, g0: float):
     """n_z = |L cos(alpha) + D sin(alpha)| / g0 (paper 000 eq. 35), L, D in m/s^2."""
-    return abs(lift_acc * np.cos(alpha) + drag_acc * np.sin(alpha)) / g0
+    return abs(signed_normal_load_factor(lift_acc, drag_acc, alpha, g0))
 
 
 def total_load_factor(lift_acc, drag_acc, g0: float):

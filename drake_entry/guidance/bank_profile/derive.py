@@ -23,8 +23,7 @@ def derive(scenario) -> Derivation:
     """BankProfile settings for ``scenario``'s mission stating no
     block of this method (derivation_for returns a stated one as it is)."""
     interface = terminal_interface(scenario)
-    mach = interface.mach if interface.mach is not None else interface.speed_m_s / float(
-        scenario.make_atmosphere().speed_of_sound(interface.altitude_km * 1e3))
+    mach = interface.mach
     heading, velocity, corridor = reversal_corridor(scenario)
     spec = BankProfile(terminal_altitude_km=interface.altitude_km, terminal_mach=round(mach, 4),
                        bank_start_deg=BANK_CANDIDATES_DEG[0], bank_end_deg=BANK_CANDIDATES_DEG[0],  # searched

@@ -29,8 +29,7 @@ def derive(scenario) -> Derivation:
     """DragEnergy settings for ``scenario``'s mission stating no
     block of this method (derivation_for returns a stated one as it is)."""
     interface = terminal_interface(scenario)
-    a = float(scenario.make_atmosphere().speed_of_sound(interface.altitude_km * 1e3))
-    mach = interface.mach if interface.mach is not None else interface.speed_m_s / a
+    mach = interface.mach
     heading, velocity, corridor = reversal_corridor(scenario)
     breakpoints, values, alpha_how = alpha_rewritten(scenario, interface, "normalized_energy")
     own = scenario.alpha
@@ -42,7 +41,7 @@ def derive(scenario) -> Derivation:
                       bandwidth_rad_s=0.1, reversal_heading_deg=heading, reversal_velocity_m_s=velocity)
     choices = [
         Choice("guidance.terminal_mach", round(mach, 4), "the centre of the mission's acceptance box"
-               + ("" if interface.mach is not None else f" ({interface.speed_m_s:g} m/s as a Mach number)")),
+               + ("" if interface.mach_given else f" ({interface.speed_m_s:g} m/s as a Mach number)")),
         Choice("alpha", "as the mission's" if alpha is None else
                ", ".join(f"{v:g} deg at e = {b:.3f}" for b, v in zip(breakpoints, values)),
                alpha_how if alpha is not None else "the planner flies alpha(E): the mission's schedule is in energy"),

@@ -5,9 +5,9 @@ margin), the alpha law the mission's alpha rewritten in speed, the heading bound
 either side of the entry heading; the plan bounds the vehicle's heat flux and whichever load it
 limits, and is re-planned on board as paper 001's own scenario is. A mission whose box gives no
 altitude window or no distance cannot be posed: CannotFly."""
-import math
 
 from drake_entry.guidance.derivation import CannotFly, Choice, Derivation, alpha_rewritten, terminal_interface
+from drake_entry.guidance.scvx.mission import planned_load
 from drake_entry.guidance.scvx.spec import Scvx
 
 __all__ = ["derive", "SITE_RADIUS_FRACTION", "STOP_ABOVE_WINDOW_KM", "REPLAN_PERIOD_S", "OBJECTIVE", "FORMULATION"]
@@ -39,7 +39,7 @@ def derive(scenario) -> Derivation:
     if not t.distance_tolerance_km:
         raise CannotFly("the mission's box gives no distance tolerance: SCvx plans into a cone about the site "
                         "(paper 001 eqs. 67-68)")
-    a = float(scenario.make_atmosphere().speed_of_sound(interface.altitude_km * 1e3))
+    a = interface.speed_of_sound
     if t.mach is not None and t.mach_tolerance:
         mach_lo, mach_hi, mach_how = t.mach - t.mach_tolerance, t.mach + t.mach_tolerance, "the box's Mach window"
     elif t.velocity_m_s is not None and t.velocity_tolerance_m_s:
@@ -49,7 +49,7 @@ def derive(scenario) -> Derivation:
     else:
         mach_lo, mach_hi, mach_how = 0.0, 10.0, "the box checks no speed: the Mach window is open"
     mach_lo = max(mach_lo, 0.0)
-    mach = interface.speed_m_s / a
+    mach = interface.mach
     h = interface.altitude_km
     window = [round((h - t.altitude_tolerance_km) * 1e3, 3), round((h + t.altitude_tolerance_km) * 1e3, 3)]
     if window[0] < 0.0:
@@ -69,8 +69,7 @@ def derive(scenario) -> Derivation:
                 flight_path_bounds_deg=[-30.0, 5.0], objective=OBJECTIVE, formulation=FORMULATION,
                 alpha_deg=alpha_deg, alpha_speeds_m_s=alpha_speeds, alpha_bounds_deg=bounds,
                 replan_period_s=REPLAN_PERIOD_S)
-    limits = scenario.make_vehicle().limits
-    load = "total" if math.isfinite(limits.total_load_max) else "normal"
+    load, _ = planned_load(scenario.make_vehicle().limits)
     choices = [
         Choice("guidance.final_altitude_m", f"{window[0] / 1e3:g}-{window[1] / 1e3:g} km", "the box's altitude window"),
         Choice("guidance.terminal_altitude_km", spec.terminal_altitude_km,

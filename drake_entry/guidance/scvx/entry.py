@@ -61,14 +61,14 @@ from pydrake.symbolic import Expression, Variable, uninterpreted_function
 
 from drake_entry.errors import ScenarioError, UnsupportedScalarError
 from drake_entry.guidance.scvx.engine import ConvexifiableProblem, Evaluation, Linearisation
-from drake_entry.guidance.scvx.mission import ScvxMission
+from drake_entry.guidance.scvx.mission import ScvxMission, planned_load
 from drake_entry.guidance.scvx.settings import (
     FORMULATIONS,
     RATE_OBJECTIVES,
     EntryProblemSettings,
 )
 from drake_entry.models.atmosphere import Atmosphere
-from drake_entry.models.constraints import total_load_factor
+from drake_entry.models.constraints import signed_normal_load_factor, total_load_factor
 from drake_entry.models.dynamics import STATE_NAMES, aero_accelerations, air_data, equations_of_motion_lift_components
 from drake_entry.models.expression_tape import ExpressionTape, TracedAtmosphere
 from drake_entry.models.planet import Earth
@@ -120,10 +120,7 @@ class EntryProblem(ConvexifiableProblem):
         self.x0 = mission.entry_state(planet)
         self.site_lon, self.site_lat = mission.site(planet)
         limits = vehicle.limits
-        #: the load the plan bounds: the total (paper 001 eq. 10) where the vehicle limits it, else
-        #: the normal load (L cos(alpha) + D sin(alpha)) / g0 (paper 000 eq. 35)
-        self.load_kind = "total" if math.isfinite(limits.total_load_max) else "normal"
-        self.load_max = limits.total_load_max if self.load_kind == "total" else limits.normal_load_max
+        self.load_kind, self.load_max = planned_load(limits)  # the total load, else the normal
         if not (math.isfinite(limits.heat_flux_max) and math.isfinite(self.load_max)):
             raise ScenarioError(f"vehicle '{vehicle.name}' needs a finite heat_flux_max_kW_m2 and a finite "
                                 f"total_load_max_g or normal_load_max_g for the SCvx planner")
@@ -277,7 +274,7 @@ class EntryProblem(ConvexifiableProblem):
             xdot.append(u[control])
         q = self.vehicle.heat_flux(rho, x[3])
         n = (total_load_factor(L, D, self.planet.g0) if self.load_kind == "total"
-             else (L * np.cos(alpha) + D * np.sin(alpha)) / self.planet.g0)  # positive in flight: no abs
+             else signed_normal_load_factor(L, D, alpha, self.planet.g0))
         return [*xdot, q, n, a, self.planet.atmospheric_altitude(x[0], x[2])]
 
     @functools.cached_property

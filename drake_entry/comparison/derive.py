@@ -107,41 +107,37 @@ def apply_derivation(mission, derivation: Derivation, values: dict | None = None
     return scenario
 
 
-def _box_ratio(box: dict) -> float:
-    """The largest |error| / tolerance of an acceptance box ({criterion: {error, tolerance}})."""
-    ratios = [abs(b["error"]) / b["tolerance"] for b in box.values() if b["tolerance"] > 0]
-    return max(ratios) if ratios and all(math.isfinite(r) for r in ratios) else math.inf
+def _flight(sample: str, row: dict, tolerances: dict) -> Flight:
+    """One search flight from its campaign row (drake_entry.campaign.sample.campaign_row): its
+    box ratio, the largest |error| / tolerance over the box's criteria (``tolerances``: each
+    criterion's tolerance), plus LIMIT_PENALTY when it breached a limit and SHORT_PENALTY when it
+    stopped short of its interface."""
+    ratios = [abs(row.get(f"box_{k}_error", math.nan)) / t for k, t in tolerances.items() if t > 0]
+    ratio = max(ratios) if ratios and all(math.isfinite(r) for r in ratios) else math.inf
+    ratio += (0.0 if row.get("within_limits", False) else LIMIT_PENALTY) + (
+        0.0 if row.get("reached_terminal", False) else SHORT_PENALTY)
+    success, message = bool(row.get("success", False)), str(row.get("message") or "")
+    return Flight(sample, success, ratio, "" if success or not message else message.splitlines()[0][:200])
 
 
 def _fly_candidate(scenario, draws: int) -> tuple[list[Flight], str]:
     """The nominal flight and ``draws`` dispersed samples of ``scenario``; ('', flights) or the
     pre-flight failure."""
-    from drake_entry.campaign.sample import run_sample
+    from drake_entry.campaign.sample import campaign_row, run_sample
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
 
     try:
         setup = ClosedLoopSetup.from_scenario(scenario)
     except DrakeEntryError as e:
         return [], f"pre-flight planning failed: {str(e).splitlines()[0][:300]}"
-    flights = []
+    tolerances = {k: b["tolerance"] for k, b in
+                  acceptance_box(scenario.terminal, altitude_m=math.nan, mach=math.nan, distance_m=math.nan).items()}
     try:
-        res = fly(setup)
-        ratio = _box_ratio(res.box) + (0.0 if res.verdict.within_limits else LIMIT_PENALTY)
-        flights.append(Flight("nominal", bool(res.success), ratio if res.reached else ratio + SHORT_PENALTY,
-                              "" if res.success else res.message.splitlines()[0][:200]))
+        flights = [_flight("nominal", campaign_row(fly(setup), setup), tolerances)]
     except (DrakeEntryError, RuntimeError) as e:
-        flights.append(Flight("nominal", False, math.inf, str(e).splitlines()[0][:200]))
-    tolerances = acceptance_box(scenario.terminal, altitude_m=math.nan, mach=math.nan, distance_m=math.nan)
-    for i in range(draws):
-        row, _ = run_sample(setup, SEARCH_SEED, i, trajectory_step_s=0)
-        box = {k: {"error": row.get(f"box_{k}_error", math.nan), "tolerance": b["tolerance"]}
-               for k, b in tolerances.items()}
-        ratio = _box_ratio(box) + (0.0 if row.get("within_limits", False) else LIMIT_PENALTY)
-        if not row.get("reached_terminal", False):
-            ratio += SHORT_PENALTY
-        flights.append(Flight(str(i), bool(row.get("success", False)), ratio,
-                              "" if row.get("success") else str(row.get("message", ""))[:200]))
-    return flights, ""
+        flights = [Flight("nominal", False, math.inf, str(e).splitlines()[0][:200])]
+    return flights + [_flight(str(i), run_sample(setup, SEARCH_SEED, i, trajectory_step_s=0)[0], tolerances)
+                      for i in range(draws)], ""
 
 
 def derive_settings(mission, derivation: Derivation, *, draws: int = SEARCH_DRAWS, progress=None) -> DerivedSettings:

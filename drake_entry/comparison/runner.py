@@ -128,13 +128,19 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
     return write_comparison_report(out_dir)
 
 
+def _spec_type(entry):
+    """The registered spec class of ``entry``'s method (its tag, validated by Comparison.validate)."""
+    from drake_entry.guidance import REGISTRY
+
+    return next(spec for spec in REGISTRY if spec.__name__ == entry.method)
+
+
 def _cannot_fly(mission, entry) -> str:
     """Why ``entry``'s method cannot fly the mission, when its derivation says so without flying ('' else)."""
-    from drake_entry.guidance import REGISTRY
     from drake_entry.guidance.derivation import derivation_for
 
     try:
-        derivation_for(mission, next(spec for spec in REGISTRY if spec.__name__ == entry.method))
+        derivation_for(mission, _spec_type(entry))
     except CannotFly as e:
         return f"cannot fly this mission: {e}"
     return ""
@@ -146,13 +152,11 @@ def _derived_scenario(comp: Comparison, entry, mission, path: str, earlier: dict
     derivation is deterministic), else derived and searched now (CannotFly when the method cannot
     fly the mission)."""
     from drake_entry.comparison.derive import derive_settings
-    from drake_entry.guidance import REGISTRY
     from drake_entry.guidance.derivation import derivation_for
 
     if earlier and earlier.get("derivation") and os.path.exists(path):
         return method_scenario(comp, entry, load_scenario(path)), earlier["derivation"]
-    spec_type = next(spec for spec in REGISTRY if spec.__name__ == entry.method)
-    derivation = derivation_for(mission, spec_type)
+    derivation = derivation_for(mission, _spec_type(entry))
     if progress:
         print(f"== {entry.label} (!{entry.method}): settings derived from the mission"
               + (", searched on the nominal flight and dispersed draws" if derivation.search else ""), flush=True)

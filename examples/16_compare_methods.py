@@ -16,6 +16,7 @@ import json
 import os
 
 from drake_entry.claims import Claims, run_example
+from drake_entry.comparison.report import summary_text
 from drake_entry.comparison.runner import run_comparison
 from drake_entry.comparison.spec import load_comparison
 
@@ -29,12 +30,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/16", runs: int = 20) 
     report = run_comparison(comparison, runs=runs, out_dir=out_dir, seed=SEED, only=only)
     with open(os.path.join(out_dir, "comparison_summary.json")) as f:
         summary = json.load(f)
-    print(f"\n{'method':14s} {'successful':>11s} {'miss median [km]':>17s} {'core s/sample':>14s}")
-    for label, s in summary["methods"].items():
-        miss = (s.get("miss_km") or {}).get("median", float("nan"))
-        print(f"{label:14s} {s['successful']:>4d} of {s['samples']:<4d} {miss:17.3g} {s['wall_time_s']['mean']:14.1f}")
-    for label, reason in summary["not_flown"].items():
-        print(f"{label:14s} not flown: {reason}")
+    print("\n" + summary_text(summary))
     print(f"report: {report}")
     return {"summary": summary, "report": report, "quick": quick, "runs": runs}
 

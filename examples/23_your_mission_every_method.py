@@ -23,6 +23,7 @@ import json
 import os
 
 from drake_entry.claims import Claims, run_example
+from drake_entry.comparison.report import summary_text
 from drake_entry.comparison.runner import run_comparison
 from drake_entry.comparison.spec import load_comparison_or_mission
 from drake_entry.guidance import REGISTRY, folder_of
@@ -104,12 +105,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/23", runs: int = 20) 
         summary = json.load(f)
     with open(os.path.join(folder, "comparison.json")) as f:
         manifest = json.load(f)
-    print(f"\n{'method':14s} {'successful':>11s} {'miss median [km]':>17s}")
-    for label, s in summary["methods"].items():
-        miss = (s.get("miss_km") or {}).get("median", float("nan"))
-        print(f"{label:14s} {s['successful']:>4d} of {s['samples']:<4d} {miss:17.3g}")
-    for label, reason in summary["not_flown"].items():
-        print(f"{label:14s} not flown: {reason[:160]}")
+    print("\n" + summary_text(summary))
     fnpeg = manifest["methods"]["fnpeg"].get("derivation", {})
     print("\nFNPEG's settings, derived:", json.dumps(fnpeg.get("chosen", {})))
     return {"summary": summary, "manifest": manifest, "report": report, "runs": runs, "quick": quick,

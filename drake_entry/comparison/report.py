@@ -36,7 +36,7 @@ from drake_entry.errors import CampaignError
 from drake_entry.figures import plt, save_figure
 
 __all__ = ["MANIFEST", "LEVEL", "MARGIN_NAMES", "read_comparison_manifest", "clopper_pearson", "method_summary",
-           "dispersion_check", "write_comparison_report", "footprints", "success_intervals", "miss_distributions"]
+           "summary_text", "dispersion_check", "write_comparison_report", "footprints", "success_intervals", "miss_distributions"]
 
 #: the file a comparison directory is identified by
 MANIFEST = "comparison.json"
@@ -119,6 +119,18 @@ def dispersion_check(all_rows: dict) -> tuple[bool, int, float]:
             if np.isfinite(vals).all():
                 worst = max(worst, float(np.ptp(vals)))
     return worst == 0.0, compared, worst
+
+
+def summary_text(summary: dict) -> str:
+    """A comparison summary (comparison_summary.json) as a console table: each flown method's
+    successes, median miss [km] and core seconds per sample, then each method not flown and why."""
+    lines = [f"{'method':14s} {'successful':>11s} {'miss median [km]':>17s} {'core s/sample':>14s}"]
+    for label, s in summary["methods"].items():
+        miss = (s.get("miss_km") or {}).get("median", float("nan"))
+        wall = (s.get("wall_time_s") or {}).get("mean", float("nan"))
+        lines.append(f"{label:14s} {s['successful']:>4d} of {s['samples']:<4d} {miss:17.3g} {wall:14.1f}")
+    lines += [f"{label:14s} not flown: {reason[:160]}" for label, reason in summary["not_flown"].items()]
+    return "\n".join(lines)
 
 
 def write_comparison_report(out_dir: str) -> str:

@@ -85,9 +85,11 @@ def test_fnpeg_on_horus2b_takes_the_box_centre_the_limits_and_the_alpha_ramp():
     assert (d.spec.heat_rate_limit_kW_m2, d.spec.load_limit_g, d.spec.dynamic_pressure_limit_kPa) == pytest.approx(
         (LIMIT_MARGINS[0] * 530.0, LIMIT_MARGINS[0] * 2.5, LIMIT_MARGINS[0] * 10.0))
     assert d.spec.alpha_deg == [15.0, 40.0] and d.spec.reversal_heading_deg == [5.0, 15.0]
-    assert [s.name for s in d.search] == ["limit margin", "guidance.terminal_altitude_km", "guidance.bank_end_deg"]
-    assert d.search[1].candidates[0] == {"guidance.terminal_altitude_km": 25.0}
-    assert {26.5, 24.0} <= {c["guidance.terminal_altitude_km"] for c in d.search[1].candidates}
+    # sigma_f (which sets the altitude at e_f) is flown over its whole grid, then the margin re-checked at it
+    assert [s.name for s in d.search] == ["limit margin", "guidance.bank_end_deg", "limit margin at that sigma_f"]
+    assert [s.exhaustive for s in d.search] == [False, True, False] and d.search[2].candidates == d.search[0].candidates
+    sigma_f = [c["guidance.bank_end_deg"] for c in d.search[1].candidates]
+    assert sigma_f[0] == d.spec.bank_end_deg == 45.0 and sorted(sigma_f) == [20.0 + 5.0 * i for i in range(11)]
     assert interface_altitudes(scenario, terminal_interface(scenario)) == (25.0, 25.5, 26.0, 26.5, 24.5, 24.0)
 
 
@@ -154,6 +156,25 @@ def test_a_trial_is_kept_by_its_successes_then_its_box_ratio():
     assert min([failing, ok], key=Trial.score) is ok
     assert better.good_enough() and not ok.good_enough() and GOOD_ENOUGH == 0.75
     assert not Trial("s", {}, [], 0.0, "pre-flight planning failed").good_enough()
+
+
+def test_an_exhaustive_step_flies_every_candidate_and_keeps_the_best(monkeypatch):
+    """A graded setting is not cut short by a first good-enough candidate: of the ratios 0.7, 0.2,
+    0.5 (all successes) the plain step keeps the first, the exhaustive one flies all three and
+    keeps 0.2."""
+    import drake_entry.comparison.derive as derive
+    from drake_entry.guidance.fnpeg.spec import Fnpeg
+
+    ratio = {45.0: 0.7, 50.0: 0.2, 40.0: 0.5}
+    monkeypatch.setattr(derive, "_fly_candidate", lambda scenario, draws: (
+        [Flight("nominal", True, ratio[scenario.guidance.bank_end_deg])], ""))
+    mission = load_scenario("horus2b")
+    spec = Fnpeg(terminal_altitude_km=25.0, terminal_velocity_m_s=750.0, bank_end_deg=45.0)
+    for exhaustive, flown, kept in ((False, [45.0], 45.0), (True, [45.0, 50.0, 40.0], 50.0)):
+        step = SearchStep.over("guidance.bank_end_deg", (45.0, 50.0, 40.0), "test", exhaustive=exhaustive)
+        chosen = derive_settings(mission, Derivation(spec, [], [step]))
+        assert [t.values["guidance.bank_end_deg"] for t in chosen.trials] == flown
+        assert chosen.chosen == {"guidance.bank_end_deg": kept}
 
 
 def test_the_search_flies_its_candidates_and_keeps_the_best():

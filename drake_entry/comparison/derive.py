@@ -6,7 +6,8 @@ The search runs its steps one after the other. In a step, each candidate (in the
 order) is flown by the Drake closed loop: the nominal entry and ``draws`` dispersed samples of
 the mission's own dispersions, drawn with SEARCH_SEED (never a campaign's seed: the campaign is
 not tuned on its own samples). The first candidate whose every flight succeeds within
-GOOD_ENOUGH of every box tolerance is kept; when none does, the best: most successes, then the
+GOOD_ENOUGH of every box tolerance is kept; when none does (or the step is exhaustive: every
+candidate flown), the best: most successes, then the
 smallest mean box ratio (a flight's largest |error| / tolerance; one that breaches a limit or
 stops short counts LIMIT_PENALTY or SHORT_PENALTY more). The same mission gives the same
 settings.
@@ -161,7 +162,7 @@ def derive_settings(mission, derivation: Derivation, *, draws: int = SEARCH_DRAW
                 shown = ", ".join(f"{k.split('.')[-1]} {v:g}" for k, v in values.items())
                 progress(f"{step.name}: {shown}: {trial.successes}/{len(flights)} successful, mean box ratio "
                          f"{trial.mean_ratio:.2f} ({trial.wall_s:.1f} s){' ' + failure if failure else ''}")
-            if trial.good_enough():
+            if trial.good_enough() and not step.exhaustive:
                 break
         trials += step_trials
         flown = [t for t in step_trials if t.flights]

@@ -45,15 +45,18 @@ class Choice:
 class SearchStep:
     """One free setting: ``name`` (what is searched), ``candidates`` tried in order, each the
     dotted fields it sets ({'guidance.bank_end_deg': 45.0}; the first is the derivation's own
-    value), and why it is free. ``over`` builds the step of one field."""
+    value), and why it is free. ``exhaustive``: every candidate is flown and the best kept (a
+    setting whose effect is graded, such as one that moves the terminal altitude), instead of
+    the first good enough. ``over`` builds the step of one field."""
 
     name: str
     candidates: tuple
     why: str
+    exhaustive: bool = False
 
     @classmethod
-    def over(cls, field: str, values, why: str) -> "SearchStep":
-        return cls(field, tuple({field: v} for v in values), why)
+    def over(cls, field: str, values, why: str, *, exhaustive: bool = False) -> "SearchStep":
+        return cls(field, tuple({field: v} for v in values), why, exhaustive)
 
 
 @dc.dataclass

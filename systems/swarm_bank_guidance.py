@@ -74,7 +74,7 @@ class SwarmBankGuidance(ReplanScheduler):
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self.bank_port = self.DeclareVectorInputPort("bank_command", 1)
-        alpha0 = problem.alpha_max if problem.initial_alpha is None else problem.initial_alpha
+        alpha0 = problem.entry_alpha
         self._state = self.DeclareDiscreteState(BasicVector([alpha0, 0.0, 0.0, sigma0, 1.0, 1.0]))
         self.DeclareReplanSchedule(replan_period_s=replan_period,
                                    first_due_s=replan_period if replan_period > 0 else math.inf,

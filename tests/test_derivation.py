@@ -278,3 +278,37 @@ def test_a_resumed_comparison_reuses_the_derived_scenario(tmp_path, monkeypatch)
     assert again == record and scenario.guidance.bank_end_deg == 30.0 and scenario.name == "horus2b-fnpeg"
     with pytest.raises(AssertionError, match="searched again"):  # no record: it derives
         _derived_scenario(comp, entry, mission, str(path), None, progress=False)
+
+
+def test_swarm_bank_on_horus2b_flies_the_mission_alpha_and_weighs_the_box():
+    """Paper 004's law on another mission: the mission's alpha ramp rewritten in speed (the load
+    law as the second candidate), sigma_f searched with sigma_0 before flight, eq. 32's units at
+    the box tolerances (2 km, 2 km), limits kept at 0.97 in the search."""
+    from drake_entry.guidance.swarm_bank.derive import BANK_END_BOUNDS_DEG, LIMIT_FRACTION
+    from drake_entry.guidance.swarm_bank.spec import SwarmBank
+
+    scenario = load_scenario("horus2b")
+    d = derivation_for(scenario, SwarmBank)
+    speeds, alphas, _ = alpha_rewritten(scenario, terminal_interface(scenario), "velocity")
+    g = d.spec
+    assert g.alpha_law == "schedule" and g.alpha_deg == alphas == [15.0, 40.0]
+    assert g.alpha_velocity_m_s == pytest.approx(speeds, abs=1e-3) and (g.alpha_min_deg, g.alpha_max_deg) == (15.0, 40.0)
+    assert g.bank_end_bounds_deg == list(BANK_END_BOUNDS_DEG) and g.optimizer == "differential_evolution"
+    assert (g.objective_range_unit_km, g.objective_altitude_unit_km) == (2.0, 2.0) and g.limit_fraction == LIMIT_FRACTION
+    assert [s.name for s in d.search] == ["guidance.alpha_law", "guidance.terminal_altitude_km"]
+    assert d.search[0].candidates == ({"guidance.alpha_law": "schedule"}, {"guidance.alpha_law": "load"})
+    g.validate(dc.replace(scenario, guidance=g))
+
+
+def test_the_schedule_law_s_search_pays_for_each_limit_it_breaches():
+    """limit_excess: the relative excess of each peak over its limit (times the fraction),
+    summed; a limit the vehicle does not have costs nothing."""
+    import math
+
+    from drake_entry.guidance.swarm_bank.evaluator import limit_excess
+
+    limits = load_scenario("horus2b").make_vehicle().limits  # 530 kW/m^2, 10 kPa, normal load 2.5 g
+    assert math.isinf(limits.total_load_max) and limits.normal_load_max == 2.5
+    peaks = np.array([[530e3, 583e3], [9e3, 11e3], [2.0, 3.0]])
+    np.testing.assert_allclose(limit_excess(limits, peaks), [0.0, 0.1 + 0.1 + 0.2], rtol=1e-12)
+    np.testing.assert_allclose(limit_excess(limits, peaks, 0.9)[0], 530 / 477 - 1.0, rtol=1e-12)

@@ -108,12 +108,45 @@ def test_plan_names_violated_path_limits():
     ("bank_start_bounds_deg", [50.0, 40.0], "lower < upper"),
     ("landmark_iteration", 30, "guidance.landmark_iteration = 30 is out of range"),
     ("replan_period_s", 0.5, "replan_period_s = 0.5 is out of range; allowed: 0 "),
+    ("alpha_law", "schedule", "guidance.alpha_deg has 0 values and guidance.alpha_velocity_m_s 0"),
 ])
 def test_bad_spec_fields_are_one_line_errors(field, value, match):
     s = load_scenario("cav_h_paper004")
     setattr(s.guidance, field, value)
     with pytest.raises(ScenarioError, match=match):
         s.validate()
+
+
+@pytest.mark.parametrize("alphas, speeds, match", [
+    ([12.0, 14.0], [7000.0, 2000.0], r"guidance.alpha_velocity_m_s = \[7000.0, 2000.0\] must increase"),
+    ([12.0, 25.0], [2000.0, 7000.0], r"guidance.alpha_deg = 25.0 is out of range; allowed \[10, 20\]"),
+    ([12.0], [2000.0, 7000.0], "guidance.alpha_deg has 1 values and guidance.alpha_velocity_m_s 2"),
+])
+def test_a_bad_alpha_schedule_names_its_field(alphas, speeds, match):
+    s = load_scenario("cav_h_paper004")
+    s.guidance.alpha_law, s.guidance.alpha_deg, s.guidance.alpha_velocity_m_s = "schedule", alphas, speeds
+    with pytest.raises(ScenarioError, match=match):
+        s.validate()
+
+
+def test_the_schedule_law_flies_alpha_linear_in_speed_and_starts_on_it():
+    """'schedule': alpha interpolated in speed between the breakpoints and held beyond them,
+    whatever the load; the actuator starts at the schedule's value at the entry speed."""
+    from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, law_commands
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario
+
+    s = _scenario()
+    s.guidance.alpha_law, s.guidance.alpha_deg, s.guidance.alpha_velocity_m_s = "schedule", [11.0, 14.0], [2000.0, 7000.0]
+    p = problem_from_scenario(s)
+    assert p.entry_alpha == pytest.approx(math.radians(14.0))  # 7400 m/s: beyond the top breakpoint
+    law, veh = p.law(), p.vehicle
+    x = np.array([[60e3] * 3, [0.0] * 3, [0.0] * 3, [1500.0, 4500.0, 9000.0], [0.0] * 3, [0.0] * 3])
+    three = np.ones(3)
+    _, alpha, mem = law_commands(law, three, x, p.planet.radius(x[0]), 3e-4 * three, 10.0 * three, 9.0 * three,
+                                 3.0 * three, 3e6 * three, 5e4 * three, veh.aero, veh.area_over_mass,
+                                 LawMemory.start(0.2, 3))
+    np.testing.assert_allclose(np.degrees(alpha), [11.0, 12.5, 14.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(mem.alpha_command, alpha, rtol=0, atol=0)
 
 
 def test_case2_switch_is_latched_once_mach_has_fallen_below_the_shift():
@@ -262,7 +295,8 @@ def test_a_plan_that_reaches_taem_far_from_the_target_is_not_a_success(case1_pla
         best.evaluation.time_s[0], abs=1e-9)
 
 
-@pytest.mark.parametrize("variant", ["load", "heat", "scaled aerodynamics", "two parameters", "floor and time"])
+@pytest.mark.parametrize("variant", ["load", "heat", "schedule", "scaled aerodynamics", "two parameters",
+                                     "floor and time"])
 def test_compiled_population_flies_as_the_numpy_evaluator(variant):
     """The population flown in one compiled call (population_flight with kernels generated from
     the models) against the vectorised numpy evaluator it replicates: every member's J within
@@ -278,6 +312,8 @@ def test_compiled_population_flies_as_the_numpy_evaluator(variant):
     sigma0, sigma_f = np.radians(np.linspace(10.0, 85.0, 9)), None
     if variant == "heat":
         p = dc.replace(p, case="heat", mach_shift=16.0)
+    elif variant == "schedule":  # cav_h_fnpeg's alpha in speed, with its entry value beyond the top breakpoint
+        p = dc.replace(p, case="schedule", alpha_schedule=((2000.0, 5500.0, 7000.0), tuple(np.radians([11.0, 10.5, 14.0]))))
     elif variant == "scaled aerodynamics":
         p = dc.replace(p, vehicle=dc.replace(p.vehicle, aero=ScaledAero(p.vehicle.aero, 1.06, 0.95)))
     elif variant == "two parameters":

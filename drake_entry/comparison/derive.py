@@ -23,7 +23,7 @@ from drake_entry.guidance.derivation import Choice, Derivation
 from drake_entry.models.verdict import acceptance_box
 
 __all__ = ["SEARCH_SEED", "SEARCH_DRAWS", "GOOD_ENOUGH", "Flight", "Trial", "DerivedSettings", "derive_settings",
-           "apply_derivation"]
+           "apply_derivation", "value_text"]
 
 #: the campaign seed of a search's dispersed draws (apart from the seeds campaigns use)
 SEARCH_SEED = 918_273_645
@@ -95,6 +95,11 @@ class DerivedSettings:
                             "why": [f.why for f in t.flights if f.why][:3]} for t in self.trials]}
 
 
+def value_text(value) -> str:
+    """A searched setting's value as the reports write it: a number in %g, anything else as it is."""
+    return f"{value:g}" if isinstance(value, (int, float)) and not isinstance(value, bool) else str(value)
+
+
 def apply_derivation(mission, derivation: Derivation, values: dict | None = None):
     """The mission scenario flying ``derivation``'s spec (and its alpha) with ``values``
     ({'guidance.<field>': value}) set on it."""
@@ -159,7 +164,7 @@ def derive_settings(mission, derivation: Derivation, *, draws: int = SEARCH_DRAW
             trial = Trial(step.name, values, flights, time.perf_counter() - t0, failure)
             step_trials.append(trial)
             if progress:
-                shown = ", ".join(f"{k.split('.')[-1]} {v:g}" for k, v in values.items())
+                shown = ", ".join(f"{k.split('.')[-1]} {value_text(v)}" for k, v in values.items())
                 progress(f"{step.name}: {shown}: {trial.successes}/{len(flights)} successful, mean box ratio "
                          f"{trial.mean_ratio:.2f} ({trial.wall_s:.1f} s){' ' + failure if failure else ''}")
             if trial.good_enough() and not step.exhaustive:

@@ -32,6 +32,7 @@ from drake_entry.campaign.report import (
 )
 from drake_entry.campaign.statistics import finite_column
 from drake_entry.campaign.store import coverage, read_manifest
+from drake_entry.comparison.derive import value_text
 from drake_entry.errors import CampaignError
 from drake_entry.figures import plt, save_figure
 
@@ -317,12 +318,12 @@ def _derivation_tables(meta) -> str:
            "mean box ratio |error| / tolerance, a limit breach counting 10 more, a flight stopped short 100 more). "
            "Steps run in order, each at the values kept before it."]
     for label, d in derived.items():
-        kept = ", ".join(f"{k} = {v:g}" for k, v in d["chosen"].items()) or "nothing searched"
+        kept = ", ".join(f"{k} = {value_text(v)}" for k, v in d["chosen"].items()) or "nothing searched"
         out += ["", f"**{label}**: kept {kept}",
                 "", "| step | candidate | successful | mean box ratio | s | why not (first flights) |",
                 "|---|---|---|---|---|---|"]
         for t in d["trials"]:
-            values = ", ".join(f"{k.replace('guidance.', '')} {v:g}" for k, v in t["values"].items())
+            values = ", ".join(f"{k.replace('guidance.', '')} {value_text(v)}" for k, v in t["values"].items())
             ratio = "—" if t["mean_box_ratio"] is None else f"{t['mean_box_ratio']:.2f}"
             why = t["setup_failure"] or "; ".join(t["why"])
             out.append(f"| {t['step']} | {values} | {t['successes']} of {t['flights']} | {ratio} | {t['wall_s']:.1f} | "

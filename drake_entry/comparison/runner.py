@@ -19,6 +19,7 @@ from pydrake.common.yaml import yaml_dump_typed
 from drake_entry.campaign.engine import session, versions
 from drake_entry.campaign.montecarlo import TRAJECTORY_STEP_S, run_campaign
 from drake_entry.campaign.store import write_atomic
+from drake_entry.comparison.derive import value_text
 from drake_entry.comparison.report import MANIFEST, read_comparison_manifest, write_comparison_report
 from drake_entry.comparison.spec import Comparison, load_comparison, method_scenario, needs_derivation
 from drake_entry.errors import DrakeEntryError, ScenarioError
@@ -168,7 +169,7 @@ def _derived_scenario(comp: Comparison, entry, mission, path: str, earlier: dict
 def _derivation_text(record: dict) -> str:
     """One paragraph for the mapping table: each setting taken from the mission, and the search's choices."""
     taken = "; ".join(f"{c['field'].replace('guidance.', '')} {c['value']} ({c['how']})" for c in record["choices"])
-    chosen = ", ".join(f"{k.replace('guidance.', '')} {v:g}" for k, v in record["chosen"].items())
+    chosen = ", ".join(f"{k.replace('guidance.', '')} {value_text(v)}" for k, v in record["chosen"].items())
     tried = len(record["trials"])
     text = f"Derived from the mission: {taken}."
     if tried:

@@ -1,13 +1,16 @@
 """Paper 004's settings from a mission (drake_entry.guidance.derivation): the TAEM interface at the
-mission's box centre, alpha from the load factor (Case 1, eq. 31) between the mission's alpha
-extremes, its reversal corridor, sigma_0 searched before flight and re-solved on board; sigma_f
-searched."""
+mission's box centre, alpha bounds at the mission's alpha extremes, its reversal corridor,
+sigma_0 searched before flight and re-solved on board; searched: the alpha law (the mission's
+alpha schedule in speed, or the load factor of Case 1, eq. 31) and the interface altitude;
+sigma_f is searched with sigma_0 before flight."""
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
+    CannotFly,
     Choice,
     Derivation,
     SearchStep,
+    alpha_rewritten,
     interface_altitudes,
     mission_alpha,
     reversal_corridor,
@@ -15,10 +18,21 @@ from drake_entry.guidance.derivation import (
 )
 from drake_entry.guidance.swarm_bank.spec import SwarmBank
 
-__all__ = ["derive", "BANK_END_CANDIDATES_DEG", "REPLAN_PERIOD_S"]
+__all__ = ["derive", "BANK_END_BOUNDS_DEG", "REPLAN_PERIOD_S", "OPTIMIZER", "LIMIT_FRACTION", "REPLAN_UNTIL_E"]
 
-#: sigma_f tried, in order [deg] (paper 004: 60)
-BANK_END_CANDIDATES_DEG = (60.0, 45.0, 30.0, 75.0)
+#: sigma_f's bounds when searched with sigma_0 before flight [deg] (paper 004: 60, fixed): sigma_0
+#: alone trades the range against the altitude at the TAEM energy (on HORUS-2B its best plan ends
+#: 6.9 km off with sigma_f 50 deg, 1.1 km off but breaching q with 60 deg)
+BANK_END_BOUNDS_DEG = (20.0, 85.0)
+#: the pre-flight search of (sigma_0, sigma_f): paper 004's PIO budget (10 x 21 trajectories) does
+#: not converge in two dimensions (HORUS-2B: J 14.5 against differential evolution's 0.40)
+OPTIMIZER = "differential_evolution"
+#: under the mission's alpha schedule the search penalises peaks past this fraction of the limits
+#: (the replica samples the guidance step, Drake every integrator step: at 1.0 the plan's Drake
+#: flight breached HORUS-2B's q by 0.03 %, at 0.93 no plan held the heat rate)
+LIMIT_FRACTION = 0.97
+#: no re-solution past this normalised energy (paper 004's mission: 0.95)
+REPLAN_UNTIL_E = 0.99
 #: sigma_0 re-solved on board every this [s] (paper 004's plan-once sigma_0 meets its own
 #: mission's dispersions in 1 of 20 runs, re-solved every 100 s in 20 of 20)
 REPLAN_PERIOD_S = 100.0
@@ -34,24 +48,48 @@ def derive(scenario) -> Derivation:
     lo, hi = min(alphas), max(alphas)
     if hi - lo < 1.0:  # a constant alpha: the load law still needs room to move
         lo, hi = lo - 1.0, hi + 1.0
+    try:  # the mission's alpha in speed, as FNPEG flies it: the first alpha law tried
+        speeds, scheduled, how = alpha_rewritten(scenario, interface, "velocity")
+        laws = ("schedule", "load")
+    except CannotFly as e:
+        speeds, scheduled, how, laws = [], [], f"no schedule in speed ({e})", ("load",)
+    term = scenario.terminal
+    distance_km = term.distance_tolerance_km or SwarmBank.objective_range_unit_km  # the paper's where none
+    altitude_km = term.altitude_tolerance_km or SwarmBank.objective_altitude_unit_km
     bank_limit = min(89.0, scenario.make_vehicle().bank_limit_deg)
-    candidates = tuple(b for b in BANK_END_CANDIDATES_DEG if b <= bank_limit)
+    end_bounds = [BANK_END_BOUNDS_DEG[0], min(BANK_END_BOUNDS_DEG[1], bank_limit)]
     spec = SwarmBank(terminal_altitude_km=interface.altitude_km, terminal_velocity_m_s=round(interface.speed_m_s, 3),
-                     bank_end_deg=candidates[0], bank_start_bounds_deg=[0.0, bank_limit], alpha_law="load",
+                     bank_start_bounds_deg=[0.0, bank_limit], bank_end_bounds_deg=end_bounds, alpha_law=laws[0],
+                     alpha_deg=scheduled, alpha_velocity_m_s=[round(v, 3) for v in speeds],
                      alpha_min_deg=lo, alpha_max_deg=hi, replan_period_s=REPLAN_PERIOD_S,
+                     objective_range_unit_km=distance_km, objective_altitude_unit_km=altitude_km,
+                     optimizer=OPTIMIZER, limit_fraction=LIMIT_FRACTION, replan_until_e=REPLAN_UNTIL_E,
                      reversal_heading_deg=heading, reversal_velocity_m_s=velocity)
     choices = [
         Choice("guidance.terminal_altitude_km, terminal_velocity_m_s",
                f"{interface.altitude_km:g} km, {interface.speed_m_s:.1f} m/s",
                "eq. 32's TAEM interface at the centre of the mission's acceptance box"),
-        Choice("guidance.alpha_law, alpha_min_deg, alpha_max_deg", f"load, {lo:g}-{hi:g} deg",
-               f"Case 1 (eq. 31) between the extremes of {source} alpha schedule (widened to 2 deg when constant)"),
+        Choice("guidance.alpha_min_deg, alpha_max_deg", f"{lo:g}-{hi:g} deg",
+               f"the extremes of {source} alpha schedule (widened to 2 deg when constant)"),
+        Choice("guidance.alpha_deg, alpha_velocity_m_s",
+               ", ".join(f"{a:g} deg at {v:.0f} m/s" for a, v in zip(scheduled, speeds)) or "none", how),
         Choice("guidance.bank_start_bounds_deg", f"0-{bank_limit:g} deg", "the vehicle's bank limit"),
-        Choice("guidance.replan_period_s", REPLAN_PERIOD_S,
-               "sigma_0 re-solved on board (plan-once PIO meets paper 004's own dispersions in 1 of 20 runs)"),
+        Choice("guidance.objective_range_unit_km, objective_altitude_unit_km", f"{distance_km:g} km, {altitude_km:g} km",
+               "eq. 32's units at the mission's box tolerances (paper 004: 100 nmi and 1 km), so the search weighs "
+               "range and altitude as the box does"),
+        Choice("guidance.bank_end_bounds_deg", f"{end_bounds[0]:g}-{end_bounds[1]:g} deg",
+               "sigma_f searched with sigma_0 before flight (paper 004's two-parameter search): sigma_0 alone "
+               "trades the range against the altitude at the TAEM energy"),
+        Choice("guidance.replan_period_s, replan_until_e", f"{REPLAN_PERIOD_S:g} s, {REPLAN_UNTIL_E:g}",
+               "sigma_0 re-solved on board (plan-once PIO meets paper 004's own dispersions in 7 of 100 runs)"),
+        Choice("guidance.optimizer", OPTIMIZER, "sigma_0 and sigma_f searched together: paper 004's PIO budget "
+               "does not converge in two dimensions (HORUS-2B: J 14.5 against 0.40)"),
+        Choice("guidance.limit_fraction", LIMIT_FRACTION, "under the mission's alpha schedule the search keeps the "
+               "replica's peaks under this fraction of the vehicle's limits (the Drake flight samples finer)"),
         corridor,
     ]
-    search = [SearchStep.over("guidance.terminal_altitude_km", interface_altitudes(scenario, interface), ALTITUDE_WHY),
-              SearchStep.over("guidance.bank_end_deg", candidates,
-                              "eq. 17's sigma_f: the lift left for the range at the end")]
+    search = [SearchStep.over("guidance.alpha_law", laws,
+                              "the mission's alpha schedule (as the other methods fly it), else Case 1's load law "
+                              "(eq. 31) between its extremes"),
+              SearchStep.over("guidance.terminal_altitude_km", interface_altitudes(scenario, interface), ALTITUDE_WHY)]
     return Derivation(spec, choices, search)

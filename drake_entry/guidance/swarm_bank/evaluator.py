@@ -26,12 +26,14 @@ from pydrake.symbolic import Expression, Variable
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.swarm_bank import population_flight
 from drake_entry.guidance.swarm_bank.guidance_law import (
+    ALPHA_LAWS,
     LawMemory,
     LawSettings,
     bank_magnitude,
     heat_drag_target,
     law_commands,
     load_coefficient_target,
+    scheduled_alpha,
 )
 from drake_entry.models.actuator import integrate_actuators
 from drake_entry.models.aerodynamics import ScaledAero
@@ -42,10 +44,22 @@ from drake_entry.models.geodesy import bearings, downtrack_crosstrack
 from drake_entry.models.kernels import Kernel, compile_kernels
 
 __all__ = ["RANGE_UNIT_M", "ALTITUDE_UNIT_M", "SPEED_UNIT_M_S", "SwarmProblem", "Evaluation", "HISTORY_COLUMNS",
-           "CONTROL_COLUMNS", "ENGINES", "evaluate", "range_error"]
+           "CONTROL_COLUMNS", "ENGINES", "evaluate", "range_error", "LIMIT_WEIGHT", "limit_excess"]
 
 #: J of eq. 32: range error over 100 nmi, altitude error over 1 km, speed error over 100 m/s
 RANGE_UNIT_M, ALTITUDE_UNIT_M, SPEED_UNIT_M_S = 1.852e5, 1e3, 100.0
+#: J added per unit of relative path-limit excess under the 'schedule' alpha law, which holds no
+#: limit as Cases 1 and 2 do (a 10 % breach weighs as 10 km of altitude error)
+LIMIT_WEIGHT = 100.0
+
+
+def limit_excess(limits, peaks, fraction: float = 1.0):
+    """Sum over heat flux, dynamic pressure and load of max(0, peak / (fraction limit) - 1) per
+    member; ``peaks`` (3, n): [heat flux W/m^2, q Pa, total load g] (the total load against the
+    lower of the vehicle's total and normal load limits: the total bounds the normal)."""
+    bounds = (limits.heat_flux_max, limits.dynamic_pressure_max, min(limits.total_load_max, limits.normal_load_max))
+    return sum(np.maximum(np.asarray(peak, float) / (fraction * bound) - 1.0, 0.0)
+               for peak, bound in zip(peaks, bounds) if math.isfinite(bound))
 
 
 @dc.dataclass
@@ -61,11 +75,17 @@ class SwarmProblem:
         (None: x0's; an on-board re-solution keeps the entry's).
       alpha_min, alpha_max, alpha_rate, alpha_accel: alpha bounds and actuator limits.
       load_max [g], heat_max [W/m^2]: the path limits of eqs. 13-14.
-      case: 'load' (Case 1, eq. 31) or 'heat' (Case 2, eq. 21 until mach_shift, then eq. 31).
+      case: 'load' (Case 1, eq. 31), 'heat' (Case 2, eq. 21 until mach_shift, then eq. 31) or
+        'schedule' (alpha_schedule: another method's alpha profile, as a mission states it).
+      alpha_schedule: ((speeds [m/s], increasing), (alpha [rad])) of the 'schedule' case.
+      objective_units: eq. 32's range [m], altitude [m] and speed [m/s] units (paper 004: 100 nmi,
+        1 km, 100 m/s).
+      limit_fraction: under the 'schedule' law, J is penalised past this fraction of each limit.
       k2, beta: eq. 48 gain and eq. 46 nondimensional scale height (paper: 10, 920).
       reversal_heading, reversal_velocity: heading-error corridor [rad] linear in speed [m/s].
       initial_alpha, initial_bank, initial_sign, memory: the actuators, the reversal sign and
-        the alpha law's memory at x0 (entry: alpha_max, 0, +1, nothing latched).
+        the alpha law's memory at x0 (entry: alpha_max, or the schedule's alpha at x0's speed;
+        0, +1, nothing latched).
     """
 
     vehicle: object
@@ -98,10 +118,27 @@ class SwarmProblem:
     initial_bank: float = 0.0
     initial_sign: float = 1.0
     memory: tuple = (False, False)  # (Mach was above Mach_shift, switched to Case 1)
+    alpha_schedule: tuple = ((), ())
+    objective_units: tuple = (RANGE_UNIT_M, ALTITUDE_UNIT_M, SPEED_UNIT_M_S)
+    limit_fraction: float = 1.0
 
     def __post_init__(self):
-        if self.case not in ("load", "heat"):
-            raise ScenarioError(f"paper-004 alpha law case = {self.case!r}; allowed: 'load', 'heat'")
+        if self.case not in ALPHA_LAWS:
+            raise ScenarioError(f"paper-004 alpha law case = {self.case!r}; allowed: {', '.join(ALPHA_LAWS)}")
+        speeds, values = self.alpha_schedule
+        if self.case == "schedule" and not (len(speeds) == len(values) >= 1 and np.all(np.diff(speeds) > 0)):
+            raise ScenarioError(f"the 'schedule' alpha law needs as many alphas as increasing speeds; got "
+                                f"{len(values)} alphas at speeds {list(speeds)}")
+
+    @property
+    def entry_alpha(self) -> float:
+        """The alpha actuator at x0 [rad]: initial_alpha, else the schedule's alpha at x0's
+        speed ('schedule'), else alpha_max."""
+        if self.initial_alpha is not None:
+            return self.initial_alpha
+        if self.case == "schedule":
+            return float(scheduled_alpha(float(self.x0[3]), *self.alpha_schedule))
+        return self.alpha_max
 
     @property
     def start_energy(self) -> float:
@@ -120,7 +157,7 @@ class SwarmProblem:
         pl = self.planet
         return LawSettings(self.sigma_f, self.start_energy, self.ef, self.vehicle.bank_limit, self.alpha_min,
                            self.alpha_max, self.load_max, self.heat_max, self.case, self.mach_shift, self.k2,
-                           self.beta, pl.reference_radius, pl.g0, pl.mu)
+                           self.beta, pl.reference_radius, pl.g0, pl.mu, *map(tuple, self.alpha_schedule))
 
 
 @dc.dataclass
@@ -128,7 +165,8 @@ class Evaluation:
     """Per member (arrays): objective J (eq. 32), its parts, the final state and peaks.
 
     Attributes:
-      J: objective of eq. 32 (inf where the TAEM energy was not reached).
+      J: objective of eq. 32 (inf where the TAEM energy was not reached); under the 'schedule'
+        alpha law plus LIMIT_WEIGHT times the path limits' relative excess (limit_excess).
       range_error_m: signed along-track distance at TAEM [m], + beyond the target.
       crossrange_m: cross-track distance from the entry-to-target great circle [m].
       altitude_error_m: h - h_f at the TAEM energy [m].
@@ -194,7 +232,10 @@ def _evaluation(p: SwarmProblem, final, t_end, reached, peaks, reversals, n, his
     """The Evaluation of final states (6, n) and the rest (eq. 32)."""
     ds, c = range_error(p, final[1], final[2])
     dh, dV = final[0] - p.h_f, final[3] - p.V_f
-    J = np.abs(ds) / RANGE_UNIT_M + np.abs(dh) / ALTITUDE_UNIT_M + np.abs(dV) / SPEED_UNIT_M_S  # eq. 32
+    range_unit, altitude_unit, speed_unit = p.objective_units
+    J = np.abs(ds) / range_unit + np.abs(dh) / altitude_unit + np.abs(dV) / speed_unit  # eq. 32
+    if p.case == "schedule":  # an alpha law that holds no path limit: its breaches are penalised
+        J = J + LIMIT_WEIGHT * limit_excess(p.vehicle.limits, peaks, p.limit_fraction)
     J = np.where(reached, J, np.inf)
     return Evaluation(J, ds, c, dh, dV, final.T.copy(), t_end, reached, peaks[0], peaks[1], peaks[2], reversals, n,
                       history, controls)
@@ -206,7 +247,7 @@ def _fly_numpy(p: SwarmProblem, sigma0, sigma_f, record: bool) -> Evaluation:
     n = sigma0.size
     law = p.law()
     x = np.tile(np.asarray(p.x0, float)[:, None], (1, n))
-    alpha0 = p.alpha_max if p.initial_alpha is None else p.initial_alpha
+    alpha0 = p.entry_alpha
     alpha, alpha_rate = np.full(n, alpha0), np.zeros(n)
     bank, bank_rate = np.full(n, p.initial_bank), np.zeros(n)
     sign = np.full(n, 1.0 if p.initial_sign >= 0 else -1.0)
@@ -357,7 +398,7 @@ def _fly_compiled(p: SwarmProblem, sigma0, sigma_f):
     vehicle, kl, kd = _unscaled(p.vehicle)
     module = _population_module(p, vehicle)
     n = sigma0.size
-    alpha0 = p.alpha_max if p.initial_alpha is None else p.initial_alpha
+    alpha0 = p.entry_alpha
     values = dict(e0=p.start_energy, ef=p.ef, target_lon=p.target[0], target_lat=p.target[1], lift_scale=kl,
                   drag_scale=kd, alpha0=alpha0, bank0=p.initial_bank, sign0=p.initial_sign,
                   mach_was_above=float(p.memory[0]), switched=float(p.memory[1]), step_s=p.guidance_step_s,
@@ -366,13 +407,15 @@ def _fly_compiled(p: SwarmProblem, sigma0, sigma_f):
                   alpha_max=p.alpha_max, bank_limit=p.vehicle.bank_limit, alpha_rate=p.alpha_rate,
                   bank_rate=p.vehicle.bank_rate_limit, alpha_accel=p.alpha_accel,
                   bank_accel=p.vehicle.bank_accel_limit, bandwidth=2.0, heat_case=float(p.case == "heat"),
-                  mach_shift=p.mach_shift)
+                  mach_shift=p.mach_shift, schedule_case=float(p.case == "schedule"))
     settings = np.array([float(values[k]) for k in population_flight.SETTINGS])
     sf = np.full(n, p.sigma_f) if sigma_f is None else np.ascontiguousarray(sigma_f, float)
     final, t_end = np.zeros((n, 6)), np.zeros(n)
     reached, peaks, reversals = np.zeros(n, bool), np.zeros((n, 3)), np.zeros(n, np.int64)
+    speeds, values = p.alpha_schedule if p.case == "schedule" else ((0.0,), (0.0,))
     module["fly_population"](np.asarray(p.x0, float), np.ascontiguousarray(sigma0), sf, settings,
                              np.asarray(p.reversal_velocity, float), np.asarray(p.reversal_heading, float),
+                             np.asarray(speeds, float), np.asarray(values, float),
                              final, t_end, reached, peaks, reversals)
     return final.T, t_end, reached, peaks.T, reversals
 

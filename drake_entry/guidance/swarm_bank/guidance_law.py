@@ -21,7 +21,10 @@ from drake_entry.models.schedules import linear_bank
 
 __all__ = ["equilibrium_glide_radius", "qeg_sin_flight_path", "qeg_bank", "SOLVE_RTOL", "SOLVE_MAX_ITERATIONS",
            "load_coefficient_target", "heat_drag_target", "alpha_for_load_factor", "alpha_for_heat_rate",
-           "LawMemory", "LawSettings", "law_commands", "bank_magnitude"]
+           "LawMemory", "LawSettings", "law_commands", "bank_magnitude", "scheduled_alpha", "ALPHA_LAWS"]
+
+#: the alpha laws: Case 1 (eq. 31), Case 2 (eq. 21, then eq. 31), and a given alpha in speed
+ALPHA_LAWS = ("load", "heat", "schedule")
 
 
 def equilibrium_glide_radius(V, lift_coefficient_term, beta: float):
@@ -157,8 +160,10 @@ class LawMemory:
 class LawSettings:
     """The constants of paper 004's law (SI, rad). sigma_f: eq. 17's terminal bank;
     e0, ef: eq. 17's energies [J/kg] (e = mu/r - V^2/2); bank_limit; alpha_min, alpha_max;
-    load_max [g], heat_max [W/m^2]; case 'load' (Case 1) or 'heat' (Case 2); mach_shift;
-    k2, beta: eqs. 46-48 (nondimensional); R0 [m], g0 [m/s^2]: Lu's units; mu [m^3/s^2]."""
+    load_max [g], heat_max [W/m^2]; case 'load' (Case 1), 'heat' (Case 2) or 'schedule'; mach_shift;
+    k2, beta: eqs. 46-48 (nondimensional); R0 [m], g0 [m/s^2]: Lu's units; mu [m^3/s^2];
+    alpha_speeds [m/s] (increasing), alpha_values [rad]: the 'schedule' case's alpha, linear
+    in speed and held beyond its ends."""
 
     sigma_f: float
     e0: float
@@ -175,6 +180,14 @@ class LawSettings:
     R0: float
     g0: float
     mu: float
+    alpha_speeds: tuple = ()
+    alpha_values: tuple = ()
+
+
+def scheduled_alpha(speed, speeds, values):
+    """alpha [rad] of the 'schedule' case at speed [m/s]: linear between the breakpoints
+    ``speeds`` (increasing) and held beyond their ends."""
+    return np.interp(speed, speeds, values)
 
 
 def law_commands(s: LawSettings, sigma0, x, r, rho, mach, L, D, heat, q, aero, area_over_mass: float,
@@ -186,9 +199,13 @@ def law_commands(s: LawSettings, sigma0, x, r, rho, mach, L, D, heat, q, aero, a
     heat [W/m^2], q [Pa]: the air data and aerodynamic accelerations at the step (n,).
     |sigma|: eq. 17 (linear in e from sigma0) with the QEG compensation (eqs. 46-48), limited
     to bank_limit. alpha: eq. 31 (Case 1); Case 2: eq. 21 until Mach has fallen below
-    Mach_shift after exceeding it, then eq. 31. ``sigma_f``: per-member eq. 17 end banks
+    Mach_shift after exceeding it, then eq. 31; 'schedule': the mission's alpha in speed (the
+    law flown with another method's alpha profile). ``sigma_f``: per-member eq. 17 end banks
     (default: the settings')."""
     magnitude = bank_magnitude(s, sigma0, x[3], x[4], r, L, D, s.sigma_f if sigma_f is None else sigma_f)
+    if s.case == "schedule":
+        alpha = scheduled_alpha(np.asarray(x[3], float), s.alpha_speeds, s.alpha_values)
+        return magnitude, alpha, LawMemory(alpha, memory.mach_was_above, memory.switched)
     alpha = alpha_for_load_factor(q, mach, aero, area_over_mass, s.g0, s.load_max, s.alpha_min, s.alpha_max)
     above, switched = memory.mach_was_above, memory.switched
     if s.case == "heat":

@@ -64,6 +64,7 @@ class SwarmPlan(PlanResult):
 
     problem: SwarmProblem | None = None
     sigma0_deg: float = math.nan
+    sigma_f_deg: float = math.nan
     search: SearchResult | None = None
     evaluation: Evaluation | None = None
     violations: list = dc.field(default_factory=list)
@@ -98,7 +99,7 @@ def plan_controls(problem: SwarmProblem, ev: Evaluation) -> EntryControls:
                           bank_rate_limit=v.bank_rate_limit, bank_accel_limit=v.bank_accel_limit,
                           alpha_bounds=(p.alpha_min, p.alpha_max), alpha_rate_limit=p.alpha_rate,
                           alpha_accel_limit=p.alpha_accel, initial_bank=p.initial_bank,
-                          initial_alpha=p.alpha_max if p.initial_alpha is None else p.initial_alpha)
+                          initial_alpha=p.entry_alpha)
     return EntryControls(v, p.planet, p.atmosphere, np.asarray(p.x0, float), tf, t, bank, alpha, None, actuation)
 
 
@@ -132,11 +133,15 @@ def plan(scenario, verifier, problem: SwarmProblem | None = None) -> SwarmPlan:
     problem = problem_from_scenario(scenario) if problem is None else problem
     found = None
     if g.bank_start_deg is None:
-        found = search(problem, g.optimizer, [tuple(g.bank_start_bounds_deg)], seed=g.seed, n=g.population,
+        bounds = [tuple(g.bank_start_bounds_deg)] + ([tuple(g.bank_end_bounds_deg)] if g.bank_end_bounds_deg else [])
+        found = search(problem, g.optimizer, bounds, seed=g.seed, n=g.population,
                        k_max=g.iterations, k_c=g.landmark_iteration, R=g.map_compass_factor)
         sigma0 = float(found.x[0])
+        if len(bounds) == 2:  # sigma_f searched too: the problem (and the guidance on board) flies it
+            problem = dc.replace(problem, sigma_f=math.radians(float(found.x[1])))
     else:
         sigma0 = float(g.bank_start_deg)
+    sigma_f = math.degrees(problem.sigma_f)
     build = time.perf_counter() - t0
     ev = evaluate(problem, np.radians([sigma0]), record=True)
     reached = bool(ev.reached[0])
@@ -147,8 +152,9 @@ def plan(scenario, verifier, problem: SwarmProblem | None = None) -> SwarmPlan:
     missed = [f"{k} {box_text(k, b)}" for k, b in box.items() if not b["inside"]]
     xf = ev.final_state[0]
     from_replica = math.hypot(problem.planet.great_circle_distance(x[1], x[2], xf[1], xf[2]), x[0] - xf[0])
-    parts = [f"sigma_0 = {sigma0:.3f} deg" + (f" by {found.method} ({found.trajectories} trajectories)" if found
-                                                 else " (given)"),
+    searched_f = found is not None and len(found.x) == 2
+    parts = [f"sigma_0 = {sigma0:.3f} deg" + (f", sigma_f = {sigma_f:.3f} deg" if searched_f else "")
+             + (f" by {found.method} ({found.trajectories} trajectories)" if found else " (given)"),
              f"J = {ev.J[0]:.4f}: range error {ev.range_error_m[0] / 1e3:+.2f} km, altitude {ev.altitude_error_m[0]:+.0f} m, "
              f"speed {ev.velocity_error_m_s[0]:+.1f} m/s, crossrange {ev.crossrange_m[0] / 1e3:+.2f} km"]
     if not reached:
@@ -167,7 +173,8 @@ def plan(scenario, verifier, problem: SwarmProblem | None = None) -> SwarmPlan:
     return SwarmPlan(success=reached and not departs and not missed and not violations, message="; ".join(parts),
                      iterations=len(found.swarm.history) - 1 if found is not None and found.swarm else 0,
                      build_time=build, solve_time=time.perf_counter() - t0 - build, objective=float(ev.J[0]),
-                     problem=problem, sigma0_deg=sigma0, search=found, evaluation=ev, violations=violations,
+                     problem=problem, sigma0_deg=sigma0, sigma_f_deg=sigma_f, search=found, evaluation=ev,
+                     violations=violations,
                      flown=flown, from_replica_m=from_replica)
 
 
@@ -191,7 +198,7 @@ class SwarmBankMethod(GuidanceMethod):
         return GuidanceCommands(
             bank=reversal.GetOutputPort("bank_command"), alpha=guidance.GetOutputPort("alpha_command"),
             alpha_limits=ActuatorLimits(p.alpha_min, p.alpha_max, p.alpha_rate, p.alpha_accel),
-            initial_bank=p.initial_bank, initial_alpha=p.alpha_max if p.initial_alpha is None else p.initial_alpha,
+            initial_bank=p.initial_bank, initial_alpha=p.entry_alpha,
             logged={"alpha_command": LoggedSignal(guidance.GetOutputPort("alpha_command"), ("alpha_command_rad",)),
                     "sigma0": LoggedSignal(guidance.GetOutputPort("sigma0"), ("sigma0_rad",))})
 
@@ -204,6 +211,7 @@ class SwarmBankMethod(GuidanceMethod):
         return GuidanceSummary(planner.success, unverified, plans=int(plans), planning_wall_s=float(wall),
                                fields={"reversals": reversal_count(diagram, context),
                                        "sigma0_planned_deg": planner.sigma0_deg, "sigma0_final_deg": sigma0,
+                                       "sigma_f_deg": planner.sigma_f_deg,
                                        "resolutions_unbracketed": int(failed)},
                                details=planner)
 

@@ -36,7 +36,7 @@ __all__ = ["SETTINGS", "fly_population"]
 SETTINGS = ("e0", "ef", "target_lon", "target_lat", "lift_scale", "drag_scale", "alpha0", "bank0", "sign0",
             "mach_was_above", "switched", "step_s", "substeps", "altitude_floor_m", "max_time_s", "alpha_min",
             "alpha_max", "bank_limit", "alpha_rate", "bank_rate", "alpha_accel", "bank_accel", "bandwidth",
-            "heat_case", "mach_shift")
+            "heat_case", "mach_shift", "schedule_case")
 
 
 def _coefficient(alpha, mach, kl, kd, total, v, out):
@@ -74,16 +74,18 @@ def _solve(target, mach, kl, kd, total, lo, hi, v, out):
     return x
 
 
-def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_heading, final, t_end, reached,
-                   peaks, reversals):
+def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_heading, alpha_speeds, alpha_values,
+                   final, t_end, reached, peaks, reversals):
     """Fly every member (sigma0[i], sigma_f[i]) from x0 with ``settings`` (SETTINGS) and write
     its final state (at the TAEM energy, interpolated, or where it stopped), time, whether it
-    reached the energy, peaks [heat flux, q, load] and reversals into the output arrays."""
+    reached the energy, peaks [heat flux, q, load] and reversals into the output arrays.
+    alpha_speeds, alpha_values: the 'schedule' law's alpha [rad] in speed [m/s]."""
     e0, ef, tlon, tlat, kl, kd = settings[0], settings[1], settings[2], settings[3], settings[4], settings[5]
     dt, steps, floor, max_time = settings[11], int(settings[12]), settings[13], settings[14]
     alpha_min, alpha_max, bank_limit = settings[15], settings[16], settings[17]
     rate_limits, accel_limits = (settings[18], settings[19]), (settings[20], settings[21])  # (alpha, bank)
     bandwidth, heat_case, mach_shift = settings[22], settings[23] > 0.5, settings[24]
+    schedule_case = settings[25] > 0.5
     va, vb = np.empty(10), np.empty(10)
     aero_out, k1, k2, k3, k4 = np.empty(8), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     one, two = np.empty(1), np.empty(2)
@@ -112,9 +114,12 @@ def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_he
             vb[5], vb[6], vb[7], vb[8] = sigma0[i], sigma_f[i], e0, ef
             bank_magnitude(vb, one)
             magnitude = one[0]
-            vb[0] = q
-            load_target(vb, one)
-            command = _solve(one[0], mach, kl, kd, True, alpha_min, alpha_max, vb, two)
+            if schedule_case:
+                command = np.interp(x[3], alpha_speeds, alpha_values)
+            else:
+                vb[0] = q
+                load_target(vb, one)
+                command = _solve(one[0], mach, kl, kd, True, alpha_min, alpha_max, vb, two)
             if heat_case:
                 above = above or mach > mach_shift
                 switched = switched or (above and mach <= mach_shift)

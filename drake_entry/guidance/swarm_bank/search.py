@@ -263,4 +263,7 @@ def problem_from_scenario(scenario) -> SwarmProblem:
         load_max=vehicle.limits.total_load_max, heat_max=vehicle.limits.heat_flux_max, case=g.alpha_law,
         mach_shift=g.mach_shift, k2=g.qeg_gain, beta=g.qeg_beta,
         reversal_heading=tuple(np.radians(g.reversal_heading_deg)), reversal_velocity=tuple(g.reversal_velocity_m_s),
-        guidance_step_s=g.period_s, max_time_s=scenario.simulation.max_time_s)
+        guidance_step_s=g.period_s, max_time_s=scenario.simulation.max_time_s,
+        alpha_schedule=(tuple(g.alpha_velocity_m_s), tuple(map(rad, g.alpha_deg))),
+        objective_units=(1e3 * g.objective_range_unit_km, 1e3 * g.objective_altitude_unit_km,
+                         g.objective_speed_unit_m_s), limit_fraction=g.limit_fraction)

@@ -5,6 +5,7 @@ import typing
 
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
+from drake_entry.guidance.swarm_bank.guidance_law import ALPHA_LAWS
 
 __all__ = ["SWARMS", "OPTIMIZERS", "swarm_trajectories", "MAX_SEARCH_TRAJECTORIES", "SwarmBank"]
 
@@ -28,7 +29,8 @@ MAX_SEARCH_TRAJECTORIES = 100_000
 class SwarmBank(ReversingBankSpec, ReplansOnBoard):
     """|sigma| linear in e = mu/r - V^2/2 from bank_start_deg at entry to bank_end_deg at the
     TAEM energy (paper 004 eq. 17) with the QEG compensation (eqs. 46-48); alpha from the load
-    factor (Case 1, eq. 31) or the heat rate until Mach_shift (Case 2, eq. 21); bank sign from
+    factor (Case 1, eq. 31), the heat rate until Mach_shift (Case 2, eq. 21) or a given schedule
+    in speed ('schedule', for another method's mission); bank sign from
     the shared reversal logic. bank_start_deg is searched before flight (``optimizer``) unless
     given, and re-solved on board every ``replan_period_s`` when > 0."""
 
@@ -39,14 +41,28 @@ class SwarmBank(ReversingBankSpec, ReplansOnBoard):
     bank_start_deg: typing.Optional[float] = None
     bank_start_bounds_deg: list[float] = dc.field(default_factory=lambda: [0.0, 89.0])
     bank_end_deg: float = 60.0
-    # alpha law: 'load' (Case 1, eq. 31) or 'heat' (Case 2: eq. 21 until Mach < mach_shift)
+    # sigma_f searched before flight with sigma_0 in these bounds [deg] (None: bank_end_deg, fixed;
+    # paper 004's two-parameter search), then held while sigma_0 is re-solved on board
+    bank_end_bounds_deg: typing.Optional[list[float]] = None
+    # alpha law: 'load' (Case 1, eq. 31), 'heat' (Case 2: eq. 21 until Mach < mach_shift) or
+    # 'schedule' (alpha_deg at alpha_velocity_m_s, linear in speed: another method's alpha profile)
     alpha_law: str = "load"
     mach_shift: float = 20.0
+    alpha_deg: list[float] = dc.field(default_factory=list)
+    alpha_velocity_m_s: list[float] = dc.field(default_factory=list)
     # alpha bounds and actuator limits (paper 004: [10, 20] deg, 4 deg/s, 8 deg/s^2)
     alpha_min_deg: float = 10.0
     alpha_max_deg: float = 20.0
     alpha_rate_deg_s: float = 4.0
     alpha_accel_deg_s2: float = 8.0
+    # eq. 32's units: J = |range error| / range + |altitude error| / altitude + |speed error| / speed
+    # (paper 004: 100 nmi, 1 km, 100 m/s)
+    objective_range_unit_km: float = 185.2
+    objective_altitude_unit_km: float = 1.0
+    objective_speed_unit_m_s: float = 100.0
+    # under the 'schedule' alpha law (which holds no path limit) J is penalised for peaks past this
+    # fraction of the vehicle's limits: the margin for what the replica's guidance steps miss
+    limit_fraction: float = 1.0
     # QEG compensation (eq. 48 gain k2, eq. 46 nondimensional scale height beta)
     qeg_gain: float = 10.0
     qeg_beta: float = 920.0
@@ -79,13 +95,37 @@ class SwarmBank(ReversingBankSpec, ReplansOnBoard):
         if self.bank_start_deg is not None:
             check_range("guidance.bank_start_deg", self.bank_start_deg, 0.0, 90.0)
         check_range("guidance.bank_end_deg", self.bank_end_deg, 0.0, bank_limit)
-        if self.alpha_law not in ("load", "heat"):
-            raise ScenarioError(f"guidance.alpha_law = {self.alpha_law!r}; allowed: 'load' (Case 1), 'heat' (Case 2)")
+        if self.bank_end_bounds_deg is not None:
+            if len(self.bank_end_bounds_deg) != 2 or not self.bank_end_bounds_deg[0] < self.bank_end_bounds_deg[1]:
+                raise ScenarioError(f"guidance.bank_end_bounds_deg = {self.bank_end_bounds_deg} needs [lower, upper] "
+                                    "with lower < upper")
+            for v in self.bank_end_bounds_deg:
+                check_range("guidance.bank_end_bounds_deg", v, 0.0, bank_limit)
+            if self.optimizer not in SWARMS + ("differential_evolution",):
+                raise ScenarioError(f"guidance.bank_end_bounds_deg searches sigma_f with sigma_0, which "
+                                    f"guidance.optimizer = {self.optimizer!r} cannot; allowed: "
+                                    f"{', '.join(SWARMS)}, differential_evolution")
+        if self.alpha_law not in ALPHA_LAWS:
+            raise ScenarioError(f"guidance.alpha_law = {self.alpha_law!r}; allowed: 'load' (Case 1), 'heat' (Case 2), "
+                                "'schedule' (alpha_deg at alpha_velocity_m_s)")
         check_range("guidance.mach_shift", self.mach_shift, 0.5, 40.0)
         check_range("guidance.alpha_min_deg", self.alpha_min_deg, -10.0, 60.0)
         check_range("guidance.alpha_max_deg", self.alpha_max_deg, self.alpha_min_deg + 1e-6, 60.0)
+        if self.alpha_law == "schedule":
+            speeds, alphas = self.alpha_velocity_m_s, self.alpha_deg
+            if not alphas or len(alphas) != len(speeds):
+                raise ScenarioError(f"guidance.alpha_deg has {len(alphas)} values and guidance.alpha_velocity_m_s "
+                                    f"{len(speeds)}: the 'schedule' alpha law needs one alpha per speed, at least one")
+            if any(b <= a for a, b in zip(speeds, speeds[1:])):
+                raise ScenarioError(f"guidance.alpha_velocity_m_s = {speeds} must increase")
+            for a in alphas:  # the alpha actuator's position bounds hold the schedule
+                check_range("guidance.alpha_deg", a, self.alpha_min_deg, self.alpha_max_deg)
         check_range("guidance.alpha_rate_deg_s", self.alpha_rate_deg_s, 1e-3, 100.0)
         check_range("guidance.alpha_accel_deg_s2", self.alpha_accel_deg_s2, 1e-3, 1000.0)
+        check_range("guidance.objective_range_unit_km", self.objective_range_unit_km, 1e-3, 1e5)
+        check_range("guidance.objective_altitude_unit_km", self.objective_altitude_unit_km, 1e-3, 1e3)
+        check_range("guidance.objective_speed_unit_m_s", self.objective_speed_unit_m_s, 1e-3, 1e5)
+        check_range("guidance.limit_fraction", self.limit_fraction, 0.5, 1.0)
         check_range("guidance.qeg_gain", self.qeg_gain, 0.0, 1e4)
         check_range("guidance.qeg_beta", self.qeg_beta, 1.0, 1e5)
         if self.optimizer not in OPTIMIZERS:

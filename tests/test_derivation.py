@@ -312,3 +312,23 @@ def test_the_schedule_law_s_search_pays_for_each_limit_it_breaches():
     peaks = np.array([[530e3, 583e3], [9e3, 11e3], [2.0, 3.0]])
     np.testing.assert_allclose(limit_excess(limits, peaks), [0.0, 0.1 + 0.1 + 0.2], rtol=1e-12)
     np.testing.assert_allclose(limit_excess(limits, peaks, 0.9)[0], 530 / 477 - 1.0, rtol=1e-12)
+
+
+def test_a_box_alpha_window_the_mission_s_alpha_misses_is_beyond_a_bank_only_method():
+    """MaRV's impact box asks alpha 0 +- 2 deg; its alpha schedule is 11.9 deg: every method that
+    flies the mission's alpha with the bank as its only control says so with those figures (the
+    swarm's load law moves alpha 1 deg about a constant schedule, still outside), and a box without
+    an alpha window constrains nothing."""
+    from drake_entry.guidance.bank_profile.spec import BankProfile
+    from drake_entry.guidance.drag_energy.spec import DragEnergy
+    from drake_entry.guidance.fnpeg.spec import Fnpeg
+    from drake_entry.guidance.swarm_bank.spec import SwarmBank
+
+    marv = load_scenario("marv_guidance")
+    for spec, flown in ((Fnpeg, r"\(11.9 deg\)"), (DragEnergy, r"\(11.9 deg\)"), (BankProfile, r"\(11.9 deg\)"),
+                        (SwarmBank, r"\(10.9 to 12.9 deg\)")):
+        with pytest.raises(CannotFly, match=r"asks alpha 0 \+- 2 deg at its interface, and this method flies the "
+                                            r"mission's alpha schedule " + flown):
+            derivation_for(marv, spec)
+    marv.terminal.alpha_tolerance_deg = 15.0  # 11.9 deg is then inside the window
+    assert derivation_for(marv, Fnpeg).spec.alpha_deg == [11.9]

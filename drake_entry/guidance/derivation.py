@@ -25,7 +25,7 @@ from drake_entry.scenario import stated_guidance
 
 __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
-           "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN"]
+           "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
 #: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
@@ -113,6 +113,22 @@ def derivation_for(scenario, spec_type) -> Derivation:
     if type(derivation.spec) is not spec_type:
         raise TypeError(f"{name}.derive returned a {type(derivation.spec).__name__}, not a {spec_type.__name__}")
     return derivation
+
+
+def require_alpha_window(scenario, widen_deg: float = 0.0) -> None:
+    """CannotFly when the mission's box asks an alpha window at the interface that no alpha of the
+    mission's alpha schedule (widened by ``widen_deg`` each side: a law moving alpha between
+    bounds) falls in: a method flying that schedule cannot end inside the box, whatever its bank."""
+    t = scenario.terminal
+    if t.alpha_deg is None or t.alpha_tolerance_deg is None:  # no alpha criterion in the box
+        return
+    tol = t.alpha_tolerance_deg
+    alpha, source = mission_alpha(scenario)
+    lo, hi = min(alpha.values_deg) - widen_deg, max(alpha.values_deg) + widen_deg
+    if hi < t.alpha_deg - tol or lo > t.alpha_deg + tol:
+        flown = f"{lo:g} deg" if lo == hi else f"{lo:g} to {hi:g} deg"
+        raise CannotFly(f"the mission's box asks alpha {t.alpha_deg:g} +- {tol:g} deg at its interface, and this "
+                        f"method flies {source} alpha schedule ({flown}), with the bank its only control")
 
 
 def terminal_interface(scenario) -> Interface:

@@ -9,6 +9,7 @@ from drake_entry.guidance.derivation import (
     Derivation,
     SearchStep,
     interface_altitudes,
+    require_alpha_window,
     reversal_corridor,
     terminal_interface,
 )
@@ -22,6 +23,7 @@ BANK_CANDIDATES_DEG = (60.0, 45.0, 75.0, 30.0, 85.0, 15.0)
 def derive(scenario) -> Derivation:
     """BankProfile settings for ``scenario``'s mission stating no
     block of this method (derivation_for returns a stated one as it is)."""
+    require_alpha_window(scenario)
     interface = terminal_interface(scenario)
     mach = interface.mach
     heading, velocity, corridor = reversal_corridor(scenario)

@@ -11,6 +11,7 @@ from drake_entry.guidance.derivation import (
     SearchStep,
     alpha_rewritten,
     interface_altitudes,
+    require_alpha_window,
     reversal_corridor,
     terminal_interface,
 )
@@ -28,6 +29,7 @@ REPLAN_PERIOD_S = 20.0
 def derive(scenario) -> Derivation:
     """DragEnergy settings for ``scenario``'s mission stating no
     block of this method (derivation_for returns a stated one as it is)."""
+    require_alpha_window(scenario)
     interface = terminal_interface(scenario)
     mach = interface.mach
     heading, velocity, corridor = reversal_corridor(scenario)

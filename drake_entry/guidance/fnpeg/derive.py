@@ -9,6 +9,7 @@ from drake_entry.guidance.derivation import (
     Derivation,
     SearchStep,
     alpha_rewritten,
+    require_alpha_window,
     reversal_corridor,
     terminal_interface,
 )
@@ -29,6 +30,7 @@ PATH_GAIN = 40.0
 
 def derive(scenario) -> Derivation:
     """Fnpeg settings for ``scenario``'s mission that states no !Fnpeg block (module doc)."""
+    require_alpha_window(scenario)
     interface = terminal_interface(scenario)
     speeds, alphas, alpha_how = alpha_rewritten(scenario, interface, "velocity")
     heading, velocity, corridor = reversal_corridor(scenario)

@@ -13,6 +13,7 @@ from drake_entry.guidance.derivation import (
     alpha_rewritten,
     interface_altitudes,
     mission_alpha,
+    require_alpha_window,
     reversal_corridor,
     terminal_interface,
 )
@@ -46,8 +47,9 @@ def derive(scenario) -> Derivation:
     alpha, source = mission_alpha(scenario)
     alphas = [float(a) for a in alpha.values_deg]
     lo, hi = min(alphas), max(alphas)
-    if hi - lo < 1.0:  # a constant alpha: the load law still needs room to move
-        lo, hi = lo - 1.0, hi + 1.0
+    widen = 1.0 if hi - lo < 1.0 else 0.0  # a constant alpha: the load law still needs room to move
+    require_alpha_window(scenario, widen)
+    lo, hi = lo - widen, hi + widen
     try:  # the mission's alpha in speed, as FNPEG flies it: the first alpha law tried
         speeds, scheduled, how = alpha_rewritten(scenario, interface, "velocity")
         laws = ("schedule", "load")

@@ -26,7 +26,6 @@ from pydrake.symbolic import Expression, Variable
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.swarm_bank import population_flight
 from drake_entry.guidance.swarm_bank.guidance_law import (
-    ALPHA_LAWS,
     LawMemory,
     LawSettings,
     bank_magnitude,
@@ -35,6 +34,7 @@ from drake_entry.guidance.swarm_bank.guidance_law import (
     load_coefficient_target,
     scheduled_alpha,
 )
+from drake_entry.guidance.swarm_bank.spec import ALPHA_LAWS
 from drake_entry.models.actuator import integrate_actuators
 from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle

@@ -21,10 +21,7 @@ from drake_entry.models.schedules import linear_bank
 
 __all__ = ["equilibrium_glide_radius", "qeg_sin_flight_path", "qeg_bank", "SOLVE_RTOL", "SOLVE_MAX_ITERATIONS",
            "load_coefficient_target", "heat_drag_target", "alpha_for_load_factor", "alpha_for_heat_rate",
-           "LawMemory", "LawSettings", "law_commands", "bank_magnitude", "scheduled_alpha", "ALPHA_LAWS"]
-
-#: the alpha laws: Case 1 (eq. 31), Case 2 (eq. 21, then eq. 31), and a given alpha in speed
-ALPHA_LAWS = ("load", "heat", "schedule")
+           "LawMemory", "LawSettings", "law_commands", "bank_magnitude", "scheduled_alpha"]
 
 
 def equilibrium_glide_radius(V, lift_coefficient_term, beta: float):

@@ -5,10 +5,11 @@ import typing
 
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
-from drake_entry.guidance.swarm_bank.guidance_law import ALPHA_LAWS
 
-__all__ = ["SWARMS", "OPTIMIZERS", "swarm_trajectories", "MAX_SEARCH_TRAJECTORIES", "SwarmBank"]
+__all__ = ["ALPHA_LAWS", "SWARMS", "OPTIMIZERS", "swarm_trajectories", "MAX_SEARCH_TRAJECTORIES", "SwarmBank"]
 
+#: the alpha laws: Case 1 (eq. 31), Case 2 (eq. 21, then eq. 31), and a given alpha in speed
+ALPHA_LAWS = ("load", "heat", "schedule")
 #: sigma_0 searches: the paper's swarms and the scipy baselines (guidance/swarm_bank/search.py)
 #: the swarm optimizers (paper 004's PIO and PSO; their budget: swarm_trajectories)
 SWARMS = ("pio", "pso", "pso_stable")

@@ -295,7 +295,8 @@ def test_swarm_bank_on_horus2b_flies_the_mission_alpha_and_weighs_the_box():
     assert g.alpha_velocity_m_s == pytest.approx(speeds, abs=1e-3) and (g.alpha_min_deg, g.alpha_max_deg) == (15.0, 40.0)
     assert g.bank_end_bounds_deg == list(BANK_END_BOUNDS_DEG) and g.optimizer == "differential_evolution"
     assert (g.objective_range_unit_km, g.objective_altitude_unit_km) == (2.0, 2.0) and g.limit_fraction == LIMIT_FRACTION
-    assert [s.name for s in d.search] == ["guidance.alpha_law", "guidance.terminal_altitude_km"]
+    assert [s.name for s in d.search] == ["guidance.alpha_law", "guidance.qeg_gain", "guidance.terminal_altitude_km"]
+    assert d.search[1].candidates == ({"guidance.qeg_gain": 10.0}, {"guidance.qeg_gain": 0.0})
     assert d.search[0].candidates == ({"guidance.alpha_law": "schedule"}, {"guidance.alpha_law": "load"})
     g.validate(dc.replace(scenario, guidance=g))
 

@@ -1,8 +1,8 @@
 """Paper 004's settings from a mission (drake_entry.guidance.derivation): the TAEM interface at the
 mission's box centre, alpha bounds at the mission's alpha extremes, its reversal corridor,
 sigma_0 searched before flight and re-solved on board; searched: the alpha law (the mission's
-alpha schedule in speed, or the load factor of Case 1, eq. 31) and the interface altitude;
-sigma_f is searched with sigma_0 before flight."""
+alpha schedule in speed, or the load factor of Case 1, eq. 31), the QEG compensation's gain
+and the interface altitude; sigma_f is searched with sigma_0 before flight."""
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
@@ -19,7 +19,8 @@ from drake_entry.guidance.derivation import (
 )
 from drake_entry.guidance.swarm_bank.spec import SwarmBank
 
-__all__ = ["derive", "BANK_END_BOUNDS_DEG", "REPLAN_PERIOD_S", "OPTIMIZER", "LIMIT_FRACTION", "REPLAN_UNTIL_E"]
+__all__ = ["derive", "BANK_END_BOUNDS_DEG", "REPLAN_PERIOD_S", "OPTIMIZER", "LIMIT_FRACTION", "REPLAN_UNTIL_E",
+           "QEG_GAINS"]
 
 #: sigma_f's bounds when searched with sigma_0 before flight [deg] (paper 004: 60, fixed): sigma_0
 #: alone trades the range against the altitude at the TAEM energy (on HORUS-2B its best plan ends
@@ -32,6 +33,8 @@ OPTIMIZER = "differential_evolution"
 #: (the replica samples the guidance step, Drake every integrator step: at 1.0 the plan's Drake
 #: flight breached HORUS-2B's q by 0.03 %, at 0.93 no plan held the heat rate)
 LIMIT_FRACTION = 0.97
+#: eq. 48's QEG gain k2 tried, in order (paper 004: 10; 0 turns the compensation off)
+QEG_GAINS = (10.0, 0.0)
 #: no re-solution past this normalised energy (paper 004's mission: 0.95)
 REPLAN_UNTIL_E = 0.99
 #: sigma_0 re-solved on board every this [s] (paper 004's plan-once sigma_0 meets its own
@@ -93,5 +96,8 @@ def derive(scenario) -> Derivation:
     search = [SearchStep.over("guidance.alpha_law", laws,
                               "the mission's alpha schedule (as the other methods fly it), else Case 1's load law "
                               "(eq. 31) between its extremes"),
+              SearchStep.over("guidance.qeg_gain", QEG_GAINS,
+                              "eqs. 46-48 steer towards a quasi-equilibrium glide, which a low-L/D capsule does not "
+                              "fly (Lu 2008's capsule: 4 of 10 with the paper's k2 = 10, 10 of 10 without)"),
               SearchStep.over("guidance.terminal_altitude_km", interface_altitudes(scenario, interface), ALTITUDE_WHY)]
     return Derivation(spec, choices, search)

@@ -4,8 +4,8 @@ These functions are not called from Python as written: ``Predictor`` compiles th
 together with two kernels generated from the model expressions (models.kernels), which they
 call by name:
 
-  ``rhs(v, out)``           out[0:7] = d/dt [h, lon, lat, V, gamma, psi, s] at v (12: the 7
-                            states, then sigma_0, e_0, sign, k_L, k_D)
+  ``rhs(v, out)``           out[0:7] = d/dt [h, lon, lat, V, gamma, psi, s] at v (14: the 7
+                            states, then sigma_0, e_0, sign, k_L, k_D, sigma_f, e_f)
   ``energy(v, out)``        out[0] = e = mu/r - V^2/2 [J/kg]
   ``energy_rate(v, out)``   out[0] = e, out[1] = de/dt (the right-hand side's h and V rates)
 
@@ -43,7 +43,7 @@ def rk3_step(v, h, out, k1, k2, k3, work):
 
 
 def predict_flight(v0, step, e_f, floor, ceiling, max_time, steps_per_check):
-    """The predicted flight from v0 (12, ``rhs``'s layout) with fixed steps ``step`` [s] until
+    """The predicted flight from v0 (14, ``rhs``'s layout) with fixed steps ``step`` [s] until
     the energy e_f [J/kg] or a stop checked every ``steps_per_check`` steps: below ``floor`` [m],
     above ``ceiling`` [m], at ``max_time`` [s]. Returns (stop code, time [s], the final v, the
     number of right-hand sides evaluated)."""

@@ -46,7 +46,9 @@ from drake_entry.models.symbolic_system import stateless
 __all__ = ["STAGED_SIZE_RATIO", "ENGINES", "Prediction", "alpha_expression", "Predictor"]
 
 _STATE = [Variable(n) for n in ("h", "lon", "lat", "V", "gamma", "psi", "s")]
-_INPUT = [Variable(n) for n in ("sigma0", "e0", "sign", "lift_scale", "drag_scale")]
+#: the inputs held through a prediction; sigma_f and e_f among them, so the kernels of one vehicle,
+#: alpha profile and law serve every end bank and terminal energy (a derivation's search) unrecompiled
+_INPUT = [Variable(n) for n in ("sigma0", "e0", "sign", "lift_scale", "drag_scale", "sigma_f", "e_f")]
 #: the aerodynamic stage's outputs (scaled lift and drag accelerations [m/s^2], density [kg/m^3])
 _AERO = [Variable(n) for n in ("L", "D", "rho")]
 #: two stages when one system's expanded expressions are at least this many times the stages'
@@ -117,9 +119,9 @@ class Predictor:
             raise ScenarioError(f"FNPEG predictor step_s = {step_s}; allowed > 0 s")
         if engine not in ENGINES:
             raise ScenarioError(f"FNPEG predictor engine = {engine!r}; allowed: {', '.join(ENGINES)}")
-        self.planet, self.mu, self.e_f, self.engine = planet, planet.mu, e_f, engine
+        self.planet, self.mu, self.e_f, self.sigma_f, self.engine = planet, planet.mu, e_f, sigma_f, engine
         self.step_s, self.floor_m, self.ceiling_m, self.max_time_s = step_s, floor_m, ceiling_m, max_time_s
-        aero, motion = _equations(vehicle, planet, atmosphere, law, sigma_f, e_f, alpha, constant)
+        aero, motion = _equations(vehicle, planet, atmosphere, law, alpha, constant)
         one = [f.Substitute(dict(zip(_AERO, aero))) for f in motion]
         self.staged = _size(one) >= STAGED_SIZE_RATIO * (_size(aero) + _size(motion))
         self.evaluations = 0
@@ -153,8 +155,9 @@ class Predictor:
 
     def derivatives(self, y, params) -> np.ndarray:
         """d/dt of the 7 states [h, lon, lat, V, gamma, psi, s] (SI) at ``y`` with the inputs
-        ``params`` = [sigma_0 rad, e_0 J/kg, sign, k_L, k_D], by the predictor's engine."""
-        v = np.array([*map(float, y), *map(float, params)])
+        ``params`` = [sigma_0 rad, e_0 J/kg, sign, k_L, k_D] (sigma_f and e_f the predictor's), by
+        the predictor's engine."""
+        v = np.array([*map(float, y), *map(float, params), self.sigma_f, self.e_f])
         if self.engine == "compiled":
             out = np.empty(len(_STATE))
             self.kernels["rhs"](v, out)
@@ -175,7 +178,7 @@ class Predictor:
             return self._predict_compiled(x, sigma0, sign, scales)
         ctx = self.context
         ctx.SetTime(0.0)
-        self._set_state([*x, 0.0, float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0, *map(float, scales)])
+        self._set_state(self._start(x, sigma0, sign, scales))
         integrator = self.simulator.get_mutable_integrator()
         n0 = integrator.get_num_derivative_evaluations()
         self.simulator.Initialize()
@@ -188,7 +191,7 @@ class Predictor:
             self.evaluations += integrator.get_num_derivative_evaluations() - n0
 
     def _predict_compiled(self, x, sigma0, sign, scales) -> Prediction:
-        v0 = np.array([*x, 0.0, float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0, *map(float, scales)])
+        v0 = self._start(x, sigma0, sign, scales)
         code, t, v, evaluations = self.kernels["predict_flight"](
             v0, self.step_s, self.e_f, self.floor_m, self.ceiling_m, self.max_time_s, _STEPS_PER_CALL)
         self.evaluations += evaluations
@@ -199,6 +202,11 @@ class Predictor:
                               "the prediction left the models' domain (a state became NaN or infinite)")
         flown = v[6] if code == predicted_flight.FLOOR else math.nan
         return Prediction(flown, v[:6].copy(), t, False, self._stop(v, t))
+
+    def _start(self, x, sigma0, sign, scales) -> np.ndarray:
+        """The states and inputs (_STATE, _INPUT) a prediction from ``x`` starts with."""
+        return np.array([*x, 0.0, float(sigma0), self.energy(x), 1.0 if sign >= 0 else -1.0, *map(float, scales),
+                         self.sigma_f, self.e_f])
 
     def _fly(self) -> Prediction:
         ctx, sim, e_f = self.context, self.simulator, self.e_f
@@ -251,11 +259,11 @@ class Predictor:
         return Prediction(y[6], y[:6], ctx.get_time(), True)
 
 
-def _equations(vehicle, planet, atmosphere, law, sigma_f, e_f, alpha, constant):
-    """(aerodynamics, motion): [k_L L, k_D D, rho] of the 7 states and 5 inputs, and the 7
+def _equations(vehicle, planet, atmosphere, law, alpha, constant):
+    """(aerodynamics, motion): [k_L L, k_D D, rho] of the 7 states and 7 inputs, and the 7
     derivatives of the states reading those three as the Variables _AERO (module docstring)."""
     x = [Expression(v) for v in _STATE[:6]]
-    sigma0, e0, sign, k_lift, k_drag = (Expression(u) for u in _INPUT)
+    sigma0, e0, sign, k_lift, k_drag, sigma_f, e_f = (Expression(u) for u in _INPUT)
     L, D, rho = (Expression(v) for v in _AERO)  # the aerodynamic stage's outputs
     h, V, gamma = x[0], x[3], x[4]
     r = planet.radius(h)
@@ -282,8 +290,8 @@ def _size(expressions) -> int:
 
 
 def _build(aerodynamics, motion: list):
-    """(Diagram, its motion system): the motion system integrates the 7 states and holds the 5
-    inputs (_INPUT) as constant states; with ``aerodynamics`` ([k_L L, k_D D, rho] of those 12)
+    """(Diagram, its motion system): the motion system integrates the 7 states and holds the 7
+    inputs (_INPUT) as constant states; with ``aerodynamics`` ([k_L L, k_D D, rho] of those 14)
     an algebraic system computes them for it (``motion`` then reads _AERO), else ``motion``
     holds them itself."""
     held = [*_STATE, *_INPUT]

@@ -7,10 +7,9 @@ order) is flown by the Drake closed loop: the nominal entry and ``draws`` disper
 the mission's own dispersions, drawn with SEARCH_SEED (never a campaign's seed: the campaign is
 not tuned on its own samples). The first candidate whose every flight succeeds within
 GOOD_ENOUGH of every box tolerance is kept; when none does (or the step is exhaustive: every
-candidate flown), the best: most successes, then the
-smallest mean box ratio (a flight's largest |error| / tolerance; one that breaches a limit or
-stops short counts LIMIT_PENALTY or SHORT_PENALTY more). The same mission gives the same
-settings.
+candidate flown), the best: most successes, then the smallest mean box ratio (a flight's largest
+|error| / tolerance; one that breaches a limit or stops short counts LIMIT_PENALTY or
+SHORT_PENALTY more). The same mission gives the same settings.
 """
 from __future__ import annotations
 

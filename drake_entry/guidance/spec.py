@@ -11,6 +11,7 @@ import math
 from drake_entry.errors import ScenarioError, check_range
 
 __all__ = ["MAX_REPLAN_PERIOD_S", "MAX_REPLAN_LATENCY_S", "MAX_REPLAN_LATENCY_FACTOR", "check_replanning",
+           "check_alpha_in_speed",
            "GuidanceSpecBase", "ReplansOnBoard", "ReversingBankSpec", "ReplanningSpec"]
 
 #: the longest on-board re-planning period [s]
@@ -31,6 +32,19 @@ def check_replanning(spec) -> None:
                             f"first plan) or from guidance.period_s = {period} to {MAX_REPLAN_PERIOD_S:g} s")
     check_range("guidance.replan_latency_s", spec.replan_latency_s, 0.0, MAX_REPLAN_LATENCY_S)
     check_range("guidance.replan_latency_factor", spec.replan_latency_factor, 0.0, MAX_REPLAN_LATENCY_FACTOR)
+
+
+def check_alpha_in_speed(alpha_deg, speeds_m_s, lowest_deg: float, highest_deg: float) -> None:
+    """The one rule of an alpha schedule in speed (``guidance.alpha_deg`` at
+    ``guidance.alpha_velocity_m_s``, linear between them): one alpha per speed, at least one, the
+    speeds increasing, every alpha in [lowest_deg, highest_deg]."""
+    if not alpha_deg or len(alpha_deg) != len(speeds_m_s):
+        raise ScenarioError(f"guidance.alpha_deg has {len(alpha_deg)} values and guidance.alpha_velocity_m_s "
+                            f"{len(speeds_m_s)}: an alpha schedule in speed needs one alpha per speed, at least one")
+    if any(b <= a for a, b in zip(speeds_m_s, speeds_m_s[1:])):
+        raise ScenarioError(f"guidance.alpha_velocity_m_s = {speeds_m_s} must increase")
+    for a in alpha_deg:
+        check_range("guidance.alpha_deg", a, lowest_deg, highest_deg)
 
 
 @dc.dataclass

@@ -197,6 +197,12 @@ class PathLimits:
             if not getattr(self, name) > 0:
                 raise ScenarioError(f"PathLimits.{name} must be > 0, got {getattr(self, name)}")
 
+    @property
+    def load_bound_max(self) -> float:
+        """The lower of the normal and total load limits [g]: what a law holding one load must
+        hold it under (the total load bounds the normal)."""
+        return min(self.normal_load_max, self.total_load_max)
+
     def margins(self, *, heat_flux, dynamic_pressure, normal_load, total_load) -> dict:
         """Relative margins 1 - value/limit (negative means violated)."""
         return {

@@ -37,7 +37,7 @@ def derive(scenario) -> Derivation:
     v = scenario.make_vehicle()
     lim = v.limits
     limits = {"heat_rate_limit_kW_m2": lim.heat_flux_max / 1e3,
-              "load_limit_g": min(lim.normal_load_max, lim.total_load_max),
+              "load_limit_g": lim.load_bound_max,
               "dynamic_pressure_limit_kPa": lim.dynamic_pressure_max / 1e3}
 
     def enforced(margin: float) -> dict:

@@ -3,7 +3,7 @@
 import dataclasses as dc
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
+from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec, check_alpha_in_speed
 
 __all__ = ["Fnpeg"]
 
@@ -79,13 +79,7 @@ class Fnpeg(ReversingBankSpec, ReplansOnBoard):
         check_range("guidance.bank_start_guess_deg", self.bank_start_guess_deg, 0.0, 90.0)
         check_range("guidance.bank_before_engagement_deg", self.bank_before_engagement_deg, 0.0, limit)
         check_range("guidance.engage_acceleration_m_s2", self.engage_acceleration_m_s2, 0.0, 100.0)
-        if not self.alpha_deg or len(self.alpha_deg) != len(self.alpha_velocity_m_s):
-            raise ScenarioError(f"guidance.alpha_deg ({len(self.alpha_deg)} values) and guidance.alpha_velocity_m_s "
-                                f"({len(self.alpha_velocity_m_s)}) need the same number of values, at least one")
-        if any(b <= a for a, b in zip(self.alpha_velocity_m_s, self.alpha_velocity_m_s[1:])):
-            raise ScenarioError(f"guidance.alpha_velocity_m_s = {self.alpha_velocity_m_s} must be increasing")
-        for a in self.alpha_deg:
-            check_range("guidance.alpha_deg", a, -10.0, 60.0)
+        check_alpha_in_speed(self.alpha_deg, self.alpha_velocity_m_s, -10.0, 60.0)
         check_range("guidance.alpha_rate_deg_s", self.alpha_rate_deg_s, 1e-3, 100.0)
         check_range("guidance.alpha_accel_deg_s2", self.alpha_accel_deg_s2, 1e-3, 1000.0)
         check_range("guidance.range_tolerance_km", self.range_tolerance_km, 1e-4, 100.0)

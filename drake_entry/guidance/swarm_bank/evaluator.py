@@ -57,7 +57,7 @@ def limit_excess(limits, peaks, fraction: float = 1.0):
     """Sum over heat flux, dynamic pressure and load of max(0, peak / (fraction limit) - 1) per
     member; ``peaks`` (3, n): [heat flux W/m^2, q Pa, total load g] (the total load against the
     lower of the vehicle's total and normal load limits: the total bounds the normal)."""
-    bounds = (limits.heat_flux_max, limits.dynamic_pressure_max, min(limits.total_load_max, limits.normal_load_max))
+    bounds = (limits.heat_flux_max, limits.dynamic_pressure_max, limits.load_bound_max)
     return sum(np.maximum(np.asarray(peak, float) / (fraction * bound) - 1.0, 0.0)
                for peak, bound in zip(peaks, bounds) if math.isfinite(bound))
 

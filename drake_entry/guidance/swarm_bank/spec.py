@@ -4,7 +4,7 @@ import dataclasses as dc
 import typing
 
 from drake_entry.errors import ScenarioError, check_range
-from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
+from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec, check_alpha_in_speed
 
 __all__ = ["ALPHA_LAWS", "SWARMS", "OPTIMIZERS", "swarm_trajectories", "MAX_SEARCH_TRAJECTORIES", "SwarmBank"]
 
@@ -112,15 +112,8 @@ class SwarmBank(ReversingBankSpec, ReplansOnBoard):
         check_range("guidance.mach_shift", self.mach_shift, 0.5, 40.0)
         check_range("guidance.alpha_min_deg", self.alpha_min_deg, -10.0, 60.0)
         check_range("guidance.alpha_max_deg", self.alpha_max_deg, self.alpha_min_deg + 1e-6, 60.0)
-        if self.alpha_law == "schedule":
-            speeds, alphas = self.alpha_velocity_m_s, self.alpha_deg
-            if not alphas or len(alphas) != len(speeds):
-                raise ScenarioError(f"guidance.alpha_deg has {len(alphas)} values and guidance.alpha_velocity_m_s "
-                                    f"{len(speeds)}: the 'schedule' alpha law needs one alpha per speed, at least one")
-            if any(b <= a for a, b in zip(speeds, speeds[1:])):
-                raise ScenarioError(f"guidance.alpha_velocity_m_s = {speeds} must increase")
-            for a in alphas:  # the alpha actuator's position bounds hold the schedule
-                check_range("guidance.alpha_deg", a, self.alpha_min_deg, self.alpha_max_deg)
+        if self.alpha_law == "schedule":  # the alpha actuator's position bounds hold the schedule
+            check_alpha_in_speed(self.alpha_deg, self.alpha_velocity_m_s, self.alpha_min_deg, self.alpha_max_deg)
         check_range("guidance.alpha_rate_deg_s", self.alpha_rate_deg_s, 1e-3, 100.0)
         check_range("guidance.alpha_accel_deg_s2", self.alpha_accel_deg_s2, 1e-3, 1000.0)
         check_range("guidance.objective_range_unit_km", self.objective_range_unit_km, 1e-3, 1e5)

@@ -6,6 +6,8 @@ Entry controls (SCvx plans), as the closed loop flies them:
 
     bank(t + lead) --> BankActuator (sampled every period) --bank--> EntryVehicle
     alpha(t + lead) or ScheduleSource(alpha(V)) --> AlphaActuator --alpha--> EntryVehicle
+    (with ``tracking``: ReplanningGuidance without re-plans, its feedback fed the flown state,
+     --bank_command, alpha_command--> the actuators, as the closed loop flies a plan)
     AtmosphereSystem(state) --air_data--> EntryVehicle; PlantGuard(state) (native plant)
 
 A command known in advance (the plan's spline) is flown as its actuator's response, computed
@@ -43,6 +45,7 @@ from drake_entry.planning.verification import Actuation, EntryControls, FlownCon
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.monitors import PlantGuard
 from drake_entry.systems.native_plant import add_plant, flight_stop
+from drake_entry.systems.replanning_guidance import ReplanningGuidance
 from drake_entry.systems.schedule import ScheduleSource
 
 __all__ = ["ENTRY_STEPS_PER_PERIOD", "ENTRY_ACCURACY", "OCP_ACCURACY", "LOG_POINTS", "FLIGHT_ERRORS", "fly_controls",
@@ -114,12 +117,15 @@ def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_
         alpha_act = AlphaActuator(alpha_min=lo, alpha_max=hi, rate_limit=act.alpha_rate_limit,
                                   accel_limit=act.alpha_accel_limit, initial_alpha=act.initial_alpha,
                                   period=act.period_s)
-    bank_out = _actuated(builder, "bank", bank_plan, bank_act, tf, actuator_systems)
-    if alpha_plan is None:  # the alpha(V) law, fed back from the state
+    if c.tracking is not None:  # the plan and its feedback as the closed loop flies them
+        bank_out, alpha_out = _tracked(builder, c, plant.GetOutputPort("state"), bank_act, alpha_act, tf)
+    elif alpha_plan is None:  # the alpha(V) law, fed back from the state
+        bank_out = _actuated(builder, "bank", bank_plan, bank_act, tf, actuator_systems)
         schedule = builder.AddNamedSystem("alpha_plan", ScheduleSource(c.alpha_law, c.planet))
         builder.Connect(plant.GetOutputPort("state"), schedule.GetInputPort("state"))
         alpha_out = _actuated(builder, "alpha", schedule.get_output_port(), alpha_act, tf, actuator_systems)
     else:
+        bank_out = _actuated(builder, "bank", bank_plan, bank_act, tf, actuator_systems)
         alpha_out = _actuated(builder, "alpha", alpha_plan, alpha_act, tf, actuator_systems)
     builder.Connect(bank_out, plant.GetInputPort("bank"))
     builder.Connect(alpha_out, plant.GetInputPort("alpha"))
@@ -142,6 +148,19 @@ def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_
                             reason=failure or "t_f", wall_time=0.0, step_loggers=step_loggers,
                             final_instant=not failure)
     return FlownControls(tr.time, tr.state, tr, failure)
+
+
+def _tracked(builder, c: EntryControls, state, bank_act, alpha_act, t_end: float):
+    """The bank and alpha output ports of the plan flown with its feedback: the closed loop's
+    ReplanningGuidance without re-plans (the plan's commands read ``lead_s`` ahead plus the
+    offsets its tracking law builds up every period from the flown state) through the actuator
+    systems."""
+    act, tr = c.actuation, c.tracking
+    guidance = builder.AddNamedSystem("tracking", ReplanningGuidance(
+        tr.plan, period=act.period_s, lead=act.lead_s, feedback=tr.feedback, offset_limits=tr.offset_limits))
+    builder.Connect(state, guidance.GetInputPort("estimated_state"))
+    return (_actuated(builder, "bank", guidance.GetOutputPort("bank_command"), bank_act, t_end, True),
+            _actuated(builder, "alpha", guidance.GetOutputPort("alpha_command"), alpha_act, t_end, True))
 
 
 def _actuated(builder, name: str, command, actuator, t_end: float, as_system: bool):

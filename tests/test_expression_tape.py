@@ -134,8 +134,8 @@ def test_scvx_path_margin_ramps_in_from_the_first_node(sphynx):
     vehicle, planet, atmosphere, mission, guess = sphynx
     settings = EntryProblemSettings(formulation="direct")
     problem = EntryProblem(vehicle, planet, atmosphere, mission, settings, 1000.0)
-    q, n = problem.node_limits
-    q_max, n_max = EntryProblem(vehicle, planet, atmosphere, mission, EntryProblemSettings(
+    q, n, _ = problem.node_limits
+    q_max, n_max, _ = EntryProblem(vehicle, planet, atmosphere, mission, EntryProblemSettings(
         formulation="direct", path_margin=0.0), 1000.0).node_limits
     t = problem.mesh.s[1:] * 1000.0
     margin = settings.path_margin * np.minimum(1.0, t / settings.path_margin_ramp_s)

@@ -229,15 +229,18 @@ def test_entry_jacobians_equal_central_differences(sphynx_case, formulation, obj
         assert lin.objective_gradient[i] == pytest.approx((up.objective - down.objective) / (2 * eps), abs=1e-6)
 
 
-def test_a_vehicle_limiting_the_normal_load_and_a_mach_window(sphynx_case):
-    """A vehicle whose only load limit is the normal load (HORUS-2B's kind): the plan bounds
-    (L cos(alpha) + D sin(alpha)) / g0 at the nodes; a DRS Mach window's lower edge is an event
-    row M_min a - V; both rows' Jacobians equal central differences."""
+def test_a_vehicle_limiting_the_normal_load_the_dynamic_pressure_and_a_mach_window(sphynx_case):
+    """A vehicle whose only load limit is the normal load and that limits the dynamic pressure
+    (HORUS-2B's kind): the plan bounds (L cos(alpha) + D sin(alpha)) / g0 and rho V^2 / 2 at the
+    nodes (paper 000 eqs. 34-35); a DRS Mach window's lower edge is an event row M_min a - V;
+    the rows' Jacobians equal central differences. Without a dynamic-pressure limit its rows
+    are -1 with no gradient."""
     from drake_entry.models.constraints import PathLimits, normal_load_factor
     from drake_entry.models.dynamics import aero_accelerations, air_data
 
     vehicle, planet, atmosphere, mission, guess = sphynx_case
-    normal = dc.replace(vehicle, limits=PathLimits(heat_flux_max=vehicle.limits.heat_flux_max, normal_load_max=2.8))
+    normal = dc.replace(vehicle, limits=PathLimits(heat_flux_max=vehicle.limits.heat_flux_max, normal_load_max=2.8,
+                                                   dynamic_pressure_max=20e3))
     window = dc.replace(mission, final_mach_min=0.4)
     problem = EntryProblem(normal, planet, atmosphere, window,
                            EntryProblemSettings(segments=3, nodes_per_segment=3, formulation="direct",
@@ -257,6 +260,18 @@ def test_a_vehicle_limiting_the_normal_load_and_a_mach_window(sphynx_case):
     assert event == pytest.approx((0.4 * a_f - xf[3]) / 100.0, rel=1e-12)
     assert "DRS Mach lower bound" in problem.describe_inequality(problem.n_path + problem.n_epigraph + 4)
     assert problem.describe_inequality(1).startswith("normal load at")
+    assert problem.describe_inequality(2 + 5 * 3).startswith("dynamic pressure at node 4")
+    p_max = problem.node_limits[2]
+    for k in (1, 4, len(X) - 1):
+        rho_k, _ = air_data(X[k, :6], planet, atmosphere)
+        assert ev.inequalities[(k - 1) * 5 + 2] == pytest.approx(0.5 * rho_k * X[k, 3] ** 2 / p_max[k - 1] - 1.0,
+                                                                 rel=1e-12)
+    assert p_max[-1] == pytest.approx(20e3 * (1.0 - problem.settings.path_margin))
+    unlimited = EntryProblem(vehicle, planet, atmosphere, window, problem.settings, guess.final_time)
+    assert not np.isfinite(vehicle.limits.dynamic_pressure_max)
+    rows = np.arange(unlimited.n_nodes - 1) * 5 + 2
+    assert np.all(unlimited.evaluate(z).inequalities[rows] == -1.0)
+    assert not unlimited.linearise(z).inequality_jacobian.toarray()[rows].any()
     lin = problem.linearise(z)
     G = lin.inequality_jacobian.toarray()
     eps = 1e-6

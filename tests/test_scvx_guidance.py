@@ -72,3 +72,62 @@ def test_guidance_system_serves_the_plan_bank_and_alpha(setup):
 
 # The nominal closed loop (re-planned, plan alone, without the lead) and a campaign of the
 # scenario's dispersions are flown once per session, by example 09 (tests/test_examples.py).
+
+
+def test_scvx_derived_for_horus2b_ends_its_plans_where_the_flight_stops_below_the_dynamic_pressure_limit():
+    """On HORUS-2B's mission SCvx plans to the box's centre altitude (the flight's stop), within
+    50 m of it, inside the box's Mach window and below the Mach number where 10 kPa is met there
+    (25 km at Mach 2.5 would be 11 kPa); each searched altitude likewise; it tracks its plans
+    between re-plans and keeps the shared limit margin."""
+    import math
+
+    from drake_entry.guidance.derivation import LIMIT_MARGIN, derivation_for
+    from drake_entry.guidance.scvx.spec import Scvx
+
+    mission = load_scenario("horus2b")
+    t = mission.terminal
+    d = derivation_for(mission, Scvx)
+    spec = d.spec
+    assert spec.terminal_altitude_km == t.altitude_km == 25.0
+    assert spec.feedback == "tvlqr" and spec.objective == "control_effort"
+    assert spec.path_margin == pytest.approx(1.0 - LIMIT_MARGIN)
+    atmosphere, q_max = mission.make_atmosphere(), mission.make_vehicle().limits.dynamic_pressure_max
+    assert q_max == 10e3
+    candidates = d.search[0].candidates
+    assert len(candidates) >= 4
+    for c in candidates:
+        h = c["guidance.terminal_altitude_km"]
+        lo, hi = c["guidance.final_altitude_m"]
+        assert t.altitude_km - t.altitude_tolerance_km <= lo / 1e3 < h < hi / 1e3 <= t.altitude_km + t.altitude_tolerance_km
+        assert hi - lo - 2.0 * c["guidance.final_altitude_margin_m"] == pytest.approx(100.0)  # the aim: h +- 50 m
+        q_mach = math.sqrt(2.0 * q_max / float(atmosphere.density(h * 1e3))) / float(atmosphere.speed_of_sound(h * 1e3))
+        assert t.mach - t.mach_tolerance <= c["guidance.final_mach_min"] < c["guidance.final_mach_max"] < q_mach
+        assert c["guidance.final_mach_min"] <= c["guidance.terminal_mach"] <= c["guidance.final_mach_max"]
+    assert q_mach < t.mach + t.mach_tolerance
+
+
+def test_an_scvx_plan_flown_with_its_tracking_law_ends_where_it_planned_and_open_loop_does_not():
+    """HORUS-2B's derived SCvx plan, flown by the Drake verifier through the closed loop's
+    actuators with the TVLQR feedback the guidance flies between re-plans, ends 0.29 km from its
+    terminal point and is verified; its same controls without the feedback drift 36.8 km over
+    the 1500-s glide (the actuators' lag alone)."""
+    from drake_entry.comparison.derive import apply_derivation
+    from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.guidance.derivation import derivation_for
+    from drake_entry.guidance.scvx.method import METHOD
+    from drake_entry.guidance.scvx.planner import PROPAGATION_TOLERANCE_M, flown_check, plan_controls
+    from drake_entry.guidance.scvx.spec import Scvx
+    from drake_entry.planning.verification import EntryControls
+
+    mission = load_scenario("horus2b")
+    plan = METHOD.make_planner(apply_derivation(mission, derivation_for(mission, Scvx)), fly_controls)
+    assert plan.success, plan.message
+    assert plan.flight.feedback == "tvlqr" and plan.propagated_error_m < 0.2 * PROPAGATION_TOLERANCE_M
+    assert plan.flown.within_limits and plan.flown.drs_ok
+    assert plan.peaks["heat_flux_W_m2"] <= 530e3 and plan.metrics["max_dynamic_pressure_kPa"] <= 10.0
+    open_loop = flown_check(plan, fly_controls(plan_controls(plan, dc.replace(plan.flight, feedback="none"))))
+    assert open_loop.from_plan_m > 4 * PROPAGATION_TOLERANCE_M
+    controls = plan_controls(plan, plan.flight)
+    with pytest.raises(ScenarioError, match="tracking needs an actuation"):
+        dc.replace(controls, actuation=None)
+    assert isinstance(controls, EntryControls)

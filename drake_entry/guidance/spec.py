@@ -141,8 +141,29 @@ class ReplanningSpec(ReplansOnBoard):
     # on-board re-planning (replan_period_s) only while the plan in use has more than
     # replan_min_time_to_go_s [s] to go
     replan_min_time_to_go_s: float = 300.0
+    # between re-plans the commands track the plan in use: "tvlqr" (a time-varying LQR of the
+    # plan's linearised dynamics, planning.tracking; the plans are then verified flown with it)
+    # or "none" (its controls in time only; a method may offer more: FEEDBACKS);
+    # feedback_state_weight: the LQR's path weight (TrackingWeights.entry_commands); the
+    # feedback's bank and alpha offsets are bounded by the two limits [deg]
+    feedback: str = "none"
+    feedback_state_weight: float = 1.0e-3
+    feedback_bank_limit_deg: float = 30.0
+    feedback_alpha_limit_deg: float = 5.0
+
+    #: the feedback kinds the method offers
+    FEEDBACKS = ("tvlqr", "none")
 
     def validate(self, scenario) -> None:
         super().validate(scenario)
         check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
         check_range("guidance.replan_min_time_to_go_s", self.replan_min_time_to_go_s, 0.0, 1e4)
+        if self.feedback not in self.FEEDBACKS:
+            raise ScenarioError(f"guidance.feedback = '{self.feedback}' is unknown; allowed: {', '.join(self.FEEDBACKS)}")
+        check_range("guidance.feedback_state_weight", self.feedback_state_weight, 1e-9, 1e3)
+        check_range("guidance.feedback_bank_limit_deg", self.feedback_bank_limit_deg, 0.0, 180.0)
+        check_range("guidance.feedback_alpha_limit_deg", self.feedback_alpha_limit_deg, 0.0, 45.0)
+
+    def feedback_offset_limits(self) -> tuple[float, float]:
+        """The feedback's bank and alpha offset bounds [rad]."""
+        return math.radians(self.feedback_bank_limit_deg), math.radians(self.feedback_alpha_limit_deg)

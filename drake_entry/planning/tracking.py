@@ -77,6 +77,21 @@ class TrackingWeights:
             control_scale={"u_sigma": d(1.0)},
             terminal_scale={"lon": d(0.01), "lat": d(0.01), "h": 1.0e3, "V": 10.0})
 
+    @staticmethod
+    def entry_commands(state_weight: float) -> "TrackingWeights":
+        """Weights for feedback on the bank and alpha commands of an entry plan (bank and alpha
+        states, their rates 'u_sigma', 'u_alpha' the controls; planning.ocp's 'rates' layout): a
+        deviation of 1 km, 0.1 deg of position or path angles, 10 m/s, 1 deg of alpha or bank
+        costs 1 per second times ``state_weight``; 1 deg/s of alpha or bank rate costs 1; the
+        final position weighted by 0.01 deg (1.1 km), the final speed by 10 m/s and the final
+        flight-path angle by 1 deg (the re-solving guidances' feedback between re-plans)."""
+        d = math.radians
+        return TrackingWeights(
+            state_scale={"h": 1.0e3, "lon": d(0.1), "lat": d(0.1), "V": 10.0, "gamma": d(0.1), "psi": d(0.1),
+                         "alpha": d(1.0), "sigma": d(1.0)},
+            control_scale={"u_alpha": d(1.0), "u_sigma": d(1.0)}, state_weight=state_weight,
+            terminal_scale={"lon": d(0.01), "lat": d(0.01), "V": 10.0, "gamma": d(1.0)})
+
     def matrices(self, state_names, control_names) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(sx, su, Q, R, Qf) for the layout: scales (unnamed states scale 1 and cost 0)."""
         for where, names, given in (("state_scale", state_names, self.state_scale),

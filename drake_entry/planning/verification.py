@@ -9,7 +9,8 @@ every path limit. That flight is a service of the diagrams layer
     verifier(controls: EntryControls | OcpControls) -> FlownControls
 
 - ``EntryControls``: bank and angle of attack in time, flown on the entry vehicle, through the
-  closed loop's bank and alpha actuators when ``actuation`` is given (SCvx plans);
+  closed loop's bank and alpha actuators when ``actuation`` is given (SCvx plans), with the
+  closed loop's feedback between re-plans when ``tracking`` is given;
 - ``OcpControls``: an optimal-control problem's controls in time, flown on the problem's own
   dynamics (NLP solutions, which no closed loop flies yet).
 
@@ -24,7 +25,7 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["Actuation", "EntryControls", "OcpControls", "FlownControls", "Verifier", "require_verifier"]
+__all__ = ["Actuation", "Tracking", "EntryControls", "OcpControls", "FlownControls", "Verifier", "require_verifier"]
 
 
 @dc.dataclass(frozen=True)
@@ -53,6 +54,18 @@ class Actuation:
 
 
 @dc.dataclass(frozen=True)
+class Tracking:
+    """The tracking law the closed loop flies on top of a plan's commands between re-plans
+    (systems/replanning_guidance.py): ``plan`` as that system flies it (its control_samples(),
+    and problem.alpha where alpha follows a law), ``feedback`` its law maker (plan ->
+    CommandFeedback or None) and ``offset_limits`` (bank, alpha) [rad]."""
+
+    plan: object
+    feedback: Callable
+    offset_limits: tuple
+
+
+@dc.dataclass(frozen=True)
 class EntryControls:
     """Bank and angle of attack of a plan in time, to fly from its entry state.
 
@@ -65,6 +78,7 @@ class EntryControls:
         ``alpha_law`` (an alpha(V) schedule, evaluated at the flown speed).
       actuation: the closed loop's actuators, or None to feed bank and alpha to the vehicle
         directly (a C2 spline through the samples).
+      tracking: the closed loop's feedback on the commands (needs ``actuation``), or None.
     """
 
     vehicle: object
@@ -77,8 +91,11 @@ class EntryControls:
     alpha: np.ndarray | None = None
     alpha_law: object = None
     actuation: Actuation | None = None
+    tracking: Tracking | None = None
 
     def __post_init__(self):
+        if self.tracking is not None and self.actuation is None:
+            raise ScenarioError("EntryControls.tracking needs an actuation: the feedback acts through the actuators")
         _check_samples("EntryControls", self.time, {"bank": self.bank, "alpha": self.alpha}, self.final_time)
         if self.alpha is None and self.alpha_law is None:
             raise ScenarioError("EntryControls needs alpha samples or an alpha_law")

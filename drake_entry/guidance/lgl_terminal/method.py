@@ -14,8 +14,6 @@ use flies on. The closed loop stops at impact (``stops_at_altitude``).
 """
 from __future__ import annotations
 
-import math
-
 from drake_entry.guidance.interface import (
     ActuatorLimits,
     GuidanceCommands,
@@ -46,8 +44,7 @@ class LglTerminalMethod(GuidanceMethod):
                                            time_to_go_fraction=g.replan_time_to_go_fraction or None,
                                            model_scales=g.replan_model_scales,
                                            feedback=feedback_maker(g.feedback),
-                                           offset_limits=(math.radians(g.feedback_bank_limit_deg),
-                                                          math.radians(g.feedback_alpha_limit_deg)))
+                                           offset_limits=g.feedback_offset_limits())
         if g.replan_model_scales:
             ratios = builder.AddNamedSystem(RATIO_SYSTEM, AccelerationRatioFilter(
                 scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere(), period=g.period_s))

@@ -130,17 +130,9 @@ class LglPlan:
 
 
 def feedback_weights(spec) -> TrackingWeights:
-    """The LQR weights of the feedback between re-solves (scaled units, planning.tracking): a
-    deviation of 1 km, 0.1 deg of position or path angles, 10 m/s, 1 deg of alpha or bank costs
-    1 per second times ``spec.feedback_state_weight``; 1 deg/s of alpha or bank rate costs 1;
-    the final position weighted by 0.01 deg (1.1 km), the final speed by 10 m/s and the final
-    flight-path angle by 1 deg."""
-    d = math.radians
-    return TrackingWeights(
-        state_scale={"h": 1.0e3, "lon": d(0.1), "lat": d(0.1), "V": 10.0, "gamma": d(0.1), "psi": d(0.1),
-                     "alpha": d(1.0), "sigma": d(1.0)},
-        control_scale={"u_alpha": d(1.0), "u_sigma": d(1.0)}, state_weight=spec.feedback_state_weight,
-        terminal_scale={"lon": d(0.01), "lat": d(0.01), "V": 10.0, "gamma": d(1.0)})
+    """The LQR weights of the feedback between re-solves (planning.tracking,
+    ``TrackingWeights.entry_commands``) at the spec's ``feedback_state_weight``."""
+    return TrackingWeights.entry_commands(spec.feedback_state_weight)
 
 
 def feedback_maker(kind: str):

@@ -24,6 +24,7 @@ class LglTerminal(ReplanningSpec):
 
     #: fields naming a file: a relative path is read beside the scenario file (typed_yaml.resolve_file_fields)
     FILE_FIELDS = ('problem',)
+    FEEDBACKS = FEEDBACKS
 
     # the closed loop stops at impact
     stops_at_altitude = True
@@ -60,15 +61,10 @@ class LglTerminal(ReplanningSpec):
     # re-solves predict with the nominal lift and drag times the low-passed ratios of the sensed
     # to the modelled accelerations (a density, aerodynamic or mass error the flight has shown)
     replan_model_scales: bool = True
-    # between re-solves the commands track the solution in use: "tvlqr" (a time-varying LQR of
-    # the solution's linearised dynamics, planning.tracking), "costate" (the neighbouring-optimal
-    # law of its costates, planning.neighbouring_optimal) or "none" (its controls in time only);
-    # feedback_state_weight: the LQR's path weight (planner.feedback_weights); the feedback's
-    # bank and alpha offsets are bounded by the two limits [deg]
+    # between re-solves the commands track the solution in use (ReplanningSpec's feedback
+    # fields): "tvlqr", "costate" (the neighbouring-optimal law of its costates,
+    # planning.neighbouring_optimal) or "none"
     feedback: str = "tvlqr"
-    feedback_state_weight: float = 1.0e-3
-    feedback_bank_limit_deg: float = 30.0
-    feedback_alpha_limit_deg: float = 5.0
     # the angle-of-attack actuator's acceleration limit [deg/s^2] (its rate limit is the
     # problem's alpha-rate bound, eq. 17)
     alpha_accel_limit_deg_s2: float = 40.0
@@ -108,11 +104,6 @@ class LglTerminal(ReplanningSpec):
         check_range("guidance.replan_time_to_go_fraction", self.replan_time_to_go_fraction, 0.0, 1.0)
         check_range("guidance.replan_speed_window_m_s", self.replan_speed_window_m_s, 0.0, 1e3)
         check_range("guidance.replan_flight_path_window_deg", self.replan_flight_path_window_deg, 0.0, 45.0)
-        if self.feedback not in FEEDBACKS:
-            raise ScenarioError(f"guidance.feedback = '{self.feedback}' is unknown; allowed: {', '.join(FEEDBACKS)}")
-        check_range("guidance.feedback_state_weight", self.feedback_state_weight, 1e-9, 1e3)
-        check_range("guidance.feedback_bank_limit_deg", self.feedback_bank_limit_deg, 0.0, 180.0)
-        check_range("guidance.feedback_alpha_limit_deg", self.feedback_alpha_limit_deg, 0.0, 45.0)
         check_range("guidance.alpha_accel_limit_deg_s2", self.alpha_accel_limit_deg_s2, 0.1, 1e3)
         if self.final_flight_path_deg is not None:
             check_range("guidance.final_flight_path_deg", self.final_flight_path_deg, -89.9, 0.0)

@@ -18,7 +18,6 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.scvx.mission import ScvxMission
-from drake_entry.guidance.scvx.planner import initial_decision
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
@@ -96,6 +95,8 @@ def nlp_form(plan) -> tuple:
     """(OptimalControlProblem, guess) of an SCvx direct plan for ``nlp.solve``: its mission and
     models with its problem's final-time bounds, started from the glide guess the plan started
     from (``plan.guess``), so the two methods solve the same problem from the same point."""
+    from drake_entry.guidance.scvx.planner import initial_decision  # planner imports this module (feedback)
+
     p = plan.problem
     if plan.guess is None:
         raise ScenarioError("nlp_form needs a plan started from a glide guess (plan.guess is None: "

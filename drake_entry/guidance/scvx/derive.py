@@ -1,32 +1,89 @@
 """SCvx's settings from a mission (drake_entry.guidance.derivation): paper 001's DRS box posed on
-the mission's acceptance box. The altitude window is the box's, the Mach window the box's (from
-its speed window where it gives one), the site cone half the box's distance tolerance (a design
-margin), the alpha law the mission's alpha rewritten in speed, the heading bounds half a turn
-either side of the entry heading; the plan bounds the vehicle's heat flux and whichever load it
-limits, and is re-planned on board as paper 001's own scenario is. A mission whose box gives no
-altitude window or no distance cannot be posed: CannotFly."""
+the mission's acceptance box. The plan ends at the altitude where the flight stops (the box's
+centre, then other altitudes in the box: a search), inside the middle of the box's Mach window
+(from its speed window where it gives one), within half the box's distance tolerance of the
+site (a design margin); its alpha is the mission's alpha rewritten in speed, its heading bounds
+half a turn either side of the entry heading; it bounds the vehicle's heat flux, whichever load
+the vehicle limits and its dynamic pressure, and is re-planned on board as paper 001's own
+scenario is. A mission whose box gives no altitude window or no distance cannot be posed:
+CannotFly."""
+import math
 
-from drake_entry.guidance.derivation import CannotFly, Choice, Derivation, alpha_rewritten, terminal_interface
+from drake_entry.guidance.derivation import (
+    ALTITUDE_WHY,
+    LIMIT_MARGIN,
+    CannotFly,
+    Choice,
+    Derivation,
+    SearchStep,
+    alpha_rewritten,
+    interface_altitudes,
+    terminal_interface,
+)
 from drake_entry.guidance.scvx.mission import planned_load
 from drake_entry.guidance.scvx.spec import Scvx
 
-__all__ = ["derive", "SITE_RADIUS_FRACTION", "STOP_ABOVE_WINDOW_KM", "REPLAN_PERIOD_S", "OBJECTIVE", "FORMULATION"]
+__all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW_KM", "AIM_TOLERANCE_KM",
+           "FEEDBACK", "REPLAN_PERIOD_S", "OBJECTIVE", "FORMULATION", "aim_window"]
 
-#: the plan's objective and formulation on another method's mission: the miss distance, with the
-#: bank a state and alpha the mission's law. Measured on HORUS-2B's nominal (plans of 23-40
-#: iterations, 2-3 s): the flown controls of a heat-load plan end 107-164 km from its terminal
-#: point (bang-bang bank swings the actuators lag), of a miss plan with alpha planned 41 km, of a
-#: miss plan with the mission's alpha 23 km
-OBJECTIVE, FORMULATION = "miss", "direct_bank"
+#: the plan's objective and formulation on another method's mission: the control effort (the
+#: integral of |sigma_dot|), with the bank a state and alpha the mission's law. Measured on
+#: HORUS-2B's nominal with the dynamic-pressure bound (plans of 21-42 iterations, 2.5-3.5 s), the
+#: controls of each objective's plan flown open loop (no feedback) end this far from its end:
+#: control effort 0.5 km; miss 27 km (its bank chatters between nodes: any path inside the cone
+#: is as good); max load 76 km, max heat flux 132 km, heat load 183 km, time 176 km (bang-bang
+#: bank swings the actuators lag); max control rate: the sub-problem failed
+OBJECTIVE, FORMULATION = "control_effort", "direct_bank"
 
 #: the plan's site cone as a fraction of the box's distance tolerance (room for the flown error)
 SITE_RADIUS_FRACTION = 0.5
-#: the flight stops this far above the window's lower edge [km] (the plans end at the edge plus
-#: their 200 m design margin: paper 001's scenario stops 170 m above its window)
-STOP_ABOVE_WINDOW_KM = 0.15
+#: the plan's Mach window as a fraction of the box's Mach window, about its centre
+MACH_WINDOW_FRACTION = 0.5
+#: the flown plan's DRS altitude is checked within this of the stop altitude [km] (at most a
+#: quarter of the box's altitude tolerance), and the plan aims within AIM_TOLERANCE_KM of it: the
+#: flight stops at that altitude, so a plan ending 1.5 km above it (the window's upper part,
+#: where a control-effort plan settles) left 34 km and Mach 0.9 of flight it never planned
+AIM_WINDOW_KM, AIM_TOLERANCE_KM = 0.5, 0.05
+#: the feedback between re-plans (drake_entry.guidance.scvx.feedback): measured on HORUS-2B's
+#: nominal (50 x 6 mesh, path margin 0.07), the plan flown through the actuators ends 36.8 km
+#: from its terminal point without it (with 0.5 s less command lead 15 km, 1 s more 21 km), 0.38
+#: km with it; with it the paper's 33 x 4 mesh flew the nominal and two dispersed draws inside
+#: the box as 50 x 6 did (box ratio 0.84 both)
+FEEDBACK = "tvlqr"
 #: re-plan from the navigation estimate every this [s] while more than 300 s are left (paper
 #: 001's scenario: the pre-flight plan alone ends 21.5 km from its site)
 REPLAN_PERIOD_S = 200.0
+
+
+def aim_window(scenario, altitude_km: float, mach_window: tuple | None, mach: float) -> dict:
+    """The fields that make a plan end at ``altitude_km`` where the flight stops: the DRS
+    window the flown plan is checked in [m] (AIM_WINDOW_KM about it, at most a quarter of the
+    box's altitude tolerance and inside the box), the margin that narrows the plan's aim to
+    AIM_TOLERANCE_KM [m], the stop altitude [km], and the plan's Mach window: the middle
+    MACH_WINDOW_FRACTION of the box's ``mach_window`` (low, high; None: open) below the Mach
+    number where the vehicle's dynamic-pressure limit is met at that altitude (a window the
+    limit closes gives an empty window: the candidate is refused), with the interface's
+    ``mach`` held inside it as the spec's terminal_mach."""
+    t = scenario.terminal
+    centre_km, tolerance_km = t.altitude_km, t.altitude_tolerance_km
+    half = min(AIM_WINDOW_KM, 0.25 * tolerance_km, tolerance_km - abs(altitude_km - centre_km))
+    margin = min(max(half - AIM_TOLERANCE_KM, 0.0), 0.49 * 2.0 * half)
+    fields = {"guidance.final_altitude_m": [round((altitude_km - half) * 1e3, 3), round((altitude_km + half) * 1e3, 3)],
+              "guidance.final_altitude_margin_m": round(margin * 1e3, 3), "guidance.terminal_altitude_km": altitude_km}
+    if mach_window is None:
+        return fields | {"guidance.final_mach_min": 0.0, "guidance.final_mach_max": 10.0,
+                         "guidance.terminal_mach": round(min(mach, 10.0), 4)}
+    lo, hi = mach_window
+    q_max = scenario.make_vehicle().limits.dynamic_pressure_max
+    if math.isfinite(q_max):
+        atmosphere = scenario.make_atmosphere()
+        h = altitude_km * 1e3
+        rho, a = float(atmosphere.density(h)), float(atmosphere.speed_of_sound(h))
+        hi = min(hi, math.sqrt(2.0 * q_max / rho) / a)
+    centre, half_width = 0.5 * (lo + hi), 0.5 * MACH_WINDOW_FRACTION * (hi - lo)
+    lo, hi = round(max(centre - half_width, 0.0), 4), round(centre + half_width, 4)
+    return fields | {"guidance.final_mach_min": lo, "guidance.final_mach_max": hi,
+                     "guidance.terminal_mach": min(max(round(mach, 4), lo), hi)}
 
 
 def derive(scenario) -> Derivation:
@@ -41,19 +98,19 @@ def derive(scenario) -> Derivation:
                         "(paper 001 eqs. 67-68)")
     a = interface.speed_of_sound
     if t.mach is not None and t.mach_tolerance:
-        mach_lo, mach_hi, mach_how = t.mach - t.mach_tolerance, t.mach + t.mach_tolerance, "the box's Mach window"
+        mach_window, mach_how = (t.mach - t.mach_tolerance, t.mach + t.mach_tolerance), "the box's Mach window"
     elif t.velocity_m_s is not None and t.velocity_tolerance_m_s:
-        mach_lo = (t.velocity_m_s - t.velocity_tolerance_m_s) / a
-        mach_hi = (t.velocity_m_s + t.velocity_tolerance_m_s) / a
+        mach_window = ((t.velocity_m_s - t.velocity_tolerance_m_s) / a, (t.velocity_m_s + t.velocity_tolerance_m_s) / a)
         mach_how = f"the box's speed window as Mach at {interface.altitude_km:g} km"
     else:
-        mach_lo, mach_hi, mach_how = 0.0, 10.0, "the box checks no speed: the Mach window is open"
-    mach_lo = max(mach_lo, 0.0)
-    mach = interface.mach
-    h = interface.altitude_km
-    window = [round((h - t.altitude_tolerance_km) * 1e3, 3), round((h + t.altitude_tolerance_km) * 1e3, 3)]
-    if window[0] < 0.0:
-        raise CannotFly(f"the mission's altitude window reaches below the ground ({window[0] / 1e3:g} km)")
+        mach_window, mach_how = None, "the box checks no speed: the Mach window is open"
+    if mach_window is not None:
+        mach_how = (f"the middle {MACH_WINDOW_FRACTION:g} of {mach_how} below the vehicle's dynamic-pressure limit "
+                    f"at the interface altitude (room for the flown error)")
+    h, tol = interface.altitude_km, t.altitude_tolerance_km
+    if h - tol < 0.0:
+        raise CannotFly(f"the mission's altitude window reaches below the ground ({h - tol:g} km)")
+    altitudes = interface_altitudes(scenario, interface)
     speeds, alphas, alpha_how = alpha_rewritten(scenario, interface, "velocity")
     if len(alphas) == 1:
         alpha_deg, alpha_speeds = [alphas[0], alphas[0]], [2000.0, 5000.0]
@@ -61,20 +118,26 @@ def derive(scenario) -> Derivation:
         alpha_deg, alpha_speeds = [alphas[-1], alphas[0]], [max(speeds[0], 1.0), speeds[-1]]
     bounds = [min(alphas), max(alphas)] if max(alphas) > min(alphas) else [max(0.0, alphas[0] - 2.0), alphas[0] + 2.0]
     psi = scenario.entry.heading_deg
-    spec = Scvx(terminal_altitude_km=round(window[0] / 1e3 + STOP_ABOVE_WINDOW_KM, 4),
-                terminal_mach=round(min(max(mach, mach_lo), mach_hi), 4), final_altitude_m=window,
-                final_mach_min=round(mach_lo, 4), final_mach_max=round(mach_hi, 4),
+    aims = [aim_window(scenario, altitude, mach_window, interface.mach) for altitude in altitudes]
+    aims = [aim for aim in aims if aim["guidance.final_mach_min"] < aim["guidance.final_mach_max"]]
+    if not aims:
+        raise CannotFly(f"the vehicle's dynamic-pressure limit closes the box's Mach window {mach_window} at every "
+                        f"altitude of the box ({', '.join(f'{v:g}' for v in altitudes)} km)")
+    first = aims[0]
+    spec = Scvx(terminal_altitude_km=first["guidance.terminal_altitude_km"], terminal_mach=first["guidance.terminal_mach"],
+                final_altitude_m=first["guidance.final_altitude_m"],
+                final_altitude_margin_m=first["guidance.final_altitude_margin_m"],
+                final_mach_min=first["guidance.final_mach_min"], final_mach_max=first["guidance.final_mach_max"],
                 site_radius_m=round(SITE_RADIUS_FRACTION * t.distance_tolerance_km * 1e3, 3),
                 final_vertical_speed_min_m_s=-300.0, heading_bounds_deg=[psi - 180.0, psi + 180.0],
                 flight_path_bounds_deg=[-30.0, 5.0], objective=OBJECTIVE, formulation=FORMULATION,
                 alpha_deg=alpha_deg, alpha_speeds_m_s=alpha_speeds, alpha_bounds_deg=bounds,
-                replan_period_s=REPLAN_PERIOD_S)
+                replan_period_s=REPLAN_PERIOD_S,
+                path_margin=round(1.0 - LIMIT_MARGIN, 4), feedback=FEEDBACK)
     load, _ = planned_load(scenario.make_vehicle().limits)
     choices = [
-        Choice("guidance.final_altitude_m", f"{window[0] / 1e3:g}-{window[1] / 1e3:g} km", "the box's altitude window"),
-        Choice("guidance.terminal_altitude_km", spec.terminal_altitude_km,
-               f"the flight stops {STOP_ABOVE_WINDOW_KM:g} km above the window's lower edge, where the plans end"),
-        Choice("guidance.final_mach_min, final_mach_max", f"{mach_lo:.3g}-{mach_hi:.3g}", mach_how),
+        Choice("guidance.final_mach_min, final_mach_max",
+               f"{first['guidance.final_mach_min']:.3g}-{first['guidance.final_mach_max']:.3g}", mach_how),
         Choice("guidance.site_radius_m", spec.site_radius_m,
                f"{SITE_RADIUS_FRACTION:g} x the box's distance tolerance (room for the flown error)"),
         Choice("guidance.alpha_deg, alpha_speeds_m_s, alpha_bounds_deg",
@@ -83,8 +146,20 @@ def derive(scenario) -> Derivation:
         Choice("guidance.flight_path_bounds_deg", spec.flight_path_bounds_deg,
                "paper 001's lower bound; the upper opened to 5 deg (the mission does not bound gamma)"),
         Choice("guidance.objective, formulation", f"{OBJECTIVE}, {FORMULATION}",
-               "the miss, with the mission's alpha: the plans whose controls fly closest to themselves"),
-        Choice("the plan's load bound", load, f"the vehicle limits the {load} load"),
+               "the control effort, with the mission's alpha: the plans whose controls fly closest to themselves"),
+        Choice("the plan's path bounds", f"heat flux, {load} load, dynamic pressure",
+               f"the vehicle's limits (it limits the {load} load)"),
+        Choice("guidance.path_margin", spec.path_margin,
+               f"the plans keep {LIMIT_MARGIN:g} of each limit, the shared margin for dispersions (between re-plans "
+               f"the flight drifts: at paper 001's 0.02 a dispersed HORUS-2B flight met 100.5 % of its heat-flux "
+               f"limit 100 s after the first re-plan)"),
         Choice("guidance.replan_period_s", REPLAN_PERIOD_S, "re-planned on board as paper 001's scenario is"),
+        Choice("guidance.feedback", FEEDBACK,
+               "between re-plans the commands track the plan (not paper 001's): without it the plan flown through "
+               "the actuators drifts 5-37 km from itself over HORUS-2B's glide, with it 0.4 km"),
     ]
-    return Derivation(spec, choices, [])
+    search = [
+        SearchStep("the interface altitude (the plan ends where the flight stops)",
+                   tuple(aims), ALTITUDE_WHY),
+    ]
+    return Derivation(spec, choices, search)

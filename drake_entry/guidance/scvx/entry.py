@@ -25,8 +25,9 @@ nodes; 2 nodes per segment is the paper's trapezoid, Sec. IV.B),
 
 Constraints: control bounds (eqs. 36, 43-44, hard), |u| <= 1 (eq. 42, hard cone, lossless);
 buffered (eq. 24) at every node: heat flux <= q_max (eq. 9), total load <= n_max (eq. 10), or
-the normal load (paper 000 eq. 35) for a vehicle that limits only that (both less the settings'
-path_margin),
+the normal load (paper 000 eq. 35) for a vehicle that limits only that, dynamic pressure <=
+the vehicle's limit where it states one (paper 000 eq. 34; inactive rows otherwise) (all less
+the settings' path_margin),
 flight-path bounds (eq. 70); at the DRS point: geodetic altitude window (eq. 64, narrowed by
 the mission's final_altitude_margin_m), M_min a <= V <= M a
 (eq. 65; M_min 0 in paper 001, a TAEM box's lower Mach otherwise), V sin(gamma) >= V_v,min (eq. 66), and a cone ||miss|| <= site radius (eqs. 67-68)
@@ -68,7 +69,7 @@ from drake_entry.guidance.scvx.settings import (
     EntryProblemSettings,
 )
 from drake_entry.models.atmosphere import Atmosphere
-from drake_entry.models.constraints import signed_normal_load_factor, total_load_factor
+from drake_entry.models.constraints import dynamic_pressure, signed_normal_load_factor, total_load_factor
 from drake_entry.models.dynamics import STATE_NAMES, aero_accelerations, air_data, equations_of_motion_lift_components
 from drake_entry.models.expression_tape import ExpressionTape, TracedAtmosphere
 from drake_entry.models.planet import Earth
@@ -89,7 +90,7 @@ GAMMA_RATE_SCALE = 1e-3  # rad/s
 MISS_SCALE = 1e4  # m
 
 
-PATH_NAMES = ("heat flux", "total load", "flight-path lower bound", "flight-path upper bound")
+PATH_NAMES = ("heat flux", "total load", "dynamic pressure", "flight-path lower bound", "flight-path upper bound")
 EVENT_NAMES = ("DRS altitude lower bound", "DRS altitude upper bound", "DRS Mach", "DRS vertical speed",
                "DRS Mach lower bound")
 #: |u| below which the bank-norm floor's gradient takes the direction (1, 0)
@@ -144,8 +145,8 @@ class EntryProblem(ConvexifiableProblem):
             control_scale.append(ALPHA_RATE_SCALE)
         self.state_scale, self.control_scale = np.array(state_scale), np.array(control_scale)
         self.n_x, self.n_u = nx, nu = len(state_scale), len(control_scale)
-        self.out_q, self.out_n, self.out_a, self.out_h = nx, nx + 1, nx + 2, nx + 3
-        self.n_outputs = nx + 4
+        self.out_q, self.out_n, self.out_a, self.out_h, self.out_p = nx, nx + 1, nx + 2, nx + 3, nx + 4
+        self.n_outputs = nx + 5
         n = self.n_nodes = self.mesh.n_nodes
         objective = settings.objective
         self.n_aux = n if objective == "control_effort" else (0 if objective in ("heat_load", "time") else 1)
@@ -175,12 +176,14 @@ class EntryProblem(ConvexifiableProblem):
         self._gamma_bounds = np.radians(mission.flight_path_bounds_deg) + np.radians(
             settings.flight_path_margins_deg) * np.array([1.0, -1.0])
         self.rate_chords = f.bank == "lossless" and settings.lossless_rate_limit
-        #: heat flux [W/m^2] and load [g] bounds at nodes 1..n-1 (n - 1 each): the vehicle's less
-        #: the path margin, ramped in over the first path_margin_ramp_s of the final-time guess
+        #: heat flux [W/m^2], load [g] and dynamic pressure [Pa] bounds at nodes 1..n-1 (n - 1
+        #: each; inf where the vehicle states no dynamic-pressure limit): the vehicle's less the
+        #: path margin, ramped in over the first path_margin_ramp_s of the final-time guess
         t_nodes = self.mesh.s[1:] * final_time_guess
         ramp_s = settings.path_margin_ramp_s
         margin = settings.path_margin * (np.minimum(1.0, t_nodes / ramp_s) if ramp_s > 0 else np.ones_like(t_nodes))
-        self.node_limits = ((1.0 - margin) * limits.heat_flux_max, (1.0 - margin) * self.load_max)
+        self.node_limits = ((1.0 - margin) * limits.heat_flux_max, (1.0 - margin) * self.load_max,
+                            (1.0 - margin) * limits.dynamic_pressure_max)
 
     # ----- layout -------------------------------------------------------------------------
     def _set_bounds(self, tf_guess):
@@ -262,8 +265,8 @@ class EntryProblem(ConvexifiableProblem):
         return c, s, alpha
 
     def node_outputs(self, x, u, atmosphere: Atmosphere | None = None):
-        """[xdot (n_x), heat flux W/m^2, load g (total or normal: ``load_kind``), speed of sound m/s, geodetic altitude m]
-        at state x and control u (eqs. 1-10, 34-41, 54-57). Any scalar type; ``atmosphere``
+        """[xdot (n_x), heat flux W/m^2, load g (total or normal: ``load_kind``), speed of sound m/s, geodetic
+        altitude m, dynamic pressure Pa] at state x and control u (eqs. 1-10, 34-41, 54-57). Any scalar type; ``atmosphere``
         replaces the problem's (the tape's trace)."""
         position = x[:6]
         rho, a = air_data(position, self.planet, atmosphere or self.atmosphere)
@@ -275,7 +278,7 @@ class EntryProblem(ConvexifiableProblem):
         q = self.vehicle.heat_flux(rho, x[3])
         n = (total_load_factor(L, D, self.planet.g0) if self.load_kind == "total"
              else signed_normal_load_factor(L, D, alpha, self.planet.g0))
-        return [*xdot, q, n, a, self.planet.atmospheric_altitude(x[0], x[2])]
+        return [*xdot, q, n, a, self.planet.atmospheric_altitude(x[0], x[2]), dynamic_pressure(rho, x[3])]
 
     @functools.cached_property
     def tape(self) -> ExpressionTape | None:
@@ -340,8 +343,8 @@ class EntryProblem(ConvexifiableProblem):
         gam = X[1:, 4]
         m = self.mission
         g_lo, g_hi = self._gamma_bounds
-        q_max, n_max = self.node_limits
-        path = np.stack([q[1:] / q_max - 1.0, load[1:] / n_max - 1.0,
+        q_max, n_max, p_max = self.node_limits
+        path = np.stack([q[1:] / q_max - 1.0, load[1:] / n_max - 1.0, nodes[1:, self.out_p] / p_max - 1.0,
                          (g_lo - gam) / 0.1, (gam - g_hi) / 0.1], axis=1)
         objective = self.settings.objective
         if self.n_epigraph:
@@ -440,11 +443,12 @@ class EntryProblem(ConvexifiableProblem):
         mi = self.mission
         k = np.arange(1, n)
         path_rows = (k - 1) * len(PATH_NAMES)
-        r_idx = [np.repeat(path_rows, nv), np.repeat(path_rows + 1, nv), path_rows + 2, path_rows + 3]
-        c_idx = [var_cols[k].ravel(), var_cols[k].ravel(), self._col_x(k, 4), self._col_x(k, 4)]
-        q_max, n_max = self.node_limits
+        r_idx = [np.repeat(path_rows, nv), np.repeat(path_rows + 1, nv), np.repeat(path_rows + 2, nv),
+                 path_rows + 3, path_rows + 4]
+        c_idx = [var_cols[k].ravel(), var_cols[k].ravel(), var_cols[k].ravel(), self._col_x(k, 4), self._col_x(k, 4)]
+        q_max, n_max, p_max = self.node_limits
         vals = [(jac[k, self.out_q, :] / q_max[:, None]).ravel(), (jac[k, self.out_n, :] / n_max[:, None]).ravel(),
-                np.full(n - 1, -1.0 / 0.1), np.full(n - 1, 1.0 / 0.1)]
+                (jac[k, self.out_p, :] / p_max[:, None]).ravel(), np.full(n - 1, -1.0 / 0.1), np.full(n - 1, 1.0 / 0.1)]
         objective = self.settings.objective
         e0 = self.n_path
         if self.n_epigraph:

@@ -17,6 +17,7 @@ import numpy as np
 
 from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, GuidanceMethod, GuidanceSummary, PlantPorts
 from drake_entry.guidance.replanning_wiring import add_replanning_guidance, replanning_commands, replanning_record
+from drake_entry.guidance.scvx.feedback import feedback_maker
 from drake_entry.guidance.scvx.planner import ScvxPlan, plan_entry, replan_from
 
 __all__ = ["GUIDANCE_SYSTEM", "ScvxMethod", "METHOD"]
@@ -36,7 +37,9 @@ class ScvxMethod(GuidanceMethod):
     def add_systems(self, builder, scenario, planner: ScvxPlan, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance
         guidance = add_replanning_guidance(builder, GUIDANCE_SYSTEM, planner,
-                                           functools.partial(replan_from, settings=g.planner_settings()[1]), g, plant)
+                                           functools.partial(replan_from, settings=g.planner_settings()[1]), g, plant,
+                                           feedback=feedback_maker(g.feedback, g.feedback_state_weight),
+                                           offset_limits=g.feedback_offset_limits())
         lo, hi = np.radians(g.alpha_bounds_deg)
         return replanning_commands(guidance, ActuatorLimits(float(lo), float(hi), math.radians(g.alpha_rate_limit_deg_s),
                                                             math.radians(planner.flight.alpha_acceleration_deg_s2)),

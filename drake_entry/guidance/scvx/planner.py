@@ -11,6 +11,7 @@ from scipy.interpolate import CubicSpline
 
 from drake_entry.guidance.scvx.engine import max_defect, max_violation, solve_scvx
 from drake_entry.guidance.scvx.entry import EntryProblem
+from drake_entry.guidance.scvx.feedback import feedback_maker
 from drake_entry.guidance.scvx.guess import GlideGuess, glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
@@ -25,7 +26,14 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.models.verdict import PathLimit, breaches_text, check_limits, vehicle_path_limits
 from drake_entry.planning.result import PlanResult
-from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, Verifier, require_verifier
+from drake_entry.planning.verification import (
+    Actuation,
+    EntryControls,
+    FlownControls,
+    Tracking,
+    Verifier,
+    require_verifier,
+)
 
 __all__ = ["GAP_LIFT_FRACTION", "BETWEEN_NODE_TOLERANCE", "POINTS_PER_SEGMENT", "PROPAGATION_TOLERANCE_M",
            "OBJECTIVE_METRIC", "ScvxPlan", "decision_from_trajectory", "initial_decision", "plan_metrics",
@@ -34,8 +42,9 @@ __all__ = ["GAP_LIFT_FRACTION", "BETWEEN_NODE_TOLERANCE", "POINTS_PER_SEGMENT", 
 
 #: the lossless gap is judged where the lift can act: L >= this fraction of g0
 GAP_LIFT_FRACTION = 0.05
-#: between-node re-check: relative tolerance on heat flux and load, absolute on gamma [rad]
-BETWEEN_NODE_TOLERANCE = (0.02, 0.02, math.radians(0.2))
+#: between-node re-check: relative tolerance on heat flux, load and dynamic pressure, absolute
+#: on gamma [rad]
+BETWEEN_NODE_TOLERANCE = (0.02, 0.02, 0.02, math.radians(0.2))
 #: evaluation points per mesh segment for the between-node check and the rate metrics
 POINTS_PER_SEGMENT = 8
 #: the plan's controls flown must end within this of its terminal point [m]
@@ -64,8 +73,9 @@ class ScvxPlan(PlanResult):
       lossless_gap: max(1 - |u|) over nodes where L >= 5 % g0; lossless_gap_all: over all nodes
         (0 when the bank is a state: the flown bank is the planned one).
       max_defect, max_violation: largest scaled dynamics defect and constraint violation.
-      between_nodes: worst relative excess of q and n and of gamma [rad] over their limits on
-        the segment polynomials between the nodes (8 points per segment).
+      between_nodes: worst relative excess of heat flux, load and dynamic pressure and of gamma
+        [rad] over their limits on the segment polynomials between the nodes (8 points per
+        segment).
       miss_m: planned DRS point to the site [m]; drs: planned DRS altitude (geodetic) [m], Mach,
         vertical speed [m/s].
       metrics: the paper's Table 2, 3 and 6 quantities (``plan_metrics``).
@@ -73,6 +83,7 @@ class ScvxPlan(PlanResult):
         flown DRS point and box, the path-limit checks); verifier: what flew it (re-plans
         use the same).
       guess: the glide guess it started from; history: the engine's IterationRecords.
+      feedback_laws: the tracking laws made about it (``scvx.feedback.plan_feedback``).
     """
 
     formulation: str
@@ -97,6 +108,8 @@ class ScvxPlan(PlanResult):
     verifier: Verifier | None = dc.field(default=None, repr=False)
     history: list = dc.field(default_factory=list, repr=False)
     problem: EntryProblem | None = dc.field(default=None, repr=False)
+    #: its feedback laws by (kind, weight), made once (drake_entry.guidance.scvx.feedback)
+    feedback_laws: dict = dc.field(default_factory=dict, repr=False)
 
     @property
     def propagated_error_m(self) -> float:
@@ -202,13 +215,15 @@ def _dense(problem: EntryProblem, X, U):
 
 
 def _between_nodes(problem: EntryProblem, X, U) -> dict:
-    """Worst excess of q, n (relative) and gamma (rad) over their limits between the nodes."""
+    """Worst excess of heat flux, load, dynamic pressure (relative; 0 where the vehicle states
+    no dynamic-pressure limit) and gamma (rad) over their limits between the nodes."""
     _, Xd, Ud = _dense(problem, X, U)
     outputs = np.array([problem.node_outputs(x, u) for x, u in zip(Xd, Ud)])
     lim = problem.vehicle.limits
     g_lo, g_hi = np.radians(problem.mission.flight_path_bounds_deg)
     return {"heat_flux": float(max(outputs[:, problem.out_q].max() / lim.heat_flux_max - 1.0, 0.0)),
             "load": float(max(outputs[:, problem.out_n].max() / problem.load_max - 1.0, 0.0)),
+            "dynamic_pressure": float(max(outputs[:, problem.out_p].max() / lim.dynamic_pressure_max - 1.0, 0.0)),
             "flight_path_rad": float(max((g_lo - Xd[:, 4]).max(), (Xd[:, 4] - g_hi).max(), 0.0))}
 
 
@@ -247,7 +262,8 @@ def plan_controls(plan: ScvxPlan, flight: FlightCheck | None, samples_per_segmen
     """The plan's bank and alpha (planned, or the mission's alpha(V) law at the flown speed) as
     the verifier flies them: from its entry state to its t_f, through the closed loop's bank and
     alpha actuators as ``flight`` says (the vehicle's bank limits, the mission's alpha bounds and
-    rate limit), or directly when ``flight`` is None or has no period."""
+    rate limit) with the closed loop's feedback between re-plans where it has one, or directly
+    when ``flight`` is None or has no period."""
     p, v, m = plan.problem, plan.problem.vehicle, plan.problem.mission
     tt, bank, alpha = plan.control_samples(samples_per_segment)
     actuation = None
@@ -258,8 +274,11 @@ def plan_controls(plan: ScvxPlan, flight: FlightCheck | None, samples_per_segmen
                               alpha_bounds=(float(lo), float(hi)), alpha_rate_limit=math.radians(m.alpha_rate_limit_deg_s),
                               alpha_accel_limit=math.radians(flight.alpha_acceleration_deg_s2),
                               initial_bank=float(plan.bank[0]), initial_alpha=float(plan.alpha[0]))
+    maker = None if flight is None or flight.period_s is None else feedback_maker(flight.feedback,
+                                                                               flight.feedback_state_weight)
+    tracking = None if maker is None else Tracking(plan, maker, flight.feedback_offset_limits)
     return EntryControls(p.vehicle, p.planet, p.atmosphere, plan.states[0, :6].astype(float), plan.final_time,
-                         tt, bank, alpha, p.alpha, actuation)
+                         tt, bank, alpha, p.alpha, actuation, tracking)
 
 
 @dc.dataclass
@@ -397,13 +416,14 @@ def plan_entry(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mission:
     xf = X[-1]
     final = problem.node_outputs(xf, U[-1])
     ev = outcome.evaluation
-    tol_q, tol_n, tol_g = BETWEEN_NODE_TOLERANCE
-    checked = (between["heat_flux"] <= tol_q and between["load"] <= tol_n
+    tol_q, tol_n, tol_p, tol_g = BETWEEN_NODE_TOLERANCE
+    checked = (between["heat_flux"] <= tol_q and between["load"] <= tol_n and between["dynamic_pressure"] <= tol_p
                and between["flight_path_rad"] <= tol_g)
     message = outcome.message
     if outcome.converged and not checked:
         message += (f"; converged but violated between the nodes (heat flux +{between['heat_flux']:.1%}, "
-                    f"{problem.load_kind} load +{between['load']:.1%}, gamma {math.degrees(between['flight_path_rad']):.2f} deg): "
+                    f"{problem.load_kind} load +{between['load']:.1%}, dynamic pressure "
+                    f"+{between['dynamic_pressure']:.1%}, gamma {math.degrees(between['flight_path_rad']):.2f} deg): "
                     f"refine the mesh")
     plan = ScvxPlan(
         success=False, message=message, iterations=outcome.iterations, build_time=build,

@@ -229,8 +229,14 @@ class FlightCheck:
         the period for the hold plus 1/omega of the 2 rad/s position loop, 1.0 s at a 1-s period), as the SCvx guidance does.
       alpha_acceleration_deg_s2: the alpha actuator's acceleration limit (not in paper 001: a
         labelled choice well above what a 1 deg/s planned alpha rate needs).
+      feedback, feedback_state_weight, feedback_offset_limits: the closed loop's tracking law
+        between re-plans ("tvlqr" or "none"; guidance.spec.ReplanningSpec), its LQR path weight
+        and its bank and alpha offset bounds [rad]: the plan is verified flown with it.
     """
 
     period_s: float | None = 1.0
     lead_s: float = 1.0
     alpha_acceleration_deg_s2: float = 5.0
+    feedback: str = "none"
+    feedback_state_weight: float = 1.0e-3
+    feedback_offset_limits: tuple = (0.0, 0.0)

@@ -81,8 +81,10 @@ class Scvx(ReplanningSpec):
 
     def flight_check(self) -> FlightCheck:
         """How the plans are verified: flown through the closed loop's actuators at the guidance
-        period with the guidance's command lead."""
-        return FlightCheck(period_s=self.period_s, lead_s=self.command_lead_s)
+        period with the guidance's command lead and its feedback between re-plans."""
+        return FlightCheck(period_s=self.period_s, lead_s=self.command_lead_s, feedback=self.feedback,
+                           feedback_state_weight=self.feedback_state_weight,
+                           feedback_offset_limits=self.feedback_offset_limits())
 
     def planner_settings(self) -> tuple[EntryProblemSettings, ScvxSettings]:
         given = {k: getattr(self, k) for k in shared_fields(self, EntryProblemSettings) if getattr(self, k) is not None}

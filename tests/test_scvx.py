@@ -233,15 +233,15 @@ def test_a_vehicle_limiting_the_normal_load_the_dynamic_pressure_and_a_mach_wind
     """A vehicle whose only load limit is the normal load and that limits the dynamic pressure
     (HORUS-2B's kind): the plan bounds (L cos(alpha) + D sin(alpha)) / g0 and rho V^2 / 2 at the
     nodes (paper 000 eqs. 34-35); a DRS Mach window's lower edge is an event row M_min a - V;
-    the rows' Jacobians equal central differences. Without a dynamic-pressure limit its rows
-    are -1 with no gradient."""
+    a vertical speed's upper bound is another (not in paper 001); the rows' Jacobians equal
+    central differences. Without a dynamic-pressure limit its rows are -1 with no gradient."""
     from drake_entry.models.constraints import PathLimits, normal_load_factor
     from drake_entry.models.dynamics import aero_accelerations, air_data
 
     vehicle, planet, atmosphere, mission, guess = sphynx_case
     normal = dc.replace(vehicle, limits=PathLimits(heat_flux_max=vehicle.limits.heat_flux_max, normal_load_max=2.8,
                                                    dynamic_pressure_max=20e3))
-    window = dc.replace(mission, final_mach_min=0.4)
+    window = dc.replace(mission, final_mach_min=0.4, final_vertical_speed_max_m_s=-20.0)
     problem = EntryProblem(normal, planet, atmosphere, window,
                            EntryProblemSettings(segments=3, nodes_per_segment=3, formulation="direct",
                                                 objective="max_load"), guess.final_time)
@@ -259,6 +259,9 @@ def test_a_vehicle_limiting_the_normal_load_the_dynamic_pressure_and_a_mach_wind
     event = ev.inequalities[problem.n_path + problem.n_epigraph + 4]
     assert event == pytest.approx((0.4 * a_f - xf[3]) / 100.0, rel=1e-12)
     assert "DRS Mach lower bound" in problem.describe_inequality(problem.n_path + problem.n_epigraph + 4)
+    assert ev.inequalities[problem.n_path + problem.n_epigraph + 5] == pytest.approx(
+        (xf[3] * math.sin(xf[4]) + 20.0) / 100.0, rel=1e-12)
+    assert "DRS vertical speed upper bound" in problem.describe_inequality(problem.n_path + problem.n_epigraph + 5)
     assert problem.describe_inequality(1).startswith("normal load at")
     assert problem.describe_inequality(2 + 5 * 3).startswith("dynamic pressure at node 4")
     p_max = problem.node_limits[2]

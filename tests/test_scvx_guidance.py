@@ -131,3 +131,25 @@ def test_an_scvx_plan_flown_with_its_tracking_law_ends_where_it_planned_and_open
     with pytest.raises(ScenarioError, match="tracking needs an actuation"):
         dc.replace(controls, actuation=None)
     assert isinstance(controls, EntryControls)
+
+
+def test_scvx_derived_where_the_box_checks_no_speed_aims_at_the_interface_speed_and_replans_near_the_end():
+    """Paper 004's box checks altitude and distance only; the other methods stop at the
+    interface's energy (30 km, 2000 m/s), so the derived SCvx plans arrive within 2.5 % of its
+    Mach number rather than at any speed; it re-plans closer together near the end (0.4 of the
+    time to go, to 60 s) and bounds gamma at -45 deg (paper 001's -30 is its own mission's)."""
+    from drake_entry.guidance.derivation import derivation_for, terminal_interface
+    from drake_entry.guidance.scvx.derive import FLIGHT_PATH_BOUNDS_DEG, INTERFACE_SPEED_WINDOW, MACH_WINDOW_FRACTION
+    from drake_entry.guidance.scvx.spec import Scvx
+
+    mission = load_scenario("cav_h_paper004")
+    assert mission.terminal.velocity_tolerance_m_s is None and mission.terminal.mach_tolerance is None
+    mach = terminal_interface(mission).mach
+    d = derivation_for(mission, Scvx)
+    half = MACH_WINDOW_FRACTION * INTERFACE_SPEED_WINDOW
+    for c in d.search[0].candidates:
+        assert c["guidance.final_mach_min"] == pytest.approx(mach * (1 - half), abs=1e-4)
+        assert c["guidance.final_mach_max"] == pytest.approx(mach * (1 + half), abs=1e-4)
+    spec = d.spec
+    assert (spec.replan_period_s, spec.replan_time_to_go_fraction, spec.replan_min_time_to_go_s) == (200.0, 0.4, 60.0)
+    assert tuple(spec.flight_path_bounds_deg) == FLIGHT_PATH_BOUNDS_DEG == (-45.0, 5.0)

@@ -33,7 +33,8 @@ def success_lower_bound(successes: int, runs: int, level: float = LEVEL) -> floa
 
 def read_comparison(folder: str) -> dict:
     """A comparison directory's manifest and summary: {'mission', 'name', 'runs', 'seed',
-    'methods': {label: {'method', 'flown', 'reason', 'summary'}}}; CampaignError when it holds none."""
+    'commits' (of every session that flew into it), 'methods': {label: {'method', 'flown', 'reason',
+    'summary'}}}; CampaignError when it holds none."""
     paths = [os.path.join(folder, name) for name in ("comparison.json", "comparison_summary.json")]
     if not all(os.path.isfile(p) for p in paths):
         raise CampaignError(f"{folder} holds no comparison report (comparison.json and comparison_summary.json): "
@@ -49,7 +50,7 @@ def read_comparison(folder: str) -> dict:
                           "derived": bool(info.get("derivation"))}
     return {"mission": os.path.splitext(os.path.basename(manifest["mission"]))[0], "name": manifest["comparison"],
             "runs": manifest["runs"], "seed": manifest["seed"],
-            "commit": (manifest.get("sessions") or [{}])[-1].get("git_commit"),
+            "commits": [str(session.get("git_commit")) for session in manifest.get("sessions") or [{}]],
             "methods": methods}
 
 
@@ -90,7 +91,7 @@ def matrix_markdown(folders: list[str]) -> str:
 
 def write_matrix(folders: list[str], path: str, *, title: str = "Every method on every mission") -> str:
     """Write the matrix of ``folders`` to the Markdown file ``path``; returns ``path``."""
-    commits = sorted({str(read_comparison(f)["commit"]) for f in folders})
+    commits = sorted({c for f in folders for c in read_comparison(f)["commits"]})  # every session's: --only mixes
     text = (f"# {title}\n\nFrom {len(folders)} comparison directories (`drake-entry compare MISSION`), commit "
             f"{', '.join(commits)}.\n\n" + matrix_markdown(folders) + "\n")
     write_atomic(path, text.encode())

@@ -16,11 +16,12 @@ __all__ = ["add_replanning_guidance", "replanning_commands", "replanning_record"
 
 def add_replanning_guidance(builder, name: str, plan, replan, spec, plant: PlantPorts, **options):
     """Add ReplanningGuidance (named ``name``) flying ``plan`` with the method's ``replan``, the
-    spec's period, re-plan period, time to go and command lead (``options``: the system's other
-    arguments), connected to the navigation estimate; return it."""
+    spec's period, re-plan period, time to go (and its fraction) and command lead (``options``:
+    the system's other arguments), connected to the navigation estimate; return it."""
     system = builder.AddNamedSystem(name, ReplanningGuidance(
         plan, replan=replan, period=spec.period_s, replan_period=spec.replan_period_s,
-        min_time_to_go=spec.replan_min_time_to_go_s, lead=spec.command_lead_s, **spec.latency(), **options))
+        min_time_to_go=spec.replan_min_time_to_go_s, lead=spec.command_lead_s,
+        time_to_go_fraction=spec.replan_time_to_go_fraction or None, **spec.latency(), **options))
     builder.Connect(plant.estimated_state, system.GetInputPort("estimated_state"))
     return system
 

@@ -141,6 +141,9 @@ class ReplanningSpec(ReplansOnBoard):
     # on-board re-planning (replan_period_s) only while the plan in use has more than
     # replan_min_time_to_go_s [s] to go
     replan_min_time_to_go_s: float = 300.0
+    # the re-plan period shrinks to this fraction of the time to go (never below period_s; 0:
+    # every replan_period_s): re-plans come closer together as the end nears
+    replan_time_to_go_fraction: float = 0.0
     # between re-plans the commands track the plan in use: "tvlqr" (a time-varying LQR of the
     # plan's linearised dynamics, planning.tracking; the plans are then verified flown with it)
     # or "none" (its controls in time only; a method may offer more: FEEDBACKS);
@@ -158,6 +161,7 @@ class ReplanningSpec(ReplansOnBoard):
         super().validate(scenario)
         check_range("guidance.command_lead_s", self.command_lead_s, 0.0, 10.0)
         check_range("guidance.replan_min_time_to_go_s", self.replan_min_time_to_go_s, 0.0, 1e4)
+        check_range("guidance.replan_time_to_go_fraction", self.replan_time_to_go_fraction, 0.0, 1.0)
         if self.feedback not in self.FEEDBACKS:
             raise ScenarioError(f"guidance.feedback = '{self.feedback}' is unknown; allowed: {', '.join(self.FEEDBACKS)}")
         check_range("guidance.feedback_state_weight", self.feedback_state_weight, 1e-9, 1e3)

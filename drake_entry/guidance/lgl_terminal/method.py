@@ -41,7 +41,6 @@ class LglTerminalMethod(GuidanceMethod):
         g = scenario.guidance
         guidance = add_replanning_guidance(builder, GUIDANCE_SYSTEM, planner, replan, g, plant,
                                            first_replan=g.replan_start_s,
-                                           time_to_go_fraction=g.replan_time_to_go_fraction or None,
                                            model_scales=g.replan_model_scales,
                                            feedback=feedback_maker(g.feedback),
                                            offset_limits=g.feedback_offset_limits())

@@ -50,8 +50,7 @@ class LglTerminal(ReplanningSpec):
     replan_node_spacing_s: float = 10.0
     replan_nodes: list[int] = dc.field(default_factory=lambda: [40, 60])
     replan_tolerance: float = 1.0e-6
-    # the re-solve period shrinks to this fraction of the time to go (never below period_s; 0:
-    # every replan_period_s): re-solves come closer together as impact nears
+    # re-solves come closer together as impact nears (ReplanningSpec)
     replan_time_to_go_fraction: float = 0.4
     # re-solves aim at the final speed and flight-path angle within these windows [m/s, deg]
     # (the pre-flight plan at the values themselves): from a dispersed state the exact values
@@ -101,7 +100,6 @@ class LglTerminal(ReplanningSpec):
             raise ScenarioError(f"guidance.replan_nodes = {self.replan_nodes}; allowed [min, max] with "
                                 f"5 <= min <= max <= 400")
         check_range("guidance.replan_tolerance", self.replan_tolerance, 1e-12, 1e-2)
-        check_range("guidance.replan_time_to_go_fraction", self.replan_time_to_go_fraction, 0.0, 1.0)
         check_range("guidance.replan_speed_window_m_s", self.replan_speed_window_m_s, 0.0, 1e3)
         check_range("guidance.replan_flight_path_window_deg", self.replan_flight_path_window_deg, 0.0, 45.0)
         check_range("guidance.alpha_accel_limit_deg_s2", self.alpha_accel_limit_deg_s2, 0.1, 1e3)

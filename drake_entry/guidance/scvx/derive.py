@@ -24,7 +24,8 @@ from drake_entry.guidance.scvx.mission import planned_load
 from drake_entry.guidance.scvx.spec import Scvx
 
 __all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW_KM", "AIM_TOLERANCE_KM",
-           "FEEDBACK", "REPLAN_PERIOD_S", "OBJECTIVE", "FORMULATION", "aim_window"]
+           "FEEDBACK", "REPLAN_PERIOD_S", "REPLAN_TIME_TO_GO_FRACTION", "REPLAN_MIN_TIME_TO_GO_S",
+           "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "FINAL_DESCENT_DEG", "OBJECTIVE", "FORMULATION", "aim_window"]
 
 #: the plan's objective and formulation on another method's mission: the control effort (the
 #: integral of |sigma_dot|), with the bank a state and alpha the mission's law. Measured on
@@ -50,9 +51,23 @@ AIM_WINDOW_KM, AIM_TOLERANCE_KM = 0.5, 0.05
 #: km with it; with it the paper's 33 x 4 mesh flew the nominal and two dispersed draws inside
 #: the box as 50 x 6 did (box ratio 0.84 both)
 FEEDBACK = "tvlqr"
-#: re-plan from the navigation estimate every this [s] while more than 300 s are left (paper
-#: 001's scenario: the pre-flight plan alone ends 21.5 km from its site)
-REPLAN_PERIOD_S = 200.0
+#: re-plan from the navigation estimate every REPLAN_PERIOD_S [s] (paper 001's scenario: the
+#: pre-flight plan alone ends 21.5 km from its site), every REPLAN_TIME_TO_GO_FRACTION of the time
+#: to go when that is shorter, while more than REPLAN_MIN_TIME_TO_GO_S [s] are left (paper 001's
+#: scenario: 300 s, over which Lu 2008's capsule, a 550-s flight, was re-planned once and missed
+#: by 8-30 km; paper 004's CAV-H by 20-67 km at the end of a 2450-s glide)
+REPLAN_PERIOD_S, REPLAN_TIME_TO_GO_FRACTION, REPLAN_MIN_TIME_TO_GO_S = 200.0, 0.4, 60.0
+#: the plan's speed window about the interface's speed where the box checks none (an open window
+#: let the plans arrive at the stop altitude at any speed, away from the interface's energy)
+INTERFACE_SPEED_WINDOW = 0.05
+#: the plans end descending at least this steeply [deg] (a vertical-speed bound at the interface
+#: speed): paper 004's CAV-H planned to a shallow glide at its stop altitude crossed it 90 s
+#: (140 km) late in 5 of 10 dispersed flights
+FINAL_DESCENT_DEG = 1.0
+#: the flight-path bounds of eq. 70 on a mission that bounds no gamma [deg]: paper 001's -30 deg
+#: is its own mission's (a capsule's last minute below 25 km dives to -31 to -35 deg), the upper
+#: bound opened to 5 deg
+FLIGHT_PATH_BOUNDS_DEG = (-45.0, 5.0)
 
 
 def aim_window(scenario, altitude_km: float, mach_window: tuple | None, mach: float) -> dict:
@@ -102,8 +117,11 @@ def derive(scenario) -> Derivation:
     elif t.velocity_m_s is not None and t.velocity_tolerance_m_s:
         mach_window = ((t.velocity_m_s - t.velocity_tolerance_m_s) / a, (t.velocity_m_s + t.velocity_tolerance_m_s) / a)
         mach_how = f"the box's speed window as Mach at {interface.altitude_km:g} km"
-    else:
-        mach_window, mach_how = None, "the box checks no speed: the Mach window is open"
+    else:  # the interface's speed, which the box does not check: the plan aims at it
+        m = interface.mach
+        mach_window = (m * (1.0 - INTERFACE_SPEED_WINDOW), m * (1.0 + INTERFACE_SPEED_WINDOW))
+        mach_how = (f"the box checks no speed: the interface's Mach {m:.3g} +- {INTERFACE_SPEED_WINDOW:.0%} (where the "
+                    f"other methods' energy stop puts it)")
     if mach_window is not None:
         mach_how = (f"the middle {MACH_WINDOW_FRACTION:g} of {mach_how} below the vehicle's dynamic-pressure limit "
                     f"at the interface altitude (room for the flown error)")
@@ -129,10 +147,13 @@ def derive(scenario) -> Derivation:
                 final_altitude_margin_m=first["guidance.final_altitude_margin_m"],
                 final_mach_min=first["guidance.final_mach_min"], final_mach_max=first["guidance.final_mach_max"],
                 site_radius_m=round(SITE_RADIUS_FRACTION * t.distance_tolerance_km * 1e3, 3),
-                final_vertical_speed_min_m_s=-300.0, heading_bounds_deg=[psi - 180.0, psi + 180.0],
-                flight_path_bounds_deg=[-30.0, 5.0], objective=OBJECTIVE, formulation=FORMULATION,
+                final_vertical_speed_min_m_s=-300.0,
+                final_vertical_speed_max_m_s=round(-interface.speed_m_s * math.sin(math.radians(FINAL_DESCENT_DEG)), 3),
+                heading_bounds_deg=[psi - 180.0, psi + 180.0],
+                flight_path_bounds_deg=list(FLIGHT_PATH_BOUNDS_DEG), objective=OBJECTIVE, formulation=FORMULATION,
                 alpha_deg=alpha_deg, alpha_speeds_m_s=alpha_speeds, alpha_bounds_deg=bounds,
-                replan_period_s=REPLAN_PERIOD_S,
+                replan_period_s=REPLAN_PERIOD_S, replan_min_time_to_go_s=REPLAN_MIN_TIME_TO_GO_S,
+                replan_time_to_go_fraction=REPLAN_TIME_TO_GO_FRACTION,
                 path_margin=round(1.0 - LIMIT_MARGIN, 4), feedback=FEEDBACK)
     load, _ = planned_load(scenario.make_vehicle().limits)
     choices = [
@@ -143,8 +164,11 @@ def derive(scenario) -> Derivation:
         Choice("guidance.alpha_deg, alpha_speeds_m_s, alpha_bounds_deg",
                f"{alpha_deg} deg at {[round(v) for v in alpha_speeds]} m/s, bounds {bounds} deg", alpha_how),
         Choice("guidance.heading_bounds_deg", spec.heading_bounds_deg, "half a turn either side of the entry heading"),
+        Choice("guidance.final_vertical_speed_max_m_s", spec.final_vertical_speed_max_m_s,
+               f"the plans end descending at {FINAL_DESCENT_DEG:g} deg or steeper at the interface speed (the "
+               f"altitude stop then falls where the plan ends)"),
         Choice("guidance.flight_path_bounds_deg", spec.flight_path_bounds_deg,
-               "paper 001's lower bound; the upper opened to 5 deg (the mission does not bound gamma)"),
+               "the mission bounds no gamma: wider than paper 001's [-30, 0.5] deg, its own mission's"),
         Choice("guidance.objective, formulation", f"{OBJECTIVE}, {FORMULATION}",
                "the control effort, with the mission's alpha: the plans whose controls fly closest to themselves"),
         Choice("the plan's path bounds", f"heat flux, {load} load, dynamic pressure",
@@ -153,7 +177,9 @@ def derive(scenario) -> Derivation:
                f"the plans keep {LIMIT_MARGIN:g} of each limit, the shared margin for dispersions (between re-plans "
                f"the flight drifts: at paper 001's 0.02 a dispersed HORUS-2B flight met 100.5 % of its heat-flux "
                f"limit 100 s after the first re-plan)"),
-        Choice("guidance.replan_period_s", REPLAN_PERIOD_S, "re-planned on board as paper 001's scenario is"),
+        Choice("guidance.replan_period_s, replan_time_to_go_fraction, replan_min_time_to_go_s",
+               f"{REPLAN_PERIOD_S:g} s, {REPLAN_TIME_TO_GO_FRACTION:g}, {REPLAN_MIN_TIME_TO_GO_S:g} s",
+               "re-planned on board as paper 001's scenario is, closer together near the end"),
         Choice("guidance.feedback", FEEDBACK,
                "between re-plans the commands track the plan (not paper 001's): without it the plan flown through "
                "the actuators drifts 5-37 km from itself over HORUS-2B's glide, with it 0.4 km"),

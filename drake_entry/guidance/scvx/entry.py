@@ -30,7 +30,9 @@ the vehicle's limit where it states one (paper 000 eq. 34; inactive rows otherwi
 the settings' path_margin),
 flight-path bounds (eq. 70); at the DRS point: geodetic altitude window (eq. 64, narrowed by
 the mission's final_altitude_margin_m), M_min a <= V <= M a
-(eq. 65; M_min 0 in paper 001, a TAEM box's lower Mach otherwise), V sin(gamma) >= V_v,min (eq. 66), and a cone ||miss|| <= site radius (eqs. 67-68)
+(eq. 65; M_min 0 in paper 001, a TAEM box's lower Mach otherwise), V sin(gamma) >= V_v,min (eq. 66)
+and, where the mission sets one, V sin(gamma) <= V_v,max (not in paper 001: a glide's final
+descent made definite, so that the flight's altitude stop falls where the plan ends), and a cone ||miss|| <= site radius (eqs. 67-68)
 with a buffer. Hard bounds on the other states (eq. 70) and the fixed entry state.
 
 Objectives (paper 001 Table 2, ``OBJECTIVES``; the min-max ones through an epigraph variable
@@ -169,7 +171,11 @@ class EntryProblem(ConvexifiableProblem):
         self._epigraph_signs = (1.0, -1.0) if objective == "max_flight_path_rate" else (1.0,)
         self.n_epigraph = 0 if self._epigraph_output is None else len(self._epigraph_signs) * n
         self.n_bank_floor = n if (f.bank == "lossless" and settings.max_lossless_gap < 1.0) else 0
-        self.n_inequalities = self.n_path + self.n_epigraph + len(EVENT_NAMES) + self.n_bank_floor
+        #: the DRS point's rows: EVENT_NAMES, then an upper bound on the vertical speed where the
+        #: mission sets one (``final_vertical_speed_max_m_s``)
+        self.event_names = EVENT_NAMES + (() if mission.final_vertical_speed_max_m_s is None
+                                          else ("DRS vertical speed upper bound",))
+        self.n_inequalities = self.n_path + self.n_epigraph + len(self.event_names) + self.n_bank_floor
         sign = settings.heading_sign or heading_regulariser_sign(self.x0, self.site_lat)
         weight = settings.heading_weight if (f.bank == "lossless" and not self.n_bank_floor) else 0.0
         self.heading_lambda = sign * weight / final_time_guess  # per rad s, scaled objective
@@ -357,7 +363,9 @@ class EntryProblem(ConvexifiableProblem):
         events = np.array([(h_lo - hstar[-1]) / 1e3, (hstar[-1] - h_hi) / 1e3,
                            (xf[3] - m.final_mach_max * a[-1]) / 100.0,
                            (m.final_vertical_speed_min_m_s - xf[3] * math.sin(xf[4])) / 100.0,
-                           (m.final_mach_min * a[-1] - xf[3]) / 100.0])
+                           (m.final_mach_min * a[-1] - xf[3]) / 100.0]
+                          + ([] if m.final_vertical_speed_max_m_s is None
+                             else [(xf[3] * math.sin(xf[4]) - m.final_vertical_speed_max_m_s) / 100.0]))
         floor = (1.0 - self.settings.max_lossless_gap) - np.hypot(U[:, 0], U[:, 1]) if self.n_bank_floor else np.zeros(0)
         w = mesh.weights
         if objective == "heat_load":
@@ -469,11 +477,15 @@ class EntryProblem(ConvexifiableProblem):
         d_mach_min[3] -= 1.0
         vals += [-jf[self.out_h, :] / 1e3, jf[self.out_h, :] / 1e3, d_mach / 100.0,
                  -np.array([math.sin(xf[4]), xf[3] * math.cos(xf[4])]) / 100.0, d_mach_min / 100.0]
+        if len(self.event_names) > len(EVENT_NAMES):  # the vertical speed's upper bound
+            r_idx.append(np.full(2, e0 + len(EVENT_NAMES)))
+            c_idx.append(self._col_x(n - 1, np.array([3, 4])))
+            vals.append(np.array([math.sin(xf[4]), xf[3] * math.cos(xf[4])]) / 100.0)
         if self.n_bank_floor:  # d(1 - gap - |u_k|)/du_k = -u_k / |u_k|
             norm = np.hypot(U[:, 0], U[:, 1])
             direction = np.where(norm[:, None] > _NORM_FLOOR, U[:, :2] / np.maximum(norm, _NORM_FLOOR)[:, None],
                                  np.array([1.0, 0.0]))
-            rows = e0 + len(EVENT_NAMES) + np.arange(n)
+            rows = e0 + len(self.event_names) + np.arange(n)
             r_idx.append(np.repeat(rows, 2))
             c_idx.append(self._col_u(np.arange(n)[:, None], np.arange(2)[None, :]).ravel())
             vals.append(-direction.ravel())
@@ -596,11 +608,11 @@ class EntryProblem(ConvexifiableProblem):
 
     def describe_inequality(self, i: int) -> str:
         events = self.n_path + self.n_epigraph
-        if i >= events + len(EVENT_NAMES):
-            node = i - events - len(EVENT_NAMES)
+        if i >= events + len(self.event_names):
+            node = i - events - len(self.event_names)
             return f"bank-norm floor |u| >= {1.0 - self.settings.max_lossless_gap:g} at {self.node_time(node)}"
         if i >= self.n_path + self.n_epigraph:
-            return EVENT_NAMES[i - self.n_path - self.n_epigraph] + " at the DRS point"
+            return self.event_names[i - self.n_path - self.n_epigraph] + " at the DRS point"
         if i >= self.n_path:
             node = (i - self.n_path) % self.n_nodes
             return f"{self.settings.objective} epigraph at {self.node_time(node)}"

@@ -59,6 +59,8 @@ class ScvxMission:
       final_mach_max: largest DRS Mach number (eq. 65: subsonic).
       final_mach_min: smallest DRS Mach number (0 in paper 001; a TAEM box's lower edge).
       final_vertical_speed_min_m_s: lowest V sin(gamma) at the DRS point [m/s] (eq. 66).
+      final_vertical_speed_max_m_s: highest V sin(gamma) there [m/s], or None (paper 001: none);
+        planned, not checked on the flown DRS point (a design aim, not a box criterion).
       flight_path_bounds_deg: path bounds on gamma [deg] (eq. 70), buffered.
       heading_bounds_deg: hard bounds on the heading [deg] (eq. 70).
       bank_min_deg: smallest bank magnitude [deg] (eq. 43).
@@ -84,6 +86,7 @@ class ScvxMission:
     final_mach_max: float = 1.0
     final_mach_min: float = 0.0
     final_vertical_speed_min_m_s: float = -140.0
+    final_vertical_speed_max_m_s: float | None = None
     flight_path_bounds_deg: tuple = (-30.0, 0.5)
     heading_bounds_deg: tuple = (-10.0, 270.0)
     bank_min_deg: float = 5.0
@@ -111,6 +114,9 @@ class ScvxMission:
         check("final_mach_max", self.final_mach_max, 0.1, 10.0, "-")
         check("final_mach_min", self.final_mach_min, 0.0, self.final_mach_max, "- (below final_mach_max)")
         check("final_vertical_speed_min_m_s", self.final_vertical_speed_min_m_s, -2000.0, 0.0, "m/s")
+        if self.final_vertical_speed_max_m_s is not None:
+            check("final_vertical_speed_max_m_s", self.final_vertical_speed_max_m_s, self.final_vertical_speed_min_m_s,
+                  0.0, "m/s (at least final_vertical_speed_min_m_s)")
         check("bank_min_deg", self.bank_min_deg, 0.0, 45.0, "deg")
         check("alpha_rate_limit_deg_s", self.alpha_rate_limit_deg_s, 1e-3, 90.0, "deg/s")
         for f, lo, hi in (("final_altitude_m", 0.0, 100e3), ("flight_path_bounds_deg", -89.0, 30.0),

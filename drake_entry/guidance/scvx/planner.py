@@ -346,7 +346,8 @@ def flown_check(plan: ScvxPlan, flown: FlownControls) -> PlanFlight:
 def drs_point(mission: ScvxMission, planet: Earth, xf, mach: float, site_tolerance_m: float) -> tuple[dict, bool]:
     """The flown DRS point of a final state ``xf`` at Mach ``mach``: (geodetic altitude [m],
     Mach, vertical speed [m/s], site miss [m]) and whether it is inside the DRS box (eqs. 64-68:
-    the altitude window, Mach, vertical speed, the site within ``site_tolerance_m``)."""
+    the altitude window, Mach, vertical speed, the site within ``site_tolerance_m``; a vertical
+    speed's upper bound is the plan's design aim, not a box criterion)."""
     drs = {"altitude_m": float(planet.atmospheric_altitude(xf[0], xf[2])), "mach": float(mach),
            "vertical_speed_m_s": float(xf[3] * math.sin(xf[4])),
            "site_miss_m": float(planet.great_circle_distance(xf[1], xf[2], *mission.site(planet)))}

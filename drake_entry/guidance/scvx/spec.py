@@ -39,6 +39,9 @@ class Scvx(ReplanningSpec):
     # the DRS point's lowest Mach (0: paper 001's subsonic DRS has none; a TAEM box's lower edge)
     final_mach_min: float = 0.0
     final_vertical_speed_min_m_s: float = -140.0
+    # the DRS point's highest vertical speed [m/s] (None: paper 001's box has none; a glider's
+    # derived box asks a definite descent, so that the altitude stop falls where the plan ends)
+    final_vertical_speed_max_m_s: Optional[float] = None
     # path bounds (eq. 70) and the smallest bank magnitude of the lossless bank (eq. 43) [deg]
     flight_path_bounds_deg: list[float] = dc.field(default_factory=lambda: [-30.0, 0.5])
     heading_bounds_deg: list[float] = dc.field(default_factory=lambda: [-10.0, 270.0])

@@ -315,7 +315,9 @@ def test_bad_vehicle_values_are_one_line(tmp_path, capsys, old, new, needle):
 @pytest.mark.parametrize("csv_text", ["coefficient,alpha_deg,M2.0,M4.0\n",
                                       "coefficient,alpha_deg,M2.0,M4.0\nCX,10,0.1,0.2\nCD,20,0.1,0.2\n",
                                       "coefficient,alpha_deg,Mfoo,M4.0\nCL,10,0.1,0.2\nCD,20,0.1,0.2\n",
-                                      "coefficient,alpha_deg,M2.0,M4.0\nCL,ten,0.1,0.2\nCD,20,0.1,0.2\n"])
+                                      "coefficient,alpha_deg,M2.0,M4.0\nCL,ten,0.1,0.2\nCD,20,0.1,0.2\n",
+                                      "coefficient,alpha_deg,M2.0,M4.0\nCL,10,0.1,0.2\nCL,20,0.3,0.4\nCL,10,0.5,0.6\n"
+                                      "CD,10,0.1,0.2\nCD,20,0.1,0.2\n"])
 def test_bad_aero_tables_are_one_line(tmp_path, capsys, csv_text):
     (tmp_path / "aero.csv").write_text(csv_text)
     text = (ROOT / "drake_entry/vehicles/horus2b.yaml").read_text().replace(
@@ -323,7 +325,10 @@ def test_bad_aero_tables_are_one_line(tmp_path, capsys, csv_text):
         "    fill_csv: horus2b_clean_aero_fill_2024.csv\n", "").replace("default_aero: fit", "default_aero: table")
     (tmp_path / "v.yaml").write_text(text)
     path = _scenario_file(tmp_path, "vehicle: horus2b\naero: fit", f"vehicle: {tmp_path / 'v.yaml'}\naero: table")
-    assert "aero table" in _one_line_error(capsys, ["simulate", path, "--out", str(tmp_path / "o")])
+    err = _one_line_error(capsys, ["simulate", path, "--out", str(tmp_path / "o")])
+    assert "aero table" in err
+    if "CL,10,0.5" in csv_text:  # a repeated row was kept silently (the later one) before
+        assert "row 4: CL at alpha 10 deg is given twice (row 2 too)" in err, err
 
 
 def test_bad_problem_files_are_one_line(tmp_path, capsys):

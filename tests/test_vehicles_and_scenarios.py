@@ -34,6 +34,20 @@ def test_user_vehicle_yaml_with_polynomial_aero(tmp_path):
     assert cd == pytest.approx(0.05 + 0.2 / 5 + 0.05)
 
 
+@pytest.mark.parametrize("cl, needle", [("[[]]", "PolynomialAero.CL = [[]] must be a non-empty rectangular"),
+                                        ("[[.nan]]", "PolynomialAero.CL[0][0] = nan must be a finite number"),
+                                        ("[[0.0], [0.03, 1.0]]", "rectangular"),
+                                        ("[[0.0], [.inf]]", "PolynomialAero.CL[1][0] = inf must be a finite number")])
+def test_an_empty_ragged_or_non_finite_polynomial_is_refused_naming_the_entry(tmp_path, cl, needle):
+    """CL: [[]] flew with zero lift and a NaN coefficient reached the solvers before."""
+    f = tmp_path / "v.yaml"
+    f.write_text("name: my\nmass_kg: 500\nreference_area_m2: 2\nnose_radius_m: 0.3\n"
+                 f"aero:\n  poly: {{model: polynomial, CL: {cl}, CD: [[0.05]]}}\n")
+    with pytest.raises(ScenarioError, match="aero.poly") as raised:
+        load_vehicle(str(f))
+    assert needle in str(raised.value) and "\n" not in str(raised.value)
+
+
 def test_negative_mass_names_the_field_and_range(tmp_path):
     f = tmp_path / "v.yaml"
     f.write_text("name: bad\nmass_kg: -5\nreference_area_m2: 1\nnose_radius_m: 1\naero: {a: {model: cav_h}}\n")

@@ -267,10 +267,15 @@ def read_wide_table(path_or_file, *, fill=None) -> TableAero:
         mach = np.array([float(h.strip().lstrip("Mm")) for h in header[2:]])
         alphas = sorted({float(r[1]) for r in rows[1:]})
         data = {c: np.full((len(alphas), mach.size), np.nan) for c in ("CL", "CD")}
+        seen = {}  # (coefficient, alpha) -> the row that gave it
         for k, r in enumerate(rows[1:], start=2):
             if r[0] not in data or len(r) > len(header):
                 raise ValueError(f"row {k}: coefficient '{r[0]}' (allowed CL, CD) with {len(r)} cells "
                                  f"(header has {len(header)})")
+            if (r[0], float(r[1])) in seen:
+                raise ValueError(f"row {k}: {r[0]} at alpha {float(r[1]):g} deg is given twice (row "
+                                 f"{seen[(r[0], float(r[1]))]} too): one row per coefficient and angle of attack")
+            seen[(r[0], float(r[1]))] = k
             i = alphas.index(float(r[1]))
             for j, v in enumerate(r[2:]):
                 if v.strip():
@@ -477,8 +482,13 @@ class PolynomialAero(AeroModel):
             raise ScenarioError(f"PolynomialAero.alpha_unit must be 'deg' or 'rad', got '{self.alpha_unit}'")
         for name in ("CL", "CD"):
             m = getattr(self, name)
-            if not m or not all(isinstance(r, (list, tuple)) and len(r) == len(m[0]) for r in m):
-                raise ScenarioError(f"PolynomialAero.{name} must be a non-empty rectangular list of lists")
+            if not m or not all(isinstance(r, (list, tuple)) and len(r) == len(m[0]) for r in m) or not m[0]:
+                raise ScenarioError(f"PolynomialAero.{name} = {m!r} must be a non-empty rectangular list of lists "
+                                    f"(rows: powers of alpha, columns: powers of 1/M)")
+            for i, row in enumerate(m):
+                for j, c in enumerate(row):
+                    if isinstance(c, bool) or not isinstance(c, (int, float)) or not math.isfinite(c):
+                        raise ScenarioError(f"PolynomialAero.{name}[{i}][{j}] = {c!r} must be a finite number")
         _check_mach_range(self)
 
     @staticmethod

@@ -70,12 +70,12 @@ FINAL_DESCENT_DEG = 1.0
 FLIGHT_PATH_BOUNDS_DEG = (-45.0, 5.0)
 
 
-def aim_window(scenario, altitude_km: float, mach_window: tuple | None, mach: float) -> dict:
+def aim_window(scenario, altitude_km: float, mach_window: tuple, mach: float) -> dict:
     """The fields that make a plan end at ``altitude_km`` where the flight stops: the DRS
     window the flown plan is checked in [m] (AIM_WINDOW_KM about it, at most a quarter of the
     box's altitude tolerance and inside the box), the margin that narrows the plan's aim to
     AIM_TOLERANCE_KM [m], the stop altitude [km], and the plan's Mach window: the middle
-    MACH_WINDOW_FRACTION of the box's ``mach_window`` (low, high; None: open) below the Mach
+    MACH_WINDOW_FRACTION of the box's ``mach_window`` (low, high) below the Mach
     number where the vehicle's dynamic-pressure limit is met at that altitude (a window the
     limit closes gives an empty window: the candidate is refused), with the interface's
     ``mach`` held inside it as the spec's terminal_mach."""
@@ -85,9 +85,6 @@ def aim_window(scenario, altitude_km: float, mach_window: tuple | None, mach: fl
     margin = min(max(half - AIM_TOLERANCE_KM, 0.0), 0.49 * 2.0 * half)
     fields = {"guidance.final_altitude_m": [round((altitude_km - half) * 1e3, 3), round((altitude_km + half) * 1e3, 3)],
               "guidance.final_altitude_margin_m": round(margin * 1e3, 3), "guidance.terminal_altitude_km": altitude_km}
-    if mach_window is None:
-        return fields | {"guidance.final_mach_min": 0.0, "guidance.final_mach_max": 10.0,
-                         "guidance.terminal_mach": round(min(mach, 10.0), 4)}
     lo, hi = mach_window
     q_max = scenario.make_vehicle().limits.dynamic_pressure_max
     if math.isfinite(q_max):
@@ -122,9 +119,8 @@ def derive(scenario) -> Derivation:
         mach_window = (m * (1.0 - INTERFACE_SPEED_WINDOW), m * (1.0 + INTERFACE_SPEED_WINDOW))
         mach_how = (f"the box checks no speed: the interface's Mach {m:.3g} +- {INTERFACE_SPEED_WINDOW:.0%} (where the "
                     f"other methods' energy stop puts it)")
-    if mach_window is not None:
-        mach_how = (f"the middle {MACH_WINDOW_FRACTION:g} of {mach_how} below the vehicle's dynamic-pressure limit "
-                    f"at the interface altitude (room for the flown error)")
+    mach_how = (f"the middle {MACH_WINDOW_FRACTION:g} of {mach_how} below the vehicle's dynamic-pressure limit "
+                f"at the interface altitude (room for the flown error)")
     h, tol = interface.altitude_km, t.altitude_tolerance_km
     if h - tol < 0.0:
         raise CannotFly(f"the mission's altitude window reaches below the ground ({h - tol:g} km)")

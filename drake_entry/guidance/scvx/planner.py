@@ -16,10 +16,8 @@ from drake_entry.guidance.scvx.guess import GlideGuess, glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
 from drake_entry.models.atmosphere import Atmosphere
-from drake_entry.models.constraints import dynamic_pressure
 from drake_entry.models.dynamics import (
     STATE_NAMES,
-    air_data,
     flight_conditions,
 )
 from drake_entry.models.planet import Earth
@@ -247,8 +245,7 @@ def plan_metrics(problem: EntryProblem, X, U, tf: float) -> dict:
             "max_heat_flux_kW_m2": float(nodes[:, problem.out_q].max() / 1e3),
             "max_load_g": float(nodes[:, problem.out_n].max()),
             "max_flight_path_rate_deg_s": deg(float(np.abs(nodes[:, 4]).max())),
-            "max_dynamic_pressure_kPa": max(dynamic_pressure(air_data(x, problem.planet, problem.atmosphere)[0], x[3])
-                                            for x in X) / 1e3,
+            "max_dynamic_pressure_kPa": float(nodes[:, problem.out_p].max() / 1e3),
             "bank_effort_deg": deg(float(np.trapezoid(np.abs(sigma_dot), t))),
             "max_bank_rate_deg_s": deg(float(np.abs(sigma_dot).max())),
             "alpha_effort_deg": deg(float(np.trapezoid(np.abs(alpha_dot), t))),

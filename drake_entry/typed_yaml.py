@@ -11,6 +11,9 @@ Every input goes through the same two steps:
    the first type of a tagged union for ``guidance: 3``), an unknown type tag.
 2. Drake's ``yaml_load_typed`` builds the objects (its own errors, if any remain, are turned
    into one line too).
+3. ``check_numbers``: every number of the loaded tree is finite (a NaN never reaches a solver);
+   a field may be infinite only where its default is (an unbounded limit such as a vehicle's
+   ``dynamic_pressure_max_kPa: .inf``). Validators of objects built in Python call it too.
 
 An override (``override(root, "guidance.period_s", "2.5")``) walks the dotted path on the
 loaded objects, checks the value against the field's declared type as a file's value would
@@ -33,8 +36,8 @@ from pydrake.common.yaml import yaml_load_typed
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["Tagged", "DuplicateKeyError", "parse", "check", "packaged_names", "load_packaged_or_file",
-           "load_yaml_typed", "resolve_file_fields", "override"]
+__all__ = ["Tagged", "DuplicateKeyError", "parse", "check", "check_numbers", "packaged_names",
+           "load_packaged_or_file", "load_yaml_typed", "resolve_file_fields", "override"]
 
 
 class Tagged(NamedTuple):
@@ -201,6 +204,47 @@ def check(hint, value, path: str) -> None:
     # anything else (Drake's schema classes, Any): Drake's loader decides
 
 
+def _default(field):
+    """A dataclass field's default value (None when it has none or a factory)."""
+    return field.default if field.default is not dc.MISSING else None
+
+
+def _fields(obj) -> list[tuple[str, object]]:
+    """(name, default) of the fields of a dataclass or a Drake schema struct (``__fields__``)."""
+    if dc.is_dataclass(obj) and not isinstance(obj, type):
+        return [(f.name, _default(f)) for f in dc.fields(obj)]
+    return [(f.name, None) for f in getattr(type(obj), "__fields__", ())]
+
+
+def check_numbers(root, path: str = "", default=None) -> None:
+    """Raise a ScenarioError (no file prefix) for the first number of ``root`` (a loaded tree:
+    dataclasses, Drake schema structs, lists, tuples, dicts, numpy arrays) that is NaN, or
+    infinite where its field's default is not an infinity of that sign."""
+    import numpy as np
+
+    if isinstance(root, bool) or root is None or isinstance(root, (str, bytes)):
+        return
+    if isinstance(root, (int, float, np.integer, np.floating)):
+        x = float(root)
+        if x != x:
+            raise ScenarioError(f"{path or 'value'} = nan is not a finite number")
+        if x in (np.inf, -np.inf) and not (isinstance(default, (int, float)) and default == x):
+            raise ScenarioError(f"{path or 'value'} = {x} is not a finite number"
+                                + (" (this field has no unbounded value)" if path else ""))
+        return
+    if isinstance(root, np.ndarray):
+        root = root.tolist()
+    if isinstance(root, (list, tuple)):
+        for i, item in enumerate(root):
+            check_numbers(item, _join(path, i))
+    elif isinstance(root, dict):
+        for key, item in root.items():
+            check_numbers(item, _join(path, key))
+    else:
+        for name, field_default in _fields(root):
+            check_numbers(getattr(root, name, None), _join(path, name), field_default)
+
+
 def _tag_name(cls) -> str:
     return cls.__name__.split("\U0001d4e3")[0]  # Drake's template instances: DeterministicVector𝓣None𝓤
 
@@ -322,6 +366,9 @@ def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None,
             raise ScenarioError(f"{path} is not a text (UTF-8) YAML file") from None
         except OSError as e:
             raise ScenarioError(f"{path}: cannot be read ({e.strerror or e})") from None
+    if text is not None and not isinstance(text, str):
+        raise ScenarioError(f"{where}: text must be YAML text (a str), got {type(text).__name__}; to build a "
+                            f"{schema.__name__} from Python values, construct it and call its validate()")
     empty = f"{where}: the file is empty (no fields, only comments or blanks); a {schema.__name__} needs its fields"
     if not text or not text.strip():
         raise ScenarioError(empty)
@@ -348,6 +395,10 @@ def load_yaml_typed(schema, *, path: str | None = None, text: str | None = None,
         loaded = _drake_load(schema, text, where, defaults=defaults)
     else:
         loaded = _drake_load(schema, text, where)
+    try:
+        check_numbers(loaded)
+    except ScenarioError as e:
+        raise ScenarioError(f"{where}: {e}") from None
     if path is not None:
         resolve_file_fields(loaded, os.path.dirname(os.path.abspath(path)))
     if callable(getattr(loaded, "loaded_from", None)):
@@ -366,7 +417,7 @@ def resolve_file_fields(root, folder: str) -> None:
             value = getattr(root, name)
             if isinstance(value, str) and value and not os.path.isabs(value):
                 beside = os.path.join(folder, value)
-                if os.path.isfile(beside):
+                if os.path.exists(beside):  # a file, or a directory its loader then refuses by name
                     setattr(root, name, os.path.abspath(beside))
         children = [getattr(root, f.name) for f in dc.fields(root)]
     elif isinstance(root, dict):
@@ -422,4 +473,9 @@ def override(root, dotted: str, value, where: str = "override") -> None:
         raise ScenarioError(f"{where} {e}") from None
     document = f"{last}:\n{textwrap.indent(text, '  ')}" if "\n" in text else f"{last}: {text}"
     loaded = _drake_load(type(parent), document, f"{where} {dotted}", defaults=parent)
+    field_default = dict(_fields(parent)).get(last)
+    try:
+        check_numbers(getattr(loaded, last), dotted, field_default)
+    except ScenarioError as e:
+        raise ScenarioError(f"{where} {e}") from None
     setattr(parent, last, getattr(loaded, last))

@@ -146,7 +146,7 @@ def test_the_method_summary_counts_and_measures_the_rows():
 
 
 @pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
-def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path, monkeypatch):
+def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path, monkeypatch, capsys):
     from drake_entry.comparison.runner import run_comparison
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 
@@ -180,6 +180,13 @@ def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path, m
     # worker's (one process here); the nominal flight used to plan a third time
     assert sorted(built) == ["horus2b-bank_profile"] * 2 + ["horus2b-drag_energy"] * 2 and all((tmp_path / "cmp" / m / "nominal.json").exists() for m in ("drag_energy", "bank_profile"))
     assert "guidance: !BankProfile" in (tmp_path / "cmp" / "scenarios" / "bank_profile.yaml").read_text()
+    # `drake-entry report` on a comparison directory rewrites the comparison's report (it advised `campaign`)
+    from drake_entry.cli import main
+
+    (tmp_path / "cmp" / "report.md").unlink()
+    capsys.readouterr()
+    assert main(["report", str(tmp_path / "cmp")]) == 0 and (tmp_path / "cmp" / "report.md").read_text() == text
+    assert "drag_energy: 2 of 2 successful" in capsys.readouterr().out
     # a second call with another seed into the same directory is refused, not mixed
     with pytest.raises(ScenarioError, match="holds comparison 'tiny' with seed 7"):
         run_comparison(comp, runs=2, out_dir=str(tmp_path / "cmp"), seed=8, workers=1, progress=False)

@@ -148,7 +148,8 @@ def test_report_covers_partial_killed_and_all_failed_campaigns(tmp_path, capsys)
 def test_a_campaign_of_the_previous_format_is_reported_but_not_extended(tmp_path, capsys):
     old = tmp_path / "old"
     old.mkdir()
-    row = {"index": 0, "seed": 1, "success": True, "stop": "reached energy", "message": "ok", "err_distance_m": 10.0}
+    row = {"index": 0, "seed": 1, "success": True, "stop": "reached energy", "message": "ok", "err_distance_m": 10.0,
+           "reached_terminal": True, "inside_box": True, "within_limits": True, "flight_time_s": 1500.0}
     (old / "samples.jsonl").write_text(json.dumps(row) + "\n")
     (old / "campaign.json").write_text(json.dumps({"scenario": "horus2b", "runs": 1, "seed": 0, "overrides": {}}))
     assert "written by an older drake_entry (format 1)" in _one_line_error(

@@ -12,10 +12,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drake_entry.campaign.montecarlo import MAX_RUNS, run_campaign
+from drake_entry.campaign.arguments import MAX_RUNS, check_output_dir
+from drake_entry.campaign.montecarlo import run_campaign
 from drake_entry.campaign.store import done_indices
 from drake_entry.cli import main
-from drake_entry.cli.common import check_output_dir, os_error_line
+from drake_entry.cli.common import os_error_line
 from drake_entry.errors import ScenarioError
 
 

@@ -9,6 +9,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from drake_entry.campaign.montecarlo import run_campaign
+from drake_entry.campaign.rows import row_problem
+from drake_entry.campaign.store import read_rows
 from drake_entry.scenario import load_scenario
 
 #: the path limits as the papers state them (peak column: limit, SI)
@@ -44,3 +46,5 @@ def test_dispersed_campaign_rows_carry_verdicts_their_numbers_support(name, tmp_
         assert r["inside_box"] == all(r[c] for c in rows.columns if c.startswith("inside_") and c.endswith("_box"))
         assert r["success"] == (r["reached_terminal"] and r["inside_box"] and r["within_limits"])
         assert math.isfinite(r["flight_time_s"]) and np.isfinite(r["err_distance_m"])
+    streamed = read_rows(out)[0]  # the rows a report reads meet the campaign-row schema
+    assert len(streamed) == 2 and all(row_problem(r) == "" for r in streamed.values())

@@ -35,11 +35,12 @@ def test_user_vehicle_yaml_with_polynomial_aero(tmp_path):
 
 
 @pytest.mark.parametrize("cl, needle", [("[[]]", "PolynomialAero.CL = [[]] must be a non-empty rectangular"),
-                                        ("[[.nan]]", "PolynomialAero.CL[0][0] = nan must be a finite number"),
+                                        ("[[.nan]]", "aero.poly.CL[0][0] = nan is not a finite number"),
                                         ("[[0.0], [0.03, 1.0]]", "rectangular"),
-                                        ("[[0.0], [.inf]]", "PolynomialAero.CL[1][0] = inf must be a finite number")])
+                                        ("[[0.0], [.inf]]", "aero.poly.CL[1][0] = inf is not a finite number")])
 def test_an_empty_ragged_or_non_finite_polynomial_is_refused_naming_the_entry(tmp_path, cl, needle):
-    """CL: [[]] flew with zero lift and a NaN coefficient reached the solvers before."""
+    """CL: [[]] flew with zero lift and a NaN coefficient reached the solvers before (a
+    non-finite number is now refused by the loader, typed_yaml.check_numbers)."""
     f = tmp_path / "v.yaml"
     f.write_text("name: my\nmass_kg: 500\nreference_area_m2: 2\nnose_radius_m: 0.3\n"
                  f"aero:\n  poly: {{model: polynomial, CL: {cl}, CD: [[0.05]]}}\n")
@@ -51,7 +52,7 @@ def test_an_empty_ragged_or_non_finite_polynomial_is_refused_naming_the_entry(tm
 def test_negative_mass_names_the_field_and_range(tmp_path):
     f = tmp_path / "v.yaml"
     f.write_text("name: bad\nmass_kg: -5\nreference_area_m2: 1\nnose_radius_m: 1\naero: {a: {model: cav_h}}\n")
-    with pytest.raises(ScenarioError, match=r"mass_kg = -5.0 is out of range: must be > 0 kg"):
+    with pytest.raises(ScenarioError, match=r"mass_kg = -5.0 is out of range; allowed: \(0, 1e\+06\] kg"):
         load_vehicle(str(f))
 
 

@@ -8,14 +8,13 @@ Drake RandomSimulation (campaign.sample). The report is drake_entry.campaign.rep
 from __future__ import annotations
 
 import hashlib
-import math
 import os
 
-import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
 
+from drake_entry.campaign.arguments import MAX_RUNS, RUNS_NOTE, check_output_dir, check_run_arguments
 from drake_entry.campaign.backends import Task
-from drake_entry.campaign.engine import SampleCases, check_backend, run_cases, session, versions
+from drake_entry.campaign.engine import SampleCases, run_cases, session, versions
 from drake_entry.campaign.sample import (  # noqa: F401 (API)
     DETAILED_STEP_S,
     TIMING_COLUMNS,
@@ -35,9 +34,6 @@ __all__ = ["DETAILED_STEP_S", "TIMING_COLUMNS", "TRAJECTORY_STEP_S", "campaign_r
            "apply_overrides", "load_campaign_scenario", "MAX_RUNS", "RUNS_NOTE", "campaign_manifest", "run_campaign",
            "fly_nominal"]
 
-#: the largest campaign accepted: 10^7 samples at 0.5-40 s of a core each are 2-4600 core-days
-MAX_RUNS = 10_000_000
-RUNS_NOTE = " (10^7 samples take 2 to 4600 core-days by method; split larger studies into campaigns)"
 
 
 def _absolute_and_hash(path: str) -> tuple[str, str]:
@@ -87,18 +83,10 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     ``runs`` with the same settings extends it. Rows stream to out_dir/samples.jsonl,
     trajectories to trajectories.jsonl; at the end both are converted to Parquet.
     """
-    check_backend(backend, workers)
-    for name, value in (("scenario_path", scenario_path), ("out_dir", out_dir)):
-        if not isinstance(value, (str, os.PathLike)):
-            raise ScenarioError(f"{name} must be a path (text); got {type(value).__name__}")
-    scenario_path, out_dir = os.fspath(scenario_path), os.fspath(out_dir)
-    for name, value, lo, hi in (("runs", runs, 1, MAX_RUNS), ("seed", seed, 0, 2**63 - 1)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value <= hi:
-            raise ScenarioError(f"{name} = {value} is out of range; allowed: an integer in [{lo}, {hi}]"
-                                + (RUNS_NOTE if name == "runs" else ""))
-    if not (isinstance(trajectory_step_s, (int, float)) and 0 <= trajectory_step_s < math.inf):
-        raise ScenarioError(f"trajectory_step_s = {trajectory_step_s} is out of range; allowed: >= 0 s "
-                            f"(0 = no trajectories)")
+    check_run_arguments(runs=runs, seed=seed, trajectory_step_s=trajectory_step_s, workers=workers, backend=backend)
+    if not isinstance(scenario_path, (str, os.PathLike)):
+        raise ScenarioError(f"scenario_path must be a path (text); got {type(scenario_path).__name__}")
+    scenario_path, out_dir = os.fspath(scenario_path), check_output_dir(out_dir, "out_dir")
     manifest = campaign_manifest(scenario_path, seed=seed, trajectory_step_s=trajectory_step_s, overrides=overrides,
                                  runs=runs)
     task = Task("drake_entry.campaign.sample:setup_worker", "drake_entry.campaign.sample:run_case",

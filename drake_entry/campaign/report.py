@@ -26,6 +26,7 @@ import numpy as np
 
 from drake_entry.campaign import report_figures as figures
 from drake_entry.campaign.drivers import failure_drivers
+from drake_entry.campaign.rows import row_problem
 from drake_entry.campaign.statistics import (
     CONFIDENCE,
     COVERAGE,
@@ -207,7 +208,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     flown scenario's vehicle); ``reference``: published results put beside the terminal errors
     (default: the flown scenario's ``reference_results``). Raises CampaignError when out_dir
     holds no campaign."""
-    cov = coverage(out_dir)
+    cov = coverage(out_dir, row_problem)
     meta = cov["manifest"]
     records = [cov["rows"][k] for k in sorted(cov["rows"])]
     if not records:

@@ -358,16 +358,25 @@ def done_indices(out_dir: str) -> set:
     return set(read_rows(out_dir)[0])
 
 
-def coverage(out_dir: str) -> dict:
+def coverage(out_dir: str, row_problem=None) -> dict:
     """What a campaign directory holds, for reports: requested runs, complete rows, cut and
-    invalid lines still in the streams, quarantined lines. CampaignError when it holds no
-    campaign."""
+    invalid lines still in the streams, quarantined lines. ``row_problem(row)``: why a row is
+    not one of this campaign's (''), e.g. campaign.rows.row_problem; such rows are counted
+    invalid. CampaignError when it holds no campaign, or rows of which none is one."""
     if not os.path.isdir(out_dir):
         raise CampaignError(f"{out_dir} is not a directory: no campaign to report")
     manifest = read_manifest(out_dir)
     rows, counts = read_rows(out_dir)
     if manifest is None and not rows:
         raise CampaignError(f"{out_dir} holds no campaign (no campaign.json, no rows): run `drake-entry campaign` first")
+    if row_problem is not None:
+        problems = {i: row_problem(r) for i, r in rows.items()}
+        bad = sorted(i for i, p in problems.items() if p)
+        if bad and len(bad) == len(rows):
+            raise CampaignError(f"{os.path.join(out_dir, ROWS)}: none of its {len(rows)} row(s) is a campaign row "
+                                f"(index {bad[0]}: {problems[bad[0]][:200]}); nothing to report")
+        rows = {i: r for i, r in rows.items() if not problems[i]}
+        counts["invalid"] += len(bad)
     quarantined = len(_read_lines(os.path.join(out_dir, QUARANTINE))[0])
     return {"manifest": manifest or {}, "rows": rows, "requested": int((manifest or {}).get("runs", len(rows))),
             "quarantined": quarantined, **counts}

@@ -5,7 +5,8 @@ Commands:
                       scenario's YAML file with its comments
   campaign SCENARIO   closed-loop Monte-Carlo campaign (Drake RandomSimulation) with a report;
                       exit 1 when a sample is not successful
-  report DIR          (re)write the report (report.md, report.html) of a campaign directory
+  report DIR          (re)write the report (report.md, report.html) of a campaign or comparison
+                      directory
   fly SCENARIO        one closed-loop guided flight with plots
   plan SCENARIO       the guidance method's reference plan, flown by Drake, with its figures
                       (drag-energy, SCvx, AMPI, swarm-bank and LGL terminal methods)
@@ -24,7 +25,8 @@ import argparse
 import importlib
 import sys
 
-from drake_entry.cli.common import Command, HelpWithDefaults, check_output_dir, os_error_line
+from drake_entry.campaign.arguments import check_output_dir
+from drake_entry.cli.common import Command, HelpWithDefaults, os_error_line
 from drake_entry.errors import DrakeEntryError, Interrupted
 
 __all__ = ["main", "commands", "FAMILIES"]

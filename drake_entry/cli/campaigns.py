@@ -28,6 +28,15 @@ def campaign(args) -> int:
 
 
 def report(args) -> int:
+    from drake_entry.comparison.report import read_comparison_manifest, write_comparison_report
+
+    if os.path.isdir(args.dir) and read_comparison_manifest(args.dir) is not None:  # a comparison's directory
+        from drake_entry.cli.comparisons import print_comparison_summary
+
+        path = write_comparison_report(args.dir)
+        print_comparison_summary(args.dir)
+        print(f"comparison report: {path}")
+        return 0
     write_and_print_report(args.dir)
     return 0
 
@@ -67,7 +76,8 @@ def _add_campaign_arguments(parser) -> None:
 
 
 def _add_report_arguments(parser) -> None:
-    parser.add_argument("dir", help="a campaign directory (finished, running, killed or partial)")
+    parser.add_argument("dir", help="a campaign directory (finished, running, killed or partial) or a comparison "
+                        "directory (drake-entry compare --out)")
 
 
 def _add_results_arguments(parser) -> None:
@@ -139,7 +149,7 @@ def results(args) -> int:
 
 
 COMMANDS = (Command("campaign", "closed-loop Monte-Carlo campaign with a report", _add_campaign_arguments, campaign),
-            Command("report", "write the report (report.md, report.html) of a campaign directory",
+            Command("report", "write the report (report.md, report.html) of a campaign or comparison directory",
                     _add_report_arguments, report),
             Command("results", "every packaged closed-loop scenario as a Monte-Carlo campaign with its report",
                     _add_results_arguments, results))

@@ -11,7 +11,7 @@ from typing import Callable, NamedTuple
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["write_plan_report", "Command", "HelpWithDefaults", "add_scenario_argument", "add_overrides_argument", "check_output_dir",
+__all__ = ["write_plan_report", "Command", "HelpWithDefaults", "add_scenario_argument", "add_overrides_argument",
            "parse_overrides", "os_error_line"]
 
 
@@ -48,25 +48,6 @@ def add_overrides_argument(parser, example: str) -> None:
     parser.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE", dest="overrides",
                         help=f"override a scenario field, e.g. --set {example} (repeatable; the value is read as "
                              "YAML)")
-
-
-def check_output_dir(out: str) -> None:
-    """Refuse an output directory that cannot be made or written before any work starts: a
-    file on its path, a read-only or forbidden place (one line naming it)."""
-    if not out or not out.strip():
-        raise ScenarioError("--out is empty; give a directory")
-    if "\0" in out:
-        raise ScenarioError(f"--out {out!r} contains a NUL character; give a directory path")
-    parent = os.path.normpath(out)  # 'a_file/' names the file too
-    if os.path.exists(parent) and not os.path.isdir(parent):
-        raise ScenarioError(f"--out {out} is a file, not a directory")
-    while parent and not os.path.exists(parent):
-        parent = os.path.dirname(parent.rstrip(os.sep))
-    parent = parent or "."
-    if not os.path.isdir(parent):
-        raise ScenarioError(f"--out {out}: {parent} is a file, not a directory; choose another --out")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise ScenarioError(f"--out {out}: {parent} is not writable (read-only or no permission); choose another --out")
 
 
 def parse_overrides(items) -> dict:

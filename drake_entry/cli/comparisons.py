@@ -8,7 +8,7 @@ import sys
 
 from drake_entry.cli.common import Command
 
-__all__ = ["COMMANDS"]
+__all__ = ["COMMANDS", "print_comparison_summary"]
 
 
 def _add_compare_arguments(parser) -> None:
@@ -35,6 +35,20 @@ def compare(args) -> int:
     out = args.out or os.path.join("out", "compare", comparison.name)
     path = run_comparison(comparison, runs=args.runs, out_dir=out, seed=args.seed, workers=args.workers,
                           only=args.only, trajectory_step_s=args.trajectory_step)
+    failed, flown = print_comparison_summary(out)
+    print(f"report: {path}")
+    if not flown:
+        print("drake-entry: no method flew this mission (each one's reason is above and in the report)",
+              file=sys.stderr)
+        return 1
+    if failed:
+        print(f"drake-entry: {failed} method(s) with samples that are not successful (see the report)", file=sys.stderr)
+    return 1 if failed else 0
+
+
+def print_comparison_summary(out: str) -> tuple[int, int]:
+    """Print each method's count of successful samples and each not-flown method's reason from
+    ``out``'s comparison_summary.json; return (methods with an unsuccessful sample, methods flown)."""
     with open(os.path.join(out, "comparison_summary.json")) as f:
         summary = json.load(f)
     failed = 0
@@ -43,10 +57,7 @@ def compare(args) -> int:
         print(f"   {label}: {s['successful']} of {s['samples']} successful")
     for label, reason in summary["not_flown"].items():
         print(f"   {label}: not flown ({reason.split(';')[0][:100]})")
-    print(f"report: {path}")
-    if failed:
-        print(f"drake-entry: {failed} method(s) with samples that are not successful (see the report)", file=sys.stderr)
-    return 1 if failed else 0
+    return failed, len(summary["methods"])
 
 
 def _add_matrix_arguments(parser) -> None:

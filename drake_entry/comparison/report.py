@@ -30,6 +30,7 @@ from drake_entry.campaign.report import (
     table_cell,
     write_markdown_report,
 )
+from drake_entry.campaign.rows import row_problem
 from drake_entry.campaign.statistics import finite_column
 from drake_entry.campaign.store import coverage, read_manifest
 from drake_entry.comparison.derive import value_text
@@ -50,11 +51,18 @@ MARGIN_NAMES = {"margin_heat_flux": "heat flux", "margin_dynamic_pressure": "dyn
 
 def read_comparison_manifest(out_dir: str) -> dict | None:
     """comparison.json of ``out_dir`` (None when absent)."""
+    path = os.path.join(out_dir, MANIFEST)
     try:
-        with open(os.path.join(out_dir, MANIFEST)) as f:
-            return json.load(f)
+        with open(path) as f:
+            manifest = json.load(f)
     except FileNotFoundError:
         return None
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise CampaignError(f"{path} is not a comparison manifest (not JSON: {str(e).splitlines()[0]}); give "
+                            f"another directory") from None
+    if not isinstance(manifest, dict) or not isinstance(manifest.get("methods"), dict):
+        raise CampaignError(f"{path} is not a comparison manifest (no 'methods' record); give another directory")
+    return manifest
 
 
 def clopper_pearson(successes: int, runs: int, level: float = LEVEL) -> tuple[float, float]:
@@ -64,7 +72,7 @@ def clopper_pearson(successes: int, runs: int, level: float = LEVEL) -> tuple[fl
 
 
 def _method_rows(out_dir: str, label: str) -> dict | None:
-    cov = coverage(os.path.join(out_dir, label))
+    cov = coverage(os.path.join(out_dir, label), row_problem)
     records = [cov["rows"][k] for k in sorted(cov["rows"])]
     return rows_as_columns(records) if records else None
 

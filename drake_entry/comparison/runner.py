@@ -10,29 +10,36 @@ Then each campaign's report and the comparison's report (comparison.report).
 """
 from __future__ import annotations
 
+import dataclasses as dc
+import hashlib
 import json
 import os
 import time
 
 from pydrake.common.yaml import yaml_dump_typed
 
+from drake_entry.campaign.arguments import check_output_dir, check_run_arguments
 from drake_entry.campaign.engine import session, versions
 from drake_entry.campaign.montecarlo import TRAJECTORY_STEP_S, run_campaign
-from drake_entry.campaign.store import write_atomic
+from drake_entry.campaign.store import MANIFEST as CAMPAIGN_MANIFEST
+from drake_entry.campaign.store import ROWS, write_atomic
 from drake_entry.comparison.derive import value_text
 from drake_entry.comparison.report import MANIFEST, read_comparison_manifest, write_comparison_report
-from drake_entry.comparison.spec import Comparison, load_comparison, method_scenario, needs_derivation
+from drake_entry.comparison.spec import (
+    SCENARIOS,
+    Comparison,
+    load_comparison,
+    method_scenario,
+    needs_derivation,
+)
 from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.guidance.derivation import CannotFly
 from drake_entry.scenario import load_scenario
 
-__all__ = ["SCENARIOS", "run_comparison"]
+__all__ = ["SCENARIOS", "run_comparison", "comparison_identity", "check_comparison_dir"]
 
 #: how the search flies each candidate, in words
 SEARCH_DRAWS_TEXT = "a few dispersed draws of another seed"
-
-#: the folder of a comparison directory that holds the scenario each method flew
-SCENARIOS = "scenarios"
 
 
 def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, workers: int | None = None,
@@ -46,29 +53,30 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
     from drake_entry.campaign.report import write_report
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 
+    check_run_arguments(runs=runs, seed=seed, trajectory_step_s=trajectory_step_s, workers=workers)
+    out_dir = check_output_dir(out_dir, "out_dir")
     comp = comparison if isinstance(comparison, Comparison) else load_comparison(comparison)
     comp.validate()
     entries = comp.entries()
     labels = [m.label for m in entries]
-    unknown = [x for x in (only or []) if x not in labels]
-    if unknown:
-        raise ScenarioError(f"only: {', '.join(unknown)} not in comparison {comp.name}; allowed: {', '.join(labels)}")
+    only = _checked_only(only, entries, comp.name)
+    if not comp.flown():
+        raise ScenarioError(f"comparison {comp.name} has nothing to fly: every method it lists is not_flown ("
+                            + "; ".join(f"{m.label}: {m.not_flown}" for m in entries)[:300] + ")")
     mission = load_scenario(comp.mission)
     derived = {m.label for m in comp.flown() if needs_derivation(comp, m, mission)}
     scenarios = {m.label: method_scenario(comp, m) for m in comp.flown()
                  if m.label not in derived}  # every bad entry before any flight
+    identity = comparison_identity(comp, mission)
+    manifest = check_comparison_dir(out_dir, comp.name, identity, seed)  # before anything is written
     os.makedirs(os.path.join(out_dir, SCENARIOS), exist_ok=True)
-    manifest = read_comparison_manifest(out_dir) or {}
-    if manifest and (manifest.get("comparison") != comp.name or manifest.get("seed") != seed):
-        raise ScenarioError(f"{out_dir} holds comparison {manifest.get('comparison')!r} with seed "
-                            f"{manifest.get('seed')}; use another --out")
     methods = dict(manifest.get("methods", {}))
     order = {label: i for i, label in enumerate(labels + [m.label for m in comp.not_configured()])}
     earlier_runs, sessions = int(manifest.get("runs", 0)), list(manifest.get("sessions", [])) + [session()]
 
     def save(methods: dict) -> None:
         record = {"comparison": comp.name, "description": comp.description, "mission": comp.mission,
-                  "comparison_yaml": yaml_dump_typed(comp), "runs": max(int(runs), earlier_runs),
+                  "identity": identity, "comparison_yaml": yaml_dump_typed(comp), "runs": max(int(runs), earlier_runs),
                   "seed": int(seed), "versions": versions(), "sessions": sessions,
                   "methods": dict(sorted(methods.items(), key=lambda kv: order.get(kv[0], len(order))))}
         write_atomic(os.path.join(out_dir, MANIFEST), json.dumps(record, indent=2).encode())
@@ -127,6 +135,55 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
         save(methods)  # each method's record (its derivation) kept as soon as it is flown
     save(methods)
     return write_comparison_report(out_dir)
+
+
+def _checked_only(only, entries, name: str) -> list[str] | None:
+    """``only`` as a list of labels of flown entries, or a one-line ScenarioError."""
+    if only is None:
+        return None
+    if isinstance(only, str) or not isinstance(only, (list, tuple)) or not all(isinstance(x, str) for x in only):
+        raise ScenarioError(f"only = {only!r}: give a list of labels, e.g. only=[{only!r}]" if isinstance(only, str)
+                            else f"only = {only!r}: give a list of labels (text)")
+    labels = {m.label: m for m in entries}
+    unknown = [x for x in only if x not in labels]
+    if unknown:
+        raise ScenarioError(f"only: {', '.join(unknown)} not in comparison {name}; allowed: {', '.join(labels)}")
+    not_flown = [x for x in only if labels[x].not_flown]
+    if not_flown and len(not_flown) == len(only):
+        raise ScenarioError(f"only: {', '.join(not_flown)}: nothing to fly (not flown on this mission: "
+                            f"{labels[not_flown[0]].not_flown[:200]})")
+    return list(only)
+
+
+def comparison_identity(comp: Comparison, mission) -> str:
+    """What a comparison directory holds, as a SHA-256: the methods' settings and the mission's
+    content (the scenario as loaded), not the comparison's name or where its files are."""
+    from pydrake.common.yaml import yaml_dump_typed
+
+    methods = yaml_dump_typed(dc.replace(comp, name="", description="", mission=""))
+    return hashlib.sha256(json.dumps([methods, yaml_dump_typed(mission)]).encode()).hexdigest()
+
+
+def check_comparison_dir(out_dir: str, name: str, identity: str, seed: int) -> dict:
+    """The manifest of ``out_dir`` ({} when it is new or empty), or a ScenarioError when it holds
+    something else: a campaign, other files, another comparison (other content or seed)."""
+    if not os.path.isdir(out_dir) or not os.listdir(out_dir):
+        return {}
+    manifest = read_comparison_manifest(out_dir)
+    if manifest is None:
+        if os.path.exists(os.path.join(out_dir, CAMPAIGN_MANIFEST)) or os.path.exists(os.path.join(out_dir, ROWS)):
+            raise ScenarioError(f"{out_dir} holds a campaign ({CAMPAIGN_MANIFEST}), not a comparison; give another "
+                                f"directory")
+        raise ScenarioError(f"{out_dir} is not empty and holds no comparison ({MANIFEST}); give a new or empty "
+                            f"directory")
+    if manifest.get("seed") != seed:
+        raise ScenarioError(f"{out_dir} holds comparison {manifest.get('comparison')!r} with seed "
+                            f"{manifest.get('seed')}; use another --out")
+    held = manifest.get("identity")
+    if (held or manifest.get("comparison")) != (identity if held else name):
+        raise ScenarioError(f"{out_dir} holds comparison {manifest.get('comparison')!r} of other content (another "
+                            f"mission or other methods' settings) than {name!r}; use another --out, or the same file")
+    return manifest
 
 
 def _spec_type(entry):

@@ -23,14 +23,18 @@ from drake_entry.guidance import REGISTRY, GuidanceSpec, known_tags
 from drake_entry.scenario import Scenario, apply_overrides, load_scenario, stated_guidance
 from drake_entry.typed_yaml import load_packaged_or_file, packaged_names
 
-__all__ = ["METHOD_FIELDS", "LABEL", "ComparedMethod", "Comparison", "PACKAGED_COMPARISONS", "load_comparison",
-           "needs_derivation", "method_scenario", "mission_comparison",
+__all__ = ["METHOD_FIELDS", "LABEL", "NAME", "SCENARIOS", "ComparedMethod", "Comparison", "PACKAGED_COMPARISONS",
+           "load_comparison", "needs_derivation", "method_scenario", "mission_comparison",
            "load_comparison_or_mission"]
 
 #: the scenario fields an entry may override: the method's settings, never the mission
 METHOD_FIELDS = ("guidance", "alpha")
 #: a label names a directory: letters, digits, '-' and '_'
 LABEL = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,39}$")
+#: a comparison's name names its default directory (out/compare/<name>): one path component
+NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,79}$")
+#: the folder of a comparison directory that holds the scenario each method flew (no label may take it)
+SCENARIOS = "scenarios"
 
 
 @dc.dataclass
@@ -70,20 +74,37 @@ class Comparison:
     def validate(self) -> "Comparison":
         """One-line ScenarioErrors for a missing mission, unknown methods, duplicate or bad labels,
         an entry both flown and not flown, and overrides of the mission's own fields."""
+        from drake_entry.guidance import folder_of
+
+        if not isinstance(self.name, str) or not NAME.match(self.name) or ".." in self.name:
+            raise ScenarioError(f"name = {self.name!r}: allowed: 1-80 letters, digits, '.', '-' or '_', starting with "
+                                f"a letter or digit, without '..' (it names the directory out/compare/<name>)")
         if not isinstance(self.mission, str) or not self.mission:
             raise ScenarioError("mission: missing; give a packaged scenario name or a scenario file")
         tags = {spec.__name__: spec for spec in REGISTRY}
+        folders = {folder_of(spec): spec.__name__ for spec in REGISTRY}
         seen = set()
         for i, m in enumerate(self.methods):
             where = f"methods[{i}]"
-            if not LABEL.match(m.label):
+            if not isinstance(m.label, str) or not LABEL.match(m.label):
                 raise ScenarioError(f"{where}.label = {m.label!r}: allowed: 1-40 letters, digits, '-' or '_', "
                                     f"starting with a letter or digit")
+            if m.label == SCENARIOS:
+                raise ScenarioError(f"{where}.label = {m.label!r} is the comparison directory's own folder (the "
+                                    f"scenarios each method flew); give another label")
             if m.label in seen:
                 raise ScenarioError(f"{where}.label = {m.label!r} is given twice; labels are directory names")
             seen.add(m.label)
             if m.method not in tags:
                 raise ScenarioError(f"{where}.method = {m.method!r}; allowed: {known_tags().replace('!', '')}")
+            if folders.get(m.label, m.method) != m.method:
+                raise ScenarioError(f"{where}.label = {m.label!r} names !{folders[m.label]} but method is {m.method}; "
+                                    f"give a label that is not another method's name")
+            tag = _override_tag(m.overrides.get("guidance"))
+            if tag is not None and tag != m.method:
+                raise ScenarioError(f"{where}.overrides.guidance is !{tag} but method is {m.method}: an entry flies "
+                                    f"the method its 'method' names (give !{m.method} settings, or list !{tag} as "
+                                    f"its own entry)")
             if m.not_flown and (m.guidance is not None or m.overrides):
                 raise ScenarioError(f"{where} ({m.label}): not_flown and settings (guidance, overrides) exclude each "
                                     f"other")
@@ -117,19 +138,26 @@ class Comparison:
 
         if not self.methods:
             return []
-        listed = {m.method for m in self.methods}
-        labels = {m.label for m in self.methods}
+        listed = {m.method for m in self.methods}  # a listed label is never an unlisted method's folder (validate)
         out = []
         for spec in REGISTRY:
             if spec.__name__ in listed:
                 continue
-            label = folder_of(spec)
-            label = label if label not in labels else f"{label}_not_configured"
-            out.append(ComparedMethod(label=label, method=spec.__name__, not_flown=(
+            out.append(ComparedMethod(label=folder_of(spec), method=spec.__name__, not_flown=(
                 f"not configured: this comparison does not list !{spec.__name__} (list it without a guidance "
                 f"block to derive its settings from the mission, with one to set them, or with not_flown and the "
                 f"reason)")))
         return out
+
+
+def _override_tag(text) -> str | None:
+    """The !Tag of an override's YAML text (None: no text, or untagged)."""
+    from drake_entry.typed_yaml import Tagged, parse
+
+    if not isinstance(text, str):
+        return None
+    value = parse(text, "overrides.guidance")
+    return value.tag if isinstance(value, Tagged) else None
 
 
 #: the comparisons shipped in drake_entry/comparisons (``<name>.yaml``)
@@ -138,7 +166,11 @@ PACKAGED_COMPARISONS = packaged_names("comparisons")
 
 def load_comparison(name_or_path) -> Comparison:
     """Read and validate a comparison: a packaged name or a YAML file path."""
-    return load_packaged_or_file(Comparison, name_or_path, kind="comparison", folder="comparisons").validate()
+    comparison = load_packaged_or_file(Comparison, name_or_path, kind="comparison", folder="comparisons")
+    try:
+        return comparison.validate()
+    except ScenarioError as e:
+        raise ScenarioError(f"comparison '{name_or_path}': {e}") from None
 
 
 def needs_derivation(comparison: Comparison, entry: ComparedMethod, mission: Scenario | None = None) -> bool:
@@ -172,6 +204,8 @@ def method_scenario(comparison: Comparison, entry: ComparedMethod,
                                 f"guidance: !{entry.method} block: its settings are derived from the mission when the "
                                 f"comparison runs (drake_entry.comparison.derive), or give the block")
         apply_overrides(scenario, dict(entry.overrides))
+        if type(scenario.guidance).__name__ != entry.method:
+            raise ScenarioError(f"its settings are !{type(scenario.guidance).__name__} but method is {entry.method}")
         scenario.validate()
     except ScenarioError as e:
         raise ScenarioError(f"comparison {comparison.name}, method {entry.label}: {e}") from None
@@ -183,7 +217,8 @@ def mission_comparison(mission: str) -> Comparison:
     """The comparison of a mission alone (a packaged scenario name or a scenario file): every
     registered method, each with its settings derived from the mission; named after it."""
     scenario = load_scenario(mission)
-    return Comparison(name=scenario.name, description=f"every guidance method on {scenario.name}, settings derived "
+    name = re.sub(r"[^A-Za-z0-9._-]+", "_", scenario.name).replace("..", "_").lstrip("._-")[:80] or "mission"
+    return Comparison(name=name, description=f"every guidance method on {scenario.name}, settings derived "
                       f"from the mission", mission=mission).validate()
 
 

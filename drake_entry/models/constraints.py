@@ -8,6 +8,7 @@ families (docs/references.md, "Heat flux").
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -127,6 +128,16 @@ def make_heat_flux(form: str, *, nose_radius: float, coefficient: float | None =
 
 
 def _heat_flux_form(form, nose_radius, coefficient, velocity_exponent, circular_speed) -> HeatFlux:
+    if coefficient is not None and not 0 < coefficient < math.inf:
+        raise ScenarioError(f"heat_flux.coefficient = {coefficient} is out of range; allowed: a finite number > 0 "
+                            f"(empty: the form's published constant)")
+    if velocity_exponent is not None:
+        if form == "sutton_graves":
+            raise ScenarioError(f"heat_flux.velocity_exponent applies to forms chapman, normalised and lumped; form "
+                                f"'{form}' has its own (give none)")
+        if not 0 < velocity_exponent <= 10:
+            raise ScenarioError(f"heat_flux.velocity_exponent = {velocity_exponent} is out of range; allowed: (0, 10] "
+                                f"(Chapman 3.15, Sutton-Graves 3)")
     if circular_speed is not None and (form != "normalised" or not 0 < circular_speed < 1e5):
         raise ScenarioError(f"heat_flux.circular_speed_m_s = {circular_speed} applies to form 'normalised' only "
                             f"and must be in (0, 1e5) m/s")

@@ -19,7 +19,14 @@ from drake_entry.models.constraints import HeatFlux, PathLimits, make_heat_flux
 from drake_entry.typed_yaml import load_packaged_or_file, packaged_names
 
 __all__ = ["AeroSpec", "HeatFluxSpec", "VehicleSpec", "Vehicle", "build_aero", "vehicle_from_spec",
-           "PACKAGED_VEHICLES", "vehicle_spec", "LIMIT_FIELDS", "load_vehicle"]
+           "PACKAGED_VEHICLES", "vehicle_spec", "LIMIT_FIELDS", "SIZE_RANGES", "load_vehicle"]
+
+#: the allowed size of a vehicle file's vehicle: (field, low, high, unit), low excluded (a
+#: dispersion then scales it within its own bounds). The highs bound every vehicle flown or
+#: proposed (a 100-t orbiter, a 9-m diameter aeroshell: 64 m^2; inflatable decelerators to
+#: about 30 m across: 700 m^2) by an order of magnitude, and keep rho V^2 S / m inside
+#: floating point (an area of 1e308 overflowed to NaN in the trim root finder).
+SIZE_RANGES = (("mass_kg", 0.0, 1e6, "kg"), ("reference_area_m2", 0.0, 1e4, "m^2"), ("nose_radius_m", 0.0, 100.0, "m"))
 
 
 @dc.dataclass
@@ -129,7 +136,7 @@ class Vehicle:
 
     def __post_init__(self):
         for field, unit in (("mass", "kg"), ("reference_area", "m^2"), ("nose_radius", "m"), ("bank_rate_limit", "rad/s"),
-                            ("bank_accel_limit", "rad/s^2")):
+                            ("bank_accel_limit", "rad/s^2")):  # a file's vehicle is inside SIZE_RANGES; a dispersed one scaled
             v = getattr(self, field)
             if isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 < v < math.inf):
                 raise ScenarioError(f"Vehicle.{field} = {v!r} must be a finite number > 0 {unit}")
@@ -151,14 +158,16 @@ class Vehicle:
         return self.reference_area / self.mass
 
 
-def _resolve_data(path: str):
-    """A packaged data file name or a filesystem path."""
+def _resolve_data(path: str, field: str):
+    """A packaged data file name or a filesystem path (``field``: the vehicle-file field naming it)."""
+    if os.path.isdir(path):
+        raise ScenarioError(f"{field} = '{path}' is a directory; give a CSV file")
     if os.path.exists(path):
         return open(path)
     try:
         return aero_mod.packaged_data(path)
     except FileNotFoundError:
-        raise ScenarioError(f"aero table '{path}' is neither a file nor a packaged data file (a relative path is "
+        raise ScenarioError(f"{field} = '{path}' is neither a file nor a packaged data file (a relative path is "
                             f"read beside the vehicle file, then here)") from None
 
 
@@ -169,9 +178,9 @@ def build_aero(spec: AeroSpec, where: str = "aero") -> aero_mod.AeroModel:
         if m == "table":
             if not spec.table_csv:
                 raise ScenarioError(f"{where}.table_csv is required for model 'table'")
-            with _resolve_data(spec.table_csv) as t:
+            with _resolve_data(spec.table_csv, "table_csv") as t:
                 if spec.fill_csv:
-                    with _resolve_data(spec.fill_csv) as f:
+                    with _resolve_data(spec.fill_csv, "fill_csv") as f:
                         table = aero_mod.read_wide_table(t, fill=f)
                 else:
                     table = aero_mod.read_wide_table(t)
@@ -199,10 +208,10 @@ def build_aero(spec: AeroSpec, where: str = "aero") -> aero_mod.AeroModel:
 
 def vehicle_from_spec(spec: VehicleSpec, aero: str | None = None, where: str = "vehicle") -> Vehicle:
     """Vehicle from a VehicleSpec; ``aero`` picks one of the file's aero models."""
-    for field, unit in (("mass_kg", "kg"), ("reference_area_m2", "m^2"), ("nose_radius_m", "m")):
+    for field, low, high, unit in SIZE_RANGES:
         v = getattr(spec, field)
-        if not v > 0:
-            raise ScenarioError(f"{where}.{field} = {v} is out of range: must be > 0 {unit}")
+        if not low < v <= high:
+            raise ScenarioError(f"{where}.{field} = {v!r} is out of range; allowed: ({low:g}, {high:g}] {unit}")
     if not spec.aero:
         raise ScenarioError(f"{where}.aero is empty: give at least one aerodynamic model")
     key = aero or spec.default_aero or next(iter(spec.aero))

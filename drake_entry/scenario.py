@@ -20,7 +20,7 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import VARIABLES, Schedule
 from drake_entry.models.vehicles import Vehicle, load_vehicle
 from drake_entry.models.verdict import PathLimit, acceptance_box, vehicle_path_limits
-from drake_entry.typed_yaml import load_packaged_or_file, override, packaged_names
+from drake_entry.typed_yaml import check_numbers, load_packaged_or_file, override, packaged_names
 
 __all__ = ["RENAMED_GUIDANCE_FIELDS", "upgrade_scenario_yaml", "scenario_from_dump", "EntryStateSpec", "TargetSpec", "TerminalSpec", "ScheduleSpec", "unstated_guidance", "stated_guidance", "PLANTS", "SimulationSpec",
            "ReferenceResultsSpec", "ERROR_COLUMNS", "Scenario", "INTEGRATORS", "SCHEDULE_VALUES_DEG",
@@ -270,6 +270,7 @@ class Scenario:
 
     def validate(self) -> "Scenario":
         """Check every field against its allowed range; return self."""
+        check_numbers(self)  # a scenario built or changed in Python: no NaN, no infinity but an unbounded default
         if self.altitude_datum not in ("sphere", "ellipsoid"):
             raise ScenarioError(f"altitude_datum = '{self.altitude_datum}' is unknown; allowed: sphere, ellipsoid")
         if self.altitude_datum == "ellipsoid" and self.planet.model != "oblate":

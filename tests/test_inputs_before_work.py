@@ -269,3 +269,10 @@ def test_report_of_a_bare_row_is_refused_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "none of its 1 row(s) is a campaign row (index 0: seed (missing)" in err and "nothing to report" in err
     assert sorted(os.listdir(out)) == ["samples.jsonl"]
+
+
+def test_a_scenario_changed_in_python_is_held_to_the_same_numbers():
+    s = load_scenario("horus2b")
+    s.entry.velocity_m_s = float("nan")
+    with pytest.raises(ScenarioError, match=r"^entry.velocity_m_s = nan is not a finite number$"):
+        s.validate()

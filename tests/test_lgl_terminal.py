@@ -136,3 +136,101 @@ def test_feedback_kinds_map_to_the_plans_laws():
 
     assert feedback_maker("none") is None
     assert feedback_maker("tvlqr")(Plan()) == "law tvlqr" and feedback_maker("costate")(Plan()) == "law costate"
+
+
+# -- the problem a mission poses (problem: mission) --------------------------------------------
+@pytest.fixture(scope="module")
+def horus_derived():
+    """HORUS-2B's mission with the LGL settings derived from it."""
+    import dataclasses as dc
+
+    from drake_entry.guidance.derivation import derivation_for
+    from drake_entry.guidance.lgl_terminal.spec import LglTerminal
+
+    mission = load_scenario("horus2b")
+    derivation = derivation_for(mission, LglTerminal)
+    return dc.replace(mission, guidance=derivation.spec).validate(), derivation
+
+
+def test_a_mission_poses_its_own_terminal_problem(horus_derived):
+    """Entry state to the box's altitude over the target, alpha within the mission's schedule, the
+    bank within the vehicle's limit and rate, the vehicle's limits planned 8 % inside, eq. 11."""
+    from drake_entry.guidance.lgl_terminal.mission import GAMMA_BOUNDS_DEG
+
+    s, _ = horus_derived
+    g, v = s.guidance, s.make_vehicle()
+    p = g.problem_for(s)
+    assert g.problem == "mission" and p.controls == "rates"
+    assert np.allclose([p.initial[k] for k in ("h", "lon", "lat", "V", "gamma", "psi")], s.initial_state())
+    assert p.final["h"] == 25e3 and p.final["V"] == g.terminal_velocity_m_s and "gamma" not in p.final
+    assert (p.final["lon"], p.final["lat"]) == pytest.approx((math.radians(s.target.longitude_deg),
+                                                              math.radians(s.target.latitude_deg)))
+    assert np.degrees(p.state_bounds["alpha"]) == pytest.approx([15.0, 40.0])  # the mission's schedule
+    assert p.state_bounds["sigma"] == pytest.approx((-v.bank_limit, v.bank_limit))
+    assert np.degrees(p.state_bounds["gamma"]) == pytest.approx(GAMMA_BOUNDS_DEG)
+    assert p.control_bounds["u_sigma"] == pytest.approx((-v.bank_rate_limit, v.bank_rate_limit))
+    assert p.control_bounds["u_alpha"] == pytest.approx((-math.radians(2.0), math.radians(2.0)))
+    planned = {c.label: c.max for c in p.path}
+    assert planned == pytest.approx({"heat_flux": 0.92 * v.limits.heat_flux_max,
+                                     "dynamic_pressure": 0.92 * v.limits.dynamic_pressure_max,
+                                     "normal_load": 0.92 * v.limits.normal_load_max})
+    assert [t.kind for t in p.objective] == ["control_margin"] and p.objective[0].k == (1.0, 18.0, 20.0)
+    assert s.guidance.path_limits(s) == []  # its constraints are the vehicle's limits, checked anyway
+    assert s.guidance.terminal_speed(300.0) == g.terminal_velocity_m_s
+
+
+def test_the_derived_final_speed_stays_below_the_planned_dynamic_pressure(horus_derived):
+    """HORUS-2B's box centre (Mach 2.5 at 25 km) is 11 kPa against its 10 kPa limit: each candidate
+    altitude ends below Q_SPEED_FRACTION of the speed where 0.92 of the limit is met, inside the box."""
+    from drake_entry.guidance.lgl_terminal.derive import Q_SPEED_FRACTION
+
+    s, derivation = horus_derived
+    atmosphere, q_max = s.make_atmosphere(), s.make_vehicle().limits.dynamic_pressure_max
+    (step,) = derivation.search
+    assert [c["guidance.terminal_altitude_km"] for c in step.candidates] == [25.0, 25.5, 26.0, 26.5, 24.5, 24.0]
+    for c in step.candidates:
+        h, V = c["guidance.terminal_altitude_km"] * 1e3, c["guidance.terminal_velocity_m_s"]
+        q = 0.5 * float(atmosphere.density(h)) * V ** 2
+        assert q == pytest.approx(Q_SPEED_FRACTION ** 2 * 0.92 * q_max, rel=1e-5)
+        assert 2.0 <= V / float(atmosphere.speed_of_sound(h)) <= 2.5  # the box's Mach window, below its centre
+
+
+def test_a_mission_whose_box_is_beyond_the_dynamic_pressure_limit_cannot_be_flown():
+    from drake_entry.guidance.derivation import CannotFly, derivation_for
+    from drake_entry.guidance.lgl_terminal.spec import LglTerminal
+    from drake_entry.scenario import apply_overrides
+
+    s = load_scenario("horus2b")
+    apply_overrides(s, {"vehicle_limits": "{dynamic_pressure_max_kPa: 5.0}"})
+    with pytest.raises(CannotFly, match=r"at 24 km the vehicle's dynamic-pressure limit, planned at 0.92 of it, is met "
+                                        r"at \d+ m/s, below the box's 597 m/s"):
+        derivation_for(s, LglTerminal)
+
+
+@pytest.mark.parametrize("field, value, words", [
+    ("terminal_velocity_m_s", None, "guidance.terminal_velocity_m_s is needed with problem: mission"),
+    ("alpha_bounds_deg", [20.0], "guidance.alpha_bounds_deg = [20.0]: with problem: mission give [min, max]"),
+    ("alpha_bounds_deg", [30.0, 10.0], "with -90 <= min < max <= 90 deg"),
+    ("alpha_rate_deg_s", 0.0, "guidance.alpha_rate_deg_s"),
+])
+def test_bad_mission_problem_fields_are_named(horus_derived, field, value, words):
+    import dataclasses as dc
+
+    s, _ = horus_derived
+    with pytest.raises(ScenarioError) as e:
+        dc.replace(s, guidance=dc.replace(s.guidance, **{field: value})).validate()
+    assert words in str(e.value)
+
+
+@pytest.mark.slow  # an 80-node SNOPT solve and its verification flights: about 90 s of a core
+def test_the_derived_horus_plan_is_verified_flown_with_its_feedback(horus_derived):
+    """The plan solved on HORUS-2B's own mission is verified (between the nodes and propagated)
+    and, flown through the closed loop's actuators with the TVLQR it flies between re-solves, ends
+    inside the 2-km box (measured 4.7 m); the same plan flown open loop ended 3.6 km away."""
+    from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.guidance.lgl_terminal.planner import plan_terminal
+
+    s, _ = horus_derived
+    plan = plan_terminal(s, fly_controls, progress=False)
+    assert plan.result.success and plan.success, plan.message
+    assert plan.flight.box["distance"]["error"] < 200.0 and all(c.held for c in plan.flight.checks)

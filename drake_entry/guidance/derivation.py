@@ -25,7 +25,7 @@ from drake_entry.scenario import stated_guidance
 
 __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
-           "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window"]
+           "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
 #: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
@@ -235,6 +235,17 @@ def interface_altitudes(scenario, interface: Interface) -> tuple[float, ...]:
     if not tol:
         return (interface.altitude_km,)
     return tuple(h for h in (round(interface.altitude_km + k * tol, 4) for k in ALTITUDE_STEPS) if h >= 0.0)
+
+
+def q_limit_speed(scenario, altitude_km: float, fraction: float = 1.0) -> float:
+    """The speed [m/s] at which the vehicle meets ``fraction`` of its dynamic-pressure limit at
+    ``altitude_km`` (the mission's atmosphere; inf when the vehicle limits none): a plan ending
+    there faster breaches it."""
+    q_max = scenario.make_vehicle().limits.dynamic_pressure_max
+    if not math.isfinite(q_max):
+        return math.inf
+    rho = float(scenario.make_atmosphere().density(altitude_km * 1e3))
+    return math.sqrt(2.0 * fraction * q_max / rho)
 
 
 def reversal_corridor(scenario) -> tuple[list[float], list[float], Choice]:

@@ -1,16 +1,91 @@
-"""The LGL terminal guidance's settings from a mission (drake_entry.guidance.derivation). Today:
-the mission that states its !LglTerminal block flies it (derivation_for); any other mission is
-refused with the figure that stops it (the problem file poses paper 002's impact). Posing the
-terminal problem from a mission's interface is future work."""
+"""The LGL terminal guidance's settings from a mission (drake_entry.guidance.derivation).
 
-from drake_entry.guidance.derivation import CannotFly, Derivation, terminal_interface
+Paper 002 solves its own impact problem; on another mission the guidance solves the problem
+that mission poses (``problem: mission``, guidance.lgl_terminal.mission.mission_problem): from
+the entry state to the centre of the acceptance box over the target, at the box's speed (its
+flight-path angle and alpha where the box gives them), alpha within the mission's alpha
+schedule's range, inside the vehicle's limits. The terminal altitude is searched inside the
+box on the nominal flight and a few dispersed draws."""
 
-__all__ = ["derive"]
+from drake_entry.guidance.derivation import (
+    ALTITUDE_WHY,
+    CannotFly,
+    Choice,
+    Derivation,
+    SearchStep,
+    interface_altitudes,
+    mission_alpha,
+    q_limit_speed,
+    terminal_interface,
+)
+from drake_entry.guidance.lgl_terminal.mission import MISSION
+from drake_entry.guidance.lgl_terminal.spec import LglTerminal
+
+__all__ = ["derive", "terminal_speed", "ALPHA_WIDEN_DEG", "ALPHA_RATE_DEG_S", "NODES", "Q_SPEED_FRACTION"]
+
+#: a constant mission alpha is flown within this much either side [deg] (alpha is a state of
+#: the problem and needs a range)
+ALPHA_WIDEN_DEG = 1.0
+#: alpha's rate bound [deg/s] (paper 002 eq. 17 bounds 10 deg/s for a slender MaRV; a glider's
+#: schedule moves alpha by tens of degrees over minutes)
+ALPHA_RATE_DEG_S = 2.0
+#: the pre-flight solve's LGL nodes on a mission (paper 002 flies 125 on its 714-s problem; HORUS-2B's
+#: 1300-s glide on 40 is converged but inaccurate: 0.013 between the nodes, 62 km when propagated)
+NODES = 80
+#: the final speed is at most this fraction of the speed where the planned dynamic-pressure
+#: bound is met at the terminal altitude (HORUS-2B's box centre, Mach 2.5 at 25 km, is 11 kPa
+#: against its 10 kPa limit)
+Q_SPEED_FRACTION = 0.97
+
+
+def terminal_speed(scenario, interface, altitude_km: float, path_margin: float) -> float:
+    """The final speed [m/s] planned at ``altitude_km``: the box's centre speed, or below the
+    planned dynamic-pressure bound (Q_SPEED_FRACTION of its speed) where that is lower; CannotFly
+    when that is below the box's speed window."""
+    V = min(interface.speed_m_s, Q_SPEED_FRACTION * q_limit_speed(scenario, altitude_km, 1.0 - path_margin))
+    t = scenario.terminal
+    a = interface.speed_of_sound
+    low = (t.mach - t.mach_tolerance) * a if t.mach is not None and t.mach_tolerance else \
+        (t.velocity_m_s - t.velocity_tolerance_m_s if t.velocity_m_s is not None and t.velocity_tolerance_m_s else 0.0)
+    if V < low:
+        raise CannotFly(f"at {altitude_km:g} km the vehicle's dynamic-pressure limit, planned at {1 - path_margin:g} of "
+                        f"it, is met at {V / Q_SPEED_FRACTION:.0f} m/s, below the box's {low:.0f} m/s")
+    return round(V, 3)
 
 
 def derive(scenario) -> Derivation:
-    """LglTerminal settings for ``scenario``'s mission; CannotFly for another method's mission."""
+    """LglTerminal settings for ``scenario``'s mission stating no block of this method."""
     interface = terminal_interface(scenario)
-    raise CannotFly(f"it solves a problem file (packaged: paper 002's MaRV impact at the ground, a final speed "
-                    f"and alpha); this mission ends at {interface.altitude_km:g} km, {interface.speed_m_s:.0f} m/s "
-                    f"over its target, and posing the terminal problem from a mission's interface is not written")
+    alpha, source = mission_alpha(scenario)
+    lo, hi = min(alpha.values_deg), max(alpha.values_deg)
+    if lo == hi:
+        lo, hi = lo - ALPHA_WIDEN_DEG, hi + ALPHA_WIDEN_DEG
+    gamma = scenario.terminal.flight_path_deg
+    margin = LglTerminal.path_margin
+    candidates = []
+    for h in interface_altitudes(scenario, interface):
+        try:
+            candidates.append({"guidance.terminal_altitude_km": h,
+                               "guidance.terminal_velocity_m_s": terminal_speed(scenario, interface, h, margin)})
+        except CannotFly as e:
+            refused = e
+    if not candidates:
+        raise refused
+    first = candidates[0]
+    spec = LglTerminal(problem=MISSION, terminal_altitude_km=first["guidance.terminal_altitude_km"],
+                       terminal_velocity_m_s=first["guidance.terminal_velocity_m_s"], final_flight_path_deg=gamma,
+                       alpha_bounds_deg=[lo, hi], alpha_rate_deg_s=ALPHA_RATE_DEG_S, nodes=NODES)
+    choices = [Choice("guidance.problem", MISSION, "the problem the mission poses: its entry state, target, box and "
+                      "vehicle limits (paper 002's eq. 11 objective)"),
+               Choice("guidance.terminal_altitude_km, terminal_velocity_m_s",
+                      f"{spec.terminal_altitude_km:g} km, {spec.terminal_velocity_m_s:.1f} m/s",
+                      f"the box's centre speed ({interface.speed_m_s:.1f} m/s), or {Q_SPEED_FRACTION:g} of the "
+                      f"speed where the planned dynamic-pressure bound is met at the altitude when lower"),
+               Choice("guidance.alpha_bounds_deg", f"[{lo:g}, {hi:g}]", f"the range of {source} alpha schedule"
+                      + (f", widened {ALPHA_WIDEN_DEG:g} deg each side" if min(alpha.values_deg) == max(
+                          alpha.values_deg) else "")),
+               Choice("guidance.final_flight_path_deg", "free" if gamma is None else f"{gamma:g}",
+                      "the box's flight-path angle" if gamma is not None else "the box checks none"),
+               Choice("guidance.nodes, alpha_rate_deg_s", f"{NODES}, {ALPHA_RATE_DEG_S:g}", "the derivation's")]
+    search = [SearchStep("guidance.terminal_altitude_km", tuple(candidates), ALTITUDE_WHY)]
+    return Derivation(spec, choices, search)

@@ -1,6 +1,8 @@
-"""Paper 002's mission as the terminal guidance flies it: the problem file's conditions on the
-scenario's vehicle, planet, entry state and target, its path constraints planned inside their
-bounds, and those bounds as flown limits (pure data: loading a scenario imports no solver)."""
+"""The terminal guidance's problem on a scenario: a problem file's conditions (paper 002's MaRV
+impact) on the scenario's vehicle, planet, entry state and target, or, with ``problem:
+mission``, the problem the mission itself poses (its terminal interface, target and vehicle
+limits; ``mission_problem``); its path constraints planned inside their bounds, and those
+bounds as flown limits (pure data: loading a scenario imports no solver)."""
 from __future__ import annotations
 
 import dataclasses as dc
@@ -8,10 +10,50 @@ import math
 
 from drake_entry.errors import ScenarioError
 from drake_entry.models.verdict import PathLimit
-from drake_entry.planning.ocp import PATH_QUANTITIES
+from drake_entry.planning.ocp import PATH_QUANTITIES, ObjectiveTerm, OptimalControlProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
 
-__all__ = ["load_guidance_problem", "problem_for_scenario", "mission_path_limits"]
+__all__ = ["MISSION", "GAMMA_BOUNDS_DEG", "load_guidance_problem", "mission_problem", "problem_for_scenario",
+           "mission_path_limits"]
+
+#: the ``problem`` value that poses the problem from the mission instead of a file
+MISSION = "mission"
+#: the flight-path bounds of a mission's problem [deg] (paper 002 bounds none; a glide stays
+#: inside them, and they keep the solver off the heading equation's singularity at -90 deg)
+GAMMA_BOUNDS_DEG = (-60.0, 15.0)
+
+
+def mission_problem(spec, scenario) -> OptimalControlProblem:
+    """The terminal problem a mission poses (not in paper 002, which solves its own impact
+    problem): from the entry state to the guidance's terminal altitude over the target at the
+    spec's ``terminal_velocity_m_s`` (and final flight-path angle and alpha when the spec and the
+    box give them), on the scenario's models; alpha and the bank states (paper 002 eq. 6),
+    alpha within ``alpha_bounds_deg`` at rates up to ``alpha_rate_deg_s``, the bank within the
+    vehicle's limit and rate; the vehicle's heat-flux, dynamic-pressure and load limits (the
+    total load where the vehicle limits it, else the normal) as path constraints (eq. 18's
+    form); paper 002's control-margin objective (eq. 11, eq. 19's weights) with alpha-bar the
+    vehicle's maximum-L/D alpha."""
+    vehicle = scenario.make_vehicle()
+    limits = vehicle.limits
+    load = ("total_load", limits.total_load_max) if math.isfinite(limits.total_load_max) else \
+        ("normal_load", limits.normal_load_max)
+    path = [PathConstraint(q, max=bound) for q, bound in (("heat_flux", limits.heat_flux_max),
+                                                          ("dynamic_pressure", limits.dynamic_pressure_max), load)
+            if math.isfinite(bound)]
+    final = {"V": float(spec.terminal_velocity_m_s)}
+    if scenario.terminal.alpha_deg is not None:
+        final["alpha"] = math.radians(scenario.terminal.alpha_deg)
+    alpha_lo, alpha_hi = (math.radians(a) for a in spec.alpha_bounds_deg)
+    rate = math.radians(spec.alpha_rate_deg_s)
+    bank = vehicle.bank_limit
+    objective = ObjectiveTerm("control_margin", alpha_max=alpha_hi, u_alpha_max=rate, u_sigma_max=vehicle.bank_rate_limit)
+    return OptimalControlProblem(
+        vehicle=vehicle, planet=scenario.make_planet(), atmosphere=scenario.make_atmosphere(), initial={},
+        final=final, final_time=(1.0, 2.0e4), objective=[objective], controls="rates",
+        state_bounds={"alpha": (alpha_lo, alpha_hi), "sigma": (-bank, bank),
+                      "gamma": tuple(math.radians(g) for g in GAMMA_BOUNDS_DEG)},
+        control_bounds={"u_alpha": (-rate, rate), "u_sigma": (-vehicle.bank_rate_limit, vehicle.bank_rate_limit)},
+        path=path, name=MISSION)
 
 
 def load_guidance_problem(spec):
@@ -29,7 +71,7 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
     constraints ``spec.path_margin`` inside their bounds (``margin=False``: as the file gives
     them, the bounds the verdict checks); the rest (final speed and alpha, bounds, objective)
     from the problem file."""
-    p = load_guidance_problem(spec)
+    p = mission_problem(spec, scenario) if spec.problem == MISSION else load_guidance_problem(spec)
     x0 = scenario.initial_state()
     initial = dict(p.initial)
     initial.update({n: float(v) for n, v in zip(("h", "lon", "lat", "V", "gamma", "psi"), x0)})

@@ -24,7 +24,7 @@ from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.verdict import box_text, breaches_text, check_limits
 from drake_entry.planning.neighbouring_optimal import neighbouring_optimal, without_odd_even_mode
 from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlqr
-from drake_entry.planning.verification import Actuation, EntryControls, require_verifier
+from drake_entry.planning.verification import Actuation, EntryControls, Tracking, require_verifier
 
 __all__ = ["SAMPLES_PER_S", "PlanFlight", "LglPlan", "feedback_weights", "feedback_maker", "actuation", "fly_plan",
            "judged", "plan_terminal", "replan_nodes", "final_windows", "replan"]
@@ -156,13 +156,17 @@ def actuation(problem, spec, initial_bank: float, initial_alpha: float) -> Actua
 
 
 def fly_plan(plan: LglPlan, scenario, verifier) -> PlanFlight:
-    """Fly the plan's bank and alpha from its first node through the closed loop's actuators and
-    judge the flight as the closed loop's verdict would (acceptance box at t_f, path limits)."""
+    """Fly the plan's bank and alpha from its first node through the closed loop's actuators, with
+    the feedback the closed loop flies between re-solves (the spec's ``feedback``), and judge the
+    flight as the closed loop's verdict would (acceptance box at t_f, path limits)."""
     r, spec = plan.result, scenario.guidance
     t, bank, alpha = plan.control_samples()
     x0 = r.states[0]
+    maker = feedback_maker(spec.feedback)
+    tracking = None if maker is None else Tracking(plan, maker, spec.feedback_offset_limits())
     controls = EntryControls(r.problem.vehicle, r.problem.planet, r.problem.atmosphere, x0[:6].astype(float),
-                             r.final_time, t, bank, alpha, None, actuation(r.problem, spec, bank[0], alpha[0]))
+                             r.final_time, t, bank, alpha, None, actuation(r.problem, spec, bank[0], alpha[0]),
+                             tracking)
     flown = verifier(controls)
     tr = flown.trajectory
     planet = r.problem.planet

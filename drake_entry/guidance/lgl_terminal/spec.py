@@ -29,7 +29,14 @@ class LglTerminal(ReplanningSpec):
     # the closed loop stops at impact
     stops_at_altitude = True
     terminal_altitude_km: float = 0.0
+    # a packaged problem or a problem YAML, or 'mission': the problem the scenario's mission
+    # poses (mission.mission_problem: its interface, target and vehicle limits; the three
+    # fields below then set what a problem file would)
     problem: str = "marv"
+    # 'mission' only: the final speed [m/s], alpha's bounds [deg] and alpha's rate bound [deg/s]
+    terminal_velocity_m_s: Optional[float] = None
+    alpha_bounds_deg: list[float] = dc.field(default_factory=list)
+    alpha_rate_deg_s: float = 2.0
     # the final flight-path angle [deg] planned (None: the problem's)
     final_flight_path_deg: Optional[float] = None
     # design margin of the plans (not the paper's): each path constraint planned this fraction
@@ -69,15 +76,20 @@ class LglTerminal(ReplanningSpec):
     alpha_accel_limit_deg_s2: float = 40.0
 
     def terminal_speed(self, speed_of_sound: float) -> float:
-        """V_f [m/s]: the problem's final speed (the impact speed of eq. 16)."""
-        from drake_entry.guidance.lgl_terminal.mission import load_guidance_problem
+        """V_f [m/s]: the problem's final speed (the impact speed of eq. 16; a mission's: the spec's)."""
+        from drake_entry.guidance.lgl_terminal.mission import MISSION, load_guidance_problem
 
+        if self.problem == MISSION:
+            return float(self.terminal_velocity_m_s)
         return float(load_guidance_problem(self).final["V"])
 
     def path_limits(self, scenario) -> list:
-        """The problem's path constraints (eq. 18: q >= 12 kPa, a <= 45 g0) as flown limits."""
-        from drake_entry.guidance.lgl_terminal.mission import mission_path_limits, problem_for_scenario
+        """The problem's path constraints (eq. 18: q >= 12 kPa, a <= 45 g0) as flown limits (a
+        mission's problem adds none: its constraints are the vehicle's limits, checked anyway)."""
+        from drake_entry.guidance.lgl_terminal.mission import MISSION, mission_path_limits, problem_for_scenario
 
+        if self.problem == MISSION:
+            return []
         return mission_path_limits(problem_for_scenario(self, scenario, margin=False))
 
     def problem_for(self, scenario):
@@ -105,4 +117,12 @@ class LglTerminal(ReplanningSpec):
         check_range("guidance.alpha_accel_limit_deg_s2", self.alpha_accel_limit_deg_s2, 0.1, 1e3)
         if self.final_flight_path_deg is not None:
             check_range("guidance.final_flight_path_deg", self.final_flight_path_deg, -89.9, 0.0)
+        if self.problem == "mission":
+            if self.terminal_velocity_m_s is None:
+                raise ScenarioError("guidance.terminal_velocity_m_s is needed with problem: mission (the final speed)")
+            check_range("guidance.terminal_velocity_m_s", self.terminal_velocity_m_s, 1.0, 2.0e4)
+            if len(self.alpha_bounds_deg) != 2 or not -90.0 <= self.alpha_bounds_deg[0] < self.alpha_bounds_deg[1] <= 90:
+                raise ScenarioError(f"guidance.alpha_bounds_deg = {self.alpha_bounds_deg}: with problem: mission give "
+                                    f"[min, max] with -90 <= min < max <= 90 deg")
+            check_range("guidance.alpha_rate_deg_s", self.alpha_rate_deg_s, 0.01, 100.0)
         self.problem_for(scenario)

@@ -18,6 +18,7 @@ from drake_entry.guidance.derivation import (
     SearchStep,
     alpha_rewritten,
     interface_altitudes,
+    q_limit_speed,
     terminal_interface,
 )
 from drake_entry.guidance.scvx.mission import planned_load
@@ -86,12 +87,8 @@ def aim_window(scenario, altitude_km: float, mach_window: tuple, mach: float) ->
     fields = {"guidance.final_altitude_m": [round((altitude_km - half) * 1e3, 3), round((altitude_km + half) * 1e3, 3)],
               "guidance.final_altitude_margin_m": round(margin * 1e3, 3), "guidance.terminal_altitude_km": altitude_km}
     lo, hi = mach_window
-    q_max = scenario.make_vehicle().limits.dynamic_pressure_max
-    if math.isfinite(q_max):
-        atmosphere = scenario.make_atmosphere()
-        h = altitude_km * 1e3
-        rho, a = float(atmosphere.density(h)), float(atmosphere.speed_of_sound(h))
-        hi = min(hi, math.sqrt(2.0 * q_max / rho) / a)
+    hi = min(hi, q_limit_speed(scenario, altitude_km) / float(scenario.make_atmosphere().speed_of_sound(
+        altitude_km * 1e3)))
     centre, half_width = 0.5 * (lo + hi), 0.5 * MACH_WINDOW_FRACTION * (hi - lo)
     lo, hi = round(max(centre - half_width, 0.0), 4), round(centre + half_width, 4)
     return fields | {"guidance.final_mach_min": lo, "guidance.final_mach_max": hi,

@@ -179,8 +179,8 @@ def check_comparison_dir(out_dir: str, name: str, identity: str, seed: int) -> d
     if manifest.get("seed") != seed:
         raise ScenarioError(f"{out_dir} holds comparison {manifest.get('comparison')!r} with seed "
                             f"{manifest.get('seed')}; use another --out")
-    held = manifest.get("identity")
-    if (held or manifest.get("comparison")) != (identity if held else name):
+    held = manifest.get("identity")  # a directory written before identities: its name stands for it
+    if (held != identity) if held else (manifest.get("comparison") != name):
         raise ScenarioError(f"{out_dir} holds comparison {manifest.get('comparison')!r} of other content (another "
                             f"mission or other methods' settings) than {name!r}; use another --out, or the same file")
     return manifest

@@ -190,3 +190,24 @@ def test_two_methods_fly_the_same_draws_and_one_report_compares_them(tmp_path, m
     # a second call with another seed into the same directory is refused, not mixed
     with pytest.raises(ScenarioError, match="holds comparison 'tiny' with seed 7"):
         run_comparison(comp, runs=2, out_dir=str(tmp_path / "cmp"), seed=8, workers=1, progress=False)
+
+
+@pytest.mark.slow  # a 1-sample campaign and its report: about 10 s
+def test_a_method_left_out_by_only_never_keeps_a_reason_that_no_longer_holds(tmp_path):
+    """A derived method not flown in a run with --only keeps no earlier 'not flown' reason: its
+    settings derive from the mission now (the LGL terminal guidance's 'it solves a problem file'
+    stayed in the matrix after it learnt to pose a mission's problem)."""
+    from drake_entry.comparison.runner import run_comparison
+
+    comp = Comparison(name="tiny", mission="horus2b", methods=[
+        ComparedMethod(label="bank_profile", method="BankProfile",
+                       guidance=BankProfile(terminal_altitude_km=26.5, bank_start_deg=66.0, bank_end_deg=50.0)),
+        ComparedMethod(label="fnpeg", method="Fnpeg")])
+    out = tmp_path / "cmp"
+    run_comparison(comp, runs=1, out_dir=str(out), seed=7, workers=1, only=["bank_profile"], progress=False)
+    manifest = json.loads((out / "comparison.json").read_text())
+    manifest["methods"]["fnpeg"]["reason"] = "an old reason"
+    (out / "comparison.json").write_text(json.dumps(manifest))
+    run_comparison(comp, runs=1, out_dir=str(out), seed=7, workers=1, only=["bank_profile"], progress=False)
+    fnpeg = json.loads((out / "comparison.json").read_text())["methods"]["fnpeg"]
+    assert not fnpeg["flown"] and fnpeg["reason"].startswith("not flown in this directory yet: its settings derive")

@@ -210,4 +210,4 @@ def test_a_method_left_out_by_only_never_keeps_a_reason_that_no_longer_holds(tmp
     (out / "comparison.json").write_text(json.dumps(manifest))
     run_comparison(comp, runs=1, out_dir=str(out), seed=7, workers=1, only=["bank_profile"], progress=False)
     fnpeg = json.loads((out / "comparison.json").read_text())["methods"]["fnpeg"]
-    assert not fnpeg["flown"] and fnpeg["reason"].startswith("not flown in this directory yet: its settings derive")
+    assert not fnpeg["flown"] and fnpeg["reason"].startswith("yet to fly in this directory: its settings derive")

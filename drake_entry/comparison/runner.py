@@ -90,7 +90,7 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
             reason = _cannot_fly(mission, entry) if entry.label in derived else ""
             earlier = methods.get(entry.label)
             if not reason and entry.label in derived and (earlier is None or not earlier.get("flown")):
-                reason = (f"not flown in this directory yet: its settings derive from this mission (fly it with "
+                reason = (f"yet to fly in this directory: its settings derive from this mission (fly it with "
                           f"--only {entry.label})")  # an earlier run's reason may no longer hold
             if reason:  # known without flying: recorded whatever an earlier run left
                 methods[entry.label] = {"method": entry.method, "flown": False, "mapping": entry.mapping,

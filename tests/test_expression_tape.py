@@ -8,10 +8,10 @@ from pydrake.symbolic import max as smax
 from pydrake.symbolic import min as smin
 
 from drake_entry.errors import UnsupportedScalarError
+from drake_entry.guidance.scvx.decision import initial_decision
 from drake_entry.guidance.scvx.entry import EntryProblem
 from drake_entry.guidance.scvx.guess import glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
-from drake_entry.guidance.scvx.planner import initial_decision
 from drake_entry.guidance.scvx.settings import EntryProblemSettings
 from drake_entry.models.atmosphere import DispersedAtmosphere, US76Atmosphere
 from drake_entry.models.expression_tape import ExpressionTape, TracedAtmosphere

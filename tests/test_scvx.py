@@ -9,6 +9,7 @@ import scipy.sparse as sp
 
 from drake_entry.diagrams.verification import fly_controls
 from drake_entry.errors import ScenarioError
+from drake_entry.guidance.scvx.decision import initial_decision
 from drake_entry.guidance.scvx.engine import (
     ConvexifiableProblem,
     Evaluation,
@@ -22,7 +23,7 @@ from drake_entry.guidance.scvx.engine import (
 from drake_entry.guidance.scvx.entry import EntryProblem, heading_regulariser_sign
 from drake_entry.guidance.scvx.guess import glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
-from drake_entry.guidance.scvx.planner import initial_decision, plan_controls, plan_entry
+from drake_entry.guidance.scvx.planner import plan_controls, plan_entry
 from drake_entry.guidance.scvx.settings import PAPER_LOSSLESS, EntryProblemSettings
 from drake_entry.models.atmosphere import US76Atmosphere
 from drake_entry.models.planet import Earth

@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from drake_entry.errors import ScenarioError
+from drake_entry.guidance.scvx.decision import initial_decision
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
@@ -79,7 +80,7 @@ def mission_problem(vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, mis
 
 def nlp_guess(problem, z) -> tuple:
     """(t [s], states, controls) of the SCvx direct problem's decision z (a plan's, or
-    ``planner.initial_decision`` of its glide guess) in the OptimalControlProblem's order
+    ``decision.initial_decision`` of its glide guess) in the OptimalControlProblem's order
     ([h, lon, lat, V, gamma, psi, alpha, sigma], [u_alpha, u_sigma])."""
     if problem.i_sigma is None or problem.i_alpha is None:
         raise ScenarioError(f"nlp_guess needs the bank and alpha as states (the 'direct' formulation), "
@@ -95,7 +96,6 @@ def nlp_form(plan) -> tuple:
     """(OptimalControlProblem, guess) of an SCvx direct plan for ``nlp.solve``: its mission and
     models with its problem's final-time bounds, started from the glide guess the plan started
     from (``plan.guess``), so the two methods solve the same problem from the same point."""
-    from drake_entry.guidance.scvx.planner import initial_decision  # planner imports this module (feedback)
 
     p = plan.problem
     if plan.guess is None:

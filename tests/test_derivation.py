@@ -333,3 +333,18 @@ def test_a_box_alpha_window_the_mission_s_alpha_misses_is_beyond_a_bank_only_met
             derivation_for(marv, spec)
     marv.terminal.alpha_tolerance_deg = 15.0  # 11.9 deg is then inside the window
     assert derivation_for(marv, Fnpeg).spec.alpha_deg == [11.9]
+
+
+def test_drag_energy_says_before_flying_that_a_capsule_lies_below_its_corridor():
+    """Paper 000's corridor floor (eq. 70, the equilibrium glide with the lift vertical) at the
+    capsule's interface is 30 m/s^2 and its drag there 9-17 m/s^2: the guidance never engaged in
+    any of 10 dispersed flights (1180-km misses). The derivation now says so with the figures; the
+    gliders' interfaces lie inside the corridor and derive as before."""
+    from drake_entry.guidance.drag_energy.spec import DragEnergy
+
+    with pytest.raises(CannotFly, match=r"at the box's interface \(17.5-21.25 km, 305 m/s, alpha 20 deg\) the "
+                                        r"vehicle's drag is 9.29-16.8 m/s\^2, below the 29.9-30 m/s\^2 of its "
+                                        r"equilibrium glide"):
+        derivation_for(load_scenario("capsule_lu2008"), DragEnergy)
+    for glider in ("horus2b_flight", "cav_h_paper004", "cav_h_fnpeg"):
+        assert type(derivation_for(load_scenario(glider), DragEnergy).spec) is DragEnergy

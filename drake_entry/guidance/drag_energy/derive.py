@@ -4,8 +4,13 @@ reversal corridor; the interface's altitude and the corridor margin searched (pa
 corridor closes where the vehicle's limits meet: the altitude that keeps it open is the
 mission's)."""
 
+import math
+
+import numpy as np
+
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
+    CannotFly,
     Choice,
     Derivation,
     SearchStep,
@@ -18,12 +23,42 @@ from drake_entry.guidance.derivation import (
 from drake_entry.guidance.drag_energy.spec import DragEnergy
 from drake_entry.scenario import ScheduleSpec
 
-__all__ = ["derive", "MARGIN_CANDIDATES", "REPLAN_PERIOD_S"]
+__all__ = ["derive", "require_glide_floor", "MARGIN_CANDIDATES", "REPLAN_PERIOD_S"]
 #: corridor margins tried (paper 000 keeps the profile inside the limits by a margin)
 MARGIN_CANDIDATES = (0.05, 0.03, 0.08, 0.02)
 #: re-plan from the navigation state every this [s] (paper 000 plans once; re-planning is what
 #: dispersed entries need: HORUS-2B's single plan ends 24.3 +- 4.3 km from the runway)
 REPLAN_PERIOD_S = 20.0
+
+
+def require_glide_floor(scenario, interface, altitudes_km, alpha_deg: float) -> None:
+    """CannotFly when at every candidate interface altitude the vehicle's drag at the box's speed
+    (and the mission's alpha there) lies below the corridor's floor, the equilibrium glide with
+    the lift vertical (paper 000 eq. 70): the guidance flies inside the corridor and never engages
+    (a capsule of L/D 0.3 at 19 km, 305 m/s: 13 m/s^2 against 30)."""
+    from drake_entry.guidance.drag_energy.corridor import compute_corridor
+    from drake_entry.guidance.drag_energy.drag_dynamics import drag_acceleration
+
+    vehicle, atmosphere = scenario.make_vehicle(), scenario.make_atmosphere()
+    planet = scenario.make_planet().with_(j2=0.0)
+    alpha = math.radians(alpha_deg)
+    below = []
+    for h_km in altitudes_km:
+        h = h_km * 1e3
+        E = float(planet.specific_energy(h, interface.speed_m_s))
+        floor = float(compute_corridor([E], lambda _: alpha, vehicle, planet, atmosphere).D_min[0])
+        drag = float(drag_acceleration(h, interface.speed_m_s, alpha, vehicle, atmosphere))
+        if drag >= floor:
+            return
+        below.append((h_km, drag, floor))
+    def span(values, fmt: str) -> str:
+        lo, hi = format(min(values), fmt), format(max(values), fmt)
+        return lo if lo == hi else f"{lo}-{hi}"
+    heights, drags, floors = zip(*below)
+    raise CannotFly(f"at the box's interface ({span(heights, 'g')} km, {interface.speed_m_s:.0f} m/s, alpha "
+                    f"{alpha_deg:g} deg) the vehicle's drag is {span(drags, '.3g')} m/s^2, below the "
+                    f"{span(floors, '.3g')} m/s^2 of its equilibrium glide with the lift vertical, the floor of "
+                    f"paper 000's drag corridor (eq. 70): the guidance flies inside the corridor and would never engage")
 
 
 def derive(scenario) -> Derivation:
@@ -38,6 +73,7 @@ def derive(scenario) -> Derivation:
     alpha = (None if own.variable in ("energy", "normalized_energy")
              else ScheduleSpec("normalized_energy", breakpoints, values, own.smooth))
     altitudes = interface_altitudes(scenario, interface)
+    require_glide_floor(scenario, interface, altitudes, float(np.interp(1.0, breakpoints, values)))
     spec = DragEnergy(terminal_altitude_km=altitudes[0], terminal_mach=round(mach, 4),
                       corridor_margin=MARGIN_CANDIDATES[0], replan_period_s=REPLAN_PERIOD_S, replan_until_e=0.99,
                       bandwidth_rad_s=0.1, reversal_heading_deg=heading, reversal_velocity_m_s=velocity)

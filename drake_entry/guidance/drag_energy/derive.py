@@ -55,10 +55,10 @@ def require_glide_floor(scenario, interface, altitudes_km, alpha_deg: float) -> 
         lo, hi = format(min(values), fmt), format(max(values), fmt)
         return lo if lo == hi else f"{lo}-{hi}"
     heights, drags, floors = zip(*below)
-    raise CannotFly(f"at the box's interface ({span(heights, 'g')} km, {interface.speed_m_s:.0f} m/s, alpha "
-                    f"{alpha_deg:g} deg) the vehicle's drag is {span(drags, '.3g')} m/s^2, below the "
-                    f"{span(floors, '.3g')} m/s^2 of its equilibrium glide with the lift vertical, the floor of "
-                    f"paper 000's drag corridor (eq. 70): the guidance flies inside the corridor and would never engage")
+    raise CannotFly(f"drag below the glide floor at the interface: {span(drags, '.3g')} m/s^2 against "
+                    f"{span(floors, '.3g')} ({span(heights, 'g')} km, {interface.speed_m_s:.0f} m/s, alpha "
+                    f"{alpha_deg:g} deg; the floor of paper 000's drag corridor, eq. 70, is the equilibrium glide "
+                    f"with the lift vertical): the guidance flies inside the corridor and would never engage")
 
 
 def derive(scenario) -> Derivation:

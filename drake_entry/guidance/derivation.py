@@ -25,7 +25,8 @@ from drake_entry.scenario import stated_guidance
 
 __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
-           "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed"]
+           "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed",
+           "box_mach_window"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
 #: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
@@ -235,6 +236,20 @@ def interface_altitudes(scenario, interface: Interface) -> tuple[float, ...]:
     if not tol:
         return (interface.altitude_km,)
     return tuple(h for h in (round(interface.altitude_km + k * tol, 4) for k in ALTITUDE_STEPS) if h >= 0.0)
+
+
+def box_mach_window(scenario, interface: Interface) -> tuple[tuple[float, float], str] | None:
+    """The Mach window the mission's box checks at the interface ((low, high), and how it was
+    read: the box's Mach window, or its speed window as Mach numbers at the interface), None
+    when the box checks no speed."""
+    t = scenario.terminal
+    if t.mach is not None and t.mach_tolerance:
+        return (t.mach - t.mach_tolerance, t.mach + t.mach_tolerance), "the box's Mach window"
+    if t.velocity_m_s is not None and t.velocity_tolerance_m_s:
+        a = interface.speed_of_sound
+        return (((t.velocity_m_s - t.velocity_tolerance_m_s) / a, (t.velocity_m_s + t.velocity_tolerance_m_s) / a),
+                f"the box's speed window as Mach at {interface.altitude_km:g} km")
+    return None
 
 
 def q_limit_speed(scenario, altitude_km: float, fraction: float = 1.0) -> float:

@@ -208,6 +208,13 @@ class PathLimits:
             if not getattr(self, name) > 0:
                 raise ScenarioError(f"PathLimits.{name} must be > 0, got {getattr(self, name)}")
 
+    def planned_load(self) -> tuple[str, float]:
+        """The load a plan bounds and its limit [g]: ('total', limit) where the vehicle limits the
+        total load (paper 001 eq. 10), else ('normal', limit) (paper 000 eq. 35)."""
+        if math.isfinite(self.total_load_max):
+            return "total", self.total_load_max
+        return "normal", self.normal_load_max
+
     @property
     def load_bound_max(self) -> float:
         """The lower of the normal and total load limits [g]: what a law holding one load must

@@ -13,6 +13,7 @@ from drake_entry.guidance.derivation import (
     Choice,
     Derivation,
     SearchStep,
+    box_mach_window,
     interface_altitudes,
     mission_alpha,
     q_limit_speed,
@@ -43,10 +44,8 @@ def terminal_speed(scenario, interface, altitude_km: float, path_margin: float) 
     planned dynamic-pressure bound (Q_SPEED_FRACTION of its speed) where that is lower; CannotFly
     when that is below the box's speed window."""
     V = min(interface.speed_m_s, Q_SPEED_FRACTION * q_limit_speed(scenario, altitude_km, 1.0 - path_margin))
-    t = scenario.terminal
-    a = interface.speed_of_sound
-    low = (t.mach - t.mach_tolerance) * a if t.mach is not None and t.mach_tolerance else \
-        (t.velocity_m_s - t.velocity_tolerance_m_s if t.velocity_m_s is not None and t.velocity_tolerance_m_s else 0.0)
+    window = box_mach_window(scenario, interface)
+    low = window[0][0] * interface.speed_of_sound if window is not None else 0.0
     if V < low:
         raise CannotFly(f"at {altitude_km:g} km the vehicle's dynamic-pressure limit, planned at {1 - path_margin:g} of "
                         f"it, is met at {V / Q_SPEED_FRACTION:.0f} m/s, below the box's {low:.0f} m/s")
@@ -58,7 +57,8 @@ def derive(scenario) -> Derivation:
     interface = terminal_interface(scenario)
     alpha, source = mission_alpha(scenario)
     lo, hi = min(alpha.values_deg), max(alpha.values_deg)
-    if lo == hi:
+    constant = lo == hi
+    if constant:
         lo, hi = lo - ALPHA_WIDEN_DEG, hi + ALPHA_WIDEN_DEG
     gamma = scenario.terminal.flight_path_deg
     margin = LglTerminal.path_margin
@@ -82,8 +82,7 @@ def derive(scenario) -> Derivation:
                       f"the box's centre speed ({interface.speed_m_s:.1f} m/s), or {Q_SPEED_FRACTION:g} of the "
                       f"speed where the planned dynamic-pressure bound is met at the altitude when lower"),
                Choice("guidance.alpha_bounds_deg", f"[{lo:g}, {hi:g}]", f"the range of {source} alpha schedule"
-                      + (f", widened {ALPHA_WIDEN_DEG:g} deg each side" if min(alpha.values_deg) == max(
-                          alpha.values_deg) else "")),
+                      + (f", widened {ALPHA_WIDEN_DEG:g} deg each side" if constant else "")),
                Choice("guidance.final_flight_path_deg", "free" if gamma is None else f"{gamma:g}",
                       "the box's flight-path angle" if gamma is not None else "the box checks none"),
                Choice("guidance.nodes, alpha_rate_deg_s", f"{NODES}, {ALPHA_RATE_DEG_S:g}", "the derivation's")]

@@ -35,10 +35,10 @@ def mission_problem(spec, scenario) -> OptimalControlProblem:
     vehicle's maximum-L/D alpha."""
     vehicle = scenario.make_vehicle()
     limits = vehicle.limits
-    load = ("total_load", limits.total_load_max) if math.isfinite(limits.total_load_max) else \
-        ("normal_load", limits.normal_load_max)
+    kind, load_max = limits.planned_load()
     path = [PathConstraint(q, max=bound) for q, bound in (("heat_flux", limits.heat_flux_max),
-                                                          ("dynamic_pressure", limits.dynamic_pressure_max), load)
+                                                          ("dynamic_pressure", limits.dynamic_pressure_max),
+                                                          (f"{kind}_load", load_max))
             if math.isfinite(bound)]
     final = {"V": float(spec.terminal_velocity_m_s)}
     if scenario.terminal.alpha_deg is not None:

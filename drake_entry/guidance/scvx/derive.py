@@ -17,11 +17,11 @@ from drake_entry.guidance.derivation import (
     Derivation,
     SearchStep,
     alpha_rewritten,
+    box_mach_window,
     interface_altitudes,
     q_limit_speed,
     terminal_interface,
 )
-from drake_entry.guidance.scvx.mission import planned_load
 from drake_entry.guidance.scvx.spec import Scvx
 
 __all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW_KM", "AIM_TOLERANCE_KM",
@@ -105,12 +105,9 @@ def derive(scenario) -> Derivation:
     if not t.distance_tolerance_km:
         raise CannotFly("the mission's box gives no distance tolerance: SCvx plans into a cone about the site "
                         "(paper 001 eqs. 67-68)")
-    a = interface.speed_of_sound
-    if t.mach is not None and t.mach_tolerance:
-        mach_window, mach_how = (t.mach - t.mach_tolerance, t.mach + t.mach_tolerance), "the box's Mach window"
-    elif t.velocity_m_s is not None and t.velocity_tolerance_m_s:
-        mach_window = ((t.velocity_m_s - t.velocity_tolerance_m_s) / a, (t.velocity_m_s + t.velocity_tolerance_m_s) / a)
-        mach_how = f"the box's speed window as Mach at {interface.altitude_km:g} km"
+    box_window = box_mach_window(scenario, interface)
+    if box_window is not None:
+        mach_window, mach_how = box_window
     else:  # the interface's speed, which the box does not check: the plan aims at it
         m = interface.mach
         mach_window = (m * (1.0 - INTERFACE_SPEED_WINDOW), m * (1.0 + INTERFACE_SPEED_WINDOW))
@@ -148,7 +145,7 @@ def derive(scenario) -> Derivation:
                 replan_period_s=REPLAN_PERIOD_S, replan_min_time_to_go_s=REPLAN_MIN_TIME_TO_GO_S,
                 replan_time_to_go_fraction=REPLAN_TIME_TO_GO_FRACTION,
                 path_margin=round(1.0 - LIMIT_MARGIN, 4), feedback=FEEDBACK)
-    load, _ = planned_load(scenario.make_vehicle().limits)
+    load, _ = scenario.make_vehicle().limits.planned_load()
     choices = [
         Choice("guidance.final_mach_min, final_mach_max",
                f"{first['guidance.final_mach_min']:.3g}-{first['guidance.final_mach_max']:.3g}", mach_how),

@@ -64,7 +64,7 @@ from pydrake.symbolic import Expression, Variable, uninterpreted_function
 
 from drake_entry.errors import ScenarioError, UnsupportedScalarError
 from drake_entry.guidance.scvx.engine import ConvexifiableProblem, Evaluation, Linearisation
-from drake_entry.guidance.scvx.mission import ScvxMission, planned_load
+from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import (
     FORMULATIONS,
     RATE_OBJECTIVES,
@@ -123,7 +123,7 @@ class EntryProblem(ConvexifiableProblem):
         self.x0 = mission.entry_state(planet)
         self.site_lon, self.site_lat = mission.site(planet)
         limits = vehicle.limits
-        self.load_kind, self.load_max = planned_load(limits)  # the total load, else the normal
+        self.load_kind, self.load_max = limits.planned_load()  # the total load, else the normal
         if not (math.isfinite(limits.heat_flux_max) and math.isfinite(self.load_max)):
             raise ScenarioError(f"vehicle '{vehicle.name}' needs a finite heat_flux_max_kW_m2 and a finite "
                                 f"total_load_max_g or normal_load_max_g for the SCvx planner")

@@ -18,8 +18,7 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
 from drake_entry.models.verdict import PathLimit
 
-__all__ = ["SITE_RADIUS_MAX_M", "ENTRY_SPEED_RANGE_M_S", "DEFAULT_DRS_ALTITUDE_MARGIN_M", "planned_load",
-           "ScvxMission"]
+__all__ = ["SITE_RADIUS_MAX_M", "ENTRY_SPEED_RANGE_M_S", "DEFAULT_DRS_ALTITUDE_MARGIN_M", "ScvxMission"]
 
 #: the largest site radius a mission accepts [m] (a minimum-miss abort opens its cone to it)
 SITE_RADIUS_MAX_M = 5e6
@@ -29,14 +28,6 @@ ENTRY_SPEED_RANGE_M_S = (500.0, 12e3)
 #: |u| < 1 at the final pull-up is lift the real bank cannot dump, so it flies its DRS point
 #: about 500 m above the plan's (measured on the nominal mission); a bank state flies within 20 m
 DEFAULT_DRS_ALTITUDE_MARGIN_M = {"lossless": 1200.0, "rate": 200.0}
-
-
-def planned_load(limits) -> tuple[str, float]:
-    """The load an SCvx plan bounds and its limit [g] for a vehicle's PathLimits: the total
-    (paper 001 eq. 10) where the vehicle limits it, else the normal load (paper 000 eq. 35)."""
-    if math.isfinite(limits.total_load_max):
-        return "total", limits.total_load_max
-    return "normal", limits.normal_load_max
 
 
 @dc.dataclass

@@ -99,6 +99,8 @@ class LglTerminal(ReplanningSpec):
         return problem_for_scenario(self, scenario)
 
     def validate(self, scenario) -> None:
+        from drake_entry.guidance.lgl_terminal.mission import MISSION
+
         super().validate(scenario)
         if self.solver not in SOLVERS:
             raise ScenarioError(f"guidance.solver = '{self.solver}' is unknown; allowed: {', '.join(SOLVERS)}")
@@ -117,7 +119,7 @@ class LglTerminal(ReplanningSpec):
         check_range("guidance.alpha_accel_limit_deg_s2", self.alpha_accel_limit_deg_s2, 0.1, 1e3)
         if self.final_flight_path_deg is not None:
             check_range("guidance.final_flight_path_deg", self.final_flight_path_deg, -89.9, 0.0)
-        if self.problem == "mission":
+        if self.problem == MISSION:
             if self.terminal_velocity_m_s is None:
                 raise ScenarioError("guidance.terminal_velocity_m_s is needed with problem: mission (the final speed)")
             check_range("guidance.terminal_velocity_m_s", self.terminal_velocity_m_s, 1.0, 2.0e4)

@@ -1,6 +1,7 @@
 """The layers of docs/architecture.md, read from the import statements of every module.
 
-  base        drake_entry/errors.py, typed_yaml.py, models/       physics, data, the typed YAML reader
+  base        drake_entry/errors.py, typed_yaml.py, user_cache.py,  physics, data, the typed YAML reader,
+              models/                                             the user's cache folders
   planning    drake_entry/ (all but the other rows): planning/,   shared planning, every method's spec
               guidance/ (specs, planners, laws), scenario,        and planner, the scenario, shared
               figures, tables                                     figures and tables
@@ -64,7 +65,8 @@ def is_study(module: str) -> bool:
 
 def layer(module: str) -> str:
     parts = module.split(".")
-    if module in ("drake_entry.errors", "drake_entry.typed_yaml") or parts[:2] == ["drake_entry", "models"]:
+    if module in ("drake_entry.errors", "drake_entry.typed_yaml", "drake_entry.user_cache") or parts[:2] == [
+            "drake_entry", "models"]:
         return "base"
     top = {"systems": "systems", "diagrams": "diagrams", "campaign": "campaign", "comparison": "comparison",
            "cli": "cli"}

@@ -182,7 +182,7 @@ def test_a_mission_poses_its_own_terminal_problem(horus_derived):
 def test_the_derived_final_speed_stays_below_the_planned_dynamic_pressure(horus_derived):
     """HORUS-2B's box centre (Mach 2.5 at 25 km) is 11 kPa against its 10 kPa limit: each candidate
     altitude ends below Q_SPEED_FRACTION of the speed where 0.92 of the limit is met, inside the box."""
-    from drake_entry.guidance.lgl_terminal.derive import Q_SPEED_FRACTION
+    from drake_entry.guidance.derivation import Q_SPEED_FRACTION
 
     s, derivation = horus_derived
     atmosphere, q_max = s.make_atmosphere(), s.make_vehicle().limits.dynamic_pressure_max

@@ -88,8 +88,6 @@ def test_bank_rate_layout_errors_name_the_field():
     problem = _bank_rate_problem()
     with pytest.raises(ScenarioError, match="alpha_schedule is given exactly with controls='bank_rate'"):
         dc.replace(problem, controls="rates", alpha_schedule=ALPHA_LAW)
-    with pytest.raises(ScenarioError, match="alpha_schedule.variable = 'energy'; allowed: time"):
-        dc.replace(problem, alpha_schedule=dc.replace(ALPHA_LAW, variable="energy"))
     with pytest.raises(ScenarioError, match="'bank_effort' needs the bank as a state"):
         dc.replace(problem, controls="direct", alpha_schedule=None, initial={}, state_bounds={}, control_bounds={})
 

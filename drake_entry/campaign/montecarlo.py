@@ -15,6 +15,7 @@ from pydrake.common.yaml import yaml_dump_typed
 from drake_entry.campaign.arguments import MAX_RUNS, RUNS_NOTE, check_output_dir, check_run_arguments
 from drake_entry.campaign.backends import Task
 from drake_entry.campaign.engine import SampleCases, run_cases, session, versions
+from drake_entry.campaign.preparation import prepare
 from drake_entry.campaign.sample import (  # noqa: F401 (API)
     DETAILED_STEP_S,
     TIMING_COLUMNS,
@@ -27,7 +28,12 @@ from drake_entry.campaign.sample import (  # noqa: F401 (API)
 from drake_entry.campaign.store import done_indices, finalise, read_nominal, write_nominal  # noqa: F401 (API)
 from drake_entry.errors import ScenarioError
 from drake_entry.models.vehicles import PACKAGED_VEHICLES
-from drake_entry.scenario import PACKAGED_SCENARIOS, apply_overrides, load_campaign_scenario  # noqa: F401 (API)
+from drake_entry.scenario import (  # noqa: F401 (API)
+    PACKAGED_SCENARIOS,
+    apply_overrides,
+    load_campaign_scenario,
+    scenario_from_dump,
+)
 
 __all__ = ["DETAILED_STEP_S", "TIMING_COLUMNS", "TRAJECTORY_STEP_S", "campaign_row", "downsample", "run_sample",
            "sample_seed", "done_indices", "finalise", "read_nominal", "write_nominal", "PACKAGED_SCENARIOS",
@@ -92,6 +98,9 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     task = Task("drake_entry.campaign.sample:setup_worker", "drake_entry.campaign.sample:run_case",
                 {"scenario_yaml": manifest["scenario_yaml"], "seed": int(seed),
                  "trajectory_step_s": float(trajectory_step_s)})
+    prepared = prepare(scenario_from_dump(manifest["scenario_yaml"]), progress=progress)  # before any worker
+    if prepared and progress:
+        print(f"drake-entry: {prepared}", flush=True)
     cases = SampleCases(runs, lambda i: sample_seed(seed, i))
     run_cases(task, cases, out_dir, manifest, backend=backend, workers=workers, scheduler=scheduler,
               progress=progress, desc="campaign")

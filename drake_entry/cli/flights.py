@@ -48,6 +48,7 @@ def simulate(args) -> int:
 
 
 def fly(args) -> int:
+    from drake_entry.campaign.preparation import prepare
     from drake_entry.campaign.sample import campaign_row
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
     from drake_entry.figures import trajectory_plots
@@ -56,6 +57,9 @@ def fly(args) -> int:
 
     scenario = load_scenario(args.scenario)
     apply_overrides(scenario, parse_overrides(args.overrides))
+    prepared = prepare(scenario)  # e.g. AMPI's database for this mission: built once, then cached
+    if prepared:
+        print(prepared)
     setup = ClosedLoopSetup.from_scenario(scenario)
     res = fly(setup)
     tr = res.trajectory

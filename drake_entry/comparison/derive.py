@@ -128,10 +128,12 @@ def _flight(sample: str, row: dict, tolerances: dict) -> Flight:
 def _fly_candidate(scenario, draws: int) -> tuple[list[Flight], str]:
     """The nominal flight and ``draws`` dispersed samples of ``scenario``; ('', flights) or the
     pre-flight failure."""
+    from drake_entry.campaign.preparation import prepare
     from drake_entry.campaign.sample import campaign_row, run_sample
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
 
     try:
+        prepare(scenario)  # nothing, or built once and cached (e.g. AMPI's database for the mission)
         setup = ClosedLoopSetup.from_scenario(scenario)
     except DrakeEntryError as e:
         return [], f"pre-flight planning failed: {str(e).splitlines()[0][:300]}"

@@ -21,6 +21,7 @@ from pydrake.common.yaml import yaml_dump_typed
 from drake_entry.campaign.arguments import check_output_dir, check_run_arguments
 from drake_entry.campaign.engine import session, versions
 from drake_entry.campaign.montecarlo import TRAJECTORY_STEP_S, run_campaign
+from drake_entry.campaign.preparation import prepare
 from drake_entry.campaign.store import MANIFEST as CAMPAIGN_MANIFEST
 from drake_entry.campaign.store import ROWS, write_atomic
 from drake_entry.comparison.derive import value_text
@@ -121,6 +122,9 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
             print(f"== {entry.label} (!{entry.method}): pre-flight planning", flush=True)
         t = time.perf_counter()
         try:
+            prepared = prepare(scenario, progress=progress)  # e.g. AMPI's database for this mission
+            if prepared and progress:
+                print(f"   {prepared}", flush=True)
             setup = ClosedLoopSetup.from_scenario(scenario)
         except DrakeEntryError as e:
             methods[entry.label] = {**record, "flown": False, "reason": f"its planner failed on this mission: {e}"}

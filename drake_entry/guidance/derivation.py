@@ -26,7 +26,7 @@ from drake_entry.scenario import stated_guidance
 __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
            "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed",
-           "box_mach_window"]
+           "box_mach_window", "Q_SPEED_FRACTION", "terminal_speed"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
 #: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
@@ -261,6 +261,25 @@ def q_limit_speed(scenario, altitude_km: float, fraction: float = 1.0) -> float:
         return math.inf
     rho = float(scenario.make_atmosphere().density(altitude_km * 1e3))
     return math.sqrt(2.0 * fraction * q_max / rho)
+
+
+#: the final speed is at most this fraction of the speed where the planned dynamic-pressure
+#: bound is met at the terminal altitude (HORUS-2B's box centre, Mach 2.5 at 25 km, is 11 kPa
+#: against its 10 kPa limit)
+Q_SPEED_FRACTION = 0.97
+
+
+def terminal_speed(scenario, interface, altitude_km: float, path_margin: float) -> float:
+    """The final speed [m/s] planned at ``altitude_km``: the box's centre speed, or below the
+    planned dynamic-pressure bound (Q_SPEED_FRACTION of its speed) where that is lower; CannotFly
+    when that is below the box's speed window."""
+    V = min(interface.speed_m_s, Q_SPEED_FRACTION * q_limit_speed(scenario, altitude_km, 1.0 - path_margin))
+    window = box_mach_window(scenario, interface)
+    low = window[0][0] * interface.speed_of_sound if window is not None else 0.0
+    if V < low:
+        raise CannotFly(f"at {altitude_km:g} km the vehicle's dynamic-pressure limit, planned at {1 - path_margin:g} of "
+                        f"it, is met at {V / Q_SPEED_FRACTION:.0f} m/s, below the box's {low:.0f} m/s")
+    return round(V, 3)
 
 
 def reversal_corridor(scenario) -> tuple[list[float], list[float], Choice]:

@@ -109,6 +109,11 @@ class GuidanceMethod:
 
     #: name used in rows, reports and messages (snake_case)
     name: str = ""
+    #: what must exist before ``make_planner`` can run, built once per mission by the campaign
+    #: layer (drake_entry.campaign.preparation): None, or 'module:function' of the method's own
+    #: study, called as function(scenario, progress=...) -> a one-line summary (e.g. AMPI's
+    #: database for the mission). A name, not an import: a method's wiring imports no campaign.
+    preparation: str | None = None
 
     def make_planner(self, scenario, verifier):
         """What the method builds once per mission and reuses for every flight and sample

@@ -46,7 +46,7 @@ from drake_entry.models.winds import WindProfile, WindSpec, WindyAtmosphere, dra
 __all__ = ["Scalar", "Vector", "EntryDispersionSpec", "AeroRegimeDispersionSpec", "ENTRY_TABLE_TO_SI", "MAX_AERO_SIGMA",
            "PERTURBATION_COLUMNS_KM", "AtmospherePerturbationSpec", "WindSpec",
            "InertialNavigationSpec",
-           "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate"]
+           "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate", "entry_spread"]
 
 Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
 Vector = typing.Union[schema.DeterministicVectorX, schema.GaussianVectorX, schema.UniformVectorX]
@@ -323,6 +323,26 @@ def _support_ceiling(d) -> float:
     if isinstance(d, schema.Gaussian):
         return float(d.mean) + GAUSSIAN_REACH * float(d.stddev)
     return _support_floor(d)
+
+
+def _three_sigma(d) -> float:
+    """The half-width a scalar deviation reaches about 0: a uniform's farther bound, a Gaussian's
+    |mean| + 3 stddev, a constant's |value|."""
+    if isinstance(d, schema.Uniform):
+        return max(abs(float(d.min)), abs(float(d.max)))
+    if isinstance(d, schema.Gaussian):
+        return abs(float(d.mean)) + 3.0 * float(d.stddev)
+    return abs(_support_floor(d))
+
+
+def entry_spread(spec: DispersionSpec) -> np.ndarray:
+    """The entry deviations' 3-sigma half-widths [m, deg, deg, m/s, deg, deg] (the ``entry``
+    block's, ``_three_sigma``, combined root-sum-square with the delivery covariance's 3 sqrt(C_ii))."""
+    e = spec.entry
+    out = np.array([_three_sigma(getattr(e, f.name)) for f in dc.fields(EntryDispersionSpec)])
+    if spec.entry_covariance is not None:
+        out = np.hypot(out, 3.0 * np.sqrt(np.maximum(np.diag(np.asarray(spec.entry_covariance, float)), 0.0)))
+    return out
 
 
 def validate(spec: DispersionSpec, where: str = "dispersions") -> None:

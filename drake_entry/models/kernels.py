@@ -14,7 +14,7 @@ no physics), so the driver and its kernels compile as one unit. The module is wr
 kernel cache directory under the SHA-256 of its text and compiled with ``cache=True``: the
 machine code is kept on disk and a later process (a campaign worker) loads it instead of
 compiling. ``DRAKE_ENTRY_KERNEL_CACHE`` sets the directory (default
-``$XDG_CACHE_HOME/drake_entry/kernels`` or ``~/.cache/drake_entry/kernels``; where it cannot be
+``kernels`` in the user's cache, drake_entry.user_cache; where it cannot be
 written, a directory of this user's under the system's temporary one).
 
 Semantics are the float model's: ``min``/``max``, ``abs``, comparisons and logic as in Python;
@@ -37,6 +37,7 @@ from pathlib import Path
 from pydrake.symbolic import Expression, ExpressionKind, Formula, FormulaKind, Variable
 
 from drake_entry.errors import UnsupportedScalarError
+from drake_entry.user_cache import cache_root
 
 __all__ = ["Kernel", "CompiledModule", "kernel_cache_dir", "kernel_source", "compile_kernels"]
 
@@ -374,8 +375,7 @@ def kernel_cache_dir() -> Path:
     explicit = os.environ.get("DRAKE_ENTRY_KERNEL_CACHE")
     if explicit:
         return Path(explicit)
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "drake_entry" / "kernels"
+    return cache_root() / "kernels"
 
 
 def _scratch_dir() -> Path:

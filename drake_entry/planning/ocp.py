@@ -24,7 +24,14 @@ import numpy as np
 
 from drake_entry.errors import ScenarioError
 from drake_entry.models.atmosphere import Atmosphere
-from drake_entry.models.dynamics import STATE_NAMES, FlightConditions, flight_conditions, state_derivatives
+from drake_entry.models.dynamics import (
+    STATE_NAMES,
+    FlightConditions,
+    air_data,
+    flight_conditions,
+    specific_energy,
+    state_derivatives,
+)
 from drake_entry.models.geodesy import central_angle_smooth, crossrange_from_great_circle
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
@@ -40,6 +47,9 @@ PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
     "mach": ("mach", "-"),
     # geodetic altitude above the ellipsoid (the atmosphere's altitude, planet.atmospheric_altitude)
     "geodetic_altitude": (None, "m"),
+    # V^2/2 - mu/r: the central-gravity specific energy at which a closed loop stops
+    # (Scenario.guidance_terminal_state), without the J2 term of FlightConditions.energy
+    "central_energy": (None, "J/kg"),
 }
 LAGRANGE_KINDS = ("control_margin", "bank_effort", "heat_load", "lagrange")
 MAYER_KINDS = ("final_time", "miss_distance", "final_latitude", "final_crossrange", "final_velocity",
@@ -84,6 +94,8 @@ class PathConstraint:
             return self.quantity(x, u, env)
         if self.quantity == "geodetic_altitude":
             return planet.atmospheric_altitude(x[0], x[2])
+        if self.quantity == "central_energy":
+            return 0.5 * x[3] * x[3] - planet.mu / planet.radius(x[0])
         return getattr(env, PATH_QUANTITIES[self.quantity][0])
 
 
@@ -317,11 +329,13 @@ class OptimalControlProblem(_ProblemLayout):
         States not named are free.
       final_time: fixed t_f [s], (min, max) (None for an open end) or None (free); t_0 = 0.
       controls: 'rates' (alpha, sigma are states, controls are their rates), 'direct', or
-        'bank_rate' (alpha = alpha_schedule(t); sigma and a clock t are states, u_sigma the
+        'bank_rate' (alpha = alpha_schedule(s); sigma and a clock t are states, u_sigma the
         control).
-      alpha_schedule: the angle-of-attack law over time [s] -> [rad] for 'bank_rate'
-        (schedules.Schedule, variable 'time'; paper 003 Table 2: 42 deg to 58 s, linear to
-        17.5 deg at 88 s).
+      alpha_schedule: the angle-of-attack law [rad] for 'bank_rate' (schedules.Schedule) over
+        time [s] (the clock state; paper 003 Table 2: 42 deg to 58 s, linear to 17.5 deg at
+        88 s), speed [m/s], specific energy [J/kg, central gravity, as the closed loop's
+        schedule reads it] or Mach (the speed over the speed of sound at the geodetic
+        altitude): the law a mission flies, whatever its variable.
       state_bounds, control_bounds: name -> (min, max) along the whole trajectory.
       path: path constraints. objective: terms (at least one).
       terminal: constraints on the final node (PathConstraint: the same quantities or a
@@ -347,10 +361,8 @@ class OptimalControlProblem(_ProblemLayout):
         if self.controls not in CONTROL_LAYOUTS:
             raise ScenarioError(f"controls must be one of {', '.join(CONTROL_LAYOUTS)}, got '{self.controls}'")
         if (self.controls == "bank_rate") != (self.alpha_schedule is not None):
-            raise ScenarioError("alpha_schedule is given exactly with controls='bank_rate' (alpha over time)")
+            raise ScenarioError("alpha_schedule is given exactly with controls='bank_rate' (alpha scheduled)")
         if self.alpha_schedule is not None:
-            if self.alpha_schedule.variable != "time":
-                raise ScenarioError(f"alpha_schedule.variable = '{self.alpha_schedule.variable}'; allowed: time")
             if "t" not in self.initial:  # the clock starts at 0 s unless told
                 self.initial = {**self.initial, "t": 0.0}
         self._check_layout()
@@ -429,9 +441,25 @@ class OptimalControlProblem(_ProblemLayout):
         return sx, su, R / Vc
 
     # -- models (float and AutoDiffXd) ---------------------------------------------------
+    def scheduled_alpha(self, x):
+        """alpha [rad] of the 'bank_rate' layout's schedule at state x (any scalar type)."""
+        s = self.alpha_schedule
+        if s.variable == "time":
+            return s.at(x[7])
+        if s.variable == "velocity":
+            return s.at(x[3])
+        if s.variable == "energy":
+            return s.at(specific_energy(x, self._energy_planet))
+        return s.at(x[3] / air_data(x, self.planet, self.atmosphere)[1])  # Mach
+
+    @functools.cached_property
+    def _energy_planet(self) -> Earth:
+        """The planet an energy schedule is read with: central gravity (the closed loop's)."""
+        return self.planet.with_(j2=0.0)
+
     def alpha_sigma(self, x, u):
         if self.controls == "bank_rate":
-            return self.alpha_schedule.at(x[7]), x[6]
+            return self.scheduled_alpha(x), x[6]
         return (x[6], x[7]) if self.controls == "rates" else (u[0], u[1])
 
     def dynamics(self, x, u) -> np.ndarray:

@@ -10,7 +10,8 @@ bounded, or absent = free):
   atmosphere: {model: exponential, rho0_kg_m3: 1.225, scale_height_m: 7200.0}  # (default us76)
   controls: rates               # rates (alpha, sigma states; u_alpha, u_sigma controls) | direct
                                 # | bank_rate (alpha over time; sigma, t states; u_sigma control)
-  alpha_schedule: {breakpoints_s: [58, 88], values_deg: [42, 17.5]}   # bank_rate only
+  alpha_schedule: {breakpoints_s: [58, 88], values_deg: [42, 17.5]}   # bank_rate only; or
+                  # {variable: velocity | energy | mach, breakpoints: [...] (m/s, J/kg, -), values_deg, smooth}
   initial: {altitude_km: {value: 37.0}, ...}
   final: {...}
   final_time_s: {min: 100.0, max: 2000.0}     # or {value: ...}
@@ -29,7 +30,7 @@ from typing import Dict, List, Optional
 
 from drake_entry.errors import ScenarioError
 from drake_entry.models.environment import AtmosphereSpec, PlanetSpec, atmosphere_from_spec, planet_from_spec
-from drake_entry.models.schedules import Schedule
+from drake_entry.models.schedules import VARIABLES, Schedule
 from drake_entry.models.vehicles import load_vehicle
 from drake_entry.planning.ocp import (
     CONTROL_LAYOUTS,
@@ -71,8 +72,15 @@ class PathSpec:
 
 @dc.dataclass
 class AlphaScheduleSpec:
+    """alpha [deg] over time (``breakpoints_s``) or, with ``variable`` velocity, energy or
+    mach, over ``breakpoints`` in m/s, J/kg (central gravity) or Mach; ``smooth``: the
+    quintic blend between breakpoints (models.schedules.Schedule)."""
+
+    variable: str = "time"
     breakpoints_s: List[float] = dc.field(default_factory=list)
+    breakpoints: List[float] = dc.field(default_factory=list)
     values_deg: List[float] = dc.field(default_factory=list)
+    smooth: bool = False
 
 
 @dc.dataclass
@@ -205,20 +213,30 @@ def _constraints(where: str, specs: list) -> list:
     return out
 
 
+def _alpha_schedule(a: AlphaScheduleSpec) -> Schedule:
+    """The Schedule of an ``alpha_schedule:`` block; one line naming the field otherwise."""
+    if a.variable not in VARIABLES:
+        raise ScenarioError(f"alpha_schedule.variable = '{a.variable}' is unknown; allowed: {', '.join(VARIABLES)}")
+    time = a.variable == "time"
+    given, other = ("breakpoints_s", "breakpoints") if time else ("breakpoints", "breakpoints_s")
+    if getattr(a, other):
+        raise ScenarioError(f"alpha_schedule.{other}: not with variable '{a.variable}'; give {given}")
+    try:
+        return Schedule(tuple(float(v) for v in getattr(a, given)), tuple(math.radians(v) for v in a.values_deg),
+                        a.variable, bool(a.smooth))
+    except ValueError as e:
+        raise ScenarioError(f"alpha_schedule: {e}") from None
+
+
 def problem_from_spec(spec: ProblemSpec) -> OptimalControlProblem:
     """OptimalControlProblem of a ProblemSpec (SI inside); one-line ScenarioError on bad input."""
     if spec.controls not in CONTROL_LAYOUTS:
         raise ScenarioError(f"controls = '{spec.controls}'; allowed: {', '.join(CONTROL_LAYOUTS)}")
     if (spec.controls == "bank_rate") != (spec.alpha_schedule is not None):
-        raise ScenarioError("alpha_schedule: give it exactly with controls: bank_rate (alpha over time)")
+        raise ScenarioError("alpha_schedule: give it exactly with controls: bank_rate (alpha scheduled)")
     schedule = None
     if spec.alpha_schedule is not None:
-        a = spec.alpha_schedule
-        try:
-            schedule = Schedule(tuple(float(v) for v in a.breakpoints_s), tuple(math.radians(v) for v in a.values_deg),
-                                "time")
-        except ValueError as e:
-            raise ScenarioError(f"alpha_schedule: {e}") from None
+        schedule = _alpha_schedule(spec.alpha_schedule)
     vehicle = load_vehicle(spec.vehicle, aero=spec.aero or None)
     if spec.mass_over_area_kg_m2 is not None:
         if not 0 < spec.mass_over_area_kg_m2 <= 1e5:

@@ -20,9 +20,13 @@ def plan_report(scenario, out_dir: str) -> int:
     """Exit 0 when the database is verified and consistent and the reference, flown open loop,
     ends inside the scenario's acceptance box (Scenario.acceptance_box) with every path
     constraint of the database's problem (eq. 3) held; 1 otherwise."""
+    from drake_entry.campaign.preparation import prepare
     from drake_entry.guidance.ampi.accuracy_study import fly_ld, reference_errors
     from drake_entry.guidance.ampi.method import METHOD
 
+    prepared = prepare(scenario)  # a mission's own database: built (or found in the cache) first
+    if prepared:
+        print(prepared)
     planner = METHOD.make_planner(scenario, verifier=None)
     db, problem = planner.database, planner.problem
     print(f"database {scenario.guidance.database}: {planner.message}; {db.n_ld} LD nodes, "

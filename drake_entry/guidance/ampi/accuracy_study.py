@@ -152,10 +152,7 @@ def accuracy_case(state: dict, case: dict):
     p = offset_problem(problem, dict(zip(db.grid.names, offsets)))
     ld = at_ld["ampi"]
     t0 = time.perf_counter()
-    r = nlp.solve(p, transcription=s["transcription"], nodes=s["nodes"], tolerance=s["tolerance"],
-                  max_iterations=s["max_iterations"], guess=(ld.time, ld.states, ld.controls),
-                  dynamics_tolerance=s["dynamics_tolerance"], propagation_tolerance=s["propagation_tolerance"],
-                  verifier=fly_controls)
+    r = nlp.solve(p, guess=(ld.time, ld.states, ld.controls), verifier=fly_controls, **s)
     row.update(ocp_s=time.perf_counter() - t0, ocp_objective=float(r.objective), ocp_final_time_s=float(r.final_time),
                message=r.message[:300])
     if not r.success:

@@ -68,7 +68,7 @@ class DatabaseStudy:
 
 
 def setup_worker(config: dict) -> dict:
-    """A worker's state: the nominal problem, the grid and the solve settings."""
+    """A worker's state: the nominal problem, the grid and the solve settings (nlp.solve's keywords)."""
     problem, solve = load_problem(config["problem"])
     grid = ParameterGrid.from_dict(config["grid"])
     if not 3 <= int(config["ld_nodes"]) <= 400:
@@ -77,7 +77,8 @@ def setup_worker(config: dict) -> dict:
                 "nodes": int(config.get("nodes") or solve.nodes),
                 "tolerance": float(config.get("tolerance") or solve.tolerance),
                 "max_iterations": int(config.get("max_iterations") or solve.max_iterations),
-                "dynamics_tolerance": solve.dynamics_tolerance, "propagation_tolerance": solve.propagation_tolerance}
+                "dynamics_tolerance": solve.dynamics_tolerance, "propagation_tolerance": solve.propagation_tolerance,
+                "refine": bool(solve.refine), "max_nodes": int(solve.max_nodes) or None}
     for name in grid.names:
         if not isinstance(problem.initial.get(name), float):
             raise ScenarioError(f"grid offsets '{name}' but the problem's initial {name} is not fixed")
@@ -112,10 +113,7 @@ def solve_case(state: dict, case: dict):
         g = case["guess"]
         guess = (np.asarray(g["t"]), np.asarray(g["states"]), np.asarray(g["controls"]))
     t0 = time.perf_counter()
-    r = nlp.solve(case_problem(problem, grid, index), transcription=s["transcription"], nodes=s["nodes"],
-                  tolerance=s["tolerance"], max_iterations=s["max_iterations"], guess=guess,
-                  dynamics_tolerance=s["dynamics_tolerance"],
-                  propagation_tolerance=s["propagation_tolerance"], verifier=fly_controls)
+    r = nlp.solve(case_problem(problem, grid, index), guess=guess, verifier=fly_controls, **s)
     wall = time.perf_counter() - t0
     t = 0.5 * (lgl_nodes(state["ld_nodes"]) + 1.0) * r.final_time  # the LD times
     X, U = r.state_function()(t), r.control_function()(t)

@@ -1,19 +1,99 @@
-"""AMPI's settings from a mission (drake_entry.guidance.derivation). Today: only a mission that
-states its !Ampi block flies it (derivation_for); any other mission is refused with the figure
-that stops it (the databases' vehicle and entry). Building a database for a mission on demand is
-future work."""
+"""AMPI's settings from a mission (drake_entry.guidance.derivation): the database built for the
+mission itself (``database: mission``, guidance.ampi.mission), ending at the centre of the
+mission's acceptance box (below the speed where the planned dynamic-pressure bound is met, as the
+LGL guidance's), over a grid of the entry offsets the mission disperses most, each spanning its
+3-sigma reach (paper 003 eq. 5's form: the grid step is the dispersion's 3 sigma).
 
-from drake_entry.guidance.ampi.spec import packaged_databases
-from drake_entry.guidance.derivation import CannotFly, Derivation
+Nothing is searched: each candidate would be a database of its own (minutes of solves); the
+terminal altitude is the box centre, or the first of the shared steps inside the box where the
+dynamic-pressure bound leaves a speed in the box."""
 
-__all__ = ["derive"]
+import math
+
+from drake_entry.guidance.ampi.spec import MISSION_DATABASE, Ampi
+from drake_entry.guidance.derivation import (
+    Q_SPEED_FRACTION,
+    CannotFly,
+    Choice,
+    Derivation,
+    interface_altitudes,
+    mission_alpha,
+    require_alpha_window,
+    terminal_interface,
+    terminal_speed,
+)
+from drake_entry.models.dispersions import entry_spread
+
+__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "range_effects", "derive"]
+
+#: the most entry offsets a derived grid spans (3 levels each: 27 solves, a few minutes on 2 cores)
+GRID_DIMENSIONS = 3
+#: the grid's names of the entry deviations, in the dispersions' order [m, deg, deg, m/s, deg, deg]
+GRID_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
+
+
+def range_effects(scenario, spread) -> dict:
+    """How far [m] each entry deviation's 3-sigma reach ``spread`` (dispersions.entry_spread) moves
+    the flight's end, to first order: a position offset by itself (the arc length), a speed or
+    altitude offset by its share of the energy to dissipate times the range to go (range grows
+    with the energy spent), a flight-path or heading offset as that angle times the range to go."""
+    planet = scenario.make_planet().with_(j2=0.0)
+    x0 = scenario.initial_state()
+    interface = terminal_interface(scenario)
+    hf = interface.altitude_km * 1e3
+    span = float(planet.specific_energy(x0[0], x0[3]) - planet.specific_energy(hf, interface.speed_m_s))
+    R = planet.reference_radius
+    lon_t, lat_t = math.radians(scenario.target.longitude_deg), math.radians(scenario.target.latitude_deg)
+    to_go = planet.great_circle_distance(x0[1], x0[2], lon_t, lat_t)
+    d = math.radians
+    h, lon, lat, V, gamma, psi = (float(v) for v in spread)
+    return {"h": to_go * planet.g0 * h / span, "lon": R * d(lon) * math.cos(x0[2]), "lat": R * d(lat),
+            "V": to_go * float(x0[3]) * V / span, "gamma": to_go * d(gamma), "psi": to_go * d(psi)}
 
 
 def derive(scenario) -> Derivation:
-    """Ampi settings for ``scenario``'s mission; CannotFly for another method's mission."""
-    e = scenario.entry
-    raise CannotFly(f"AMPI interpolates references from a database of optimal trajectories of one vehicle and "
-                    f"entry box (paper 003); the packaged databases ({', '.join(packaged_databases())}) are not of "
-                    f"vehicle '{scenario.vehicle}' entering at {e.altitude_km:g} km, {e.velocity_m_s:g} m/s, "
-                    f"{e.flight_path_deg:g} deg, and building one for a mission on demand is not written "
-                    f"(`drake-entry ampi-database` builds one from a problem file)")
+    """Ampi settings for ``scenario``'s mission stating no block of this method."""
+    require_alpha_window(scenario)
+    interface = terminal_interface(scenario)
+    margin = Ampi.path_margin
+    refused = None
+    for h in interface_altitudes(scenario, interface):
+        try:
+            altitude, speed = h, terminal_speed(scenario, interface, h, margin)
+            break
+        except CannotFly as e:
+            refused = e
+    else:
+        raise refused
+    spread = entry_spread(scenario.dispersions)
+    effects = range_effects(scenario, spread)
+    ranked = sorted((n for n, s in zip(GRID_NAMES, spread) if s > 0.0), key=lambda n: -effects[n])
+    if not ranked:
+        raise CannotFly("the mission disperses no entry state: a database of one entry is its nominal plan (fly "
+                        "the LGL or SCvx guidance, which plan it)")
+    names = ranked[:GRID_DIMENSIONS]
+    steps = {n: float(spread[GRID_NAMES.index(n)]) for n in names}
+    alpha, source = mission_alpha(scenario)
+    own_alpha = alpha is scenario.alpha
+    spec = Ampi(database=MISSION_DATABASE, terminal_altitude_km=altitude, terminal_velocity_m_s=speed,
+                grid={n: round(v, 6) for n, v in steps.items()})
+    units = {"h": "m", "V": "m/s"}
+    left = [n for n in ranked if n not in names]
+    choices = [
+        Choice("guidance.database", MISSION_DATABASE, "built for this mission on demand and cached: paper 003's "
+               "problem form (bank rate, alpha scheduled, bank effort) from the mission's entry, target, interface "
+               "and vehicle limits"),
+        Choice("guidance.terminal_altitude_km, terminal_velocity_m_s", f"{altitude:g} km, {speed:.1f} m/s",
+               f"the box's centre speed ({interface.speed_m_s:.1f} m/s), or {Q_SPEED_FRACTION:g} of the speed where "
+               f"the planned dynamic-pressure bound is met at the altitude when lower"),
+        Choice("guidance.grid", ", ".join(f"{n} {steps[n]:g} {units.get(n, 'deg')}" for n in names),
+               "the entry deviations that move the end most, each at its 3-sigma reach (end moved by "
+               + ", ".join(f"{n} {effects[n] / 1e3:.3g} km" for n in ranked)
+               + (f"; {', '.join(left)} left to the tracker" if left else "") + ")"),
+        Choice("alpha", "as the mission's" if own_alpha else ", ".join(
+            f"{v:g} deg" + ("" if len(alpha.breakpoints) == 1 else f" at {b:g}")
+            for b, v in zip(alpha.breakpoints, alpha.values_deg)) + f" ({alpha.variable})",
+            f"{source} alpha schedule, flown by the database's problem and the closed loop alike"),
+    ]
+    return Derivation(spec, choices, [], alpha=None if own_alpha else alpha)
+

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import math
 
+from drake_entry.guidance.ampi.mission import built_database
 from drake_entry.guidance.ampi.reference import DatabaseReference
+from drake_entry.guidance.ampi.spec import MISSION_DATABASE
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
 from drake_entry.systems.reference_tracking import ReferenceTracker
 
@@ -23,10 +25,14 @@ GUIDANCE_SYSTEM = "reference_tracker"
 
 class AmpiMethod(GuidanceMethod):
     name = "ampi"
+    preparation = "drake_entry.guidance.ampi.mission_study:prepare"
 
     def make_planner(self, scenario, verifier) -> DatabaseReference:
         g = scenario.guidance
-        return DatabaseReference.load(g.database, g.reference, hd_points=g.hd_points, weights=g.weights(),
+        database = g.database
+        if database == MISSION_DATABASE:  # built for this mission beforehand (preparation), cached
+            database = built_database(g, scenario).path
+        return DatabaseReference.load(database, g.reference, hd_points=g.hd_points, weights=g.weights(),
                                       gain_samples=g.gain_samples)
 
     def add_systems(self, builder, scenario, planner: DatabaseReference, plant: PlantPorts) -> GuidanceCommands:

@@ -4,11 +4,17 @@ import dataclasses as dc
 import math
 import os
 from importlib import resources
+from typing import Dict
 
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import GuidanceSpecBase
 
-__all__ = ["MODES", "packaged_databases", "database_path", "Ampi"]
+__all__ = ["MISSION_DATABASE", "MAX_MISSION_CASES", "MODES", "packaged_databases", "database_path", "Ampi"]
+
+#: the ``database`` value that builds the database for the scenario's own mission
+MISSION_DATABASE = "mission"
+#: the most grid cases a mission database may have (3^5: an hour of solves on 2 cores at 30 s each)
+MAX_MISSION_CASES = 243
 
 #: how the on-board reference is made: AMPI synthesis or the nearest entry (NTT)
 MODES = ("ampi", "ntt")
@@ -50,8 +56,20 @@ class Ampi(GuidanceSpecBase):
     terminal_altitude_km: float = 21.1
     terminal_velocity_m_s: float = 620.0
     period_s: float = 0.5
-    # packaged database name or .npz path (guidance/ampi/database_study.py builds one)
+    # packaged database name, .npz path (guidance/ampi/database_study.py builds one), or
+    # 'mission': built for the scenario's own mission on demand and cached (guidance/ampi/mission.py)
     database: str = "shefex3"
+    # database 'mission' only: the grid of entry offsets, {state: step} in m, deg or m/s (h,
+    # lon, lat, V, gamma, psi; paper 003 eq. 5's form), with grid_levels levels each (odd:
+    # the nominal at the centre); the LD nodes each solution is stored at (eq. 11's N_LD); the
+    # NLP's nodes (Hermite-Simpson); the planned fraction of each vehicle limit kept free; the
+    # fresh solves its references are checked against
+    grid: Dict[str, float] = dc.field(default_factory=dict)
+    grid_levels: int = 3
+    ld_nodes: int = 60
+    nodes: int = 100
+    path_margin: float = 0.07
+    accuracy_cases: int = 3
     reference: str = "ampi"
     # eq. 11's N_HD: equally spaced reference samples the tracker interpolates linearly
     hd_points: int = 601
@@ -68,6 +86,28 @@ class Ampi(GuidanceSpecBase):
     # zero-order hold (period/2 = 0.25 s). Measured on the SHEFEX-3 nominal: lead 0 misses by
     # 16.9 km, 0.75 s and 1.0 s by < 1.3 km (docs/methods/ampi.md)
     bank_lead_s: float = 0.75
+
+    def _validate_mission_fields(self) -> None:
+        from drake_entry.guidance.ampi.grid import PARAMETERS
+
+        if not self.grid:
+            raise ScenarioError(f"guidance.grid: database '{MISSION_DATABASE}' needs the grid of entry offsets, "
+                                f"e.g. {{velocity: 15.0}} ({', '.join(PARAMETERS)}: m, deg, m/s)")
+        for name, step in self.grid.items():
+            if name not in PARAMETERS:
+                raise ScenarioError(f"guidance.grid.{name}: not an entry state; allowed: {', '.join(PARAMETERS)}")
+            check_range(f"guidance.grid.{name}", step, 1e-9, 1e6)
+        check_range("guidance.grid_levels", self.grid_levels, 3, 9)
+        if self.grid_levels % 2 == 0:
+            raise ScenarioError(f"guidance.grid_levels = {self.grid_levels}: give an odd number (the nominal entry "
+                                f"at the centre)")
+        if self.grid_levels ** len(self.grid) > MAX_MISSION_CASES:
+            raise ScenarioError(f"guidance.grid: {self.grid_levels}^{len(self.grid)} = "
+                                f"{self.grid_levels ** len(self.grid)} cases; allowed up to {MAX_MISSION_CASES}")
+        check_range("guidance.ld_nodes", self.ld_nodes, 3, 400)
+        check_range("guidance.nodes", self.nodes, 10, 1000)
+        check_range("guidance.path_margin", self.path_margin, 0.0, 0.5)
+        check_range("guidance.accuracy_cases", self.accuracy_cases, 1, 1000)
 
     def terminal_speed(self, speed_of_sound: float) -> float:
         return self.terminal_velocity_m_s
@@ -89,10 +129,16 @@ class Ampi(GuidanceSpecBase):
         check_range("guidance.terminal_velocity_m_s", self.terminal_velocity_m_s, 1.0, scenario.entry.velocity_m_s)
         if self.reference not in MODES:
             raise ScenarioError(f"guidance.reference = '{self.reference}'; allowed: {', '.join(MODES)}")
-        try:
-            database_path(self.database)
-        except ScenarioError as e:
-            raise ScenarioError(f"guidance.{e}") from None
+        if self.database == MISSION_DATABASE:
+            self._validate_mission_fields()
+        else:
+            try:
+                database_path(self.database)
+            except ScenarioError as e:
+                raise ScenarioError(f"guidance.{e}") from None
+            if self.grid:
+                raise ScenarioError(f"guidance.grid: only with database '{MISSION_DATABASE}' (database "
+                                    f"'{self.database}' has its own grid)")
         check_range("guidance.hd_points", self.hd_points, 2, 100000)
         check_range("guidance.gain_samples", self.gain_samples, 2, 10000)
         for name, values, n in (("tracking_scales", self.tracking_scales, 7), ("terminal_scales", self.terminal_scales, 4)):

@@ -9,20 +9,20 @@ box on the nominal flight and a few dispersed draws."""
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
+    Q_SPEED_FRACTION,
     CannotFly,
     Choice,
     Derivation,
     SearchStep,
-    box_mach_window,
     interface_altitudes,
     mission_alpha,
-    q_limit_speed,
     terminal_interface,
+    terminal_speed,
 )
 from drake_entry.guidance.lgl_terminal.mission import MISSION
 from drake_entry.guidance.lgl_terminal.spec import LglTerminal
 
-__all__ = ["derive", "terminal_speed", "ALPHA_WIDEN_DEG", "ALPHA_RATE_DEG_S", "NODES", "Q_SPEED_FRACTION"]
+__all__ = ["derive", "ALPHA_WIDEN_DEG", "ALPHA_RATE_DEG_S", "NODES"]
 
 #: a constant mission alpha is flown within this much either side [deg] (alpha is a state of
 #: the problem and needs a range)
@@ -33,25 +33,6 @@ ALPHA_RATE_DEG_S = 2.0
 #: the pre-flight solve's LGL nodes on a mission (paper 002 flies 125 on its 714-s problem; HORUS-2B's
 #: 1300-s glide on 40 is converged but inaccurate: 0.013 between the nodes, 62 km when propagated)
 NODES = 80
-#: the final speed is at most this fraction of the speed where the planned dynamic-pressure
-#: bound is met at the terminal altitude (HORUS-2B's box centre, Mach 2.5 at 25 km, is 11 kPa
-#: against its 10 kPa limit)
-Q_SPEED_FRACTION = 0.97
-
-
-def terminal_speed(scenario, interface, altitude_km: float, path_margin: float) -> float:
-    """The final speed [m/s] planned at ``altitude_km``: the box's centre speed, or below the
-    planned dynamic-pressure bound (Q_SPEED_FRACTION of its speed) where that is lower; CannotFly
-    when that is below the box's speed window."""
-    V = min(interface.speed_m_s, Q_SPEED_FRACTION * q_limit_speed(scenario, altitude_km, 1.0 - path_margin))
-    window = box_mach_window(scenario, interface)
-    low = window[0][0] * interface.speed_of_sound if window is not None else 0.0
-    if V < low:
-        raise CannotFly(f"at {altitude_km:g} km the vehicle's dynamic-pressure limit, planned at {1 - path_margin:g} of "
-                        f"it, is met at {V / Q_SPEED_FRACTION:.0f} m/s, below the box's {low:.0f} m/s")
-    return round(V, 3)
-
-
 def derive(scenario) -> Derivation:
     """LglTerminal settings for ``scenario``'s mission stating no block of this method."""
     interface = terminal_interface(scenario)

@@ -1,0 +1,168 @@
+"""AMPI's trajectory database for any mission: the problem it solves, where it is cached.
+
+Paper 003 builds its database for SHEFEX-3's own problem (Sec. III). With ``database:
+mission`` the guidance poses that problem's form from the scenario instead
+(``mission_problem_spec``): from the entry state to the target, ending at the energy where the
+closed loop stops (the guidance's terminal altitude and speed) within an altitude window, alpha the mission's schedule, the bank a state driven by its rate within the vehicle's
+limits, the vehicle's heat-flux, dynamic-pressure and load limits planned ``path_margin`` inside,
+the bank-effort objective. The problem is written as a problem file; the database study
+(guidance.ampi.database_study) solves it on the spec's grid of entry offsets; a few entries
+drawn like the campaign's are then solved afresh and compared with their AMPI references
+(guidance.ampi.accuracy_study: the interpolation error, paper 003 Sec. V).
+
+The database is built before the first plan (the method's preparation,
+guidance.ampi.mission_study) into the user's cache (drake_entry.user_cache), in a folder named by
+the fingerprint of the problem file, the grid, the solve settings, a user vehicle file's content
+and the drake_entry and Drake versions; the planner loads it from there (``built_database``).
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import hashlib
+import json
+import math
+import os
+
+from pydrake.common.yaml import yaml_dump_typed
+
+from drake_entry.errors import ScenarioError
+from drake_entry.guidance.ampi.spec import MISSION_DATABASE
+from drake_entry.models.vehicles import PACKAGED_VEHICLES
+from drake_entry.planning.ocp_yaml import (
+    AlphaScheduleSpec,
+    BoundSpec,
+    ObjectiveSpec,
+    PathSpec,
+    ProblemSpec,
+    SolveSpec,
+)
+
+__all__ = ["PROBLEM_FILE", "DATABASE_FILE", "REPORT_FILE", "ALTITUDE_WINDOW_FRACTION", "ALTITUDE_WINDOW_M", "RATE_WEIGHT", "TOLERANCE",
+           "mission_problem_spec", "database_folder", "built_database",
+           "fingerprint", "MissionDatabase"]
+
+#: the references end at the energy where the flight stops (the guidance's terminal altitude and
+#: speed), at an altitude within this fraction of the box's altitude tolerance about the terminal
+#: altitude (ALTITUDE_WINDOW_M where the box gives none): fixing the speed as well left SHEFEX-3's
+#: +70 m/s entry without a solution (SNOPT info 13)
+ALTITUDE_WINDOW_FRACTION = 0.5
+ALTITUDE_WINDOW_M = 500.0
+#: the bank-rate term's weight in the bank-effort objective (problems/shefex3.yaml's)
+RATE_WEIGHT = 0.1
+#: the NLP's optimality tolerance (problems/shefex3.yaml's). The transcription is Hermite-Simpson
+#: with mesh refinement from the spec's nodes: HORUS-2B's 1400-s glide on 100 nodes was converged
+#: but inaccurate (0.0043 between the nodes on 160 dircol nodes; 0.015 on 4 LGL segments of 121
+#: nodes); refined to 220 nodes it is verified (0.00052 between the nodes) in 14 s
+TOLERANCE = 1.0e-6
+#: files of a built database's folder
+PROBLEM_FILE, DATABASE_FILE, REPORT_FILE = "problem.yaml", "database.npz", "build.json"
+
+
+def mission_problem_spec(spec, scenario) -> ProblemSpec:
+    """The optimal-control problem (a ProblemSpec, as a problem file states it) the database
+    solves for ``scenario``'s mission with the Ampi ``spec``: paper 003 Sec. III's form (bank
+    rate control, alpha scheduled, bank effort) on the mission (module docstring), ending over
+    the target at the energy where the closed loop stops, inside the altitude window."""
+    vehicle = scenario.make_vehicle()
+    limits = vehicle.limits
+    alpha = scenario.schedule("alpha")
+    breakpoints = [float(b) for b in alpha.breakpoints]
+    schedule = AlphaScheduleSpec(variable=alpha.variable, values_deg=[math.degrees(v) for v in alpha.values],
+                                 smooth=bool(alpha.smooth),
+                                 **({"breakpoints_s": breakpoints} if alpha.variable == "time" else
+                                    {"breakpoints": breakpoints}))
+    e, target = scenario.entry, scenario.target
+    initial = {"altitude_km": e.altitude_km, "longitude_deg": e.longitude_deg, "latitude_deg": e.latitude_deg,
+               "velocity_m_s": e.velocity_m_s, "flight_path_deg": e.flight_path_deg, "heading_deg": e.heading_deg,
+               "time_s": 0.0}
+    kind, load_max = limits.planned_load()
+    keep = 1.0 - spec.path_margin
+    path = [PathSpec(quantity=q, max=keep * bound) for q, bound in (("heat_flux", limits.heat_flux_max),
+                                                                   ("dynamic_pressure", limits.dynamic_pressure_max),
+                                                                   (f"{kind}_load", load_max))
+            if math.isfinite(bound)]
+    h_f = spec.terminal_altitude_km * 1e3
+    E_f = dc.replace(scenario, guidance=spec).guidance_terminal_state()[2]  # where the closed loop stops
+    tol = scenario.terminal.altitude_tolerance_km
+    window = ALTITUDE_WINDOW_FRACTION * tol * 1e3 if tol else ALTITUDE_WINDOW_M
+    bank, rate = math.degrees(vehicle.bank_limit), math.degrees(vehicle.bank_rate_limit)
+    return ProblemSpec(
+        name=f"ampi_{MISSION_DATABASE}",  # no scenario name: the same mission under another name is the same problem
+        description="paper 003's database problem posed from a mission",
+        source="drake_entry.guidance.ampi.mission.mission_problem_spec", vehicle=_vehicle_name(scenario),
+        aero=scenario.aero, planet=dc.replace(scenario.planet), altitude_datum=scenario.altitude_datum,
+        atmosphere=dc.replace(scenario.atmosphere), controls="bank_rate", alpha_schedule=schedule,
+        initial={k: BoundSpec(value=float(v)) for k, v in initial.items()},
+        final={"longitude_deg": BoundSpec(value=float(target.longitude_deg)),
+               "latitude_deg": BoundSpec(value=float(target.latitude_deg))},
+        final_time_s=BoundSpec(min=1.0, max=float(scenario.simulation.max_time_s)),
+        state_bounds={"bank_deg": BoundSpec(min=-bank, max=bank)},
+        control_bounds={"bank_rate_deg_s": BoundSpec(min=-rate, max=rate)},
+        path=path,
+        terminal=[PathSpec(quantity="central_energy", min=E_f, max=E_f),
+                  PathSpec(quantity="geodetic_altitude", min=h_f - window, max=h_f + window, scale=1.0e4)],
+        objective=[ObjectiveSpec(kind="bank_effort", bank_max_deg=bank, bank_rate_max_deg_s=rate,
+                                 rate_weight=RATE_WEIGHT)],
+        solve=SolveSpec(transcription="hermite_simpson", solver="auto", nodes=int(spec.nodes), tolerance=TOLERANCE,
+                        refine=True))
+
+
+def _vehicle_name(scenario) -> str:
+    """The scenario's vehicle as a problem file names it: a packaged name, or an absolute path."""
+    if scenario.vehicle in PACKAGED_VEHICLES:
+        return scenario.vehicle
+    return os.path.abspath(scenario.vehicle)
+
+
+def fingerprint(spec, scenario) -> tuple[str, str]:
+    """(the problem file's text, the hex fingerprint of everything the database depends on)."""
+    import importlib.metadata
+
+    import drake_entry
+
+    text = yaml_dump_typed(mission_problem_spec(spec, scenario))
+    h = hashlib.sha256()
+    for part in (text, json.dumps(dict(spec.grid), sort_keys=True), str(spec.grid_levels), str(spec.ld_nodes),
+                 str(spec.accuracy_cases),
+                 drake_entry.__version__, importlib.metadata.version("drake")):
+        h.update(part.encode())
+        h.update(b"\0")
+    if scenario.vehicle not in PACKAGED_VEHICLES:  # a user's vehicle file: its content, not its name
+        with open(scenario.vehicle, "rb") as f:
+            h.update(f.read())
+    return text, h.hexdigest()[:20]
+
+
+@dc.dataclass
+class MissionDatabase:
+    """A built mission database: ``path`` of its database.npz, ``folder``, the build ``report``
+    (cases, verified, re-solved, wall time) and the ``accuracy`` of its references against fresh
+    solves (accuracy_study.summarise), ``cached``: loaded, not built, by this call."""
+
+    path: str
+    folder: str
+    report: dict
+    accuracy: dict
+    cached: bool
+
+
+def database_folder(spec, scenario) -> tuple[str, str, str]:
+    """(the cache folder of this mission's database, its fingerprint, the problem file's text)."""
+    from drake_entry.user_cache import cache_dir
+
+    text, key = fingerprint(spec, scenario)
+    return os.path.join(cache_dir("ampi"), key), key, text
+
+
+def built_database(spec, scenario) -> MissionDatabase:
+    """The built database of ``scenario``'s mission; a ScenarioError saying how to build it when
+    it is not in the cache."""
+    folder, key, _ = database_folder(spec, scenario)
+    report = os.path.join(folder, REPORT_FILE)
+    if not os.path.exists(report):
+        raise ScenarioError(f"the AMPI database of mission '{scenario.name}' (fingerprint {key}) is not built: "
+                            f"`drake-entry plan`, `campaign` and `compare` build it first; from Python call "
+                            f"drake_entry.campaign.preparation.prepare(scenario)")
+    with open(report) as f:
+        done = json.load(f)
+    return MissionDatabase(os.path.join(folder, DATABASE_FILE), folder, done["build"], done["accuracy"], True)

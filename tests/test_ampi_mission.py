@@ -118,7 +118,10 @@ def test_mission_problem_is_the_mission_with_its_limits_planned_inside(tmp_path)
     bounds = {c.quantity: c.max for c in problem.path}
     limits = vehicle.limits
     assert bounds["dynamic_pressure"] == pytest.approx(0.93 * limits.dynamic_pressure_max)
-    assert problem.state_bounds["sigma"] == pytest.approx((-vehicle.bank_limit, vehicle.bank_limit))
+    assert problem.state_bounds["sigma"] == pytest.approx((-0.9 * vehicle.bank_limit, 0.9 * vehicle.bank_limit))
+    assert problem.control_bounds["u_sigma"] == pytest.approx((-0.25 * vehicle.bank_rate_limit,
+                                                               0.25 * vehicle.bank_rate_limit))
+    assert [t.kind for t in problem.objective] == ["bank_effort", "flight_path_effort"]
     assert solve.transcription == "hermite_simpson" and solve.refine
     # the fingerprint follows the content: another grid is another database
     assert fingerprint(dc.replace(d.spec, grid={"V": 10.0}), scenario)[1] != key
@@ -200,3 +203,13 @@ def test_prepare_builds_the_mission_database_once_and_the_planner_flies_it(tmp_p
 
     accuracy = built_database(scenario.guidance, scenario).accuracy
     assert accuracy["verified"] == 1  # the fresh solve converged and was verified
+
+
+def test_flight_path_effort_is_gamma_over_its_scale_squared():
+    from drake_entry.planning.ocp import ObjectiveTerm
+
+    problem, _ = load_problem("shefex3")
+    p = dc.replace(problem, objective=[ObjectiveTerm("flight_path_effort", weight=2.0, scale=math.radians(1.0))])
+    assert p.lagrangian(X, U) == pytest.approx(2.0 * (X[4] / math.radians(1.0)) ** 2, rel=1e-12)
+    with pytest.raises(ScenarioError, match="scale = 0.0 must be finite and > 0"):
+        ObjectiveTerm("flight_path_effort", scale=0.0)

@@ -51,7 +51,7 @@ PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
     # (Scenario.guidance_terminal_state), without the J2 term of FlightConditions.energy
     "central_energy": (None, "J/kg"),
 }
-LAGRANGE_KINDS = ("control_margin", "bank_effort", "heat_load", "lagrange")
+LAGRANGE_KINDS = ("control_margin", "bank_effort", "flight_path_effort", "heat_load", "lagrange")
 MAYER_KINDS = ("final_time", "miss_distance", "final_latitude", "final_crossrange", "final_velocity",
                "terminal_deviation", "mayer")
 CONTROL_LAYOUTS = ("rates", "direct", "bank_rate")
@@ -109,6 +109,8 @@ class ObjectiveTerm:
       bank_effort     (sigma/bank_max)^2 + rate_weight (u_sigma/u_sigma_max)^2 [1/s] (bank a
                       state: controls 'rates' or 'bank_rate'); a unique minimiser among the
                       bankings that meet hard terminal conditions (paper 003 database)
+      flight_path_effort  (gamma/scale)^2 [1/s], ``scale`` in rad: damps the phugoid, so that
+                      a long glide's least-bank flight does not skip (a mission's AMPI database)
       heat_load       heat flux [W/m^2] (J = heat load [J/m^2])
       lagrange        ``function(x, u, env)``
     Mayer kinds (at the final node): final_time [s]; miss_distance [m] to ``target``
@@ -491,6 +493,8 @@ class OptimalControlProblem(_ProblemLayout):
             elif term.kind == "bank_effort":
                 sigma, rate = self.bank_and_rate(x, u)
                 v = (sigma / term.bank_max) ** 2 + term.rate_weight * (rate / term.u_sigma_max) ** 2
+            elif term.kind == "flight_path_effort":
+                v = (x[4] / term.scale) ** 2
             else:
                 env = env if env is not None else self.conditions(x, u)
                 v = env.heat_flux if term.kind == "heat_load" else term.function(x, u, env)

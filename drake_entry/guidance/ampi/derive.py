@@ -24,10 +24,16 @@ from drake_entry.guidance.derivation import (
 )
 from drake_entry.models.dispersions import entry_spread
 
-__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "range_effects", "derive"]
+__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "TRACKING_STATE_WEIGHT", "range_effects", "derive"]
 
 #: the most entry offsets a derived grid spans (3 levels each: 27 solves, a few minutes on 2 cores)
 GRID_DIMENSIONS = 3
+#: the TVLQR's path weight on a mission (paper 003's SHEFEX-3 flight, 600 s, flies 1e-5: the
+#: terminal weight steers and the path weight only damps). On Lu 2014's CAV-H 2400-s glide the
+#: nominal flight with 1e-5 ended 3440 km off (the vehicle skipped away from the reference); 1e-3,
+#: 125 km; 1e-2, 147 km with the planned bank rate at the vehicle's limit and 0.18 km with it at a
+#: quarter and the planned bank at 0.9 of the limit (guidance.ampi.mission)
+TRACKING_STATE_WEIGHT = 1.0e-2
 #: the grid's names of the entry deviations, in the dispersions' order [m, deg, deg, m/s, deg, deg]
 GRID_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
 
@@ -76,7 +82,7 @@ def derive(scenario) -> Derivation:
     alpha, source = mission_alpha(scenario)
     own_alpha = alpha is scenario.alpha
     spec = Ampi(database=MISSION_DATABASE, terminal_altitude_km=altitude, terminal_velocity_m_s=speed,
-                grid={n: round(v, 6) for n, v in steps.items()})
+                grid={n: round(v, 6) for n, v in steps.items()}, tracking_state_weight=TRACKING_STATE_WEIGHT)
     units = {"h": "m", "V": "m/s"}
     left = [n for n in ranked if n not in names]
     choices = [
@@ -90,6 +96,9 @@ def derive(scenario) -> Derivation:
                "the entry deviations that move the end most, each at its 3-sigma reach (end moved by "
                + ", ".join(f"{n} {effects[n] / 1e3:.3g} km" for n in ranked)
                + (f"; {', '.join(left)} left to the tracker" if left else "") + ")"),
+        Choice("guidance.tracking_state_weight", TRACKING_STATE_WEIGHT,
+               "the TVLQR holds the reference along a long glide, not only at its end (paper 003's 1e-5 left "
+               "Lu 2014's CAV-H nominal 3440 km off)"),
         Choice("alpha", "as the mission's" if own_alpha else ", ".join(
             f"{v:g} deg" + ("" if len(alpha.breakpoints) == 1 else f" at {b:g}")
             for b, v in zip(alpha.breakpoints, alpha.values_deg)) + f" ({alpha.variable})",

@@ -37,7 +37,7 @@ from drake_entry.planning.ocp_yaml import (
     SolveSpec,
 )
 
-__all__ = ["PROBLEM_FILE", "DATABASE_FILE", "REPORT_FILE", "ALTITUDE_WINDOW_FRACTION", "ALTITUDE_WINDOW_M", "RATE_WEIGHT", "TOLERANCE",
+__all__ = ["PROBLEM_FILE", "DATABASE_FILE", "REPORT_FILE", "BANK_FRACTION", "BANK_RATE_FRACTION", "GAMMA_BOUNDS_DEG", "FLIGHT_PATH_SCALE_DEG", "FLIGHT_PATH_WEIGHT", "ALTITUDE_WINDOW_FRACTION", "ALTITUDE_WINDOW_M", "RATE_WEIGHT", "TOLERANCE",
            "mission_problem_spec", "database_folder", "built_database",
            "fingerprint", "MissionDatabase"]
 
@@ -47,6 +47,21 @@ __all__ = ["PROBLEM_FILE", "DATABASE_FILE", "REPORT_FILE", "ALTITUDE_WINDOW_FRAC
 #: +70 m/s entry without a solution (SNOPT info 13)
 ALTITUDE_WINDOW_FRACTION = 0.5
 ALTITUDE_WINDOW_M = 500.0
+#: the flight-path bounds of a mission's database problem [deg] (the LGL guidance's on a mission:
+#: they keep the heading equation off its singularity at -90 deg)
+GAMMA_BOUNDS_DEG = (-60.0, 15.0)
+#: the flight-path term added to the bank effort: (gamma / FLIGHT_PATH_SCALE_DEG)^2 at this weight.
+#: Without it the least bank over a long glide is a skipping flight (Lu 2014's CAV-H: the
+#: reference climbed from 38 to 87 km and back three times, and the tracker held none of 10
+#: flights); bounding gamma <= 0 instead left a level flight at 41 km that needed the bank at its
+#: limit (0/1)
+FLIGHT_PATH_SCALE_DEG, FLIGHT_PATH_WEIGHT = 1.0, 1.0
+#: the planned bank's and bank rate's bounds as fractions of the vehicle's: the tracker's room.
+#: Lu 2014's CAV-H nominal (tracking weight 1e-2): planned at the vehicle's 85 deg and 20 deg/s it
+#: ended 147 km off, dipping 7 km under the reference in its reversal (q 186 kPa against 100); at a
+#: quarter of the rate, 14 km off (the reference at 89.7 deg, beyond the limit, where the cases
+#: interpolate); with the bank at 0.9 of the limit too, 0.18 km
+BANK_FRACTION, BANK_RATE_FRACTION = 0.9, 0.25
 #: the bank-rate term's weight in the bank-effort objective (problems/shefex3.yaml's)
 RATE_WEIGHT = 0.1
 #: the NLP's optimality tolerance (problems/shefex3.yaml's). The transcription is Hermite-Simpson
@@ -85,7 +100,8 @@ def mission_problem_spec(spec, scenario) -> ProblemSpec:
     E_f = dc.replace(scenario, guidance=spec).guidance_terminal_state()[2]  # where the closed loop stops
     tol = scenario.terminal.altitude_tolerance_km
     window = ALTITUDE_WINDOW_FRACTION * tol * 1e3 if tol else ALTITUDE_WINDOW_M
-    bank, rate = math.degrees(vehicle.bank_limit), math.degrees(vehicle.bank_rate_limit)
+    bank = BANK_FRACTION * math.degrees(vehicle.bank_limit)
+    rate = BANK_RATE_FRACTION * math.degrees(vehicle.bank_rate_limit)
     return ProblemSpec(
         name=f"ampi_{MISSION_DATABASE}",  # no scenario name: the same mission under another name is the same problem
         description="paper 003's database problem posed from a mission",
@@ -96,13 +112,16 @@ def mission_problem_spec(spec, scenario) -> ProblemSpec:
         final={"longitude_deg": BoundSpec(value=float(target.longitude_deg)),
                "latitude_deg": BoundSpec(value=float(target.latitude_deg))},
         final_time_s=BoundSpec(min=1.0, max=float(scenario.simulation.max_time_s)),
-        state_bounds={"bank_deg": BoundSpec(min=-bank, max=bank)},
+        state_bounds={"bank_deg": BoundSpec(min=-bank, max=bank),
+                      "flight_path_deg": BoundSpec(min=GAMMA_BOUNDS_DEG[0], max=GAMMA_BOUNDS_DEG[1])},
         control_bounds={"bank_rate_deg_s": BoundSpec(min=-rate, max=rate)},
         path=path,
         terminal=[PathSpec(quantity="central_energy", min=E_f, max=E_f),
                   PathSpec(quantity="geodetic_altitude", min=h_f - window, max=h_f + window, scale=1.0e4)],
         objective=[ObjectiveSpec(kind="bank_effort", bank_max_deg=bank, bank_rate_max_deg_s=rate,
-                                 rate_weight=RATE_WEIGHT)],
+                                 rate_weight=RATE_WEIGHT),
+                   ObjectiveSpec(kind="flight_path_effort", weight=FLIGHT_PATH_WEIGHT,
+                                 scale=math.radians(FLIGHT_PATH_SCALE_DEG))],
         solve=SolveSpec(transcription="hermite_simpson", solver="auto", nodes=int(spec.nodes), tolerance=TOLERANCE,
                         refine=True))
 

@@ -80,6 +80,8 @@ def test_derived_settings_grid_the_deviations_that_move_the_end_most():
     q = 0.5 * float(scenario.make_atmosphere().density(25e3)) * d.spec.terminal_velocity_m_s ** 2
     assert d.spec.terminal_altitude_km == 25.0 and q == pytest.approx(0.97 ** 2 * 0.93 * 1e4, rel=1e-4)
     assert "gamma, psi, h left to the tracker" in d.choices[2].how
+    # the final position weighted at a tenth of the 2-km box (paper 003's 0.01 deg is 1.1 km)
+    assert d.spec.terminal_scales[1] == pytest.approx(math.degrees(200.0 / 6378137.0), rel=2e-3)
     _, capsule = _derived("capsule_lu2008")
     assert set(capsule.spec.grid) == {"lat", "lon", "psi"}
     assert derivation_for(load_scenario("shefex3_ampi"), Ampi).spec.database == "shefex3"  # its own settings

@@ -24,7 +24,7 @@ from drake_entry.guidance.derivation import (
 )
 from drake_entry.models.dispersions import entry_spread
 
-__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "TRACKING_STATE_WEIGHT", "range_effects", "derive"]
+__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "TRACKING_STATE_WEIGHT", "TERMINAL_POSITION_FRACTION", "range_effects", "derive"]
 
 #: the most entry offsets a derived grid spans (3 levels each: 27 solves, a few minutes on 2 cores)
 GRID_DIMENSIONS = 3
@@ -34,6 +34,10 @@ GRID_DIMENSIONS = 3
 #: 125 km; 1e-2, 147 km with the planned bank rate at the vehicle's limit and 0.18 km with it at a
 #: quarter and the planned bank at 0.9 of the limit (guidance.ampi.mission)
 TRACKING_STATE_WEIGHT = 1.0e-2
+#: the TVLQR's final-position scale as a fraction of the box's distance tolerance (paper 003's
+#: 0.01 deg, 1.1 km, for its 25-km window). HORUS-2B's nominal with 0.01 deg ended 5.6 km from the
+#: target, with 0.002 deg (220 m) 1.0 km, against its 2-km box
+TERMINAL_POSITION_FRACTION = 0.1
 #: the grid's names of the entry deviations, in the dispersions' order [m, deg, deg, m/s, deg, deg]
 GRID_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
 
@@ -83,6 +87,11 @@ def derive(scenario) -> Derivation:
     own_alpha = alpha is scenario.alpha
     spec = Ampi(database=MISSION_DATABASE, terminal_altitude_km=altitude, terminal_velocity_m_s=speed,
                 grid={n: round(v, 6) for n, v in steps.items()}, tracking_state_weight=TRACKING_STATE_WEIGHT)
+    tolerance_km = scenario.terminal.distance_tolerance_km
+    if tolerance_km:
+        position = round(math.degrees(TERMINAL_POSITION_FRACTION * tolerance_km * 1e3
+                                      / scenario.make_planet().reference_radius), 6)
+        spec.terminal_scales = [spec.terminal_scales[0], position, position, spec.terminal_scales[3]]
     units = {"h": "m", "V": "m/s"}
     left = [n for n in ranked if n not in names]
     choices = [
@@ -99,6 +108,10 @@ def derive(scenario) -> Derivation:
         Choice("guidance.tracking_state_weight", TRACKING_STATE_WEIGHT,
                "the TVLQR holds the reference along a long glide, not only at its end (paper 003's 1e-5 left "
                "Lu 2014's CAV-H nominal 3440 km off)"),
+        Choice("guidance.terminal_scales", spec.terminal_scales,
+               f"the final position weighted at {TERMINAL_POSITION_FRACTION:g} of the box's distance tolerance "
+               f"(paper 003's 0.01 deg left HORUS-2B's nominal 5.6 km from the target, against its 2-km box)"
+               if tolerance_km else "paper 003's (the box checks no distance)"),
         Choice("alpha", "as the mission's" if own_alpha else ", ".join(
             f"{v:g} deg" + ("" if len(alpha.breakpoints) == 1 else f" at {b:g}")
             for b, v in zip(alpha.breakpoints, alpha.values_deg)) + f" ({alpha.variable})",

@@ -96,7 +96,7 @@ def derive(scenario) -> Derivation:
     left = [n for n in ranked if n not in names]
     choices = [
         Choice("guidance.database", MISSION_DATABASE, "built for this mission on demand and cached: paper 003's "
-               "problem form (bank rate, alpha scheduled, bank effort) from the mission's entry, target, interface "
+               "problem form (bank rate, alpha scheduled, bank effort with a flight-path term) from the mission's entry, target, interface "
                "and vehicle limits"),
         Choice("guidance.terminal_altitude_km, terminal_velocity_m_s", f"{altitude:g} km, {speed:.1f} m/s",
                f"the box's centre speed ({interface.speed_m_s:.1f} m/s), or {Q_SPEED_FRACTION:g} of the speed where "

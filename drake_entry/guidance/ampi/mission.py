@@ -37,14 +37,16 @@ from drake_entry.planning.ocp_yaml import (
     SolveSpec,
 )
 
-__all__ = ["PROBLEM_FILE", "DATABASE_FILE", "REPORT_FILE", "BANK_FRACTION", "BANK_RATE_FRACTION", "GAMMA_BOUNDS_DEG", "FLIGHT_PATH_SCALE_DEG", "FLIGHT_PATH_WEIGHT", "ALTITUDE_WINDOW_FRACTION", "ALTITUDE_WINDOW_M", "RATE_WEIGHT", "TOLERANCE",
-           "mission_problem_spec", "database_folder", "built_database",
-           "fingerprint", "MissionDatabase"]
+__all__ = ["PROBLEM_FILE", "DATABASE_FILE", "REPORT_FILE", "BANK_FRACTION", "BANK_RATE_FRACTION",
+           "GAMMA_BOUNDS_DEG", "FLIGHT_PATH_SCALE_DEG", "FLIGHT_PATH_WEIGHT", "ALTITUDE_WINDOW_FRACTION",
+           "ALTITUDE_WINDOW_M", "RATE_WEIGHT", "TOLERANCE", "mission_problem_spec", "database_folder",
+           "built_database", "fingerprint", "MissionDatabase"]
 
 #: the references end at the energy where the flight stops (the guidance's terminal altitude and
-#: speed), at an altitude within this fraction of the box's altitude tolerance about the terminal
-#: altitude (ALTITUDE_WINDOW_M where the box gives none): fixing the speed as well left SHEFEX-3's
-#: +70 m/s entry without a solution (SNOPT info 13)
+#: speed: a reference ending at another energy leaves flight unplanned, or is cut short), at an
+#: altitude within this fraction of the box's altitude tolerance about the terminal altitude
+#: (ALTITUDE_WINDOW_M where the box gives none), the speed free: fixing it too leaves the
+#: optimiser one point of the box
 ALTITUDE_WINDOW_FRACTION = 0.5
 ALTITUDE_WINDOW_M = 500.0
 #: the flight-path bounds of a mission's database problem [deg] (the LGL guidance's on a mission:
@@ -76,7 +78,7 @@ PROBLEM_FILE, DATABASE_FILE, REPORT_FILE = "problem.yaml", "database.npz", "buil
 def mission_problem_spec(spec, scenario) -> ProblemSpec:
     """The optimal-control problem (a ProblemSpec, as a problem file states it) the database
     solves for ``scenario``'s mission with the Ampi ``spec``: paper 003 Sec. III's form (bank
-    rate control, alpha scheduled, bank effort) on the mission (module docstring), ending over
+    rate control, alpha scheduled, bank effort, here with a flight-path term) on the mission (module docstring), ending over
     the target at the energy where the closed loop stops, inside the altitude window."""
     vehicle = scenario.make_vehicle()
     limits = vehicle.limits

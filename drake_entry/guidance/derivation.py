@@ -26,7 +26,7 @@ from drake_entry.scenario import stated_guidance
 __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
            "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed",
-           "box_mach_window", "Q_SPEED_FRACTION", "terminal_speed"]
+           "box_mach_window", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
 #: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
@@ -280,6 +280,21 @@ def terminal_speed(scenario, interface, altitude_km: float, path_margin: float) 
         raise CannotFly(f"at {altitude_km:g} km the vehicle's dynamic-pressure limit, planned at {1 - path_margin:g} of "
                         f"it, is met at {V / Q_SPEED_FRACTION:.0f} m/s, below the box's {low:.0f} m/s")
     return round(V, 3)
+
+
+def interface_speeds(scenario, interface: Interface, path_margin: float) -> list[tuple[float, float]]:
+    """(altitude [km], terminal_speed [m/s]) at each of ``interface_altitudes`` where the planned
+    dynamic-pressure bound leaves a speed in the box, in their order; the last CannotFly when none
+    does."""
+    out, refused = [], None
+    for h in interface_altitudes(scenario, interface):
+        try:
+            out.append((h, terminal_speed(scenario, interface, h, path_margin)))
+        except CannotFly as e:
+            refused = e
+    if not out:
+        raise refused
+    return out
 
 
 def reversal_corridor(scenario) -> tuple[list[float], list[float], Choice]:

@@ -16,15 +16,15 @@ from drake_entry.guidance.derivation import (
     CannotFly,
     Choice,
     Derivation,
-    interface_altitudes,
+    interface_speeds,
     mission_alpha,
     require_alpha_window,
     terminal_interface,
-    terminal_speed,
 )
 from drake_entry.models.dispersions import entry_spread
 
-__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "TRACKING_STATE_WEIGHT", "TERMINAL_POSITION_FRACTION", "range_effects", "derive"]
+__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "TRACKING_STATE_WEIGHT", "TERMINAL_POSITION_FRACTION", "range_effects",
+           "derive"]
 
 #: the most entry offsets a derived grid spans (3 levels each: 27 solves, a few minutes on 2 cores)
 GRID_DIMENSIONS = 3
@@ -42,14 +42,13 @@ TERMINAL_POSITION_FRACTION = 0.1
 GRID_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
 
 
-def range_effects(scenario, spread) -> dict:
+def range_effects(scenario, interface, spread) -> dict:
     """How far [m] each entry deviation's 3-sigma reach ``spread`` (dispersions.entry_spread) moves
-    the flight's end, to first order: a position offset by itself (the arc length), a speed or
+    the flight's end at the terminal ``interface`` (derivation.terminal_interface), to first order: a position offset by itself (the arc length), a speed or
     altitude offset by its share of the energy to dissipate times the range to go (range grows
     with the energy spent), a flight-path or heading offset as that angle times the range to go."""
     planet = scenario.make_planet().with_(j2=0.0)
     x0 = scenario.initial_state()
-    interface = terminal_interface(scenario)
     hf = interface.altitude_km * 1e3
     span = float(planet.specific_energy(x0[0], x0[3]) - planet.specific_energy(hf, interface.speed_m_s))
     R = planet.reference_radius
@@ -65,18 +64,9 @@ def derive(scenario) -> Derivation:
     """Ampi settings for ``scenario``'s mission stating no block of this method."""
     require_alpha_window(scenario)
     interface = terminal_interface(scenario)
-    margin = Ampi.path_margin
-    refused = None
-    for h in interface_altitudes(scenario, interface):
-        try:
-            altitude, speed = h, terminal_speed(scenario, interface, h, margin)
-            break
-        except CannotFly as e:
-            refused = e
-    else:
-        raise refused
+    altitude, speed = interface_speeds(scenario, interface, Ampi.path_margin)[0]
     spread = entry_spread(scenario.dispersions)
-    effects = range_effects(scenario, spread)
+    effects = range_effects(scenario, interface, spread)
     ranked = sorted((n for n, s in zip(GRID_NAMES, spread) if s > 0.0), key=lambda n: -effects[n])
     if not ranked:
         raise CannotFly("the mission disperses no entry state: a database of one entry is its nominal plan (fly "

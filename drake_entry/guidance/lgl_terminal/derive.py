@@ -10,14 +10,12 @@ box on the nominal flight and a few dispersed draws."""
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
     Q_SPEED_FRACTION,
-    CannotFly,
     Choice,
     Derivation,
     SearchStep,
-    interface_altitudes,
+    interface_speeds,
     mission_alpha,
     terminal_interface,
-    terminal_speed,
 )
 from drake_entry.guidance.lgl_terminal.mission import MISSION
 from drake_entry.guidance.lgl_terminal.spec import LglTerminal
@@ -42,16 +40,8 @@ def derive(scenario) -> Derivation:
     if constant:
         lo, hi = lo - ALPHA_WIDEN_DEG, hi + ALPHA_WIDEN_DEG
     gamma = scenario.terminal.flight_path_deg
-    margin = LglTerminal.path_margin
-    candidates = []
-    for h in interface_altitudes(scenario, interface):
-        try:
-            candidates.append({"guidance.terminal_altitude_km": h,
-                               "guidance.terminal_velocity_m_s": terminal_speed(scenario, interface, h, margin)})
-        except CannotFly as e:
-            refused = e
-    if not candidates:
-        raise refused
+    candidates = [{"guidance.terminal_altitude_km": h, "guidance.terminal_velocity_m_s": V}
+                  for h, V in interface_speeds(scenario, interface, LglTerminal.path_margin)]
     first = candidates[0]
     spec = LglTerminal(problem=MISSION, terminal_altitude_km=first["guidance.terminal_altitude_km"],
                        terminal_velocity_m_s=first["guidance.terminal_velocity_m_s"], final_flight_path_deg=gamma,

@@ -40,7 +40,7 @@ from drake_entry.planning.ocp_yaml import (
 __all__ = ["PROBLEM_FILE", "DATABASE_FILE", "REPORT_FILE", "BANK_FRACTION", "BANK_RATE_FRACTION",
            "GAMMA_BOUNDS_DEG", "FLIGHT_PATH_SCALE_DEG", "FLIGHT_PATH_WEIGHT", "ALTITUDE_WINDOW_FRACTION",
            "ALTITUDE_WINDOW_M", "RATE_WEIGHT", "TOLERANCE", "mission_problem_spec", "database_folder",
-           "built_database", "fingerprint", "MissionDatabase"]
+           "read_built", "built_database", "fingerprint", "MissionDatabase"]
 
 #: the references end at the energy where the flight stops (the guidance's terminal altitude and
 #: speed: a reference ending at another energy leaves flight unplanned, or is cut short), at an
@@ -175,15 +175,23 @@ def database_folder(spec, scenario) -> tuple[str, str, str]:
     return os.path.join(cache_dir("ampi"), key), key, text
 
 
+def read_built(folder: str) -> MissionDatabase | None:
+    """The database built in ``folder`` (database_folder), or None when none is finished there."""
+    report = os.path.join(folder, REPORT_FILE)
+    if not os.path.exists(report):
+        return None
+    with open(report) as f:
+        done = json.load(f)
+    return MissionDatabase(os.path.join(folder, DATABASE_FILE), folder, done["build"], done["accuracy"], True)
+
+
 def built_database(spec, scenario) -> MissionDatabase:
     """The built database of ``scenario``'s mission; a ScenarioError saying how to build it when
     it is not in the cache."""
     folder, key, _ = database_folder(spec, scenario)
-    report = os.path.join(folder, REPORT_FILE)
-    if not os.path.exists(report):
+    built = read_built(folder)
+    if built is None:
         raise ScenarioError(f"the AMPI database of mission '{scenario.name}' (fingerprint {key}) is not built: "
                             f"`drake-entry plan`, `campaign` and `compare` build it first; from Python call "
                             f"drake_entry.campaign.preparation.prepare(scenario)")
-    with open(report) as f:
-        done = json.load(f)
-    return MissionDatabase(os.path.join(folder, DATABASE_FILE), folder, done["build"], done["accuracy"], True)
+    return built

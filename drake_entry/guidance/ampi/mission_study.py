@@ -25,6 +25,7 @@ from drake_entry.guidance.ampi.mission import (
     built_database,
     database_folder,
     mission_problem_spec,
+    read_built,
 )
 from drake_entry.guidance.ampi.spec import MISSION_DATABASE
 
@@ -59,17 +60,15 @@ def build_mission_database(spec, scenario, *, progress: bool = True, workers: in
                                 f"processes needs `if __name__ == '__main__':`)") from None
     os.makedirs(folder, exist_ok=True)
     with _locked(os.path.join(os.path.dirname(folder), f"{key}.lock")):
-        try:
-            return built_database(spec, scenario)
-        except ScenarioError:
-            pass  # not built yet: build it here
+        built = read_built(folder)  # by another process while this one waited, or by an earlier run
+        if built is not None:
+            return built
         problem_path = os.path.join(folder, PROBLEM_FILE)
         with open(problem_path, "w") as f:
             f.write(f"# {mission_problem_spec.__doc__.splitlines()[0]}\n{text}")
-        backend = "processes"
         build_dir = os.path.join(folder, "build")
-        db, report = build_database(build_dir, mission_study(spec, problem_path), backend=backend, workers=workers,
-                                    progress=progress)
+        db, report = build_database(build_dir, mission_study(spec, problem_path), backend="processes",
+                                    workers=workers, progress=progress)
         if report["verified"] < db.grid.size:
             missing = [int(i) for i in range(db.grid.size) if not db.verified[i]]
             raise ScenarioError(f"the AMPI database of mission '{scenario.name}' has {report['verified']} of "
@@ -79,7 +78,7 @@ def build_mission_database(spec, scenario, *, progress: bool = True, workers: in
         shutil.copyfile(os.path.join(build_dir, "database.npz"), path)
         rows = accuracy_study(os.path.join(folder, "accuracy"),
                               AccuracyStudy(database=path, cases=int(spec.accuracy_cases), seed=0),
-                              backend=backend, workers=workers, progress=progress)
+                              backend="processes", workers=workers, progress=progress)
         accuracy = summarise(rows)
         with open(os.path.join(folder, REPORT_FILE), "w") as f:
             json.dump({"build": report, "accuracy": accuracy, "fingerprint": key}, f, indent=1, default=float)

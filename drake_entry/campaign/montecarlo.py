@@ -82,7 +82,9 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     none: the smallest output for large campaigns; the report then omits the envelopes).
 
     nominal_setup: the ClosedLoopSetup of this very scenario, already built by the caller (its
-    pre-flight planning done), flown for the nominal trajectory instead of planning again.
+    preparation and pre-flight planning done), flown for the nominal trajectory instead of
+    planning again. Without it the method's preparation (campaign.preparation) runs here,
+    before any worker starts.
 
     The directory's manifest fingerprints the scenario content, seed, trajectory step and
     versions: a directory holding another campaign is refused (CampaignError); a larger
@@ -98,9 +100,10 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     task = Task("drake_entry.campaign.sample:setup_worker", "drake_entry.campaign.sample:run_case",
                 {"scenario_yaml": manifest["scenario_yaml"], "seed": int(seed),
                  "trajectory_step_s": float(trajectory_step_s)})
-    prepared = prepare(scenario_from_dump(manifest["scenario_yaml"]), progress=progress)  # before any worker
-    if prepared and progress:
-        print(f"drake-entry: {prepared}", flush=True)
+    if nominal_setup is None:  # a built setup has had its preparation: its planner loads what it made
+        prepared = prepare(scenario_from_dump(manifest["scenario_yaml"]), progress=progress)  # before any worker
+        if prepared and progress:
+            print(f"drake-entry: {prepared}", flush=True)
     cases = SampleCases(runs, lambda i: sample_seed(seed, i))
     run_cases(task, cases, out_dir, manifest, backend=backend, workers=workers, scheduler=scheduler,
               progress=progress, desc="campaign")

@@ -13,6 +13,12 @@ by up to |u| T per step), its change clipped to the rate limit times T and its v
 cannot be made (e.g. an enclosing database case not verified) is recorded: the tracker then
 holds its initial bank and the flight is not a success.
 
+The reference is read at the flight's clock t (``index`` 'time', paper 003's tracking) or at the
+reference time where its energy E = V^2/2 - mu/r (central gravity) equals the estimate's
+(``index`` 'energy'): a denser or draggier flight spends its energy sooner, and read in time its
+reference would ask the altitude and speed of a later state it has not reached; read in energy
+the law compares states of the same energy, and the clock's deviation is zero.
+
 Ports:
   - input  "estimated_state"  [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
   - output "bank_command"     [1]  sigma_c [rad]
@@ -27,6 +33,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import DrakeEntryError, ScenarioError
+from drake_entry.planning.tracking import INDICES
 
 __all__ = ["LAW_STATES", "TrackerMemory", "ReferenceTracker"]
 
@@ -36,19 +43,22 @@ LAW_STATES = ("h", "lon", "lat", "V", "gamma", "psi", "sigma", "t")
 
 @dc.dataclass(frozen=True)
 class TrackerMemory:
-    """reference: the TrackedReference (None when it could not be made); message: why not."""
+    """reference: the TrackedReference (None when it could not be made); message: why not;
+    energy: the reference's energy at its samples [J/kg], non-increasing (index 'energy' only)."""
 
     reference: object = None
     message: str = ""
+    energy: np.ndarray | None = None
 
 
 class ReferenceTracker(LeafSystem):
     def __init__(self, planner, *, bank_limit: float, rate_limit: float, period: float = 0.5,
-                 initial_bank: float = 0.0, lead: float = 0.0):
+                 initial_bank: float = 0.0, lead: float = 0.0, index: str = "time"):
         """Args: planner with reference(estimate) -> TrackedReference and ``problem.state_names``
         == LAW_STATES; bank_limit [rad], rate_limit [rad/s] of the command; period [s];
         initial_bank [rad] (held when no reference can be made); lead [s]: the feed-forward is
-        the reference bank this far ahead, the lag of the actuator loop the command drives."""
+        the reference bank this far ahead, the lag of the actuator loop the command drives;
+        index: 'time' or 'energy', what the reference is read at (module docstring)."""
         super().__init__()
         if tuple(planner.problem.state_names) != LAW_STATES:
             raise ScenarioError(f"ReferenceTracker needs a reference with states {LAW_STATES} (controls 'bank_rate'), "
@@ -59,7 +69,10 @@ class ReferenceTracker(LeafSystem):
         if not 0.0 <= lead <= 10.0:
             raise ScenarioError(f"ReferenceTracker.lead = {lead} s: allowed 0 to 10")
         self.planner, self.bank_limit, self.rate_limit, self.period = planner, bank_limit, rate_limit, period
-        self.lead = float(lead)
+        if index not in INDICES:
+            raise ScenarioError(f"ReferenceTracker.index = '{index}'; allowed: {', '.join(INDICES)}")
+        self.lead, self.index = float(lead), index
+        self._planet = planner.problem.planet.with_(j2=0.0)
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self._memory = self.DeclareAbstractState(AbstractValue.Make(TrackerMemory()))
         self._bank = self.DeclareDiscreteState(BasicVector([float(initial_bank)]))
@@ -67,7 +80,8 @@ class ReferenceTracker(LeafSystem):
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
         self.DeclareStateOutputPort("bank_command", self._bank)
         self.DeclareVectorOutputPort("reference_state", 7, self._reference_state,
-                                     prerequisites_of_calc={self.all_state_ticket(), self.time_ticket()})
+                                     prerequisites_of_calc={self.all_state_ticket(), self.time_ticket(),
+                                                            self.all_input_ports_ticket()})
 
     def memory(self, context) -> TrackerMemory:
         return context.get_abstract_state(int(self._memory)).get_value()
@@ -79,15 +93,34 @@ class ReferenceTracker(LeafSystem):
         except DrakeEntryError as e:  # recorded; the flight goes on without guidance
             state.get_mutable_abstract_state(int(self._memory)).set_value(TrackerMemory(None, str(e)))
             return
-        state.get_mutable_abstract_state(int(self._memory)).set_value(TrackerMemory(ref))
-        sigma0 = float(np.clip(ref.law.state(context.get_time() + self.lead)[6], -self.bank_limit, self.bank_limit))
+        energy = None
+        if self.index == "energy":  # non-increasing, so that every energy reads one time
+            energy = np.minimum.accumulate(self._energy(ref.law.states[:, 0], ref.law.states[:, 3]))
+        memory = TrackerMemory(ref, energy=energy)
+        state.get_mutable_abstract_state(int(self._memory)).set_value(memory)
+        s = self._clock(context, memory)
+        sigma0 = float(np.clip(ref.law.state(s + self.lead)[6], -self.bank_limit, self.bank_limit))
         state.get_mutable_discrete_state(self._bank).SetFromVector([sigma0])
 
+    def _energy(self, h, V):
+        """E = V^2/2 - mu/r [J/kg] (central gravity, the closed loop's stop)."""
+        return 0.5 * V * V - self._planet.mu / self._planet.radius(h)
+
+    def _clock(self, context, memory: TrackerMemory) -> float:
+        """The reference time [s] the law is read at now."""
+        if memory.energy is None:
+            return context.get_time()
+        x = self.est_port.Eval(context)
+        law = memory.reference.law
+        # np.interp needs increasing abscissae: the energy falls along the reference
+        return float(np.interp(-self._energy(x[0], x[3]), -memory.energy, law.time))
+
     def _update(self, context, discrete_state):
-        ref = self.memory(context).reference
+        memory = self.memory(context)
+        ref = memory.reference
         if ref is None:
             return
-        t, T, lead = context.get_time(), self.period, self.lead
+        t, T, lead = self._clock(context, memory), self.period, self.lead
         sigma = float(context.get_discrete_state(self._bank).GetAtIndex(0))
         law = ref.law
         ff_now, ff_next = law.state(t + lead)[6], law.state(t + T + lead)[6]
@@ -102,5 +135,6 @@ class ReferenceTracker(LeafSystem):
             [min(max(sigma + step, -self.bank_limit), self.bank_limit)])
 
     def _reference_state(self, context, output):
-        ref = self.memory(context).reference
-        output.SetFromVector(np.full(7, np.nan) if ref is None else ref.law.state(context.get_time())[:7])
+        memory = self.memory(context)
+        ref = memory.reference
+        output.SetFromVector(np.full(7, np.nan) if ref is None else ref.law.state(self._clock(context, memory))[:7])

@@ -122,12 +122,43 @@ def test_tracker_records_a_reference_it_cannot_make_and_holds_its_bank(planner):
         ReferenceTracker(planner, bank_limit=1.0, rate_limit=0)
 
 
+@pytest.mark.parametrize("index", ["time", "energy"])
+def test_tracker_reads_its_reference_at_the_clock_or_at_the_estimates_energy(planner, index):
+    """Read in energy, a flight at the reference's state of 200 s gets that state whatever its
+    clock (the energy falls by 6 kJ/kg per second there, so 0.5 s is 3 kJ/kg); read in time, the
+    state at its clock."""
+    from pydrake.systems.analysis import Simulator
+
+    from drake_entry.systems.reference_tracking import ReferenceTracker
+
+    tracker = ReferenceTracker(planner, bank_limit=math.radians(60), rate_limit=math.radians(5), index=index)
+    ctx = tracker.CreateDefaultContext()
+    x0 = [planner.problem.initial[n] for n in ("h", "lon", "lat", "V", "gamma", "psi")]
+    port = tracker.GetInputPort("estimated_state")
+    port.FixValue(ctx, x0)
+    Simulator(tracker, ctx).Initialize()
+    law = tracker.memory(ctx).reference.law
+    energy = tracker.memory(ctx).energy
+    if index == "time":
+        assert energy is None
+    else:  # the reference's energy at its samples, falling
+        assert energy.shape == law.time.shape and np.all(np.diff(energy) <= 0.0) and energy[0] > energy[-1] + 1e6
+    port.FixValue(ctx, law.state(200.0)[:6])
+    read = tracker.GetOutputPort("reference_state").Eval(ctx)
+    expected = law.state(200.0 if index == "energy" else 0.0)[:7]
+    scale = np.array([100.0, 1e-5, 1e-5, 1.0, 1e-4, 1e-4, 1e-3])  # 0.5 s of the reference, about
+    assert np.all(np.abs(read - expected) < scale), (read - expected) / scale
+    with pytest.raises(ScenarioError, match="ReferenceTracker.index = 'range'; allowed: time, energy"):
+        ReferenceTracker(planner, bank_limit=1.0, rate_limit=0.1, index="range")
+
+
 @pytest.mark.parametrize("field, value, message", [
     ("reference", "best", "guidance.reference = 'best'; allowed: ampi, ntt"),
     ("database", "nowhere.npz", "guidance.database 'nowhere.npz' is neither a packaged database"),
     ("tracking_scales", [1.0] * 6, "guidance.tracking_scales needs 7 values, got 6"),
     ("bank_lead_s", 20.0, r"guidance.bank_lead_s = 20.0 is out of range; allowed \[0, 10\]"),
     ("hd_points", 1, r"guidance.hd_points = 1 is out of range"),
+    ("tracking_index", "range", "guidance.tracking_index = 'range'; allowed: time, energy"),
     ("terminal_velocity_m_s", 9000.0, r"guidance.terminal_velocity_m_s = 9000.0 is out of range"),
 ])
 def test_spec_errors_name_the_field(field, value, message):

@@ -89,6 +89,28 @@ def test_derived_settings_grid_the_deviations_that_move_the_end_most():
         derivation_for(load_scenario("marv_guidance"), Ampi)
 
 
+def test_derived_ld_nodes_resolve_a_planned_bank_reversal():
+    """Paper 004's CAV-H: a planned reversal (0.9 x 85 deg each side at a quarter of 20 deg/s)
+    takes 30.6 s; the flight ~2420 s (11 369 km at the mean of 7400 and 2000 m/s); the widest LGL
+    interval of the derived nodes is half a reversal at most, and one node fewer would not do.
+    SHEFEX-3's-length flights keep paper 003's 60."""
+    from drake_entry.guidance.ampi.derive import LD_NODES_RANGE, ld_nodes
+    from drake_entry.guidance.derivation import terminal_interface
+    from drake_entry.planning.pseudospectral import lgl_nodes
+
+    scenario, d = _derived("cav_h_paper004")
+    n, duration, reversal = ld_nodes(scenario, terminal_interface(scenario))
+    assert reversal == pytest.approx(2 * 0.9 * 85.0 / (0.25 * 20.0), rel=1e-9)
+    assert duration == pytest.approx(2419.0, abs=5.0) and d.spec.ld_nodes == n
+
+    def widest(nodes):
+        return float(np.max(np.diff(lgl_nodes(nodes)))) * duration / 2.0
+
+    assert widest(n) <= reversal / 2.0 < widest(n - 1)
+    capsule, _ = _derived("capsule_lu2008")
+    assert ld_nodes(capsule, terminal_interface(capsule))[0] == LD_NODES_RANGE[0]
+
+
 def test_entry_spread_is_the_three_sigma_reach():
     spread = entry_spread(load_scenario("shefex3_ampi").dispersions)  # Gaussian, sigma = step / 3
     assert spread == pytest.approx([250.0, 0.5, 0.5, 70.0, 0.5, 0.5], rel=1e-4)

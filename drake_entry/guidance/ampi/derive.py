@@ -4,26 +4,30 @@ mission's acceptance box (below the speed where the planned dynamic-pressure bou
 LGL guidance's), over a grid of the entry offsets the mission disperses most, each spanning its
 3-sigma reach (paper 003 eq. 5's form: the grid step is the dispersion's 3 sigma).
 
-Nothing is searched: each candidate would be a database of its own (minutes of solves); the
+The database's settings are not searched: each candidate would be a database of its own (minutes
+of solves); only the tracker's reading of the reference (time or energy) is, on the one database. The
 terminal altitude is the box centre, or the first of the shared steps inside the box where the
 dynamic-pressure bound leaves a speed in the box."""
 
 import math
 
+from drake_entry.guidance.ampi.mission import BANK_FRACTION, BANK_RATE_FRACTION
 from drake_entry.guidance.ampi.spec import MISSION_DATABASE, Ampi
 from drake_entry.guidance.derivation import (
     Q_SPEED_FRACTION,
     CannotFly,
     Choice,
     Derivation,
+    SearchStep,
     interface_speeds,
     mission_alpha,
     require_alpha_window,
     terminal_interface,
 )
 from drake_entry.models.dispersions import entry_spread
+from drake_entry.planning.tracking import INDICES
 
-__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "TRACKING_STATE_WEIGHT", "TERMINAL_POSITION_FRACTION", "range_effects",
+__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "LD_NODES_RANGE", "ld_nodes", "TRACKING_STATE_WEIGHT", "TERMINAL_POSITION_FRACTION", "range_effects",
            "derive"]
 
 #: the most entry offsets a derived grid spans (3 levels each: 27 solves, a few minutes on 2 cores)
@@ -38,8 +42,28 @@ TRACKING_STATE_WEIGHT = 1.0e-2
 #: 0.01 deg, 1.1 km, for its 25-km window). HORUS-2B's nominal with 0.01 deg ended 5.6 km from the
 #: target, with 0.002 deg (220 m) 1.0 km, against its 2-km box
 TERMINAL_POSITION_FRACTION = 0.1
+#: the fewest and most LD nodes of a derived database (paper 003 stores its 600-s flights at 60)
+LD_NODES_RANGE = (60, 400)
 #: the grid's names of the entry deviations, in the dispersions' order [m, deg, deg, m/s, deg, deg]
 GRID_NAMES = ("h", "lon", "lat", "V", "gamma", "psi")
+
+
+def ld_nodes(scenario, interface) -> tuple[int, float, float]:
+    """(the LD nodes of a mission database, the flight's duration estimate [s], a planned bank
+    reversal's duration [s]): enough Legendre-Gauss-Lobatto nodes that their widest interval,
+    pi T / (2 N) in the middle of a flight of T seconds, is at most half a reversal (the planned
+    bank from one side to the other at the planned rate, guidance.ampi.mission), within
+    LD_NODES_RANGE. T: the great-circle range to the target over the mean of the entry and
+    terminal speeds."""
+    vehicle = scenario.make_vehicle()
+    reversal = float(2.0 * BANK_FRACTION * vehicle.bank_limit / (BANK_RATE_FRACTION * vehicle.bank_rate_limit))
+    planet = scenario.make_planet()
+    x0 = scenario.initial_state()
+    to_go = planet.great_circle_distance(x0[1], x0[2], math.radians(scenario.target.longitude_deg),
+                                         math.radians(scenario.target.latitude_deg))
+    duration = float(to_go / (0.5 * (x0[3] + interface.speed_m_s)))
+    low, high = LD_NODES_RANGE
+    return min(max(math.ceil(math.pi * duration / reversal), low), high), duration, reversal
 
 
 def range_effects(scenario, interface, spread) -> dict:
@@ -75,7 +99,8 @@ def derive(scenario) -> Derivation:
     steps = {n: float(spread[GRID_NAMES.index(n)]) for n in names}
     alpha, source = mission_alpha(scenario)
     own_alpha = alpha is scenario.alpha
-    spec = Ampi(database=MISSION_DATABASE, terminal_altitude_km=altitude, terminal_velocity_m_s=speed,
+    nodes, duration, reversal = ld_nodes(scenario, interface)
+    spec = Ampi(database=MISSION_DATABASE, terminal_altitude_km=altitude, terminal_velocity_m_s=speed, ld_nodes=nodes,
                 grid={n: round(v, 6) for n, v in steps.items()}, tracking_state_weight=TRACKING_STATE_WEIGHT)
     tolerance_km = scenario.terminal.distance_tolerance_km
     if tolerance_km:
@@ -95,6 +120,11 @@ def derive(scenario) -> Derivation:
                "the entry deviations that move the end most, each at its 3-sigma reach (end moved by "
                + ", ".join(f"{n} {effects[n] / 1e3:.3g} km" for n in ranked)
                + (f"; {', '.join(left)} left to the tracker" if left else "") + ")"),
+        Choice("guidance.ld_nodes", nodes,
+               f"a planned bank reversal ({reversal:.0f} s) spans two LGL intervals or more in a flight of about "
+               f"{duration:.0f} s (the range over the mean speed), within {LD_NODES_RANGE[0]}-{LD_NODES_RANGE[1]}: "
+               f"one global polynomial through fewer nodes overshoots a reversal (paper 004's CAV-H at 60 nodes: the "
+               f"reference bank at 130 deg against the planned 76.5, the nominal 124 km off; at 200, 6 km)"),
         Choice("guidance.tracking_state_weight", TRACKING_STATE_WEIGHT,
                "the TVLQR holds the reference along a long glide, not only at its end (paper 003's 1e-5 left "
                "Lu 2014's CAV-H nominal 3440 km off)"),
@@ -107,5 +137,13 @@ def derive(scenario) -> Derivation:
             for b, v in zip(alpha.breakpoints, alpha.values_deg)) + f" ({alpha.variable})",
             f"{source} alpha schedule, flown by the database's problem and the closed loop alike"),
     ]
-    return Derivation(spec, choices, [], alpha=None if own_alpha else alpha)
+    # one database serves both candidates (the index is not in its fingerprint): the search's
+    # flights cost seconds once it is built
+    search = [SearchStep.over("guidance.tracking_index", INDICES,
+                              "read in time, the reference asks the state a flight that spends its energy sooner or "
+                              "later has not reached; read in energy, the altitude and speed it trades at that energy "
+                              "(10 runs of Lu 2014's CAV-H: 64 km median miss in time, 28 km in energy; paper 004's "
+                              "CAV-H: 70 km in time, 144 km in energy): every candidate flown, the best kept",
+                              exhaustive=True)]
+    return Derivation(spec, choices, search, alpha=None if own_alpha else alpha)
 

@@ -41,7 +41,7 @@ class AmpiMethod(GuidanceMethod):
         tracker = builder.AddNamedSystem(GUIDANCE_SYSTEM, ReferenceTracker(
             planner, bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit,
             period=scenario.guidance.period_s, initial_bank=bank0,
-            lead=scenario.guidance.bank_lead_s))
+            lead=scenario.guidance.bank_lead_s, index=scenario.guidance.tracking_index))
         builder.Connect(plant.estimated_state, tracker.GetInputPort("estimated_state"))
         return GuidanceCommands(
             bank=tracker.GetOutputPort("bank_command"), initial_bank=bank0,

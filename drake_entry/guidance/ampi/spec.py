@@ -86,6 +86,9 @@ class Ampi(GuidanceSpecBase):
     # zero-order hold (period/2 = 0.25 s). Measured on the SHEFEX-3 nominal: lead 0 misses by
     # 16.9 km, 0.75 s and 1.0 s by < 1.3 km (docs/methods/ampi.md)
     bank_lead_s: float = 0.75
+    # what the tracker reads the reference at: 'time' (the flight's clock, paper 003's) or
+    # 'energy' (the reference time of the estimate's energy; systems/reference_tracking.py)
+    tracking_index: str = "time"
 
     def _validate_mission_fields(self) -> None:
         from drake_entry.guidance.ampi.grid import PARAMETERS
@@ -149,3 +152,6 @@ class Ampi(GuidanceSpecBase):
         check_range("guidance.tracking_state_weight", self.tracking_state_weight, 1e-12, 1e6)
         check_range("guidance.tracking_rate_deg_s", self.tracking_rate_deg_s, 1e-6, 1e3)
         check_range("guidance.bank_lead_s", self.bank_lead_s, 0.0, 10.0)
+        from drake_entry.planning.tracking import INDICES
+        if self.tracking_index not in INDICES:
+            raise ScenarioError(f"guidance.tracking_index = '{self.tracking_index}'; allowed: {', '.join(INDICES)}")

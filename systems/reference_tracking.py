@@ -33,7 +33,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import DrakeEntryError, ScenarioError
-from drake_entry.planning.tracking import INDICES
+from drake_entry.guidance.ampi.spec import TRACKING_INDICES
 
 __all__ = ["LAW_STATES", "TrackerMemory", "ReferenceTracker"]
 
@@ -69,8 +69,8 @@ class ReferenceTracker(LeafSystem):
         if not 0.0 <= lead <= 10.0:
             raise ScenarioError(f"ReferenceTracker.lead = {lead} s: allowed 0 to 10")
         self.planner, self.bank_limit, self.rate_limit, self.period = planner, bank_limit, rate_limit, period
-        if index not in INDICES:
-            raise ScenarioError(f"ReferenceTracker.index = '{index}'; allowed: {', '.join(INDICES)}")
+        if index not in TRACKING_INDICES:
+            raise ScenarioError(f"ReferenceTracker.index = '{index}'; allowed: {', '.join(TRACKING_INDICES)}")
         self.lead, self.index = float(lead), index
         self._planet = planner.problem.planet.with_(j2=0.0)
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)

@@ -35,16 +35,13 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["INDICES", "RICCATI_ACCURACY", "RICCATI_MAX_STEP_S", "TrackingWeights", "TrackingLaw", "CommandFeedback", "lerp",
+__all__ = ["RICCATI_ACCURACY", "RICCATI_MAX_STEP_S", "TrackingWeights", "TrackingLaw", "CommandFeedback", "lerp",
            "resample", "scaled_linearisation", "linearise", "tvlqr"]
 
 #: Riccati integration (Drake's RK3 with error control): 1e-3 changes K by < 1e-3 of its
 #: largest entry against 1e-4 on the SHEFEX-3 nominal, at 60 % of the cost
 RICCATI_ACCURACY = 1.0e-3
 RICCATI_MAX_STEP_S = 20.0
-#: what a tracker may read its reference at: the flight's clock, or the reference time of the
-#: flight's energy (systems/reference_tracking.py)
-INDICES = ("time", "energy")
 
 
 @dc.dataclass(frozen=True)

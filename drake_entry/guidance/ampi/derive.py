@@ -12,7 +12,7 @@ dynamic-pressure bound leaves a speed in the box."""
 import math
 
 from drake_entry.guidance.ampi.mission import BANK_FRACTION, BANK_RATE_FRACTION
-from drake_entry.guidance.ampi.spec import MISSION_DATABASE, Ampi
+from drake_entry.guidance.ampi.spec import MISSION_DATABASE, TRACKING_INDICES, Ampi
 from drake_entry.guidance.derivation import (
     Q_SPEED_FRACTION,
     CannotFly,
@@ -25,7 +25,6 @@ from drake_entry.guidance.derivation import (
     terminal_interface,
 )
 from drake_entry.models.dispersions import entry_spread
-from drake_entry.planning.tracking import INDICES
 
 __all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "LD_NODES_RANGE", "ld_nodes", "TRACKING_STATE_WEIGHT", "TERMINAL_POSITION_FRACTION", "range_effects",
            "derive"]
@@ -139,7 +138,7 @@ def derive(scenario) -> Derivation:
     ]
     # one database serves both candidates (the index is not in its fingerprint): the search's
     # flights cost seconds once it is built
-    search = [SearchStep.over("guidance.tracking_index", INDICES,
+    search = [SearchStep.over("guidance.tracking_index", TRACKING_INDICES,
                               "read in time, the reference asks the state a flight that spends its energy sooner or "
                               "later has not reached; read in energy, the altitude and speed it trades at that energy "
                               "(10 runs of Lu 2014's CAV-H: 64 km median miss in time, 28 km in energy; paper 004's "

@@ -9,7 +9,7 @@ from typing import Dict
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import GuidanceSpecBase
 
-__all__ = ["MISSION_DATABASE", "MAX_MISSION_CASES", "MODES", "packaged_databases", "database_path", "Ampi"]
+__all__ = ["MISSION_DATABASE", "MAX_MISSION_CASES", "MODES", "TRACKING_INDICES", "packaged_databases", "database_path", "Ampi"]
 
 #: the ``database`` value that builds the database for the scenario's own mission
 MISSION_DATABASE = "mission"
@@ -18,6 +18,9 @@ MAX_MISSION_CASES = 243
 
 #: how the on-board reference is made: AMPI synthesis or the nearest entry (NTT)
 MODES = ("ampi", "ntt")
+#: what the tracker reads its reference at: the flight's clock, or the reference time of the
+#: flight's energy (systems/reference_tracking.py)
+TRACKING_INDICES = ("time", "energy")
 
 
 def packaged_databases() -> tuple:
@@ -152,6 +155,6 @@ class Ampi(GuidanceSpecBase):
         check_range("guidance.tracking_state_weight", self.tracking_state_weight, 1e-12, 1e6)
         check_range("guidance.tracking_rate_deg_s", self.tracking_rate_deg_s, 1e-6, 1e3)
         check_range("guidance.bank_lead_s", self.bank_lead_s, 0.0, 10.0)
-        from drake_entry.planning.tracking import INDICES
-        if self.tracking_index not in INDICES:
-            raise ScenarioError(f"guidance.tracking_index = '{self.tracking_index}'; allowed: {', '.join(INDICES)}")
+        if self.tracking_index not in TRACKING_INDICES:
+            raise ScenarioError(f"guidance.tracking_index = '{self.tracking_index}'; allowed: "
+                                f"{', '.join(TRACKING_INDICES)}")

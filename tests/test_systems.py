@@ -1,4 +1,5 @@
 """Each LeafSystem: ports, units, and behaviour against the model functions."""
+import dataclasses as dc
 import math
 
 import numpy as np
@@ -323,6 +324,27 @@ def test_acceleration_ratio_filter_low_passes_sensed_over_modelled_lift_and_drag
     assert far == pytest.approx((1.05, 0.97), rel=1e-12)
     thin = np.array([90e3, 0.1, 0.0, 7000.0, 0.0, 1.5])
     assert filtered_ratios((1.2, 0.8), thin, alpha, 1.0, 1.0, vehicle, planet, atmosphere, 1.0) == (1.2, 0.8)
+
+
+def test_sensed_vehicle_scales_the_nominal_coefficients_once():
+    """A re-plan's vehicle predicts with C_L k_L and C_D k_D; a plan re-planned again is scaled
+    from the nominal coefficients (k of the latest ratios, not their product), and the dispersed
+    plant's ScaledAero is never mistaken for a sensed one."""
+    from drake_entry.models.acceleration_ratios import sensed_vehicle
+    from drake_entry.models.aerodynamics import ScaledAero
+    from drake_entry.scenario import load_scenario
+
+    nominal = load_scenario("cav_h_fnpeg").make_vehicle()
+    alpha, mach = math.radians(12.0), 15.0
+    cl, cd = nominal.aero.coefficients(alpha, mach)
+    once = sensed_vehicle(nominal, (1.06, 0.97))
+    twice = sensed_vehicle(once, np.array([0.95, 1.10]))
+    assert once.aero.coefficients(alpha, mach) == pytest.approx((1.06 * cl, 0.97 * cd), rel=1e-14)
+    assert twice.aero.coefficients(alpha, mach) == pytest.approx((0.95 * cl, 1.10 * cd), rel=1e-14)
+    assert nominal.aero.coefficients(alpha, mach) == (cl, cd)  # the nominal vehicle is untouched
+    dispersed = dc.replace(nominal, aero=ScaledAero(nominal.aero, 1.2, 1.0))
+    assert sensed_vehicle(dispersed, (1.0, 0.5)).aero.coefficients(alpha, mach) == pytest.approx(
+        (1.2 * cl, 0.5 * cd), rel=1e-14)
 
 
 def test_compiled_actuator_path_is_the_actuator_law():

@@ -8,21 +8,37 @@ import math
 import numpy as np
 
 from drake_entry.guidance.interface import ActuatorLimits, GuidanceCommands, LoggedSignal, PlantPorts
+from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 from drake_entry.systems.replan_scheduler import ReplanStats
 from drake_entry.systems.replanning_guidance import ReplanMemory, ReplanningGuidance
 
-__all__ = ["add_replanning_guidance", "replanning_commands", "replanning_record"]
+__all__ = ["RATIO_SYSTEM", "add_replanning_guidance", "replanning_commands", "replanning_record"]
+
+#: the name of the filter of the sensed lift and drag ratios the re-plans predict with
+RATIO_SYSTEM = "acceleration_ratios"
 
 
-def add_replanning_guidance(builder, name: str, plan, replan, spec, plant: PlantPorts, **options):
+def add_replanning_guidance(builder, name: str, plan, replan, scenario, plant: PlantPorts, **options):
     """Add ReplanningGuidance (named ``name``) flying ``plan`` with the method's ``replan``, the
-    spec's period, re-plan period, time to go (and its fraction) and command lead (``options``:
-    the system's other arguments), connected to the navigation estimate; return it."""
+    guidance spec's period, re-plan period, time to go (and its fraction) and command lead
+    (``options``: the system's other arguments), connected to the navigation estimate; with the
+    spec's ``replan_model_scales``, an AccelerationRatioFilter (RATIO_SYSTEM) of the scenario's
+    nominal models gives the re-plans the lift and drag ratios the flight has shown. Return the
+    guidance system."""
+    spec = scenario.guidance
     system = builder.AddNamedSystem(name, ReplanningGuidance(
         plan, replan=replan, period=spec.period_s, replan_period=spec.replan_period_s,
         min_time_to_go=spec.replan_min_time_to_go_s, lead=spec.command_lead_s,
-        time_to_go_fraction=spec.replan_time_to_go_fraction or None, **spec.latency(), **options))
+        time_to_go_fraction=spec.replan_time_to_go_fraction or None, model_scales=spec.replan_model_scales,
+        **spec.latency(), **options))
     builder.Connect(plant.estimated_state, system.GetInputPort("estimated_state"))
+    if spec.replan_model_scales:
+        ratios = builder.AddNamedSystem(RATIO_SYSTEM, AccelerationRatioFilter(
+            scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere(), period=spec.period_s))
+        builder.Connect(plant.estimated_state, ratios.GetInputPort("estimated_state"))
+        builder.Connect(plant.flight_conditions, ratios.GetInputPort("flight_conditions"))
+        builder.Connect(system.GetOutputPort("alpha_command"), ratios.GetInputPort("alpha_command"))
+        builder.Connect(ratios.GetOutputPort("ratios"), system.GetInputPort("model_scales"))
     return system
 
 

@@ -144,6 +144,10 @@ class ReplanningSpec(ReplansOnBoard):
     # the re-plan period shrinks to this fraction of the time to go (never below period_s; 0:
     # every replan_period_s): re-plans come closer together as the end nears
     replan_time_to_go_fraction: float = 0.0
+    # re-plans predict with the nominal lift and drag times the low-passed ratios of the sensed to
+    # the modelled accelerations (a density, aerodynamic or mass error the flight has shown;
+    # models.acceleration_ratios)
+    replan_model_scales: bool = False
     # between re-plans the commands track the plan in use: "tvlqr" (a time-varying LQR of the
     # plan's linearised dynamics, planning.tracking; the plans are then verified flown with it)
     # or "none" (its controls in time only; a method may offer more: FEEDBACKS);

@@ -3,13 +3,17 @@ drag accelerations (the accelerometer's) to the nominal models' at the estimated
 
 A guidance that predicts with its nominal models scales them by these ratios (lift by k_L,
 drag by k_D: ``ScaledAero``), so a density, aerodynamic or mass error seen so far is carried
-into the prediction. Used by paper 004's on-board re-solution and paper 002's re-solves.
+into the prediction. Used by paper 004's on-board re-solution and the re-plans of paper 001's
+SCvx and paper 002's LGL guidance (``sensed_vehicle``).
 """
 from __future__ import annotations
 
+import dataclasses as dc
+
+from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.dynamics import aero_accelerations
 
-__all__ = ["RATIO_TIME_CONSTANT_S", "RATIO_MIN_DRAG", "filtered_ratios"]
+__all__ = ["RATIO_TIME_CONSTANT_S", "RATIO_MIN_DRAG", "SensedAero", "filtered_ratios", "sensed_vehicle"]
 
 #: time constant [s] of the low-pass, and the modelled drag [m/s^2] below which the ratios are
 #: not updated (thin air: the ratio is noise)
@@ -30,3 +34,17 @@ def filtered_ratios(ratios, x, alpha: float, lift: float, drag: float, vehicle, 
         return k_l, k_d
     w = min(1.0, step_s / RATIO_TIME_CONSTANT_S)
     return k_l + w * (lift / L - k_l), k_d + w * (drag / D - k_d)
+
+
+@dc.dataclass
+class SensedAero(ScaledAero):
+    """The nominal aerodynamics times the ratios a flight has sensed (``sensed_vehicle``)."""
+
+
+def sensed_vehicle(vehicle, scales):
+    """``vehicle`` predicting with its nominal lift and drag coefficients times ``scales`` =
+    (k_L, k_D), the ratios the flight has shown; a vehicle already so scaled (a plan re-planned
+    before) is scaled from its nominal coefficients, not compounded."""
+    nominal = vehicle.aero.base if isinstance(vehicle.aero, SensedAero) else vehicle.aero
+    k_l, k_d = (float(k) for k in scales)
+    return dc.replace(vehicle, aero=SensedAero(nominal, k_l, k_d))

@@ -1,6 +1,6 @@
 """Paper 002's terminal guidance as a GuidanceMethod.
 
-  estimate, sensed lift and drag --> AccelerationRatioFilter --ratios (k_L, k_D)--+
+  estimate, sensed lift and drag --> AccelerationRatioFilter --ratios (k_L, k_D)--+   (replanning_wiring)
   estimate --> ReplanningGuidance (the LGL solution's sigma(t), alpha(t) plus the offsets of   <--+
       its TVLQR; re-solves on the remaining horizon with the models
       scaled by k_L, k_D)                                   --bank_command--> (shared bank actuator)
@@ -24,11 +24,10 @@ from drake_entry.guidance.interface import (
 )
 from drake_entry.guidance.lgl_terminal.planner import LglPlan, actuation, feedback_maker, plan_terminal, replan
 from drake_entry.guidance.replanning_wiring import add_replanning_guidance, replanning_commands, replanning_record
-from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 
-__all__ = ["GUIDANCE_SYSTEM", "RATIO_SYSTEM", "LglTerminalMethod", "METHOD"]
+__all__ = ["GUIDANCE_SYSTEM", "LglTerminalMethod", "METHOD"]
 
-GUIDANCE_SYSTEM, RATIO_SYSTEM = "lgl_terminal_guidance", "acceleration_ratios"
+GUIDANCE_SYSTEM = "lgl_terminal_guidance"
 
 
 class LglTerminalMethod(GuidanceMethod):
@@ -39,18 +38,10 @@ class LglTerminalMethod(GuidanceMethod):
 
     def add_systems(self, builder, scenario, planner: LglPlan, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance
-        guidance = add_replanning_guidance(builder, GUIDANCE_SYSTEM, planner, replan, g, plant,
+        guidance = add_replanning_guidance(builder, GUIDANCE_SYSTEM, planner, replan, scenario, plant,
                                            first_replan=g.replan_start_s,
-                                           model_scales=g.replan_model_scales,
                                            feedback=feedback_maker(g.feedback),
                                            offset_limits=g.feedback_offset_limits())
-        if g.replan_model_scales:
-            ratios = builder.AddNamedSystem(RATIO_SYSTEM, AccelerationRatioFilter(
-                scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere(), period=g.period_s))
-            builder.Connect(plant.estimated_state, ratios.GetInputPort("estimated_state"))
-            builder.Connect(plant.flight_conditions, ratios.GetInputPort("flight_conditions"))
-            builder.Connect(guidance.GetOutputPort("alpha_command"), ratios.GetInputPort("alpha_command"))
-            builder.Connect(ratios.GetOutputPort("ratios"), guidance.GetInputPort("model_scales"))
         _, bank, alpha = planner.control_samples()
         act = actuation(planner.result.problem, g, bank[0], alpha[0])  # the actuators the plans are verified with
         commands = replanning_commands(guidance, ActuatorLimits(*act.alpha_bounds, act.alpha_rate_limit,

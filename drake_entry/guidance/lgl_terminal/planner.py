@@ -20,7 +20,7 @@ import math
 import numpy as np
 
 from drake_entry.errors import ScenarioError
-from drake_entry.models.aerodynamics import ScaledAero
+from drake_entry.models.acceleration_ratios import sensed_vehicle
 from drake_entry.models.verdict import box_text, breaches_text, check_limits
 from drake_entry.planning.neighbouring_optimal import neighbouring_optimal, without_odd_even_mode
 from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlqr
@@ -240,8 +240,7 @@ def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scal
     x_now[names.index("sigma")] = float(bank)
     problem = final_windows(r.problem, spec)
     if scales is not None:
-        nominal = scenario.make_vehicle()
-        problem = dc.replace(problem, vehicle=dc.replace(nominal, aero=ScaledAero(nominal.aero, *map(float, scales))))
+        problem = dc.replace(problem, vehicle=sensed_vehicle(scenario.make_vehicle(), scales))
     again = resolve_from(r, x_now, elapsed, problem=problem, nodes=replan_nodes(spec, r.final_time - elapsed), solver=spec.solver,
                          tolerance=spec.replan_tolerance, max_iterations=spec.max_iterations,
                          verifier=previous.verifier, progress=False)

@@ -1,6 +1,7 @@
 """Paper 001's guidance as a GuidanceMethod.
 
-  estimate --> ReplanningGuidance (the plan's sigma(t), alpha(t) or alpha(V); re-plans) --bank_command-->
+  estimate --> ReplanningGuidance (the plan's sigma(t), alpha(t) or alpha(V); re-plans, with the
+      sensed lift and drag ratios when replan_model_scales: replanning_wiring) --bank_command-->
       (shared bank actuator);   ReplanningGuidance --alpha_command--> (shared alpha actuator)
 
 The pre-flight plan (``make_planner``) is made once per mission from the scenario's entry
@@ -37,7 +38,8 @@ class ScvxMethod(GuidanceMethod):
     def add_systems(self, builder, scenario, planner: ScvxPlan, plant: PlantPorts) -> GuidanceCommands:
         g = scenario.guidance
         guidance = add_replanning_guidance(builder, GUIDANCE_SYSTEM, planner,
-                                           functools.partial(replan_from, settings=g.planner_settings()[1]), g, plant,
+                                           functools.partial(replan_from, settings=g.planner_settings()[1]), scenario,
+                                           plant,
                                            feedback=feedback_maker(g.feedback, g.feedback_state_weight),
                                            offset_limits=g.feedback_offset_limits())
         lo, hi = np.radians(g.alpha_bounds_deg)

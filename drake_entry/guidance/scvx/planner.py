@@ -15,6 +15,7 @@ from drake_entry.guidance.scvx.feedback import feedback_maker
 from drake_entry.guidance.scvx.guess import GlideGuess, glide_guess
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
+from drake_entry.models.acceleration_ratios import sensed_vehicle
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.dynamics import (
     STATE_NAMES,
@@ -414,14 +415,16 @@ _ENTRY_FIELDS = ("entry_altitude_m", "entry_longitude_deg", "entry_latitude_deg"
                  "entry_bank_deg", "entry_alpha_deg")
 
 
-def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float, *,
+def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float, scales=None, *,
                 settings: ScvxSettings | None = None) -> ScvxPlan:
     """Re-plan ``previous``'s mission from state ``x`` [h, lon, lat, V, gamma, psi] reached
     ``elapsed`` [s] into it, holding the bank and alpha being flown [rad] where they are
     states (the rate formulations): the same site, DRS box, limits, formulation and mesh,
     warm-started from the rest of the previous plan (its states and bank from ``elapsed`` to
     its t_f, the state at ``elapsed`` replaced by ``x``; the remaining time its t_f guess). A state outside the mission's bounds (e.g. gamma above
-    0.5 deg in a dispersed skip) is clipped into them for the new entry point."""
+    0.5 deg in a dispersed skip) is clipped into them for the new entry point. With ``scales`` =
+    (k_L, k_D), the lift and drag ratios the flight has shown, the plan predicts (and is verified)
+    with the nominal coefficients times them (models.acceleration_ratios.sensed_vehicle)."""
     p = previous.problem
     m = p.mission
     x = np.array(x, float)
@@ -440,6 +443,7 @@ def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float
     guess = GlideGuess(rest - rest[0], states, ref["bank"], math.nan, math.nan, True, alpha=ref["alpha"])
     if guess.final_time <= 0.0:
         raise ValueError(f"the previous plan has no time left at {elapsed:.1f} s (t_f {previous.final_time:.1f} s)")
-    return plan_entry(p.vehicle, p.planet, p.atmosphere, mission, problem_settings=p.settings,
+    vehicle = p.vehicle if scales is None else sensed_vehicle(p.vehicle, scales)
+    return plan_entry(vehicle, p.planet, p.atmosphere, mission, problem_settings=p.settings,
                       settings=settings, guess=guess, flight=previous.flight or FlightCheck(),
                       verifier=previous.verifier)

@@ -254,3 +254,26 @@ def test_the_report_lists_regime_errors_and_the_delivery_covariance():
     assert "| trim angle-of-attack error | 0 | Gaussian | 1σ 0.5 | deg |" in text
     assert "| entry speed (delivery covariance) | 0 | Gaussian, correlated | 1σ 10 | m/s |" in text
     assert "altitude-speed -0.80" in text
+
+
+def test_force_dispersions_name_what_changes_the_lift_or_drag():
+    """Only the entry and navigation dispersed (HORUS-2B): none. A density, aerodynamic or mass
+    scale whose distribution leaves 1 (a constant 1.02 too), a density wave, regimes with a sigma,
+    perturbations or winds are named; a constant scale of 1 is not."""
+    import dataclasses as dc
+
+    from pydrake.common import schema
+
+    from drake_entry.models.dispersions import AeroRegimeDispersionSpec, force_dispersions
+
+    assert force_dispersions(load_scenario("horus2b").dispersions) == []
+    spec = DispersionSpec(density_scale=schema.Gaussian(mean=1.0, stddev=0.05), lift_scale=1.0,
+                          drag_scale=schema.Deterministic(value=1.0), mass_scale=1.02)
+    assert force_dispersions(spec) == ["density_scale", "mass_scale"]
+    spec = dc.replace(DispersionSpec(), density_wave_amplitude=schema.Uniform(min=-0.01, max=0.01),
+                      aero_regimes=AeroRegimeDispersionSpec())
+    assert force_dispersions(spec) == ["density_wave_amplitude"]  # regimes without a sigma disperse nothing
+    spec.aero_regimes.drag_sigma = [0.0, 0.0, 0.05, 0.05]
+    assert force_dispersions(spec) == ["density_wave_amplitude", "aero_regimes"]
+    assert force_dispersions(load_scenario("capsule_lu2008").dispersions) == [
+        "density_scale", "lift_scale", "drag_scale", "mass_scale"]

@@ -46,7 +46,7 @@ from drake_entry.models.winds import WindProfile, WindSpec, WindyAtmosphere, dra
 __all__ = ["Scalar", "Vector", "EntryDispersionSpec", "AeroRegimeDispersionSpec", "ENTRY_TABLE_TO_SI", "MAX_AERO_SIGMA",
            "PERTURBATION_COLUMNS_KM", "AtmospherePerturbationSpec", "WindSpec",
            "InertialNavigationSpec",
-           "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate", "entry_spread"]
+           "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate", "entry_spread", "force_dispersions"]
 
 Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
 Vector = typing.Union[schema.DeterministicVectorX, schema.GaussianVectorX, schema.UniformVectorX]
@@ -343,6 +343,19 @@ def entry_spread(spec: DispersionSpec) -> np.ndarray:
     if spec.entry_covariance is not None:
         out = np.hypot(out, 3.0 * np.sqrt(np.maximum(np.diag(np.asarray(spec.entry_covariance, float)), 0.0)))
     return out
+
+
+def force_dispersions(spec: DispersionSpec) -> list[str]:
+    """The dispersions that make a sample's lift or drag differ from the nominal models' at the
+    same state (density, its waves and perturbations, winds, aerodynamic scales and regimes,
+    mass), by their field names; empty when only the entry and the navigation are dispersed."""
+    names = [name for name, nominal in (("density_scale", 1.0), ("lift_scale", 1.0), ("drag_scale", 1.0),
+                                        ("mass_scale", 1.0), ("density_wave_amplitude", 0.0))
+             if not _support_floor(getattr(spec, name)) == nominal == _support_ceiling(getattr(spec, name))]
+    regimes = spec.aero_regimes
+    if regimes is not None and (any(regimes.lift_sigma) or any(regimes.drag_sigma) or regimes.trim_alpha_sigma_deg):
+        names.append("aero_regimes")
+    return names + [name for name in ("atmosphere_perturbations", "winds") if getattr(spec, name) is not None]
 
 
 def validate(spec: DispersionSpec, where: str = "dispersions") -> None:

@@ -23,9 +23,10 @@ from drake_entry.guidance.derivation import (
     terminal_interface,
 )
 from drake_entry.guidance.scvx.spec import Scvx
+from drake_entry.models.dispersions import force_dispersions
 
 __all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW_KM", "AIM_TOLERANCE_KM",
-           "FEEDBACK", "REPLAN_PERIOD_S", "REPLAN_TIME_TO_GO_FRACTION", "REPLAN_MIN_TIME_TO_GO_S", "REPLAN_MODEL_SCALES",
+           "FEEDBACK", "REPLAN_PERIOD_S", "REPLAN_TIME_TO_GO_FRACTION", "REPLAN_MIN_TIME_TO_GO_S",
            "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "FINAL_DESCENT_DEG", "OBJECTIVE", "FORMULATION", "aim_window"]
 
 #: the plan's objective and formulation on another method's mission: the control effort (the
@@ -59,9 +60,11 @@ FEEDBACK = "tvlqr"
 #: by 8-30 km; paper 004's CAV-H by 20-67 km at the end of a 2450-s glide)
 REPLAN_PERIOD_S, REPLAN_TIME_TO_GO_FRACTION, REPLAN_MIN_TIME_TO_GO_S = 200.0, 0.4, 60.0
 #: re-plans predict with the lift and drag ratios the flight has shown (models.acceleration_ratios;
-#: not paper 001's, whose dispersions are the entry's): Lu 2014's CAV-H draws with 6 % more lift
-#: ended 223 and 259 km from the target with the nominal models, 4.4 and 4.5 km with the ratios
-REPLAN_MODEL_SCALES = True
+#: not paper 001's, whose dispersions are the entry's) where the mission disperses what changes
+#: the lift or drag (dispersions.force_dispersions): Lu 2014's CAV-H draws with 6 % more lift ended
+#: 223 and 259 km from the target with the nominal models, 4.4 and 4.5 km with the ratios. Where
+#: it disperses only the entry the ratios learn nothing but the alpha actuator's lag behind its
+#: command (HORUS-2B, 10 runs: 10/10 without them, 8/10 with, two flights' re-plans refused)
 #: the plan's speed window about the interface's speed where the box checks none (an open window
 #: let the plans arrive at the stop altitude at any speed, away from the interface's energy)
 INTERFACE_SPEED_WINDOW = 0.05
@@ -136,6 +139,7 @@ def derive(scenario) -> Derivation:
         raise CannotFly(f"the vehicle's dynamic-pressure limit closes the box's Mach window {mach_window} at every "
                         f"altitude of the box ({', '.join(f'{v:g}' for v in altitudes)} km)")
     first = aims[0]
+    forces = force_dispersions(scenario.dispersions)
     spec = Scvx(terminal_altitude_km=first["guidance.terminal_altitude_km"], terminal_mach=first["guidance.terminal_mach"],
                 final_altitude_m=first["guidance.final_altitude_m"],
                 final_altitude_margin_m=first["guidance.final_altitude_margin_m"],
@@ -148,7 +152,7 @@ def derive(scenario) -> Derivation:
                 alpha_deg=alpha_deg, alpha_speeds_m_s=alpha_speeds, alpha_bounds_deg=bounds,
                 replan_period_s=REPLAN_PERIOD_S, replan_min_time_to_go_s=REPLAN_MIN_TIME_TO_GO_S,
                 replan_time_to_go_fraction=REPLAN_TIME_TO_GO_FRACTION,
-                path_margin=round(1.0 - LIMIT_MARGIN, 4), feedback=FEEDBACK, replan_model_scales=REPLAN_MODEL_SCALES)
+                path_margin=round(1.0 - LIMIT_MARGIN, 4), feedback=FEEDBACK, replan_model_scales=bool(forces))
     load, _ = scenario.make_vehicle().limits.planned_load()
     choices = [
         Choice("guidance.final_mach_min, final_mach_max",
@@ -174,10 +178,12 @@ def derive(scenario) -> Derivation:
         Choice("guidance.replan_period_s, replan_time_to_go_fraction, replan_min_time_to_go_s",
                f"{REPLAN_PERIOD_S:g} s, {REPLAN_TIME_TO_GO_FRACTION:g}, {REPLAN_MIN_TIME_TO_GO_S:g} s",
                "re-planned on board as paper 001's scenario is, closer together near the end"),
-        Choice("guidance.replan_model_scales", REPLAN_MODEL_SCALES,
-               "re-plans predict with the nominal lift and drag times the ratios the flight has sensed (not paper "
-               "001's): with the nominal models alone Lu 2014's CAV-H draws ended 220-260 km from the target, with "
-               "the ratios 4.4-4.5 km"),
+        Choice("guidance.replan_model_scales", bool(forces),
+               f"the mission disperses {', '.join(forces)}: re-plans predict with the nominal lift and drag times the "
+               f"ratios the flight has sensed (with the nominal models alone two Lu 2014 CAV-H draws ended 220-260 km "
+               f"from the target, with the ratios 4.4-4.5 km)" if forces else
+               "the mission disperses nothing that changes the lift or drag: the ratios would learn only the alpha "
+               "actuator's lag (HORUS-2B: 10/10 without, 8/10 with)"),
         Choice("guidance.feedback", FEEDBACK,
                "between re-plans the commands track the plan (not paper 001's): without it the plan flown through "
                "the actuators drifts 5-37 km from itself over HORUS-2B's glide, with it 0.4 km"),

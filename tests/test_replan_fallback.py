@@ -295,3 +295,43 @@ def test_a_plan_whose_feedback_law_cannot_be_made_flies_on_its_own_and_is_counte
     context = guidance.GetMyContextFromRoot(simulator.get_context())
     assert guidance.GetOutputPort("bank_command").Eval(context)[0] == pytest.approx(2.0, abs=1e-15)
     assert guidance.memory(context).unfed == [0.0, 100.0]
+
+
+def test_a_swarm_resolution_without_a_root_in_sigma0_re_solves_sigma_f(monkeypatch):
+    """With end bounds, a sigma_0 re-solution that brackets no root (here at its 89-deg bound)
+    is followed by the sigma_f re-solution with that sigma_0 held; both fly from then on (the
+    sigma_f port), and a bracketed sigma_f counts as a good re-solution."""
+    import math
+
+    import drake_entry.systems.swarm_bank_guidance as swarm
+    from drake_entry.guidance.swarm_bank.search import Resolution, problem_from_scenario
+    from drake_entry.scenario import load_scenario
+
+    problem = problem_from_scenario(load_scenario("cav_h_paper004"))
+    held = []
+    monkeypatch.setattr(swarm, "resolve_sigma0", lambda here, previous_deg, bounds_deg: Resolution(89.0, False, -9e3, 24))
+
+    def end(here, sigma0_deg, bounds_deg):
+        held.append((sigma0_deg, tuple(bounds_deg), math.degrees(here.sigma_f)))
+        return Resolution(sigma0_deg, True, 0.0, 16, sigma_f_deg=72.5)
+
+    monkeypatch.setattr(swarm, "resolve_bank_end", end)
+    out = {}
+    for bounds in ((20.0, 85.0), None):
+        builder = DiagramBuilder()
+        guidance = builder.AddSystem(swarm.SwarmBankGuidance(problem, math.radians(58.0), period=1.0,
+                                                             replan_period=10.0, acceleration_scaling=False,
+                                                             end_bounds_deg=bounds))
+        for port, value in (("estimated_state", problem.x0),
+                            ("flight_conditions", np.ones(len(FLIGHT_CONDITION_NAMES))), ("bank_command", [0.5])):
+            builder.Connect(builder.AddSystem(ConstantVectorSource(np.asarray(value, float))).get_output_port(),
+                            guidance.GetInputPort(port))
+        simulator = Simulator(builder.Build())
+        simulator.AdvanceTo(12.5)
+        context = guidance.GetMyContextFromRoot(simulator.get_context())
+        out[bounds] = [math.degrees(guidance.GetOutputPort(p).Eval(context)[0]) for p in ("sigma0", "sigma_f")] + [
+            guidance.GetOutputPort("plan_stats").Eval(context)[1]]
+    assert held == [(89.0, (20.0, 85.0), pytest.approx(60.0))]  # once, from the planned sigma_f
+    assert out[(20.0, 85.0)] == pytest.approx([89.0, 72.5, 0.0])
+    # without end bounds the best sigma_0 flies, the re-solution counted without a root, sigma_f planned
+    assert out[None] == pytest.approx([89.0, 60.0, 1.0])

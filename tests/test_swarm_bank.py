@@ -87,6 +87,27 @@ def test_on_board_resolution_from_entry_recovers_the_planned_sigma0():
     assert r.bracketed and r.sigma0_deg == pytest.approx(SIGMA0_CASE1, abs=0.05) and r.trajectories <= 24
 
 
+def test_on_board_bank_end_resolution_zeroes_the_range_with_sigma0_held():
+    """With sigma_0 held at the planned root the sigma_f re-solution finds the planned 60 deg; held
+    3 deg off (a range error of kilometres), it finds the sigma_f whose predicted flight ends at
+    the range within 1 % of that error, in at most 3 populations."""
+    import math
+
+    from drake_entry.guidance.swarm_bank.evaluator import evaluate
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario, resolve_bank_end
+
+    problem = problem_from_scenario(_scenario())
+    at_root = resolve_bank_end(problem, SIGMA0_CASE1, (20.0, 85.0))
+    assert at_root.bracketed and at_root.sigma0_deg == SIGMA0_CASE1
+    assert at_root.sigma_f_deg == pytest.approx(60.0, abs=0.1) and at_root.trajectories <= 24
+    held = SIGMA0_CASE1 + 3.0
+    before = evaluate(problem, np.radians([held])).range_error_m[0]
+    off = resolve_bank_end(problem, held, (20.0, 85.0))
+    after = evaluate(problem, np.radians([held]), sigma_f=np.radians([off.sigma_f_deg])).range_error_m[0]
+    assert off.bracketed and abs(before) > 5e3 and abs(after) < 0.01 * abs(before), (before, after)
+    assert not math.isclose(off.sigma_f_deg, 60.0, abs_tol=1.0)
+
+
 def test_plan_names_violated_path_limits():
     """A sigma_0 whose flight breaks the dynamic-pressure limit is not a success, and the
     message says which limit, its peak, when and by how much on the Drake flight of its commands
@@ -238,7 +259,7 @@ def test_on_board_predictions_learn_the_lift_and_drag_the_flight_shows():
     simulator.AdvanceTo(300.0)  # 300 guidance periods; below 2 g the law holds alpha at its maximum
     memory = context.get_discrete_state(0).value()
     assert memory[0] == pytest.approx(p.alpha_max)
-    ratios = memory[-2:]
+    ratios = memory[4:6]  # the law memory (3), sigma_0, then k_L and k_D
     assert ratios == pytest.approx([1.04, 0.97], abs=1e-4)
 
 

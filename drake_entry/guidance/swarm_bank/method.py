@@ -189,7 +189,8 @@ class SwarmBankMethod(GuidanceMethod):
         guidance = builder.AddNamedSystem(GUIDANCE_SYSTEM, SwarmBankGuidance(
             p, math.radians(planner.sigma0_deg), period=g.period_s, replan_period=g.replan_period_s,
             replan_until_e=g.replan_until_e, bounds_deg=tuple(g.bank_start_bounds_deg),
-            acceleration_scaling=g.acceleration_scaling, **g.latency()))
+            acceleration_scaling=g.acceleration_scaling,
+            end_bounds_deg=tuple(g.bank_end_bounds_deg) if g.resolve_bank_end else None, **g.latency()))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
         reversal = add_bank_reversal(builder, scenario, plant, guidance.GetOutputPort("bank_magnitude"),
@@ -207,11 +208,12 @@ class SwarmBankMethod(GuidanceMethod):
         mine = system.GetMyContextFromRoot(context)
         plans, failed, wall = system.GetOutputPort("plan_stats").Eval(mine)
         sigma0 = math.degrees(system.GetOutputPort("sigma0").Eval(mine)[0])
+        sigma_f = math.degrees(system.GetOutputPort("sigma_f").Eval(mine)[0])
         unverified = "" if planner.success else f"the pre-flight plan is not verified: {planner.message}"
         return GuidanceSummary(planner.success, unverified, plans=int(plans), planning_wall_s=float(wall),
                                fields={"reversals": reversal_count(diagram, context),
                                        "sigma0_planned_deg": planner.sigma0_deg, "sigma0_final_deg": sigma0,
-                                       "sigma_f_deg": planner.sigma_f_deg,
+                                       "sigma_f_deg": planner.sigma_f_deg, "sigma_f_final_deg": sigma_f,
                                        "resolutions_unbracketed": int(failed)},
                                details=planner)
 

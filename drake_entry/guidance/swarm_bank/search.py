@@ -1,6 +1,7 @@
 """Searches for paper 004's sigma_0 (and optionally sigma_f): the paper's swarms (PIO, PSO) and
 the scipy baselines that answer whether a swarm is needed for one or two parameters, all on
-the same counted, vectorised objective; and the on-board re-solution of sigma_0.
+the same counted, vectorised objective; and the on-board re-solution of sigma_0 (and of sigma_f
+where sigma_0 alone cannot zero the range error).
 
 Angles are in degrees here (the paper's and the user's unit); the evaluator works in rad.
 
@@ -37,7 +38,7 @@ from drake_entry.guidance.swarm_bank.spec import SWARMS, swarm_trajectories
 from drake_entry.planning.progress import ProgressLine, wanted
 
 __all__ = ["BASELINES", "Objective", "SearchResult", "swarm_searches", "search", "Resolution", "resolve_sigma0",
-           "problem_from_scenario"]
+           "resolve_bank_end", "problem_from_scenario"]
 
 BASELINES = ("grid", "brentq", "secant", "bounded", "differential_evolution")
 
@@ -46,8 +47,11 @@ class Objective:
     """J (eq. 32) of positions in degrees, (m, 1) = sigma_0 or (m, 2) = (sigma_0, sigma_f),
     evaluated as one population; counts trajectories and keeps every evaluation."""
 
-    def __init__(self, problem: SwarmProblem, progress: ProgressLine | None = None, budget: int | None = None):
+    def __init__(self, problem: SwarmProblem, progress: ProgressLine | None = None, budget: int | None = None,
+                 sigma0_held_deg: float | None = None):
+        """``sigma0_held_deg``: the positions are sigma_f (m, 1), flown with this sigma_0 [deg]."""
         self.problem = problem
+        self.sigma0_held_deg = sigma0_held_deg
         self.trajectories = 0
         self.calls = 0
         self.log: list[tuple[np.ndarray, Evaluation]] = []
@@ -58,8 +62,11 @@ class Objective:
 
     def evaluate(self, X) -> Evaluation:
         X = np.atleast_2d(np.asarray(X, float))
-        sigma_f = np.radians(X[:, 1]) if X.shape[1] > 1 else None
-        ev = evaluate(self.problem, np.radians(X[:, 0]), sigma_f=sigma_f)
+        if self.sigma0_held_deg is not None:
+            ev = evaluate(self.problem, np.full(len(X), math.radians(self.sigma0_held_deg)), sigma_f=np.radians(X[:, 0]))
+        else:
+            sigma_f = np.radians(X[:, 1]) if X.shape[1] > 1 else None
+            ev = evaluate(self.problem, np.radians(X[:, 0]), sigma_f=sigma_f)
         self.trajectories += len(X)
         self.calls += 1
         self.log.append((X.copy(), ev))
@@ -217,12 +224,31 @@ def _bracketed_secant(f: Objective, lo: float, hi: float) -> str:
 @dc.dataclass
 class Resolution:
     """An on-board re-solution: sigma_0 [deg], whether a root of the signed range error was
-    bracketed, the predicted range error of the closest member when not [m], trajectories."""
+    bracketed, the predicted range error of the closest member when not [m], trajectories, and
+    sigma_f [deg] when it was re-solved too (``resolve_bank_end``; nan: unchanged)."""
 
     sigma0_deg: float
     bracketed: bool
     range_error_m: float
     trajectories: int
+    sigma_f_deg: float = math.nan
+
+
+def _root(f: Objective, previous: float, bounds_deg, width_deg: float, points: int, rounds: int):
+    """(the position zeroing the signed range error, bracketed, its range error [m]): grid rounds
+    of ``points`` positions, first within +-``width_deg`` of ``previous`` (the whole bounds when
+    that holds no sign change), then inside the bracket, then the secant of the bracket's ends;
+    without a sign change, the member with the smallest |range error|."""
+    lo_b, hi_b = bounds_deg
+    lo, hi = max(lo_b, previous - width_deg), min(hi_b, previous + width_deg)
+    found = _refine(f, np.linspace(lo, hi, points), points=points, rounds=rounds)
+    if found is None and (lo > lo_b or hi < hi_b):
+        found = _refine(f, np.linspace(lo_b, hi_b, 2 * points), points=points, rounds=rounds)
+    if found is None:
+        X, d, _, ok = _samples(f)
+        i = int(np.argmin(np.where(ok, np.abs(d), np.inf)))
+        return float(X[i]), False, float(d[i])
+    return _secant(found), True, 0.0
 
 
 def resolve_sigma0(problem: SwarmProblem, previous_deg: float, bounds_deg=(0.0, 89.0), *, width_deg: float = 6.0,
@@ -232,17 +258,20 @@ def resolve_sigma0(problem: SwarmProblem, previous_deg: float, bounds_deg=(0.0, 
     trajectories, first within +-``width_deg`` of the previous sigma_0 (the whole bounds when
     that holds no sign change), then inside the bracket, then the secant of the bracket's
     ends. Without a sign change the member with the smallest |range error| is kept."""
-    lo_b, hi_b = bounds_deg
     f = Objective(problem)
-    lo, hi = max(lo_b, previous_deg - width_deg), min(hi_b, previous_deg + width_deg)
-    found = _refine(f, np.linspace(lo, hi, points), points=points, rounds=rounds)
-    if found is None and (lo > lo_b or hi < hi_b):
-        found = _refine(f, np.linspace(lo_b, hi_b, 2 * points), points=points, rounds=rounds)
-    if found is None:
-        X, d, _, ok = _samples(f)
-        i = int(np.argmin(np.where(ok, np.abs(d), np.inf)))
-        return Resolution(float(X[i]), False, float(d[i]), f.trajectories)
-    return Resolution(_secant(found), True, 0.0, f.trajectories)
+    sigma0, bracketed, miss = _root(f, previous_deg, bounds_deg, width_deg, points, rounds)
+    return Resolution(sigma0, bracketed, miss, f.trajectories)
+
+
+def resolve_bank_end(problem: SwarmProblem, sigma0_deg: float, bounds_deg, *, width_deg: float = 6.0,
+                     points: int = 8, rounds: int = 3) -> Resolution:
+    """sigma_f [deg] in ``bounds_deg`` that zeroes the predicted signed range error with sigma_0
+    held at ``sigma0_deg`` (not the paper's: where sigma_0 alone brackets no root, typically at
+    its bound late in the flight, when eq. 17's weight on sigma_0 has shrunk with the energy
+    left), searched as ``resolve_sigma0`` searches sigma_0, from ``problem.sigma_f``."""
+    f = Objective(problem, sigma0_held_deg=sigma0_deg)
+    sigma_f, bracketed, miss = _root(f, math.degrees(problem.sigma_f), bounds_deg, width_deg, points, rounds)
+    return Resolution(sigma0_deg, bracketed, miss, f.trajectories, sigma_f_deg=sigma_f)
 
 
 # ---------------------------------------------------------------------------------------

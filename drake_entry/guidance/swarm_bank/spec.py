@@ -45,6 +45,10 @@ class SwarmBank(ReversingBankSpec, ReplansOnBoard):
     # sigma_f searched before flight with sigma_0 in these bounds [deg] (None: bank_end_deg, fixed;
     # paper 004's two-parameter search), then held while sigma_0 is re-solved on board
     bank_end_bounds_deg: typing.Optional[list[float]] = None
+    # on board, where a re-solution's sigma_0 brackets no root of the range error (at its bound:
+    # late in the flight eq. 17's weight on sigma_0 has shrunk), sigma_f is re-solved within
+    # bank_end_bounds_deg with that sigma_0 held (not the paper's; needs bank_end_bounds_deg)
+    resolve_bank_end: bool = False
     # alpha law: 'load' (Case 1, eq. 31), 'heat' (Case 2: eq. 21 until Mach < mach_shift) or
     # 'schedule' (alpha_deg at alpha_velocity_m_s, linear in speed: another method's alpha profile)
     alpha_law: str = "load"
@@ -96,6 +100,9 @@ class SwarmBank(ReversingBankSpec, ReplansOnBoard):
         if self.bank_start_deg is not None:
             check_range("guidance.bank_start_deg", self.bank_start_deg, 0.0, 90.0)
         check_range("guidance.bank_end_deg", self.bank_end_deg, 0.0, bank_limit)
+        if self.resolve_bank_end and self.bank_end_bounds_deg is None:
+            raise ScenarioError("guidance.resolve_bank_end re-solves sigma_f within bank_end_bounds_deg: give "
+                                "bank_end_bounds_deg [lower, upper] (deg), or set resolve_bank_end false")
         if self.bank_end_bounds_deg is not None:
             if len(self.bank_end_bounds_deg) != 2 or not self.bank_end_bounds_deg[0] < self.bank_end_bounds_deg[1]:
                 raise ScenarioError(f"guidance.bank_end_bounds_deg = {self.bank_end_bounds_deg} needs [lower, upper] "

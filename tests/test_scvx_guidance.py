@@ -2,7 +2,9 @@
 the mission it builds from the scenario and the guidance system against its plan (the closed
 loop and a campaign: example 09's test)."""
 import dataclasses as dc
+import math
 
+import numpy as np
 import pytest
 
 from drake_entry.errors import ScenarioError
@@ -103,6 +105,10 @@ def test_scvx_derived_for_horus2b_ends_its_plans_where_the_flight_stops_below_th
         q_mach = math.sqrt(2.0 * q_max / float(atmosphere.density(h * 1e3))) / float(atmosphere.speed_of_sound(h * 1e3))
         assert t.mach - t.mach_tolerance <= c["guidance.final_mach_min"] < c["guidance.final_mach_max"] < q_mach
         assert c["guidance.final_mach_min"] <= c["guidance.terminal_mach"] <= c["guidance.final_mach_max"]
+        # the flown plan is judged up to the q-limited window it aims inside, plus half its own width
+        window = c["guidance.final_mach_max"] - c["guidance.final_mach_min"]
+        assert c["guidance.final_mach_max"] + c["guidance.flown_mach_margin"] == pytest.approx(
+            min(t.mach + t.mach_tolerance, q_mach) + 0.5 * window, abs=2e-4)
     assert q_mach < t.mach + t.mach_tolerance
 
 
@@ -150,6 +156,31 @@ def test_scvx_derived_where_the_box_checks_no_speed_aims_at_the_interface_speed_
     for c in d.search[0].candidates:
         assert c["guidance.final_mach_min"] == pytest.approx(mach * (1 - half), abs=1e-4)
         assert c["guidance.final_mach_max"] == pytest.approx(mach * (1 + half), abs=1e-4)
+        assert c["guidance.flown_mach_margin"] == pytest.approx(mach * (INTERFACE_SPEED_WINDOW - half) + mach * half,
+                                                              abs=2e-4)
     spec = d.spec
     assert (spec.replan_period_s, spec.replan_time_to_go_fraction, spec.replan_min_time_to_go_s) == (200.0, 0.4, 60.0)
     assert tuple(spec.flight_path_bounds_deg) == FLIGHT_PATH_BOUNDS_DEG == (-45.0, 5.0)
+
+
+def test_a_flown_plan_is_judged_up_to_its_mach_margin_and_a_heading_a_turn_away_is_the_same():
+    """drs_point's Mach criterion is final_mach_max plus the mission's flown margin (Lu 2014's
+    CAV-H: a plan flown to Mach 6.83 against its 6.82 aim was refused); a re-plan's heading past
+    the entry heading + 180 deg is taken a turn lower where that lies in the bounds."""
+    from drake_entry.guidance.scvx.mission import ScvxMission
+    from drake_entry.guidance.scvx.planner import drs_point, equivalent_heading
+    from drake_entry.models.planet import Earth
+
+    planet = Earth.spherical()
+    m = ScvxMission(final_altitude_m=(27.5e3, 28.5e3), final_mach_min=6.49, final_mach_max=6.82,
+                    final_vertical_speed_min_m_s=-300.0, site_radius_m=2.5e3)
+    xf = np.array([28e3, *m.site(planet), 2000.0, -0.02, 0.0])
+    assert drs_point(m, planet, xf, 6.80, 3e3)[1] and not drs_point(m, planet, xf, 6.83, 3e3)[1]
+    assert drs_point(dc.replace(m, flown_mach_margin=0.33), planet, xf, 6.83, 3e3)[1]
+    with pytest.raises(Exception, match="flown_mach_margin"):
+        dc.replace(m, flown_mach_margin=-0.1)
+    bounds = np.radians([-141.4332, 218.5668])
+    assert equivalent_heading(math.radians(221.27), bounds) == pytest.approx(math.radians(221.27 - 360.0))
+    assert equivalent_heading(math.radians(100.0), bounds) == pytest.approx(math.radians(100.0))
+    narrow = np.radians([0.0, 90.0])
+    assert equivalent_heading(math.radians(200.0), narrow) == pytest.approx(math.radians(200.0))  # none inside

@@ -49,6 +49,8 @@ class ScvxMission:
         (``drs_altitude_window``).
       final_mach_max: largest DRS Mach number (eq. 65: subsonic).
       final_mach_min: smallest DRS Mach number (0 in paper 001; a TAEM box's lower edge).
+      flown_mach_margin: a plan's flown DRS point may exceed final_mach_max by this (0 in paper
+        001): where the plan aims inside a narrower window than the mission's box checks.
       final_vertical_speed_min_m_s: lowest V sin(gamma) at the DRS point [m/s] (eq. 66).
       final_vertical_speed_max_m_s: highest V sin(gamma) there [m/s], or None (paper 001: none);
         planned, not checked on the flown DRS point (a design aim, not a box criterion).
@@ -76,6 +78,7 @@ class ScvxMission:
     final_altitude_margin_m: float | None = None
     final_mach_max: float = 1.0
     final_mach_min: float = 0.0
+    flown_mach_margin: float = 0.0
     final_vertical_speed_min_m_s: float = -140.0
     final_vertical_speed_max_m_s: float | None = None
     flight_path_bounds_deg: tuple = (-30.0, 0.5)
@@ -104,6 +107,7 @@ class ScvxMission:
         check("site_radius_m", self.site_radius_m, 1.0, SITE_RADIUS_MAX_M, "m")
         check("final_mach_max", self.final_mach_max, 0.1, 10.0, "-")
         check("final_mach_min", self.final_mach_min, 0.0, self.final_mach_max, "- (below final_mach_max)")
+        check("flown_mach_margin", self.flown_mach_margin, 0.0, 10.0, "-")
         check("final_vertical_speed_min_m_s", self.final_vertical_speed_min_m_s, -2000.0, 0.0, "m/s")
         if self.final_vertical_speed_max_m_s is not None:
             check("final_vertical_speed_max_m_s", self.final_vertical_speed_max_m_s, self.final_vertical_speed_min_m_s,

@@ -37,7 +37,7 @@ from drake_entry.planning.verification import (
 __all__ = ["GAP_LIFT_FRACTION", "BETWEEN_NODE_TOLERANCE", "POINTS_PER_SEGMENT", "PROPAGATION_TOLERANCE_M",
            "OBJECTIVE_METRIC", "ScvxPlan", "plan_metrics",
            "plan_controls", "PlanFlight", "flown_check", "drs_point", "plan_path_limits", "terminal_distance",
-           "plan_entry", "replan_from"]
+           "plan_entry", "equivalent_heading", "replan_from"]
 
 #: the lossless gap is judged where the lift can act: L >= this fraction of g0
 GAP_LIFT_FRACTION = 0.05
@@ -292,13 +292,14 @@ def flown_check(plan: ScvxPlan, flown: FlownControls) -> PlanFlight:
 def drs_point(mission: ScvxMission, planet: Earth, xf, mach: float, site_tolerance_m: float) -> tuple[dict, bool]:
     """The flown DRS point of a final state ``xf`` at Mach ``mach``: (geodetic altitude [m],
     Mach, vertical speed [m/s], site miss [m]) and whether it is inside the DRS box (eqs. 64-68:
-    the altitude window, Mach, vertical speed, the site within ``site_tolerance_m``; a vertical
-    speed's upper bound is the plan's design aim, not a box criterion)."""
+    the altitude window, Mach up to final_mach_max plus the mission's flown_mach_margin, vertical
+    speed, the site within ``site_tolerance_m``; a vertical speed's upper bound is the plan's
+    design aim, not a box criterion)."""
     drs = {"altitude_m": float(planet.atmospheric_altitude(xf[0], xf[2])), "mach": float(mach),
            "vertical_speed_m_s": float(xf[3] * math.sin(xf[4])),
            "site_miss_m": float(planet.great_circle_distance(xf[1], xf[2], *mission.site(planet)))}
     inside = (mission.final_altitude_m[0] <= drs["altitude_m"] <= mission.final_altitude_m[1]
-              and drs["mach"] <= mission.final_mach_max
+              and drs["mach"] <= mission.final_mach_max + mission.flown_mach_margin
               and drs["vertical_speed_m_s"] >= mission.final_vertical_speed_min_m_s
               and drs["site_miss_m"] <= site_tolerance_m)
     return drs, bool(inside)
@@ -415,6 +416,16 @@ _ENTRY_FIELDS = ("entry_altitude_m", "entry_longitude_deg", "entry_latitude_deg"
                  "entry_bank_deg", "entry_alpha_deg")
 
 
+def equivalent_heading(psi: float, bounds) -> float:
+    """``psi`` [rad] or the same direction a whole turn away, whichever lies in ``bounds`` [rad]
+    (a glide's heading drifts past a bound measured from the entry heading; as a direction it
+    may still be inside); ``psi`` itself when none does."""
+    for turn in (0.0, -2.0 * math.pi, 2.0 * math.pi):
+        if bounds[0] <= psi + turn <= bounds[1]:
+            return float(psi + turn)
+    return float(psi)
+
+
 def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float, scales=None, *,
                 settings: ScvxSettings | None = None) -> ScvxPlan:
     """Re-plan ``previous``'s mission from state ``x`` [h, lon, lat, V, gamma, psi] reached
@@ -422,13 +433,15 @@ def replan_from(previous: ScvxPlan, x, elapsed: float, bank: float, alpha: float
     states (the rate formulations): the same site, DRS box, limits, formulation and mesh,
     warm-started from the rest of the previous plan (its states and bank from ``elapsed`` to
     its t_f, the state at ``elapsed`` replaced by ``x``; the remaining time its t_f guess). A state outside the mission's bounds (e.g. gamma above
-    0.5 deg in a dispersed skip) is clipped into them for the new entry point. With ``scales`` =
+    0.5 deg in a dispersed skip) is clipped into them for the new entry point, and a heading past
+    its bounds taken a whole turn away when that is inside (``equivalent_heading``). With ``scales`` =
     (k_L, k_D), the lift and drag ratios the flight has shown, the plan predicts (and is verified)
     with the nominal coefficients times them (models.acceleration_ratios.sensed_vehicle)."""
     p = previous.problem
     m = p.mission
     x = np.array(x, float)
     x[4] = np.clip(x[4], *np.radians(m.flight_path_bounds_deg))
+    x[5] = equivalent_heading(x[5], np.radians(m.heading_bounds_deg))
     fields = {k: v for k, v in dc.asdict(m).items() if k not in _ENTRY_FIELDS}
     f = p.formulation
     if f.bank == "rate":

@@ -38,6 +38,9 @@ class Scvx(ReplanningSpec):
     final_mach_max: float = 1.0
     # the DRS point's lowest Mach (0: paper 001's subsonic DRS has none; a TAEM box's lower edge)
     final_mach_min: float = 0.0
+    # a plan's flown DRS Mach may exceed final_mach_max by this (0: paper 001's; a derived plan
+    # aims inside the box's window, and the box is what the flight is judged by)
+    flown_mach_margin: float = 0.0
     final_vertical_speed_min_m_s: float = -140.0
     # the DRS point's highest vertical speed [m/s] (None: paper 001's box has none; a glider's
     # derived box asks a definite descent, so that the altitude stop falls where the plan ends)

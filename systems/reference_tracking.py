@@ -34,6 +34,7 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.guidance.ampi.spec import TRACKING_INDICES
+from drake_entry.models.dynamics import specific_energy
 
 __all__ = ["LAW_STATES", "TrackerMemory", "ReferenceTracker"]
 
@@ -72,7 +73,7 @@ class ReferenceTracker(LeafSystem):
         if index not in TRACKING_INDICES:
             raise ScenarioError(f"ReferenceTracker.index = '{index}'; allowed: {', '.join(TRACKING_INDICES)}")
         self.lead, self.index = float(lead), index
-        self._planet = planner.problem.planet.with_(j2=0.0)
+        self._planet = planner.problem.planet.with_(j2=0.0)  # central gravity: the closed loop's stop
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self._memory = self.DeclareAbstractState(AbstractValue.Make(TrackerMemory()))
         self._bank = self.DeclareDiscreteState(BasicVector([float(initial_bank)]))
@@ -95,16 +96,12 @@ class ReferenceTracker(LeafSystem):
             return
         energy = None
         if self.index == "energy":  # non-increasing, so that every energy reads one time
-            energy = np.minimum.accumulate(self._energy(ref.law.states[:, 0], ref.law.states[:, 3]))
+            energy = np.minimum.accumulate(specific_energy(ref.law.states.T, self._planet))
         memory = TrackerMemory(ref, energy=energy)
         state.get_mutable_abstract_state(int(self._memory)).set_value(memory)
         s = self._clock(context, memory)
         sigma0 = float(np.clip(ref.law.state(s + self.lead)[6], -self.bank_limit, self.bank_limit))
         state.get_mutable_discrete_state(self._bank).SetFromVector([sigma0])
-
-    def _energy(self, h, V):
-        """E = V^2/2 - mu/r [J/kg] (central gravity, the closed loop's stop)."""
-        return 0.5 * V * V - self._planet.mu / self._planet.radius(h)
 
     def _clock(self, context, memory: TrackerMemory) -> float:
         """The reference time [s] the law is read at now."""
@@ -113,7 +110,7 @@ class ReferenceTracker(LeafSystem):
         x = self.est_port.Eval(context)
         law = memory.reference.law
         # np.interp needs increasing abscissae: the energy falls along the reference
-        return float(np.interp(-self._energy(x[0], x[3]), -memory.energy, law.time))
+        return float(np.interp(-specific_energy(x, self._planet), -memory.energy, law.time))
 
     def _update(self, context, discrete_state):
         memory = self.memory(context)

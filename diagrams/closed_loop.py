@@ -205,6 +205,8 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
         builder.Connect(commands.alpha, alpha.get_input_port())
         alpha_out = alpha.GetOutputPort("alpha")
     builder.Connect(alpha_out, plant.GetInputPort("alpha"))
+    for sink in commands.alpha_sinks:
+        builder.Connect(alpha_out, sink)
     # altitudes of the stop and the floor are geodetic with altitude_datum 'ellipsoid'
     stop = ({"altitude": g.terminal_altitude_km * 1e3} if g.stops_at_altitude
             else {"energy": setup.terminal[2], "altitude": ALTITUDE_FLOOR_M})

@@ -19,14 +19,25 @@ reference time where its energy E = V^2/2 - mu/r (central gravity) equals the es
 reference would ask the altitude and speed of a later state it has not reached; read in energy
 the law compares states of the same energy, and the clock's deviation is zero.
 
+With ``model_scales`` the tracker also reads the lift and drag ratios the flight has sensed,
+k_L and k_D (systems/acceleration_ratios.py), and flies the reference the flight's own air and
+aerodynamics call for: the reference altitude raised by H ln k_D (H the density scale height
+there), where the sensed drag equals the reference's, so that the range flown per unit of energy
+(dR/dE = -cos(gamma) / (D/m)) is the reference's; and the feed-forward bank with
+cos(sigma_ff) = cos(sigma_ref) k_D / k_L, the reference's vertical lift at that altitude. A
+plan made at the entry with the nominal models (paper 003's) otherwise asks a denser or draggier
+flight for the nominal altitude, and the range it loses per unit of energy is the drag's excess.
+
 Ports:
   - input  "estimated_state"  [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
+  - input  "model_scales"     [2]  (model_scales only) k_L, k_D sensed
   - output "bank_command"     [1]  sigma_c [rad]
   - output "reference_state"  [7]  the reference [h m, lon, lat rad, V m/s, gamma, psi, sigma rad] now
 """
 from __future__ import annotations
 
 import dataclasses as dc
+import math
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -36,10 +47,27 @@ from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.guidance.ampi.spec import TRACKING_INDICES
 from drake_entry.models.dynamics import specific_energy
 
-__all__ = ["LAW_STATES", "TrackerMemory", "ReferenceTracker"]
+__all__ = ["LAW_STATES", "SCALE_HEIGHT_STEP_M", "TrackerMemory", "ReferenceTracker", "sensed_reference"]
 
 #: the reference problem's state layout the law is written in
 LAW_STATES = ("h", "lon", "lat", "V", "gamma", "psi", "sigma", "t")
+#: the altitude step [m] of the density scale height's central difference
+SCALE_HEIGHT_STEP_M = 100.0
+
+
+def sensed_reference(h_ref: float, sigmas, scales, density) -> tuple[float, list[float]]:
+    """(the altitude [m], the bank angles [rad]) a flight whose sensed lift and drag are
+    ``scales`` = (k_L, k_D) times the nominal models' flies for a reference at altitude
+    ``h_ref`` [m] with bank angles ``sigmas`` [rad]: the altitude h where k_D rho(h) =
+    rho(h_ref), h_ref + H ln k_D with the local scale height H of ``density`` (altitude [m] ->
+    kg/m^3); each bank with cos(sigma) = cos(sigma_ref) k_D / k_L (clipped to [-1, 1]), its
+    sign kept."""
+    k_l, k_d = (float(k) for k in scales)
+    step = SCALE_HEIGHT_STEP_M
+    H = 2.0 * step / math.log(density(h_ref - step) / density(h_ref + step))
+    h = h_ref + H * math.log(k_d)
+    ratio = k_d / k_l
+    return h, [math.copysign(math.acos(min(max(math.cos(s) * ratio, -1.0), 1.0)), s) for s in sigmas]
 
 
 @dc.dataclass(frozen=True)
@@ -54,12 +82,14 @@ class TrackerMemory:
 
 class ReferenceTracker(LeafSystem):
     def __init__(self, planner, *, bank_limit: float, rate_limit: float, period: float = 0.5,
-                 initial_bank: float = 0.0, lead: float = 0.0, index: str = "time"):
+                 initial_bank: float = 0.0, lead: float = 0.0, index: str = "time", density=None):
         """Args: planner with reference(estimate) -> TrackedReference and ``problem.state_names``
         == LAW_STATES; bank_limit [rad], rate_limit [rad/s] of the command; period [s];
         initial_bank [rad] (held when no reference can be made); lead [s]: the feed-forward is
         the reference bank this far ahead, the lag of the actuator loop the command drives;
-        index: 'time' or 'energy', what the reference is read at (module docstring)."""
+        index: 'time' or 'energy', what the reference is read at (module docstring); density:
+        the nominal atmosphere's density [kg/m^3] at an altitude [m], given to read the
+        reference at the sensed lift and drag ratios (input "model_scales", module docstring)."""
         super().__init__()
         if tuple(planner.problem.state_names) != LAW_STATES:
             raise ScenarioError(f"ReferenceTracker needs a reference with states {LAW_STATES} (controls 'bank_rate'), "
@@ -75,6 +105,10 @@ class ReferenceTracker(LeafSystem):
         self.lead, self.index = float(lead), index
         self._planet = planner.problem.planet.with_(j2=0.0)  # central gravity: the closed loop's stop
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
+        self.density = density
+        self.scales_port = None if density is None else self.DeclareVectorInputPort("model_scales", 2)
+        if density is not None:  # the ratios of the last update (its feed-forward's)
+            self._scales = self.DeclareDiscreteState(BasicVector([1.0, 1.0]))
         self._memory = self.DeclareAbstractState(AbstractValue.Make(TrackerMemory()))
         self._bank = self.DeclareDiscreteState(BasicVector([float(initial_bank)]))
         self.DeclareInitializationUnrestrictedUpdateEvent(self._start)
@@ -122,6 +156,13 @@ class ReferenceTracker(LeafSystem):
         law = ref.law
         ff_now, ff_next = law.state(t + lead)[6], law.state(t + T + lead)[6]
         x_ref = law.state(t)
+        if self.scales_port is not None:  # the offset carried is the command's from the last feed-forward
+            scales = np.asarray(self.scales_port.Eval(context), float)
+            before = context.get_discrete_state(self._scales).get_value()
+            x_ref = x_ref.copy()
+            x_ref[0], (ff_next, x_ref[6]) = sensed_reference(x_ref[0], (ff_next, x_ref[6]), scales, self.density)
+            ff_now = sensed_reference(x_ref[0], (ff_now,), before, self.density)[1][0]
+            discrete_state.get_mutable_vector(self._scales).SetFromVector(scales)
         # the bank deviation is the command's from the feed-forward (the reference bank
         # ``lead`` seconds ahead, which the lagging actuator delivers now)
         x = np.concatenate([self.est_port.Eval(context), [x_ref[6] + sigma - ff_now, t]])

@@ -152,6 +152,66 @@ def test_tracker_reads_its_reference_at_the_clock_or_at_the_estimates_energy(pla
         ReferenceTracker(planner, bank_limit=1.0, rate_limit=0.1, index="range")
 
 
+def test_sensed_reference_raises_the_altitude_to_the_reference_drag_and_keeps_the_vertical_lift():
+    """In an exponential atmosphere (scale height 7 km) the altitude is h_ref + H ln k_D exactly,
+    where k_D rho(h) = rho(h_ref); each bank gives k_L cos(sigma) rho(h) = cos(sigma_ref)
+    rho(h_ref), its sign kept; nominal ratios change nothing."""
+    from drake_entry.systems.reference_tracking import sensed_reference
+
+    H = 7000.0
+
+    def density(h):
+        return 1.2 * math.exp(-h / H)
+
+    h, (s1, s2) = sensed_reference(40e3, (0.9, -0.4), (1.06, 1.04), density)
+    assert h == pytest.approx(40e3 + H * math.log(1.04), abs=1e-6)
+    assert 1.04 * density(h) == pytest.approx(density(40e3), rel=1e-12)
+    for s, ref in ((s1, 0.9), (s2, -0.4)):
+        assert 1.06 * math.cos(s) * density(h) == pytest.approx(math.cos(ref) * density(40e3), rel=1e-12)
+        assert math.copysign(1.0, s) == math.copysign(1.0, ref)
+    assert sensed_reference(40e3, (0.9,), (1.0, 1.0), density) == (pytest.approx(40e3), [pytest.approx(0.9)])
+    # more drag than lift asks more vertical lift than a bank can give: wings level
+    assert sensed_reference(40e3, (0.1,), (0.8, 1.3), density)[1] == [0.0]
+
+
+def test_tracker_at_nominal_ratios_commands_what_it_commands_without_them(planner):
+    """One update at the reference's state where it banks most (read in energy): the port "model_scales" at
+    (1, 1) leaves the command unchanged; more sensed lift than drag (1.1, 1.0) turns the bank
+    further from wings level, keeping the reference's vertical lift (1.1 cos(sigma) = cos(sigma_ref))."""
+    from pydrake.systems.analysis import Simulator
+
+    from drake_entry.models.atmosphere import make_atmosphere
+    from drake_entry.systems.reference_tracking import ReferenceTracker
+
+    density = make_atmosphere("us76").density
+    x0 = [planner.problem.initial[n] for n in ("h", "lon", "lat", "V", "gamma", "psi")]
+    banks = {}
+    for scales in (None, (1.0, 1.0), (1.1, 1.0)):
+        tracker = ReferenceTracker(planner, bank_limit=math.radians(85), rate_limit=math.radians(500),
+                                   index="energy", density=None if scales is None else density)
+        ctx = tracker.CreateDefaultContext()
+        port = tracker.GetInputPort("estimated_state")
+        port.FixValue(ctx, x0)
+        if scales is not None:
+            tracker.GetInputPort("model_scales").FixValue(ctx, scales)
+        Simulator(tracker, ctx).Initialize()
+        law = tracker.memory(ctx).reference.law
+        t = float(law.time[np.argmax(np.abs(law.states[:, 6]))])  # where the reference banks most
+        port.FixValue(ctx, law.state(t)[:6])
+        bank = tracker.GetOutputPort("bank_command")
+        for k in range(ctx.num_discrete_state_groups()):  # the command at the reference's bank then
+            if ctx.get_discrete_state(k).size() == 1:
+                ctx.SetDiscreteState(k, [law.state(t + tracker.lead)[6]])
+        ctx.SetDiscreteState(tracker.EvalUniquePeriodicDiscreteUpdate(ctx))
+        banks[scales] = float(bank.Eval(ctx)[0])
+    assert abs(banks[None]) > math.radians(5.0), banks
+    assert banks[(1.0, 1.0)] == pytest.approx(banks[None], abs=1e-9)
+    # at the reference's state the feedback is nil: the command is the feed-forward, scaled
+    assert 1.1 * math.cos(banks[(1.1, 1.0)]) == pytest.approx(math.cos(banks[None]), abs=1e-9), banks
+    assert abs(banks[(1.1, 1.0)]) > abs(banks[None]) + math.radians(2.0), banks
+    assert not ReferenceTracker(planner, bank_limit=1.0, rate_limit=0.1).HasInputPort("model_scales")
+
+
 @pytest.mark.parametrize("field, value, message", [
     ("reference", "best", "guidance.reference = 'best'; allowed: ampi, ntt"),
     ("database", "nowhere.npz", "guidance.database 'nowhere.npz' is neither a packaged database"),

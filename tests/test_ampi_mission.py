@@ -84,6 +84,12 @@ def test_derived_settings_grid_the_deviations_that_move_the_end_most():
     assert d.spec.terminal_scales[1] == pytest.approx(math.degrees(200.0 / 6378137.0), rel=2e-3)
     _, capsule = _derived("capsule_lu2008")
     assert set(capsule.spec.grid) == {"lat", "lon", "psi"}
+    # the reading of the reference searched; the sensed ratios only where the air or aerodynamics
+    # are dispersed (the capsule's density, C_L, C_D, mass; HORUS-2B's entry alone)
+    assert [step.name for step in d.search] == ["guidance.tracking_index"]
+    assert [step.name for step in capsule.search] == ["guidance.tracking_index", "guidance.model_scales"]
+    assert capsule.search[1].candidates == ({"guidance.model_scales": False}, {"guidance.model_scales": True})
+    assert "density_scale, lift_scale, drag_scale, mass_scale" in capsule.search[1].why
     assert derivation_for(load_scenario("shefex3_ampi"), Ampi).spec.database == "shefex3"  # its own settings
     with pytest.raises(CannotFly, match="box asks alpha 0 \\+- 2 deg"):
         derivation_for(load_scenario("marv_guidance"), Ampi)

@@ -72,6 +72,8 @@ class GuidanceCommands:
         ``alpha_limits``; None = the scenario's alpha schedule flies the vehicle.
       initial_bank, initial_alpha: [rad] what the actuators hold until the first command.
       logged: signals to log, by name.
+      alpha_sinks: input ports of the method's systems that the closed loop feeds with the
+        angle of attack flown [rad] (e.g. a filter of the sensed lift and drag ratios).
     """
 
     bank: OutputPort
@@ -80,6 +82,7 @@ class GuidanceCommands:
     initial_bank: float = 0.0
     initial_alpha: float = 0.0
     logged: dict[str, LoggedSignal] = dc.field(default_factory=dict)
+    alpha_sinks: tuple = ()
 
 
 @dc.dataclass

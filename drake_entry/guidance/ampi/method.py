@@ -3,6 +3,8 @@
   estimate --> ReferenceTracker (at entry: the database reference for the measured state,
       AMPI or NTT, and its TVLQR; then sigma_c' = u_ref - K (x - x_ref)) --bank_command-->
       (shared bank actuator);   alpha: the scenario's schedule (Table 2)
+  with ``model_scales``: estimate, sensed lift and drag, alpha flown --> AccelerationRatioFilter
+      --k_L, k_D--> ReferenceTracker (the reference read at the sensed ratios)
 
 The planner (``make_planner``) loads the database once per mission and checks it (every case
 verified, none out of line with its neighbours); each flight makes its own reference at
@@ -16,6 +18,8 @@ from drake_entry.guidance.ampi.mission import built_database
 from drake_entry.guidance.ampi.reference import DatabaseReference
 from drake_entry.guidance.ampi.spec import MISSION_DATABASE
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
+from drake_entry.guidance.replanning_wiring import RATIO_SYSTEM
+from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 from drake_entry.systems.reference_tracking import ReferenceTracker
 
 __all__ = ["GUIDANCE_SYSTEM", "AmpiMethod", "METHOD"]
@@ -36,17 +40,27 @@ class AmpiMethod(GuidanceMethod):
                                       gain_samples=g.gain_samples)
 
     def add_systems(self, builder, scenario, planner: DatabaseReference, plant: PlantPorts) -> GuidanceCommands:
-        vehicle = scenario.make_vehicle()
+        vehicle, g = scenario.make_vehicle(), scenario.guidance
         bank0 = float(planner.evaluate([0.0])["sigma"][0])
+        atmosphere = scenario.make_atmosphere() if g.model_scales else None
         tracker = builder.AddNamedSystem(GUIDANCE_SYSTEM, ReferenceTracker(
             planner, bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit,
-            period=scenario.guidance.period_s, initial_bank=bank0,
-            lead=scenario.guidance.bank_lead_s, index=scenario.guidance.tracking_index))
+            period=g.period_s, initial_bank=bank0, lead=g.bank_lead_s, index=g.tracking_index,
+            density=None if atmosphere is None else atmosphere.density))
         builder.Connect(plant.estimated_state, tracker.GetInputPort("estimated_state"))
+        sinks = ()
+        if g.model_scales:
+            ratios = builder.AddNamedSystem(RATIO_SYSTEM, AccelerationRatioFilter(
+                vehicle, scenario.make_planet(), atmosphere, period=g.period_s))
+            builder.Connect(plant.estimated_state, ratios.GetInputPort("estimated_state"))
+            builder.Connect(plant.flight_conditions, ratios.GetInputPort("flight_conditions"))
+            builder.Connect(ratios.GetOutputPort("ratios"), tracker.GetInputPort("model_scales"))
+            sinks = (ratios.GetInputPort("alpha_command"),)
         return GuidanceCommands(
             bank=tracker.GetOutputPort("bank_command"), initial_bank=bank0,
             logged={"reference_state": LoggedSignal(tracker.GetOutputPort("reference_state"), (
-                "h_ref_m", "lon_ref_rad", "lat_ref_rad", "V_ref_m_s", "gamma_ref_rad", "psi_ref_rad", "bank_ref_rad"))})
+                "h_ref_m", "lon_ref_rad", "lat_ref_rad", "V_ref_m_s", "gamma_ref_rad", "psi_ref_rad", "bank_ref_rad"))},
+            alpha_sinks=sinks)
 
     def summarise(self, diagram, context, planner: DatabaseReference) -> GuidanceSummary:
         system = diagram.GetSubsystemByName(GUIDANCE_SYSTEM)

@@ -92,6 +92,10 @@ class Ampi(GuidanceSpecBase):
     # what the tracker reads the reference at: 'time' (the flight's clock, paper 003's) or
     # 'energy' (the reference time of the estimate's energy; systems/reference_tracking.py)
     tracking_index: str = "time"
+    # read the reference at the lift and drag ratios the flight has sensed (the altitude where
+    # the sensed drag is the reference's, the bank that gives its vertical lift there;
+    # systems/reference_tracking.py); off: the reference as planned with the nominal models
+    model_scales: bool = False
 
     def _validate_mission_fields(self) -> None:
         from drake_entry.guidance.ampi.grid import PARAMETERS

@@ -2,8 +2,8 @@
 
 1. AMPI's settings derived from the mission (`database: mission`): the problem it poses, the grid
    of the entry deviations that move the end most, the LD nodes, the tracker's weights, and the
-   search that chooses whether the tracker reads the reference in time or in energy (the nominal
-   and two dispersed flights with each).
+   search that chooses whether the tracker reads the reference in time or in energy, then whether
+   at the lift and drag ratios the flight senses (the nominal and two dispersed flights with each).
 2. The database built for the mission (every case an NLP solve, verified) and cached, and its
    references against fresh solves of three entries drawn like the campaign's (AMPI against the
    nearest entry, NTT).
@@ -116,6 +116,10 @@ def check(r: dict, quick: bool = False) -> Claims:
     dispersed = r["campaigns"]["as the mission disperses"]
     c.check("the search flew both readings of the reference", {t.values["guidance.tracking_index"] for t in
             r["derived"].trials} == {"time", "energy"}, r["derived"].chosen["guidance.tracking_index"])
+    c.check("the search flew the reference as planned and read at the sensed lift and drag ratios (the mission "
+            "disperses them)", {t.values["guidance.model_scales"] for t in r["derived"].trials
+                                if "guidance.model_scales" in t.values} == {False, True},
+            r["derived"].chosen["guidance.model_scales"])
     c.check("with the mission's density and aerodynamic dispersions fewer flights succeed (one reference made at "
             "the entry)", dispersed["success"].sum() < entry_only["success"].sum(),
             f"{int(dispersed['success'].sum())} of {len(dispersed)}")

@@ -21,12 +21,14 @@ the law compares states of the same energy, and the clock's deviation is zero.
 
 With ``model_scales`` the tracker also reads the lift and drag ratios the flight has sensed,
 k_L and k_D (systems/acceleration_ratios.py), and flies the reference the flight's own air and
-aerodynamics call for: the reference altitude raised by H ln k_D (H the density scale height
-there), where the sensed drag equals the reference's, so that the range flown per unit of energy
-(dR/dE = -cos(gamma) / (D/m)) is the reference's; and the feed-forward bank with
-cos(sigma_ff) = cos(sigma_ref) k_D / k_L, the reference's vertical lift at that altitude. A
-plan made at the entry with the nominal models (paper 003's) otherwise asks a denser or draggier
-flight for the nominal altitude, and the range it loses per unit of energy is the drag's excess.
+aerodynamics call for (``sensed_reference``): the state of the reference's energy where the
+sensed drag equals the reference's (the altitude moved by about H ln k_D, H the density scale
+height, less at low speed where the speed traded for that altitude changes the drag too), so
+that the range flown per unit of energy, dR/dE = -cos(gamma) / (D/m), is the reference's; and
+the feed-forward bank with cos(sigma_ff) = cos(sigma_ref) k_D / k_L, the reference's vertical
+lift there. A plan made at the entry with the nominal models (paper 003's) otherwise asks a
+denser or draggier flight for the nominal altitude, and the range it loses per unit of energy
+is the drag's excess.
 
 Ports:
   - input  "estimated_state"  [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
@@ -55,19 +57,22 @@ LAW_STATES = ("h", "lon", "lat", "V", "gamma", "psi", "sigma", "t")
 SCALE_HEIGHT_STEP_M = 100.0
 
 
-def sensed_reference(h_ref: float, sigmas, scales, density) -> tuple[float, list[float]]:
-    """(the altitude [m], the bank angles [rad]) a flight whose sensed lift and drag are
-    ``scales`` = (k_L, k_D) times the nominal models' flies for a reference at altitude
-    ``h_ref`` [m] with bank angles ``sigmas`` [rad]: the altitude h where k_D rho(h) =
-    rho(h_ref), h_ref + H ln k_D with the local scale height H of ``density`` (altitude [m] ->
-    kg/m^3); each bank with cos(sigma) = cos(sigma_ref) k_D / k_L (clipped to [-1, 1]), its
-    sign kept."""
+def sensed_reference(h_ref: float, V_ref: float, sigmas, scales, density, gravity: float) -> tuple[float, float, list[float]]:
+    """(the altitude [m], the speed [m/s], the bank angles [rad]) a flight whose sensed lift and
+    drag are ``scales`` = (k_L, k_D) times the nominal models' flies for a reference at altitude
+    ``h_ref`` [m] and speed ``V_ref`` [m/s] with bank angles ``sigmas`` [rad]: the state of the
+    reference's energy (V^2/2 + g h, ``gravity`` g [m/s^2]) where the sensed drag is the
+    reference's, k_D rho(h) V^2 = rho(h_ref) V_ref^2, to first order in ln k_D: h = h_ref + dh,
+    dh = ln k_D / (1/H + 2 g / V_ref^2) with the local scale height H of ``density`` (altitude
+    [m] -> kg/m^3), V^2 = V_ref^2 - 2 g dh; each bank with cos(sigma) = cos(sigma_ref) k_D / k_L
+    (the reference's vertical lift; clipped to [-1, 1]), its sign kept."""
     k_l, k_d = (float(k) for k in scales)
     step = SCALE_HEIGHT_STEP_M
     H = 2.0 * step / math.log(density(h_ref - step) / density(h_ref + step))
-    h = h_ref + H * math.log(k_d)
+    dh = math.log(k_d) / (1.0 / H + 2.0 * gravity / (V_ref * V_ref))
+    V = math.sqrt(max(V_ref * V_ref - 2.0 * gravity * dh, 0.0))
     ratio = k_d / k_l
-    return h, [math.copysign(math.acos(min(max(math.cos(s) * ratio, -1.0), 1.0)), s) for s in sigmas]
+    return h_ref + dh, V, [math.copysign(math.acos(min(max(math.cos(s) * ratio, -1.0), 1.0)), s) for s in sigmas]
 
 
 @dc.dataclass(frozen=True)
@@ -159,9 +164,10 @@ class ReferenceTracker(LeafSystem):
         if self.scales_port is not None:  # the offset carried is the command's from the last feed-forward
             scales = np.asarray(self.scales_port.Eval(context), float)
             before = context.get_discrete_state(self._scales).get_value()
-            x_ref = x_ref.copy()
-            x_ref[0], (ff_next, x_ref[6]) = sensed_reference(x_ref[0], (ff_next, x_ref[6]), scales, self.density)
-            ff_now = sensed_reference(x_ref[0], (ff_now,), before, self.density)[1][0]
+            x_ref, g = x_ref.copy(), self._planet.mu / self._planet.radius(x_ref[0]) ** 2
+            x_ref[0], x_ref[3], (ff_next, x_ref[6]) = sensed_reference(x_ref[0], x_ref[3], (ff_next, x_ref[6]), scales,
+                                                                       self.density, g)
+            ff_now = sensed_reference(x_ref[0], x_ref[3], (ff_now,), before, self.density, g)[2][0]
             discrete_state.get_mutable_vector(self._scales).SetFromVector(scales)
         # the bank deviation is the command's from the feed-forward (the reference bank
         # ``lead`` seconds ahead, which the lagging actuator delivers now)

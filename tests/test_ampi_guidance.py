@@ -152,26 +152,33 @@ def test_tracker_reads_its_reference_at_the_clock_or_at_the_estimates_energy(pla
         ReferenceTracker(planner, bank_limit=1.0, rate_limit=0.1, index="range")
 
 
-def test_sensed_reference_raises_the_altitude_to_the_reference_drag_and_keeps_the_vertical_lift():
-    """In an exponential atmosphere (scale height 7 km) the altitude is h_ref + H ln k_D exactly,
-    where k_D rho(h) = rho(h_ref); each bank gives k_L cos(sigma) rho(h) = cos(sigma_ref)
-    rho(h_ref), its sign kept; nominal ratios change nothing."""
+def test_sensed_reference_is_the_state_of_the_reference_energy_with_the_reference_drag():
+    """In an exponential atmosphere (scale height 7 km): the state keeps the reference's energy
+    V^2/2 + g h; its drag k_D rho V^2 is the reference's, to 1e-6 at orbital speed and to second
+    order in ln k_D at 400 m/s (where the altitude moves less than H ln k_D: the speed it trades
+    changes the drag too); each bank gives k_L cos(sigma) rho V^2 = cos(sigma_ref) rho_ref
+    V_ref^2, its sign kept; nominal ratios change nothing."""
     from drake_entry.systems.reference_tracking import sensed_reference
 
-    H = 7000.0
+    H, g = 7000.0, 9.7
 
     def density(h):
         return 1.2 * math.exp(-h / H)
 
-    h, (s1, s2) = sensed_reference(40e3, (0.9, -0.4), (1.06, 1.04), density)
-    assert h == pytest.approx(40e3 + H * math.log(1.04), abs=1e-6)
-    assert 1.04 * density(h) == pytest.approx(density(40e3), rel=1e-12)
-    for s, ref in ((s1, 0.9), (s2, -0.4)):
-        assert 1.06 * math.cos(s) * density(h) == pytest.approx(math.cos(ref) * density(40e3), rel=1e-12)
-        assert math.copysign(1.0, s) == math.copysign(1.0, ref)
-    assert sensed_reference(40e3, (0.9,), (1.0, 1.0), density) == (pytest.approx(40e3), [pytest.approx(0.9)])
+    for V_ref, tolerance in ((7000.0, 1e-6), (400.0, 2e-3)):
+        h, V, (s1, s2) = sensed_reference(40e3, V_ref, (0.9, -0.4), (1.06, 1.04), density, g)
+        assert 0.5 * V * V + g * h == pytest.approx(0.5 * V_ref ** 2 + g * 40e3, rel=1e-12)
+        drag = density(40e3) * V_ref ** 2
+        assert 1.04 * density(h) * V * V == pytest.approx(drag, rel=tolerance)
+        assert 0.0 < h - 40e3 <= H * math.log(1.04) + 1e-9
+        for s, ref in ((s1, 0.9), (s2, -0.4)):
+            assert 1.06 * math.cos(s) == pytest.approx(1.04 * math.cos(ref), rel=1e-12)
+            assert math.copysign(1.0, s) == math.copysign(1.0, ref)
+    assert h - 40e3 < 0.6 * H * math.log(1.04)  # at 400 m/s
+    assert sensed_reference(40e3, 400.0, (0.9,), (1.0, 1.0), density, g) == (
+        pytest.approx(40e3), pytest.approx(400.0), [pytest.approx(0.9)])
     # more drag than lift asks more vertical lift than a bank can give: wings level
-    assert sensed_reference(40e3, (0.1,), (0.8, 1.3), density)[1] == [0.0]
+    assert sensed_reference(40e3, 400.0, (0.1,), (0.8, 1.3), density, g)[2] == [0.0]
 
 
 def test_tracker_at_nominal_ratios_commands_what_it_commands_without_them(planner):

@@ -243,3 +243,38 @@ def test_flight_path_effort_is_gamma_over_its_scale_squared():
     assert p.lagrangian(X, U) == pytest.approx(2.0 * (X[4] / math.radians(1.0)) ** 2, rel=1e-12)
     with pytest.raises(ScenarioError, match="scale = 0.0 must be finite and > 0"):
         ObjectiveTerm("flight_path_effort", scale=0.0)
+
+
+def test_centred_bank_effort_measures_the_bank_magnitude_from_its_centre():
+    """bank_centre c: ((sqrt(sigma^2 + 1 deg^2) - c) / bank_max)^2 + the rate term, the same on
+    either side of the plan; c = 0 is paper 003's (sigma / bank_max)^2; its gradient matches
+    central differences (the NLP differentiates it); c at or above bank_max is refused."""
+    from pydrake.autodiffutils import AutoDiffXd
+
+    from drake_entry.planning.ocp import BANK_SMOOTHING, ObjectiveTerm
+
+    problem, _ = load_problem("shefex3")
+    c, bmax, umax = math.radians(30.0), math.radians(60.0), math.radians(5.0)
+    p = dc.replace(problem, objective=[ObjectiveTerm("bank_effort", bank_max=bmax, u_sigma_max=umax, bank_centre=c,
+                                                     rate_weight=0.1)])
+    plain = dc.replace(problem, objective=[ObjectiveTerm("bank_effort", bank_max=bmax, u_sigma_max=umax,
+                                                         rate_weight=0.1)])
+    rate = 0.1 * (U[0] / umax) ** 2
+    for sigma in (0.0, c, -c, math.radians(50.0), -math.radians(50.0)):
+        x = np.array(X, float)
+        x[6] = sigma
+        expected = ((math.sqrt(sigma ** 2 + BANK_SMOOTHING ** 2) - c) / bmax) ** 2 + rate
+        assert p.lagrangian(x, U) == pytest.approx(expected, rel=1e-12)
+        assert plain.lagrangian(x, U) == pytest.approx((sigma / bmax) ** 2 + rate, rel=1e-12)
+    assert p.lagrangian(np.where(np.arange(len(X)) == 6, c, X), U) - rate < 1e-4  # at the centre, nearly free
+    x = np.array(X, float)
+    x[6] = math.radians(12.0)
+    ad = np.array([AutoDiffXd(v, np.eye(len(x))[i]) for i, v in enumerate(x)], dtype=object)
+    grad = p.lagrangian(ad, U).derivatives()
+    for i in range(len(x)):
+        step = np.zeros(len(x))
+        step[i] = 1e-6
+        fd = (p.lagrangian(x + step, U) - p.lagrangian(x - step, U)) / 2e-6
+        assert grad[i] == pytest.approx(fd, rel=1e-5, abs=1e-9)
+    with pytest.raises(ScenarioError, match="bank_centre = 60 deg; allowed 0 to below bank_max"):
+        ObjectiveTerm("bank_effort", bank_max=bmax, bank_centre=bmax)

@@ -51,6 +51,8 @@ PATH_QUANTITIES = {  # name -> (FlightConditions field, unit)
     # (Scenario.guidance_terminal_state), without the J2 term of FlightConditions.energy
     "central_energy": (None, "J/kg"),
 }
+#: the smoothing of |sigma| in a centred bank effort [rad]
+BANK_SMOOTHING = math.radians(1.0)
 LAGRANGE_KINDS = ("control_margin", "bank_effort", "flight_path_effort", "heat_load", "lagrange")
 MAYER_KINDS = ("final_time", "miss_distance", "final_latitude", "final_crossrange", "final_velocity",
                "terminal_deviation", "mayer")
@@ -108,7 +110,11 @@ class ObjectiveTerm:
                       + k2 (u_alpha/u_alpha_max)^2 + k3 (u_sigma/u_sigma_max)^2 [1/s]
       bank_effort     (sigma/bank_max)^2 + rate_weight (u_sigma/u_sigma_max)^2 [1/s] (bank a
                       state: controls 'rates' or 'bank_rate'); a unique minimiser among the
-                      bankings that meet hard terminal conditions (paper 003 database)
+                      bankings that meet hard terminal conditions (paper 003 database). With
+                      ``bank_centre`` > 0 [rad] the first term is ((|sigma|_s - bank_centre) /
+                      bank_max)^2, |sigma|_s = sqrt(sigma^2 + BANK_SMOOTHING^2) (smooth): the
+                      least deviation of the bank's magnitude from the centre, so that a tracker
+                      has lift to shed and to gain on either side of the plan
       flight_path_effort  (gamma/scale)^2 [1/s], ``scale`` in rad: damps the phugoid, so that
                       a long glide's least-bank flight does not skip (a mission's AMPI database)
       heat_load       heat flux [W/m^2] (J = heat load [J/m^2])
@@ -136,6 +142,7 @@ class ObjectiveTerm:
     function: Callable | None = None
     bank_max: float = math.radians(60.0)
     rate_weight: float = 0.1
+    bank_centre: float = 0.0
     reference: dict | None = None
     weights: dict | None = None
     units: str = "si"
@@ -165,6 +172,9 @@ class ObjectiveTerm:
                     raise ScenarioError(f"objective 'bank_effort': {name} = {getattr(self, name)} must be finite and > 0")
             if not 0 <= self.rate_weight < math.inf:
                 raise ScenarioError(f"objective 'bank_effort': rate_weight = {self.rate_weight} must be finite and >= 0")
+            if not 0 <= self.bank_centre < self.bank_max:
+                raise ScenarioError(f"objective 'bank_effort': bank_centre = {math.degrees(self.bank_centre):g} deg; "
+                                    f"allowed 0 to below bank_max ({math.degrees(self.bank_max):g} deg)")
         if self.kind == "terminal_deviation":
             if not self.weights or not self.reference:
                 raise ScenarioError("objective 'terminal_deviation' needs weights and reference {state: value}")
@@ -492,6 +502,8 @@ class OptimalControlProblem(_ProblemLayout):
                      + k3 * (u[1] / term.u_sigma_max) ** 2)
             elif term.kind == "bank_effort":
                 sigma, rate = self.bank_and_rate(x, u)
+                if term.bank_centre > 0.0:
+                    sigma = np.sqrt(sigma * sigma + BANK_SMOOTHING ** 2) - term.bank_centre
                 v = (sigma / term.bank_max) ** 2 + term.rate_weight * (rate / term.u_sigma_max) ** 2
             elif term.kind == "flight_path_effort":
                 v = (x[4] / term.scale) ** 2

@@ -97,6 +97,7 @@ class ObjectiveSpec:
     scale: float = 1.0
     bank_max_deg: float = 60.0  # bank_effort
     rate_weight: float = 0.1  # bank_effort
+    bank_centre_deg: float = 0.0  # bank_effort: the bank magnitude the effort is measured from
     # terminal_deviation (paper 003 eq. 1): state field (altitude_km, ...) -> reference / weight
     reference: Dict[str, float] = dc.field(default_factory=dict)
     weights: Dict[str, float] = dc.field(default_factory=dict)
@@ -271,6 +272,7 @@ def problem_from_spec(spec: ProblemSpec) -> OptimalControlProblem:
                                        u_alpha_max=math.radians(o.alpha_rate_max_deg_s),
                                        u_sigma_max=math.radians(o.bank_rate_max_deg_s), target=target, scale=o.scale,
                                        bank_max=math.radians(o.bank_max_deg), rate_weight=o.rate_weight,
+                                       bank_centre=math.radians(o.bank_centre_deg),
                                        reference=_deviation_fields(f"objective[{i}].reference", o.reference,
                                                                    convert=True) or None,
                                        weights=_deviation_fields(f"objective[{i}].weights", o.weights,

@@ -66,6 +66,8 @@ FLIGHT_PATH_SCALE_DEG, FLIGHT_PATH_WEIGHT = 1.0, 1.0
 BANK_FRACTION, BANK_RATE_FRACTION = 0.9, 0.25
 #: the bank-rate term's weight in the bank-effort objective (problems/shefex3.yaml's)
 RATE_WEIGHT = 0.1
+#: the bank magnitude the bank effort is measured from, as a fraction of the planned bank bound
+BANK_CENTRE_FRACTION = 0.5
 #: the NLP's optimality tolerance (problems/shefex3.yaml's). The transcription is Hermite-Simpson
 #: with mesh refinement from the spec's nodes: HORUS-2B's 1400-s glide on 100 nodes was converged
 #: but inaccurate (0.0043 between the nodes on 160 dircol nodes; 0.015 on 4 LGL segments of 121
@@ -121,7 +123,7 @@ def mission_problem_spec(spec, scenario) -> ProblemSpec:
         terminal=[PathSpec(quantity="central_energy", min=E_f, max=E_f),
                   PathSpec(quantity="geodetic_altitude", min=h_f - window, max=h_f + window, scale=1.0e4)],
         objective=[ObjectiveSpec(kind="bank_effort", bank_max_deg=bank, bank_rate_max_deg_s=rate,
-                                 rate_weight=RATE_WEIGHT),
+                                 rate_weight=RATE_WEIGHT, bank_centre_deg=BANK_CENTRE_FRACTION * bank),
                    ObjectiveSpec(kind="flight_path_effort", weight=FLIGHT_PATH_WEIGHT,
                                  scale=math.radians(FLIGHT_PATH_SCALE_DEG))],
         solve=SolveSpec(transcription="hermite_simpson", solver="auto", nodes=int(spec.nodes), tolerance=TOLERANCE,

@@ -347,6 +347,28 @@ def test_sensed_vehicle_scales_the_nominal_coefficients_once():
         (1.2 * cl, 0.5 * cd), rel=1e-14)
 
 
+def test_sensed_vehicle_holds_q_and_the_heat_rate_in_the_air_it_senses():
+    """Lift and drag sensed 1.2 and 1.1 times the nominal models': the density ratio assumed is
+    sqrt(1.2 * 1.1); the q limit is divided by it and the heat-rate limit by its root (the
+    models compute q and the heat rate with the nominal density), loads untouched; re-scaled
+    from the nominal limits, not compounded; thinner air than modelled never loosens them."""
+    from drake_entry.models.acceleration_ratios import sensed_density_ratio, sensed_vehicle
+    from drake_entry.scenario import load_scenario
+
+    nominal = load_scenario("cav_h_fnpeg").make_vehicle()
+    lim = nominal.limits
+    k = math.sqrt(1.2 * 1.1)
+    assert sensed_density_ratio((1.2, 1.1)) == pytest.approx(k, rel=1e-15)
+    dense = sensed_vehicle(nominal, (1.2, 1.1))
+    assert dense.limits.dynamic_pressure_max == pytest.approx(lim.dynamic_pressure_max / k, rel=1e-14)
+    assert dense.limits.heat_flux_max == pytest.approx(lim.heat_flux_max / math.sqrt(k), rel=1e-14)
+    assert (dense.limits.total_load_max, dense.limits.normal_load_max) == (lim.total_load_max, lim.normal_load_max)
+    again = sensed_vehicle(dense, (1.2, 1.1))
+    assert again.limits == dense.limits and nominal.limits == lim
+    assert sensed_vehicle(dense, (0.8, 0.9)).limits == lim  # thinner air: the nominal limits
+    assert sensed_density_ratio((1.3, 0.9)) == pytest.approx(math.sqrt(1.17), rel=1e-15)
+
+
 def test_compiled_actuator_path_is_the_actuator_law():
     """actuator_path (the form numba kernels call, compiled inline) gives integrate_actuator's
     positions and rates: a limited reversal, linear tracking, a settled actuator and a command

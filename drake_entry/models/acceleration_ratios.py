@@ -9,11 +9,13 @@ SCvx and paper 002's LGL guidance (``sensed_vehicle``).
 from __future__ import annotations
 
 import dataclasses as dc
+import math
 
 from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.dynamics import aero_accelerations
 
-__all__ = ["RATIO_TIME_CONSTANT_S", "RATIO_MIN_DRAG", "SensedAero", "filtered_ratios", "sensed_vehicle"]
+__all__ = ["RATIO_TIME_CONSTANT_S", "RATIO_MIN_DRAG", "SensedAero", "filtered_ratios", "sensed_density_ratio",
+           "sensed_vehicle"]
 
 #: time constant [s] of the low-pass, and the modelled drag [m/s^2] below which the ratios are
 #: not updated (thin air: the ratio is noise)
@@ -38,13 +40,34 @@ def filtered_ratios(ratios, x, alpha: float, lift: float, drag: float, vehicle, 
 
 @dc.dataclass
 class SensedAero(ScaledAero):
-    """The nominal aerodynamics times the ratios a flight has sensed (``sensed_vehicle``)."""
+    """The nominal aerodynamics times the ratios a flight has sensed (``sensed_vehicle``), and
+    the vehicle's nominal path limits (``nominal_limits``: what a re-scaling starts from)."""
+
+    nominal_limits: object = None
+
+
+def sensed_density_ratio(scales) -> float:
+    """The density ratio a guidance assumes from the sensed (k_L, k_D): their geometric mean (the
+    density multiplies both; independent coefficient errors cancel on average), never below 1
+    (thinner air than modelled only lowers q and the heat rate)."""
+    k_l, k_d = (float(k) for k in scales)
+    return max(1.0, math.sqrt(k_l * k_d))
 
 
 def sensed_vehicle(vehicle, scales):
     """``vehicle`` predicting with its nominal lift and drag coefficients times ``scales`` =
-    (k_L, k_D), the ratios the flight has shown; a vehicle already so scaled (a plan re-planned
-    before) is scaled from its nominal coefficients, not compounded."""
-    nominal = vehicle.aero.base if isinstance(vehicle.aero, SensedAero) else vehicle.aero
+    (k_L, k_D), the ratios the flight has shown, and its dynamic-pressure and heat-rate limits
+    divided by k_rho and sqrt(k_rho), k_rho = ``sensed_density_ratio``: the models compute q =
+    rho V^2 / 2 and the heat rate (proportional to sqrt(rho)) with the nominal density, so in air
+    k_rho times denser a plan held to the nominal limits flies k_rho times over its q. A vehicle
+    already so scaled (a plan re-planned before) is scaled from its nominal coefficients and
+    limits, not compounded."""
+    if isinstance(vehicle.aero, SensedAero):
+        nominal, limits = vehicle.aero.base, vehicle.aero.nominal_limits
+    else:
+        nominal, limits = vehicle.aero, vehicle.limits
     k_l, k_d = (float(k) for k in scales)
-    return dc.replace(vehicle, aero=SensedAero(nominal, k_l, k_d))
+    k_rho = sensed_density_ratio(scales)
+    sensed_limits = dc.replace(limits, dynamic_pressure_max=limits.dynamic_pressure_max / k_rho,
+                               heat_flux_max=limits.heat_flux_max / math.sqrt(k_rho))
+    return dc.replace(vehicle, aero=SensedAero(nominal, k_l, k_d, nominal_limits=limits), limits=sensed_limits)

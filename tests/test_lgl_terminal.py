@@ -234,3 +234,19 @@ def test_the_derived_horus_plan_is_verified_flown_with_its_feedback(horus_derive
     plan = plan_terminal(s, fly_controls, progress=False)
     assert plan.result.success and plan.success, plan.message
     assert plan.flight.box["distance"]["error"] < 200.0 and all(c.held for c in plan.flight.checks)
+
+
+def test_a_resolve_in_denser_air_holds_q_and_the_heat_rate_there():
+    """sensed_path: with lift and drag sensed 1.21 and 1.21 times the models' (air 21 % denser)
+    the q bound is divided by 1.21 and the heat-rate bound by 1.1; the load and a terminal-like
+    callable constraint are kept; thinner air keeps every bound."""
+    from drake_entry.guidance.lgl_terminal.planner import sensed_path
+    from drake_entry.planning.ocp import PathConstraint
+
+    path = [PathConstraint("heat_flux", max=5e5), PathConstraint("dynamic_pressure", max=3e4),
+            PathConstraint("total_load", max=3.0), PathConstraint(lambda x, u, env: x[0], max=1.0, name="h")]
+    dense = sensed_path(path, (1.21, 1.21))
+    assert dense[0].max == pytest.approx(5e5 / 1.1, rel=1e-14)
+    assert dense[1].max == pytest.approx(3e4 / 1.21, rel=1e-14)
+    assert dense[2] == path[2] and dense[3] is path[3]
+    assert sensed_path(path, (0.8, 0.9)) == path

@@ -15,7 +15,7 @@ from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.dynamics import aero_accelerations
 
 __all__ = ["RATIO_TIME_CONSTANT_S", "RATIO_MIN_DRAG", "SensedAero", "filtered_ratios", "sensed_density_ratio",
-           "sensed_vehicle"]
+           "sensed_limit_factors", "sensed_vehicle"]
 
 #: time constant [s] of the low-pass, and the modelled drag [m/s^2] below which the ratios are
 #: not updated (thin air: the ratio is noise)
@@ -54,6 +54,15 @@ def sensed_density_ratio(scales) -> float:
     return max(1.0, math.sqrt(k_l * k_d))
 
 
+def sensed_limit_factors(scales) -> dict:
+    """What the nominal models' q and heat-rate bounds are multiplied by to hold the limits in the
+    air the sensed (k_L, k_D) imply: 1/k_rho and 1/sqrt(k_rho), k_rho = ``sensed_density_ratio``
+    (q = rho V^2 / 2 and the heat rate, proportional to sqrt(rho), are computed with the nominal
+    density), by path quantity name."""
+    k_rho = sensed_density_ratio(scales)
+    return {"dynamic_pressure": 1.0 / k_rho, "heat_flux": 1.0 / math.sqrt(k_rho)}
+
+
 def sensed_vehicle(vehicle, scales):
     """``vehicle`` predicting with its nominal lift and drag coefficients times ``scales`` =
     (k_L, k_D), the ratios the flight has shown, and its dynamic-pressure and heat-rate limits
@@ -67,7 +76,7 @@ def sensed_vehicle(vehicle, scales):
     else:
         nominal, limits = vehicle.aero, vehicle.limits
     k_l, k_d = (float(k) for k in scales)
-    k_rho = sensed_density_ratio(scales)
-    sensed_limits = dc.replace(limits, dynamic_pressure_max=limits.dynamic_pressure_max / k_rho,
-                               heat_flux_max=limits.heat_flux_max / math.sqrt(k_rho))
+    factor = sensed_limit_factors(scales)
+    sensed_limits = dc.replace(limits, dynamic_pressure_max=limits.dynamic_pressure_max * factor["dynamic_pressure"],
+                               heat_flux_max=limits.heat_flux_max * factor["heat_flux"])
     return dc.replace(vehicle, aero=SensedAero(nominal, k_l, k_d, nominal_limits=limits), limits=sensed_limits)

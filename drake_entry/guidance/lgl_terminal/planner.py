@@ -20,13 +20,13 @@ import math
 import numpy as np
 
 from drake_entry.errors import ScenarioError
-from drake_entry.models.acceleration_ratios import sensed_vehicle
+from drake_entry.models.acceleration_ratios import sensed_limit_factors, sensed_vehicle
 from drake_entry.models.verdict import box_text, breaches_text, check_limits
 from drake_entry.planning.neighbouring_optimal import neighbouring_optimal, without_odd_even_mode
 from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlqr
 from drake_entry.planning.verification import Actuation, EntryControls, Tracking, require_verifier
 
-__all__ = ["SAMPLES_PER_S", "PlanFlight", "LglPlan", "feedback_weights", "feedback_maker", "actuation", "fly_plan",
+__all__ = ["SAMPLES_PER_S", "PlanFlight", "LglPlan", "feedback_weights", "feedback_maker", "actuation", "fly_plan", "sensed_path",
            "judged", "plan_terminal", "replan_nodes", "final_windows", "replan"]
 
 #: command samples per second of a plan (linear interpolation between them by the guidance)
@@ -220,14 +220,24 @@ def final_windows(problem, spec):
     return dc.replace(problem, final=final)
 
 
+def sensed_path(path, scales) -> list:
+    """The path constraints ``path`` with their q and heat-rate maxima held in the air the sensed
+    ratios ``scales`` = (k_L, k_D) imply (models.acceleration_ratios.sensed_limit_factors): the
+    problem computes both with the nominal density."""
+    factors = sensed_limit_factors(scales)
+    return [dc.replace(c, max=c.max * factors[c.quantity]) if isinstance(c.quantity, str) and c.quantity in factors
+            else c for c in path]
+
+
 def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scales=None) -> LglPlan:
     """Re-solve from the navigation state ``x`` [h, lon, lat, V, gamma, psi] reached ``elapsed`` [s]
     into ``previous``, with the bank and alpha being commanded [rad] as the initial alpha and
     sigma states (clipped into their bounds), on the horizon that remains, warm-started from
     ``previous`` (shrinking_horizon.resolve_from), aiming at the final speed and flight-path
     angle within the spec's re-solve windows (``final_windows``), with the nominal lift and drag
-    times ``scales`` = (k_L, k_D) when given (the sensed/modelled ratios); judged, with the same
-    models, as the pre-flight plan is."""
+    times ``scales`` = (k_L, k_D) when given (the sensed/modelled ratios) and the q and heat-rate
+    bounds held in the air they imply (``sensed_path``); judged, with the same models, as the
+    pre-flight plan is."""
     from drake_entry.planning.nlp.shrinking_horizon import resolve_from
 
     r, scenario = previous.result, previous.scenario
@@ -240,7 +250,8 @@ def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scal
     x_now[names.index("sigma")] = float(bank)
     problem = final_windows(r.problem, spec)
     if scales is not None:
-        problem = dc.replace(problem, vehicle=sensed_vehicle(scenario.make_vehicle(), scales))
+        problem = dc.replace(problem, vehicle=sensed_vehicle(scenario.make_vehicle(), scales),
+                             path=sensed_path(r.problem.path, scales))
     again = resolve_from(r, x_now, elapsed, problem=problem, nodes=replan_nodes(spec, r.final_time - elapsed), solver=spec.solver,
                          tolerance=spec.replan_tolerance, max_iterations=spec.max_iterations,
                          verifier=previous.verifier, progress=False)

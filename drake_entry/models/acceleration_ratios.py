@@ -55,12 +55,12 @@ def sensed_density_ratio(scales) -> float:
 
 
 def sensed_limit_factors(scales) -> dict:
-    """What the nominal models' q and heat-rate bounds are multiplied by to hold the limits in the
-    air the sensed (k_L, k_D) imply: 1/k_rho and 1/sqrt(k_rho), k_rho = ``sensed_density_ratio``
+    """What the nominal models' q and heat-rate bounds are divided by to hold the limits in the
+    air the sensed (k_L, k_D) imply: k_rho and sqrt(k_rho), k_rho = ``sensed_density_ratio``
     (q = rho V^2 / 2 and the heat rate, proportional to sqrt(rho), are computed with the nominal
     density), by path quantity name."""
     k_rho = sensed_density_ratio(scales)
-    return {"dynamic_pressure": 1.0 / k_rho, "heat_flux": 1.0 / math.sqrt(k_rho)}
+    return {"dynamic_pressure": k_rho, "heat_flux": math.sqrt(k_rho)}
 
 
 def sensed_vehicle(vehicle, scales):
@@ -76,7 +76,7 @@ def sensed_vehicle(vehicle, scales):
     else:
         nominal, limits = vehicle.aero, vehicle.limits
     k_l, k_d = (float(k) for k in scales)
-    factor = sensed_limit_factors(scales)
-    sensed_limits = dc.replace(limits, dynamic_pressure_max=limits.dynamic_pressure_max * factor["dynamic_pressure"],
-                               heat_flux_max=limits.heat_flux_max * factor["heat_flux"])
+    divisor = sensed_limit_factors(scales)
+    sensed_limits = dc.replace(limits, dynamic_pressure_max=limits.dynamic_pressure_max / divisor["dynamic_pressure"],
+                               heat_flux_max=limits.heat_flux_max / divisor["heat_flux"])
     return dc.replace(vehicle, aero=SensedAero(nominal, k_l, k_d, nominal_limits=limits), limits=sensed_limits)

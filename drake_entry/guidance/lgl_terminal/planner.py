@@ -224,8 +224,8 @@ def sensed_path(path, scales) -> list:
     """The path constraints ``path`` with their q and heat-rate maxima held in the air the sensed
     ratios ``scales`` = (k_L, k_D) imply (models.acceleration_ratios.sensed_limit_factors): the
     problem computes both with the nominal density."""
-    factors = sensed_limit_factors(scales)
-    return [dc.replace(c, max=c.max * factors[c.quantity]) if isinstance(c.quantity, str) and c.quantity in factors
+    divisors = sensed_limit_factors(scales)
+    return [dc.replace(c, max=c.max / divisors[c.quantity]) if isinstance(c.quantity, str) and c.quantity in divisors
             else c for c in path]
 
 

@@ -49,7 +49,8 @@ from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.guidance.ampi.spec import TRACKING_INDICES
 from drake_entry.models.dynamics import specific_energy
 
-__all__ = ["LAW_STATES", "SCALE_HEIGHT_STEP_M", "TrackerMemory", "ReferenceTracker", "sensed_reference"]
+__all__ = ["LAW_STATES", "SCALE_HEIGHT_STEP_M", "TrackerMemory", "ReferenceTracker", "sensed_reference",
+           "sensed_bank"]
 
 #: the reference problem's state layout the law is written in
 LAW_STATES = ("h", "lon", "lat", "V", "gamma", "psi", "sigma", "t")
@@ -66,13 +67,20 @@ def sensed_reference(h_ref: float, V_ref: float, sigmas, scales, density, gravit
     dh = ln k_D / (1/H + 2 g / V_ref^2) with the local scale height H of ``density`` (altitude
     [m] -> kg/m^3), V^2 = V_ref^2 - 2 g dh; each bank with cos(sigma) = cos(sigma_ref) k_D / k_L
     (the reference's vertical lift; clipped to [-1, 1]), its sign kept."""
-    k_l, k_d = (float(k) for k in scales)
+    k_d = float(scales[1])
     step = SCALE_HEIGHT_STEP_M
     H = 2.0 * step / math.log(density(h_ref - step) / density(h_ref + step))
     dh = math.log(k_d) / (1.0 / H + 2.0 * gravity / (V_ref * V_ref))
     V = math.sqrt(max(V_ref * V_ref - 2.0 * gravity * dh, 0.0))
-    ratio = k_d / k_l
-    return h_ref + dh, V, [math.copysign(math.acos(min(max(math.cos(s) * ratio, -1.0), 1.0)), s) for s in sigmas]
+    return h_ref + dh, V, [sensed_bank(s, scales) for s in sigmas]
+
+
+def sensed_bank(sigma_ref: float, scales) -> float:
+    """The bank [rad] with cos(sigma) = cos(``sigma_ref``) k_D / k_L (clipped to [-1, 1]), the
+    sign of ``sigma_ref``: the reference's vertical lift where the sensed drag is the reference's
+    (``sensed_reference``), ``scales`` = (k_L, k_D)."""
+    ratio = float(scales[1]) / float(scales[0])
+    return math.copysign(math.acos(min(max(math.cos(sigma_ref) * ratio, -1.0), 1.0)), sigma_ref)
 
 
 @dc.dataclass(frozen=True)
@@ -167,7 +175,7 @@ class ReferenceTracker(LeafSystem):
             x_ref, g = x_ref.copy(), self._planet.mu / self._planet.radius(x_ref[0]) ** 2
             x_ref[0], x_ref[3], (ff_next, x_ref[6]) = sensed_reference(x_ref[0], x_ref[3], (ff_next, x_ref[6]), scales,
                                                                        self.density, g)
-            ff_now = sensed_reference(x_ref[0], x_ref[3], (ff_now,), before, self.density, g)[2][0]
+            ff_now = sensed_bank(ff_now, before)
             discrete_state.get_mutable_vector(self._scales).SetFromVector(scales)
         # the bank deviation is the command's from the feed-forward (the reference bank
         # ``lead`` seconds ahead, which the lagging actuator delivers now)

@@ -12,7 +12,7 @@ from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 from drake_entry.systems.replan_scheduler import ReplanStats
 from drake_entry.systems.replanning_guidance import ReplanMemory, ReplanningGuidance
 
-__all__ = ["RATIO_SYSTEM", "add_replanning_guidance", "replanning_commands", "replanning_record"]
+__all__ = ["RATIO_SYSTEM", "add_replanning_guidance", "add_ratio_filter", "replanning_commands", "replanning_record"]
 
 #: the name of the filter of the sensed lift and drag ratios the re-plans predict with
 RATIO_SYSTEM = "acceleration_ratios"
@@ -33,13 +33,23 @@ def add_replanning_guidance(builder, name: str, plan, replan, scenario, plant: P
         **spec.latency(), **options))
     builder.Connect(plant.estimated_state, system.GetInputPort("estimated_state"))
     if spec.replan_model_scales:
-        ratios = builder.AddNamedSystem(RATIO_SYSTEM, AccelerationRatioFilter(
-            scenario.make_vehicle(), scenario.make_planet(), scenario.make_atmosphere(), period=spec.period_s))
-        builder.Connect(plant.estimated_state, ratios.GetInputPort("estimated_state"))
-        builder.Connect(plant.flight_conditions, ratios.GetInputPort("flight_conditions"))
+        ratios = add_ratio_filter(builder, scenario, plant, system.GetInputPort("model_scales"))
         builder.Connect(system.GetOutputPort("alpha_command"), ratios.GetInputPort("alpha_command"))
-        builder.Connect(ratios.GetOutputPort("ratios"), system.GetInputPort("model_scales"))
     return system
+
+
+def add_ratio_filter(builder, scenario, plant: PlantPorts, model_scales, atmosphere=None):
+    """Add the AccelerationRatioFilter (RATIO_SYSTEM) of ``scenario``'s nominal models
+    (``atmosphere``: the scenario's when None), at the guidance period, fed by the navigation
+    estimate and the sensed flight conditions, its ratios connected to the input port
+    ``model_scales``; return it (its input "alpha_command" is the caller's to connect)."""
+    ratios = builder.AddNamedSystem(RATIO_SYSTEM, AccelerationRatioFilter(
+        scenario.make_vehicle(), scenario.make_planet(), atmosphere or scenario.make_atmosphere(),
+        period=scenario.guidance.period_s))
+    builder.Connect(plant.estimated_state, ratios.GetInputPort("estimated_state"))
+    builder.Connect(plant.flight_conditions, ratios.GetInputPort("flight_conditions"))
+    builder.Connect(ratios.GetOutputPort("ratios"), model_scales)
+    return ratios
 
 
 def replanning_commands(system, alpha_limits: ActuatorLimits, initial_bank: float,

@@ -18,8 +18,7 @@ from drake_entry.guidance.ampi.mission import built_database
 from drake_entry.guidance.ampi.reference import DatabaseReference
 from drake_entry.guidance.ampi.spec import MISSION_DATABASE
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
-from drake_entry.guidance.replanning_wiring import RATIO_SYSTEM
-from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
+from drake_entry.guidance.replanning_wiring import add_ratio_filter
 from drake_entry.systems.reference_tracking import ReferenceTracker
 
 __all__ = ["GUIDANCE_SYSTEM", "AmpiMethod", "METHOD"]
@@ -49,12 +48,8 @@ class AmpiMethod(GuidanceMethod):
             density=None if atmosphere is None else atmosphere.density))
         builder.Connect(plant.estimated_state, tracker.GetInputPort("estimated_state"))
         sinks = ()
-        if g.model_scales:
-            ratios = builder.AddNamedSystem(RATIO_SYSTEM, AccelerationRatioFilter(
-                vehicle, scenario.make_planet(), atmosphere, period=g.period_s))
-            builder.Connect(plant.estimated_state, ratios.GetInputPort("estimated_state"))
-            builder.Connect(plant.flight_conditions, ratios.GetInputPort("flight_conditions"))
-            builder.Connect(ratios.GetOutputPort("ratios"), tracker.GetInputPort("model_scales"))
+        if g.model_scales:  # alpha is the scenario's schedule: the closed loop feeds the filter the alpha flown
+            ratios = add_ratio_filter(builder, scenario, plant, tracker.GetInputPort("model_scales"), atmosphere)
             sinks = (ratios.GetInputPort("alpha_command"),)
         return GuidanceCommands(
             bank=tracker.GetOutputPort("bank_command"), initial_bank=bank0,

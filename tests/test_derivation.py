@@ -249,6 +249,14 @@ def test_the_matrix_reads_comparison_directories(tmp_path):
     assert "commit abc" in open(path).read()
     with pytest.raises(CampaignError, match="holds no comparison report"):
         matrix_markdown([str(tmp_path)])
+    manifest = json.loads((folder / "comparison.json").read_text())  # an expensive method flown with fewer runs
+    manifest["methods"]["scvx"] = {"method": "Scvx", "flown": True}
+    (folder / "comparison.json").write_text(json.dumps(manifest))
+    summary = json.loads((folder / "comparison_summary.json").read_text())
+    summary["methods"]["scvx"] = {"successful": 9, "samples": 10, "miss_km": {"median": 1.0, "p95": 2.0}}
+    (folder / "comparison_summary.json").write_text(json.dumps(summary))
+    assert "| mine (runs per cell, seed 3) | **20/20** (>= 89 %), miss 1.5 / 2.25 km, 0.8 s * | **9/10** (>= 66 %)" \
+        in matrix_markdown([str(folder)])
 
 
 def test_a_resumed_comparison_reuses_the_derived_scenario(tmp_path, monkeypatch):

@@ -72,6 +72,13 @@ def _cell(m: dict) -> str:
     return text + (" *" if m["derived"] else "")
 
 
+def _runs_text(comparison: dict) -> str:
+    """'N runs' when every flown cell has N samples, else 'runs per cell' (``--only`` may fly
+    an expensive method with fewer samples into the same directory)."""
+    counts = {m["summary"]["samples"] for m in comparison["methods"].values() if m["flown"] and m["summary"]}
+    return f"{counts.pop()} runs" if len(counts) == 1 else "runs per cell" if counts else f"{comparison['runs']} runs"
+
+
 def matrix_markdown(folders: list[str]) -> str:
     """The matrix of these comparison directories (rows: missions; columns: methods)."""
     comparisons = [read_comparison(f) for f in folders]
@@ -81,7 +88,7 @@ def matrix_markdown(folders: list[str]) -> str:
     out = ["| mission | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]
     for c in comparisons:
         cells = [_cell(c["methods"][label]) if label in c["methods"] else "—" for label in labels]
-        out.append(f"| {c['name']} ({c['runs']} runs, seed {c['seed']}) | " + " | ".join(cells) + " |")
+        out.append(f"| {c['name']} ({_runs_text(c)}, seed {c['seed']}) | " + " | ".join(cells) + " |")
     out += ["", f"Each cell: successful/samples (the one-sided {100 * LEVEL:.0f} % lower Clopper-Pearson bound on the "
             f"success probability), the miss distance's median / 95th percentile over the samples that reached the "
             f"interface, core seconds per sample; * settings derived from the mission (the mission's own method "

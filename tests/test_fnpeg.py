@@ -13,10 +13,10 @@ from drake_entry.guidance.fnpeg.corrector import SIGMA0_BOUNDS, CorrectorSetting
 from drake_entry.guidance.fnpeg.law import (
     FeedbackSettings,
     commanded_bank,
-    path_limit_sin_flight_path,
     qegc_sin_flight_path,
 )
 from drake_entry.guidance.fnpeg.onboard import FnpegSetup
+from drake_entry.guidance.path_feedback import path_limit_sin_flight_path
 from drake_entry.models import dynamics
 from drake_entry.models.schedules import linear_bank
 from drake_entry.models.vehicles import load_vehicle
@@ -85,7 +85,7 @@ def test_path_limit_bound_keeps_the_predicted_quantity_at_its_limit(which):
                                        "heat": (4e6, 0.5, 3.15)}[which]
     limit = 0.9 * value
     kwargs = {"load_max": limit} if which == "load" else {"q_max": limit} if which == "q" else {"heat_max": limit}
-    s = FeedbackSettings(R0, G0, beta=beta, horizon=d, **kwargs)
+    s = FeedbackSettings(R0, G0, beta=beta, horizon=d, **kwargs).path_limits
     loads = {"load": value, "q": 1.0, "heat": 1.0}
     u = path_limit_sin_flight_path(V, D, loads["load"], value if which == "heat" else 1.0,
                                    value if which == "q" else 1.0, s)

@@ -130,6 +130,8 @@ def test_plan_names_violated_path_limits():
     ("landmark_iteration", 30, "guidance.landmark_iteration = 30 is out of range"),
     ("replan_period_s", 0.5, "replan_period_s = 0.5 is out of range; allowed: 0 "),
     ("alpha_law", "schedule", "guidance.alpha_deg has 0 values and guidance.alpha_velocity_m_s 0"),
+    ("path_limit_fraction", 0.3, "guidance.path_limit_fraction = 0.3 is out of range"),
+    ("path_gain", -1.0, "guidance.path_gain = -1.0 is out of range"),
 ])
 def test_bad_spec_fields_are_one_line_errors(field, value, match):
     s = load_scenario("cav_h_paper004")
@@ -317,7 +319,7 @@ def test_a_plan_that_reaches_taem_far_from_the_target_is_not_a_success(case1_pla
 
 
 @pytest.mark.parametrize("variant", ["load", "heat", "schedule", "scaled aerodynamics", "two parameters",
-                                     "floor and time"])
+                                     "floor and time", "path feedback"])
 def test_compiled_population_flies_as_the_numpy_evaluator(variant):
     """The population flown in one compiled call (population_flight with kernels generated from
     the models) against the vectorised numpy evaluator it replicates: every member's J within
@@ -341,6 +343,12 @@ def test_compiled_population_flies_as_the_numpy_evaluator(variant):
         sigma_f = np.radians(np.linspace(30.0, 80.0, 9))
     elif variant == "floor and time":
         p = dc.replace(p, altitude_floor_m=55e3, max_time_s=900.0)
+    elif variant == "path feedback":  # Lu 2014's feedback on a re-solution's sensed vehicle (limits divided)
+        from drake_entry.models.acceleration_ratios import sensed_vehicle
+        p = dc.replace(p, vehicle=sensed_vehicle(p.vehicle, (1.06, 1.1)), path_gain=40.0, path_fraction=0.8)
+        assert p.law().path is None  # under the load law eq. 31's alpha holds the limits: no feedback
+        p = dc.replace(p, case="schedule", alpha_schedule=((2000.0, 5500.0, 7000.0), tuple(np.radians([11.0, 10.5, 14.0]))))
+        assert p.law().path.active
     a = evaluate(p, sigma0, sigma_f=sigma_f)
     b = evaluate(p, sigma0, sigma_f=sigma_f, engine="numpy")
     assert (a.reached == b.reached).all() and (a.reversals == b.reversals).all()
@@ -349,6 +357,9 @@ def test_compiled_population_flies_as_the_numpy_evaluator(variant):
     np.testing.assert_allclose(a.time_s, b.time_s, rtol=0.0, atol=1e-9)
     for peak in ("peak_heat_flux_W_m2", "peak_dynamic_pressure_Pa", "peak_total_load_g"):
         np.testing.assert_allclose(getattr(a, peak), getattr(b, peak), rtol=1e-12)
+    if variant == "path feedback":  # the feedback acts on this population
+        off = evaluate(dc.replace(p, path_gain=0.0), sigma0, sigma_f=sigma_f)
+        assert np.abs(off.final_state - a.final_state).max() > 1.0
     if variant == "floor and time":
         assert not a.reached.any() and (a.final_state[:, 0] < 55e3).any() and (a.time_s == 900.0).any()
     else:

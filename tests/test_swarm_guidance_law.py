@@ -113,3 +113,32 @@ def test_case1_optimum_is_where_the_substitute_target_puts_it():
     assert ev.peak_heat_flux_W_m2 == pytest.approx(2.90e6, rel=0.02)
     assert (ev.peak_total_load_g <= 2.0 * 1.01).all()
     assert (np.abs(ev.velocity_error_m_s) < 5.0).all()
+
+
+def test_path_feedback_lifts_only_where_a_limit_would_be_passed_ahead():
+    """Lu 2014's path-limit feedback in paper 004's bank law (guidance.path_feedback): off or far
+    from every limit the law is eqs. 17 and 46-48 exactly; descending towards the heat-rate
+    limit it flies more vertical lift, by L cos(sigma) lowered by k V (sin(gamma) - U) sqrt(g0/R0)
+    with U the flight-path sine that meets the limit ``horizon`` seconds ahead."""
+    import dataclasses as dc
+
+    from drake_entry.guidance.path_feedback import PathLimits, path_limit_sin_flight_path
+    from drake_entry.guidance.swarm_bank.guidance_law import LawSettings, bank_magnitude
+
+    R0, g0 = 6378137.0, 9.80665
+    law = LawSettings(sigma_f=D2R(60.0), e0=4.0e7, ef=5.5e7, bank_limit=D2R(85.0), alpha_min=D2R(10.0),
+                      alpha_max=D2R(20.0), load_max=2.5, heat_max=5e5, case="load", mach_shift=20.0, k2=0.0,
+                      beta=BETA, R0=R0, g0=g0, mu=3.986004418e14)
+    path = PathLimits(R0, g0, beta=BETA, gain=40.0, horizon=16.0, heat_max=5e5)
+    fed = dc.replace(law, path=path)
+    V, r, L, D, q = 5000.0, R0 + 50e3, 6.0, 2.0, 2e4  # (eq. 48's gain 0: the base is eq. 17 alone)
+    args = (D2R(50.0), V, -0.02, r, L, D, D2R(60.0))
+    base = bank_magnitude(law, *args)
+    assert bank_magnitude(fed, *args, heat=1e5, q=q) == base  # far below the limit: untouched
+    near = bank_magnitude(fed, *args, heat=4.6e5, q=q)
+    assert near < base
+    u = path_limit_sin_flight_path(V, D, math.hypot(L, D), 4.6e5, q, path)
+    assert u > math.sin(-0.02)
+    expected = math.cos(base) - 40.0 * V * (math.sin(-0.02) - u) * math.sqrt(g0 / R0) / L
+    assert math.cos(near) == pytest.approx(expected, rel=1e-12)
+    assert bank_magnitude(dc.replace(law, path=dc.replace(path, gain=0.0)), *args, heat=4.6e5, q=q) == base

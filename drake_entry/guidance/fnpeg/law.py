@@ -15,25 +15,22 @@ guidance (systems/fnpeg_guidance.py) evaluates it on the navigated state.
     above V_off + ramp, ramped linearly to 0 at V_off;
   * path limits: sin(gamma_ref) = max{sin gamma, U_a, U_Q, U_q}, the smallest flight-path angle
     that keeps the load, heat rate and dynamic pressure under their limits ``delta`` seconds
-    ahead (a first-order prediction in an exponential atmosphere), gain k_path.
+    ahead (a first-order prediction in an exponential atmosphere), gain k_path; shared with
+    paper 004's law (guidance.path_feedback).
   The two corrections add (this library's reading where both are active).
 """
 from __future__ import annotations
 
 import dataclasses as dc
+import functools
 import math
 
 import numpy as np
-from pydrake.symbolic import max as symbolic_max
 
-from drake_entry.models.scalar import clamp, is_symbolic
+from drake_entry.guidance.path_feedback import PathLimits, path_limit_correction
+from drake_entry.models.scalar import clamp
 
-__all__ = ["HEAT_RATE_VELOCITY_EXPONENT", "FeedbackSettings", "qegc_sin_flight_path", "path_limit_sin_flight_path",
-           "commanded_bank"]
-
-#: exponent of V in the heat-rate law the path-limit reference assumes (Lu 2014: 3.15)
-HEAT_RATE_VELOCITY_EXPONENT = 3.15
-
+__all__ = ["FeedbackSettings", "qegc_sin_flight_path", "commanded_bank"]
 
 @dc.dataclass(frozen=True)
 class FeedbackSettings:
@@ -67,9 +64,11 @@ class FeedbackSettings:
     q_max: float = math.inf
     bank_limit: float = math.radians(90.0)
 
-
-def _max(a, b):
-    return symbolic_max(a, b) if is_symbolic(a) or is_symbolic(b) else max(a, b)
+    @functools.cached_property
+    def path_limits(self) -> PathLimits:
+        """The path-limit feedback's part (guidance.path_feedback)."""
+        return PathLimits(self.R0, self.g0, beta=self.beta, gain=self.path_gain, horizon=self.horizon,
+                          load_max=self.load_max, heat_max=self.heat_max, q_max=self.q_max)
 
 
 def _ramp(v, lo: float, width: float):
@@ -84,29 +83,6 @@ def qegc_sin_flight_path(V, lift_to_drag, s: FeedbackSettings):
     return -2.0 / (s.beta * v2 * math.cos(s.damping_bank) * lift_to_drag)
 
 
-def path_limit_sin_flight_path(V, D, load, heat, q, s: FeedbackSettings):
-    """max{U_a, U_Q, U_q}: the smallest sin(gamma) that keeps the aerodynamic acceleration
-    ``load`` [m/s^2], the heat rate ``heat`` [W/m^2] and the dynamic pressure ``q`` [Pa] under
-    their limits ``horizon`` seconds ahead. With rho'/rho = -beta/R0 and dV/dt = -D:
-    a(t + delta) = a [1 + (-beta V sin(gamma)/R0 - 2D/V) delta] <= a_max gives
-    U_a = [a_max - a (1 - 2 D delta / V)] / (-a beta V delta / R0); the heat rate (sqrt(rho) V^3.15)
-    gives U_Q with 0.5 beta and 3.15 D. A limit that is inf contributes -1 (no bound)."""
-    d = s.horizon
-    k = s.beta * V * d / s.R0
-    bounds = []
-    if math.isfinite(s.load_max):
-        bounds.append((s.load_max - load * (1.0 - 2.0 * D * d / V)) / (-load * k))
-    if math.isfinite(s.q_max):
-        bounds.append((s.q_max - q * (1.0 - 2.0 * D * d / V)) / (-q * k))
-    if math.isfinite(s.heat_max):
-        n = HEAT_RATE_VELOCITY_EXPONENT
-        bounds.append((s.heat_max - heat * (1.0 - n * D * d / V)) / (-0.5 * heat * k))
-    out = -1.0
-    for b in bounds:
-        out = _max(out, b)
-    return out
-
-
 def commanded_bank(sigma_base, V, gamma, L, D, load, heat, q, s: FeedbackSettings):
     """|sigma_cmd| [rad] in [0, bank_limit]: the baseline magnitude with the altitude-rate
     feedback (module docstring), at speed V [m/s], flight-path angle gamma [rad], lift and drag
@@ -118,8 +94,7 @@ def commanded_bank(sigma_base, V, gamma, L, D, load, heat, q, s: FeedbackSetting
     if s.damping_gain > 0.0:
         k = s.damping_gain * _ramp(V, s.damping_off_speed, s.ramp)
         correction = correction + k * (hdot - V * qegc_sin_flight_path(V, L / D, s))
-    if s.path_gain > 0.0 and (math.isfinite(s.load_max) or math.isfinite(s.heat_max) or math.isfinite(s.q_max)):
-        limit = path_limit_sin_flight_path(V, D, load, heat, q, s)
-        correction = correction + s.path_gain * V * (sg - _max(sg, limit))  # <= 0: only lifts
+    if s.path_limits.active:
+        correction = correction + path_limit_correction(V, sg, D, load, heat, q, s.path_limits)  # <= 0: only lifts
     c = np.cos(sigma_base) - correction * math.sqrt(s.g0 / s.R0) / L
     return np.arccos(clamp(c, math.cos(s.bank_limit), 1.0))

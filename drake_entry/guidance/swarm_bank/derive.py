@@ -1,8 +1,10 @@
 """Paper 004's settings from a mission (drake_entry.guidance.derivation): the TAEM interface at the
 mission's box centre, alpha bounds at the mission's alpha extremes, its reversal corridor,
 sigma_0 searched before flight and re-solved on board; searched: the alpha law (the mission's
-alpha schedule in speed, or the load factor of Case 1, eq. 31), the QEG compensation's gain
-and the interface altitude; sigma_f is searched with sigma_0 before flight."""
+alpha schedule in speed, or the load factor of Case 1, eq. 31), Lu 2014's path-limit feedback
+on the bank, the QEG compensation's gain and the interface altitude; sigma_f is searched with
+sigma_0 before flight."""
+import math
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
@@ -20,7 +22,7 @@ from drake_entry.guidance.derivation import (
 from drake_entry.guidance.swarm_bank.spec import SwarmBank
 
 __all__ = ["derive", "BANK_END_BOUNDS_DEG", "REPLAN_PERIOD_S", "OPTIMIZER", "LIMIT_FRACTION", "REPLAN_UNTIL_E",
-           "RESOLVE_BANK_END", "QEG_GAINS"]
+           "RESOLVE_BANK_END", "QEG_GAINS", "PATH_GAINS", "PATH_LIMIT_FRACTION"]
 
 #: sigma_f's bounds when searched with sigma_0 before flight [deg] (paper 004: 60, fixed): sigma_0
 #: alone trades the range against the altitude at the TAEM energy (on HORUS-2B its best plan ends
@@ -35,6 +37,14 @@ OPTIMIZER = "differential_evolution"
 LIMIT_FRACTION = 0.97
 #: eq. 48's QEG gain k2 tried, in order (paper 004: 10; 0 turns the compensation off)
 QEG_GAINS = (10.0, 0.0)
+#: Lu 2014's path-limit feedback gain tried first where the vehicle has limits, then none (under a
+#: mission's alpha schedule paper 004's alpha laws, which hold its limits, are not flown: HORUS-2B's
+#: heat rate was 0.3-2.8 % over in 43 of 100 runs without it)
+PATH_GAINS = (40.0, 0.0)
+#: the fraction of the vehicle's limits the feedback holds (HORUS-2B, 100 runs: 100 of 100 at 0.95;
+#: at 0.9, 14 of 20: the flights lofted over the heat peak end steeper, q 0.1-1.6 % over in the last
+#: 30 s, where the first-order prediction sees q falling)
+PATH_LIMIT_FRACTION = 0.95
 #: no re-solution past this normalised energy (paper 004's mission: 0.95)
 REPLAN_UNTIL_E = 0.99
 #: sigma_f re-solved on board where sigma_0 alone brackets no root (not paper 004's): 10 runs of
@@ -65,7 +75,10 @@ def derive(scenario) -> Derivation:
     term = scenario.terminal
     distance_km = term.distance_tolerance_km or SwarmBank.objective_range_unit_km  # the paper's where none
     altitude_km = term.altitude_tolerance_km or SwarmBank.objective_altitude_unit_km
-    bank_limit = min(89.0, scenario.make_vehicle().bank_limit_deg)
+    vehicle = scenario.make_vehicle()
+    bank_limit = min(89.0, vehicle.bank_limit_deg)
+    lim = vehicle.limits
+    limited = any(math.isfinite(x) for x in (lim.heat_flux_max, lim.dynamic_pressure_max, lim.load_bound_max))
     end_bounds = [BANK_END_BOUNDS_DEG[0], min(BANK_END_BOUNDS_DEG[1], bank_limit)]
     spec = SwarmBank(terminal_altitude_km=interface.altitude_km, terminal_velocity_m_s=round(interface.speed_m_s, 3),
                      bank_start_bounds_deg=[0.0, bank_limit], bank_end_bounds_deg=end_bounds, alpha_law=laws[0],
@@ -73,7 +86,8 @@ def derive(scenario) -> Derivation:
                      alpha_min_deg=lo, alpha_max_deg=hi, replan_period_s=REPLAN_PERIOD_S,
                      objective_range_unit_km=distance_km, objective_altitude_unit_km=altitude_km,
                      optimizer=OPTIMIZER, limit_fraction=LIMIT_FRACTION, replan_until_e=REPLAN_UNTIL_E,
-                     resolve_bank_end=RESOLVE_BANK_END,
+                     resolve_bank_end=RESOLVE_BANK_END, path_gain=PATH_GAINS[0] if limited else 0.0,
+                     path_limit_fraction=PATH_LIMIT_FRACTION,
                      reversal_heading_deg=heading, reversal_velocity_m_s=velocity)
     choices = [
         Choice("guidance.terminal_altitude_km, terminal_velocity_m_s",
@@ -104,6 +118,13 @@ def derive(scenario) -> Derivation:
     search = [SearchStep.over("guidance.alpha_law", laws,
                               "the mission's alpha schedule (as the other methods fly it), else Case 1's load law "
                               "(eq. 31) between its extremes"),
+              *([SearchStep.over("guidance.path_gain", PATH_GAINS,
+                                 f"Lu 2014's path-limit feedback on the bank (FNPEG's), holding "
+                                 f"{PATH_LIMIT_FRACTION:g} of the vehicle's limits: the mission's alpha schedule "
+                                 f"does not hold them as paper 004's alpha laws do (HORUS-2B without it: the heat "
+                                 f"rate 0.3-2.8 % over in 43 of 100 runs; under the load law eq. 31's alpha "
+                                 f"holds the limits and the feedback is off); off where it does not help")]
+                if limited else []),
               SearchStep.over("guidance.qeg_gain", QEG_GAINS,
                               "eqs. 46-48 steer towards a quasi-equilibrium glide, which a low-L/D capsule does not "
                               "fly (Lu 2008's capsule: 4 of 10 with the paper's k2 = 10, 10 of 10 without)"),

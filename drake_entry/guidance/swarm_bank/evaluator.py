@@ -24,6 +24,7 @@ import numpy as np
 from pydrake.symbolic import Expression, Variable
 
 from drake_entry.errors import ScenarioError
+from drake_entry.guidance.path_feedback import PathLimits
 from drake_entry.guidance.swarm_bank import population_flight
 from drake_entry.guidance.swarm_bank.guidance_law import (
     LawMemory,
@@ -34,6 +35,7 @@ from drake_entry.guidance.swarm_bank.guidance_law import (
     load_coefficient_target,
     scheduled_alpha,
 )
+from drake_entry.guidance.swarm_bank.population_flight import PATH_LIMIT_FIELDS
 from drake_entry.guidance.swarm_bank.spec import ALPHA_LAWS
 from drake_entry.models.actuator import integrate_actuators
 from drake_entry.models.aerodynamics import ScaledAero
@@ -81,6 +83,9 @@ class SwarmProblem:
       objective_units: eq. 32's range [m], altitude [m] and speed [m/s] units (paper 004: 100 nmi,
         1 km, 100 m/s).
       limit_fraction: under the 'schedule' law, J is penalised past this fraction of each limit.
+      path_gain, path_horizon_s, path_fraction: Lu 2014's path-limit feedback on the bank (gain,
+        horizon [s]) holding this fraction of the vehicle's limits under the 'schedule' case
+        (guidance.path_feedback; gain 0: paper 004's law).
       k2, beta: eq. 48 gain and eq. 46 nondimensional scale height (paper: 10, 920).
       reversal_heading, reversal_velocity: heading-error corridor [rad] linear in speed [m/s].
       initial_alpha, initial_bank, initial_sign, memory: the actuators, the reversal sign and
@@ -121,6 +126,9 @@ class SwarmProblem:
     alpha_schedule: tuple = ((), ())
     objective_units: tuple = (RANGE_UNIT_M, ALTITUDE_UNIT_M, SPEED_UNIT_M_S)
     limit_fraction: float = 1.0
+    path_gain: float = 0.0
+    path_horizon_s: float = 16.0
+    path_fraction: float = 0.9
 
     def __post_init__(self):
         if self.case not in ALPHA_LAWS:
@@ -153,11 +161,24 @@ class SwarmProblem:
         """e = mu/r - V^2/2 [J/kg] (eq. 10): any scalar type or numpy arrays."""
         return self.planet.mu / self.planet.radius(h) - 0.5 * V * V
 
+    def path_limits(self) -> PathLimits | None:
+        """The path-limit feedback's settings: path_fraction of the vehicle's limits (those of a
+        re-solution's sensed vehicle, models.acceleration_ratios.sensed_vehicle, in its nominal
+        air), or None without a gain or under paper 004's alpha laws (their alpha holds the
+        limits: eq. 31 flies the load on its limit, which the feedback would fight)."""
+        if self.path_gain <= 0.0 or self.case != "schedule":
+            return None
+        lim, f = self.vehicle.limits, self.path_fraction
+        return PathLimits(self.planet.reference_radius, self.planet.g0, beta=self.beta, gain=self.path_gain,
+                          horizon=self.path_horizon_s, load_max=f * lim.load_bound_max * self.planet.g0,
+                          heat_max=f * lim.heat_flux_max, q_max=f * lim.dynamic_pressure_max)
+
     def law(self) -> LawSettings:
         pl = self.planet
         return LawSettings(self.sigma_f, self.start_energy, self.ef, self.vehicle.bank_limit, self.alpha_min,
                            self.alpha_max, self.load_max, self.heat_max, self.case, self.mach_shift, self.k2,
-                           self.beta, pl.reference_radius, pl.g0, pl.mu, *map(tuple, self.alpha_schedule))
+                           self.beta, pl.reference_radius, pl.g0, pl.mu, *map(tuple, self.alpha_schedule),
+                           path=self.path_limits())
 
 
 @dc.dataclass
@@ -352,14 +373,18 @@ def _population_module(p: SwarmProblem, vehicle):
     # what the trace reads: the objects by identity (an on-board re-solution rebuilds the vehicle
     # around the same aerodynamics each time), the numbers by value
     objects = (vehicle.aero, vehicle.heat_flux, p.planet, p.atmosphere)
+    path = law.path if law.path is not None and law.path.active else None
+    # the path feedback's limits are inputs (a re-solution's sensed vehicle moves them): its form is in the key
+    path_form = None if path is None else (path.gain, path.horizon, path.beta, path.R0, path.g0,
+                                           *(math.isfinite(getattr(path, k)) for k in PATH_LIMIT_FIELDS))
     key = (*map(id, objects), vehicle.mass, vehicle.reference_area, vehicle.nose_radius, p.load_max, p.heat_max,
-           law.k2, law.beta, law.bank_limit)
+           law.k2, law.beta, law.bank_limit, path_form)
     found = _COMPILED.get(key)
     if found is not None and all(a is b for a, b in zip(found[0], objects)):
         return found[1]
     pl, atm = p.planet, p.atmosphere
     names = ("h", "lon", "lat", "V", "gamma", "psi", "alpha", "bank", "L", "D", "kL", "kD", "sigma0", "sigmaf",
-             "e0", "ef", "mach", "q", "cd", "heat", "tlon", "tlat")
+             "e0", "ef", "mach", "q", "cd", "heat", "tlon", "tlat", *(f"path_{k}" for k in PATH_LIMIT_FIELDS))
     v = {n: Variable(n) for n in names}
     e = {n: Expression(var) for n, var in v.items()}
     x = [e[n] for n in names[:6]]
@@ -369,8 +394,10 @@ def _population_module(p: SwarmProblem, vehicle):
         mach, L, D = aero_accelerations(x, e["alpha"], rho, a, traced)
         aero = (rho, a, mach, L, D, dynamic_pressure(rho, e["V"]), traced.heat_flux(rho, e["V"]),
                 np.sqrt(L * L + D * D) / pl.g0)
-        magnitude = bank_magnitude(law, e["sigma0"], e["V"], e["gamma"], pl.radius(e["h"]), e["L"], e["D"],
-                                   e["sigmaf"], e["e0"], e["ef"])
+        traced_law = law if path is None else dc.replace(law, path=dc.replace(path, **{
+            k: e[f"path_{k}"] for k in PATH_LIMIT_FIELDS if math.isfinite(getattr(path, k))}))
+        magnitude = bank_magnitude(traced_law, e["sigma0"], e["V"], e["gamma"], pl.radius(e["h"]), e["L"], e["D"],
+                                   e["sigmaf"], e["e0"], e["ef"], heat=e["heat"], q=e["q"])
         kernels = [
             Kernel("aero", aero, tuple(v[n] for n in (*names[:7], "kL", "kD"))),
             Kernel("motion", tuple(equations_of_motion(x, e["bank"], e["L"], e["D"], pl)),
@@ -378,7 +405,8 @@ def _population_module(p: SwarmProblem, vehicle):
             Kernel("derivatives", tuple(state_derivatives(x, e["bank"], e["alpha"], traced, pl, atm)),
                    tuple(v[n] for n in (*names[:6], "bank", "alpha", "kL", "kD"))),
             Kernel("bank_magnitude", (magnitude,),
-                   tuple(v[n] for n in ("h", "V", "gamma", "L", "D", "sigma0", "sigmaf", "e0", "ef"))),
+                   tuple(v[n] for n in ("h", "V", "gamma", "L", "D", "sigma0", "sigmaf", "e0", "ef", "q", "heat",
+                                        *(f"path_{k}" for k in PATH_LIMIT_FIELDS)))),
             Kernel("coefficients", tuple(traced.aero.coefficients(e["alpha"], e["mach"])),
                    tuple(v[n] for n in ("alpha", "mach", "kL", "kD"))),
             Kernel("load_target", (load_coefficient_target(e["q"], vehicle.area_over_mass, pl.g0, p.load_max),),
@@ -397,6 +425,7 @@ def _fly_compiled(p: SwarmProblem, sigma0, sigma_f):
     """(final (6, n), t_end, reached, peaks (3, n), reversals) of the population, compiled."""
     vehicle, kl, kd = _unscaled(p.vehicle)
     module = _population_module(p, vehicle)
+    path = p.path_limits()
     n = sigma0.size
     alpha0 = p.entry_alpha
     values = dict(e0=p.start_energy, ef=p.ef, target_lon=p.target[0], target_lat=p.target[1], lift_scale=kl,
@@ -407,7 +436,8 @@ def _fly_compiled(p: SwarmProblem, sigma0, sigma_f):
                   alpha_max=p.alpha_max, bank_limit=p.vehicle.bank_limit, alpha_rate=p.alpha_rate,
                   bank_rate=p.vehicle.bank_rate_limit, alpha_accel=p.alpha_accel,
                   bank_accel=p.vehicle.bank_accel_limit, bandwidth=2.0, heat_case=float(p.case == "heat"),
-                  mach_shift=p.mach_shift, schedule_case=float(p.case == "schedule"))
+                  mach_shift=p.mach_shift, schedule_case=float(p.case == "schedule"),
+                  **{f"path_{k}": getattr(path, k) if path is not None else math.inf for k in PATH_LIMIT_FIELDS})
     settings = np.array([float(values[k]) for k in population_flight.SETTINGS])
     sf = np.full(n, p.sigma_f) if sigma_f is None else np.ascontiguousarray(sigma_f, float)
     final, t_end = np.zeros((n, 6)), np.zeros(n)

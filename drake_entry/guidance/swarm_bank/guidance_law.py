@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from drake_entry.errors import ScenarioError
+from drake_entry.guidance.path_feedback import PathLimits, path_limit_correction
 from drake_entry.models.scalar import clamp
 from drake_entry.models.schedules import linear_bank
 
@@ -160,7 +161,8 @@ class LawSettings:
     load_max [g], heat_max [W/m^2]; case 'load' (Case 1), 'heat' (Case 2) or 'schedule'; mach_shift;
     k2, beta: eqs. 46-48 (nondimensional); R0 [m], g0 [m/s^2]: Lu's units; mu [m^3/s^2];
     alpha_speeds [m/s] (increasing), alpha_values [rad]: the 'schedule' case's alpha, linear
-    in speed and held beyond its ends."""
+    in speed and held beyond its ends; path: Lu 2014's path-limit feedback on the bank
+    (guidance.path_feedback; None or a zero gain: paper 004's law, which holds its limits with alpha)."""
 
     sigma_f: float
     e0: float
@@ -179,6 +181,7 @@ class LawSettings:
     mu: float
     alpha_speeds: tuple = ()
     alpha_values: tuple = ()
+    path: PathLimits | None = None
 
 
 def scheduled_alpha(speed, speeds, values):
@@ -199,7 +202,8 @@ def law_commands(s: LawSettings, sigma0, x, r, rho, mach, L, D, heat, q, aero, a
     Mach_shift after exceeding it, then eq. 31; 'schedule': the mission's alpha in speed (the
     law flown with another method's alpha profile). ``sigma_f``: per-member eq. 17 end banks
     (default: the settings')."""
-    magnitude = bank_magnitude(s, sigma0, x[3], x[4], r, L, D, s.sigma_f if sigma_f is None else sigma_f)
+    magnitude = bank_magnitude(s, sigma0, x[3], x[4], r, L, D, s.sigma_f if sigma_f is None else sigma_f,
+                               heat=heat, q=q)
     if s.case == "schedule":
         alpha = scheduled_alpha(np.asarray(x[3], float), s.alpha_speeds, s.alpha_values)
         return magnitude, alpha, LawMemory(alpha, memory.mach_was_above, memory.switched)
@@ -213,13 +217,21 @@ def law_commands(s: LawSettings, sigma0, x, r, rho, mach, L, D, heat, q, aero, a
     return magnitude, alpha, LawMemory(alpha, above, switched)
 
 
-def bank_magnitude(s: LawSettings, sigma0, V, gamma, r, L, D, sigma_f, e0=None, ef=None):
+def bank_magnitude(s: LawSettings, sigma0, V, gamma, r, L, D, sigma_f, e0=None, ef=None, heat=None, q=None):
     """|sigma| [rad] of eq. 17 (linear in e from sigma0 at e0 to sigma_f at ef; default the
-    settings' energies) with the QEG compensation (eqs. 46-48), limited to bank_limit, at speed V
-    [m/s], flight-path angle gamma [rad], radius r [m] and lift and drag L, D [m/s^2]. Any
-    scalar type or numpy arrays (the compiled population flight traces it)."""
+    settings' energies) with the QEG compensation (eqs. 46-48) and, with ``s.path``, Lu 2014's
+    path-limit feedback (cos(sigma) lowered by its term sqrt(g0/R0) / L: more vertical lift where
+    the load, heat rate or q would pass their limits ``horizon`` seconds ahead), limited to
+    bank_limit, at speed V [m/s], flight-path angle gamma [rad], radius r [m], lift and drag L, D
+    [m/s^2], heat rate [W/m^2] and q [Pa]. Any scalar type or numpy arrays (the compiled
+    population flight traces it)."""
     e = s.mu / r - 0.5 * V * V
     base = linear_bank(e, s.e0 if e0 is None else e0, s.ef if ef is None else ef, sigma0, sigma_f)
     v_scale = math.sqrt(s.g0 * s.R0)
     s_qeg = qeg_sin_flight_path(r / s.R0, V / v_scale, D / s.g0, s.beta)
-    return clamp(qeg_bank(base, L / s.g0, D / s.g0, np.sin(gamma), s_qeg, s.k2), -math.inf, s.bank_limit)
+    sin_gamma = np.sin(gamma)
+    magnitude = qeg_bank(base, L / s.g0, D / s.g0, sin_gamma, s_qeg, s.k2)
+    if s.path is not None and s.path.active:
+        term = path_limit_correction(V, sin_gamma, D, np.sqrt(L * L + D * D), heat, q, s.path)
+        magnitude = np.arccos(clamp(np.cos(magnitude) - term * math.sqrt(s.g0 / s.R0) / L, -1.0, 1.0))
+    return clamp(magnitude, -math.inf, s.bank_limit)

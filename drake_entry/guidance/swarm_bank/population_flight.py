@@ -9,7 +9,9 @@ name (v: the kernel's inputs, out: its outputs):
                        heat flux, total load g]
   ``motion``           [h, lon, lat, V, gamma, psi, bank, L, D] -> the 6 state rates
   ``derivatives``      [h, lon, lat, V, gamma, psi, bank, alpha, k_L, k_D] -> the 6 state rates
-  ``bank_magnitude``   [h, V, gamma, L, D, sigma_0, sigma_f, e_0, e_f] -> |sigma| (eqs. 17, 46-48)
+  ``bank_magnitude``   [h, V, gamma, L, D, sigma_0, sigma_f, e_0, e_f, q, heat flux, the path
+                       feedback's load, heat-flux and q limits] -> |sigma| (eqs. 17, 46-48, Lu 2014's
+                       path-limit feedback where the law has it)
   ``coefficients``     [alpha, Mach, k_L, k_D] -> [C_L, C_D]
   ``load_target``      [q] -> sqrt(C_L^2 + C_D^2) at the load limit (eq. 31)
   ``heat_target``      [C_D previous, heat flux] -> C_DQ (eq. 21, the flux over its limit)
@@ -30,13 +32,16 @@ from drake_entry.guidance.swarm_bank.guidance_law import SOLVE_MAX_ITERATIONS, S
 from drake_entry.models.actuator import actuator_path
 from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle
 
-__all__ = ["SETTINGS", "fly_population"]
+__all__ = ["PATH_LIMIT_FIELDS", "SETTINGS", "fly_population"]
+
+#: the path feedback's limits (guidance.path_feedback.PathLimits fields), inputs of bank_magnitude
+PATH_LIMIT_FIELDS = ("load_max", "heat_max", "q_max")
 
 #: the layout of fly_population's ``settings`` array
 SETTINGS = ("e0", "ef", "target_lon", "target_lat", "lift_scale", "drag_scale", "alpha0", "bank0", "sign0",
             "mach_was_above", "switched", "step_s", "substeps", "altitude_floor_m", "max_time_s", "alpha_min",
             "alpha_max", "bank_limit", "alpha_rate", "bank_rate", "alpha_accel", "bank_accel", "bandwidth",
-            "heat_case", "mach_shift", "schedule_case")
+            "heat_case", "mach_shift", "schedule_case", "path_load_max", "path_heat_max", "path_q_max")
 
 
 def _coefficient(alpha, mach, kl, kd, total, v, out):
@@ -86,7 +91,8 @@ def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_he
     rate_limits, accel_limits = (settings[18], settings[19]), (settings[20], settings[21])  # (alpha, bank)
     bandwidth, heat_case, mach_shift = settings[22], settings[23] > 0.5, settings[24]
     schedule_case = settings[25] > 0.5
-    va, vb = np.empty(10), np.empty(10)
+    path_load, path_heat, path_q = settings[26], settings[27], settings[28]
+    va, vb = np.empty(10), np.empty(14)
     aero_out, k1, k2, k3, k4 = np.empty(8), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     one, two = np.empty(1), np.empty(2)
     a_path, b_path = np.empty(steps + 1), np.empty(steps + 1)
@@ -112,6 +118,7 @@ def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_he
             p0, p1, p2 = max(p0, heat), max(p1, q), max(p2, aero_out[7])
             vb[0], vb[1], vb[2], vb[3], vb[4] = x[0], x[3], x[4], L, D
             vb[5], vb[6], vb[7], vb[8] = sigma0[i], sigma_f[i], e0, ef
+            vb[9], vb[10], vb[11], vb[12], vb[13] = q, heat, path_load, path_heat, path_q
             bank_magnitude(vb, one)
             magnitude = one[0]
             if schedule_case:

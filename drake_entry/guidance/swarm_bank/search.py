@@ -295,4 +295,5 @@ def problem_from_scenario(scenario) -> SwarmProblem:
         guidance_step_s=g.period_s, max_time_s=scenario.simulation.max_time_s,
         alpha_schedule=(tuple(g.alpha_velocity_m_s), tuple(map(rad, g.alpha_deg))),
         objective_units=(1e3 * g.objective_range_unit_km, 1e3 * g.objective_altitude_unit_km,
-                         g.objective_speed_unit_m_s), limit_fraction=g.limit_fraction)
+                         g.objective_speed_unit_m_s), limit_fraction=g.limit_fraction,
+        path_gain=g.path_gain, path_horizon_s=g.path_horizon_s, path_fraction=g.path_limit_fraction)

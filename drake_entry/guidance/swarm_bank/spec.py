@@ -71,6 +71,13 @@ class SwarmBank(ReversingBankSpec, ReplansOnBoard):
     # QEG compensation (eq. 48 gain k2, eq. 46 nondimensional scale height beta)
     qeg_gain: float = 10.0
     qeg_beta: float = 920.0
+    # Lu 2014's path-limit feedback on the bank under alpha_law 'schedule' (paper 004's alpha laws
+    # hold the limits themselves; with them it is off): gain (0 = off; Lu: 40), prediction horizon
+    # [s] and the fraction of the vehicle's limits held (guidance/path_feedback.py); flown on board
+    # and in every prediction alike
+    path_gain: float = 0.0
+    path_horizon_s: float = 16.0
+    path_limit_fraction: float = 0.9
     # sigma_0 search: pio | pso | pso_stable | grid | brentq | secant | bounded | differential_evolution
     optimizer: str = "pio"
     # swarm settings (paper 004: N 10, k_max 20, k_c 14, R 0.2)
@@ -129,6 +136,9 @@ class SwarmBank(ReversingBankSpec, ReplansOnBoard):
         check_range("guidance.limit_fraction", self.limit_fraction, 0.5, 1.0)
         check_range("guidance.qeg_gain", self.qeg_gain, 0.0, 1e4)
         check_range("guidance.qeg_beta", self.qeg_beta, 1.0, 1e5)
+        check_range("guidance.path_gain", self.path_gain, 0.0, 1000.0)
+        check_range("guidance.path_horizon_s", self.path_horizon_s, 0.1, 600.0)
+        check_range("guidance.path_limit_fraction", self.path_limit_fraction, 0.5, 1.0)
         if self.optimizer not in OPTIMIZERS:
             raise ScenarioError(f"guidance.optimizer = {self.optimizer!r}; allowed: {', '.join(OPTIMIZERS)}")
         check_range("guidance.population", self.population, 2, 10000)

@@ -7,10 +7,16 @@ from the navigation estimate (one plan, about 10 ms of solver time at 40 nodes);
 normalised energy reaches ``replan_until_e``. A failed plan keeps the previous reference
 (or stays in pre-guidance), is recorded, and is retried a period later.
 
+With ``model_scales`` every re-plan is made in the air the flight has sensed: the corridor,
+the terminal drag and the drag-to-state maps of the vehicle with the filtered lift and drag
+ratios (DragEnergyPlanner.sensed), so that the drag a limit allows is the drag the flight will
+sense there.
+
 Ports:
   - input  "estimated_state"  [6]
   - input  "flight_conditions" [9]  only its drag entry is read: the accelerometer's drag
                                   (EntryVehicle output; the plan starts from the sensed drag)
+  - input  "model_scales"     [2]  (model_scales only) k_L, k_D sensed (systems/acceleration_ratios.py)
   - output "reference"        [4]  D_ref [m/s^2], D'_ref [1/m], D''_ref [s^2/m^3] at the
                                  estimate's energy, engaged flag (1 after the first plan)
   - output "replan_stats"     [4]  the schedule's account (systems/replan_scheduler.py)
@@ -55,10 +61,11 @@ class GuidanceMemory:
 class DragEnergyGuidance(ReplanScheduler):
     def __init__(self, planner: DragEnergyPlanner, *, period: float = 1.0, pre_guidance_min_s: float = 100.0,
                  replan_period_s: float = 0.0, replan_until_e: float = 0.9, latency_s: float = 0.0,
-                 latency_factor: float = 0.0):
+                 latency_factor: float = 0.0, model_scales: bool = False):
         """Args: planner; period [s]; pre_guidance_min_s [s]; replan_period_s [s] (0: plan once);
         replan_until_e: no re-plan past this normalised energy; latency_s [s], latency_factor: the
-        computing latency of each plan (systems/replan_scheduler.py)."""
+        computing latency of each plan (systems/replan_scheduler.py); model_scales: re-plans in
+        the sensed air (input "model_scales", module docstring)."""
         super().__init__()
         self.planner = planner
         self.pre_min = pre_guidance_min_s
@@ -67,6 +74,7 @@ class DragEnergyGuidance(ReplanScheduler):
                                    latency_factor=latency_factor)
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
+        self.scales_port = self.DeclareVectorInputPort("model_scales", 2) if model_scales else None
         self._memory = self.DeclareAbstractState(AbstractValue.Make(GuidanceMemory()))
         self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._update)
         self.DeclareVectorOutputPort("reference", 4, self._calc,
@@ -95,9 +103,11 @@ class DragEnergyGuidance(ReplanScheduler):
         if not due:
             return
         new = copy.deepcopy(mem)
+        sensed_air = ({} if self.scales_port is None or mem.reference is None
+                      else self.planner.sensed(self.scales_port.Eval(context)))  # re-plans: the filter has settled
 
         def solve():
-            ref = self.planner.plan_from_state(x, previous=mem.reference, sensed_drag=sensed)
+            ref = self.planner.plan_from_state(x, previous=mem.reference, sensed_drag=sensed, **sensed_air)
             ok = ref is not None and bool(ref.success)
             return (ref, np.array(x)), ok, "" if ok else ("the planner returned no plan" if ref is None else ref.message)
 

@@ -64,6 +64,16 @@ def test_a_mission_without_a_guidance_block_states_no_method():
     assert stated_guidance(cav_h) is None and derivation_for(cav_h, DragEnergy).search
 
 
+def test_drag_energy_re_plans_in_the_sensed_air_where_the_mission_disperses_the_forces():
+    """replan_model_scales follows the mission's dispersions: paper 004's CAV-H disperses the
+    density, lift and drag (its re-plans take the sensed vehicle's corridor), HORUS-2B only the
+    entry state (the nominal corridor is the flight's)."""
+    from drake_entry.guidance.drag_energy.spec import DragEnergy
+
+    assert derivation_for(load_scenario("cav_h_paper004"), DragEnergy).spec.replan_model_scales
+    assert not derivation_for(load_scenario("horus2b"), DragEnergy).spec.replan_model_scales
+
+
 def test_derivation_is_deterministic():
     scenario = load_scenario("horus2b")
     for spec in REGISTRY:

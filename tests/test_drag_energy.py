@@ -234,3 +234,39 @@ def test_replan_where_clarabel_stalls_without_refinement_still_succeeds(planner)
     assert ref.success, ref.message
     assert ref.range_flown() == pytest.approx(planner.range_to_go(np.array(case["state"])), rel=1e-5)
     assert 1.0 / ref.I[0] == pytest.approx(case["sensed_drag"], rel=1e-6)
+
+
+def test_a_re_plan_in_the_sensed_air_moves_each_limit_s_drag_bound_as_its_physics_does(planner, engagement_state):
+    """DragEnergyPlanner.sensed: with lift and drag sensed at k_L, k_D times the model's, the
+    drag HORUS-2B's normal-load limit allows is n_max g / (k_L/k_D L/D cos(alpha) + sin(alpha))
+    (the drag of the sensed vehicle at that altitude), the q bound moves with k_D / k_rho (k_rho = sqrt(k_L k_D),
+    the sensed density ratio: the limit is on the true q), the terminal drag is the sensed
+    vehicle's at the terminal state (inside the corridor), the nominal ratios change nothing,
+    and one set of ratios is computed once."""
+    from drake_entry.guidance.drag_energy.corridor import compute_corridor
+
+    assert planner.sensed((1.0, 1.0004)) == {}
+    k_l, k_d = 1.06, 1.03
+    over = planner.sensed((k_l, k_d))
+    assert planner.sensed((1.0601, 1.0299))["corridor"] is over["corridor"]  # rounded to 1e-3: the same
+    nominal, sensed = planner.corridor, over["corridor"]
+    free = compute_corridor(nominal.energy, planner.alpha, planner.vehicle, planner.planet, planner.atmosphere)
+    i = len(nominal.energy) // 2
+    E, alpha = nominal.energy[i], nominal.alpha[i]
+    h, V = _state_on_bound(planner, i, "normal_load")[:2]
+    cl, cd = planner.vehicle.aero.coefficients(alpha, V / planner.atmosphere.air_data(h)[1])
+    ld = cl / cd
+    ratio = (ld * math.cos(alpha) + math.sin(alpha)) / (k_l / k_d * ld * math.cos(alpha) + math.sin(alpha))
+    assert free.upper["normal_load"][i] == pytest.approx(nominal.upper["normal_load"][i])
+    assert sensed.upper["normal_load"][i] / nominal.upper["normal_load"][i] == pytest.approx(ratio, rel=2e-3)
+    k_rho = math.sqrt(k_l * k_d)
+    assert sensed.upper["dynamic_pressure"][i] / nominal.upper["dynamic_pressure"][i] == pytest.approx(
+        k_d / k_rho, rel=2e-3)
+    h_f, V_f = planner.terminal_state
+    D_f = drag_acceleration(h_f, V_f, planner.alpha(planner.E_final), over["vehicle"], planner.atmosphere)
+    lo, hi = sensed.bounds(np.array([planner.E_final]))
+    assert over["Df"] == pytest.approx(min(max(D_f, lo[0]), hi[0])) and lo[0] <= over["Df"] <= hi[0]
+    assert D_f == pytest.approx(k_d * planner.terminal_drag, rel=1e-9)
+    ref = planner.plan_from_state(engagement_state, **over)
+    assert ref.success, ref.message
+    assert np.all(ref.D <= np.interp(ref.energy, sensed.energy, sensed.D_max) * (1 + 1e-6))

@@ -2,6 +2,8 @@
 
   estimate, sensed drag --> DragEnergyGuidance --reference--> DragTrackingController
     --|sigma|--> BankReversalLogic --sigma_cmd--> (shared bank actuator)
+  with ``replan_model_scales``: estimate, sensed lift and drag, alpha flown -->
+      AccelerationRatioFilter --k_L, k_D--> DragEnergyGuidance (re-plans in the sensed air)
 
 The vehicle flies the scenario's alpha(E) schedule (paper 000 Sec. IV.A). The planner
 (``DragEnergyPlanner``: the corridor, computed once) is shared by every flight and sample.
@@ -14,6 +16,7 @@ import numpy as np
 
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
+from drake_entry.guidance.replanning_wiring import add_ratio_filter
 from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_count
 from drake_entry.systems.drag_energy_guidance import DragEnergyGuidance
 from drake_entry.systems.drag_energy_tracking import DragTrackingController
@@ -34,16 +37,20 @@ class DragEnergyMethod(GuidanceMethod):
         g = scenario.guidance
         guidance = builder.AddNamedSystem("drag_energy_guidance", DragEnergyGuidance(
             planner, period=g.period_s, pre_guidance_min_s=g.pre_guidance_min_s, replan_period_s=g.replan_period_s,
-            replan_until_e=g.replan_until_e, **g.latency()))
+            replan_until_e=g.replan_until_e, model_scales=g.replan_model_scales, **g.latency()))
         builder.Connect(plant.estimated_state, guidance.GetInputPort("estimated_state"))
         # the accelerometer's drag: guidance and feedback act on the drag actually felt
         builder.Connect(plant.flight_conditions, guidance.GetInputPort("flight_conditions"))
         pre_bank = math.radians(g.pre_guidance_bank_deg)
         magnitude = self.add_controller(builder, scenario, planner, plant, guidance.GetOutputPort("reference"))
         reversal = add_bank_reversal(builder, scenario, plant, magnitude, initial_sign=1.0 if pre_bank >= 0 else -1.0)
+        sinks = ()
+        if g.replan_model_scales:  # alpha is the scenario's schedule: the closed loop feeds the filter the alpha flown
+            ratios = add_ratio_filter(builder, scenario, plant, guidance.GetInputPort("model_scales"))
+            sinks = (ratios.GetInputPort("alpha_command"),)
         return GuidanceCommands(bank=reversal.GetOutputPort("bank_command"), initial_bank=pre_bank,
                                 logged={"reference": LoggedSignal(guidance.GetOutputPort("reference"),
-                                                                  REFERENCE_COLUMNS)})
+                                                                  REFERENCE_COLUMNS)}, alpha_sinks=sinks)
 
     def add_controller(self, builder, scenario, planner, plant: PlantPorts, reference):
         """Add the drag-tracking controller and return its bank-magnitude port |sigma| [rad];

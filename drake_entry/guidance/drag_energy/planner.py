@@ -524,7 +524,8 @@ class DragEnergyPlanner:
     def __init__(self, *, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, alpha: Schedule,
                  target_lon: float, target_lat: float, E_entry: float, E_final: float, n_nodes: int = 40,
                  solver: str = "clarabel", margin: float = 0.03, corridor_points: int = 300,
-                 sigma_max: float | None = None, terminal_drag: float | None = None):
+                 sigma_max: float | None = None, terminal_drag: float | None = None,
+                 terminal_state: tuple | None = None):
         if alpha.variable != "energy":
             raise ScenarioError(f"the drag-energy planner needs alpha scheduled in energy, got '{alpha.variable}'")
         self.vehicle, self.atmosphere, self.alpha = vehicle, atmosphere, alpha
@@ -532,10 +533,39 @@ class DragEnergyPlanner:
         self.target = (target_lon, target_lat)
         self.E_entry, self.E_final = E_entry, E_final
         self.terminal_drag = terminal_drag  # D_f of eq. 85, or None (free)
+        self.terminal_state = terminal_state  # (h_f [m], V_f [m/s]) D_f is the drag of
         self.n_nodes, self.solver = n_nodes, solver
         self.sigma_max = vehicle.bank_limit if sigma_max is None else sigma_max
         E = np.linspace(E_final, E_entry + 0.02 * (E_entry - E_final), corridor_points)
+        self.margin = margin
         self.corridor = compute_corridor(E, alpha, vehicle, self.planet, atmosphere, margin=margin)
+        self._sensed: tuple = (None, None)  # (rounded scales, their overrides): the last one asked
+
+    def sensed(self, scales) -> dict:
+        """The ``problem`` overrides of a re-plan in the flight's sensed air: the vehicle with
+        its lift and drag coefficients times ``scales`` = (k_L, k_D) and its q and heat-rate
+        limits divided by the sensed density ratio (models.acceleration_ratios.sensed_vehicle),
+        the corridor of that vehicle (the drag each limit allows, in the drag the accelerometer
+        senses) and the terminal drag (eq. 85) at the terminal state, within that corridor.
+        Scales are rounded to 1e-3 and the last set is kept, so a flight whose ratios have
+        settled computes its corridor once."""
+        from drake_entry.models.acceleration_ratios import sensed_vehicle
+
+        key = tuple(round(float(k), 3) for k in scales)
+        if key == (1.0, 1.0):
+            return {}
+        if self._sensed[0] != key:
+            vehicle = sensed_vehicle(self.vehicle, key)
+            corridor = compute_corridor(self.corridor.energy, self.alpha, vehicle, self.planet, self.atmosphere,
+                                        margin=self.margin)
+            found = {"vehicle": vehicle, "corridor": corridor}
+            if self.terminal_drag is not None and self.terminal_state is not None:
+                h_f, V_f = self.terminal_state
+                D_lo, D_hi = corridor.bounds(np.array([self.E_final]))
+                D_f = drag_acceleration(h_f, V_f, self.alpha(self.E_final), vehicle, self.atmosphere)
+                found["Df"] = float(min(max(D_f, D_lo[0]), D_hi[0]))
+            self._sensed = (key, found)
+        return dict(self._sensed[1])
 
     @staticmethod
     def from_scenario(scenario) -> "DragEnergyPlanner":
@@ -549,7 +579,7 @@ class DragEnergyPlanner:
             alpha=scenario.schedule("alpha"), target_lon=math.radians(scenario.target.longitude_deg),
             target_lat=math.radians(scenario.target.latitude_deg), E_entry=scenario.entry_energy(), E_final=Ef,
             n_nodes=g.n_nodes, solver=g.solver, margin=g.corridor_margin, corridor_points=g.corridor_points,
-            terminal_drag=D_f)
+            terminal_drag=D_f, terminal_state=(h_f, V_f))
 
     def energy(self, x) -> float:
         return float(self.planet.specific_energy(x[0], x[3]))

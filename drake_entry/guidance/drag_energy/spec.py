@@ -26,6 +26,10 @@ class DragEnergy(ReversingBankSpec, ReplansOnBoard):
     pre_guidance_min_s: float = 100.0
     # no re-planning past this normalised energy (little range is left to correct)
     replan_until_e: float = 0.9
+    # re-plans take the corridor, the terminal drag and the drag-to-state maps of the vehicle with
+    # the lift and drag ratios the flight has sensed (its q and heat-rate limits divided by the
+    # sensed density ratio, as SCvx's re-plans hold them)
+    replan_model_scales: bool = False
     # drag tracking (eq. 101), energy domain: zeta < 0 because E decreases (paper 000 Sec. VI.D)
     zeta: float = -0.7
     # pseudo-frequency omega_D [1/(J/kg)] = 2 pi / (energy per oscillation) (paper 000: constant)

@@ -16,7 +16,7 @@ from drake_entry.guidance.fnpeg.law import (
     qegc_sin_flight_path,
 )
 from drake_entry.guidance.fnpeg.onboard import FnpegSetup
-from drake_entry.guidance.path_feedback import path_limit_sin_flight_path
+from drake_entry.guidance.path_feedback import PathLimits, path_limit_sin_flight_path
 from drake_entry.models import dynamics
 from drake_entry.models.schedules import linear_bank
 from drake_entry.models.vehicles import load_vehicle
@@ -39,13 +39,13 @@ def test_linear_bank_runs_from_sigma0_to_sigmaf():
 
 
 def test_without_feedback_the_command_is_the_profile_and_the_limit_clips_it():
-    s = FeedbackSettings(R0, G0, damping_gain=0.0, path_gain=0.0, bank_limit=math.radians(85.0))
+    s = FeedbackSettings(R0, G0, damping_gain=0.0, bank_limit=math.radians(85.0))
     assert commanded_bank(0.7, 6000.0, -0.01, 5.0, 1.6, 5.2, 3e6, 3e4, s) == pytest.approx(0.7, abs=1e-12)
     assert commanded_bank(1.55, 6000.0, -0.01, 5.0, 1.6, 5.2, 3e6, 3e4, s) == pytest.approx(math.radians(85.0))
 
 
 def test_phugoid_damping_is_zero_on_the_qegc_descent_and_lifts_a_faster_descent():
-    s = FeedbackSettings(R0, G0, damping_gain=20.0, path_gain=0.0, damping_off_speed=2000.0, ramp=1000.0)
+    s = FeedbackSettings(R0, G0, damping_gain=20.0, damping_off_speed=2000.0, ramp=1000.0)
     V, L, D = 6000.0, 5.0, 1.6
     gamma_qegc = math.asin(qegc_sin_flight_path(V, L / D, s))
     assert -0.01 < gamma_qegc < 0.0  # a shallow glide descent
@@ -85,7 +85,7 @@ def test_path_limit_bound_keeps_the_predicted_quantity_at_its_limit(which):
                                        "heat": (4e6, 0.5, 3.15)}[which]
     limit = 0.9 * value
     kwargs = {"load_max": limit} if which == "load" else {"q_max": limit} if which == "q" else {"heat_max": limit}
-    s = FeedbackSettings(R0, G0, beta=beta, horizon=d, **kwargs).path_limits
+    s = PathLimits(R0, G0, beta=beta, horizon=d, **kwargs)
     loads = {"load": value, "q": 1.0, "heat": 1.0}
     u = path_limit_sin_flight_path(V, D, loads["load"], value if which == "heat" else 1.0,
                                    value if which == "q" else 1.0, s)
@@ -94,7 +94,7 @@ def test_path_limit_bound_keeps_the_predicted_quantity_at_its_limit(which):
 
 
 def test_law_is_the_same_for_float_and_symbolic_scalars():
-    s = FeedbackSettings(R0, G0, path_gain=40.0, load_max=1.8 * G0, heat_max=4.3e6, q_max=6e4,
+    s = FeedbackSettings(R0, G0, path=PathLimits(R0, G0, gain=40.0, load_max=1.8 * G0, heat_max=4.3e6, q_max=6e4),
                          bank_limit=math.radians(85.0))
     names = ("sigma", "V", "gamma", "L", "D", "a", "heat", "q")
     xs = [Variable(n) for n in names]

@@ -22,7 +22,6 @@ guidance (systems/fnpeg_guidance.py) evaluates it on the navigated state.
 from __future__ import annotations
 
 import dataclasses as dc
-import functools
 import math
 
 import numpy as np
@@ -31,6 +30,7 @@ from drake_entry.guidance.path_feedback import PathLimits, path_limit_correction
 from drake_entry.models.scalar import clamp
 
 __all__ = ["FeedbackSettings", "qegc_sin_flight_path", "commanded_bank"]
+
 
 @dc.dataclass(frozen=True)
 class FeedbackSettings:
@@ -43,10 +43,8 @@ class FeedbackSettings:
       damping_bank: sigma_QEGC [rad] (Lu 2014: 60 deg).
       damping_off_speed: V_off [m/s] where the damping gain reaches 0; ramp: the speed band [m/s]
         over which it ramps from k_0 (Lu 2014: off at V_f* + 1000 m/s).
-      path_gain: k of the path-limit feedback (Lu 2014: 40; 0 = off).
-      horizon: delta [s] of the path-limit prediction (Lu 2014: 0.02 nondimensional, about 16 s).
-      load_max [m/s^2] (total aerodynamic acceleration), heat_max [W/m^2], q_max [Pa]: limits
-        (inf = not enforced).
+      path: the path-limit feedback (guidance.path_feedback.PathLimits: gain k, Lu 2014's 40,
+        horizon delta, about 16 s, and the limits enforced); None = off.
       bank_limit: the largest |sigma_cmd| [rad].
     """
 
@@ -57,18 +55,8 @@ class FeedbackSettings:
     damping_bank: float = math.radians(60.0)
     damping_off_speed: float = 3000.0
     ramp: float = 1000.0
-    path_gain: float = 40.0
-    horizon: float = 16.0
-    load_max: float = math.inf
-    heat_max: float = math.inf
-    q_max: float = math.inf
+    path: PathLimits | None = None
     bank_limit: float = math.radians(90.0)
-
-    @functools.cached_property
-    def path_limits(self) -> PathLimits:
-        """The path-limit feedback's part (guidance.path_feedback)."""
-        return PathLimits(self.R0, self.g0, beta=self.beta, gain=self.path_gain, horizon=self.horizon,
-                          load_max=self.load_max, heat_max=self.heat_max, q_max=self.q_max)
 
 
 def _ramp(v, lo: float, width: float):
@@ -94,7 +82,7 @@ def commanded_bank(sigma_base, V, gamma, L, D, load, heat, q, s: FeedbackSetting
     if s.damping_gain > 0.0:
         k = s.damping_gain * _ramp(V, s.damping_off_speed, s.ramp)
         correction = correction + k * (hdot - V * qegc_sin_flight_path(V, L / D, s))
-    if s.path_limits.active:
-        correction = correction + path_limit_correction(V, sg, D, load, heat, q, s.path_limits)  # <= 0: only lifts
+    if s.path is not None and s.path.active:
+        correction = correction + path_limit_correction(V, sg, D, load, heat, q, s.path)  # <= 0: only lifts
     c = np.cos(sigma_base) - correction * math.sqrt(s.g0 / s.R0) / L
     return np.arccos(clamp(c, math.cos(s.bank_limit), 1.0))

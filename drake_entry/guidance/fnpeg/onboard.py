@@ -12,6 +12,7 @@ import numpy as np
 from drake_entry.guidance.fnpeg.corrector import Correction, CorrectorSettings, correct
 from drake_entry.guidance.fnpeg.law import FeedbackSettings, commanded_bank
 from drake_entry.guidance.fnpeg.predictor import Prediction, Predictor
+from drake_entry.guidance.path_feedback import PathLimits
 from drake_entry.models.schedules import Schedule, linear_bank
 
 __all__ = ["FnpegSetup"]
@@ -50,8 +51,10 @@ class FnpegSetup:
             planet.reference_radius, planet.g0, beta=g.scale_height_beta, damping_gain=g.damping_gain,
             damping_bank=math.radians(g.damping_bank_deg),
             damping_off_speed=g.terminal_velocity_m_s + g.damping_off_margin_m_s, ramp=g.damping_ramp_m_s,
-            path_gain=g.path_gain, horizon=g.path_horizon_s, load_max=limit(g.load_limit_g, planet.g0),
-            heat_max=limit(g.heat_rate_limit_kW_m2, 1e3), q_max=limit(g.dynamic_pressure_limit_kPa, 1e3),
+            path=PathLimits(planet.reference_radius, planet.g0, beta=g.scale_height_beta, gain=g.path_gain,
+                            horizon=g.path_horizon_s, load_max=limit(g.load_limit_g, planet.g0),
+                            heat_max=limit(g.heat_rate_limit_kW_m2, 1e3),
+                            q_max=limit(g.dynamic_pressure_limit_kPa, 1e3)),
             bank_limit=vehicle.bank_limit)
         alpha = Schedule(tuple(g.alpha_velocity_m_s), tuple(np.radians(g.alpha_deg)), "velocity")
         sigma_f = math.radians(g.bank_end_deg)

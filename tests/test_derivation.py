@@ -255,8 +255,21 @@ def test_the_matrix_reads_comparison_directories(tmp_path):
         "successful": 20, "samples": 20, "miss_km": {"median": 1.5, "p95": 2.25}, "wall_time_s": {"mean": 0.8}}}}))
     text = matrix_markdown([str(folder)])
     assert "| mine (20 runs, seed 3) | **20/20** (>= 89 %), miss 1.5 / 2.25 km, 0.8 s * | not flown: no DRS window |" in text
+    (folder / "scenarios").mkdir()
+    (folder / "scenarios" / "fnpeg.yaml").write_text("name: mine-fnpeg\n")
+    manifest = json.loads((folder / "comparison.json").read_text())
+    manifest["methods"]["fnpeg"].update(scenario="scenarios/fnpeg.yaml", derivation={"chosen": {
+        "guidance.bank_end_deg": 40.0}, "trials": [{"step": "guidance.bank_end_deg", "values": {
+            "guidance.bank_end_deg": 40.0}, "successes": 3, "flights": 3, "mean_box_ratio": 0.5, "wall_s": 1.0,
+            "setup_failure": "", "why": []}]})
+    (folder / "comparison.json").write_text(json.dumps(manifest))
     path = write_matrix([str(folder)], str(tmp_path / "m.md"))
-    assert "commit abc" in open(path).read()
+    text = open(path).read()
+    assert "commit abc" in text and "| [mine](derivations/mine.md) (20 runs, seed 3) |" in text
+    page = (tmp_path / "derivations" / "mine.md").read_text()  # the search that chose the settings, the scenario flown
+    assert "**fnpeg**: kept guidance.bank_end_deg = 40" in page and "| bank_end_deg 40 | 3 of 3 | 0.50 |" in page
+    assert "[mine/fnpeg.yaml](mine/fnpeg.yaml) (derived)" in page
+    assert (tmp_path / "derivations" / "mine" / "fnpeg.yaml").read_text() == "name: mine-fnpeg\n"
     with pytest.raises(CampaignError, match="holds no comparison report"):
         matrix_markdown([str(tmp_path)])
     manifest = json.loads((folder / "comparison.json").read_text())  # an expensive method flown with fewer runs

@@ -5,22 +5,29 @@ lower Clopper-Pearson bound on the success probability, the miss distance's medi
 percentile over the samples that reached the interface, and the core seconds per sample; or why
 the method was not flown (its first clause). Read from each directory's ``comparison.json`` and
 ``comparison_summary.json`` (drake_entry.comparison.report), so the matrix is regenerated from
-the directories, never typed.
+the directories, never typed. Beside it, each mission's page ``derivations/<mission>.md`` (every
+derived method's search: the candidates flown and which were kept) and the scenario each method
+flew (``derivations/<mission>/<label>.yaml``: fly a cell again with ``drake-entry campaign``).
 """
 from __future__ import annotations
 
 import json
 import os
+import shutil
 
 from scipy import stats as scipy_stats
 
 from drake_entry.campaign.store import write_atomic
+from drake_entry.comparison.report import derivation_tables, read_comparison_manifest
 from drake_entry.errors import CampaignError
 
-__all__ = ["LEVEL", "success_lower_bound", "read_comparison", "matrix_markdown", "write_matrix"]
+__all__ = ["LEVEL", "DERIVATIONS", "success_lower_bound", "read_comparison", "matrix_markdown", "write_derivations",
+           "write_matrix"]
 
 #: the one-sided confidence of the success bound
 LEVEL = 0.90
+#: the folder, beside the matrix, of each mission's derivation page and flown scenarios
+DERIVATIONS = "derivations"
 
 
 def success_lower_bound(successes: int, runs: int, level: float = LEVEL) -> float:
@@ -79,8 +86,9 @@ def _runs_text(comparison: dict) -> str:
     return f"{counts.pop()} runs" if len(counts) == 1 else "runs per cell" if counts else f"{comparison['runs']} runs"
 
 
-def matrix_markdown(folders: list[str]) -> str:
-    """The matrix of these comparison directories (rows: missions; columns: methods)."""
+def matrix_markdown(folders: list[str], *, links: bool = False) -> str:
+    """The matrix of these comparison directories (rows: missions; columns: methods); with
+    ``links`` each row names its mission's derivation page (``write_matrix`` writes them)."""
     comparisons = [read_comparison(f) for f in folders]
     labels = []
     for c in comparisons:
@@ -88,7 +96,8 @@ def matrix_markdown(folders: list[str]) -> str:
     out = ["| mission | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]
     for c in comparisons:
         cells = [_cell(c["methods"][label]) if label in c["methods"] else "—" for label in labels]
-        out.append(f"| {c['name']} ({_runs_text(c)}, seed {c['seed']}) | " + " | ".join(cells) + " |")
+        name = f"[{c['name']}]({DERIVATIONS}/{c['name']}.md)" if links else c["name"]
+        out.append(f"| {name} ({_runs_text(c)}, seed {c['seed']}) | " + " | ".join(cells) + " |")
     out += ["", f"Each cell: successful/samples (the one-sided {100 * LEVEL:.0f} % lower Clopper-Pearson bound on the "
             f"success probability), the miss distance's median / 95th percentile over the samples that reached the "
             f"interface, core seconds per sample; * settings derived from the mission (the mission's own method "
@@ -96,10 +105,39 @@ def matrix_markdown(folders: list[str]) -> str:
     return "\n".join(out)
 
 
+def write_derivations(folder: str, out_dir: str) -> str:
+    """Write ``folder``'s derivation page, ``out_dir/<mission>.md`` (each derived method's search,
+    drake_entry.comparison.report.derivation_tables; the scenario each method flew, copied to
+    ``out_dir/<mission>/<label>.yaml``); returns the page's path."""
+    c, meta = read_comparison(folder), read_comparison_manifest(folder)
+    name = c["name"]
+    os.makedirs(os.path.join(out_dir, name), exist_ok=True)
+    flown = []
+    for label, info in meta["methods"].items():
+        source = os.path.join(folder, info.get("scenario") or "")
+        if info.get("flown") and os.path.isfile(source):
+            shutil.copyfile(source, os.path.join(out_dir, name, f"{label}.yaml"))
+            flown.append(f"- {label}: [{name}/{label}.yaml]({name}/{label}.yaml)"
+                         + (" (derived)" if info.get("derivation") else " (the mission's own settings)"))
+    text = "\n".join([
+        f"# Settings of every method on {name}", "",
+        f"The scenario each method flew in the matrix's row, commit {', '.join(sorted(set(c['commits'])))} (fly a "
+        f"cell again: `drake-entry campaign {name}/LABEL.yaml --runs N --seed {c['seed']}`, N its samples):",
+        "", *(flown or ["- none flown"]), "",
+        derivation_tables(meta) or "No method's settings were derived on this mission.", ""])
+    path = os.path.join(out_dir, f"{name}.md")
+    write_atomic(path, text.encode())
+    return path
+
+
 def write_matrix(folders: list[str], path: str, *, title: str = "Every method on every mission") -> str:
-    """Write the matrix of ``folders`` to the Markdown file ``path``; returns ``path``."""
+    """Write the matrix of ``folders`` to the Markdown file ``path`` and each mission's derivation
+    page beside it (``write_derivations`` into DERIVATIONS); returns ``path``."""
     commits = sorted({c for f in folders for c in read_comparison(f)["commits"]})  # every session's: --only mixes
+    for folder in folders:
+        write_derivations(folder, os.path.join(os.path.dirname(os.path.abspath(path)), DERIVATIONS))
     text = (f"# {title}\n\nFrom {len(folders)} comparison directories (`drake-entry compare MISSION`), commit "
-            f"{', '.join(commits)}.\n\n" + matrix_markdown(folders) + "\n")
+            f"{', '.join(commits)}. Each mission links to the settings every method flew there and the search "
+            f"that chose them.\n\n" + matrix_markdown(folders, links=True) + "\n")
     write_atomic(path, text.encode())
     return path

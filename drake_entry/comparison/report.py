@@ -38,7 +38,8 @@ from drake_entry.errors import CampaignError
 from drake_entry.figures import plt, save_figure
 
 __all__ = ["MANIFEST", "LEVEL", "MARGIN_NAMES", "read_comparison_manifest", "clopper_pearson", "method_summary",
-           "summary_text", "dispersion_check", "write_comparison_report", "footprints", "success_intervals", "miss_distributions"]
+           "summary_text", "dispersion_check", "write_comparison_report", "derivation_tables", "footprints",
+           "success_intervals", "miss_distributions"]
 
 #: the file a comparison directory is identified by
 MANIFEST = "comparison.json"
@@ -168,7 +169,7 @@ def write_comparison_report(out_dir: str) -> str:
     figs = _figures(all_rows, summaries, out_dir, title, radius)
     sections = [_header(meta, summaries, same, compared, worst, scenario), _verdict_table(meta, summaries),
                 _error_table(summaries), _margin_table(summaries), _activity_table(meta, summaries),
-                _mapping_table(meta), _derivation_tables(meta), figure_list(figs) if figs else ""]
+                _mapping_table(meta), derivation_tables(meta), figure_list(figs) if figs else ""]
     return write_markdown_report(sections, out_dir, title=title)
 
 
@@ -312,7 +313,7 @@ def _mapping_table(meta) -> str:
     return "\n".join(out)
 
 
-def _derivation_tables(meta) -> str:
+def derivation_tables(meta) -> str:
     """Each derived method's search: every candidate flown, its successes of the search's flights
     and mean box ratio, and which were kept ('' when no method's settings were derived)."""
     derived = {label: info["derivation"] for label, info in meta["methods"].items() if info.get("derivation")}

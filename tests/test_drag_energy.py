@@ -252,7 +252,7 @@ def test_a_re_plan_in_the_sensed_air_moves_each_limit_s_drag_bound_as_its_physic
     nominal, sensed = planner.corridor, over["corridor"]
     free = compute_corridor(nominal.energy, planner.alpha, planner.vehicle, planner.planet, planner.atmosphere)
     i = len(nominal.energy) // 2
-    E, alpha = nominal.energy[i], nominal.alpha[i]
+    alpha = nominal.alpha[i]
     h, V = _state_on_bound(planner, i, "normal_load")[:2]
     cl, cd = planner.vehicle.aero.coefficients(alpha, V / planner.atmosphere.air_data(h)[1])
     ld = cl / cd

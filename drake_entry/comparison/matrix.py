@@ -80,10 +80,10 @@ def _cell(m: dict) -> str:
 
 
 def _runs_text(comparison: dict) -> str:
-    """'N runs' when every flown cell has N samples, else 'runs per cell' (``--only`` may fly
-    an expensive method with fewer samples into the same directory)."""
+    """'N runs' when every flown cell has N samples, 'runs per cell' when they differ (``--only``
+    may fly an expensive method with fewer samples into the same directory), 'none flown'."""
     counts = {m["summary"]["samples"] for m in comparison["methods"].values() if m["flown"] and m["summary"]}
-    return f"{counts.pop()} runs" if len(counts) == 1 else "runs per cell" if counts else f"{comparison['runs']} runs"
+    return f"{counts.pop()} runs" if len(counts) == 1 else "runs per cell" if counts else "none flown"
 
 
 def matrix_markdown(folders: list[str], *, links: bool = False) -> str:

@@ -533,7 +533,7 @@ class DragEnergyPlanner:
         self.target = (target_lon, target_lat)
         self.E_entry, self.E_final = E_entry, E_final
         self.terminal_drag = terminal_drag  # D_f of eq. 85, or None (free)
-        self.terminal_state = terminal_state  # (h_f [m], V_f [m/s]) D_f is the drag of
+        self.terminal_state = terminal_state  # (h_f [m], V_f [m/s]): where D_f is taken (sensed re-plans)
         self.n_nodes, self.solver = n_nodes, solver
         self.sigma_max = vehicle.bank_limit if sigma_max is None else sigma_max
         E = np.linspace(E_final, E_entry + 0.02 * (E_entry - E_final), corridor_points)

@@ -24,7 +24,7 @@ import numpy as np
 from pydrake.symbolic import Expression, Variable
 
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.path_feedback import PathLimits
+from drake_entry.guidance.path_feedback import PathLimits, enforced
 from drake_entry.guidance.swarm_bank import population_flight
 from drake_entry.guidance.swarm_bank.guidance_law import (
     LawMemory,
@@ -376,7 +376,7 @@ def _population_module(p: SwarmProblem, vehicle):
     path = law.path if law.path is not None and law.path.active else None
     # the path feedback's limits are inputs (a re-solution's sensed vehicle moves them): its form is in the key
     path_form = None if path is None else (path.gain, path.horizon, path.beta, path.R0, path.g0,
-                                           *(math.isfinite(getattr(path, k)) for k in PATH_LIMIT_FIELDS))
+                                           *(enforced(getattr(path, k)) for k in PATH_LIMIT_FIELDS))
     key = (*map(id, objects), vehicle.mass, vehicle.reference_area, vehicle.nose_radius, p.load_max, p.heat_max,
            law.k2, law.beta, law.bank_limit, path_form)
     found = _COMPILED.get(key)
@@ -395,7 +395,7 @@ def _population_module(p: SwarmProblem, vehicle):
         aero = (rho, a, mach, L, D, dynamic_pressure(rho, e["V"]), traced.heat_flux(rho, e["V"]),
                 np.sqrt(L * L + D * D) / pl.g0)
         traced_law = law if path is None else dc.replace(law, path=dc.replace(path, **{
-            k: e[f"path_{k}"] for k in PATH_LIMIT_FIELDS if math.isfinite(getattr(path, k))}))
+            k: e[f"path_{k}"] for k in PATH_LIMIT_FIELDS if enforced(getattr(path, k))}))
         magnitude = bank_magnitude(traced_law, e["sigma0"], e["V"], e["gamma"], pl.radius(e["h"]), e["L"], e["D"],
                                    e["sigmaf"], e["e0"], e["ef"], heat=e["heat"], q=e["q"])
         kernels = [

@@ -23,7 +23,7 @@ import os
 
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput
+from pydrake.systems.primitives import LogVectorOutput, Multiplexer
 
 from drake_entry.diagrams.common import add_step_loggers, run
 from drake_entry.diagrams.verification import fly_controls
@@ -186,6 +186,12 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
         initial_bank=commands.initial_bank, period=g.period_s))
     builder.Connect(commands.bank, bank.get_input_port())
     builder.Connect(bank.GetOutputPort("bank"), plant.GetInputPort("bank"))
+    if commands.bank_sinks:  # the bank flown and its rate, one [2] signal
+        flown = builder.AddNamedSystem("bank_flown", Multiplexer([1, 1]))
+        builder.Connect(bank.GetOutputPort("bank"), flown.get_input_port(0))
+        builder.Connect(bank.GetOutputPort("bank_rate"), flown.get_input_port(1))
+        for sink in commands.bank_sinks:
+            builder.Connect(flown.get_output_port(), sink)
     if inertial is not None:
         builder.Connect(bank.GetOutputPort("bank"), nav.GetInputPort("bank"))
     if commands.alpha is None:  # the scenario's alpha schedule, sampled at the guidance period

@@ -18,6 +18,9 @@ Ports:
   - input  "flight_conditions"  [9]  sensed rho, Mach, q, heat flux, loads, L, D, E (true vehicle)
   - input  "bank_command"       [1]  the signed bank command [rad] (its sign starts the on-board
                                    predictions; read only when re-solving, so no feedthrough)
+  - input  "bank_flown"         [2]  the bank actuator's position [rad] and rate [rad/s], where the
+                                   predictions' actuator starts (a reversal under way is flown on
+                                   in them); optional: unconnected, they start at the command, at rest
   - output "bank_magnitude"     [1]  |sigma| [rad]
   - output "alpha_command"      [1]  alpha [rad]
   - output "sigma0"             [1]  the sigma_0 in use [rad]
@@ -77,6 +80,7 @@ class SwarmBankGuidance(ReplanScheduler):
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self.bank_port = self.DeclareVectorInputPort("bank_command", 1)
+        self.flown_port = self.DeclareVectorInputPort("bank_flown", 2)
         alpha0 = problem.entry_alpha
         self._state = self.DeclareDiscreteState(BasicVector([alpha0, 0.0, 0.0, sigma0, 1.0, 1.0, problem.sigma_f]))
         self.DeclareReplanSchedule(replan_period_s=replan_period,
@@ -133,12 +137,13 @@ class SwarmBankGuidance(ReplanScheduler):
                 self.skip(discrete_state, t)
             else:
                 bank = float(self.bank_port.Eval(context)[0])
+                flown = self.flown_port.Eval(context) if self.flown_port.HasValue(context) else (bank, 0.0)
 
                 def solve():
                     vehicle = sensed_vehicle(p.vehicle, (m[_KL], m[_KD])) if self.acceleration_scaling else p.vehicle
                     here = dc.replace(p, vehicle=vehicle, x0=x, e0=p.start_energy, origin=(p.x0[1], p.x0[2]),
-                                      initial_alpha=alpha, initial_bank=bank,
-                                      initial_sign=1.0 if bank >= 0 else -1.0,
+                                      initial_alpha=alpha, initial_bank=float(flown[0]),
+                                      initial_bank_rate=float(flown[1]), initial_sign=1.0 if bank >= 0 else -1.0,
                                       memory=(bool(nxt.mach_was_above[0]), bool(nxt.switched[0])),
                                       max_time_s=max(p.max_time_s - t, p.guidance_step_s), sigma_f=float(m[_SIGMAF]))
                     r = resolve_sigma0(here, math.degrees(m[_SIGMA0]), self.bounds_deg)

@@ -265,6 +265,52 @@ def test_on_board_predictions_learn_the_lift_and_drag_the_flight_shows():
     assert ratios == pytest.approx([1.04, 0.97], abs=1e-4)
 
 
+def test_on_board_predictions_start_from_the_bank_flown(monkeypatch):
+    """A re-solution due while the actuator is mid-reversal predicts from the actuator's bank and
+    rate (input "bank_flown") with the command's sign, so the reversal under way is flown in the
+    predictions too; the closed loop feeds that input from the shared bank actuator. Started from
+    the command instead (the port unconnected), the prediction skips the sweep through wings level
+    and ends elsewhere."""
+    from pydrake.systems.analysis import Simulator
+
+    import drake_entry.systems.swarm_bank_guidance as guidance_module
+    from drake_entry.diagrams.closed_loop import ClosedLoopSetup, build_closed_loop
+    from drake_entry.guidance.swarm_bank.evaluator import evaluate
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario
+    from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, aero_accelerations
+
+    p = problem_from_scenario(_scenario())
+    seen = []
+    monkeypatch.setattr(guidance_module, "resolve_sigma0", lambda here, *a, **k: seen.append(here) or (_ for _ in ()).throw(
+        RuntimeError("stop after the problem is posed")))
+    system = guidance_module.SwarmBankGuidance(p, math.radians(SIGMA0_CASE1), replan_period=1.0,
+                                               acceleration_scaling=False)
+    context = system.CreateDefaultContext()
+    x = np.array([60e3, p.x0[1], p.x0[2], 6000.0, 0.0, p.x0[5]])
+    rho, a = p.atmosphere.air_data(60e3)
+    _, L, D = aero_accelerations(x, p.alpha_max, rho, a, p.vehicle)
+    fc = np.zeros(len(FLIGHT_CONDITION_NAMES))
+    for name, value in (("lift", L), ("drag", D), ("rho", rho), ("mach", 6000.0 / a),
+                        ("dynamic_pressure", 0.5 * rho * 6000.0**2), ("heat_flux", p.vehicle.heat_flux(rho, 6000.0))):
+        fc[FLIGHT_CONDITION_NAMES.index(name)] = value
+    system.GetInputPort("estimated_state").FixValue(context, x)
+    system.GetInputPort("flight_conditions").FixValue(context, fc)
+    system.GetInputPort("bank_command").FixValue(context, [math.radians(60.0)])
+    system.GetInputPort("bank_flown").FixValue(context, [math.radians(-50.0), math.radians(7.0)])
+    Simulator(system, context).AdvanceTo(1.5)  # the first re-solution is due at 1 s
+    here = seen[-1]
+    assert here.initial_bank == pytest.approx(math.radians(-50.0)) and here.initial_sign == 1.0
+    assert here.initial_bank_rate == pytest.approx(math.radians(7.0))
+    swept = evaluate(here, [math.radians(60.0)], record=True)
+    at_rest = evaluate(dc.replace(here, initial_bank=math.radians(60.0), initial_bank_rate=0.0), [math.radians(60.0)])
+    bank = np.array(swept.controls[0])[:, 2]
+    assert bank[0] == pytest.approx(math.radians(-50.0)) and bank.min() < math.radians(-50.0) + 1e-9
+    assert (np.diff(np.sign(bank[:400])) > 0).sum() == 1  # one sweep through wings level, to the command's side
+    assert abs(swept.range_error_m[0] - at_rest.range_error_m[0]) > 1e3
+    built = build_closed_loop(ClosedLoopSetup.from_scenario(_scenario(bank_start_deg=SIGMA0_CASE1)))
+    assert built.diagram.HasSubsystemNamed("bank_flown")
+
+
 def test_plan_evaluate_gives_controls_that_fly_the_plan(case1_plan):
     """``SwarmPlan.evaluate``'s alpha and bank, flown open loop by the Drake Simulator (the
     native plant, held to the Python one by tests/test_native_plant.py, fed by first-order-hold
@@ -319,7 +365,7 @@ def test_a_plan_that_reaches_taem_far_from_the_target_is_not_a_success(case1_pla
 
 
 @pytest.mark.parametrize("variant", ["load", "heat", "schedule", "scaled aerodynamics", "two parameters",
-                                     "floor and time", "path feedback"])
+                                     "floor and time", "path feedback", "mid-reversal"])
 def test_compiled_population_flies_as_the_numpy_evaluator(variant):
     """The population flown in one compiled call (population_flight with kernels generated from
     the models) against the vectorised numpy evaluator it replicates: every member's J within
@@ -349,6 +395,8 @@ def test_compiled_population_flies_as_the_numpy_evaluator(variant):
         assert p.law().path is None  # under the load law eq. 31's alpha holds the limits: no feedback
         p = dc.replace(p, case="schedule", alpha_schedule=((2000.0, 5500.0, 7000.0), tuple(np.radians([11.0, 10.5, 14.0]))))
         assert p.law().path.active
+    elif variant == "mid-reversal":  # an on-board re-solution while the actuator sweeps to the other side
+        p = dc.replace(p, initial_bank=math.radians(-65.0), initial_bank_rate=math.radians(-4.0), initial_sign=1.0)
     a = evaluate(p, sigma0, sigma_f=sigma_f)
     b = evaluate(p, sigma0, sigma_f=sigma_f, engine="numpy")
     assert (a.reached == b.reached).all() and (a.reversals == b.reversals).all()

@@ -74,6 +74,9 @@ class GuidanceCommands:
       logged: signals to log, by name.
       alpha_sinks: input ports of the method's systems that the closed loop feeds with the
         angle of attack flown [rad] (e.g. a filter of the sensed lift and drag ratios).
+      bank_sinks: [2] input ports that the closed loop feeds with the bank flown [rad] and its
+        rate [rad/s], the bank actuator's position (the attitude measured on board; e.g. where an
+        on-board prediction's actuator starts, mid-reversal included).
     """
 
     bank: OutputPort
@@ -83,6 +86,7 @@ class GuidanceCommands:
     initial_alpha: float = 0.0
     logged: dict[str, LoggedSignal] = dc.field(default_factory=dict)
     alpha_sinks: tuple = ()
+    bank_sinks: tuple = ()
 
 
 @dc.dataclass

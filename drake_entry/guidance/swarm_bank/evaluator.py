@@ -88,9 +88,10 @@ class SwarmProblem:
         (guidance.path_feedback; gain 0: paper 004's law).
       k2, beta: eq. 48 gain and eq. 46 nondimensional scale height (paper: 10, 920).
       reversal_heading, reversal_velocity: heading-error corridor [rad] linear in speed [m/s].
-      initial_alpha, initial_bank, initial_sign, memory: the actuators, the reversal sign and
-        the alpha law's memory at x0 (entry: alpha_max, or the schedule's alpha at x0's speed;
-        0, +1, nothing latched).
+      initial_alpha, initial_bank, initial_bank_rate, initial_sign, memory: the actuators
+        [rad, rad/s], the reversal sign and the alpha law's memory at x0 (entry: alpha_max, or
+        the schedule's alpha at x0's speed; 0, 0, +1, nothing latched). On board the bank and its
+        rate are the actuator's, so that a reversal under way is predicted as flown.
     """
 
     vehicle: object
@@ -121,6 +122,7 @@ class SwarmProblem:
     max_time_s: float = 5000.0
     initial_alpha: float | None = None
     initial_bank: float = 0.0
+    initial_bank_rate: float = 0.0
     initial_sign: float = 1.0
     memory: tuple = (False, False)  # (Mach was above Mach_shift, switched to Case 1)
     alpha_schedule: tuple = ((), ())
@@ -270,7 +272,7 @@ def _fly_numpy(p: SwarmProblem, sigma0, sigma_f, record: bool) -> Evaluation:
     x = np.tile(np.asarray(p.x0, float)[:, None], (1, n))
     alpha0 = p.entry_alpha
     alpha, alpha_rate = np.full(n, alpha0), np.zeros(n)
-    bank, bank_rate = np.full(n, p.initial_bank), np.zeros(n)
+    bank, bank_rate = np.full(n, p.initial_bank), np.full(n, p.initial_bank_rate)
     sign = np.full(n, 1.0 if p.initial_sign >= 0 else -1.0)
     memory = LawMemory.start(alpha0, n, was_above=p.memory[0], switched=p.memory[1])
     reversals = np.zeros(n, int)
@@ -429,7 +431,7 @@ def _fly_compiled(p: SwarmProblem, sigma0, sigma_f):
     n = sigma0.size
     alpha0 = p.entry_alpha
     values = dict(e0=p.start_energy, ef=p.ef, target_lon=p.target[0], target_lat=p.target[1], lift_scale=kl,
-                  drag_scale=kd, alpha0=alpha0, bank0=p.initial_bank, sign0=p.initial_sign,
+                  drag_scale=kd, alpha0=alpha0, bank0=p.initial_bank, bank_rate0=p.initial_bank_rate, sign0=p.initial_sign,
                   mach_was_above=float(p.memory[0]), switched=float(p.memory[1]), step_s=p.guidance_step_s,
                   substeps=max(1, int(round(p.guidance_step_s / p.actuator_substep_s))),
                   altitude_floor_m=p.altitude_floor_m, max_time_s=p.max_time_s, alpha_min=p.alpha_min,

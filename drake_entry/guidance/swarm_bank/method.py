@@ -201,7 +201,8 @@ class SwarmBankMethod(GuidanceMethod):
             alpha_limits=ActuatorLimits(p.alpha_min, p.alpha_max, p.alpha_rate, p.alpha_accel),
             initial_bank=p.initial_bank, initial_alpha=p.entry_alpha,
             logged={"alpha_command": LoggedSignal(guidance.GetOutputPort("alpha_command"), ("alpha_command_rad",)),
-                    "sigma0": LoggedSignal(guidance.GetOutputPort("sigma0"), ("sigma0_rad",))})
+                    "sigma0": LoggedSignal(guidance.GetOutputPort("sigma0"), ("sigma0_rad",))},
+            bank_sinks=(guidance.GetInputPort("bank_flown"),))
 
     def summarise(self, diagram, context, planner: SwarmPlan) -> GuidanceSummary:
         system = diagram.GetSubsystemByName(GUIDANCE_SYSTEM)

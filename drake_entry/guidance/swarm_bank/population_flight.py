@@ -41,7 +41,8 @@ PATH_LIMIT_FIELDS = ("load_max", "heat_max", "q_max")
 SETTINGS = ("e0", "ef", "target_lon", "target_lat", "lift_scale", "drag_scale", "alpha0", "bank0", "sign0",
             "mach_was_above", "switched", "step_s", "substeps", "altitude_floor_m", "max_time_s", "alpha_min",
             "alpha_max", "bank_limit", "alpha_rate", "bank_rate", "alpha_accel", "bank_accel", "bandwidth",
-            "heat_case", "mach_shift", "schedule_case", "path_load_max", "path_heat_max", "path_q_max")
+            "heat_case", "mach_shift", "schedule_case", "path_load_max", "path_heat_max", "path_q_max",
+            "bank_rate0")
 
 
 def _coefficient(alpha, mach, kl, kd, total, v, out):
@@ -101,7 +102,7 @@ def fly_population(x0, sigma0, sigma_f, settings, corridor_velocity, corridor_he
     half = steps // 2
     for i in range(sigma0.size):
         x[:] = x0
-        alpha, alpha_rate, bank, bank_rate = settings[6], 0.0, settings[7], 0.0
+        alpha, alpha_rate, bank, bank_rate = settings[6], 0.0, settings[7], settings[29]
         sign = 1.0 if settings[8] >= 0.0 else -1.0
         alpha_command, above, switched = settings[6], settings[9] > 0.5, settings[10] > 0.5
         n_rev, p0, p1, p2 = 0, 0.0, 0.0, 0.0

@@ -312,8 +312,8 @@ def test_a_resumed_comparison_reuses_the_derived_scenario(tmp_path, monkeypatch)
 
 
 def test_swarm_bank_on_horus2b_flies_the_mission_alpha_and_weighs_the_box():
-    """Paper 004's law on another mission: the mission's alpha ramp rewritten in speed (the load
-    law as the second candidate), sigma_f searched with sigma_0 before flight, eq. 32's units at
+    """Paper 004's law on another mission: its load law first, then the mission's alpha ramp
+    rewritten in speed, sigma_f searched with sigma_0 before flight, eq. 32's units at
     the box tolerances (2 km, 2 km), limits kept at 0.97 in the search, Lu 2014's path-limit
     feedback on the bank (HORUS-2B limits the heat rate, q and the load)."""
     from drake_entry.guidance.swarm_bank.derive import (
@@ -328,14 +328,14 @@ def test_swarm_bank_on_horus2b_flies_the_mission_alpha_and_weighs_the_box():
     d = derivation_for(scenario, SwarmBank)
     speeds, alphas, _ = alpha_rewritten(scenario, terminal_interface(scenario), "velocity")
     g = d.spec
-    assert g.alpha_law == "schedule" and g.alpha_deg == alphas == [15.0, 40.0]
+    assert g.alpha_law == "load" and g.alpha_deg == alphas == [15.0, 40.0]
     assert g.alpha_velocity_m_s == pytest.approx(speeds, abs=1e-3) and (g.alpha_min_deg, g.alpha_max_deg) == (15.0, 40.0)
     assert g.bank_end_bounds_deg == list(BANK_END_BOUNDS_DEG) and g.optimizer == "differential_evolution"
     assert (g.objective_range_unit_km, g.objective_altitude_unit_km) == (2.0, 2.0) and g.limit_fraction == LIMIT_FRACTION
     assert [s.name for s in d.search] == ["guidance.alpha_law", "guidance.qeg_gain", "guidance.terminal_altitude_km"]
     assert g.path_gain == PATH_GAIN == 40.0 and g.path_limit_fraction == PATH_LIMIT_FRACTION == 0.95
     assert d.search[1].candidates == ({"guidance.qeg_gain": 10.0}, {"guidance.qeg_gain": 0.0})
-    assert d.search[0].candidates == ({"guidance.alpha_law": "schedule"}, {"guidance.alpha_law": "load"})
+    assert d.search[0].candidates == ({"guidance.alpha_law": "load"}, {"guidance.alpha_law": "schedule"})
     g.validate(dc.replace(scenario, guidance=g))
 
 

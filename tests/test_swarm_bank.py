@@ -84,7 +84,41 @@ def test_on_board_resolution_from_entry_recovers_the_planned_sigma0():
     from drake_entry.guidance.swarm_bank.search import problem_from_scenario, resolve_sigma0
 
     r = resolve_sigma0(problem_from_scenario(_scenario()), SIGMA0_CASE1 + 4.0)
-    assert r.bracketed and r.sigma0_deg == pytest.approx(SIGMA0_CASE1, abs=0.05) and r.trajectories <= 24
+    assert r.bracketed and r.sigma0_deg == pytest.approx(SIGMA0_CASE1, abs=0.05) and r.trajectories <= 25
+    assert abs(r.range_error_m) < 1e3  # the secant point, flown to check it
+
+
+class _SignedRange:
+    """An Objective stand-in whose signed range error is ``d(sigma)`` [m] (for search._root)."""
+
+    def __init__(self, d):
+        self.d, self.log = d, []
+
+    def evaluate(self, X):
+        from types import SimpleNamespace
+
+        X = np.atleast_2d(np.asarray(X, float))
+        d = np.array([self.d(x) for x in X[:, 0]])
+        e = SimpleNamespace(range_error_m=d, J=np.abs(d) / 5e3, reached=np.ones(len(d), bool))
+        self.log.append((X.copy(), e))
+        return e
+
+
+def test_a_sign_change_across_a_jump_is_not_taken_for_a_root():
+    """The on-board root search takes a bracket's secant point only where it flies closer to the
+    target than both ends: across a jump of the signed range error (Lu 2014's CAV-H, a draw of
+    10 % more L/D: -31 000 km at 0 deg, where the flight turns away, +8900 km at 5 deg, +473 km
+    at the 85-deg bound) it keeps the member nearest the target, unbracketed; a smooth crossing
+    is still solved to its root."""
+    from drake_entry.guidance.swarm_bank.search import _root
+
+    def jump(s):
+        return -3.1e7 if s < 2.0 else 4.7e5 + (85.0 - s) * 1e5
+
+    sigma, bracketed, miss = _root(_SignedRange(jump), 80.0, (0.0, 85.0), 6.0, 8, 3)
+    assert not bracketed and sigma == 85.0 and miss == pytest.approx(4.7e5)
+    sigma, bracketed, miss = _root(_SignedRange(lambda s: (s - 41.3) * 2e4), 80.0, (0.0, 85.0), 6.0, 8, 3)
+    assert bracketed and sigma == pytest.approx(41.3, abs=1e-9) and abs(miss) < 1e-6
 
 
 def test_on_board_bank_end_resolution_zeroes_the_range_with_sigma0_held():
@@ -99,7 +133,7 @@ def test_on_board_bank_end_resolution_zeroes_the_range_with_sigma0_held():
     problem = problem_from_scenario(_scenario())
     at_root = resolve_bank_end(problem, SIGMA0_CASE1, (20.0, 85.0))
     assert at_root.bracketed and at_root.sigma0_deg == SIGMA0_CASE1
-    assert at_root.sigma_f_deg == pytest.approx(60.0, abs=0.1) and at_root.trajectories <= 24
+    assert at_root.sigma_f_deg == pytest.approx(60.0, abs=0.1) and at_root.trajectories <= 25
     held = SIGMA0_CASE1 + 3.0
     before = evaluate(problem, np.radians([held])).range_error_m[0]
     off = resolve_bank_end(problem, held, (20.0, 85.0))

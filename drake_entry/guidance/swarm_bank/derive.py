@@ -69,9 +69,9 @@ def derive(scenario) -> Derivation:
     widen = 1.0 if hi - lo < 1.0 else 0.0  # a constant alpha: the load law still needs room to move
     require_alpha_window(scenario, widen)
     lo, hi = lo - widen, hi + widen
-    try:  # the mission's alpha in speed, as FNPEG flies it: the first alpha law tried
+    try:  # the mission's alpha in speed, as FNPEG flies it: the alpha law tried after the paper's
         speeds, scheduled, how = alpha_rewritten(scenario, interface, "velocity")
-        laws = ("schedule", "load")
+        laws = ("load", "schedule")
     except CannotFly as e:
         speeds, scheduled, how, laws = [], [], f"no schedule in speed ({e})", ("load",)
     term = scenario.terminal
@@ -123,8 +123,11 @@ def derive(scenario) -> Derivation:
         corridor,
     ]
     search = [SearchStep.over("guidance.alpha_law", laws,
-                              "the mission's alpha schedule (as the other methods fly it), else Case 1's load law "
-                              "(eq. 31) between its extremes"),
+                              "Case 1's load law (eq. 31, paper 004's) between the schedule's extremes, which trades "
+                              "alpha as well as the bank for range, else the mission's alpha schedule (as the other "
+                              "methods fly it). Under the schedule a draw with more L/D than the search's can shed "
+                              "range by the bank alone: on Lu 2014's CAV-H (100 runs) the schedule, 3 of 3 in the "
+                              "search, left three draws of L/D +10 to +17 % beyond reach at an 85-deg bank"),
               SearchStep.over("guidance.qeg_gain", QEG_GAINS,
                               "eqs. 46-48 steer towards a quasi-equilibrium glide, which a low-L/D capsule does not "
                               "fly (Lu 2008's capsule: 4 of 10 with the paper's k2 = 10, 10 of 10 without)"),

@@ -224,7 +224,7 @@ def _bracketed_secant(f: Objective, lo: float, hi: float) -> str:
 @dc.dataclass
 class Resolution:
     """An on-board re-solution: sigma_0 [deg], whether a root of the signed range error was
-    bracketed, the predicted range error of the closest member when not [m], trajectories, and
+    bracketed, the predicted range error there (of the closest member when not) [m], trajectories, and
     sigma_f [deg] when it was re-solved too (``resolve_bank_end``; nan: unchanged)."""
 
     sigma0_deg: float
@@ -237,18 +237,23 @@ class Resolution:
 def _root(f: Objective, previous: float, bounds_deg, width_deg: float, points: int, rounds: int):
     """(the position zeroing the signed range error, bracketed, its range error [m]): grid rounds
     of ``points`` positions, first within +-``width_deg`` of ``previous`` (the whole bounds when
-    that holds no sign change), then inside the bracket, then the secant of the bracket's ends;
-    without a sign change, the member with the smallest |range error|."""
+    that holds no sign change), then inside the bracket, then the secant of the bracket's ends,
+    flown: it is the root only where its |range error| is below both ends' (a sign change across
+    a jump, e.g. between a flight that turns away and one that does not, is no root); otherwise,
+    or without a sign change, the member with the smallest |range error|."""
     lo_b, hi_b = bounds_deg
     lo, hi = max(lo_b, previous - width_deg), min(hi_b, previous + width_deg)
     found = _refine(f, np.linspace(lo, hi, points), points=points, rounds=rounds)
     if found is None and (lo > lo_b or hi < hi_b):
         found = _refine(f, np.linspace(lo_b, hi_b, 2 * points), points=points, rounds=rounds)
-    if found is None:
-        X, d, _, ok = _samples(f)
-        i = int(np.argmin(np.where(ok, np.abs(d), np.inf)))
-        return float(X[i]), False, float(d[i])
-    return _secant(found), True, 0.0
+    if found is not None:
+        x = _secant(found)
+        e = f.evaluate([[x]])
+        if e.reached[0] and abs(e.range_error_m[0]) <= min(abs(found[2]), abs(found[3])):
+            return x, True, float(e.range_error_m[0])
+    X, d, _, ok = _samples(f)
+    i = int(np.argmin(np.where(ok, np.abs(d), np.inf)))
+    return float(X[i]), False, float(d[i])
 
 
 def resolve_sigma0(problem: SwarmProblem, previous_deg: float, bounds_deg=(0.0, 89.0), *, width_deg: float = 6.0,

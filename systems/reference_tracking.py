@@ -30,9 +30,19 @@ lift there. A plan made at the entry with the nominal models (paper 003's) other
 denser or draggier flight for the nominal altitude, and the range it loses per unit of energy
 is the drag's excess.
 
+With ``path`` (a PathLimits, not paper 003's) each update's command also flies Lu 2014's
+path-limit feedback (guidance/path_feedback.py, as FNPEG's and paper 004's laws do): where the
+sensed load, heat rate or dynamic pressure would pass ``path``'s limits a horizon ahead,
+cos(sigma_c) is raised by k V (max{sin gamma, U} - sin gamma) sqrt(g0/R0) / L, the sign kept. The
+tracker carries the lifted command on (its offset from the feed-forward, as the feedback's), so
+the lift stays until the TVLQR feedback returns the flight to its reference. The TVLQR itself
+sees no limit: a flight away from its reference, or in denser air than planned, may pass one (the
+capsule's final dive passed its q in 21 of 100 runs without the feedback).
+
 Ports:
   - input  "estimated_state"  [6]  navigation estimate [h m, lon, lat rad, V m/s, gamma, psi rad]
   - input  "model_scales"     [2]  (model_scales only) k_L, k_D sensed
+  - input  "flight_conditions" [9] (path only) sensed flight conditions (FLIGHT_CONDITION_NAMES)
   - output "bank_command"     [1]  sigma_c [rad]
   - output "reference_state"  [7]  the reference [h m, lon, lat rad, V m/s, gamma, psi, sigma rad] now
 """
@@ -47,10 +57,13 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.guidance.ampi.spec import TRACKING_INDICES
-from drake_entry.models.dynamics import specific_energy
+from drake_entry.guidance.path_feedback import PathLimits, path_limit_correction
+from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, specific_energy
 
 __all__ = ["LAW_STATES", "SCALE_HEIGHT_STEP_M", "TrackerMemory", "ReferenceTracker", "sensed_reference",
-           "sensed_bank"]
+           "sensed_bank", "limited_bank"]
+
+_FC = {name: i for i, name in enumerate(FLIGHT_CONDITION_NAMES)}
 
 #: the reference problem's state layout the law is written in
 LAW_STATES = ("h", "lon", "lat", "V", "gamma", "psi", "sigma", "t")
@@ -83,6 +96,19 @@ def sensed_bank(sigma_ref: float, scales) -> float:
     return math.copysign(math.acos(min(max(math.cos(sigma_ref) * ratio, -1.0), 1.0)), sigma_ref)
 
 
+def limited_bank(sigma: float, x, conditions, path: PathLimits, bank_limit: float) -> float:
+    """The bank [rad] ``sigma`` with Lu 2014's path-limit feedback (module docstring) at the
+    estimate ``x`` [h, lon, lat, V, gamma, psi] and the sensed ``conditions`` (FLIGHT_CONDITION_NAMES):
+    |sigma| only lowered, within ``bank_limit`` [rad], its sign kept; unchanged without lift."""
+    L, D = float(conditions[_FC["lift"]]), float(conditions[_FC["drag"]])
+    if not L > 0.0:
+        return sigma
+    term = path_limit_correction(float(x[3]), math.sin(float(x[4])), D, math.hypot(L, D),
+                                 float(conditions[_FC["heat_flux"]]), float(conditions[_FC["dynamic_pressure"]]), path)
+    c = math.cos(sigma) - term * math.sqrt(path.g0 / path.R0) / L
+    return math.copysign(math.acos(min(max(c, math.cos(bank_limit)), 1.0)), sigma)
+
+
 @dc.dataclass(frozen=True)
 class TrackerMemory:
     """reference: the TrackedReference (None when it could not be made); message: why not;
@@ -95,14 +121,17 @@ class TrackerMemory:
 
 class ReferenceTracker(LeafSystem):
     def __init__(self, planner, *, bank_limit: float, rate_limit: float, period: float = 0.5,
-                 initial_bank: float = 0.0, lead: float = 0.0, index: str = "time", density=None):
+                 initial_bank: float = 0.0, lead: float = 0.0, index: str = "time", density=None,
+                 path: PathLimits | None = None):
         """Args: planner with reference(estimate) -> TrackedReference and ``problem.state_names``
         == LAW_STATES; bank_limit [rad], rate_limit [rad/s] of the command; period [s];
         initial_bank [rad] (held when no reference can be made); lead [s]: the feed-forward is
         the reference bank this far ahead, the lag of the actuator loop the command drives;
         index: 'time' or 'energy', what the reference is read at (module docstring); density:
         the nominal atmosphere's density [kg/m^3] at an altitude [m], given to read the
-        reference at the sensed lift and drag ratios (input "model_scales", module docstring)."""
+        reference at the sensed lift and drag ratios (input "model_scales", module docstring);
+        path: Lu 2014's path-limit feedback on the command (input "flight_conditions", module
+        docstring; None or inactive: none)."""
         super().__init__()
         if tuple(planner.problem.state_names) != LAW_STATES:
             raise ScenarioError(f"ReferenceTracker needs a reference with states {LAW_STATES} (controls 'bank_rate'), "
@@ -122,6 +151,9 @@ class ReferenceTracker(LeafSystem):
         self.scales_port = None if density is None else self.DeclareVectorInputPort("model_scales", 2)
         if density is not None:  # the ratios of the last update (its feed-forward's)
             self._scales = self.DeclareDiscreteState(BasicVector([1.0, 1.0]))
+        self.path = path if path is not None and path.active else None
+        self.fc_port = None if self.path is None else self.DeclareVectorInputPort(
+            "flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self._memory = self.DeclareAbstractState(AbstractValue.Make(TrackerMemory()))
         self._bank = self.DeclareDiscreteState(BasicVector([float(initial_bank)]))
         self.DeclareInitializationUnrestrictedUpdateEvent(self._start)
@@ -183,8 +215,10 @@ class ReferenceTracker(LeafSystem):
         feedback = float(law.gain(t)[0] @ (x - x_ref))
         target = ff_next + (sigma - ff_now) - feedback * T
         step = min(max(target - sigma, -self.rate_limit * T), self.rate_limit * T)
-        discrete_state.get_mutable_vector(self._bank).SetFromVector(
-            [min(max(sigma + step, -self.bank_limit), self.bank_limit)])
+        command = min(max(sigma + step, -self.bank_limit), self.bank_limit)
+        if self.path is not None:
+            command = limited_bank(command, x, self.fc_port.Eval(context), self.path, self.bank_limit)
+        discrete_state.get_mutable_vector(self._bank).SetFromVector([command])
 
     def _reference_state(self, context, output):
         memory = self.memory(context)

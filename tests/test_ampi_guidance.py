@@ -219,8 +219,43 @@ def test_tracker_at_nominal_ratios_commands_what_it_commands_without_them(planne
     assert not ReferenceTracker(planner, bank_limit=1.0, rate_limit=0.1).HasInputPort("model_scales")
 
 
+def test_tracker_path_limit_feedback_only_lifts_where_a_limit_is_ahead(planner):
+    """limited_bank: descending at -8 deg with q at 0.97 of a 30-kPa limit held at 0.95, Lu 2014's
+    feedback raises cos(sigma) by exactly k V (U - sin gamma) sqrt(g0/R0) / L (U the flight-path
+    sine that holds q 16 s ahead), the sign kept; level flight far below the limit, or no lift,
+    leaves the command alone. Only a tracker with an active feedback reads the flight conditions."""
+    from drake_entry.guidance.path_feedback import PathLimits, path_limit_sin_flight_path
+    from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+    from drake_entry.models.planet import Earth
+    from drake_entry.systems.reference_tracking import ReferenceTracker, limited_bank
+
+    path = PathLimits(6378137.0, 9.80665, gain=40.0, q_max=0.95 * 30e3)
+    fc = np.zeros(len(FLIGHT_CONDITION_NAMES))
+    idx = {n: i for i, n in enumerate(FLIGHT_CONDITION_NAMES)}
+    V, gamma, L, D, q = 1500.0, math.radians(-8.0), 8.0, 5.0, 0.97 * 30e3
+    fc[idx["lift"]], fc[idx["drag"]], fc[idx["dynamic_pressure"]] = L, D, q
+    x = [25e3, 0.0, 0.0, V, gamma, 0.0]
+    U = path_limit_sin_flight_path(V, D, math.hypot(L, D), 0.0, q, path)
+    assert U > math.sin(gamma)  # the limit is ahead
+    sigma = math.radians(-120.0)
+    lifted = limited_bank(sigma, x, fc, path, math.radians(170.0))
+    expected = math.cos(sigma) + 40.0 * V * (U - math.sin(gamma)) * math.sqrt(9.80665 / 6378137.0) / L
+    assert lifted < 0.0 and math.cos(lifted) == pytest.approx(min(expected, 1.0), rel=1e-12)
+    assert abs(lifted) < abs(sigma)
+    level = [25e3, 0.0, 0.0, V, 0.0, 0.0]
+    fc[idx["dynamic_pressure"]] = 0.3 * 30e3
+    assert limited_bank(sigma, level, fc, path, math.radians(170.0)) == sigma
+    fc[idx["lift"]] = 0.0
+    assert limited_bank(sigma, x, fc, path, math.radians(170.0)) == sigma
+    assert ReferenceTracker(planner, bank_limit=1.0, rate_limit=0.1, path=path).HasInputPort("flight_conditions")
+    off = PathLimits.of_vehicle(planner.problem.vehicle.limits, Earth(), gain=0.0, horizon=16.0, fraction=0.95)
+    assert not ReferenceTracker(planner, bank_limit=1.0, rate_limit=0.1, path=off).HasInputPort("flight_conditions")
+
+
 @pytest.mark.parametrize("field, value, message", [
     ("reference", "best", "guidance.reference = 'best'; allowed: ampi, ntt"),
+    ("path_gain", -1.0, r"guidance.path_gain = -1.0 is out of range; allowed \[0, 1000\]"),
+    ("path_limit_fraction", 1.2, r"guidance.path_limit_fraction = 1.2 is out of range"),
     ("database", "nowhere.npz", "guidance.database 'nowhere.npz' is neither a packaged database"),
     ("tracking_scales", [1.0] * 6, "guidance.tracking_scales needs 7 values, got 6"),
     ("bank_lead_s", 20.0, r"guidance.bank_lead_s = 20.0 is out of range; allowed \[0, 10\]"),

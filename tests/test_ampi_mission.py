@@ -80,14 +80,20 @@ def test_derived_settings_grid_the_deviations_that_move_the_end_most():
     q = 0.5 * float(scenario.make_atmosphere().density(25e3)) * d.spec.terminal_velocity_m_s ** 2
     assert d.spec.terminal_altitude_km == 25.0 and q == pytest.approx(0.97 ** 2 * 0.93 * 1e4, rel=1e-4)
     assert "gamma, psi, h left to the tracker" in d.choices[2].how
-    # the final position weighted at a tenth of the 2-km box (paper 003's 0.01 deg is 1.1 km)
+    # the final position weighted at a tenth of the 2-km box (paper 003's 0.01 deg is 1.1 km), then a
+    # fiftieth, searched
     assert d.spec.terminal_scales[1] == pytest.approx(math.degrees(200.0 / 6378137.0), rel=2e-3)
+    heavier = d.search[-1].candidates[1]["guidance.terminal_scales"]
+    assert heavier[1] == heavier[2] == pytest.approx(math.degrees(40.0 / 6378137.0), rel=2e-3)
+    # Lu 2014's path-limit feedback where the vehicle has limits (HORUS-2B: heat rate, q, load)
+    assert (d.spec.path_gain, d.spec.path_limit_fraction) == (40.0, 0.95)
     _, capsule = _derived("capsule_lu2008")
     assert set(capsule.spec.grid) == {"lat", "lon", "psi"}
     # the reading of the reference searched; the sensed ratios only where the air or aerodynamics
     # are dispersed (the capsule's density, C_L, C_D, mass; HORUS-2B's entry alone)
-    assert [step.name for step in d.search] == ["guidance.tracking_index"]
-    assert [step.name for step in capsule.search] == ["guidance.tracking_index", "guidance.model_scales"]
+    assert [step.name for step in d.search] == ["guidance.tracking_index", "guidance.terminal_scales"]
+    assert [step.name for step in capsule.search] == ["guidance.tracking_index", "guidance.model_scales",
+                                                       "guidance.terminal_scales"]
     assert capsule.search[1].candidates == ({"guidance.model_scales": False}, {"guidance.model_scales": True})
     assert "density_scale, lift_scale, drag_scale, mass_scale" in capsule.search[1].why
     assert derivation_for(load_scenario("shefex3_ampi"), Ampi).spec.database == "shefex3"  # its own settings

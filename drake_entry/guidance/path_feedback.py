@@ -42,6 +42,16 @@ class PathLimits:
     heat_max: float = math.inf
     q_max: float = math.inf
 
+    @classmethod
+    def of_vehicle(cls, limits, planet, *, gain: float, horizon: float, fraction: float,
+                   beta: float = 900.0) -> "PathLimits":
+        """The feedback holding ``fraction`` of a vehicle's ``limits`` (models.vehicles.PathLimits:
+        its load bound [g], heat rate, q; inf where it has none) on ``planet`` (reference_radius,
+        g0), with ``gain`` and ``horizon`` [s]."""
+        return cls(planet.reference_radius, planet.g0, beta=beta, gain=gain, horizon=horizon,
+                   load_max=fraction * limits.load_bound_max * planet.g0, heat_max=fraction * limits.heat_flux_max,
+                   q_max=fraction * limits.dynamic_pressure_max)
+
     @property
     def active(self) -> bool:
         """A gain and at least one limit enforced."""

@@ -16,6 +16,8 @@ import math
 from drake_entry.guidance.ampi.mission import BANK_FRACTION, BANK_RATE_FRACTION
 from drake_entry.guidance.ampi.spec import MISSION_DATABASE, TRACKING_INDICES, Ampi
 from drake_entry.guidance.derivation import (
+    PATH_GAIN,
+    PATH_LIMIT_FRACTION,
     Q_SPEED_FRACTION,
     CannotFly,
     Choice,
@@ -28,7 +30,7 @@ from drake_entry.guidance.derivation import (
 )
 from drake_entry.models.dispersions import entry_spread, force_dispersions
 
-__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "LD_NODES_RANGE", "ld_nodes", "TRACKING_STATE_WEIGHT", "TERMINAL_POSITION_FRACTION", "range_effects",
+__all__ = ["GRID_DIMENSIONS", "GRID_NAMES", "LD_NODES_RANGE", "ld_nodes", "TRACKING_STATE_WEIGHT", "TERMINAL_POSITION_FRACTIONS", "range_effects",
            "derive"]
 
 #: the most entry offsets a derived grid spans (3 levels each: 27 solves, a few minutes on 2 cores)
@@ -39,10 +41,13 @@ GRID_DIMENSIONS = 3
 #: 125 km; 1e-2, 147 km with the planned bank rate at the vehicle's limit and 0.18 km with it at a
 #: quarter and the planned bank at 0.9 of the limit (guidance.ampi.mission)
 TRACKING_STATE_WEIGHT = 1.0e-2
-#: the TVLQR's final-position scale as a fraction of the box's distance tolerance (paper 003's
-#: 0.01 deg, 1.1 km, for its 25-km window). HORUS-2B's nominal with 0.01 deg ended 5.6 km from the
-#: target, with 0.002 deg (220 m) 1.0 km, against its 2-km box
-TERMINAL_POSITION_FRACTION = 0.1
+#: the TVLQR's final-position scales searched, as fractions of the box's distance tolerance (paper
+#: 003's 0.01 deg, 1.1 km, for its 25-km window). HORUS-2B's nominal with 0.01 deg ended 5.6 km
+#: from the target, with 0.002 deg (220 m) 1.0 km, against its 2-km box. A fiftieth pulls the
+#: short flights home (20 runs with the path-limit feedback: the capsule 36 of 40 against 33 of 40,
+#: paper 004's CAV-H 18 of 20 against 5, HORUS-2B's misses 0.04 km against 0.2) and throws a long
+#: glide off (Lu 2014's CAV-H: 558 km median against 19 km), so the search flies both
+TERMINAL_POSITION_FRACTIONS = (0.1, 0.02)
 #: the fewest and most LD nodes of a derived database (paper 003 stores its 600-s flights at 60)
 LD_NODES_RANGE = (60, 400)
 #: the grid's names of the entry deviations, in the dispersions' order [m, deg, deg, m/s, deg, deg]
@@ -104,10 +109,17 @@ def derive(scenario) -> Derivation:
     spec = Ampi(database=MISSION_DATABASE, terminal_altitude_km=altitude, terminal_velocity_m_s=speed, ld_nodes=nodes,
                 grid={n: round(v, 6) for n, v in steps.items()}, tracking_state_weight=TRACKING_STATE_WEIGHT)
     tolerance_km = scenario.terminal.distance_tolerance_km
+    radius = scenario.make_planet().reference_radius
+
+    def terminal_scales(fraction: float) -> list[float]:
+        position = round(math.degrees(fraction * tolerance_km * 1e3 / radius), 6)
+        return [spec.terminal_scales[0], position, position, spec.terminal_scales[3]]
+
     if tolerance_km:
-        position = round(math.degrees(TERMINAL_POSITION_FRACTION * tolerance_km * 1e3
-                                      / scenario.make_planet().reference_radius), 6)
-        spec.terminal_scales = [spec.terminal_scales[0], position, position, spec.terminal_scales[3]]
+        spec.terminal_scales = terminal_scales(TERMINAL_POSITION_FRACTIONS[0])
+    lim = scenario.make_vehicle().limits
+    limited = any(math.isfinite(x) for x in (lim.heat_flux_max, lim.dynamic_pressure_max, lim.load_bound_max))
+    spec.path_gain, spec.path_limit_fraction = (PATH_GAIN if limited else 0.0), PATH_LIMIT_FRACTION
     units = {"h": "m", "V": "m/s"}
     left = [n for n in ranked if n not in names]
     choices = [
@@ -129,10 +141,10 @@ def derive(scenario) -> Derivation:
         Choice("guidance.tracking_state_weight", TRACKING_STATE_WEIGHT,
                "the TVLQR holds the reference along a long glide, not only at its end (paper 003's 1e-5 left "
                "Lu 2014's CAV-H nominal 3440 km off)"),
-        Choice("guidance.terminal_scales", spec.terminal_scales,
-               f"the final position weighted at {TERMINAL_POSITION_FRACTION:g} of the box's distance tolerance "
-               f"(paper 003's 0.01 deg left HORUS-2B's nominal 5.6 km from the target, against its 2-km box)"
-               if tolerance_km else "paper 003's (the box checks no distance)"),
+        Choice("guidance.path_gain, path_limit_fraction", f"{spec.path_gain:g}, {spec.path_limit_fraction:g}",
+               "Lu 2014's path-limit feedback on the tracker's command (FNPEG's), holding that fraction of the "
+               "vehicle's limits, which the TVLQR does not see (the capsule's final dive: q over in 21 of 100 runs "
+               "without it)" if limited else "the vehicle states no limit to hold"),
         Choice("alpha", "as the mission's" if own_alpha else ", ".join(
             f"{v:g} deg" + ("" if len(alpha.breakpoints) == 1 else f" at {b:g}")
             for b, v in zip(alpha.breakpoints, alpha.values_deg)) + f" ({alpha.variable})",
@@ -154,5 +166,14 @@ def derive(scenario) -> Derivation:
             f"or draggier flight for the nominal altitude; read at the sensed ratios it asks the altitude of the "
             f"reference's drag (the capsule's 6 campaign draws: 9-13 km misses as planned, 1.7-3.2 km read at the "
             f"sensed ratios): both flown, the better kept", exhaustive=True))
+    if tolerance_km:
+        search.append(SearchStep.over(
+            "guidance.terminal_scales", [terminal_scales(f) for f in TERMINAL_POSITION_FRACTIONS],
+            "the TVLQR's final position weighted at " + " or ".join(f"{f:g}" for f in TERMINAL_POSITION_FRACTIONS)
+            + " of the box's distance tolerance: the heavier pulls a short flight home and throws a long glide off "
+            "(20 runs: paper 004's CAV-H 18 of 20 against 5; Lu 2014's CAV-H 558 km median against 19): both flown, "
+            "the better kept", exhaustive=True))
+    else:
+        choices.append(Choice("guidance.terminal_scales", spec.terminal_scales, "paper 003's (the box checks no distance)"))
     return Derivation(spec, choices, search, alpha=None if own_alpha else alpha)
 

@@ -5,6 +5,7 @@
       (shared bank actuator);   alpha: the scenario's schedule (Table 2)
   with ``model_scales``: estimate, sensed lift and drag, alpha flown --> AccelerationRatioFilter
       --k_L, k_D--> ReferenceTracker (the reference read at the sensed ratios)
+  with ``path_gain``: sensed flight conditions --> ReferenceTracker (Lu 2014's path-limit feedback)
 
 The planner (``make_planner``) loads the database once per mission and checks it (every case
 verified, none out of line with its neighbours); each flight makes its own reference at
@@ -18,6 +19,7 @@ from drake_entry.guidance.ampi.mission import built_database
 from drake_entry.guidance.ampi.reference import DatabaseReference
 from drake_entry.guidance.ampi.spec import MISSION_DATABASE
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
+from drake_entry.guidance.path_feedback import PathLimits
 from drake_entry.guidance.replanning_wiring import add_ratio_filter
 from drake_entry.systems.reference_tracking import ReferenceTracker
 
@@ -42,11 +44,15 @@ class AmpiMethod(GuidanceMethod):
         vehicle, g = scenario.make_vehicle(), scenario.guidance
         bank0 = float(planner.evaluate([0.0])["sigma"][0])
         atmosphere = scenario.make_atmosphere() if g.model_scales else None
+        path = PathLimits.of_vehicle(vehicle.limits, scenario.make_planet(), gain=g.path_gain,
+                                     horizon=g.path_horizon_s, fraction=g.path_limit_fraction)
         tracker = builder.AddNamedSystem(GUIDANCE_SYSTEM, ReferenceTracker(
             planner, bank_limit=vehicle.bank_limit, rate_limit=vehicle.bank_rate_limit,
             period=g.period_s, initial_bank=bank0, lead=g.bank_lead_s, index=g.tracking_index,
-            density=None if atmosphere is None else atmosphere.density))
+            density=None if atmosphere is None else atmosphere.density, path=path))
         builder.Connect(plant.estimated_state, tracker.GetInputPort("estimated_state"))
+        if tracker.HasInputPort("flight_conditions"):  # the path-limit feedback reads the sensed loads
+            builder.Connect(plant.flight_conditions, tracker.GetInputPort("flight_conditions"))
         sinks = ()
         if g.model_scales:  # alpha is the scenario's schedule: the closed loop feeds the filter the alpha flown
             ratios = add_ratio_filter(builder, scenario, plant, tracker.GetInputPort("model_scales"), atmosphere)

@@ -96,6 +96,12 @@ class Ampi(GuidanceSpecBase):
     # the sensed drag is the reference's, the bank that gives its vertical lift there;
     # systems/reference_tracking.py); off: the reference as planned with the nominal models
     model_scales: bool = False
+    # Lu 2014's path-limit feedback on the tracker's command (not paper 003's, whose tracker sees no
+    # limit: a flight away from its reference may pass one): gain (0 = off; Lu: 40), prediction
+    # horizon [s], the fraction of the vehicle's limits held (guidance/path_feedback.py)
+    path_gain: float = 0.0
+    path_horizon_s: float = 16.0
+    path_limit_fraction: float = 0.95
 
     def _validate_mission_fields(self) -> None:
         from drake_entry.guidance.ampi.grid import PARAMETERS
@@ -159,6 +165,9 @@ class Ampi(GuidanceSpecBase):
         check_range("guidance.tracking_state_weight", self.tracking_state_weight, 1e-12, 1e6)
         check_range("guidance.tracking_rate_deg_s", self.tracking_rate_deg_s, 1e-6, 1e3)
         check_range("guidance.bank_lead_s", self.bank_lead_s, 0.0, 10.0)
+        check_range("guidance.path_gain", self.path_gain, 0.0, 1000.0)
+        check_range("guidance.path_horizon_s", self.path_horizon_s, 0.1, 600.0)
+        check_range("guidance.path_limit_fraction", self.path_limit_fraction, 0.5, 1.0)
         if self.tracking_index not in TRACKING_INDICES:
             raise ScenarioError(f"guidance.tracking_index = '{self.tracking_index}'; allowed: "
                                 f"{', '.join(TRACKING_INDICES)}")

@@ -8,6 +8,8 @@ import math
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
+    PATH_GAIN,
+    PATH_LIMIT_FRACTION,
     CannotFly,
     Choice,
     Derivation,
@@ -37,16 +39,6 @@ OPTIMIZER = "differential_evolution"
 LIMIT_FRACTION = 0.97
 #: eq. 48's QEG gain k2 tried, in order (paper 004: 10; 0 turns the compensation off)
 QEG_GAINS = (10.0, 0.0)
-#: Lu 2014's path-limit feedback gain where the vehicle has limits (under a mission's alpha schedule
-#: paper 004's alpha laws, which hold its limits, are not flown: HORUS-2B's heat rate was 0.3-2.8 %
-#: over in 43 of 100 runs without it). Not searched: the search's three flights succeeded with and
-#: without it on HORUS-2B (box ratios 0.80 and 0.79), and kept the gain of 0 that 43 % of the runs
-#: fail with
-PATH_GAIN = 40.0
-#: the fraction of the vehicle's limits the feedback holds (HORUS-2B, 100 runs: 100 of 100 at 0.95;
-#: at 0.9, 14 of 20: the flights lofted over the heat peak end steeper, q 0.1-1.6 % over in the last
-#: 30 s, where the first-order prediction sees q falling)
-PATH_LIMIT_FRACTION = 0.95
 #: no re-solution past this normalised energy (paper 004's mission: 0.95)
 REPLAN_UNTIL_E = 0.99
 #: sigma_f re-solved on board where sigma_0 alone brackets no root (not paper 004's): 10 runs of

@@ -170,10 +170,8 @@ class SwarmProblem:
         limits: eq. 31 flies the load on its limit, which the feedback would fight)."""
         if self.path_gain <= 0.0 or self.case != "schedule":
             return None
-        lim, f = self.vehicle.limits, self.path_fraction
-        return PathLimits(self.planet.reference_radius, self.planet.g0, beta=self.beta, gain=self.path_gain,
-                          horizon=self.path_horizon_s, load_max=f * lim.load_bound_max * self.planet.g0,
-                          heat_max=f * lim.heat_flux_max, q_max=f * lim.dynamic_pressure_max)
+        return PathLimits.of_vehicle(self.vehicle.limits, self.planet, gain=self.path_gain,
+                                     horizon=self.path_horizon_s, fraction=self.path_fraction, beta=self.beta)
 
     def law(self) -> LawSettings:
         pl = self.planet

@@ -12,7 +12,8 @@ from drake_entry.systems.acceleration_ratios import AccelerationRatioFilter
 from drake_entry.systems.replan_scheduler import ReplanStats
 from drake_entry.systems.replanning_guidance import ReplanMemory, ReplanningGuidance
 
-__all__ = ["RATIO_SYSTEM", "add_replanning_guidance", "add_ratio_filter", "replanning_commands", "replanning_record"]
+__all__ = ["RATIO_SYSTEM", "add_replanning_guidance", "add_ratio_filter", "scheduled_alpha_ratio_filter",
+           "replanning_commands", "replanning_record"]
 
 #: the name of the filter of the sensed lift and drag ratios the re-plans predict with
 RATIO_SYSTEM = "acceleration_ratios"
@@ -50,6 +51,13 @@ def add_ratio_filter(builder, scenario, plant: PlantPorts, model_scales, atmosph
     builder.Connect(plant.flight_conditions, ratios.GetInputPort("flight_conditions"))
     builder.Connect(ratios.GetOutputPort("ratios"), model_scales)
     return ratios
+
+
+def scheduled_alpha_ratio_filter(builder, scenario, plant: PlantPorts, model_scales, atmosphere=None) -> tuple:
+    """``add_ratio_filter`` for a method whose alpha is the scenario's schedule: returns the
+    filter's "alpha_command" input as ``GuidanceCommands.alpha_sinks``, which the closed loop
+    feeds with the alpha flown."""
+    return (add_ratio_filter(builder, scenario, plant, model_scales, atmosphere).GetInputPort("alpha_command"),)
 
 
 def replanning_commands(system, alpha_limits: ActuatorLimits, initial_bank: float,

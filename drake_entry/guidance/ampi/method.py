@@ -20,7 +20,7 @@ from drake_entry.guidance.ampi.reference import DatabaseReference
 from drake_entry.guidance.ampi.spec import MISSION_DATABASE
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
 from drake_entry.guidance.path_feedback import PathLimits
-from drake_entry.guidance.replanning_wiring import add_ratio_filter
+from drake_entry.guidance.replanning_wiring import scheduled_alpha_ratio_filter
 from drake_entry.systems.reference_tracking import ReferenceTracker
 
 __all__ = ["GUIDANCE_SYSTEM", "AmpiMethod", "METHOD"]
@@ -53,10 +53,8 @@ class AmpiMethod(GuidanceMethod):
         builder.Connect(plant.estimated_state, tracker.GetInputPort("estimated_state"))
         if tracker.HasInputPort("flight_conditions"):  # the path-limit feedback reads the sensed loads
             builder.Connect(plant.flight_conditions, tracker.GetInputPort("flight_conditions"))
-        sinks = ()
-        if g.model_scales:  # alpha is the scenario's schedule: the closed loop feeds the filter the alpha flown
-            ratios = add_ratio_filter(builder, scenario, plant, tracker.GetInputPort("model_scales"), atmosphere)
-            sinks = (ratios.GetInputPort("alpha_command"),)
+        sinks = scheduled_alpha_ratio_filter(builder, scenario, plant, tracker.GetInputPort("model_scales"),
+                                             atmosphere) if g.model_scales else ()
         return GuidanceCommands(
             bank=tracker.GetOutputPort("bank_command"), initial_bank=bank0,
             logged={"reference_state": LoggedSignal(tracker.GetOutputPort("reference_state"), (

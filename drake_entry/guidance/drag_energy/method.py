@@ -16,7 +16,7 @@ import numpy as np
 
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
 from drake_entry.guidance.interface import GuidanceCommands, GuidanceMethod, GuidanceSummary, LoggedSignal, PlantPorts
-from drake_entry.guidance.replanning_wiring import add_ratio_filter
+from drake_entry.guidance.replanning_wiring import scheduled_alpha_ratio_filter
 from drake_entry.guidance.reversal_wiring import add_bank_reversal, reversal_count
 from drake_entry.systems.drag_energy_guidance import DragEnergyGuidance
 from drake_entry.systems.drag_energy_tracking import DragTrackingController
@@ -44,10 +44,8 @@ class DragEnergyMethod(GuidanceMethod):
         pre_bank = math.radians(g.pre_guidance_bank_deg)
         magnitude = self.add_controller(builder, scenario, planner, plant, guidance.GetOutputPort("reference"))
         reversal = add_bank_reversal(builder, scenario, plant, magnitude, initial_sign=1.0 if pre_bank >= 0 else -1.0)
-        sinks = ()
-        if g.replan_model_scales:  # alpha is the scenario's schedule: the closed loop feeds the filter the alpha flown
-            ratios = add_ratio_filter(builder, scenario, plant, guidance.GetInputPort("model_scales"))
-            sinks = (ratios.GetInputPort("alpha_command"),)
+        sinks = scheduled_alpha_ratio_filter(builder, scenario, plant, guidance.GetInputPort("model_scales")) \
+            if g.replan_model_scales else ()
         return GuidanceCommands(bank=reversal.GetOutputPort("bank_command"), initial_bank=pre_bank,
                                 logged={"reference": LoggedSignal(guidance.GetOutputPort("reference"),
                                                                   REFERENCE_COLUMNS)}, alpha_sinks=sinks)

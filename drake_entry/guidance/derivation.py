@@ -27,7 +27,7 @@ __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "deri
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
            "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed",
            "box_mach_window", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds", "PATH_GAIN",
-           "PATH_LIMIT_FRACTION"]
+           "PATH_LIMIT_FRACTION", "path_gain"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
 #: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
@@ -42,6 +42,14 @@ PATH_GAIN = 40.0
 #: 100 at 0.95; at 0.9, 14 of 20: the flights lofted over the heat peak end steeper, q 0.1-1.6 %
 #: over in the last 30 s, where the first-order prediction sees q falling)
 PATH_LIMIT_FRACTION = 0.95
+
+
+def path_gain(vehicle) -> float:
+    """The derived path-limit feedback gain: PATH_GAIN where ``vehicle`` limits its load, heat rate
+    or dynamic pressure (a finite limit), else 0 (nothing to hold)."""
+    lim = vehicle.limits
+    limited = any(math.isfinite(x) for x in (lim.heat_flux_max, lim.dynamic_pressure_max, lim.load_bound_max))
+    return PATH_GAIN if limited else 0.0
 
 
 @dc.dataclass

@@ -16,7 +16,6 @@ import math
 from drake_entry.guidance.ampi.mission import BANK_FRACTION, BANK_RATE_FRACTION
 from drake_entry.guidance.ampi.spec import MISSION_DATABASE, TRACKING_INDICES, Ampi
 from drake_entry.guidance.derivation import (
-    PATH_GAIN,
     PATH_LIMIT_FRACTION,
     Q_SPEED_FRACTION,
     CannotFly,
@@ -25,6 +24,7 @@ from drake_entry.guidance.derivation import (
     SearchStep,
     interface_speeds,
     mission_alpha,
+    path_gain,
     require_alpha_window,
     terminal_interface,
 )
@@ -117,9 +117,7 @@ def derive(scenario) -> Derivation:
 
     if tolerance_km:
         spec.terminal_scales = terminal_scales(TERMINAL_POSITION_FRACTIONS[0])
-    lim = scenario.make_vehicle().limits
-    limited = any(math.isfinite(x) for x in (lim.heat_flux_max, lim.dynamic_pressure_max, lim.load_bound_max))
-    spec.path_gain, spec.path_limit_fraction = (PATH_GAIN if limited else 0.0), PATH_LIMIT_FRACTION
+    spec.path_gain, spec.path_limit_fraction = path_gain(scenario.make_vehicle()), PATH_LIMIT_FRACTION
     units = {"h": "m", "V": "m/s"}
     left = [n for n in ranked if n not in names]
     choices = [
@@ -144,7 +142,7 @@ def derive(scenario) -> Derivation:
         Choice("guidance.path_gain, path_limit_fraction", f"{spec.path_gain:g}, {spec.path_limit_fraction:g}",
                "Lu 2014's path-limit feedback on the tracker's command (FNPEG's), holding that fraction of the "
                "vehicle's limits, which the TVLQR does not see (the capsule's final dive: q over in 21 of 100 runs "
-               "without it)" if limited else "the vehicle states no limit to hold"),
+               "without it)" if spec.path_gain > 0 else "the vehicle states no limit to hold"),
         Choice("alpha", "as the mission's" if own_alpha else ", ".join(
             f"{v:g} deg" + ("" if len(alpha.breakpoints) == 1 else f" at {b:g}")
             for b, v in zip(alpha.breakpoints, alpha.values_deg)) + f" ({alpha.variable})",

@@ -9,13 +9,14 @@ from drake_entry.guidance.derivation import (
     Derivation,
     SearchStep,
     alpha_rewritten,
+    path_gain,
     require_alpha_window,
     reversal_corridor,
     terminal_interface,
 )
 from drake_entry.guidance.fnpeg.spec import Fnpeg
 
-__all__ = ["derive", "BANK_END_CANDIDATES_DEG", "PATH_GAIN", "LIMIT_MARGINS"]
+__all__ = ["derive", "BANK_END_CANDIDATES_DEG", "LIMIT_MARGINS"]
 
 #: sigma_f flown on the nominal flight and the search's draws, every one (it sets the altitude
 #: at e_f, graded: on Lu's CAV-H case 50, 40 and 30 deg end 2.0 km low, centred and 1.3 km high)
@@ -24,8 +25,6 @@ BANK_END_CANDIDATES_DEG = (45.0, 50.0, 40.0, 55.0, 35.0, 60.0, 30.0, 65.0, 25.0,
 #: fractions of the vehicle's limits the path feedback enforces, tried in order (the hand-tuned
 #: HORUS-2B values were 0.90-0.94)
 LIMIT_MARGINS = (0.93, 0.9, 0.85, 0.8)
-#: Lu 2014's path-limit feedback gain when the vehicle has a limit (the hand-tuned HORUS-2B value)
-PATH_GAIN = 40.0
 
 
 def derive(scenario) -> Derivation:
@@ -43,7 +42,7 @@ def derive(scenario) -> Derivation:
     def enforced(margin: float) -> dict:
         return {f"guidance.{k}": (round(margin * x, 4) if math.isfinite(x) else 0.0) for k, x in limits.items()}
 
-    gain = PATH_GAIN if any(math.isfinite(x) for x in limits.values()) else 0.0
+    gain = path_gain(v)  # Lu 2014's path-limit feedback where the vehicle has a limit (HORUS-2B's hand-tuned 40)
     candidates = tuple(b for b in BANK_END_CANDIDATES_DEG if b <= v.bank_limit_deg)
     first = {k.split(".", 1)[1]: x for k, x in enforced(LIMIT_MARGINS[0]).items()}
     spec = Fnpeg(terminal_altitude_km=interface.altitude_km, terminal_velocity_m_s=round(interface.speed_m_s, 3),

@@ -4,7 +4,6 @@ sigma_0 searched before flight and re-solved on board; searched: the alpha law (
 alpha schedule in speed, or the load factor of Case 1, eq. 31), Lu 2014's path-limit feedback
 on the bank, the QEG compensation's gain and the interface altitude; sigma_f is searched with
 sigma_0 before flight."""
-import math
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
@@ -17,6 +16,7 @@ from drake_entry.guidance.derivation import (
     alpha_rewritten,
     interface_altitudes,
     mission_alpha,
+    path_gain,
     require_alpha_window,
     reversal_corridor,
     terminal_interface,
@@ -71,8 +71,7 @@ def derive(scenario) -> Derivation:
     altitude_km = term.altitude_tolerance_km or SwarmBank.objective_altitude_unit_km
     vehicle = scenario.make_vehicle()
     bank_limit = min(89.0, vehicle.bank_limit_deg)
-    lim = vehicle.limits
-    limited = any(math.isfinite(x) for x in (lim.heat_flux_max, lim.dynamic_pressure_max, lim.load_bound_max))
+    gain = path_gain(vehicle)
     end_bounds = [BANK_END_BOUNDS_DEG[0], min(BANK_END_BOUNDS_DEG[1], bank_limit)]
     spec = SwarmBank(terminal_altitude_km=interface.altitude_km, terminal_velocity_m_s=round(interface.speed_m_s, 3),
                      bank_start_bounds_deg=[0.0, bank_limit], bank_end_bounds_deg=end_bounds, alpha_law=laws[0],
@@ -80,7 +79,7 @@ def derive(scenario) -> Derivation:
                      alpha_min_deg=lo, alpha_max_deg=hi, replan_period_s=REPLAN_PERIOD_S,
                      objective_range_unit_km=distance_km, objective_altitude_unit_km=altitude_km,
                      optimizer=OPTIMIZER, limit_fraction=LIMIT_FRACTION, replan_until_e=REPLAN_UNTIL_E,
-                     resolve_bank_end=RESOLVE_BANK_END, path_gain=PATH_GAIN if limited else 0.0,
+                     resolve_bank_end=RESOLVE_BANK_END, path_gain=gain,
                      path_limit_fraction=PATH_LIMIT_FRACTION,
                      reversal_heading_deg=heading, reversal_velocity_m_s=velocity)
     choices = [
@@ -107,11 +106,11 @@ def derive(scenario) -> Derivation:
                "does not converge in two dimensions (HORUS-2B: J 14.5 against 0.40)"),
         Choice("guidance.limit_fraction", LIMIT_FRACTION, "under the mission's alpha schedule the search keeps the "
                "replica's peaks under this fraction of the vehicle's limits (the Drake flight samples finer)"),
-        Choice("guidance.path_gain, path_limit_fraction", f"{PATH_GAIN if limited else 0.0:g}, {PATH_LIMIT_FRACTION:g}",
+        Choice("guidance.path_gain, path_limit_fraction", f"{gain:g}, {PATH_LIMIT_FRACTION:g}",
                "Lu 2014's path-limit feedback on the bank (FNPEG's), holding that fraction of the vehicle's limits "
                "under the mission's alpha schedule, which does not hold them as paper 004's alpha laws do (HORUS-2B, "
                "100 runs: 57 without it, the heat rate 0.3-2.8 % over; 100 with it); off under the load law, whose "
-               "alpha holds the limits" if limited else "the vehicle states no limit to hold"),
+               "alpha holds the limits" if gain > 0 else "the vehicle states no limit to hold"),
         corridor,
     ]
     search = [SearchStep.over("guidance.alpha_law", laws,

@@ -140,15 +140,16 @@ def test_an_scvx_plan_flown_with_its_tracking_law_ends_where_it_planned_and_open
 
 
 def test_scvx_derived_where_the_box_checks_no_speed_aims_at_the_interface_speed_and_replans_near_the_end():
-    """Paper 004's box checks altitude and distance only; the other methods stop at the
-    interface's energy (30 km, 2000 m/s), so the derived SCvx plans arrive within 2.5 % of its
-    Mach number rather than at any speed; it re-plans closer together near the end (0.4 of the
-    time to go, to 60 s) and bounds gamma at -45 deg (paper 001's -30 is its own mission's)."""
+    """Lu 2014's box checks altitude and distance only; the other methods stop at the
+    interface's energy, so the derived SCvx plans arrive within 2.5 % of its Mach number rather
+    than at any speed (the vehicle's load bound is far below there); it re-plans closer together
+    near the end (0.4 of the time to go, to 60 s) and bounds gamma at -45 deg (paper 001's -30 is
+    its own mission's)."""
     from drake_entry.guidance.derivation import derivation_for, terminal_interface
     from drake_entry.guidance.scvx.derive import FLIGHT_PATH_BOUNDS_DEG, INTERFACE_SPEED_WINDOW, MACH_WINDOW_FRACTION
     from drake_entry.guidance.scvx.spec import Scvx
 
-    mission = load_scenario("cav_h_paper004")
+    mission = load_scenario("cav_h_fnpeg")
     assert mission.terminal.velocity_tolerance_m_s is None and mission.terminal.mach_tolerance is None
     mach = terminal_interface(mission).mach
     d = derivation_for(mission, Scvx)
@@ -161,6 +162,88 @@ def test_scvx_derived_where_the_box_checks_no_speed_aims_at_the_interface_speed_
     spec = d.spec
     assert (spec.replan_period_s, spec.replan_time_to_go_fraction, spec.replan_min_time_to_go_s) == (200.0, 0.4, 60.0)
     assert tuple(spec.flight_path_bounds_deg) == FLIGHT_PATH_BOUNDS_DEG == (-45.0, 5.0)
+
+
+def test_scvx_derived_mach_window_lies_below_the_load_bound_and_reaches_down_for_the_dispersed_forces():
+    """Paper 004's CAV-H meets its 2 g total-load bound near the interface (1.97 g at Mach 6.79,
+    30.5 km, alpha 20 deg): each candidate's Mach window tops out where the nominal vehicle meets
+    0.93 of the limit, and its lower edge reaches down to where forces force_ratio_high x the
+    nominal (3 sigma of density and aerodynamic scales) meet it, so a re-plan predicting with
+    the forces the flight sensed keeps a feasible last node. The load there, computed by hand
+    from the aerodynamic model, is the planned bound."""
+    import math
+
+    from drake_entry.guidance.derivation import LIMIT_MARGIN, derivation_for, terminal_interface
+    from drake_entry.guidance.scvx.derive import FORCE_SIGMAS, INTERFACE_SPEED_WINDOW
+    from drake_entry.guidance.scvx.spec import Scvx
+    from drake_entry.models.dispersions import force_ratio_high
+    from drake_entry.models.planet import G0
+
+    mission = load_scenario("cav_h_paper004")
+    vehicle, atmosphere = mission.make_vehicle(), mission.make_atmosphere()
+    force_high = force_ratio_high(mission.dispersions, FORCE_SIGMAS)
+    assert force_high > 1.15
+
+    def load_g(h_km, mach, scale=1.0):
+        a, rho = float(atmosphere.speed_of_sound(h_km * 1e3)), float(atmosphere.density(h_km * 1e3))
+        CL, CD = vehicle.aero.coefficients(math.radians(20.0), mach)
+        return scale * 0.5 * rho * (mach * a) ** 2 * vehicle.area_over_mass * math.hypot(CL, CD) / G0
+
+    bound = LIMIT_MARGIN * vehicle.limits.total_load_max
+    interface_low = terminal_interface(mission).mach * (1 - INTERFACE_SPEED_WINDOW)
+    d = derivation_for(mission, Scvx)
+    reached_down = 0
+    for c in d.search[0].candidates:
+        h = c["guidance.terminal_altitude_km"]
+        lo, hi = c["guidance.final_mach_min"], c["guidance.final_mach_max"]
+        assert lo < hi <= terminal_interface(mission).mach * (1 + INTERFACE_SPEED_WINDOW)
+        assert load_g(h, hi) <= bound * (1 + 1e-3)
+        assert load_g(h, lo, force_high) <= bound * (1 + 1e-3)
+        if lo < interface_low:  # reached down: exactly to where the dispersed forces meet the bound
+            assert load_g(h, lo + 0.01, force_high) > bound
+            reached_down += 1
+        assert lo <= c["guidance.terminal_mach"] <= hi
+    assert reached_down >= 3  # the box's centre, 30 km, and the altitudes below it
+
+
+def test_force_ratio_high_combines_the_force_dispersions_root_sum_square():
+    """1 + k sqrt(sum of relative sigmas^2) times the mean scales; a uniform's sigma is its
+    width / sqrt(12); the density waves' amplitude adds; nothing dispersed gives 1."""
+    import math
+
+    import pydrake.common.schema as schema
+
+    from drake_entry.models.dispersions import DispersionSpec, force_ratio_high
+
+    assert force_ratio_high(DispersionSpec()) == 1.0
+    spec = DispersionSpec(density_scale=schema.Gaussian(mean=1.0, stddev=0.05),
+                          lift_scale=schema.Uniform(min=0.9, max=1.1), drag_scale=schema.Gaussian(mean=1.0, stddev=0.03),
+                          density_wave_amplitude=schema.Uniform(min=-0.02, max=0.02))
+    s_lift = 0.2 / math.sqrt(12.0)
+    assert force_ratio_high(spec, 3.0) == pytest.approx(1.0 + 3.0 * math.hypot(0.05, s_lift) + 0.02, rel=1e-12)
+    spec.mass_scale = schema.Gaussian(mean=1.1, stddev=0.0)
+    assert force_ratio_high(spec, 2.0) == pytest.approx((1.0 + 2.0 * math.hypot(0.05, s_lift) + 0.02) / 1.1, rel=1e-12)
+
+
+def test_load_limit_speed_meets_the_limit_and_is_infinite_without_one(monkeypatch):
+    """brentq's speed puts the nominal vehicle exactly at the fraction of its load bound; a
+    vehicle limiting no load has none."""
+    import dataclasses as dc
+    import math
+
+    from drake_entry.guidance.derivation import load_limit_speed
+    from drake_entry.models.planet import G0
+
+    mission = load_scenario("cav_h_paper004")
+    V = load_limit_speed(mission, 30.0, lambda V: 20.0, 0.9)
+    vehicle, atmosphere = mission.make_vehicle(), mission.make_atmosphere()
+    CL, CD = vehicle.aero.coefficients(math.radians(20.0), V / float(atmosphere.speed_of_sound(30e3)))
+    load = 0.5 * float(atmosphere.density(30e3)) * V * V * vehicle.area_over_mass * math.hypot(CL, CD) / G0
+    assert load == pytest.approx(0.9 * vehicle.limits.total_load_max, rel=1e-5)
+    unlimited = mission.make_vehicle()
+    unlimited.limits = dc.replace(unlimited.limits, total_load_max=math.inf, normal_load_max=math.inf)
+    monkeypatch.setattr(mission, "make_vehicle", lambda: unlimited)
+    assert load_limit_speed(mission, 30.0, lambda V: 20.0) == math.inf
 
 
 def test_a_flown_plan_is_judged_up_to_its_mach_margin_and_a_heading_a_turn_away_is_the_same():

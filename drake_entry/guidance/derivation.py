@@ -18,15 +18,17 @@ import importlib
 import math
 
 import numpy as np
+import scipy.optimize
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.spec import ReversingBankSpec
+from drake_entry.models.planet import G0
 from drake_entry.scenario import stated_guidance
 
 __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
            "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed",
-           "box_mach_window", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds", "PATH_GAIN",
+           "box_mach_window", "load_limit_speed", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds", "PATH_GAIN",
            "PATH_LIMIT_FRACTION", "path_gain"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
@@ -280,6 +282,32 @@ def q_limit_speed(scenario, altitude_km: float, fraction: float = 1.0) -> float:
         return math.inf
     rho = float(scenario.make_atmosphere().density(altitude_km * 1e3))
     return math.sqrt(2.0 * fraction * q_max / rho)
+
+
+def load_limit_speed(scenario, altitude_km: float, alpha_deg, fraction: float = 1.0) -> float:
+    """The speed [m/s] at which the vehicle meets ``fraction`` of the load it limits (total or
+    normal: PathLimits.planned_load) at ``altitude_km`` (the mission's atmosphere), flying
+    ``alpha_deg(V)`` [deg] at speed V (inf when it limits neither, or meets it at no speed below
+    orbital speed): a plan ending there faster breaches it."""
+    vehicle = scenario.make_vehicle()
+    kind, limit = vehicle.limits.planned_load()
+    if not math.isfinite(limit):
+        return math.inf
+    atmosphere = scenario.make_atmosphere()
+    rho, a = float(atmosphere.density(altitude_km * 1e3)), float(atmosphere.speed_of_sound(altitude_km * 1e3))
+
+    def excess(V: float) -> float:
+        alpha = math.radians(float(alpha_deg(V)))
+        CL, CD = (float(c) for c in vehicle.aero.coefficients(alpha, V / a))
+        C = math.hypot(CL, CD) if kind == "total" else CL * math.cos(alpha) + CD * math.sin(alpha)
+        return 0.5 * rho * V * V * vehicle.area_over_mass * C / G0 - fraction * limit
+
+    low, high = 0.5 * a, 8000.0
+    if excess(high) < 0.0:
+        return math.inf
+    if excess(low) >= 0.0:
+        return low
+    return float(scipy.optimize.brentq(excess, low, high, xtol=1e-3))
 
 
 #: the final speed is at most this fraction of the speed where the planned dynamic-pressure

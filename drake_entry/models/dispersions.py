@@ -46,7 +46,8 @@ from drake_entry.models.winds import WindProfile, WindSpec, WindyAtmosphere, dra
 __all__ = ["Scalar", "Vector", "EntryDispersionSpec", "AeroRegimeDispersionSpec", "ENTRY_TABLE_TO_SI", "MAX_AERO_SIGMA",
            "PERTURBATION_COLUMNS_KM", "AtmospherePerturbationSpec", "WindSpec",
            "InertialNavigationSpec",
-           "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate", "entry_spread", "force_dispersions"]
+           "DispersionSpec", "Draw", "draw", "GAUSSIAN_REACH", "validate", "entry_spread", "force_dispersions",
+           "force_ratio_high"]
 
 Scalar = typing.Union[float, schema.Deterministic, schema.Gaussian, schema.Uniform]
 Vector = typing.Union[schema.DeterministicVectorX, schema.GaussianVectorX, schema.UniformVectorX]
@@ -343,6 +344,35 @@ def entry_spread(spec: DispersionSpec) -> np.ndarray:
     if spec.entry_covariance is not None:
         out = np.hypot(out, 3.0 * np.sqrt(np.maximum(np.diag(np.asarray(spec.entry_covariance, float)), 0.0)))
     return out
+
+
+def _mean_and_sigma(d) -> tuple[float, float]:
+    """A scalar distribution's mean and standard deviation (a uniform's (max - min) / sqrt(12),
+    a constant's 0)."""
+    if isinstance(d, schema.Uniform):
+        return 0.5 * (float(d.min) + float(d.max)), (float(d.max) - float(d.min)) / math.sqrt(12.0)
+    if isinstance(d, schema.Gaussian):
+        return float(d.mean), float(d.stddev)
+    return _support_floor(d), 0.0
+
+
+def force_ratio_high(spec: DispersionSpec, sigmas: float = 3.0) -> float:
+    """How far above the nominal models' the aerodynamic acceleration of a sample may reach: the
+    product of the mean density, max(lift, drag) and 1/mass scales times 1 + ``sigmas`` x the
+    root-sum-square of their relative standard deviations (with the atmosphere perturbations'
+    largest density sigma and the aerodynamic regimes' largest lift or drag sigma) plus the
+    density waves' largest amplitude; winds left out (they change the airspeed, not the
+    coefficients). 1 when nothing of these is dispersed."""
+    (rho, s_rho), (lift, s_lift), (drag, s_drag), (mass, s_mass) = (
+        _mean_and_sigma(getattr(spec, name)) for name in ("density_scale", "lift_scale", "drag_scale", "mass_scale"))
+    coefficient = max(lift, drag)
+    parts = [s_rho / rho, max(s_lift / lift, s_drag / drag), s_mass / mass]
+    if spec.atmosphere_perturbations is not None:
+        parts.append(max(spec.atmosphere_perturbations.density_sigma, default=0.0))
+    if spec.aero_regimes is not None:
+        parts.append(max(max(spec.aero_regimes.lift_sigma), max(spec.aero_regimes.drag_sigma)))
+    wave = _three_sigma(spec.density_wave_amplitude)
+    return rho * coefficient / mass * (1.0 + sigmas * math.hypot(*parts) + wave)
 
 
 def force_dispersions(spec: DispersionSpec) -> list[str]:

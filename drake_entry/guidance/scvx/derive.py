@@ -9,6 +9,8 @@ scenario is. A mission whose box gives no altitude window or no distance cannot 
 CannotFly."""
 import math
 
+import numpy as np
+
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
     LIMIT_MARGIN,
@@ -19,15 +21,16 @@ from drake_entry.guidance.derivation import (
     alpha_rewritten,
     box_mach_window,
     interface_altitudes,
+    load_limit_speed,
     q_limit_speed,
     terminal_interface,
 )
 from drake_entry.guidance.scvx.spec import Scvx
-from drake_entry.models.dispersions import force_dispersions
+from drake_entry.models.dispersions import force_dispersions, force_ratio_high
 
 __all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW_KM", "AIM_TOLERANCE_KM",
            "FEEDBACK", "REPLAN_PERIOD_S", "REPLAN_TIME_TO_GO_FRACTION", "REPLAN_MIN_TIME_TO_GO_S", "FLOWN_MACH_SLACK",
-           "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "FINAL_DESCENT_DEG", "OBJECTIVE", "FORMULATION", "aim_window"]
+           "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "FINAL_DESCENT_DEG", "FORCE_SIGMAS", "OBJECTIVE", "FORMULATION", "aim_window"]
 
 #: the plan's objective and formulation on another method's mission: the control effort (the
 #: integral of |sigma_dot|), with the bank a state and alpha the mission's law. Measured on
@@ -76,21 +79,31 @@ INTERFACE_SPEED_WINDOW = 0.05
 #: speed): paper 004's CAV-H planned to a shallow glide at its stop altitude crossed it 90 s
 #: (140 km) late in 5 of 10 dispersed flights
 FINAL_DESCENT_DEG = 1.0
+#: the plan's Mach window reaches down to where a flight whose aerodynamic forces are this many
+#: standard deviations of the mission's force dispersions above the nominal meets the planned
+#: load bound (models.dispersions.force_ratio_high)
+FORCE_SIGMAS = 3.0
 #: the flight-path bounds of eq. 70 on a mission that bounds no gamma [deg]: paper 001's -30 deg
 #: is its own mission's (a capsule's last minute below 25 km dives to -31 to -35 deg), the upper
 #: bound opened to 5 deg
 FLIGHT_PATH_BOUNDS_DEG = (-45.0, 5.0)
 
 
-def aim_window(scenario, altitude_km: float, mach_window: tuple, mach: float) -> dict:
+def aim_window(scenario, altitude_km: float, mach_window: tuple, mach: float, alpha_deg, *,
+               force_high: float = 1.0, mach_floor: float = 0.0) -> dict:
     """The fields that make a plan end at ``altitude_km`` where the flight stops: the DRS
     window the flown plan is checked in [m] (AIM_WINDOW_KM about it, at most a quarter of the
     box's altitude tolerance and inside the box), the margin that narrows the plan's aim to
     AIM_TOLERANCE_KM [m], the stop altitude [km], and the plan's Mach window: the middle
     MACH_WINDOW_FRACTION of the box's ``mach_window`` (low, high) below the Mach
-    number where the vehicle's dynamic-pressure limit is met at that altitude (a window the
-    limit closes gives an empty window: the candidate is refused), with the interface's
-    ``mach`` held inside it as the spec's terminal_mach."""
+    number where the vehicle's dynamic-pressure limit, and the load it limits at its planned
+    bound flying ``alpha_deg(V)`` [deg], are met at that altitude (a window the limits close
+    gives an empty window: the candidate is refused), its lower edge extended down to where a
+    flight whose aerodynamic forces are ``force_high`` times the nominal meets the planned load
+    bound (a re-plan predicts with the forces sensed: paper 004's CAV-H with 6-9 % more drag
+    found every re-plan infeasible at its last node), not below ``mach_floor`` (the box's
+    lower edge where it checks the speed); the interface's ``mach`` held inside the window as
+    the spec's terminal_mach."""
     t = scenario.terminal
     centre_km, tolerance_km = t.altitude_km, t.altitude_tolerance_km
     half = min(AIM_WINDOW_KM, 0.25 * tolerance_km, tolerance_km - abs(altitude_km - centre_km))
@@ -98,11 +111,14 @@ def aim_window(scenario, altitude_km: float, mach_window: tuple, mach: float) ->
     fields = {"guidance.final_altitude_m": [round((altitude_km - half) * 1e3, 3), round((altitude_km + half) * 1e3, 3)],
               "guidance.final_altitude_margin_m": round(margin * 1e3, 3), "guidance.terminal_altitude_km": altitude_km}
     lo, hi = mach_window
-    hi = min(hi, q_limit_speed(scenario, altitude_km) / float(scenario.make_atmosphere().speed_of_sound(
-        altitude_km * 1e3)))
+    a = float(scenario.make_atmosphere().speed_of_sound(altitude_km * 1e3))
+    hi = min(hi, q_limit_speed(scenario, altitude_km) / a,
+             load_limit_speed(scenario, altitude_km, alpha_deg, LIMIT_MARGIN) / a)
     window_hi = hi
     centre, half_width = 0.5 * (lo + hi), 0.5 * MACH_WINDOW_FRACTION * (hi - lo)
-    lo, hi = round(max(centre - half_width, 0.0), 4), round(centre + half_width, 4)
+    lo, hi = round(max(centre - half_width, 0.0), 4), round(min(centre + half_width, window_hi), 4)
+    dispersed = load_limit_speed(scenario, altitude_km, alpha_deg, LIMIT_MARGIN / force_high) / a
+    lo = round(max(min(lo, dispersed), mach_floor, 0.0), 4)
     # a flown plan is judged against the window it aims inside, up to that window's upper edge
     # (a plan flown to Mach 6.83 against 6.82 was refused on Lu 2014's CAV-H, whose box checks no speed)
     return fields | {"guidance.final_mach_min": lo, "guidance.final_mach_max": hi,
@@ -128,8 +144,11 @@ def derive(scenario) -> Derivation:
         mach_window = (m * (1.0 - INTERFACE_SPEED_WINDOW), m * (1.0 + INTERFACE_SPEED_WINDOW))
         mach_how = (f"the box checks no speed: the interface's Mach {m:.3g} +- {INTERFACE_SPEED_WINDOW:.0%} (where the "
                     f"other methods' energy stop puts it)")
-    mach_how = (f"the middle {MACH_WINDOW_FRACTION:g} of {mach_how} below the vehicle's dynamic-pressure limit "
-                f"at the interface altitude (room for the flown error)")
+    force_high = force_ratio_high(scenario.dispersions, FORCE_SIGMAS)
+    mach_how = (f"the middle {MACH_WINDOW_FRACTION:g} of {mach_how} below the vehicle's dynamic-pressure limit and "
+                f"its planned load bound at the interface altitude (room for the flown error), reaching down to "
+                f"where forces {force_high:.3g} x the nominal ({FORCE_SIGMAS:g} sigma of the mission's force "
+                f"dispersions) meet that load bound")
     h, tol = interface.altitude_km, t.altitude_tolerance_km
     if h - tol < 0.0:
         raise CannotFly(f"the mission's altitude window reaches below the ground ({h - tol:g} km)")
@@ -141,10 +160,12 @@ def derive(scenario) -> Derivation:
         alpha_deg, alpha_speeds = [alphas[-1], alphas[0]], [max(speeds[0], 1.0), speeds[-1]]
     bounds = [min(alphas), max(alphas)] if max(alphas) > min(alphas) else [max(0.0, alphas[0] - 2.0), alphas[0] + 2.0]
     psi = scenario.entry.heading_deg
-    aims = [aim_window(scenario, altitude, mach_window, interface.mach) for altitude in altitudes]
+    aims = [aim_window(scenario, altitude, mach_window, interface.mach,
+                       lambda V: float(np.interp(V, alpha_speeds, alpha_deg[::-1])), force_high=force_high,
+                       mach_floor=mach_window[0] if box_window is not None else 0.0) for altitude in altitudes]
     aims = [aim for aim in aims if aim["guidance.final_mach_min"] < aim["guidance.final_mach_max"]]
     if not aims:
-        raise CannotFly(f"the vehicle's dynamic-pressure limit closes the box's Mach window {mach_window} at every "
+        raise CannotFly(f"the vehicle's dynamic-pressure or load limit closes the box's Mach window {mach_window} at every "
                         f"altitude of the box ({', '.join(f'{v:g}' for v in altitudes)} km)")
     first = aims[0]
     forces = force_dispersions(scenario.dispersions)

@@ -48,8 +48,12 @@ MACH_WINDOW_FRACTION = 0.5
 #: the flown plan's DRS altitude is checked within this of the stop altitude [km] (at most a
 #: quarter of the box's altitude tolerance), and the plan aims within AIM_TOLERANCE_KM of it: the
 #: flight stops at that altitude, so a plan ending 1.5 km above it (the window's upper part,
-#: where a control-effort plan settles) left 34 km and Mach 0.9 of flight it never planned
-AIM_WINDOW_KM, AIM_TOLERANCE_KM = 0.5, 0.05
+#: where a control-effort plan settles) left 34 km and Mach 0.9 of flight it never planned. The
+#: plans end descending at a shallow angle, so the aim's tolerance becomes a range error of
+#: tolerance / tan(gamma_f): at 50 m, plans settling at its top ended HORUS-2B's flights 2-4 km
+#: past the target (-13 m/s at 650 m/s; 6 of 100 outside its 2-km box) and Lu 2014's CAV-H 5.0-5.4
+#: km past (11 of 100 outside 5 km); at 10 m those draws ended 1.1 and 3.0 km out
+AIM_WINDOW_KM, AIM_TOLERANCE_KM = 0.5, 0.01
 #: the feedback between re-plans (drake_entry.guidance.scvx.feedback): measured on HORUS-2B's
 #: nominal (50 x 6 mesh, path margin 0.07), the plan flown through the actuators ends 36.8 km
 #: from its terminal point without it (with 0.5 s less command lead 15 km, 1 s more 21 km), 0.38

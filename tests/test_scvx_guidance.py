@@ -206,6 +206,38 @@ def test_scvx_derived_mach_window_lies_below_the_load_bound_and_reaches_down_for
     assert reached_down >= 3  # the box's centre, 30 km, and the altitudes below it
 
 
+def test_scvx_derived_aim_is_tight_where_the_vehicle_glides_at_the_interface_and_wider_where_it_dives():
+    """A vehicle holding level flight at the interface (HORUS-2B at 25 km, 650 m/s, alpha 15 deg:
+    lift above g - V^2/r) ends its plans at the shallow descent bound, so its plans aim within
+    10 m of the stop altitude; Lu 2008's capsule (18 km, 300 m/s, L/D 0.3) cannot hold it and
+    dives through, and aims within 50 m. The check is the lift's: just above the level-flight
+    speed it glides, just below it does not."""
+    import math
+
+    import scipy.optimize
+
+    from drake_entry.guidance.derivation import derivation_for
+    from drake_entry.guidance.scvx.derive import AIM_TOLERANCE_KM, GLIDE_AIM_TOLERANCE_KM, glides_at
+    from drake_entry.guidance.scvx.spec import Scvx
+
+    horus, capsule = load_scenario("horus2b"), load_scenario("capsule_lu2008")
+    assert glides_at(horus, 25.0, 650.0, 15.0) and not glides_at(capsule, 18.25, 305.0, 20.0)
+    for mission, tolerance_km in ((horus, GLIDE_AIM_TOLERANCE_KM), (capsule, AIM_TOLERANCE_KM)):
+        for c in derivation_for(mission, Scvx).search[0].candidates:
+            lo, hi = c["guidance.final_altitude_m"]
+            assert hi - lo - 2.0 * c["guidance.final_altitude_margin_m"] == pytest.approx(2e3 * tolerance_km)
+    # the level-flight speed of HORUS-2B at 25 km, alpha 15 deg: glides above it, not below
+    vehicle, atmosphere, planet = horus.make_vehicle(), horus.make_atmosphere(), horus.make_planet()
+    r, rho, a = float(planet.radius(25e3)), float(atmosphere.density(25e3)), float(atmosphere.speed_of_sound(25e3))
+
+    def excess(V):
+        CL, _ = vehicle.aero.coefficients(math.radians(15.0), V / a)
+        return 0.5 * rho * V * V * vehicle.area_over_mass * float(CL) - (planet.mu / r ** 2 - V * V / r)
+
+    V_level = scipy.optimize.brentq(excess, 100.0, 650.0)
+    assert glides_at(horus, 25.0, V_level * 1.01, 15.0) and not glides_at(horus, 25.0, V_level * 0.99, 15.0)
+
+
 def test_force_ratio_high_combines_the_force_dispersions_root_sum_square():
     """1 + k sqrt(sum of relative sigmas^2) times the mean scales; a uniform's sigma is its
     width / sqrt(12); the density waves' amplitude adds; nothing dispersed gives 1."""

@@ -9,8 +9,6 @@ scenario is. A mission whose box gives no altitude window or no distance cannot 
 CannotFly."""
 import math
 
-import numpy as np
-
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
     LIMIT_MARGIN,
@@ -25,7 +23,9 @@ from drake_entry.guidance.derivation import (
     q_limit_speed,
     terminal_interface,
 )
+from drake_entry.guidance.scvx.mission import alpha_law
 from drake_entry.guidance.scvx.spec import Scvx
+from drake_entry.models.constraints import equilibrium_glide_lift
 from drake_entry.models.dispersions import force_dispersions, force_ratio_high
 
 __all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW_KM", "AIM_TOLERANCE_KM",
@@ -105,7 +105,7 @@ def glides_at(scenario, altitude_km: float, speed_m_s: float, alpha_deg: float) 
     CL, _ = vehicle.aero.coefficients(math.radians(alpha_deg), speed_m_s / float(atmosphere.speed_of_sound(h)))
     lift = 0.5 * float(atmosphere.density(h)) * speed_m_s ** 2 * vehicle.area_over_mass * float(CL)
     r = float(planet.radius(h))
-    return lift >= planet.mu / r ** 2 - speed_m_s ** 2 / r
+    return lift >= equilibrium_glide_lift(speed_m_s, r, planet.mu / r ** 2)
 
 
 def aim_window(scenario, altitude_km: float, mach_window: tuple, mach: float, alpha_deg, *,
@@ -181,8 +181,9 @@ def derive(scenario) -> Derivation:
         alpha_deg, alpha_speeds = [alphas[-1], alphas[0]], [max(speeds[0], 1.0), speeds[-1]]
     bounds = [min(alphas), max(alphas)] if max(alphas) > min(alphas) else [max(0.0, alphas[0] - 2.0), alphas[0] + 2.0]
     psi = scenario.entry.heading_deg
+    law = alpha_law(alpha_deg, alpha_speeds)  # the plans' own alpha(V) [rad]
     aims = [aim_window(scenario, altitude, mach_window, interface.mach,
-                       lambda V: float(np.interp(V, alpha_speeds, alpha_deg[::-1])), force_high=force_high,
+                       lambda V: math.degrees(law(V)), force_high=force_high,
                        mach_floor=mach_window[0] if box_window is not None else 0.0) for altitude in altitudes]
     aims = [aim for aim in aims if aim["guidance.final_mach_min"] < aim["guidance.final_mach_max"]]
     if not aims:

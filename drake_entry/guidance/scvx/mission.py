@@ -18,7 +18,7 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
 from drake_entry.models.verdict import PathLimit
 
-__all__ = ["SITE_RADIUS_MAX_M", "ENTRY_SPEED_RANGE_M_S", "DEFAULT_DRS_ALTITUDE_MARGIN_M", "ScvxMission"]
+__all__ = ["SITE_RADIUS_MAX_M", "ENTRY_SPEED_RANGE_M_S", "DEFAULT_DRS_ALTITUDE_MARGIN_M", "ScvxMission", "alpha_law"]
 
 #: the largest site radius a mission accepts [m] (a minimum-miss abort opens its cone to it)
 SITE_RADIUS_MAX_M = 5e6
@@ -178,6 +178,12 @@ class ScvxMission:
 
     def alpha_schedule(self) -> Schedule:
         """alpha(V) [rad], velocity-scheduled and C2 (its derivative enters the Jacobians)."""
-        lo, hi = self.alpha_speeds_m_s
-        return Schedule((float(lo), float(hi)), (math.radians(self.alpha_deg[1]), math.radians(self.alpha_deg[0])),
-                        "velocity", smooth=True)
+        return alpha_law(self.alpha_deg, self.alpha_speeds_m_s)
+
+
+def alpha_law(alpha_deg, alpha_speeds_m_s) -> Schedule:
+    """The two-value angle-of-attack law alpha(V) [rad]: alpha_deg[0] above alpha_speeds_m_s[1],
+    alpha_deg[1] below alpha_speeds_m_s[0], a C2 blend between."""
+    lo, hi = alpha_speeds_m_s
+    return Schedule((float(lo), float(hi)), (math.radians(alpha_deg[1]), math.radians(alpha_deg[0])),
+                    "velocity", smooth=True)

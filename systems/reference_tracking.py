@@ -57,7 +57,7 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.guidance.ampi.spec import TRACKING_INDICES
-from drake_entry.guidance.path_feedback import PathLimits, path_limit_correction
+from drake_entry.guidance.path_feedback import PathLimits, corrected_cos_bank, path_limit_correction
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, specific_energy
 
 __all__ = ["LAW_STATES", "SCALE_HEIGHT_STEP_M", "TrackerMemory", "ReferenceTracker", "sensed_reference",
@@ -105,7 +105,7 @@ def limited_bank(sigma: float, x, conditions, path: PathLimits, bank_limit: floa
         return sigma
     term = path_limit_correction(float(x[3]), math.sin(float(x[4])), D, math.hypot(L, D),
                                  float(conditions[_FC["heat_flux"]]), float(conditions[_FC["dynamic_pressure"]]), path)
-    c = math.cos(sigma) - term * math.sqrt(path.g0 / path.R0) / L
+    c = corrected_cos_bank(math.cos(sigma), term, L, path.R0, path.g0)
     return math.copysign(math.acos(min(max(c, math.cos(bank_limit)), 1.0)), sigma)
 
 

@@ -14,7 +14,8 @@ from pydrake.symbolic import max as symbolic_max
 
 from drake_entry.models.scalar import is_symbolic
 
-__all__ = ["HEAT_RATE_VELOCITY_EXPONENT", "PathLimits", "enforced", "path_limit_sin_flight_path", "path_limit_correction"]
+__all__ = ["HEAT_RATE_VELOCITY_EXPONENT", "PathLimits", "enforced", "path_limit_sin_flight_path", "path_limit_correction",
+           "corrected_cos_bank"]
 
 #: exponent of V in the heat-rate law the path-limit reference assumes (Lu 2014: 3.15)
 HEAT_RATE_VELOCITY_EXPONENT = 3.15
@@ -97,7 +98,14 @@ def path_limit_sin_flight_path(V, D, load, heat, q, s: PathLimits):
 
 def path_limit_correction(V, sin_gamma, D, load, heat, q, s: PathLimits):
     """The feedback's term k V (sin(gamma) - max{sin(gamma), U}) [m/s], <= 0 (it only lifts):
-    the law then flies cos(sigma) = cos(sigma_base) - (term) sqrt(g0/R0) / L, L the lift [m/s^2]
-    (Lu 2014's nondimensional form converted to SI)."""
+    the law then flies ``corrected_cos_bank``."""
     limit = path_limit_sin_flight_path(V, D, load, heat, q, s)
     return s.gain * V * (sin_gamma - _max(sin_gamma, limit))
+
+
+def corrected_cos_bank(cos_sigma, correction, lift, R0: float, g0: float):
+    """cos(sigma) - correction sqrt(g0/R0) / L: a correction of the vertical lift given in Lu
+    2014's nondimensional form (an altitude-rate term [m/s], ``path_limit_correction``'s or
+    FNPEG's damping) applied to the bank's cosine in SI, L the lift [m/s^2], R0 [m] and g0
+    [m/s^2] Lu's units. Any scalar type; the caller clamps and takes the arc cosine."""
+    return cos_sigma - correction * math.sqrt(g0 / R0) / lift

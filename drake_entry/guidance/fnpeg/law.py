@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from drake_entry.guidance.path_feedback import PathLimits, path_limit_correction
+from drake_entry.guidance.path_feedback import PathLimits, corrected_cos_bank, path_limit_correction
 from drake_entry.models.scalar import clamp
 
 __all__ = ["FeedbackSettings", "qegc_sin_flight_path", "commanded_bank"]
@@ -84,5 +84,5 @@ def commanded_bank(sigma_base, V, gamma, L, D, load, heat, q, s: FeedbackSetting
         correction = correction + k * (hdot - V * qegc_sin_flight_path(V, L / D, s))
     if s.path is not None and s.path.active:
         correction = correction + path_limit_correction(V, sg, D, load, heat, q, s.path)  # <= 0: only lifts
-    c = np.cos(sigma_base) - correction * math.sqrt(s.g0 / s.R0) / L
+    c = corrected_cos_bank(np.cos(sigma_base), correction, L, s.R0, s.g0)
     return np.arccos(clamp(c, math.cos(s.bank_limit), 1.0))

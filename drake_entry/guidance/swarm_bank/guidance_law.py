@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.path_feedback import PathLimits, path_limit_correction
+from drake_entry.guidance.path_feedback import PathLimits, corrected_cos_bank, path_limit_correction
 from drake_entry.models.scalar import clamp
 from drake_entry.models.schedules import linear_bank
 
@@ -233,5 +233,5 @@ def bank_magnitude(s: LawSettings, sigma0, V, gamma, r, L, D, sigma_f, e0=None, 
     magnitude = qeg_bank(base, L / s.g0, D / s.g0, sin_gamma, s_qeg, s.k2)
     if s.path is not None and s.path.active:
         term = path_limit_correction(V, sin_gamma, D, np.sqrt(L * L + D * D), heat, q, s.path)
-        magnitude = np.arccos(clamp(np.cos(magnitude) - term * math.sqrt(s.g0 / s.R0) / L, -1.0, 1.0))
+        magnitude = np.arccos(clamp(corrected_cos_bank(np.cos(magnitude), term, L, s.R0, s.g0), -1.0, 1.0))
     return clamp(magnitude, -math.inf, s.bank_limit)

@@ -45,10 +45,15 @@ def test_path_constraints_are_planned_inside_the_bounds_the_verdict_checks(scena
 
 
 def test_resolve_mesh_is_one_node_per_spacing_within_the_bounds(scenario):
+    import dataclasses as dc
+
     from drake_entry.guidance.lgl_terminal.planner import replan_nodes
 
     g = scenario.guidance  # 10 s per node, within [40, 60]
     assert [replan_nodes(g, h) for h in (700.0, 500.0, 450.0, 120.0, 5.0)] == [60, 51, 46, 40, 40]
+    four = dc.replace(g, segments=4, nodes=81)  # rounded up to a count 4 segments of >= 3 nodes share
+    assert [replan_nodes(four, h) for h in (700.0, 500.0, 450.0, 120.0, 5.0)] == [61, 53, 49, 41, 41]
+    assert all((n - 1) % 4 == 0 for n in (replan_nodes(four, h) for h in np.linspace(0.0, 900.0, 91)))
 
 
 def test_a_plan_flight_is_ok_only_inside_every_criterion_with_every_limit_held():
@@ -75,6 +80,14 @@ def test_a_plan_flight_is_ok_only_inside_every_criterion_with_every_limit_held()
     ("feedback", "pid", "guidance.feedback = 'pid' is unknown; allowed: tvlqr, costate, none"),
     ("feedback_state_weight", 0.0, "guidance.feedback_state_weight"),
     ("feedback_alpha_limit_deg", 50.0, "guidance.feedback_alpha_limit_deg"),
+    ("segments", 0, "guidance.segments = 0 is out of range"),
+    ("segments", 4, "guidance.nodes = 80 with guidance.segments = 4: nodes - 1 must be a multiple of segments "
+                    "with >= 3 nodes per segment; allowed near it: 81"),
+    ("segments", 3, "guidance.nodes = 80 with guidance.segments = 3: nodes - 1 must be a multiple of segments "
+                    "with >= 3 nodes per segment; allowed near it: 79"),
+    ("segments", 40, "guidance.nodes = 80 with guidance.segments = 40: nodes - 1 must be a multiple of segments "
+                     "with >= 3 nodes per segment; allowed near it: 81"),
+    ("segments", 41, "guidance.segments = 41 is out of range"),
 ])
 def test_bad_spec_fields_are_named(scenario, field, value, words):
     import dataclasses as dc
@@ -161,6 +174,7 @@ def test_a_mission_poses_its_own_terminal_problem(horus_derived):
     g, v = s.guidance, s.make_vehicle()
     p = g.problem_for(s)
     assert g.problem == "mission" and p.controls == "rates"
+    assert (g.nodes, g.segments) == (81, 4)  # the derivation's: 4 LGL segments of 21 nodes
     assert np.allclose([p.initial[k] for k in ("h", "lon", "lat", "V", "gamma", "psi")], s.initial_state())
     assert p.final["h"] == 25e3 and p.final["V"] == g.terminal_velocity_m_s and "gamma" not in p.final
     assert (p.final["lon"], p.final["lat"]) == pytest.approx((math.radians(s.target.longitude_deg),
@@ -222,7 +236,7 @@ def test_bad_mission_problem_fields_are_named(horus_derived, field, value, words
     assert words in str(e.value)
 
 
-@pytest.mark.slow  # an 80-node SNOPT solve and its verification flights: about 90 s of a core
+@pytest.mark.slow  # an 81-node SNOPT solve in 4 segments and its verification flights: about 40 s of a core
 def test_the_derived_horus_plan_is_verified_flown_with_its_feedback(horus_derived):
     """The plan solved on HORUS-2B's own mission is verified (between the nodes and propagated)
     and, flown through the closed loop's actuators with the TVLQR it flies between re-solves, ends

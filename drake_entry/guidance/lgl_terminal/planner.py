@@ -198,15 +198,20 @@ def plan_terminal(scenario, verifier, *, progress="auto") -> LglPlan:
 
     spec = scenario.guidance
     verifier = require_verifier(verifier, "the terminal guidance's plan")
-    result = nlp.solve(spec.problem_for(scenario), nodes=spec.nodes, solver=spec.solver, tolerance=spec.tolerance,
+    result = nlp.solve(spec.problem_for(scenario), nodes=spec.nodes, segments=spec.segments, solver=spec.solver,
+                       tolerance=spec.tolerance,
                        max_iterations=spec.max_iterations, verifier=verifier, progress=progress)
     return judged(result, scenario, verifier)
 
 
 def replan_nodes(spec, horizon_s: float) -> int:
-    """Nodes of a re-solve: one per replan_node_spacing_s of the horizon, within replan_nodes."""
+    """Nodes of a re-solve: one per replan_node_spacing_s of the horizon, within replan_nodes,
+    rounded up to a count the spec's segments share."""
+    from drake_entry.planning.nlp.lgl import segment_compatible
+
     lo, hi = spec.replan_nodes
-    return int(np.clip(math.ceil(horizon_s / spec.replan_node_spacing_s) + 1, lo, hi))
+    return segment_compatible(int(np.clip(math.ceil(horizon_s / spec.replan_node_spacing_s) + 1, lo, hi)),
+                              spec.segments)
 
 
 def final_windows(problem, spec):

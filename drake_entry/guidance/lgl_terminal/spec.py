@@ -45,6 +45,11 @@ class LglTerminal(ReplanningSpec):
     path_margin: float = 0.08
     # the pre-flight solve: LGL nodes, NLP solver, its tolerance and iteration cap
     nodes: int = 80
+    # the LGL nodes in this many equal segments sharing their end nodes (1: paper 002's one
+    # polynomial; docs/methods/nlp.md, "LGL in segments"): a segment's block of the constraint
+    # Jacobian is dense, so SNOPT's factorisations shrink with the segments. nodes - 1 a multiple
+    # of it with >= 3 nodes per segment; a re-solve rounds its node count up to one they share
+    segments: int = 1
     solver: str = "snopt"
     tolerance: float = 1.0e-7
     max_iterations: int = 3000
@@ -105,6 +110,12 @@ class LglTerminal(ReplanningSpec):
         if self.solver not in SOLVERS:
             raise ScenarioError(f"guidance.solver = '{self.solver}' is unknown; allowed: {', '.join(SOLVERS)}")
         check_range("guidance.nodes", self.nodes, 10, 400)
+        check_range("guidance.segments", self.segments, 1, 40)
+        if (self.nodes - 1) % self.segments or (self.nodes - 1) // self.segments < 2:
+            m = max(2, round((self.nodes - 1) / self.segments))
+            raise ScenarioError(f"guidance.nodes = {self.nodes} with guidance.segments = {self.segments}: nodes - 1 must "
+                                f"be a multiple of segments with >= 3 nodes per segment; allowed near it: "
+                                f"{self.segments * m + 1}")
         check_range("guidance.path_margin", self.path_margin, 0.0, 0.5)
         check_range("guidance.tolerance", self.tolerance, 1e-12, 1e-2)
         check_range("guidance.max_iterations", self.max_iterations, 1, 100000)

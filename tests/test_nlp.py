@@ -143,7 +143,28 @@ def test_infeasible_problem_is_diagnosed_not_raised():
     """|u| <= 1 cannot move 1 m and stop in 1 s (needs |u| = 4 at bang-bang)."""
     r = solve(double_integrator(control_bounds={"u": (-1.0, 1.0)}), nodes=10, max_iterations=200)
     assert not r.success
-    assert "largest violation" in r.message and "defects" in r.message
+    assert "largest violation" in r.message and "defects" in r.message and "collocation row at node" in r.message
+
+
+@pytest.mark.parametrize("segments", [None, 1, 3])
+def test_a_violated_row_is_named_by_its_state_or_path_quantity_and_node(segments):
+    """row_words on Betts' heating-limited shuttle at 10 nodes (6 states, one path row): a
+    collocation row by its state and node (LGL node-major in each segment: row k nx + i; Hermite-
+    Simpson interval-major), a path row by its quantity and node, in the whole mesh's numbering."""
+    problem, _ = catalogue.shuttle_crossrange(heating_limit=True)
+    tx, _ = _transcription_at(problem, 10, segments=segments)
+    names, path = problem.state_names, problem.path[0].label
+    last = tx.parts[-1]
+    binding = tx.collocation[-1]
+    unit = "the interval from node" if segments is None else "node"
+    assert tx.row_words(binding, 2 * 6 + 3) == f": the {names[3]} collocation row at {unit} {last.start + 2}"
+    assert tx.row_words(binding, last.n_rows + last.path_nodes - 1) == f": path {path} at node {last.start + last.path_nodes - 1}"
+    assert tx.row_words(binding, last.n_rows) == f": path {path} at node {last.start}"
+    if segments == 3:  # the first segment's constraint names its own nodes
+        assert tx.row_words(tx.collocation[0], 6) == f": the {names[0]} collocation row at node 1"
+    parts = {b.evaluator().get_description() for b in tx.collocation}
+    other = next(b for b in tx.prog.GetAllConstraints() if b.evaluator().get_description() not in parts)
+    assert tx.row_words(other, 0) == ""  # a bound or terminal constraint: its description alone
 
 
 def test_bad_options_and_problems_are_rejected_with_the_allowed_values():

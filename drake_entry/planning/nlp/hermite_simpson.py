@@ -45,6 +45,7 @@ class _HermiteSimpsonTranscription(_NodeProgram):
     the N samples, in parts of about PART_INTERVALS intervals; z = [X, U, t_f] (scaled)."""
 
     description = "Hermite-Simpson collocation and path"
+    row_unit = "the interval from node"
 
     def __init__(self, problem, nodes, scaling):
         super().__init__(problem, nodes, scaling, interval_parts(nodes, problem.n_states))

@@ -80,6 +80,22 @@ class _NodeProgram(_Transcription):
         self.add_terminal(prog, self.X[-1], self.U[-1])
         self.mayer_cost(prog, self.X[-1], None if self.tf is None else [self.tf])
 
+    #: what a collocation row's index // nx counts from the part's first node (LGL: its node)
+    row_unit = "node"
+
+    def row_words(self, binding, row: int) -> str:
+        """': the <state> collocation row at node k' or ': path <quantity> at node k' for a row
+        of a part's constraint (node indices of the whole mesh)."""
+        name = binding.evaluator().get_description()  # each part's constraint names its nodes
+        part = next((p for p, b in zip(self.parts, self.collocation) if b.evaluator().get_description() == name), None)
+        if part is None:
+            return ""
+        if row < part.n_rows:
+            node, i = divmod(row, self.nx)
+            return f": the {self.problem.state_names[i]} collocation row at {self.row_unit} {part.start + node}"
+        c, k = divmod(row - part.n_rows, part.path_nodes)
+        return f": path {self.problem.path[c].label} at node {part.start + k}"
+
     # -- layout (local to a part: z_p = [X[start:stop], U[start:stop], t_f]) ----------------
     def part_variables(self, part: _Part) -> np.ndarray:
         """The decision variables a part's constraint and cost are bound to, in z_p order."""

@@ -109,17 +109,23 @@ class _Transcription:
                          np.concatenate([x_last, np.atleast_1d(tf_vars)]))
 
     def worst_violation(self, res) -> tuple[float, str]:
-        """(largest scaled constraint violation, the constraint's description) at ``res``."""
+        """(largest scaled constraint violation, the constraint's description and, where the
+        transcription names its rows, the row's: ``row_words``) at ``res``."""
         worst, where = 0.0, ""
         for b in self.prog.GetAllConstraints():
             v = res.EvalBinding(b)
             lo, hi = b.evaluator().lower_bound(), b.evaluator().upper_bound()
             viol = np.maximum(lo - v, 0.0) + np.maximum(v - hi, 0.0)
-            viol = viol[np.isfinite(viol)]
+            viol = np.where(np.isfinite(viol), viol, 0.0)
             if viol.size and viol.max() > worst:
-                worst = float(viol.max())
-                where = b.evaluator().get_description() or type(b.evaluator()).__name__
+                worst, row = float(viol.max()), int(np.argmax(viol))
+                where = (b.evaluator().get_description() or type(b.evaluator()).__name__) + self.row_words(b, row)
         return worst, where
+
+    def row_words(self, binding, row: int) -> str:
+        """What row ``row`` of ``binding`` is, as ': ...' (here: nothing; a transcription that
+        knows its rows says)."""
+        return ""
 
     def diagnose(self) -> str:
         """Name the worst violated constraint at the returned point (infeasible problems),

@@ -27,6 +27,7 @@ from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlq
 from drake_entry.planning.verification import Actuation, EntryControls, Tracking, require_verifier
 
 __all__ = ["SAMPLES_PER_S", "PlanFlight", "LglPlan", "feedback_weights", "feedback_maker", "actuation", "fly_plan", "sensed_path",
+           "measured_path",
            "judged", "plan_terminal", "replan_nodes", "final_windows", "replan"]
 
 #: command samples per second of a plan (linear interpolation between them by the guidance)
@@ -234,6 +235,24 @@ def sensed_path(path, scales) -> list:
             else c for c in path]
 
 
+def measured_path(planned, limits, values) -> list:
+    """The path constraints of a re-solve from a measured state: ``planned`` (with the spec's
+    margin) as they are, except a bound the state already passes (``values``: the constraints'
+    values there), which is planned at the vehicle's own bound (``limits``: the same constraints
+    without the margin) or, past that too, at the value itself. The state at a re-solve's first
+    node is fixed: a bound it passes cannot be met there, and SNOPT stops infeasible (HORUS-2B's
+    nominal flight: 5 of 14 re-solves, each at the first node's heat rate, q or load)."""
+    out = []
+    for c, lim, v in zip(planned, limits, values):
+        lo, hi = c.min, c.max
+        if math.isfinite(hi) and v > hi:
+            hi = max(lim.max, float(v))
+        if math.isfinite(lo) and v < lo:
+            lo = min(lim.min, float(v))
+        out.append(c if (lo, hi) == (c.min, c.max) else dc.replace(c, min=lo, max=hi))
+    return out
+
+
 def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scales=None) -> LglPlan:
     """Re-solve from the navigation state ``x`` [h, lon, lat, V, gamma, psi] reached ``elapsed`` [s]
     into ``previous``, with the bank and alpha being commanded [rad] as the initial alpha and
@@ -241,8 +260,11 @@ def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scal
     ``previous`` (shrinking_horizon.resolve_from), aiming at the final speed and flight-path
     angle within the spec's re-solve windows (``final_windows``), with the nominal lift and drag
     times ``scales`` = (k_L, k_D) when given (the sensed/modelled ratios) and the q and heat-rate
-    bounds held in the air they imply (``sensed_path``); judged, with the same models, as the
-    pre-flight plan is."""
+    bounds held in the air they imply (``sensed_path``), a bound the measured state already passes
+    planned at the vehicle's own (``measured_path``); judged, with the same models, as the
+    pre-flight plan is. The path bounds are the pre-flight problem's each time (a re-solve's
+    own, already held in the air of its time, are not carried on)."""
+    from drake_entry.guidance.lgl_terminal.mission import problem_for_scenario
     from drake_entry.planning.nlp.shrinking_horizon import resolve_from
 
     r, scenario = previous.result, previous.scenario
@@ -254,9 +276,12 @@ def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scal
     x_now[names.index("alpha")] = float(np.clip(alpha, lo, hi))
     x_now[names.index("sigma")] = float(bank)
     problem = final_windows(r.problem, spec)
+    planned, limits = spec.problem_for(scenario).path, problem_for_scenario(spec, scenario, margin=False).path
     if scales is not None:
-        problem = dc.replace(problem, vehicle=sensed_vehicle(scenario.make_vehicle(), scales),
-                             path=sensed_path(r.problem.path, scales))
+        planned, limits = sensed_path(planned, scales), sensed_path(limits, scales)
+        problem = dc.replace(problem, vehicle=sensed_vehicle(scenario.make_vehicle(), scales))
+    values = dc.replace(problem, path=planned).path_values(x_now, np.zeros(len(problem.control_names)))
+    problem = dc.replace(problem, path=measured_path(planned, limits, values))
     again = resolve_from(r, x_now, elapsed, problem=problem, nodes=replan_nodes(spec, r.final_time - elapsed), solver=spec.solver,
                          tolerance=spec.replan_tolerance, max_iterations=spec.max_iterations,
                          verifier=previous.verifier, progress=False)

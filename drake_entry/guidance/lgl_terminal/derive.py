@@ -31,8 +31,8 @@ ALPHA_RATE_DEG_S = 2.0
 #: the pre-flight solve's LGL nodes on a mission (paper 002 flies 125 on its 714-s problem; HORUS-2B's
 #: 1300-s glide on 40 is converged but inaccurate: 0.013 between the nodes, 62 km when propagated),
 #: in SEGMENTS segments: HORUS-2B's pre-flight solve at 80 nodes on one polynomial took 62 s, 8.2e-4
-#: between the nodes, 615 m propagated; at 81 in 4 segments 29 s, 1.8e-4, 84 m, and its nominal
-#: closed loop 88 s of wall time against 163 (re-solves 2.4 s median against 6.1)
+#: between the nodes, 615 m propagated; at 81 in 4 segments 29 s, 1.8e-4, 84 m, and a dispersed
+#: closed loop (draw 0 of seed 2026) 88 s of wall time against 163 (re-solves 2.4 s median against 6.1)
 NODES, SEGMENTS = 81, 4
 def derive(scenario) -> Derivation:
     """LglTerminal settings for ``scenario``'s mission stating no block of this method."""

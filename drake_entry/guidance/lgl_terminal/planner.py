@@ -240,8 +240,8 @@ def measured_path(planned, limits, values) -> list:
     margin) as they are, except a bound the state already passes (``values``: the constraints'
     values there), which is planned at the vehicle's own bound (``limits``: the same constraints
     without the margin) or, past that too, at the value itself. The state at a re-solve's first
-    node is fixed: a bound it passes cannot be met there, and SNOPT stops infeasible (HORUS-2B's
-    nominal flight: 5 of 14 re-solves, each at the first node's heat rate, q or load)."""
+    node is fixed: a bound it passes cannot be met there, and SNOPT stops infeasible (HORUS-2B,
+    draw 0 of seed 2026: 5 of 14 re-solves, each at the first node's heat rate, q or load)."""
     out = []
     for c, lim, v in zip(planned, limits, values):
         lo, hi = c.min, c.max

@@ -81,12 +81,12 @@ def test_a_plan_flight_is_ok_only_inside_every_criterion_with_every_limit_held()
     ("feedback_state_weight", 0.0, "guidance.feedback_state_weight"),
     ("feedback_alpha_limit_deg", 50.0, "guidance.feedback_alpha_limit_deg"),
     ("segments", 0, "guidance.segments = 0 is out of range"),
-    ("segments", 4, "guidance.nodes = 80 with guidance.segments = 4: nodes - 1 must be a multiple of segments "
-                    "with >= 3 nodes per segment; allowed near it: 81"),
-    ("segments", 3, "guidance.nodes = 80 with guidance.segments = 3: nodes - 1 must be a multiple of segments "
-                    "with >= 3 nodes per segment; allowed near it: 79"),
-    ("segments", 40, "guidance.nodes = 80 with guidance.segments = 40: nodes - 1 must be a multiple of segments "
-                     "with >= 3 nodes per segment; allowed near it: 81"),
+    ("segments", 4, "guidance.nodes = 80 with guidance.segments = 4: guidance.nodes - 1 must be a multiple of "
+                    "guidance.segments with at least 3 nodes per segment; allowed near it: 77 or 81"),
+    ("segments", 3, "guidance.nodes = 80 with guidance.segments = 3: guidance.nodes - 1 must be a multiple of "
+                    "guidance.segments with at least 3 nodes per segment; allowed near it: 79 or 82"),
+    ("segments", 40, "guidance.nodes = 80 with guidance.segments = 40: guidance.nodes - 1 must be a multiple of "
+                     "guidance.segments with at least 3 nodes per segment; allowed near it: 81"),
     ("segments", 41, "guidance.segments = 41 is out of range"),
 ])
 def test_bad_spec_fields_are_named(scenario, field, value, words):

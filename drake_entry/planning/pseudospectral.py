@@ -19,7 +19,7 @@ from numpy.polynomial import legendre
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["lgl_nodes", "barycentric_weights", "interpolation_matrix", "LGL", "lobatto_integration_matrix",
+__all__ = ["nodes_per_segment", "segment_compatible", "lgl_nodes", "barycentric_weights", "interpolation_matrix", "LGL", "lobatto_integration_matrix",
            "INTEGRATION_MAX_NODES", "SEGMENT_MAX_NODES", "SegmentMesh"]
 
 
@@ -140,6 +140,27 @@ def lobatto_integration_matrix(n_nodes: int) -> np.ndarray:
 INTEGRATION_MAX_NODES = 16
 #: a segment's node count cap (the LGL nodes and differentiation matrix stay accurate far beyond)
 SEGMENT_MAX_NODES = 400
+
+
+def nodes_per_segment(nodes: int, segments: int, fields: tuple = ("nodes", "segments")) -> int:
+    """LGL nodes of each of ``segments`` equal segments sharing their end nodes, for ``nodes``
+    in all; ScenarioError naming the node counts allowed when they do not divide (the two
+    counts called by their ``fields`` names, e.g. a scenario's 'guidance.nodes')."""
+    n_name, s_name = fields
+    if not (isinstance(segments, (int, np.integer)) and not isinstance(segments, bool) and segments >= 1):
+        raise ScenarioError(f"{s_name} = {segments!r}; allowed: an integer >= 1 (LGL segments)")
+    m, rest = divmod(nodes - 1, segments)
+    if rest or m < 2:
+        near = f"{2 * segments + 1}" if m < 2 else f"{segments * m + 1} or {segments * (m + 1) + 1}"
+        raise ScenarioError(f"{n_name} = {nodes} with {s_name} = {segments}: {n_name} - 1 must be a multiple of "
+                            f"{s_name} with at least 3 nodes per segment; allowed near it: {near}")
+    return m + 1
+
+
+def segment_compatible(nodes: int, segments: int) -> int:
+    """The smallest node count >= ``nodes`` that ``segments`` segments of >= 3 nodes share."""
+    m = max(2, -(-(int(nodes) - 1) // segments))
+    return segments * m + 1
 
 
 @dataclass

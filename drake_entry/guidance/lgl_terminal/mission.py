@@ -13,7 +13,7 @@ from drake_entry.models.verdict import PathLimit
 from drake_entry.planning.ocp import PATH_QUANTITIES, ObjectiveTerm, OptimalControlProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
 
-__all__ = ["MISSION", "GAMMA_BOUNDS_DEG", "load_guidance_problem", "mission_problem", "problem_for_scenario",
+__all__ = ["MISSION", "GAMMA_BOUNDS_DEG", "load_guidance_problem", "mission_problem", "problem_for_scenario", "inside_bounds",
            "mission_path_limits"]
 
 #: the ``problem`` value that poses the problem from the mission instead of a file
@@ -80,13 +80,13 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
                  lat=math.radians(scenario.target.latitude_deg))
     if spec.final_flight_path_deg is not None:
         final["gamma"] = math.radians(spec.final_flight_path_deg)
-    path = [_inside(c, spec.path_margin) for c in p.path] if margin else list(p.path)
+    path = [inside_bounds(c, spec.path_margin) for c in p.path] if margin else list(p.path)
     return dc.replace(p, vehicle=scenario.make_vehicle(), planet=scenario.make_planet(),
                       atmosphere=scenario.make_atmosphere(), initial=initial, final=final, path=path,
                       name=f"{scenario.name}_{p.name}")
 
 
-def _inside(c, margin: float):
+def inside_bounds(c, margin: float):
     """Path constraint ``c`` with each finite bound moved ``margin`` (relative) inside."""
     lo = c.min + margin * abs(c.min) if math.isfinite(c.min) else c.min
     hi = c.max - margin * abs(c.max) if math.isfinite(c.max) else c.max

@@ -23,6 +23,7 @@ from drake_entry.errors import ScenarioError
 from drake_entry.models.acceleration_ratios import sensed_limit_factors, sensed_vehicle
 from drake_entry.models.verdict import box_text, breaches_text, check_limits
 from drake_entry.planning.neighbouring_optimal import neighbouring_optimal, without_odd_even_mode
+from drake_entry.planning.pseudospectral import segment_compatible
 from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlqr
 from drake_entry.planning.verification import Actuation, EntryControls, Tracking, require_verifier
 
@@ -208,8 +209,6 @@ def plan_terminal(scenario, verifier, *, progress="auto") -> LglPlan:
 def replan_nodes(spec, horizon_s: float) -> int:
     """Nodes of a re-solve: one per replan_node_spacing_s of the horizon, within replan_nodes,
     rounded up to a count the spec's segments share."""
-    from drake_entry.planning.nlp.lgl import segment_compatible
-
     lo, hi = spec.replan_nodes
     return segment_compatible(int(np.clip(math.ceil(horizon_s / spec.replan_node_spacing_s) + 1, lo, hi)),
                               spec.segments)
@@ -264,7 +263,7 @@ def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scal
     planned at the vehicle's own (``measured_path``); judged, with the same models, as the
     pre-flight plan is. The path bounds are the pre-flight problem's each time (a re-solve's
     own, already held in the air of its time, are not carried on)."""
-    from drake_entry.guidance.lgl_terminal.mission import problem_for_scenario
+    from drake_entry.guidance.lgl_terminal.mission import inside_bounds, problem_for_scenario
     from drake_entry.planning.nlp.shrinking_horizon import resolve_from
 
     r, scenario = previous.result, previous.scenario
@@ -276,7 +275,8 @@ def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scal
     x_now[names.index("alpha")] = float(np.clip(alpha, lo, hi))
     x_now[names.index("sigma")] = float(bank)
     problem = final_windows(r.problem, spec)
-    planned, limits = spec.problem_for(scenario).path, problem_for_scenario(spec, scenario, margin=False).path
+    limits = problem_for_scenario(spec, scenario, margin=False).path
+    planned = [inside_bounds(c, spec.path_margin) for c in limits]  # as spec.problem_for plans them
     if scales is not None:
         planned, limits = sensed_path(planned, scales), sensed_path(limits, scales)
         problem = dc.replace(problem, vehicle=sensed_vehicle(scenario.make_vehicle(), scales))

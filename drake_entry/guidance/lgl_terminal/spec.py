@@ -111,11 +111,9 @@ class LglTerminal(ReplanningSpec):
             raise ScenarioError(f"guidance.solver = '{self.solver}' is unknown; allowed: {', '.join(SOLVERS)}")
         check_range("guidance.nodes", self.nodes, 10, 400)
         check_range("guidance.segments", self.segments, 1, 40)
-        if (self.nodes - 1) % self.segments or (self.nodes - 1) // self.segments < 2:
-            m = max(2, round((self.nodes - 1) / self.segments))
-            raise ScenarioError(f"guidance.nodes = {self.nodes} with guidance.segments = {self.segments}: nodes - 1 must "
-                                f"be a multiple of segments with >= 3 nodes per segment; allowed near it: "
-                                f"{self.segments * m + 1}")
+        from drake_entry.planning.pseudospectral import nodes_per_segment
+
+        nodes_per_segment(self.nodes, self.segments, fields=("guidance.nodes", "guidance.segments"))
         check_range("guidance.path_margin", self.path_margin, 0.0, 0.5)
         check_range("guidance.tolerance", self.tolerance, 1e-12, 1e-2)
         check_range("guidance.max_iterations", self.max_iterations, 1, 100000)

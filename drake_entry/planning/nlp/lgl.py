@@ -4,31 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from drake_entry.errors import ScenarioError
 from drake_entry.planning.nlp.node_program import _NodeProgram, _Part
 from drake_entry.planning.nlp.result import NlpResult
-from drake_entry.planning.pseudospectral import SegmentMesh
+from drake_entry.planning.pseudospectral import SegmentMesh, nodes_per_segment, segment_compatible  # noqa: F401 (API)
 
 __all__ = ["nodes_per_segment", "segment_compatible"]
-
-
-def nodes_per_segment(nodes: int, segments: int) -> int:
-    """LGL nodes of each of ``segments`` equal segments sharing their end nodes, for ``nodes``
-    in all; ScenarioError naming the node counts allowed when they do not divide."""
-    if not (isinstance(segments, (int, np.integer)) and not isinstance(segments, bool) and segments >= 1):
-        raise ScenarioError(f"segments = {segments!r}; allowed: an integer >= 1 (LGL segments)")
-    m, rest = divmod(nodes - 1, segments)
-    if rest or m < 2:
-        near = f"{2 * segments + 1}" if m < 2 else f"{segments * m + 1} or {segments * (m + 1) + 1}"
-        raise ScenarioError(f"nodes = {nodes} with segments = {segments}: nodes - 1 must be a multiple of segments "
-                            f"with at least 3 nodes per segment; allowed near it: {near}")
-    return m + 1
-
-
-def segment_compatible(nodes: int, segments: int) -> int:
-    """The smallest node count >= ``nodes`` that ``segments`` segments of >= 3 nodes share."""
-    m = max(2, -(-(int(nodes) - 1) // segments))
-    return segments * m + 1
 
 
 class _LglTranscription(_NodeProgram):

@@ -209,7 +209,41 @@ def test_the_derived_final_speed_stays_below_the_planned_dynamic_pressure(horus_
         assert 2.0 <= V / float(atmosphere.speed_of_sound(h)) <= 2.5  # the box's Mach window, below its centre
 
 
-def test_a_mission_whose_box_is_beyond_the_dynamic_pressure_limit_cannot_be_flown():
+def test_the_derived_final_speed_keeps_the_last_node_under_the_load_bound_with_dispersed_forces():
+    """Paper 004's CAV-H at its 30 km, 2000 m/s interface is over 0.92 x 2 g at alpha 19 deg with the
+    3-sigma forces a re-solve may sense (its last node is fixed): each candidate's speed is capped
+    where that load, computed here from the aerodynamic model, meets the planned bound; where the
+    cap is above the box's 2000 m/s the centre speed stays."""
+    from drake_entry.guidance.derivation import FORCE_SIGMAS, derivation_for
+    from drake_entry.guidance.lgl_terminal.spec import LglTerminal
+    from drake_entry.models.dispersions import force_ratio_high
+    from drake_entry.models.planet import G0
+
+    mission = load_scenario("cav_h_paper004")
+    vehicle, atmosphere = mission.make_vehicle(), mission.make_atmosphere()
+    force_high = force_ratio_high(mission.dispersions, FORCE_SIGMAS)
+    (step,) = derivation_for(mission, LglTerminal).search
+    assert derivation_for(mission, LglTerminal).spec.alpha_bounds_deg == [19.0, 21.0]
+
+    def load_g(h, V):
+        CL, CD = vehicle.aero.coefficients(math.radians(19.0), V / float(atmosphere.speed_of_sound(h)))
+        return 0.5 * float(atmosphere.density(h)) * V ** 2 * vehicle.area_over_mass * math.hypot(CL, CD) / G0
+
+    assert load_g(30e3, 2000.0) * force_high > 0.92 * 2.0  # the box centre is beyond the bound
+    capped = 0
+    for c in step.candidates:
+        h, V = c["guidance.terminal_altitude_km"] * 1e3, c["guidance.terminal_velocity_m_s"]
+        if V < 2000.0:
+            capped += 1
+            assert load_g(h, V) * force_high == pytest.approx(0.92 * 2.0, rel=1e-4)
+        else:
+            assert load_g(h, V) * force_high <= 0.92 * 2.0
+    assert capped == 5  # 31.5 km meets the bound above 2000 m/s
+    lu = derivation_for(load_scenario("cav_h_fnpeg"), LglTerminal).search[0]
+    assert {c["guidance.terminal_velocity_m_s"] for c in lu.candidates} == {2000.0}  # far from its load bound
+
+
+def test_a_mission_whose_box_is_beyond_the_dynamic_pressure_or_load_limit_cannot_be_flown():
     from drake_entry.guidance.derivation import CannotFly, derivation_for
     from drake_entry.guidance.lgl_terminal.spec import LglTerminal
     from drake_entry.scenario import apply_overrides
@@ -218,6 +252,11 @@ def test_a_mission_whose_box_is_beyond_the_dynamic_pressure_limit_cannot_be_flow
     apply_overrides(s, {"vehicle_limits": "{dynamic_pressure_max_kPa: 5.0}"})
     with pytest.raises(CannotFly, match=r"at 24 km the vehicle's dynamic-pressure limit, planned at 0.92 of it, is met "
                                         r"at \d+ m/s, below the box's 597 m/s"):
+        derivation_for(s, LglTerminal)
+    s = load_scenario("horus2b")
+    apply_overrides(s, {"vehicle_limits": "{normal_load_max_g: 0.5}"})
+    with pytest.raises(CannotFly, match=r"at 24 km the vehicle's load limit, planned at 0.92 of it with forces 1 x the "
+                                        r"nominal at alpha 15 deg, is met at 2\d\d m/s, below the box's 597 m/s"):
         derivation_for(s, LglTerminal)
 
 

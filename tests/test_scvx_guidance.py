@@ -173,8 +173,8 @@ def test_scvx_derived_mach_window_lies_below_the_load_bound_and_reaches_down_for
     from the aerodynamic model, is the planned bound."""
     import math
 
-    from drake_entry.guidance.derivation import LIMIT_MARGIN, derivation_for, terminal_interface
-    from drake_entry.guidance.scvx.derive import FORCE_SIGMAS, INTERFACE_SPEED_WINDOW
+    from drake_entry.guidance.derivation import FORCE_SIGMAS, LIMIT_MARGIN, derivation_for, terminal_interface
+    from drake_entry.guidance.scvx.derive import INTERFACE_SPEED_WINDOW
     from drake_entry.guidance.scvx.spec import Scvx
     from drake_entry.models.dispersions import force_ratio_high
     from drake_entry.models.planet import G0

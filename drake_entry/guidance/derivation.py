@@ -28,12 +28,17 @@ from drake_entry.scenario import stated_guidance
 __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
            "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed",
-           "box_mach_window", "load_limit_speed", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds", "PATH_GAIN",
+           "box_mach_window", "load_limit_speed", "FORCE_SIGMAS", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds", "PATH_GAIN",
            "PATH_LIMIT_FRACTION", "path_gain"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
 #: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
 LIMIT_MARGIN = 0.93
+#: a plan that a re-plan or re-solve predicts with the forces sensed keeps room for forces this
+#: many standard deviations of the mission's force dispersions above the nominal
+#: (models.dispersions.force_ratio_high): SCvx's Mach window reaches down to where they meet the
+#: planned load bound, the LGL terminal speed stays under it
+FORCE_SIGMAS = 3.0
 #: Lu 2014's path-limit feedback gain a method flies where the vehicle has limits and nothing else
 #: holds them (the swarm bank under a mission's alpha schedule: HORUS-2B's heat rate was 0.3-2.8 %
 #: over in 43 of 100 runs without it; the AMPI tracker: the capsule's final dive passed q in 21 of
@@ -316,27 +321,39 @@ def load_limit_speed(scenario, altitude_km: float, alpha_deg, fraction: float = 
 Q_SPEED_FRACTION = 0.97
 
 
-def terminal_speed(scenario, interface, altitude_km: float, path_margin: float) -> float:
+def terminal_speed(scenario, interface, altitude_km: float, path_margin: float, *, load_alpha_deg: float | None = None,
+                   force_high: float = 1.0) -> float:
     """The final speed [m/s] planned at ``altitude_km``: the box's centre speed, or below the
-    planned dynamic-pressure bound (Q_SPEED_FRACTION of its speed) where that is lower; CannotFly
-    when that is below the box's speed window."""
-    V = min(interface.speed_m_s, Q_SPEED_FRACTION * q_limit_speed(scenario, altitude_km, 1.0 - path_margin))
+    planned dynamic-pressure bound (Q_SPEED_FRACTION of its speed) where that is lower, and, with
+    ``load_alpha_deg`` [deg], at most the speed where forces ``force_high`` times the nominal meet
+    the planned load bound flying that alpha (a plan re-solved with the forces sensed keeps its
+    last node inside the bound: paper 004's CAV-H at 30.5 km and 2000 m/s is over 0.92 x 2 g with
+    8 % more lift and density); CannotFly when that is below the box's speed window."""
+    q_speed = Q_SPEED_FRACTION * q_limit_speed(scenario, altitude_km, 1.0 - path_margin)
+    load_speed = (math.inf if load_alpha_deg is None else
+                  load_limit_speed(scenario, altitude_km, lambda V: load_alpha_deg, (1.0 - path_margin) / force_high))
+    V = min(interface.speed_m_s, q_speed, load_speed)
     window = box_mach_window(scenario, interface)
     low = window[0][0] * interface.speed_of_sound if window is not None else 0.0
     if V < low:
-        raise CannotFly(f"at {altitude_km:g} km the vehicle's dynamic-pressure limit, planned at {1 - path_margin:g} of "
-                        f"it, is met at {V / Q_SPEED_FRACTION:.0f} m/s, below the box's {low:.0f} m/s")
+        limit = (f"the vehicle's dynamic-pressure limit, planned at {1 - path_margin:g} of it, is met at "
+                 f"{q_speed / Q_SPEED_FRACTION:.0f} m/s" if q_speed <= load_speed else
+                 f"the vehicle's load limit, planned at {1 - path_margin:g} of it with forces {force_high:.3g} x the "
+                 f"nominal at alpha {load_alpha_deg:g} deg, is met at {load_speed:.0f} m/s")
+        raise CannotFly(f"at {altitude_km:g} km {limit}, below the box's {low:.0f} m/s")
     return round(V, 3)
 
 
-def interface_speeds(scenario, interface: Interface, path_margin: float) -> list[tuple[float, float]]:
+def interface_speeds(scenario, interface: Interface, path_margin: float, *, load_alpha_deg: float | None = None,
+                     force_high: float = 1.0) -> list[tuple[float, float]]:
     """(altitude [km], terminal_speed [m/s]) at each of ``interface_altitudes`` where the planned
-    dynamic-pressure bound leaves a speed in the box, in their order; the last CannotFly when none
-    does."""
+    dynamic-pressure bound (and the load bound, with ``load_alpha_deg`` and ``force_high``: see
+    terminal_speed) leaves a speed in the box, in their order; the last CannotFly when none does."""
     out, refused = [], None
     for h in interface_altitudes(scenario, interface):
         try:
-            out.append((h, terminal_speed(scenario, interface, h, path_margin)))
+            out.append((h, terminal_speed(scenario, interface, h, path_margin, load_alpha_deg=load_alpha_deg,
+                                          force_high=force_high)))
         except CannotFly as e:
             refused = e
     if not out:

@@ -9,6 +9,7 @@ box on the nominal flight and a few dispersed draws."""
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
+    FORCE_SIGMAS,
     Q_SPEED_FRACTION,
     Choice,
     Derivation,
@@ -19,6 +20,7 @@ from drake_entry.guidance.derivation import (
 )
 from drake_entry.guidance.lgl_terminal.mission import MISSION
 from drake_entry.guidance.lgl_terminal.spec import LglTerminal
+from drake_entry.models.dispersions import force_ratio_high
 
 __all__ = ["derive", "ALPHA_WIDEN_DEG", "ALPHA_RATE_DEG_S", "NODES", "SEGMENTS"]
 
@@ -43,8 +45,10 @@ def derive(scenario) -> Derivation:
     if constant:
         lo, hi = lo - ALPHA_WIDEN_DEG, hi + ALPHA_WIDEN_DEG
     gamma = scenario.terminal.flight_path_deg
+    force_high = force_ratio_high(scenario.dispersions, FORCE_SIGMAS)
     candidates = [{"guidance.terminal_altitude_km": h, "guidance.terminal_velocity_m_s": V}
-                  for h, V in interface_speeds(scenario, interface, LglTerminal.path_margin)]
+                  for h, V in interface_speeds(scenario, interface, LglTerminal.path_margin, load_alpha_deg=lo,
+                                               force_high=force_high)]
     first = candidates[0]
     spec = LglTerminal(problem=MISSION, terminal_altitude_km=first["guidance.terminal_altitude_km"],
                        terminal_velocity_m_s=first["guidance.terminal_velocity_m_s"], final_flight_path_deg=gamma,
@@ -55,7 +59,10 @@ def derive(scenario) -> Derivation:
                Choice("guidance.terminal_altitude_km, terminal_velocity_m_s",
                       f"{spec.terminal_altitude_km:g} km, {spec.terminal_velocity_m_s:.1f} m/s",
                       f"the box's centre speed ({interface.speed_m_s:.1f} m/s), or {Q_SPEED_FRACTION:g} of the "
-                      f"speed where the planned dynamic-pressure bound is met at the altitude when lower"),
+                      f"speed where the planned dynamic-pressure bound is met at the altitude when lower, or the "
+                      f"speed where forces {force_high:.3g} x the nominal ({FORCE_SIGMAS:g} sigma of the mission's "
+                      f"force dispersions) meet the planned load bound at alpha {lo:g} deg when lower still (a "
+                      f"re-solve predicts with the forces sensed, and its last node is fixed)"),
                Choice("guidance.alpha_bounds_deg", f"[{lo:g}, {hi:g}]", f"the range of {source} alpha schedule"
                       + (f", widened {ALPHA_WIDEN_DEG:g} deg each side" if constant else "")),
                Choice("guidance.final_flight_path_deg", "free" if gamma is None else f"{gamma:g}",

@@ -11,6 +11,7 @@ import math
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
+    FORCE_SIGMAS,
     LIMIT_MARGIN,
     CannotFly,
     Choice,
@@ -30,7 +31,7 @@ from drake_entry.models.dispersions import force_dispersions, force_ratio_high
 
 __all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW_KM", "AIM_TOLERANCE_KM",
            "FEEDBACK", "REPLAN_PERIOD_S", "REPLAN_TIME_TO_GO_FRACTION", "REPLAN_MIN_TIME_TO_GO_S", "FLOWN_MACH_SLACK",
-           "GLIDE_AIM_TOLERANCE_KM", "glides_at", "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "FINAL_DESCENT_DEG", "FORCE_SIGMAS", "OBJECTIVE", "FORMULATION", "aim_window"]
+           "GLIDE_AIM_TOLERANCE_KM", "glides_at", "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "FINAL_DESCENT_DEG", "OBJECTIVE", "FORMULATION", "aim_window"]
 
 #: the plan's objective and formulation on another method's mission: the control effort (the
 #: integral of |sigma_dot|), with the bank a state and alpha the mission's law. Measured on
@@ -87,10 +88,6 @@ INTERFACE_SPEED_WINDOW = 0.05
 #: speed): paper 004's CAV-H planned to a shallow glide at its stop altitude crossed it 90 s
 #: (140 km) late in 5 of 10 dispersed flights
 FINAL_DESCENT_DEG = 1.0
-#: the plan's Mach window reaches down to where a flight whose aerodynamic forces are this many
-#: standard deviations of the mission's force dispersions above the nominal meets the planned
-#: load bound (models.dispersions.force_ratio_high)
-FORCE_SIGMAS = 3.0
 #: the flight-path bounds of eq. 70 on a mission that bounds no gamma [deg]: paper 001's -30 deg
 #: is its own mission's (a capsule's last minute below 25 km dives to -31 to -35 deg), the upper
 #: bound opened to 5 deg

@@ -305,11 +305,11 @@ def test_a_resolve_in_denser_air_holds_q_and_the_heat_rate_there():
     assert sensed_path(path, (0.8, 0.9)) == path
 
 
-def test_a_resolve_plans_a_bound_its_measured_state_already_passes_at_the_vehicles_own():
+def test_a_resolve_plans_a_bound_its_measured_state_already_passes_halfway_to_the_vehicles_own():
     """measured_path: a bound the state at the re-solve passes (its planned margin spent) is
-    planned at the vehicle's bound, or at the value when past that too; a lower bound likewise;
-    the rest as planned (the same objects)."""
-    from drake_entry.guidance.lgl_terminal.planner import measured_path
+    planned halfway from the planned bound to the vehicle's (MEASURED_MARGIN_FRACTION), or at the
+    value when past that too; a lower bound likewise; the rest as planned (the same objects)."""
+    from drake_entry.guidance.lgl_terminal.planner import MEASURED_MARGIN_FRACTION, measured_path
     from drake_entry.planning.ocp import PathConstraint
 
     limits = [PathConstraint("heat_flux", max=5e5), PathConstraint("dynamic_pressure", min=1.2e4),
@@ -318,8 +318,12 @@ def test_a_resolve_plans_a_bound_its_measured_state_already_passes_at_the_vehicl
                PathConstraint("normal_load", max=2.3)]
     inside = measured_path(planned, limits, [4.0e5, 1.5e4, 2.0])
     assert all(a is b for a, b in zip(inside, planned))
-    spent = measured_path(planned, limits, [4.8e5, 1.25e4, 2.4])  # inside the limits, past the margins
-    assert [c.max for c in spent] == [5e5, math.inf, 2.5] and spent[1].min == 1.2e4
+    assert MEASURED_MARGIN_FRACTION == 0.5
+    spent = measured_path(planned, limits, [4.7e5, 1.26e4, 2.35])  # past the margins, not halfway to the limits
+    assert [c.max for c in spent] == pytest.approx([4.8e5, math.inf, 2.4], rel=1e-14)
+    assert spent[1].min == pytest.approx(1.248e4, rel=1e-14)
+    beyond = measured_path(planned, limits, [4.9e5, 1.22e4, 2.45])  # past halfway: at the value
+    assert [c.max for c in beyond] == [4.9e5, math.inf, 2.45] and beyond[1].min == 1.22e4
     past = measured_path(planned, limits, [5.1e5, 1.1e4, 2.0])  # past the limits themselves
     assert past[0].max == 5.1e5 and past[1].min == 1.1e4 and past[2] is planned[2]
     assert [c.label for c in past] == [c.label for c in planned]

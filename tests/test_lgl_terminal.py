@@ -176,7 +176,10 @@ def test_a_mission_poses_its_own_terminal_problem(horus_derived):
     assert g.problem == "mission" and p.controls == "rates"
     assert (g.nodes, g.segments) == (81, 4)  # the derivation's: 4 LGL segments of 21 nodes
     assert np.allclose([p.initial[k] for k in ("h", "lon", "lat", "V", "gamma", "psi")], s.initial_state())
-    assert p.final["h"] == 25e3 and p.final["V"] == g.terminal_velocity_m_s and "gamma" not in p.final
+    assert p.final["h"] == 25e3 and p.final["V"] == g.terminal_velocity_m_s
+    # the box checks no flight-path angle: the plan ends descending at least 1 deg (FINAL_DESCENT_DEG)
+    assert g.final_flight_path_deg is None and g.final_descent_deg == 1.0
+    assert np.degrees(p.final["gamma"]) == pytest.approx((GAMMA_BOUNDS_DEG[0], -1.0))
     assert (p.final["lon"], p.final["lat"]) == pytest.approx((math.radians(s.target.longitude_deg),
                                                               math.radians(s.target.latitude_deg)))
     assert np.degrees(p.state_bounds["alpha"]) == pytest.approx([15.0, 40.0])  # the mission's schedule
@@ -265,6 +268,8 @@ def test_a_mission_whose_box_is_beyond_the_dynamic_pressure_or_load_limit_cannot
     ("alpha_bounds_deg", [20.0], "guidance.alpha_bounds_deg = [20.0]: with problem: mission give [min, max]"),
     ("alpha_bounds_deg", [30.0, 10.0], "with -90 <= min < max <= 90 deg"),
     ("alpha_rate_deg_s", 0.0, "guidance.alpha_rate_deg_s"),
+    ("final_descent_deg", 50.0, "guidance.final_descent_deg = 50"),
+    ("final_flight_path_deg", -5.0, "guidance.final_descent_deg = 1 with final_flight_path_deg = -5: give one of them"),
 ])
 def test_bad_mission_problem_fields_are_named(horus_derived, field, value, words):
     import dataclasses as dc
@@ -365,3 +370,13 @@ def test_resolves_from_a_dispersed_horus_flight_hold_their_bounds_from_the_pre_f
     for q_max, expected, message in seen:
         assert q_max == pytest.approx(expected, rel=1e-12) or q_max >= expected, message
         assert "largest violation" not in message or "at node 0" not in message, message
+
+
+def test_a_least_final_descent_is_refused_on_a_problem_file():
+    """MaRV's problem file states its own final conditions: final_descent_deg is named as a field
+    of problem: mission."""
+    import dataclasses as dc
+
+    s = load_scenario("marv_guidance")
+    with pytest.raises(ScenarioError, match="guidance.final_descent_deg is a field of problem: mission"):
+        dc.replace(s, guidance=dc.replace(s.guidance, final_flight_path_deg=None, final_descent_deg=1.0)).validate()

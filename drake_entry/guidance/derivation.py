@@ -28,7 +28,7 @@ from drake_entry.scenario import stated_guidance
 __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
            "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
            "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed",
-           "box_mach_window", "load_limit_speed", "FORCE_SIGMAS", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds", "PATH_GAIN",
+           "box_mach_window", "load_limit_speed", "FORCE_SIGMAS", "FINAL_DESCENT_DEG", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds", "PATH_GAIN",
            "PATH_LIMIT_FRACTION", "path_gain"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
@@ -39,6 +39,12 @@ LIMIT_MARGIN = 0.93
 #: (models.dispersions.force_ratio_high): SCvx's Mach window reaches down to where they meet the
 #: planned load bound, the LGL terminal speed stays under it
 FORCE_SIGMAS = 3.0
+#: a method's plans end descending at least this steeply [deg] where the mission's box gives no
+#: flight-path angle (the flight stops where it first crosses the interface altitude): paper 004's
+#: CAV-H planned by SCvx to a shallow glide at its stop altitude crossed it 90 s (140 km) late in
+#: 5 of 10 dispersed flights; its LGL plans, levelling off to +0.05 deg in their last 40 s, were
+#: crossed up to 39 s (75 km) early
+FINAL_DESCENT_DEG = 1.0
 #: Lu 2014's path-limit feedback gain a method flies where the vehicle has limits and nothing else
 #: holds them (the swarm bank under a mission's alpha schedule: HORUS-2B's heat rate was 0.3-2.8 %
 #: over in 43 of 100 runs without it; the AMPI tracker: the capsule's final dive passed q in 21 of

@@ -9,6 +9,7 @@ box on the nominal flight and a few dispersed draws."""
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
+    FINAL_DESCENT_DEG,
     FORCE_SIGMAS,
     Q_SPEED_FRACTION,
     Choice,
@@ -52,6 +53,7 @@ def derive(scenario) -> Derivation:
     first = candidates[0]
     spec = LglTerminal(problem=MISSION, terminal_altitude_km=first["guidance.terminal_altitude_km"],
                        terminal_velocity_m_s=first["guidance.terminal_velocity_m_s"], final_flight_path_deg=gamma,
+                       final_descent_deg=FINAL_DESCENT_DEG if gamma is None else None,
                        alpha_bounds_deg=[lo, hi], alpha_rate_deg_s=ALPHA_RATE_DEG_S, nodes=NODES,
                        segments=SEGMENTS)
     choices = [Choice("guidance.problem", MISSION, "the problem the mission poses: its entry state, target, box and "
@@ -67,6 +69,10 @@ def derive(scenario) -> Derivation:
                       + (f", widened {ALPHA_WIDEN_DEG:g} deg each side" if constant else "")),
                Choice("guidance.final_flight_path_deg", "free" if gamma is None else f"{gamma:g}",
                       "the box's flight-path angle" if gamma is not None else "the box checks none"),
+               Choice("guidance.final_descent_deg", "none" if gamma is not None else f"{FINAL_DESCENT_DEG:g}",
+                      "the box's angle is planned" if gamma is not None else
+                      "the plan ends descending at least this steeply: the flight stops where it first crosses the "
+                      "terminal altitude (paper 004's CAV-H levelling off there was crossed up to 75 km short)"),
                Choice("guidance.nodes, segments, alpha_rate_deg_s", f"{NODES}, {SEGMENTS}, {ALPHA_RATE_DEG_S:g}",
                       "the derivation's (4 LGL segments: each solve about twice as fast, verified closer)")]
     search = [SearchStep("guidance.terminal_altitude_km", tuple(candidates), ALTITUDE_WHY)]

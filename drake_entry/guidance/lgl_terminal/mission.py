@@ -67,7 +67,8 @@ def load_guidance_problem(spec):
 
 def problem_for_scenario(spec, scenario, *, margin: bool = True):
     """The problem flown: the scenario's vehicle, planet, atmosphere and entry state, its target as
-    the final longitude and latitude, the spec's final flight-path angle when given, the path
+    the final longitude and latitude, the spec's final flight-path angle when given (or, with
+    ``final_descent_deg``, a final gamma at most its negative, at least GAMMA_BOUNDS_DEG's lower bound), the path
     constraints ``spec.path_margin`` inside their bounds (``margin=False``: as the file gives
     them, the bounds the verdict checks); the rest (final speed and alpha, bounds, objective)
     from the problem file."""
@@ -80,6 +81,8 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
                  lat=math.radians(scenario.target.latitude_deg))
     if spec.final_flight_path_deg is not None:
         final["gamma"] = math.radians(spec.final_flight_path_deg)
+    elif spec.final_descent_deg is not None:
+        final["gamma"] = (math.radians(GAMMA_BOUNDS_DEG[0]), -math.radians(spec.final_descent_deg))
     path = [inside_bounds(c, spec.path_margin) for c in p.path] if margin else list(p.path)
     return dc.replace(p, vehicle=scenario.make_vehicle(), planet=scenario.make_planet(),
                       atmosphere=scenario.make_atmosphere(), initial=initial, final=final, path=path,

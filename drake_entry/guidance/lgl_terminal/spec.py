@@ -39,6 +39,10 @@ class LglTerminal(ReplanningSpec):
     alpha_rate_deg_s: float = 2.0
     # the final flight-path angle [deg] planned (None: the problem's)
     final_flight_path_deg: Optional[float] = None
+    # 'mission' without final_flight_path_deg: the plan ends descending at least this steeply
+    # [deg] (None: free). The flight stops where it first crosses the terminal altitude; a plan
+    # that levels off there is crossed early or late (paper 004's CAV-H: up to 75 km short)
+    final_descent_deg: Optional[float] = None
     # design margin of the plans (not the paper's): each path constraint planned this fraction
     # inside its bound (q >= 12 kPa planned as >= 12 (1 + m) kPa), so that the closed loop,
     # dispersed, holds the bounds its verdict checks
@@ -128,6 +132,15 @@ class LglTerminal(ReplanningSpec):
         check_range("guidance.alpha_accel_limit_deg_s2", self.alpha_accel_limit_deg_s2, 0.1, 1e3)
         if self.final_flight_path_deg is not None:
             check_range("guidance.final_flight_path_deg", self.final_flight_path_deg, -89.9, 0.0)
+        if self.final_descent_deg is not None:
+            check_range("guidance.final_descent_deg", self.final_descent_deg, 0.0, 45.0)
+            if self.final_flight_path_deg is not None:
+                raise ScenarioError(f"guidance.final_descent_deg = {self.final_descent_deg:g} with final_flight_path_deg = "
+                                    f"{self.final_flight_path_deg:g}: give one of them (the angle itself, or the "
+                                    f"least descent when the angle is free)")
+            if self.problem != MISSION:
+                raise ScenarioError("guidance.final_descent_deg is a field of problem: mission (a problem file "
+                                    "states its own final conditions)")
         if self.problem == MISSION:
             if self.terminal_velocity_m_s is None:
                 raise ScenarioError("guidance.terminal_velocity_m_s is needed with problem: mission (the final speed)")

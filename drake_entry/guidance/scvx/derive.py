@@ -11,6 +11,7 @@ import math
 
 from drake_entry.guidance.derivation import (
     ALTITUDE_WHY,
+    FINAL_DESCENT_DEG,
     FORCE_SIGMAS,
     LIMIT_MARGIN,
     CannotFly,
@@ -31,7 +32,7 @@ from drake_entry.models.dispersions import force_dispersions, force_ratio_high
 
 __all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW_KM", "AIM_TOLERANCE_KM",
            "FEEDBACK", "REPLAN_PERIOD_S", "REPLAN_TIME_TO_GO_FRACTION", "REPLAN_MIN_TIME_TO_GO_S", "FLOWN_MACH_SLACK",
-           "GLIDE_AIM_TOLERANCE_KM", "glides_at", "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "FINAL_DESCENT_DEG", "OBJECTIVE", "FORMULATION", "aim_window"]
+           "GLIDE_AIM_TOLERANCE_KM", "glides_at", "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "OBJECTIVE", "FORMULATION", "aim_window"]
 
 #: the plan's objective and formulation on another method's mission: the control effort (the
 #: integral of |sigma_dot|), with the bank a state and alpha the mission's law. Measured on
@@ -84,10 +85,6 @@ FLOWN_MACH_SLACK = 0.5
 #: the plan's speed window about the interface's speed where the box checks none (an open window
 #: let the plans arrive at the stop altitude at any speed, away from the interface's energy)
 INTERFACE_SPEED_WINDOW = 0.05
-#: the plans end descending at least this steeply [deg] (a vertical-speed bound at the interface
-#: speed): paper 004's CAV-H planned to a shallow glide at its stop altitude crossed it 90 s
-#: (140 km) late in 5 of 10 dispersed flights
-FINAL_DESCENT_DEG = 1.0
 #: the flight-path bounds of eq. 70 on a mission that bounds no gamma [deg]: paper 001's -30 deg
 #: is its own mission's (a capsule's last minute below 25 km dives to -31 to -35 deg), the upper
 #: bound opened to 5 deg

@@ -211,3 +211,35 @@ def test_a_method_left_out_by_only_never_keeps_a_reason_that_no_longer_holds(tmp
     run_comparison(comp, runs=1, out_dir=str(out), seed=7, workers=1, only=["bank_profile"], progress=False)
     fnpeg = json.loads((out / "comparison.json").read_text())["methods"]["fnpeg"]
     assert not fnpeg["flown"] and fnpeg["reason"].startswith("yet to fly in this directory: its settings derive")
+
+
+@pytest.mark.slow  # two 1-sample campaigns and a report: about 15 s
+def test_an_interrupted_comparison_resumes_with_the_same_command_keeping_its_samples(tmp_path, monkeypatch):
+    """A run stopped inside a method's campaign leaves a comparison.json naming that method as
+    unfinished; the same command then resumes it, the finished sample kept as it was (a 100-run
+    campaign stopped at 87 samples could not be resumed: the manifest was written only after it)."""
+    import drake_entry.comparison.runner as runner
+
+    comp = Comparison(name="tiny", mission="horus2b", methods=[
+        ComparedMethod(label="bank_profile", method="BankProfile",
+                       guidance=BankProfile(terminal_altitude_km=26.5, bank_start_deg=66.0, bank_end_deg=50.0))])
+    out = tmp_path / "cmp"
+    real = runner.run_campaign
+
+    def stopped(path, *, runs, **kw):  # one sample flown, then Ctrl-C
+        real(path, runs=1, **kw)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "run_campaign", stopped)
+    with pytest.raises(KeyboardInterrupt):
+        runner.run_comparison(comp, runs=2, out_dir=str(out), seed=7, workers=1, progress=False)
+    record = json.loads((out / "comparison.json").read_text())["methods"]["bank_profile"]
+    assert not record["flown"] and record["reason"] == runner.INTERRUPTED
+    rows = (out / "bank_profile" / "samples.jsonl").read_text().splitlines()
+    assert len(rows) == 1
+    monkeypatch.setattr(runner, "run_campaign", real)
+    runner.run_comparison(comp, runs=2, out_dir=str(out), seed=7, workers=1, progress=False)
+    record = json.loads((out / "comparison.json").read_text())["methods"]["bank_profile"]
+    assert record["flown"] and "reason" not in record
+    resumed = (out / "bank_profile" / "samples.jsonl").read_text().splitlines()
+    assert len(resumed) == 2 and resumed[0] == rows[0]

@@ -37,10 +37,12 @@ from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.guidance.derivation import CannotFly
 from drake_entry.scenario import load_scenario
 
-__all__ = ["SCENARIOS", "run_comparison", "comparison_identity", "check_comparison_dir"]
+__all__ = ["SCENARIOS", "INTERRUPTED", "run_comparison", "comparison_identity", "check_comparison_dir"]
 
 #: how the search flies each candidate, in words
 SEARCH_DRAWS_TEXT = "a few dispersed draws of another seed"
+#: a method's record while its campaign flies (what a directory left by an interrupted run says)
+INTERRUPTED = "its campaign did not finish in this directory: run the same command to resume it"
 
 
 def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, workers: int | None = None,
@@ -118,6 +120,10 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
         else:
             scenario = scenarios[entry.label]
         write_atomic(path, yaml_dump_typed(scenario).encode())
+        # recorded before it flies (its derivation kept): an interrupted campaign resumes with the
+        # same command, without searching again, and its finished samples are kept
+        methods[entry.label] = {**record, "flown": False, "reason": INTERRUPTED}
+        save(methods)
         if progress:
             print(f"== {entry.label} (!{entry.method}): pre-flight planning", flush=True)
         t = time.perf_counter()

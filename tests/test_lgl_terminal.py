@@ -225,8 +225,9 @@ def test_the_derived_final_speed_keeps_the_last_node_under_the_load_bound_with_d
     mission = load_scenario("cav_h_paper004")
     vehicle, atmosphere = mission.make_vehicle(), mission.make_atmosphere()
     force_high = force_ratio_high(mission.dispersions, FORCE_SIGMAS)
-    (step,) = derivation_for(mission, LglTerminal).search
-    assert derivation_for(mission, LglTerminal).spec.alpha_bounds_deg == [19.0, 21.0]
+    derivation = derivation_for(mission, LglTerminal)
+    (step,) = derivation.search
+    assert derivation.spec.alpha_bounds_deg == [19.0, 21.0]
 
     def load_g(h, V):
         CL, CD = vehicle.aero.coefficients(math.radians(19.0), V / float(atmosphere.speed_of_sound(h)))

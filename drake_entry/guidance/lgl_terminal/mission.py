@@ -68,10 +68,10 @@ def load_guidance_problem(spec):
 def problem_for_scenario(spec, scenario, *, margin: bool = True):
     """The problem flown: the scenario's vehicle, planet, atmosphere and entry state, its target as
     the final longitude and latitude, the spec's final flight-path angle when given (or, with
-    ``final_descent_deg``, a final gamma at most its negative, at least GAMMA_BOUNDS_DEG's lower bound), the path
-    constraints ``spec.path_margin`` inside their bounds (``margin=False``: as the file gives
-    them, the bounds the verdict checks); the rest (final speed and alpha, bounds, objective)
-    from the problem file."""
+    ``final_descent_deg``, a final gamma at most its negative, at least GAMMA_BOUNDS_DEG's lower
+    bound), the path constraints ``spec.path_margin`` inside their bounds (``margin=False``: as
+    the file gives them, the bounds the verdict checks); the rest (final speed and alpha, bounds,
+    objective) from the problem file."""
     p = mission_problem(spec, scenario) if spec.problem == MISSION else load_guidance_problem(spec)
     x0 = scenario.initial_state()
     initial = dict(p.initial)

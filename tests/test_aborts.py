@@ -3,11 +3,12 @@ grid and descent-abort cases, feasibility and the Tables 4-7 statistics, a faili
 recorded without losing the others, and one real orbital abort planned and flown by Drake."""
 import json
 import math
+import os
 
 import numpy as np
 import pytest
 
-from drake_entry.campaign.backends import Task
+from drake_entry.campaign.backends import Task, run_processes, worker_memory_budget
 from drake_entry.campaign.engine import run_cases, task_manifest
 from drake_entry.campaign.store import read_rows
 from drake_entry.errors import CampaignError, ScenarioError
@@ -39,6 +40,17 @@ def toy_run(state, case):
 TOY = Task("test_aborts:toy_setup", "test_aborts:toy_run", {"scale": 3.0})
 
 
+def pid_run(state, case):
+    """The toy case, answering with its worker's process id; x = 13 ends its worker abruptly."""
+    if case["x"] == 13.0:
+        os._exit(3)
+    row, traj = toy_run(state, case)
+    return {**row, "pid": os.getpid()}, traj
+
+
+PID_TOY = Task("test_aborts:toy_setup", "test_aborts:pid_run", {"scale": 3.0})
+
+
 @pytest.mark.parametrize("backend, workers", [("serial", 1), ("processes", 2)])
 def test_a_failing_case_is_a_row_with_its_reason_and_the_others_finish(tmp_path, backend, workers):
     cases = [{"index": i, "x": x} for i, x in enumerate([1.0, -2.0, 3.0])]
@@ -48,6 +60,29 @@ def test_a_failing_case_is_a_row_with_its_reason_and_the_others_finish(tmp_path,
     assert rows[0]["y"] == 3.0 and rows[2]["y"] == 27.0
     assert rows[1]["success"] is False and "ValueError: negative x -2.0" in rows[1]["message"]
     assert rows[1]["x"] == -2.0  # the case's columns identify it
+
+
+def test_a_worker_past_its_memory_budget_retires_and_a_new_one_takes_the_rest():
+    rows = []
+    run_processes(PID_TOY, [{"index": i, "x": float(i)} for i in range(5)], lambda r, t: rows.append(r), workers=2,
+                  memory_budget=0)
+    assert sorted(r["index"] for r in rows) == list(range(5)) and all(r["success"] for r in rows)
+    assert len({r["pid"] for r in rows}) == 5  # every case on a fresh worker: each retired after one
+    assert sorted(r["y"] for r in rows) == [3.0 * i ** 2 for i in range(5)]
+    rows.clear()  # within the budget one worker runs many cases
+    run_processes(PID_TOY, [{"index": i, "x": float(i)} for i in range(6)], lambda r, t: rows.append(r), workers=2,
+                  memory_budget=worker_memory_budget(2))
+    assert len(rows) == 6 and len({r["pid"] for r in rows}) <= 2
+
+
+def test_a_worker_that_dies_leaves_its_case_a_failed_row_and_the_campaign_goes_on(tmp_path):
+    cases = [{"index": i, "x": x} for i, x in enumerate([1.0, 13.0, 2.0, 3.0])]
+    run_cases(PID_TOY, cases, str(tmp_path), task_manifest(PID_TOY, cases), backend="processes", workers=2,
+              progress=False)
+    rows, _ = read_rows(str(tmp_path))
+    assert sorted(rows) == [0, 1, 2, 3]
+    assert rows[1]["success"] is False and "worker process died during the case, exit code 3" in rows[1]["message"]
+    assert [rows[i]["y"] for i in (0, 2, 3)] == [3.0, 12.0, 27.0]
 
 
 def test_cases_resume_and_another_case_list_is_refused(tmp_path):

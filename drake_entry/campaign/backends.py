@@ -21,7 +21,8 @@ import signal
 import traceback
 
 __all__ = ["BACKENDS", "SCHEDULER_TIMEOUT_S", "IN_FLIGHT_PER_WORKER", "DASK_QUIET_WORKERS", "Task",
-           "init_pool_worker", "init_worker", "failed_row", "work", "run_serial", "run_processes", "run_dask",
+           "init_pool_worker", "init_worker", "failed_row", "work", "run_serial", "WORKER_MEMORY_FRACTION",
+           "worker_memory_budget", "run_processes", "run_dask",
            "run_backend"]
 
 BACKENDS = ("serial", "processes", "dask")
@@ -114,13 +115,103 @@ def run_serial(task: Task, cases, record):
         record(*work(case))
 
 
-def run_processes(task: Task, cases, record, workers: int):
-    """``cases`` may be any iterable (a lazy one is read as the pool needs cases). On Ctrl-C
-    the workers are terminated (``with Pool`` ends them) and KeyboardInterrupt propagates."""
+#: a local worker retires after a case that leaves it holding more than this fraction of the
+#: machine's memory shared among the workers (its replacement builds the task's state afresh):
+#: pydrake 1.51.1 never frees a Diagram holding a Python LeafSystem (docs/performance.md, "Memory")
+WORKER_MEMORY_FRACTION = 0.6
+
+
+def worker_memory_budget(workers: int, fraction: float = WORKER_MEMORY_FRACTION) -> int:
+    """The resident memory [bytes] past which a local worker retires after its case."""
+    import psutil
+
+    return int(fraction * psutil.virtual_memory().total / max(workers, 1))
+
+
+def _process_worker(task: Task, inbox, outbox, slot: int, budget: int):
+    """A local worker: builds the task's state, then runs the cases it is sent (None ends it),
+    answering (slot, row, trajectory, retiring) for each; it retires (ends after answering)
+    when its resident memory has grown past ``budget`` bytes."""
+    import psutil
+
+    init_pool_worker(task)
+    me = psutil.Process()
+    while (case := inbox.get()) is not None:
+        row, traj = work(case)
+        retiring = me.memory_info().rss > budget
+        outbox.put((slot, row, traj, retiring))
+        if retiring:
+            return
+
+
+def run_processes(task: Task, cases, record, workers: int, memory_budget: int | None = None):
+    """Local spawned worker processes, each running one case at a time. ``cases`` may be any
+    iterable (a lazy one is read as workers free up). A worker whose resident memory passes
+    ``memory_budget`` bytes (default ``worker_memory_budget``) after a case retires and a new one
+    takes its place; a worker that dies during a case (killed, out of memory, a crash in native
+    code) leaves that case a failed row with its exit code, and a new worker goes on with the
+    rest. On Ctrl-C the workers are terminated and KeyboardInterrupt propagates."""
+    import queue as queue_module
+
     ctx = mp.get_context("spawn")
-    with ctx.Pool(workers, initializer=init_pool_worker, initargs=(task,)) as pool:
-        for row, traj in pool.imap_unordered(work, cases, chunksize=1):
-            record(row, traj)
+    budget = worker_memory_budget(workers) if memory_budget is None else int(memory_budget)
+    outbox = ctx.Queue()
+    pending = iter(cases)
+    slots: dict[int, dict] = {}  # slot -> {"process", "inbox", "case" (None: idle)}
+
+    def start(slot: int) -> None:
+        inbox = ctx.SimpleQueue()
+        process = ctx.Process(target=_process_worker, args=(task, inbox, outbox, slot, budget), daemon=True)
+        process.start()
+        slots[slot] = {"process": process, "inbox": inbox, "case": None}
+
+    def feed(slot: int) -> None:
+        slots[slot]["case"] = next(pending, None)
+        if slots[slot]["case"] is not None:
+            slots[slot]["inbox"].put(slots[slot]["case"])
+
+    def answered(slot: int, row: dict, traj, retiring: bool) -> None:
+        record(row, traj)
+        if retiring:
+            slots[slot]["process"].join(timeout=30)
+            start(slot)
+        feed(slot)
+
+    finished = False
+    try:
+        for slot in range(workers):
+            start(slot)
+            feed(slot)
+        while any(w["case"] is not None for w in slots.values()):
+            try:
+                answered(*outbox.get(timeout=1.0))
+                continue
+            except queue_module.Empty:
+                pass
+            for slot, w in list(slots.items()):  # a worker that died with a case in hand
+                if w["case"] is None or w["process"].is_alive():
+                    continue
+                try:  # an answer it sent before it ended is taken first
+                    while True:
+                        answered(*outbox.get(timeout=0.2))
+                except queue_module.Empty:
+                    pass
+                if slots[slot]["process"] is w["process"] and w["case"] is not None:
+                    code = w["process"].exitcode
+                    cause = " (killed: out of memory?)" if code == -9 else ""
+                    record(failed_row(w["case"], f"worker process died during the case, exit code {code}{cause}"),
+                           None)
+                    start(slot)
+                    feed(slot)
+        finished = True
+    finally:
+        for w in slots.values():
+            if finished:
+                w["inbox"].put(None)
+            else:
+                w["process"].terminate()
+        for w in slots.values():
+            w["process"].join(timeout=30)
 
 
 def _dask_task(task: Task, case: dict):

@@ -68,6 +68,32 @@ def test_a_plan_flight_is_ok_only_inside_every_criterion_with_every_limit_held()
     breached = [LimitCheck(PathLimit("q", "dynamic_pressure", lower=12e3), 11.9e3, 560.0, -0.01, False)]
     assert not PlanFlight(inside, breached).ok and "path limits breached" in PlanFlight(inside, breached).text()
     assert not PlanFlight(inside, held, failure="stopped at t = 3 s").ok
+    early = PlanFlight({"distance": {"error": 2e5, "tolerance": 5e3, "inside": False}}, held, interface_early_s=97.5)
+    assert not early.ok and early.text().startswith(
+        "flown through the actuators: it meets the terminal altitude 97.5 s before the plan's end")
+
+
+def test_a_plan_flight_is_judged_where_it_first_meets_the_terminal_altitude():
+    """The closed loop stops at the first descent through the terminal altitude: a plan whose
+    flight dips through it before its end is judged there (interpolated), not at its t_f."""
+    from drake_entry.guidance.lgl_terminal.planner import interface_crossing
+    from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+    from drake_entry.models.trajectory import Trajectory
+
+    t = np.linspace(0.0, 100.0, 101)
+    h = 28e3 + 1e3 * np.cos(np.pi * t / 50.0) - 50.0 * t / 100.0  # 29 km, under 28 km near t = 50 s, up again
+    state = np.column_stack([h, 1e-4 * t, np.zeros_like(t), 2500.0 - 5.0 * t, np.zeros((t.size, 2))])
+    conditions = np.zeros((t.size, len(FLIGHT_CONDITION_NAMES)))
+    conditions[:, FLIGHT_CONDITION_NAMES.index("mach")] = 8.0 - 0.05 * t
+    tr = Trajectory(time=t, state=state, conditions=conditions, bank=np.zeros_like(t), alpha=np.full_like(t, 0.2),
+                    reason="t_f", wall_time=0.0)
+    x, mach, alpha, t_stop = interface_crossing(tr, 28e3)
+    exact = 50.0 / np.pi * np.arccos(0.0)  # cos(pi t / 50) = 0 less the small linear term: just before 25 s
+    assert 24.0 < t_stop < exact and x[0] == pytest.approx(28e3, abs=1.0)
+    assert x[1] == pytest.approx(1e-4 * t_stop, rel=1e-9) and mach == pytest.approx(8.0 - 0.05 * t_stop, rel=1e-9)
+    assert alpha == pytest.approx(0.2)
+    x_end, _, _, t_end = interface_crossing(tr, 26e3)  # never that low: judged at its end
+    assert t_end == 100.0 and x_end[0] == h[-1]
 
 
 @pytest.mark.parametrize("field, value, words", [
@@ -185,9 +211,20 @@ def test_a_mission_poses_its_own_terminal_problem(horus_derived):
     assert np.degrees(p.state_bounds["alpha"]) == pytest.approx([15.0, 40.0])  # the mission's schedule
     assert p.state_bounds["sigma"] == pytest.approx((-v.bank_limit, v.bank_limit))
     assert np.degrees(p.state_bounds["gamma"]) == pytest.approx(GAMMA_BOUNDS_DEG)
+    # never below the terminal altitude, where the closed loop stops, before the end
+    assert p.state_bounds["h"] == (25e3, math.inf) and p.bounds_arrays()[0][0] == 25e3
     assert p.control_bounds["u_sigma"] == pytest.approx((-v.bank_rate_limit, v.bank_rate_limit))
     assert p.control_bounds["u_alpha"] == pytest.approx((-math.radians(2.0), math.radians(2.0)))
-    planned = {c.label: c.max for c in p.path}
+    floor = [c for c in p.path if c.label == "interface_floor"]
+    assert len(floor) == 1 and floor[0].min == 0.0
+    s_far = (6000.0 - g.terminal_velocity_m_s) / 100.0
+    for V, above in ((g.terminal_velocity_m_s, 0.0), (g.terminal_velocity_m_s + 100.0, 150.0),
+                     (6000.0, 300.0 * s_far ** 2 / (1.0 + s_far ** 2))):  # 300 m s^2 / (1 + s^2), s = dV / 100
+        x = np.array([25e3 + above, 0.0, 0.0, V, 0.0, 0.0, 0.3, 0.0])
+        assert floor[0].quantity(x, None, None) == pytest.approx(0.0, abs=1e-9)
+        x[0] -= 1.0
+        assert floor[0].quantity(x, None, None) == pytest.approx(-1.0, abs=1e-9)
+    planned = {c.label: c.max for c in p.path if c.label != "interface_floor"}
     assert planned == pytest.approx({"heat_flux": 0.92 * v.limits.heat_flux_max,
                                      "dynamic_pressure": 0.92 * v.limits.dynamic_pressure_max,
                                      "normal_load": 0.92 * v.limits.normal_load_max})

@@ -13,11 +13,35 @@ from drake_entry.models.verdict import PathLimit
 from drake_entry.planning.ocp import PATH_QUANTITIES, ObjectiveTerm, OptimalControlProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
 
-__all__ = ["MISSION", "GAMMA_BOUNDS_DEG", "load_guidance_problem", "mission_problem", "problem_for_scenario", "inside_bounds",
+__all__ = ["MISSION", "FLOOR_MARGIN_M", "FLOOR_SPEED_SCALE_M_S", "InterfaceFloor", "GAMMA_BOUNDS_DEG", "load_guidance_problem", "mission_problem", "problem_for_scenario", "inside_bounds",
            "mission_path_limits"]
 
 #: the ``problem`` value that poses the problem from the mission instead of a file
 MISSION = "mission"
+#: the interface floor of a mission's plans (``InterfaceFloor``): this far above the terminal
+#: altitude [m] while the speed is well above the final speed, closing within about
+#: FLOOR_SPEED_SCALE_M_S [m/s] of it
+FLOOR_MARGIN_M = 300.0
+FLOOR_SPEED_SCALE_M_S = 100.0
+
+
+@dc.dataclass(frozen=True)
+class InterfaceFloor:
+    """The altitude a mission's plan keeps above the terminal altitude ``h_f`` [m], where the
+    closed loop stops at its first descent through it: h - h_f - m s^2 / (1 + s^2) >= 0 with s =
+    (V - V_f) / ``speed_scale`` (smooth; the full ``margin`` m [m] far from the final speed V_f
+    [m/s], none at it). Without it an optimum that bleeds speed low rides the terminal altitude
+    at its nodes and dips under it between them (Lu 2014's CAV-H in thin air: the flight stopped
+    at 28 km 87 s before the plan's end, 190-240 km short)."""
+
+    h_f: float
+    v_f: float
+    margin: float = FLOOR_MARGIN_M
+    speed_scale: float = FLOOR_SPEED_SCALE_M_S
+
+    def __call__(self, x, u, env):
+        s = (x[3] - self.v_f) / self.speed_scale
+        return x[0] - self.h_f - self.margin * (s * s) / (1.0 + s * s)
 #: the flight-path bounds of a mission's problem [deg] (paper 002 bounds none; a glide stays
 #: inside them, and they keep the solver off the heading equation's singularity at -90 deg)
 GAMMA_BOUNDS_DEG = (-60.0, 15.0)
@@ -69,7 +93,9 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
     """The problem flown: the scenario's vehicle, planet, atmosphere and entry state, its target as
     the final longitude and latitude, the spec's final flight-path angle when given (or, with
     ``final_descent_deg``, a final gamma at most its negative, at least GAMMA_BOUNDS_DEG's lower
-    bound), the path constraints ``spec.path_margin`` inside their bounds (``margin=False``: as
+    bound), with ``problem: mission`` the altitude at or above the terminal altitude all the way
+    and an ``InterfaceFloor`` above it (the closed loop stops at its first descent through it),
+    the path constraints ``spec.path_margin`` inside their bounds (``margin=False``: as
     the file gives them, the bounds the verdict checks); the rest (final speed and alpha, bounds,
     objective) from the problem file."""
     p = mission_problem(spec, scenario) if spec.problem == MISSION else load_guidance_problem(spec)
@@ -84,9 +110,14 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
     elif spec.final_descent_deg is not None:
         final["gamma"] = (math.radians(GAMMA_BOUNDS_DEG[0]), -math.radians(spec.final_descent_deg))
     path = [inside_bounds(c, spec.path_margin) for c in p.path] if margin else list(p.path)
+    bounds = dict(p.state_bounds)
+    if spec.problem == MISSION:  # the closed loop stops where it first meets the terminal altitude
+        bounds["h"] = (final["h"], math.inf)
+        path.append(PathConstraint(InterfaceFloor(final["h"], spec.terminal_velocity_m_s), min=0.0,
+                                   scale=FLOOR_MARGIN_M, name="interface_floor"))
     return dc.replace(p, vehicle=scenario.make_vehicle(), planet=scenario.make_planet(),
                       atmosphere=scenario.make_atmosphere(), initial=initial, final=final, path=path,
-                      name=f"{scenario.name}_{p.name}")
+                      state_bounds=bounds, name=f"{scenario.name}_{p.name}")
 
 
 def inside_bounds(c, margin: float):

@@ -27,7 +27,7 @@ from drake_entry.planning.pseudospectral import segment_compatible
 from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlqr
 from drake_entry.planning.verification import Actuation, EntryControls, Tracking, require_verifier
 
-__all__ = ["SAMPLES_PER_S", "PlanFlight", "LglPlan", "feedback_weights", "feedback_maker", "actuation", "fly_plan", "sensed_path",
+__all__ = ["SAMPLES_PER_S", "PlanFlight", "LglPlan", "feedback_weights", "feedback_maker", "actuation", "fly_plan", "interface_crossing", "sensed_path",
            "measured_path", "MEASURED_MARGIN_FRACTION",
            "judged", "plan_terminal", "replan_nodes", "final_windows", "replan"]
 
@@ -46,14 +46,18 @@ class PlanFlight:
     """A plan's bank and alpha flown through the closed loop's actuators, and the verdict.
 
     Attributes:
-      box: the scenario's acceptance box at the plan's t_f; checks: the closed loop's path limits
-        on the flight (every log sample and integrator step); failure: why it stopped early.
+      box: the scenario's acceptance box where the closed loop would stop: the flight's first
+        descent through the terminal altitude, else the plan's t_f; checks: the closed loop's path
+        limits on the flight (every log sample and integrator step); failure: why it stopped
+        early; interface_early_s: how long [s] before the plan's t_f the flight met the terminal
+        altitude (0 when it met it at t_f or not before).
     """
 
     box: dict
     checks: list
     failure: str = ""
     trajectory: object = dc.field(default=None, repr=False)
+    interface_early_s: float = 0.0
 
     @property
     def ok(self) -> bool:
@@ -63,6 +67,9 @@ class PlanFlight:
         if self.failure:
             return f"flown through the actuators it stopped early: {self.failure}"
         parts = [f"{k} {box_text(k, b)}" for k, b in self.box.items() if not b["inside"]]
+        if parts and self.interface_early_s > 0:
+            parts.insert(0, f"it meets the terminal altitude {self.interface_early_s:.1f} s before the plan's end, "
+                            f"where the closed loop stops")
         if not all(c.held for c in self.checks):
             parts.append(f"path limits breached: {breaches_text(self.checks)}")
         return ("flown through the actuators: " + "; ".join(parts)) if parts else \
@@ -178,13 +185,29 @@ def fly_plan(plan: LglPlan, scenario, verifier) -> PlanFlight:
     flown = verifier(controls)
     tr = flown.trajectory
     planet = r.problem.planet
-    xf = tr.state[-1]
+    xf, mach, alpha, t_stop = interface_crossing(tr, spec.terminal_altitude_km * 1e3)
     distance = planet.great_circle_distance(xf[1], xf[2], math.radians(scenario.target.longitude_deg),
                                             math.radians(scenario.target.latitude_deg))
-    box = scenario.acceptance_box(planet, xf, mach=float(tr.column("mach")[-1]), distance_m=float(distance),
-                                  alpha_rad=float(tr.column("alpha")[-1]))
+    box = scenario.acceptance_box(planet, xf, mach=mach, distance_m=float(distance), alpha_rad=alpha)
     checks = check_limits(tr.flown_time(), tr.flown, scenario.path_limits(r.problem.vehicle))
-    return PlanFlight(box, checks, flown.failure, tr)
+    return PlanFlight(box, checks, flown.failure, tr, interface_early_s=max(0.0, float(tr.time[-1]) - t_stop))
+
+
+def interface_crossing(tr, h_stop: float) -> tuple[np.ndarray, float, float, float]:
+    """(state [6], Mach, alpha [rad], t [s]) where the flight ``tr`` first descends through
+    ``h_stop`` [m], interpolated linearly between its samples, as the closed loop's termination
+    monitor stops it there; its last sample when it never does before its end."""
+    h, t = tr.state[:, 0], tr.time
+    below = np.nonzero(h[1:] <= h_stop)[0]
+    if below.size == 0 or below[0] + 1 == len(t) - 1:
+        return tr.state[-1], float(tr.column("mach")[-1]), float(tr.column("alpha")[-1]), float(t[-1])
+    i = int(below[0]) + 1  # first sample at or below; i - 1 above (h[0] is the plan's start)
+    w = 0.0 if h[i - 1] == h[i] else (h[i - 1] - h_stop) / (h[i - 1] - h[i])
+
+    def at(values):
+        return (1.0 - w) * np.asarray(values[i - 1], float) + w * np.asarray(values[i], float)
+
+    return at(tr.state), float(at(tr.column("mach"))), float(at(tr.column("alpha"))), float(at(t))
 
 
 def judged(result, scenario, verifier) -> LglPlan:

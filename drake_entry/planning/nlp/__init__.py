@@ -317,7 +317,9 @@ def _solve_mesh(problem, transcription, solver, engine, nodes, guess, scaling, o
     result.converged = converged
     result.build_time, result.solve_time = build_time, solve_time
     result.callback_calls, result.callback_time = calls, seconds
-    return result, words, ("" if result.converged else tx.diagnose())
+    diagnosis = "" if result.converged else tx.diagnose()
+    tx.release()
+    return result, words, diagnosis
 
 
 def _interruptible(solve, *args):

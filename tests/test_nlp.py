@@ -110,6 +110,23 @@ def test_segmented_lgl_double_integrator_costates_are_exact_at_the_knots_too(sol
     assert np.abs(r.hamiltonian - r.hamiltonian.mean()).max() < 1e-5
 
 
+@pytest.mark.parametrize("transcription", ["lgl", "hermite_simpson", "dircol"])
+def test_a_solved_program_and_its_transcription_are_freed(transcription):
+    """The program's Python callbacks hold their transcription, which held the program: a cycle
+    through C++ that the collector cannot see, every solve's program kept alive."""
+    import gc
+
+    def alive():
+        gc.collect()
+        return sum(1 for o in gc.get_objects() if type(o).__name__ in ("MathematicalProgram", "_LglTranscription",
+                                                                       "_HermiteSimpsonTranscription",
+                                                                       "_DircolTranscription"))
+
+    before = alive()
+    r = solve(brachistochrone(), transcription=transcription, nodes=12, solver="ipopt")
+    assert r.converged and alive() == before
+
+
 def test_segmented_lgl_brachistochrone_and_its_piecewise_interpolant():
     """3 segments of 8 nodes: the cycloid's time to 2e-5 and H = -1 to 1e-3 between the knots;
     the result's interpolant is each segment's own polynomial (a function with a kink at the

@@ -13,8 +13,8 @@ from drake_entry.models.verdict import PathLimit
 from drake_entry.planning.ocp import PATH_QUANTITIES, ObjectiveTerm, OptimalControlProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
 
-__all__ = ["MISSION", "FLOOR_MARGIN_M", "FLOOR_SPEED_SCALE_M_S", "InterfaceFloor", "GAMMA_BOUNDS_DEG", "load_guidance_problem", "mission_problem", "problem_for_scenario", "inside_bounds",
-           "mission_path_limits"]
+__all__ = ["MISSION", "FLOOR_MARGIN_M", "FLOOR_SPEED_SCALE_M_S", "InterfaceFloor", "GAMMA_BOUNDS_DEG",
+           "load_guidance_problem", "mission_problem", "problem_for_scenario", "inside_bounds", "mission_path_limits"]
 
 #: the ``problem`` value that poses the problem from the mission instead of a file
 MISSION = "mission"
@@ -42,6 +42,8 @@ class InterfaceFloor:
     def __call__(self, x, u, env):
         s = (x[3] - self.v_f) / self.speed_scale
         return x[0] - self.h_f - self.margin * (s * s) / (1.0 + s * s)
+
+
 #: the flight-path bounds of a mission's problem [deg] (paper 002 bounds none; a glide stays
 #: inside them, and they keep the solver off the heading equation's singularity at -90 deg)
 GAMMA_BOUNDS_DEG = (-60.0, 15.0)
@@ -112,6 +114,8 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
     path = [inside_bounds(c, spec.path_margin) for c in p.path] if margin else list(p.path)
     bounds = dict(p.state_bounds)
     if spec.problem == MISSION:  # the closed loop stops where it first meets the terminal altitude
+        # the floor implies the bound at the nodes; the bound is a simple bound the solver keeps
+        # every iterate inside (the plans of the measured campaigns were solved with both)
         bounds["h"] = (final["h"], math.inf)
         path.append(PathConstraint(InterfaceFloor(final["h"], spec.terminal_velocity_m_s), min=0.0,
                                    scale=FLOOR_MARGIN_M, name="interface_floor"))

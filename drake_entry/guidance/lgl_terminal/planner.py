@@ -27,8 +27,8 @@ from drake_entry.planning.pseudospectral import segment_compatible
 from drake_entry.planning.tracking import CommandFeedback, TrackingWeights, tvlqr
 from drake_entry.planning.verification import Actuation, EntryControls, Tracking, require_verifier
 
-__all__ = ["SAMPLES_PER_S", "PlanFlight", "LglPlan", "feedback_weights", "feedback_maker", "actuation", "fly_plan", "interface_crossing", "sensed_path",
-           "measured_path", "MEASURED_MARGIN_FRACTION",
+__all__ = ["SAMPLES_PER_S", "PlanFlight", "LglPlan", "feedback_weights", "feedback_maker", "actuation", "fly_plan",
+           "interface_crossing", "sensed_path", "measured_path", "MEASURED_MARGIN_FRACTION",
            "judged", "plan_terminal", "replan_nodes", "final_windows", "replan"]
 
 #: command samples per second of a plan (linear interpolation between them by the guidance)

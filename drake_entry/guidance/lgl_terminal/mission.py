@@ -13,7 +13,8 @@ from drake_entry.models.verdict import PathLimit
 from drake_entry.planning.ocp import PATH_QUANTITIES, ObjectiveTerm, OptimalControlProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
 
-__all__ = ["MISSION", "FLOOR_MARGIN_M", "FLOOR_SPEED_SCALE_M_S", "InterfaceFloor", "GAMMA_BOUNDS_DEG",
+__all__ = ["MISSION", "FLOOR_MARGIN_M", "FLOOR_SPEED_SCALE_M_S", "FLOOR_LABEL", "InterfaceFloor",
+           "without_interface_floor", "GAMMA_BOUNDS_DEG",
            "load_guidance_problem", "mission_problem", "problem_for_scenario", "inside_bounds", "mission_path_limits"]
 
 #: the ``problem`` value that poses the problem from the mission instead of a file
@@ -23,6 +24,8 @@ MISSION = "mission"
 #: FLOOR_SPEED_SCALE_M_S [m/s] of it
 FLOOR_MARGIN_M = 300.0
 FLOOR_SPEED_SCALE_M_S = 100.0
+#: the floor's path-constraint label (a refusal names it: "path interface_floor at node k")
+FLOOR_LABEL = "interface_floor"
 
 
 @dc.dataclass(frozen=True)
@@ -118,10 +121,17 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
         # every iterate inside (the plans of the measured campaigns were solved with both)
         bounds["h"] = (final["h"], math.inf)
         path.append(PathConstraint(InterfaceFloor(final["h"], spec.terminal_velocity_m_s), min=0.0,
-                                   scale=FLOOR_MARGIN_M, name="interface_floor"))
+                                   scale=FLOOR_MARGIN_M, name=FLOOR_LABEL))
     return dc.replace(p, vehicle=scenario.make_vehicle(), planet=scenario.make_planet(),
                       atmosphere=scenario.make_atmosphere(), initial=initial, final=final, path=path,
                       state_bounds=bounds, name=f"{scenario.name}_{p.name}")
+
+
+def without_interface_floor(problem):
+    """``problem`` without its ``InterfaceFloor`` path constraint (the same object when it has
+    none): the pre-flight plan's first solve (planner.plan_terminal)."""
+    path = [c for c in problem.path if c.label != FLOOR_LABEL]
+    return problem if len(path) == len(problem.path) else dc.replace(problem, path=path)
 
 
 def inside_bounds(c, margin: float):

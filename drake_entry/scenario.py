@@ -77,6 +77,15 @@ class TerminalSpec:
 
 
 @dc.dataclass
+class SuccessRequirementSpec:
+    """The success probability a campaign of this mission must show, at a confidence
+    (drake_entry.campaign.success_requirement; none: the report gives the bounds only)."""
+
+    probability: Optional[float] = None  # e.g. 0.9973 (3 sigma); in (0, 1)
+    confidence: float = 0.9  # of the one-sided Clopper-Pearson lower bound; in (0.5, 1)
+
+
+@dc.dataclass
 class ScheduleSpec:
     """Piecewise-linear command: values [deg] at breakpoints of ``variable``
     (time s | energy J/kg | mach | velocity m/s)."""
@@ -178,6 +187,8 @@ class Scenario:
     entry: EntryStateSpec = dc.field(default_factory=EntryStateSpec)  # entry-interface state
     target: TargetSpec = dc.field(default_factory=TargetSpec)  # target site (runway or TAEM point)
     terminal: TerminalSpec = dc.field(default_factory=TerminalSpec)  # terminal interface and the acceptance box
+    # the success probability a campaign must show, and at what confidence (optional)
+    success_requirement: SuccessRequirementSpec = dc.field(default_factory=SuccessRequirementSpec)
     # open-loop angle-of-attack schedule (a guidance method may command alpha instead)
     alpha: ScheduleSpec = dc.field(default_factory=ScheduleSpec)
     # open-loop bank schedule (open-loop runs; guidance replaces it in closed loop)
@@ -309,6 +320,11 @@ class Scenario:
             if getattr(t, tol) is not None and getattr(t, centre) is None:
                 raise ScenarioError(f"terminal.{tol} is given without terminal.{centre}, the value it is about")
         check_range("terminal.path_limit_tolerance", t.path_limit_tolerance, 0.0, 0.5)
+        req = self.success_requirement
+        if req.probability is not None and not 0.0 < req.probability < 1.0:
+            raise ScenarioError(f"success_requirement.probability = {req.probability}: allowed in (0, 1), e.g. 0.9973")
+        if not 0.5 < req.confidence < 1.0:
+            raise ScenarioError(f"success_requirement.confidence = {req.confidence}: allowed in (0.5, 1), e.g. 0.9")
         for col, v in self.reference_results.errors.items():
             if col not in ERROR_COLUMNS:
                 raise ScenarioError(f"reference_results.errors: '{col}' is not a terminal-error column; allowed: "

@@ -396,3 +396,13 @@ def test_example_24(tmp_path, monkeypatch):
     assert r["built"].report["verified"] == r["built"].report["cases"] == 9
     assert r["campaigns"]["entry dispersions only"]["success"].all()
     assert os.path.exists(r["plot"])
+
+
+@pytest.mark.slow
+def test_example_25(tmp_path):
+    """A required success probability (50 % at 90 % on the quick run): 2 runs first, then the 2
+    that show it, PASS in the summary and the report."""
+    r = _run("25_success_requirement", tmp_path)
+    v = r["verdict"]
+    assert (v.status, v.runs, v.successes) == ("PASS", 4, 4) and v.lower == pytest.approx(0.1 ** 0.25)
+    assert "| success probability | >= 50 % at 90 % confidence |" in open(os.path.join(r["campaign"], "report.md")).read()

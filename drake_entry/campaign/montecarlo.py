@@ -38,7 +38,7 @@ from drake_entry.scenario import (  # noqa: F401 (API)
 __all__ = ["DETAILED_STEP_S", "TIMING_COLUMNS", "TRAJECTORY_STEP_S", "campaign_row", "downsample", "run_sample",
            "sample_seed", "done_indices", "finalise", "read_nominal", "write_nominal", "PACKAGED_SCENARIOS",
            "apply_overrides", "load_campaign_scenario", "MAX_RUNS", "RUNS_NOTE", "campaign_manifest", "run_campaign",
-           "fly_nominal"]
+           "fly_nominal", "run_until_confident"]
 
 
 
@@ -128,3 +128,34 @@ def fly_nominal(out_dir: str, scenario_yaml: str, *, setup=None) -> None:
         print(f"drake-entry: the nominal flight of the campaign failed ({e}); the report shows the campaign alone")
         return
     write_nominal(out_dir, downsample(tr, -1, DETAILED_STEP_S))
+
+
+def run_until_confident(scenario_path: str, *, runs: int, max_runs: int, out_dir: str, overrides: dict | None = None,
+                        progress: bool = True, **campaign_args):
+    """Run the campaign (run_campaign's arguments) in batches until the scenario's success
+    requirement (``success_requirement``; campaign.success_requirement) is shown (PASS) or shown
+    not met (FAIL), or ``max_runs`` samples are done: ``runs`` first, then each time the further
+    runs that would show it were every one successful, at most as many as are done. Returns
+    (out_dir, the SuccessVerdict on every sample done)."""
+    from drake_entry.campaign.rows import row_problem
+    from drake_entry.campaign.store import coverage
+    from drake_entry.campaign.success_requirement import success_verdict
+
+    req = load_campaign_scenario(scenario_path, overrides).success_requirement
+    if req.probability is None:
+        raise ScenarioError(f"{scenario_path}: running until confident needs the scenario's "
+                            f"success_requirement.probability (e.g. 0.9973 for 3 sigma; confidence {req.confidence:g})")
+    if not (isinstance(max_runs, int) and runs <= max_runs <= MAX_RUNS):
+        raise ScenarioError(f"max_runs = {max_runs}: allowed an integer from runs ({runs}) to {MAX_RUNS}")
+    target = runs
+    while True:
+        run_campaign(scenario_path, runs=target, out_dir=out_dir, overrides=overrides, progress=progress,
+                     **campaign_args)
+        rows = coverage(out_dir, row_problem)["rows"]
+        verdict = success_verdict(sum(bool(r.get("success")) for r in rows.values()), len(rows), req.probability,
+                                  req.confidence)
+        if progress:
+            print(f"drake-entry: {verdict.text()}", flush=True)
+        if verdict.status != "OPEN" or verdict.more_runs is None or len(rows) >= max_runs:
+            return out_dir, verdict
+        target = min(max_runs, len(rows) + min(verdict.more_runs, len(rows)))

@@ -13,6 +13,7 @@ misses and failures (drake_entry.campaign.drivers), cost and captioned figures
 from __future__ import annotations
 
 import base64
+import dataclasses as dc
 import datetime
 import hashlib
 import html
@@ -38,6 +39,7 @@ from drake_entry.campaign.statistics import (
     success_lower_bound,
 )
 from drake_entry.campaign.store import coverage, read_nominal, read_trajectories
+from drake_entry.campaign.success_requirement import success_verdict
 from drake_entry.errors import CampaignError, DrakeEntryError
 from drake_entry.models.aerodynamics import AERO_REGIMES
 from drake_entry.models.dispersions import PERTURBATION_COLUMNS_KM
@@ -46,7 +48,7 @@ from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario, upgrade_scenario_yaml
 from drake_entry.typed_yaml import load_yaml_typed
 
-__all__ = ["ERROR_COLUMNS", "MARGIN_COLUMNS", "failure_categories", "reached_terminal",
+__all__ = ["ERROR_COLUMNS", "MARGIN_COLUMNS", "failure_categories", "reached_terminal", "requirement_verdict",
            "summary_statistics", "counts_sentence", "errors_markdown", "flown_scenario", "rows_as_columns",
            "write_report", "write_markdown_report", "PEAK_QUANTITIES", "OTHER_QUANTITIES", "CONTROL_QUANTITIES",
            "DISPERSION_FIELDS", "NAV_UNITS", "DISPERSION_LABELS", "NAV_NAMES", "table_cell", "format_number",
@@ -231,6 +233,9 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
                          "invalid_lines": cov["invalid"], "quarantined_lines": cov["quarantined"]}
     stats["success_lower_bound"] = {f"{level:g}": success_lower_bound(stats["successful"], stats["samples"], level)
                                     for level in SUCCESS_LEVELS}
+    verdict = requirement_verdict(stats, scenario)
+    if verdict is not None:
+        stats["success_requirement"] = dc.asdict(verdict) | {"text": verdict.text()}
     reached = reached_terminal(rows)
     quantities = _quantities(rows, reached)
     stats["distributions"] = {key: describe(values) for key, (_, _, values) in quantities.items()}
@@ -377,6 +382,10 @@ def _header(meta: dict, stats: dict, title: str | None, rows: dict) -> str:
     lines.append(f"**{k} of {n} samples successful; the success probability is at least "
                  f"{100 * lb['0.9']:.2f} % at 90 % confidence and {100 * lb['0.95']:.2f} % at 95 % confidence** "
                  "(one-sided Clopper-Pearson bounds on these samples).")
+    if "success_requirement" in stats:
+        lines += ["", f"**Required success probability {stats['success_requirement']['probability'] * 100:g} % at "
+                  f"{stats['success_requirement']['confidence'] * 100:g} % confidence: "
+                  f"{stats['success_requirement']['text']}.**"]
     lines += ["", f"Scenario `{meta.get('scenario', '?')}` (guidance method `{_method(rows)}`), seed "
               f"{meta.get('seed', '?')}. "
               f"Covers {c['done']} of {c['requested']} requested samples"
@@ -571,10 +580,24 @@ def _dispersions(scenario) -> str:
             "| parameter | nominal | distribution | bounds or σ | unit |\n|---|---|---|---|---|\n" + "\n".join(lines))
 
 
+def requirement_verdict(stats: dict, scenario):
+    """The SuccessVerdict of the scenario's success requirement on the campaign's counts (None
+    when the scenario states none)."""
+    req = getattr(scenario, "success_requirement", None)
+    if req is None or req.probability is None or not stats["samples"]:
+        return None
+    return success_verdict(stats["successful"], stats["samples"], req.probability, req.confidence)
+
+
 def _requirements(rows: dict, reached, stats: dict, scenario) -> str:
     n = len(rows["index"])
     nr = int(reached.sum())
     lines = []
+    verdict = requirement_verdict(stats, scenario)
+    if verdict is not None:
+        lines.append(f"| success probability | {verdict.required} | one-sided Clopper-Pearson lower bound of "
+                     f"{verdict.successes} of {verdict.runs} | {100 * verdict.lower:.3f} % | "
+                     f"{100 * (verdict.lower - verdict.probability):+.3f} % | {verdict.text()} |")
     term = scenario.terminal if scenario is not None else None
     lines.append(f"| reach the terminal interface | every sample | count | {nr} of {n} | — | "
                  f"{'PASS' if nr == n else 'FAIL'} |")

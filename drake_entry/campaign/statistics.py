@@ -4,6 +4,8 @@ Monte-Carlo practice (Hanson & Beard 2010, NASA/TP-2010-216447; docs/references.
 - ``success_lower_bound``: the one-sided Clopper-Pearson lower confidence bound on the success
   probability (scipy.stats.binomtest; for n successes in n runs it is (1 - level)^(1/n):
   0.9772 at 90 % for 100 of 100);
+- ``success_upper_bound``: the one-sided Clopper-Pearson upper bound (1 - (1 - level)^(1/n)
+  for 0 successes in n runs);
 - ``order_statistic_bound``: the distribution-free (Wilks) bound: the r-th largest of n
   samples exceeds the ``coverage`` quantile with probability ``confidence`` when
   P(Binomial(n, 1 - coverage) >= r) >= confidence (scipy.stats.binom); with the maximum
@@ -22,7 +24,8 @@ from scipy import stats
 
 from drake_entry.errors import ScenarioError
 
-__all__ = ["PERCENTILES", "COVERAGE", "CONFIDENCE", "SUCCESS_LEVELS", "success_lower_bound", "runs_for_bound",
+__all__ = ["PERCENTILES", "COVERAGE", "CONFIDENCE", "SUCCESS_LEVELS", "success_lower_bound",
+           "success_upper_bound", "runs_for_bound",
            "order_statistic_rank", "order_statistic_bound", "finite_column", "describe", "percentile_key"]
 
 #: the percentiles of the report [%] (P0.13 and P99.87: the normal distribution's 3-sigma levels)
@@ -46,6 +49,14 @@ def success_lower_bound(successes: int, runs: int, level: float) -> float:
         return 0.0
     return float(stats.binomtest(int(successes), int(runs)).proportion_ci(confidence_level=2.0 * level - 1.0,
                                                                           method="exact").low)
+
+
+def success_upper_bound(successes: int, runs: int, level: float) -> float:
+    """One-sided upper ``level`` confidence bound on the success probability (Clopper-Pearson,
+    exact): the upper end of the equal-tailed two-sided interval at 2 level - 1."""
+    if runs >= 1 and isinstance(successes, (int, np.integer)) and 0 <= successes <= runs:
+        return 1.0 - success_lower_bound(int(runs - successes), runs, level)  # the failures' lower bound
+    return success_lower_bound(successes, runs, level)  # its error names the field
 
 
 def runs_for_bound(coverage: float = COVERAGE, confidence: float = CONFIDENCE) -> int:

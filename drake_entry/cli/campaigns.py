@@ -13,13 +13,24 @@ __all__ = ["write_results_index", "COMMANDS", "write_and_print_report"]
 
 
 def campaign(args) -> int:
-    from drake_entry.campaign.montecarlo import run_campaign
+    from drake_entry.campaign.montecarlo import run_campaign, run_until_confident
 
     backend = "dask" if args.scheduler else args.backend
-    out = run_campaign(args.scenario, runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
-                       overrides=parse_overrides(args.overrides), backend=backend, scheduler=args.scheduler,
-                       trajectory_step_s=args.trajectory_step)
+    settings = dict(runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
+                    overrides=parse_overrides(args.overrides), backend=backend, scheduler=args.scheduler,
+                    trajectory_step_s=args.trajectory_step)
+    if args.until_confident:
+        out, _ = run_until_confident(args.scenario, max_runs=args.max_runs, **settings)
+    else:
+        out = run_campaign(args.scenario, **settings)
     stats = write_and_print_report(out)
+    required = stats.get("success_requirement")
+    if required is not None:  # a stated success requirement decides
+        if required["status"] != "PASS":
+            print(f"drake-entry: the success requirement is not shown: {required['text']} (see "
+                  f"{os.path.join(out, 'report.md')})", file=sys.stderr)
+            return 1
+        return 0
     if stats["successful"] < stats["samples"]:  # a campaign that shows a failure exits non-zero
         print(f"drake-entry: {stats['samples'] - stats['successful']} of {stats['samples']} samples are not "
               f"successful (see {os.path.join(out, 'report.md')})", file=sys.stderr)
@@ -72,6 +83,11 @@ def _add_campaign_arguments(parser) -> None:
     parser.add_argument("--trajectory-step", type=float, default=10.0, metavar="SECONDS",
                         help="keep each sample's trajectory every SECONDS (0 = none, rows only; the first 5 samples "
                              "every 1 s for the report's bank histories)")
+    parser.add_argument("--until-confident", action="store_true",
+                        help="run in batches (--runs first) until the scenario's success_requirement is shown "
+                             "(PASS) or shown not met (FAIL), or --max-runs are done")
+    parser.add_argument("--max-runs", type=int, default=10_000, help="with --until-confident: the most samples "
+                                                                     "(default: 10000)")
     add_overrides_argument(parser, "guidance.replan_period_s=100")
 
 

@@ -6,11 +6,14 @@ import pytest
 from scipy import stats
 
 from drake_entry.campaign.statistics import (
+    convergence_counts,
     describe,
     order_statistic_bound,
     order_statistic_rank,
+    running_estimates,
     runs_for_bound,
     success_lower_bound,
+    success_upper_bound,
 )
 from drake_entry.errors import ScenarioError
 
@@ -121,3 +124,25 @@ def test_order_statistic_bound_uses_the_confidence_it_is_given():
     assert r50 > r90 >= 1
     assert order_statistic_bound(x, 0.9, 0.5) == x[-r50] and order_statistic_bound(x, 0.9, 0.9) == x[-r90]
     assert order_statistic_bound(x, 0.9, 0.5, upper=False) == x[r50 - 1]
+
+
+def test_running_estimates_are_those_of_each_prefix():
+    """At every count n: the success fraction and the one-sided bounds of the first n samples,
+    and the percentiles of their values (P1 and P99 only from 100 values, as the report's)."""
+    rng = np.random.default_rng(7)
+    success = rng.random(300) < 0.9
+    miss = rng.lognormal(0.0, 1.0, 300)
+    miss[5] = np.nan  # a sample that did not reach the interface
+    est = running_estimates(success, {"miss": miss}, level=0.95)
+    n = np.array(est["n"])
+    assert n[0] == 1 and n[-1] == 300 and np.all(np.diff(n) > 0) and set(range(1, 21)) <= set(n.tolist())
+    assert np.array_equal(convergence_counts(300), n) and list(convergence_counts(7)) == list(range(1, 8))
+    for i in (0, 19, 40, len(n) - 1):
+        k, m = int(success[:n[i]].sum()), int(n[i])
+        assert est["fraction"][i] == k / m
+        assert est["lower"][i] == success_lower_bound(k, m, 0.95) and est["upper"][i] == success_upper_bound(k, m, 0.95)
+        v = miss[:m][np.isfinite(miss[:m])]
+        assert est["quantities"]["miss"]["p50"][i] == pytest.approx(np.percentile(v, 50))
+        assert est["quantities"]["miss"]["max"][i] == v.max()
+        assert (est["quantities"]["miss"]["p99"][i] is None) == (v.size < 100)
+    assert est["quantities"]["miss"]["p99"][-1] == pytest.approx(np.percentile(miss[np.isfinite(miss)], 99))

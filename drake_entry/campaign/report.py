@@ -35,6 +35,7 @@ from drake_entry.campaign.statistics import (
     describe,
     finite_column,
     order_statistic_bound,
+    running_estimates,
     runs_for_bound,
     success_lower_bound,
 )
@@ -795,7 +796,25 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
         figs.append(figures.ground_tracks(traj, out_dir, title, target=target))
         step = float((meta or {}).get("trajectory_step_s") or 10.0)
         figs.append(figures.bank_histories(traj, out_dir, title, detailed=_detailed_samples(traj, step)))
+    figs.append(_convergence_figure(rows, out_dir, scenario, title))
     return [f for f in figs if f is not None]
+
+
+def _convergence_figure(rows: dict, out_dir: str, scenario, title: str):
+    """figures.convergence of the campaign's rows (the miss distance in km, the path-limit margins)."""
+    n = len(rows["index"])
+    quantities = {}
+    miss = "miss distance [km]" if "err_distance_m" in rows else None
+    if miss:
+        quantities[miss] = finite_column(rows, "err_distance_m", n) / 1e3
+    margins = tuple(c for c in MARGIN_COLUMNS if c in rows and np.isfinite(finite_column(rows, c, n)).any())
+    quantities.update({c: finite_column(rows, c, n) for c in margins})
+    est = running_estimates([bool(v) for v in rows["success"]], quantities)
+    req = getattr(scenario, "success_requirement", None)
+    terminal = getattr(scenario, "terminal", None)
+    return figures.convergence(est, out_dir, title, miss=miss, tolerance=getattr(terminal, "distance_tolerance_km",
+                                                                                  None),
+                               margins=margins, required=None if req is None else req.probability)
 
 
 def _detailed_samples(traj: dict, step_s: float) -> list:

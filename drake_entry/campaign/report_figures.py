@@ -16,7 +16,7 @@ from drake_entry.figures import plt, save_figure  # sets the Agg backend before 
 
 __all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "error_histograms",
            "footprint", "peak_histograms", "envelopes", "OFF_SCALE", "path_quantities", "drag_profiles",
-           "ground_tracks", "bank_histories", "energy_range", "normalised_energy"]
+           "ground_tracks", "bank_histories", "energy_range", "normalised_energy", "convergence"]
 
 #: k of the 99 % probability ellipse of a 2-D normal: sqrt(chi2.ppf(0.99, 2)) = 3.035
 ELLIPSE_99_K = math.sqrt(stats.chi2.ppf(0.99, 2))
@@ -322,6 +322,63 @@ def bank_histories(traj: dict, out_dir: str, title: str, *, detailed: list) -> t
     return path, (f"Bank angle flown by samples {', '.join(str(s) for s in detailed)} (stored every 1 s or at the "
                   "scenario's log period when longer, not at the campaign's storage step), the bank actuator's "
                   "position: reversals cross wings-level at the bank-rate limit.")
+
+
+def convergence(est: dict, out_dir: str, title: str, *, miss: str | None = None, tolerance: float | None = None,
+                margins: tuple = (), required: float | None = None) -> tuple[str, str] | None:
+    """The running estimates (statistics.running_estimates) against the sample count: the
+    success fraction with its one-sided bounds (and the ``required`` probability), the P50 and P99
+    of the quantity ``miss`` (with the box's ``tolerance`` in its unit), the P1 of each of
+    ``margins`` [%] (with the limit at 0)."""
+    n = np.asarray(est["n"], float)
+    if n.size < 2:
+        return None
+    q = est["quantities"]
+    panels = 1 + (miss is not None) + bool(margins)
+    fig, axes = plt.subplots(panels, 1, figsize=(8, 2.6 * panels + 0.6), sharex=True, squeeze=False)
+    axes = axes[:, 0]
+    level = 100 * float(est.get("level", 0.9))
+    ax = axes[0]
+    ax.fill_between(n, 100 * np.asarray(est["lower"]), 100 * np.asarray(est["upper"]), color="C0", alpha=0.2,
+                    label=f"one-sided {level:g} % bounds")
+    ax.plot(n, 100 * np.asarray(est["fraction"]), "C0-", lw=1.2, label="success fraction")
+    if required is not None:
+        ax.axhline(100 * required, color="r", ls="--", lw=1.0, label=f"required {100 * required:g} %")
+    ax.set_ylabel("successful [%]")
+    ax.set_ylim(max(0.0, 100 * min(est["lower"]) - 2), 100.5)
+    k = 1
+    if miss is not None:
+        ax = axes[k]
+        k += 1
+        for key, style, label in (("p50", "C2-", "P50"), ("p99", "C3.-", "P99 (from 100 samples)"),
+                                  ("max", "C3:", "largest")):
+            v = np.array([np.nan if x is None else x for x in q[miss][key]], float)
+            ax.plot(n, v, style, lw=1.0, ms=4, label=label)
+        if tolerance is not None:
+            ax.axhline(tolerance, color="k", ls="--", lw=1.0, label=f"box {tolerance:g}")
+        ax.set_ylabel(miss)
+    if margins:
+        ax = axes[k]
+        for i, name in enumerate(margins):
+            for key, style, words in (("p1", ".-", "P1"), ("min", ":", "smallest")):
+                v = np.array([np.nan if x is None else 100 * x for x in q[name][key]], float)
+                ax.plot(n, v, f"C{i % 10}{style}", lw=1.0, ms=4, label=f"{name.removeprefix('margin_')} {words}")
+        ax.axhline(0.0, color="r", ls="--", lw=1.0, label="limit (margin 0)")
+        ax.set_ylabel("margin [% of limit]")
+    for ax in axes:
+        ax.set_xscale("log")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7, loc="best")
+    axes[-1].set_xlabel("samples N (in sample order)")
+    path = _save(fig, out_dir, "convergence.png", title)
+    return path, (f"How the estimates settle as the {int(n[-1])} samples accumulate in sample order: the success "
+                  f"fraction with its one-sided {level:g} % Clopper-Pearson bounds"
+                  + (f" and the required {100 * required:g} %" if required is not None else "")
+                  + (f"; the {miss} P50, P99 (from 100 samples) and largest" if miss is not None else "")
+                  + ("; the P1 (from 100 samples) and smallest of each path-limit margin (below 0 a limit is "
+                     "passed)" if margins else "")
+                  + ". Look at: an estimate still moving at the right end is not converged; the bounds close "
+                    "as 1/N.")
 
 
 def energy_range(traj: dict) -> tuple[float, float]:

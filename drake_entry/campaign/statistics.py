@@ -26,7 +26,7 @@ from drake_entry.errors import ScenarioError
 
 __all__ = ["PERCENTILES", "COVERAGE", "CONFIDENCE", "SUCCESS_LEVELS", "success_lower_bound",
            "success_upper_bound", "runs_for_bound",
-           "order_statistic_rank", "order_statistic_bound", "finite_column", "describe", "percentile_key"]
+           "order_statistic_rank", "order_statistic_bound", "finite_column", "describe", "percentile_key", "convergence_counts", "running_estimates"]
 
 #: the percentiles of the report [%] (P0.13 and P99.87: the normal distribution's 3-sigma levels)
 PERCENTILES = (0.13, 1.0, 50.0, 99.0, 99.87)
@@ -114,6 +114,36 @@ def describe(values) -> dict:
         tail = min(p, 100.0 - p) / 100.0
         resolved = tail == 0.5 or n * tail >= 1.0
         out[percentile_key(p)] = float(np.percentile(v, p, method="linear")) if resolved else None
+    return out
+
+
+def convergence_counts(runs: int, points: int = 60) -> np.ndarray:
+    """The sample counts the running estimates are computed at: every count up to 20, then about
+    ``points`` more spaced evenly in log n up to ``runs`` (ending at it)."""
+    first = np.arange(1, min(runs, 20) + 1)
+    if runs <= 20:
+        return first
+    later = np.unique(np.round(np.geomspace(21, runs, points)).astype(int))
+    return np.unique(np.concatenate([first, later]))
+
+
+def running_estimates(success, quantities: dict, level: float = CONFIDENCE, points: int = 60) -> dict:
+    """How a campaign's estimates settle as its samples accumulate (in sample order): at each of
+    ``convergence_counts`` n, the success fraction of the first n samples with its one-sided
+    ``level`` lower and upper Clopper-Pearson bounds, and for each of ``quantities`` ({name:
+    values in sample order}) its min, P1, P50, P99 and max over the finite values among the
+    first n (None where ``describe`` would not resolve them: P1 and P99 from 100 values).
+    Returns {"n", "level", "fraction", "lower", "upper", "quantities": {name: {"min", "p1",
+    "p50", "p99", "max"}}}, lists."""
+    ok = np.cumsum(np.asarray(success, bool))
+    counts = convergence_counts(int(ok.size), points) if ok.size else np.zeros(0, int)
+    out = {"n": counts.tolist(), "level": level, "fraction": [float(ok[n - 1] / n) for n in counts],
+           "lower": [success_lower_bound(int(ok[n - 1]), int(n), level) for n in counts],
+           "upper": [success_upper_bound(int(ok[n - 1]), int(n), level) for n in counts], "quantities": {}}
+    for name, values in quantities.items():
+        v = np.asarray(values, float)
+        rows = [describe(v[:n]) for n in counts]
+        out["quantities"][name] = {k: [r.get(k) for r in rows] for k in ("min", "p1", "p50", "p99", "max")}
     return out
 
 

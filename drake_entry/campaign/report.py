@@ -780,7 +780,8 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
     figs = []
     if reached.any():
         errors = {f"{label} [{unit}]": finite_column(rows, col, n)[reached] for col, label, unit in ERROR_COLUMNS if col in rows}
-        figs.append(figures.error_histograms(errors, out_dir, title))
+        distance = tuple(f"{label} [{unit}]" for col, label, unit in ERROR_COLUMNS if col == "err_distance_m")
+        figs.append(figures.error_histograms(errors, out_dir, title, nonnegative=distance))
         radius = getattr(getattr(scenario, "terminal", None), "distance_tolerance_km", None)
         figs.append(figures.footprint(finite_column(rows, "err_crossrange_m", n)[reached] / 1e3,
                                       finite_column(rows, "err_range_m", n)[reached] / 1e3, out_dir, title, radius_km=radius))

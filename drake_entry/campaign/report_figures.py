@@ -14,7 +14,8 @@ from scipy import stats
 
 from drake_entry.figures import plt, save_figure  # sets the Agg backend before pyplot is imported
 
-__all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "error_histograms",
+__all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "plain_axis",
+           "error_histograms",
            "footprint", "peak_histograms", "envelopes", "OFF_SCALE", "path_quantities", "drag_profiles",
            "ground_tracks", "bank_histories", "energy_range", "normalised_energy", "convergence"]
 
@@ -45,8 +46,17 @@ def _save(fig, out_dir: str, name: str, title: str) -> str:
     return paths[0]
 
 
-def error_histograms(errors: dict, out_dir: str, title: str) -> tuple[str, str]:
-    """``errors``: {label [unit]: values} of the reached samples."""
+def plain_axis(ax, which: str = "x") -> None:
+    """Tick labels in the axis' own units: no offset and no 'x 1e6' multiplier beside the axis."""
+    formatter = (ax.xaxis if which == "x" else ax.yaxis).get_major_formatter()
+    if hasattr(formatter, "set_useOffset"):
+        formatter.set_useOffset(False)
+        formatter.set_scientific(False)
+
+
+def error_histograms(errors: dict, out_dir: str, title: str, *, nonnegative: tuple = ()) -> tuple[str, str]:
+    """``errors``: {label [unit]: values} of the reached samples; the labels in ``nonnegative``
+    (a distance) get their mean and largest value instead of mean +- 3 sigma, from 0."""
     n_panels = len(errors)
     cols = 4
     rows = math.ceil(n_panels / cols)
@@ -57,11 +67,17 @@ def error_histograms(errors: dict, out_dir: str, title: str) -> tuple[str, str]:
         v = v[np.isfinite(v)]
         n = max(n, v.size)
         ax.hist(v, bins=fd_bins(v), color="C0", alpha=0.8)
-        if v.size > 1:
+        if label in nonnegative and v.size:
+            ax.axvline(v.mean(), color="k", lw=1.2, label="mean")
+            ax.axvline(v.max(), color="C3", ls=":", lw=1.2, label="largest")
+            ax.set_xlim(left=0.0)
+            ax.legend(fontsize=7)
+        elif v.size > 1:
             m, s = v.mean(), v.std(ddof=1)
             ax.axvline(m, color="k", lw=1.2, label="mean")
             for k in (-3, 3):
                 ax.axvline(m + k * s, color="k", ls="--", lw=0.9, label="mean ± 3σ" if k > 0 else None)
+        plain_axis(ax)
         ax.set_xlabel(label)
         ax.locator_params(axis="x", nbins=5)
         ax.grid(True, alpha=0.4)
@@ -73,7 +89,9 @@ def error_histograms(errors: dict, out_dir: str, title: str) -> tuple[str, str]:
     path = _save(fig, out_dir, "error_histograms.png", title)
     return path, (f"Terminal errors of the {n} samples that reached the terminal interface (final minus target "
                   "values). Bins by the Freedman-Diaconis rule; solid line the mean, dashed lines mean ± 3σ (99.73 % "
-                  "of a normal distribution). Look for skew and outliers beyond the dashed lines.")
+                  "of a normal distribution)"
+                  + (f"; {', '.join(nonnegative)}, never negative, with its largest value dotted instead"
+                     if nonnegative else "") + ". Look for skew and outliers beyond the dashed lines.")
 
 
 def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float | None) -> tuple[str, str]:
@@ -135,6 +153,7 @@ def peak_histograms(peaks: dict, out_dir: str, title: str) -> tuple[str, str] | 
         if lim is not None and np.isfinite(lim):
             ax.axvline(lim, color="r", ls="--", lw=1.4, label=f"limit {lim:g}")
             ax.legend(fontsize=8)
+        plain_axis(ax)
         ax.set_xlabel(label)
         ax.grid(True, alpha=0.4)
     axes[0, 0].set_ylabel("samples")

@@ -100,8 +100,9 @@ def summary_statistics(rows: dict) -> dict:
     """Statistics of a campaign's rows (a column dict, e.g. from Parquet).
 
     Counts, each separately: samples, successful (the verdict: reached, inside the box and
-    within every path limit), reached (terminal interface reached), inside_acceptance_box and
-    within_limits (among the reached), failed (not successful) with their reasons
+    within every path limit), reached (terminal interface reached), inside_acceptance_box (among
+    the reached), within_limits (among every flight: a flight stopped before its interface that
+    breached no limit is within them), failed (not successful) with their reasons
     (``failure_categories``), and the samples inside each box criterion. Terminal-error
     statistics over the reached samples; path-limit margins (every ``margin_*`` column) over
     every sample that flew (a finite margin).
@@ -110,7 +111,7 @@ def summary_statistics(rows: dict) -> dict:
     ok = np.array([bool(v) for v in rows["success"]])
     reached = reached_terminal(rows)
     inside = _flags(rows, "inside_box", n, ok) & reached  # rows before the verdict columns: success
-    within = _flags(rows, "within_limits", n, ok) & reached
+    within = _flags(rows, "within_limits", n, ok)  # every flight: one stopped early held its limits till then
     out = {"samples": n, "successful": int(ok.sum()), "reached": int(reached.sum()),
            "inside_acceptance_box": int(inside.sum()), "within_limits": int(within.sum()),
            "failed": int(n - ok.sum()), "errors": {}, "margins": {}, "inside_box": {}}
@@ -159,8 +160,8 @@ def counts_sentence(stats: dict) -> str:
     """'N successful (reached, inside the box and within every path limit); ...' of a summary."""
     return (f"{stats['successful']} successful (reached, inside the acceptance box and within every path limit); "
             f"{stats['reached']} reached the terminal interface, {stats.get('inside_acceptance_box', '?')} of them "
-            f"inside the acceptance box and {stats.get('within_limits', '?')} within every path limit; "
-            f"{stats['failed']} not successful")
+            f"inside the acceptance box; {stats.get('within_limits', '?')} of {stats['samples']} within every path "
+            f"limit (a flight stopped early counts when it breached none); {stats['failed']} not successful")
 
 
 def errors_markdown(stats: dict, reference=None) -> str:

@@ -146,3 +146,25 @@ def test_running_estimates_are_those_of_each_prefix():
         assert est["quantities"]["miss"]["max"][i] == v.max()
         assert (est["quantities"]["miss"]["p99"][i] is None) == (v.size < 100)
     assert est["quantities"]["miss"]["p99"][-1] == pytest.approx(np.percentile(miss[np.isfinite(miss)], 99))
+
+
+def test_a_cloud_in_separate_arms_has_several_modes_and_no_normal_ellipse(tmp_path):
+    """One normal cloud (with a far outlier, or skewed) has 1 mode along its principal axes; three
+    separate arms have 3, two clusters 2.5 sigma apart each side of 0 have 2; the footprint then
+    draws no 99 % normal ellipse and its caption says why."""
+    from drake_entry.campaign.report_figures import footprint
+    from drake_entry.campaign.statistics import principal_axis_modes
+
+    rng = np.random.default_rng(1)
+    assert principal_axis_modes(*rng.normal(size=(2, 300))) == 1
+    assert principal_axis_modes(*np.hstack([rng.normal(size=(2, 99)), [[50.0], [0.0]]])) == 1
+    assert principal_axis_modes(*rng.lognormal(size=(2, 300))) == 1
+    arms = np.hstack([0.5 * rng.normal(size=(2, 100)) + np.array([[c], [0.0]]) for c in (-6.0, 0.0, 6.0)])
+    assert principal_axis_modes(*arms) == 3
+    assert principal_axis_modes(*np.hstack([rng.normal(size=(2, 150)) + np.array([[c], [0.0]])
+                                            for c in (-2.5, 2.5)])) == 2
+    assert principal_axis_modes([0.0, 1.0, 2.0], [0.0, 1.0, 2.0]) == 1  # too few points to tell
+    _, caption = footprint(arms[0], arms[1], str(tmp_path), "arms", radius_km=5.0)
+    assert "No normal ellipse: the cloud is not one cluster (3 modes" in caption
+    _, caption = footprint(*rng.normal(size=(2, 300)), str(tmp_path), "normal", radius_km=5.0)
+    assert "The ellipse holds 99 % of a normal distribution" in caption

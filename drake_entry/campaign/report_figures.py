@@ -12,6 +12,7 @@ import math
 import numpy as np
 from scipy import stats
 
+from drake_entry.campaign.statistics import principal_axis_modes
 from drake_entry.figures import plt, save_figure  # sets the Agg backend before pyplot is imported
 
 __all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "plain_axis",
@@ -106,14 +107,17 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
     circle = np.vstack([np.cos(t), np.sin(t)])
     extent = [np.abs(x).max(initial=0.0), np.abs(y).max(initial=0.0)]
     miss = np.hypot(x, y)
+    modes = principal_axis_modes(x, y)
     if x.size > 2:
-        vals, vecs = np.linalg.eigh(np.cov(np.vstack([x, y])))
-        ell = vecs @ (ELLIPSE_99_K * np.sqrt(np.maximum(vals, 0.0))[:, None] * circle)
-        ax.plot(x.mean() + ell[0], y.mean() + ell[1], "C1-", lw=1.5,
-                label=f"99 % ellipse (k = {ELLIPSE_99_K:.3f}σ, normal)")
+        if modes == 1:
+            vals, vecs = np.linalg.eigh(np.cov(np.vstack([x, y])))
+            ell = vecs @ (ELLIPSE_99_K * np.sqrt(np.maximum(vals, 0.0))[:, None] * circle)
+            ax.plot(x.mean() + ell[0], y.mean() + ell[1], "C1-", lw=1.5,
+                    label=f"99 % ellipse (k = {ELLIPSE_99_K:.3f}σ, normal)")
+            extent += [np.abs(x.mean() + ell[0]).max(), np.abs(y.mean() + ell[1]).max()]
         p99 = float(np.percentile(miss, 99))
         ax.plot(p99 * circle[0], p99 * circle[1], "C2:", lw=1.5, label=f"P99 miss radius {p99:.3g} km")
-        extent += [np.abs(x.mean() + ell[0]).max(), np.abs(y.mean() + ell[1]).max(), p99]
+        extent.append(p99)
     in_view = radius_km is not None and radius_km <= 4.0 * max(extent)  # else the samples would be a dot
     if radius_km is not None:
         ax.plot(radius_km * circle[0], radius_km * circle[1], "r--", lw=1.2,
@@ -130,8 +134,12 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
     ax.grid(True, alpha=0.4)
     path = _save(fig, out_dir, "footprint.png", title)
     caption = (f"Terminal footprint of the {x.size} samples that reached the terminal interface, centred on the "
-               "target, equal axes. The ellipse holds 99 % of a normal distribution with the sample's mean and "
-               "covariance (k = 3.035σ in 2-D); the dotted circle is the 99th percentile of the miss distance")
+               "target, equal axes. "
+               + ("The ellipse holds 99 % of a normal distribution with the sample's mean and covariance (k = 3.035σ "
+                  "in 2-D)" if modes == 1 else
+                  f"No normal ellipse: the cloud is not one cluster ({modes} modes of its kernel density along a "
+                  "principal axis), and an ellipse would cover ground no sample reached")
+               + "; the dotted circle is the 99th percentile of the miss distance")
     caption += (f"; the dashed circle is the acceptance region ({radius_km:g} km)" if radius_km is not None else "")
     if radius_km is not None and not in_view:
         caption += " (drawn only when near the samples: here far outside the axes)"

@@ -26,7 +26,8 @@ from drake_entry.errors import ScenarioError
 
 __all__ = ["PERCENTILES", "COVERAGE", "CONFIDENCE", "SUCCESS_LEVELS", "success_lower_bound",
            "success_upper_bound", "runs_for_bound",
-           "order_statistic_rank", "order_statistic_bound", "finite_column", "describe", "percentile_key", "convergence_counts", "running_estimates"]
+           "order_statistic_rank", "order_statistic_bound", "finite_column", "describe", "percentile_key", "convergence_counts", "running_estimates",
+           "MODE_PROMINENCE", "principal_axis_modes"]
 
 #: the percentiles of the report [%] (P0.13 and P99.87: the normal distribution's 3-sigma levels)
 PERCENTILES = (0.13, 1.0, 50.0, 99.0, 99.87)
@@ -115,6 +116,37 @@ def describe(values) -> dict:
         resolved = tail == 0.5 or n * tail >= 1.0
         out[percentile_key(p)] = float(np.percentile(v, p, method="linear")) if resolved else None
     return out
+
+
+#: a density peak counts as a mode when it rises this fraction of the highest peak above the
+#: valleys beside it (scipy.signal.find_peaks' prominence)
+MODE_PROMINENCE = 0.1
+
+
+def principal_axis_modes(x, y, grid: int = 512) -> int:
+    """The most modes of the cloud (x, y) along either of its principal axes: the peaks of its
+    Gaussian kernel density (scipy.stats.gaussian_kde, Scott's bandwidth) on the projection,
+    counted where their prominence is at least MODE_PROMINENCE of the highest. 1 for a normal
+    cloud; a footprint in separate arms (a cluster per reversal count) has several, and its
+    normal 99 % ellipse would cover empty ground. Fewer than 4 points or a degenerate cloud: 1."""
+    from scipy.signal import find_peaks
+
+    pts = np.vstack([np.asarray(x, float), np.asarray(y, float)])
+    pts = pts[:, np.isfinite(pts).all(axis=0)]
+    if pts.shape[1] < 4:
+        return 1
+    _, vecs = np.linalg.eigh(np.cov(pts))
+    most = 1
+    for axis in vecs.T:
+        u = axis @ (pts - pts.mean(axis=1, keepdims=True))
+        if np.ptp(u) <= 0.0:
+            continue
+        kde = stats.gaussian_kde(u)
+        pad = 0.1 * np.ptp(u)
+        density = kde(np.linspace(u.min() - pad, u.max() + pad, grid))
+        peaks, _ = find_peaks(np.concatenate([[0.0], density, [0.0]]), prominence=MODE_PROMINENCE * density.max())
+        most = max(most, len(peaks))
+    return most
 
 
 def convergence_counts(runs: int, points: int = 60) -> np.ndarray:

@@ -168,3 +168,36 @@ def test_a_cloud_in_separate_arms_has_several_modes_and_no_normal_ellipse(tmp_pa
     assert "No normal ellipse: the cloud is not one cluster (3 modes" in caption
     _, caption = footprint(*rng.normal(size=(2, 300)), str(tmp_path), "normal", radius_km=5.0)
     assert "The ellipse holds 99 % of a normal distribution" in caption
+
+
+def test_path_figure_draws_failed_samples_on_top_and_the_total_load_where_limited(tmp_path):
+    """Two stored samples, one not successful: the caption says so; a vehicle limiting the total
+    load gets its panel (four axes), one without it three."""
+    import types
+
+    from drake_entry.campaign.report_figures import path_quantities
+    from drake_entry.figures import plt
+
+    t = np.linspace(0.0, 1.0, 20)
+    traj = {"sample": [0] * 20 + [1] * 20, "energy_J_kg": list(-t) * 2,
+            "dynamic_pressure_Pa": list(1e4 * t) * 2, "heat_flux_W_m2": list(1e5 * t) * 2,
+            "normal_load_g": list(t) * 2, "total_load_g": list(1.1 * t) * 2}
+    limits = types.SimpleNamespace(dynamic_pressure_max=2e4, heat_flux_max=5e5, normal_load_max=2.5,
+                                   total_load_max=2.0)
+    figures = []
+    real_subplots = plt.subplots
+
+    def counting(*a, **k):
+        fig, axes = real_subplots(*a, **k)
+        figures.append(len(np.atleast_1d(axes)))
+        return fig, axes
+
+    plt.subplots = counting
+    try:
+        _, caption = path_quantities(traj, str(tmp_path), "t", limits, failed=[1, 7])
+        limits.total_load_max = math.inf
+        path_quantities(traj, str(tmp_path), "t", limits)
+    finally:
+        plt.subplots = real_subplots
+    assert "not successful in red, on top: 1" in caption and "of the 2 stored trajectories" in caption
+    assert figures == [4, 3]

@@ -792,7 +792,9 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
     figs.append(figures.peak_histograms(peaks, out_dir, title))
     if traj is not None:
         figs.append(figures.envelopes(traj, out_dir, title, nominal=read_nominal(out_dir)))
-        figs.append(figures.path_quantities(traj, out_dir, title, limits, mission_limits=_mission_limits(scenario)))
+        failed = [i for i, ok in zip(rows["index"], rows["success"]) if not ok]
+        figs.append(figures.path_quantities(traj, out_dir, title, limits, mission_limits=_mission_limits(scenario),
+                                            failed=failed))
         figs.append(figures.drag_profiles(traj, out_dir, title))
         target = ((scenario.target.longitude_deg, scenario.target.latitude_deg) if scenario is not None else None)
         figs.append(figures.ground_tracks(traj, out_dir, title, target=target))

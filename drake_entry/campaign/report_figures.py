@@ -228,21 +228,30 @@ def envelopes(traj: dict, out_dir: str, title: str, *, nominal: dict | None = No
 OFF_SCALE = 3.0
 
 
-def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits=()) -> tuple[str, str]:
-    """Dynamic pressure, heat flux and normal load against normalised energy, every sample; the
-    vehicle's limits (``limits``) dashed and the mission's (``mission_limits``: PathLimits on the
-    same quantities, e.g. a lower bound on q) dotted, each labelled."""
+def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits=(),
+                    failed=()) -> tuple[str, str]:
+    """Dynamic pressure, heat flux and normal load (and the total load where the vehicle limits
+    it) against normalised energy, every sample, the ``failed`` samples (indices) drawn on top in
+    red; the vehicle's limits (``limits``) dashed and the mission's (``mission_limits``:
+    PathLimits on the same quantities, e.g. a lower bound on q) dotted, each labelled."""
     sample = np.asarray(traj["sample"])
     e = normalised_energy(traj)
-    groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.0))
-    for ax, (col, quantity, scale, label, lim, unit) in zip(axes, (
-            ("dynamic_pressure_Pa", "dynamic_pressure", 1e-3, "dynamic pressure [kPa]", "dynamic_pressure_max", "kPa"),
-            ("heat_flux_W_m2", "heat_flux", 1e-3, "heat flux [kW/m^2]", "heat_flux_max", "kW/m^2"),
-            ("normal_load_g", "normal_load", 1.0, "normal load [g]", "normal_load_max", "g"))):
+    ids = np.unique(sample)
+    failed = {int(i) for i in failed} & {int(i) for i in ids}
+    groups = [np.flatnonzero(sample == s) for s in ids if int(s) not in failed]
+    bad = [np.flatnonzero(sample == s) for s in sorted(failed)]
+    panels = [("dynamic_pressure_Pa", "dynamic_pressure", 1e-3, "dynamic pressure [kPa]", "dynamic_pressure_max", "kPa"),
+              ("heat_flux_W_m2", "heat_flux", 1e-3, "heat flux [kW/m^2]", "heat_flux_max", "kW/m^2"),
+              ("normal_load_g", "normal_load", 1.0, "normal load [g]", "normal_load_max", "g")]
+    if limits is not None and np.isfinite(getattr(limits, "total_load_max", np.inf)) and "total_load_g" in traj:
+        panels.append(("total_load_g", "total_load", 1.0, "total load [g]", "total_load_max", "g"))
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.7 * len(panels), 4.0))
+    for ax, (col, quantity, scale, label, lim, unit) in zip(axes, panels):
         v = np.asarray(traj[col], float) * scale
         for g in groups:
             ax.plot(e[g], v[g], lw=0.4, alpha=0.4, color="C0")
+        for k, g in enumerate(bad):
+            ax.plot(e[g], v[g], lw=0.9, alpha=0.9, color="C3", label=f"not successful ({len(bad)})" if k == 0 else None)
         top = float(np.nanmax(v)) if v.size else 0.0
         value = getattr(limits, lim, None) if limits is not None else None
         lines = [] if value is None or not np.isfinite(value) else [(value * scale, f"vehicle limit {value * scale:g} {unit}",
@@ -257,14 +266,15 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits
                 ax.plot([], [], " ", label=f"{text} (off scale)")
             else:
                 ax.axhline(y, color="r", ls=style, lw=1.2, label=text)
-        if lines:
+        if lines or bad:
             ax.legend(fontsize=8)
         ax.set_xlabel(ENERGY_AXIS)
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.4)
     path = _save(fig, out_dir, "path_quantities.png", title)
-    return path, (f"Path quantities of the {len(groups)} stored trajectories against normalised energy (one line per "
-                  "sample, at the storage step: the peaks between stored points are in the peak histograms), the "
+    return path, (f"Path quantities of the {len(groups) + len(bad)} stored trajectories against normalised energy (one "
+                  "line per sample, at the storage step: the peaks between stored points are in the peak histograms"
+                  + (f"; not successful in red, on top: {len(bad)}" if bad else "") + "), the "
                   "vehicle's limits dashed and the mission's dotted (a limit more than "
                   f"{OFF_SCALE:g} times the largest flown value is named in the legend, not drawn). {ENERGY_DEFINITION}.")
 

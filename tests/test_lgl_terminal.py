@@ -360,6 +360,31 @@ def test_a_plan_meeting_the_interface_early_is_solved_again_with_the_floor(monke
     assert plan.flight.interface_early_s == 0.0 and plan.flight.box["distance"]["error"] < 100.0
 
 
+@pytest.mark.parametrize("converged, solved_on", [(False, [4, 1]), (True, [4])])
+def test_a_pre_flight_plan_whose_segments_do_not_converge_is_solved_on_one_polynomial(horus_derived, monkeypatch,
+                                                                                     converged, solved_on):
+    """The spec's 4 segments first; only when they do not converge, one polynomial of the same
+    nodes (each solve without the interface floor: it is added only for a plan meeting the
+    terminal altitude early)."""
+    import types
+
+    from drake_entry.guidance.lgl_terminal import planner
+    from drake_entry.planning import nlp
+
+    s, _ = horus_derived
+    calls = []
+
+    def solve(problem, **kw):
+        calls.append((kw["segments"], kw["nodes"], [c.label for c in problem.path]))
+        return types.SimpleNamespace(success=False, converged=converged and kw["segments"] == 4,
+                                     message="not solved: SNOPT: major iteration limit reached (info 32)")
+
+    monkeypatch.setattr(nlp, "solve", solve)
+    plan = planner.plan_terminal(s, lambda *a, **k: None, progress=False)
+    assert [c[0] for c in calls] == solved_on and all(c[1] == 81 for c in calls)
+    assert all("interface_floor" not in c[2] for c in calls) and not plan.success
+
+
 def test_a_resolve_in_denser_air_holds_q_and_the_heat_rate_there():
     """sensed_path: with lift and drag sensed 1.21 and 1.21 times the models' (air 21 % denser)
     the q bound is divided by 1.21 and the heat-rate bound by 1.1; the load and a terminal-like

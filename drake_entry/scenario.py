@@ -22,7 +22,7 @@ from drake_entry.models.vehicles import Vehicle, load_vehicle
 from drake_entry.models.verdict import PathLimit, acceptance_box, vehicle_path_limits
 from drake_entry.typed_yaml import check_numbers, load_packaged_or_file, override, packaged_names
 
-__all__ = ["RENAMED_GUIDANCE_FIELDS", "upgrade_scenario_yaml", "scenario_from_dump", "EntryStateSpec", "TargetSpec", "TerminalSpec", "ScheduleSpec", "unstated_guidance", "stated_guidance", "PLANTS", "SimulationSpec",
+__all__ = ["RENAMED_GUIDANCE_FIELDS", "upgrade_scenario_yaml", "scenario_from_dump", "EntryStateSpec", "TargetSpec", "TerminalSpec", "SuccessRequirementSpec", "ScheduleSpec", "unstated_guidance", "stated_guidance", "PLANTS", "SimulationSpec",
            "ReferenceResultsSpec", "ERROR_COLUMNS", "Scenario", "INTEGRATORS", "SCHEDULE_VALUES_DEG",
            "SCHEDULE_BREAKPOINTS", "PACKAGED_SCENARIOS", "closed_loop_scenarios", "load_scenario", "apply_overrides",
            "load_campaign_scenario"]
@@ -83,6 +83,13 @@ class SuccessRequirementSpec:
 
     probability: Optional[float] = None  # e.g. 0.9973 (3 sigma); in (0, 1)
     confidence: float = 0.9  # of the one-sided Clopper-Pearson lower bound; in (0.5, 1)
+
+    def validate(self) -> None:
+        """Each field in its range (ScenarioError naming it); an unstated probability passes."""
+        if self.probability is not None and not 0.0 < self.probability < 1.0:
+            raise ScenarioError(f"success_requirement.probability = {self.probability}: allowed in (0, 1), e.g. 0.9973")
+        if not 0.5 < self.confidence < 1.0:
+            raise ScenarioError(f"success_requirement.confidence = {self.confidence}: allowed in (0.5, 1), e.g. 0.9")
 
 
 @dc.dataclass
@@ -320,11 +327,7 @@ class Scenario:
             if getattr(t, tol) is not None and getattr(t, centre) is None:
                 raise ScenarioError(f"terminal.{tol} is given without terminal.{centre}, the value it is about")
         check_range("terminal.path_limit_tolerance", t.path_limit_tolerance, 0.0, 0.5)
-        req = self.success_requirement
-        if req.probability is not None and not 0.0 < req.probability < 1.0:
-            raise ScenarioError(f"success_requirement.probability = {req.probability}: allowed in (0, 1), e.g. 0.9973")
-        if not 0.5 < req.confidence < 1.0:
-            raise ScenarioError(f"success_requirement.confidence = {req.confidence}: allowed in (0.5, 1), e.g. 0.9")
+        self.success_requirement.validate()
         for col, v in self.reference_results.errors.items():
             if col not in ERROR_COLUMNS:
                 raise ScenarioError(f"reference_results.errors: '{col}' is not a terminal-error column; allowed: "

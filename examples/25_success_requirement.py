@@ -24,7 +24,7 @@ import numpy as np
 
 from drake_entry.campaign.montecarlo import run_until_confident
 from drake_entry.campaign.rows import row_problem
-from drake_entry.campaign.statistics import success_lower_bound, success_upper_bound
+from drake_entry.campaign.statistics import running_estimates
 from drake_entry.campaign.store import coverage
 from drake_entry.campaign.success_requirement import runs_to_show
 from drake_entry.claims import Claims, run_example
@@ -44,14 +44,11 @@ def write_scenario(folder: str, probability: float, confidence: float) -> str:
     return path
 
 
-def bound_history(out_dir: str, confidence: float):
-    """(runs, successes, lower, upper): the successes and bounds of the first n samples (in sample
-    order) for every n."""
+def bound_history(out_dir: str, confidence: float) -> dict:
+    """The success fraction and its bounds over the first n samples (in sample order), n on a
+    fine grid (campaign.statistics.running_estimates)."""
     rows = coverage(out_dir, row_problem)["rows"]
-    ok = np.cumsum([bool(rows[i].get("success")) for i in sorted(rows)])
-    n = np.arange(1, ok.size + 1)
-    return (n, ok, np.array([success_lower_bound(int(k), int(m), confidence) for k, m in zip(ok, n)]),
-            np.array([success_upper_bound(int(k), int(m), confidence) for k, m in zip(ok, n)]))
+    return running_estimates([bool(rows[i].get("success")) for i in sorted(rows)], {}, level=confidence, points=400)
 
 
 def main(quick: bool = False, out_dir: str = "out/examples/25") -> dict:
@@ -62,12 +59,13 @@ def main(quick: bool = False, out_dir: str = "out/examples/25") -> dict:
     _, verdict = run_until_confident(scenario, runs=runs, max_runs=2000, out_dir=campaign, seed=SEED, workers=2,
                                      trajectory_step_s=0.0)
     stats = write_and_print_report(campaign)
-    n, ok, lower, upper = bound_history(campaign, confidence)
+    est = bound_history(campaign, confidence)
+    n, fraction, lower, upper = (np.asarray(est[k], float) for k in ("n", "fraction", "lower", "upper"))
 
     fig, ax = plt.subplots(figsize=(8, 4.2))
     ax.plot(n, 100 * lower, "C0-", lw=1.2, label=f"lower bound ({100 * confidence:g} %, one-sided)")
     ax.plot(n, 100 * upper, "C1-", lw=1.2, label=f"upper bound ({100 * confidence:g} %, one-sided)")
-    ax.plot(n, 100 * ok / n, "k:", lw=0.8, label="observed success fraction")
+    ax.plot(n, 100 * fraction, "k:", lw=0.8, label="observed success fraction")
     ax.axhline(100 * probability, color="r", ls="--", lw=1.2, label=f"required {100 * probability:g} %")
     ax.axvline(verdict.runs, color="0.4", ls=":", lw=1.0, label=f"stopped: {verdict.status} at {verdict.runs} runs")
     # zoomed on the requirement: ten times its failure allowance below it

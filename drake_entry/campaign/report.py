@@ -247,7 +247,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     name = title or _name(meta)
     figs = _figures(rows, reached, traj, out_dir, scenario, limits, name, meta)
     sections = [_header(meta, stats, title, rows), _provenance(meta, stats), _dispersions(scenario),
-                _requirements(rows, reached, stats, scenario), _outcome(rows, stats, traj),
+                _requirements(rows, reached, stats, scenario, verdict), _outcome(rows, stats, traj),
                 _distributions(rows, quantities, reached, stats, reference), _drivers(stats), _cost(stats),
                 figure_list(figs)]
     return write_markdown_report(sections, out_dir, title=name)
@@ -591,11 +591,12 @@ def requirement_verdict(stats: dict, scenario):
     return success_verdict(stats["successful"], stats["samples"], req.probability, req.confidence)
 
 
-def _requirements(rows: dict, reached, stats: dict, scenario) -> str:
+def _requirements(rows: dict, reached, stats: dict, scenario, verdict=None) -> str:
+    """The requirement table: ``verdict`` (requirement_verdict: the scenario's success
+    requirement, None when it states none), every box criterion and path limit."""
     n = len(rows["index"])
     nr = int(reached.sum())
     lines = []
-    verdict = requirement_verdict(stats, scenario)
     if verdict is not None:
         lines.append(f"| success probability | {verdict.required} | one-sided Clopper-Pearson lower bound of "
                      f"{verdict.successes} of {verdict.runs} | {100 * verdict.lower:.3f} % | "

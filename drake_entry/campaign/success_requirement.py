@@ -16,10 +16,9 @@ from __future__ import annotations
 
 import dataclasses as dc
 
-from scipy import stats
-
 from drake_entry.campaign.statistics import success_lower_bound, success_upper_bound
 from drake_entry.errors import ScenarioError
+from drake_entry.scenario import SuccessRequirementSpec
 
 __all__ = ["STATUSES", "MAX_RUNS", "SuccessVerdict", "runs_to_show", "success_verdict"]
 
@@ -64,10 +63,7 @@ class SuccessVerdict:
 
 
 def _check(probability: float, confidence: float) -> None:
-    if not 0.0 < probability < 1.0:
-        raise ScenarioError(f"success_requirement.probability = {probability}: allowed in (0, 1), e.g. 0.9973")
-    if not 0.5 < confidence < 1.0:
-        raise ScenarioError(f"success_requirement.confidence = {confidence}: allowed in (0.5, 1), e.g. 0.9")
+    SuccessRequirementSpec(probability, confidence).validate()
 
 
 def runs_to_show(failures: int, probability: float, confidence: float) -> int | None:
@@ -79,7 +75,7 @@ def runs_to_show(failures: int, probability: float, confidence: float) -> int | 
         raise ScenarioError(f"failures must be >= 0, got {failures}")
 
     def shown(n: int) -> bool:
-        return float(stats.beta.ppf(1.0 - confidence, n - failures, failures + 1)) >= probability
+        return success_lower_bound(n - failures, n, confidence) >= probability
 
     lo, hi = failures, failures + 1  # shown(lo) is False (no success); find hi with shown(hi)
     while not shown(hi):

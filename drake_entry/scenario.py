@@ -19,7 +19,7 @@ from drake_entry.models.environment import AtmosphereSpec, PlanetSpec, atmospher
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import VARIABLES, Schedule
 from drake_entry.models.vehicles import Vehicle, load_vehicle
-from drake_entry.models.verdict import PathLimit, acceptance_box, vehicle_path_limits
+from drake_entry.models.verdict import BOX_CRITERIA, PathLimit, acceptance_box, vehicle_path_limits
 from drake_entry.typed_yaml import check_numbers, load_packaged_or_file, override, packaged_names
 
 __all__ = ["RENAMED_GUIDANCE_FIELDS", "upgrade_scenario_yaml", "scenario_from_dump", "EntryStateSpec", "TargetSpec", "TerminalSpec", "SuccessRequirementSpec", "ScheduleSpec", "unstated_guidance", "stated_guidance", "PLANTS", "SimulationSpec",
@@ -71,6 +71,21 @@ class TerminalSpec:
     flight_path_tolerance_deg: Optional[float] = None
     alpha_deg: Optional[float] = None
     alpha_tolerance_deg: Optional[float] = None
+    # terminal vertical speed V sin(gamma) [m/s] and its window (+- m/s), e.g. paper 001 eq. 66
+    vertical_speed_m_s: Optional[float] = None
+    vertical_speed_tolerance_m_s: Optional[float] = None
+    # terminal geodetic altitude [km] and its window (+- km), whatever the scenario's altitude
+    # datum (paper 001 eq. 64's DRS window is geodetic on a sphere-datum scenario)
+    geodetic_altitude_km: Optional[float] = None
+    geodetic_altitude_tolerance_km: Optional[float] = None
+    # where each requirement comes from, by its name (a box criterion: altitude, mach, distance,
+    # velocity, flight_path, alpha, vertical_speed, geodetic_altitude; a path limit: its name and
+    # '_limit', e.g. heat_flux_limit, flight_path_limit): the report's requirement table prints it,
+    # and a requirement that departs from its source says so here ("departure: ...")
+    requirement_sources: dict[str, str] = dc.field(default_factory=dict)
+    # what the source requires that this box does not judge, each with why (the report's
+    # requirement table lists them as NOT JUDGED)
+    departures: dict[str, str] = dc.field(default_factory=dict)
     # relative tolerance on every path limit (vehicle and mission): a limit counts as held up to
     # limit + this x |limit|, at every log sample and integrator step; 0: a limit is a limit
     path_limit_tolerance: float = 0.0
@@ -232,6 +247,23 @@ class Scenario:
         v = self.make_vehicle() if vehicle is None else vehicle
         return vehicle_path_limits(v.limits, v.bank_limit) + list(self.guidance.path_limits(self))
 
+    def _check_requirement_sources(self) -> None:
+        """Every key of terminal.requirement_sources names a box criterion or a path limit
+        ('<limit>_limit': a limit another guidance block brings may be named, e.g. SCvx's
+        flight_path_limit on a mission another method flies) (ScenarioError listing the allowed
+        names otherwise)."""
+        names = [c.name for c in BOX_CRITERIA] + [f"{lim.name}_limit" for lim in self.path_limits()]
+        for key, text in self.terminal.requirement_sources.items():
+            if key not in names and not key.endswith("_limit"):
+                raise ScenarioError(f"terminal.requirement_sources: '{key}' names no requirement of this scenario; "
+                                    f"allowed: {', '.join(names)} (or another path limit's name and '_limit')")
+            if not str(text).strip():
+                raise ScenarioError(f"terminal.requirement_sources.{key} is empty: say where the requirement comes from")
+        for requirement, why in self.terminal.departures.items():
+            if not str(requirement).strip() or not str(why).strip():
+                raise ScenarioError(f"terminal.departures: '{requirement}' needs the requirement and why it is not "
+                                    "judged, both non-empty")
+
     def initial_state(self) -> np.ndarray:
         """Entry state x0 = [h, lon, lat, V, gamma, psi] in SI / rad (h: the state altitude,
         converted from the geodetic entry altitude with altitude_datum 'ellipsoid')."""
@@ -248,9 +280,11 @@ class Scenario:
         'ellipsoid', else the state altitude; speed and flight-path angle from ``x``; the Mach
         number, the distance to the target [m] and the angle of attack [rad] as measured (an
         alpha criterion with no alpha given is missed)."""
-        h = planet.atmospheric_altitude(x[0], x[2]) if self.altitude_datum == "ellipsoid" else x[0]
+        geodetic = float(planet.atmospheric_altitude(x[0], x[2]))
+        h = geodetic if self.altitude_datum == "ellipsoid" else x[0]
         return acceptance_box(self.terminal, altitude_m=float(h), mach=float(mach), distance_m=float(distance_m),
-                              velocity_m_s=float(x[3]), flight_path_rad=float(x[4]), alpha_rad=float(alpha_rad))
+                              velocity_m_s=float(x[3]), flight_path_rad=float(x[4]), alpha_rad=float(alpha_rad),
+                              vertical_speed_m_s=float(x[3] * math.sin(x[4])), geodetic_altitude_m=geodetic)
 
     def entry_energy(self) -> float:
         """Specific energy at the entry interface [J/kg] (central gravity, eq. 37 convention)."""
@@ -315,15 +349,21 @@ class Scenario:
             check_range("terminal.energy_MJ_kg", t.energy_MJ_kg, planet.specific_energy(0.0, 0.0) / 1e6,
                         self.entry_energy() / 1e6)
         for name in ("altitude_tolerance_km", "mach_tolerance", "distance_tolerance_km", "velocity_tolerance_m_s",
-                     "flight_path_tolerance_deg", "alpha_tolerance_deg"):
+                     "flight_path_tolerance_deg", "alpha_tolerance_deg", "vertical_speed_tolerance_m_s",
+                     "geodetic_altitude_tolerance_km"):
             if getattr(t, name) is not None:
                 check_range(f"terminal.{name}", getattr(t, name), 0.0, 1e5)
         if t.flight_path_deg is not None:
             check_range("terminal.flight_path_deg", t.flight_path_deg, -90.0, 90.0)
         if t.alpha_deg is not None:
             check_range("terminal.alpha_deg", t.alpha_deg, -90.0, 90.0)
+        if t.vertical_speed_m_s is not None:
+            check_range("terminal.vertical_speed_m_s", t.vertical_speed_m_s, -1e4, 1e4)
+        if t.geodetic_altitude_km is not None:
+            check_range("terminal.geodetic_altitude_km", t.geodetic_altitude_km, -1.0, self.entry.altitude_km + 100.0)
         for centre, tol in (("velocity_m_s", "velocity_tolerance_m_s"), ("flight_path_deg", "flight_path_tolerance_deg"),
-                            ("alpha_deg", "alpha_tolerance_deg")):
+                            ("alpha_deg", "alpha_tolerance_deg"), ("vertical_speed_m_s", "vertical_speed_tolerance_m_s"),
+                            ("geodetic_altitude_km", "geodetic_altitude_tolerance_km")):
             if getattr(t, tol) is not None and getattr(t, centre) is None:
                 raise ScenarioError(f"terminal.{tol} is given without terminal.{centre}, the value it is about")
         check_range("terminal.path_limit_tolerance", t.path_limit_tolerance, 0.0, 0.5)
@@ -342,6 +382,7 @@ class Scenario:
         except ValueError as e:
             raise ScenarioError(str(e)) from None
         self.guidance.validate(self)  # the method's fields (period_s among them) before what depends on them
+        self._check_requirement_sources()
         sim = self.simulation
         check_range("simulation.max_time_s", sim.max_time_s, 1.0, 1e5)
         check_range("simulation.accuracy", sim.accuracy, 1e-14, 1e-1)

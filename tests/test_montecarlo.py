@@ -89,8 +89,18 @@ def test_report_is_self_contained_with_provenance_requirements_and_bounds(tmp_pa
     assert "`drake-entry campaign horus2b --runs 2 --seed 4 --trajectory-step 10.0 --out DIR`" in text
     assert "Source: paper 000 Table 2 (entry interface only, uniform)" in text
     assert "| entry altitude (deviation) | 122000 m | uniform | [-250, 250] | m |" in text
-    assert "| terminal altitude about 25 km | ≤ 2 km | largest absolute error of 2 |" in text
+    assert "| terminal altitude | in [23, 27] km | largest distance from the centre 25 km of 2 |" in text
+    assert "PASS (2 of 2 inside) | paper 000 Table 1 |" in text  # the requirement's source
+    assert "PASS (2 of 2 held) | paper 000 Table 1 (530 kW/m^2) |" in text
     assert "| heat_flux | <= 530 kW/m^2 | worst flown sample of 2 |" in text and "PASS (2 of 2 held)" in text
+    # the errors against the guidance's aim (26.5 km at its energy stop) and against the box's centre
+    assert "The guidance aims at the energy of h_f = 26.5 km, V_f = " in text
+    assert "| ΔV (at the energy stop: -g Δh / V, follows Δh) (bound on the absolute value) | m/s | 2 |" in text
+    centre = text.split("### Terminal errors against the acceptance box's centre")[1].split("###")[0]
+    row = next(line for line in centre.splitlines() if line.startswith("| terminal altitude − box centre"))
+    cells = row.split("|")
+    min_p50_mean_max = [float(cells[i]) for i in (4, 7, 8, 12)]
+    assert all(1.0 < v < 2.0 for v in min_p50_mean_max)  # the flights end about 26.5 km: 1.5 km above the centre
     assert "| peak heat flux | kW/m^2 | 2 |" in text and "— (needs 230 runs)" in text
     assert "| bank reversals | - | 2 |" in text
     assert "Why the figures differ from paper 000 Table 3: This guidance re-plans the drag profile every 20 s" in text

@@ -245,3 +245,75 @@ def test_texts_zero_bounds_and_the_recorded_tolerance():
     assert PathLimit("x", "x", upper=3.0).bound_text() == "<= 3"
     tr = _trajectory([0.0, 1.0], [1.0, 2.0])
     assert judge(tr, [], reached=True, inside_box=True, tolerance=0.02).tolerance == 0.02
+
+
+def test_vertical_speed_and_geodetic_altitude_criteria_are_windows_about_their_values():
+    """Paper 001's DRS box: V sin(gamma) in [-140, 0] m/s (eq. 65) and 10-13 km geodetic (eq. 64),
+    each closed at its edges and missed just beyond them or when not measured."""
+    from drake_entry.models.verdict import acceptance_box
+
+    term = _terminal(mach=0.5, mach_tolerance=0.5, vertical_speed_m_s=-70.0, vertical_speed_tolerance_m_s=70.0,
+                     geodetic_altitude_km=11.5, geodetic_altitude_tolerance_km=1.5)
+    box = acceptance_box(term, altitude_m=2.5e3, mach=0.6, distance_m=0.0, vertical_speed_m_s=-140.0,
+                         geodetic_altitude_m=10.0e3)
+    assert box["vertical_speed"]["inside"] and box["geodetic_altitude"]["inside"]
+    assert box["vertical_speed"]["error"] == pytest.approx(-70.0) and box["geodetic_altitude"]["error"] == -1.5e3
+    box = acceptance_box(term, altitude_m=2.5e3, mach=0.6, distance_m=0.0, vertical_speed_m_s=-140.01,
+                         geodetic_altitude_m=13.001e3)
+    assert not box["vertical_speed"]["inside"] and not box["geodetic_altitude"]["inside"]
+    box = acceptance_box(term, altitude_m=2.5e3, mach=0.6, distance_m=0.0)
+    assert not box["vertical_speed"]["inside"] and not box["geodetic_altitude"]["inside"]
+
+
+def test_a_scenario_box_measures_vertical_speed_and_geodetic_altitude_from_the_state():
+    """Scenario.acceptance_box: V sin(gamma) from the state, the geodetic altitude on the oblate
+    Earth at the state's latitude (the sphere-datum SPHYNX scenario: 2.5 km state = 10.17 km
+    geodetic at the Azores site)."""
+    from drake_entry.scenario import load_scenario
+
+    s = load_scenario("sphynx_paper001")
+    planet = s.make_planet()
+    lat = math.radians(s.target.latitude_deg)
+    x = np.array([2.5e3, math.radians(s.target.longitude_deg), lat, 200.0, math.radians(-15.0), 0.0])
+    box = s.acceptance_box(planet, x, mach=0.6, distance_m=1e3)
+    assert box["vertical_speed"]["error"] == pytest.approx(200.0 * math.sin(math.radians(-15.0)) + 70.0)
+    geodetic = box["geodetic_altitude"]["error"] + 11.5e3
+    assert geodetic == pytest.approx(float(planet.atmospheric_altitude(2.5e3, lat))) and 10.1e3 < geodetic < 10.25e3
+    assert all(b["inside"] for b in box.values())
+
+
+@pytest.mark.parametrize("terminal, needle", [
+    ({"requirement_sources": {"altitud": "paper 000 Table 1"}},
+     r"terminal.requirement_sources: 'altitud' names no requirement of this scenario; allowed: altitude, mach, "),
+    ({"requirement_sources": {"heat_flux_limit": " "}}, r"terminal.requirement_sources.heat_flux_limit is empty"),
+    ({"vertical_speed_tolerance_m_s": 70.0},
+     r"terminal.vertical_speed_tolerance_m_s is given without terminal.vertical_speed_m_s"),
+    ({"geodetic_altitude_km": 11.5, "geodetic_altitude_tolerance_km": -1.0},
+     r"terminal.geodetic_altitude_tolerance_km = -1.0 is out of range"),
+])
+def test_a_bad_requirement_field_names_itself_and_what_is_allowed(terminal, needle):
+    """Requirement sources name a box criterion or a path limit ('<limit>_limit') of the
+    scenario; a window's tolerance needs its centre and is >= 0."""
+    from drake_entry.errors import ScenarioError
+    from drake_entry.scenario import load_scenario
+
+    s = load_scenario("horus2b")
+    s = dc.replace(s, terminal=dc.replace(s.terminal, **terminal))
+    with pytest.raises(ScenarioError, match=needle):
+        s.validate()
+
+
+def test_the_requirement_table_names_each_source_and_lists_the_departures_not_judged():
+    """shefex3_ampi: Table 1's altitude window judged with its source, the substitute target's
+    25-km ring marked as a departure, Table 1's speed window listed NOT JUDGED with why."""
+    from drake_entry.campaign.report import _requirements
+    from drake_entry.scenario import load_scenario
+
+    rows = {"index": [0, 1], "inside_altitude_box": [True, False], "box_altitude_error": [100.0, -2600.0],
+            "inside_distance_box": [True, True], "box_distance_error": [1e3, 2e3]}
+    text = _requirements(rows, np.array([True, True]), {"margins": {}}, load_scenario("shefex3_ampi"))
+    assert ("| terminal altitude | in [21, 26] km | largest distance from the centre 23.5 km of 2 | 2.6 km | -0.1 km | "
+            "FAIL (1 of 2 inside) | paper 003 Table 1 |") in text
+    assert "| distance to the target | ≤ 25 km | largest value of 2 | 2 km | 23 km | PASS (2 of 2 inside) | departure: " in text
+    assert ("| terminal speed in [570, 620] m/s (paper 003 Table 1) | not judged | — | — | — | NOT JUDGED | departure: "
+            "the packaged database's references end at the window's 620 m/s corner") in text

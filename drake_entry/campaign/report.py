@@ -53,7 +53,7 @@ __all__ = ["ERROR_COLUMNS", "MARGIN_COLUMNS", "failure_categories", "reached_ter
            "summary_statistics", "counts_sentence", "errors_markdown", "flown_scenario", "rows_as_columns",
            "write_report", "write_markdown_report", "PEAK_QUANTITIES", "OTHER_QUANTITIES", "CONTROL_QUANTITIES",
            "DISPERSION_FIELDS", "NAV_UNITS", "DISPERSION_LABELS", "NAV_NAMES", "table_cell", "format_number",
-           "drake_entry_version", "MAX_FAILED_LISTED", "figure_list", "write_html"]
+           "drake_entry_version", "MAX_FAILED_LISTED", "figure_list", "write_html", "aim_text"]
 
 # (row column, label, unit) of the terminal errors, in the scenario schema's order
 ERROR_COLUMNS = tuple(zip(ERROR_COLUMN_NAMES,
@@ -239,7 +239,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     if verdict is not None:
         stats["success_requirement"] = dc.asdict(verdict) | {"text": verdict.text()}
     reached = reached_terminal(rows)
-    quantities = _quantities(rows, reached)
+    quantities = _quantities(rows, reached, scenario)
     stats["distributions"] = {key: describe(values) for key, (_, _, values) in quantities.items()}
     stats["drivers"] = failure_drivers(rows)
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
@@ -248,7 +248,7 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     figs = _figures(rows, reached, traj, out_dir, scenario, limits, name, meta)
     sections = [_header(meta, stats, title, rows), _provenance(meta, stats), _dispersions(scenario),
                 _requirements(rows, reached, stats, scenario, verdict), _outcome(rows, stats, traj),
-                _distributions(rows, quantities, reached, stats, reference), _drivers(stats), _cost(stats),
+                _distributions(rows, quantities, reached, stats, reference, scenario), _drivers(stats), _cost(stats),
                 figure_list(figs)]
     return write_markdown_report(sections, out_dir, title=name)
 
@@ -349,14 +349,24 @@ def _vehicle_limits(scenario):
         return None
 
 
-def _quantities(rows: dict, reached) -> dict:
+def _quantities(rows: dict, reached, scenario=None) -> dict:
     """{key: (label, unit, values)} of every quantity of the statistics tables: terminal errors
-    over the reached samples, the rest over every sample that flew (finite)."""
+    against the guidance's aim and (``box_<criterion>_error``, in the box's units) against the
+    acceptance box's centre over the reached samples, the rest over every sample that flew
+    (finite). With an energy stop, ΔV is labelled as what it is: -g Δh / V, not a second error."""
     n = len(rows["index"])
     out = {}
+    energy_stop = scenario is not None and not getattr(scenario.guidance, "stops_at_altitude", True)
     for col, label, unit in ERROR_COLUMNS:
         if col in rows:
+            if col == "err_velocity_m_s" and energy_stop:
+                label = "ΔV (at the energy stop: -g Δh / V, follows Δh)"
             out[col] = (label, unit, finite_column(rows, col, n)[reached])
+    for c in BOX_CRITERIA:
+        col = f"box_{c.name}_error"
+        if col in rows:
+            out[col] = (c.label + ("" if c.centre is None else " − box centre"), c.unit or "-",
+                        finite_column(rows, col, n)[reached] / c.si)
     for col, label, unit, scale, *_ in PEAK_QUANTITIES + OTHER_QUANTITIES + CONTROL_QUANTITIES:
         if col in rows:
             out[col] = (label, unit, finite_column(rows, col, n) * scale)
@@ -597,13 +607,15 @@ def _requirements(rows: dict, reached, stats: dict, scenario, verdict=None) -> s
     n = len(rows["index"])
     nr = int(reached.sum())
     lines = []
+    sources = dict(getattr(scenario.terminal, "requirement_sources", {}) or {}) if scenario is not None else {}
     if verdict is not None:
         lines.append(f"| success probability | {verdict.required} | one-sided Clopper-Pearson lower bound of "
                      f"{verdict.successes} of {verdict.runs} | {100 * verdict.lower:.3f} % | "
-                     f"{100 * (verdict.lower - verdict.probability):+.3f} % | {verdict.text()} |")
+                     f"{100 * (verdict.lower - verdict.probability):+.3f} % | {verdict.text()} | the scenario's "
+                     "`success_requirement` |")
     term = scenario.terminal if scenario is not None else None
     lines.append(f"| reach the terminal interface | every sample | count | {nr} of {n} | — | "
-                 f"{'PASS' if nr == n else 'FAIL'} |")
+                 f"{'PASS' if nr == n else 'FAIL'} | the verdict's |")
     for c in BOX_CRITERIA:
         col, flag = f"box_{c.name}_error", f"inside_{c.name}_box"
         if term is None or getattr(term, c.tolerance, None) is None or flag not in rows:
@@ -614,10 +626,13 @@ def _requirements(rows: dict, reached, stats: dict, scenario, verdict=None) -> s
         e = finite_column(rows, col, n)[reached] / c.si if col in rows else np.array([])
         e = e[np.isfinite(e)]
         worst = float(np.abs(e).max()) if e.size else math.nan
-        centre = "" if c.centre is None or getattr(term, c.centre) is None else f" about {getattr(term, c.centre):g}{unit}"
-        lines.append(f"| {c.label}{centre} | ≤ {tol:g}{unit} | largest absolute error of {nr} | "
-                     f"{format_number(worst)}{unit} | {format_number(tol - worst)}{unit} | "
-                     f"{'PASS' if inside == nr == n else 'FAIL'} ({inside} of {n} inside) |")
+        centre = None if c.centre is None else getattr(term, c.centre)
+        threshold = f"≤ {tol:g}{unit}" if centre is None else f"in [{centre - tol:g}, {centre + tol:g}]{unit}"
+        statistic = (f"largest value of {nr}" if centre is None else
+                     f"largest distance from the centre {centre:g}{unit} of {nr}")
+        lines.append(f"| {c.label} | {threshold} | {statistic} | {format_number(worst)}{unit} | "
+                     f"{format_number(tol - worst)}{unit} | {'PASS' if inside == nr == n else 'FAIL'} ({inside} of {n} "
+                     f"inside) | {table_cell(sources.get(c.name, '—'))} |")
     limits = []
     if scenario is not None:
         try:
@@ -641,19 +656,24 @@ def _requirements(rows: dict, reached, stats: dict, scenario, verdict=None) -> s
         ok = m["violations"] == 0
         lines.append(f"| {lim.name} | {table_cell(lim.bound_text())} | worst flown sample of {flew} | {peak} | "
                      f"{100 * m['worst']:.2f} % (sample {m['worst_sample']}) | "
-                     f"{'PASS' if ok else 'FAIL'} ({flew - m['violations']} of {flew} held) |")
+                     f"{'PASS' if ok else 'FAIL'} ({flew - m['violations']} of {flew} held) | "
+                     f"{table_cell(sources.get(f'{lim.name}_limit', '—'))} |")
+    for requirement, why in (getattr(term, "departures", {}) or {}).items():
+        lines.append(f"| {table_cell(requirement)} | not judged | — | — | — | NOT JUDGED | "
+                     f"departure: {table_cell(' '.join(str(why).split()))} |")
     note = (f"A limit counts as held up to its value plus {100 * tolerance:g} % of it (the scenario's "
             "`terminal.path_limit_tolerance`), at every log sample and integrator step. PASS means every sample met "
             "the requirement; the statistic and the margin are those of the worst sample (margins relative to the "
             "limit). A bank margin of 0 % means the bank actuator reached the vehicle's bank limit, where it clips: "
-            "held, not breached.")
+            "held, not breached. The source column is the scenario's `terminal.requirement_sources` (— where it "
+            "names none); a requirement that departs from its source says so there.")
     verdict = ("A sample succeeds when it reached the terminal interface, ended inside every acceptance criterion "
                "and held every path limit at every log sample and integrator step.")
     limits_text = _limits_text(scenario)
     if limits_text:
         verdict += " Path limits: " + limits_text + "."
     return ("## Requirements\n\n" + verdict + "\n\n| requirement | threshold | statistic | campaign value | margin | "
-            "verdict |\n|---|---|---|---|---|---|\n" + "\n".join(lines) + "\n\n" + note)
+            "verdict | source |\n|---|---|---|---|---|---|---|\n" + "\n".join(lines) + "\n\n" + note)
 
 
 def _outcome(rows: dict, stats: dict, traj) -> str:
@@ -686,7 +706,25 @@ def _outcome(rows: dict, stats: dict, traj) -> str:
 MAX_FAILED_LISTED = 50
 
 
-def _distributions(rows: dict, quantities: dict, reached, stats: dict, reference) -> str:
+def aim_text(scenario) -> str:
+    """Where the guidance aims, as the statistics tables say it: 'the guidance's terminal
+    interface: altitude 26.5 km (a stop on altitude)' or '... energy of h_f = 26.5 km, V_f = 727
+    m/s (a stop on energy)'; '' when the scenario is unknown or states no interface."""
+    if scenario is None:
+        return ""
+    try:
+        h, V, _ = scenario.guidance_terminal_state()
+    except (DrakeEntryError, AttributeError, TypeError, ValueError):
+        return ""
+    g = scenario.guidance
+    datum = " geodetic" if scenario.altitude_datum == "ellipsoid" else ""
+    if getattr(g, "stops_at_altitude", False):
+        return f"altitude {g.terminal_altitude_km:g} km{datum} (the flight stops there), speed {V:.1f} m/s"
+    return (f"the energy of h_f = {g.terminal_altitude_km:g} km{datum}, V_f = {V:.1f} m/s (the flight stops there: at "
+            "that energy ΔV = -g Δh / V follows Δh)")
+
+
+def _distributions(rows: dict, quantities: dict, reached, stats: dict, reference, scenario=None) -> str:
     n_reached = int(reached.sum())
     head = ("| quantity | unit | N | min | P0.13 | P1 | P50 | mean | σ | P99 | P99.87 | max | "
             f"Wilks {100 * COVERAGE:g} %/{100 * CONFIDENCE:g} % |")
@@ -701,7 +739,7 @@ def _distributions(rows: dict, quantities: dict, reached, stats: dict, reference
             d = stats["distributions"][key]
             if d.get("n", 0) == 0:
                 continue
-            signed = key.startswith("err_") and key != "err_distance_m"
+            signed = key.startswith(("err_", "box_")) and key not in ("err_distance_m", "box_distance_error")
             bound = order_statistic_bound(np.abs(values) if signed else values)
             cells = [label + (" (bound on the absolute value)" if signed else ""), unit, str(d["n"])]
             cells += [format_number(d.get(k)) for k in ("min", "p0.13", "p1", "p50", "mean", "sigma", "p99", "p99.87", "max")]
@@ -716,8 +754,11 @@ def _distributions(rows: dict, quantities: dict, reached, stats: dict, reference
            f"distribution. The Wilks column is a distribution-free bound: with {runs_for_bound()} runs or more, the "
            f"largest value (or a lower order statistic) exceeds the {100 * COVERAGE:g} % quantile with "
            f"{100 * CONFIDENCE:g} % confidence.", "",
-           f"### Terminal errors ({n_reached} samples that reached the terminal interface)", "",
-           table([c for c, _, _ in ERROR_COLUMNS])]
+           f"### Terminal errors against the guidance's aim ({n_reached} samples that reached the terminal "
+           "interface)", "",
+           "The guidance aims at " + (aim_text(scenario) or "its terminal interface") + " over the target; "
+           "these errors say how well it hit its aim. The acceptance box judges against its own centre (its table below).",
+           "", table([c for c, _, _ in ERROR_COLUMNS])]
     if stats["errors"]:
         out += ["", errors_markdown(stats, reference), "",
                 "ΔR is the range to go along the final heading (+ short of the target); the cross-range is reported "
@@ -725,6 +766,12 @@ def _distributions(rows: dict, quantities: dict, reached, stats: dict, reference
         note = getattr(reference, "note", "") if reference is not None and reference.source else ""
         if note:
             out += ["", f"Why the figures differ from {reference.source}: {note}"]
+    box_keys = [f"box_{c.name}_error" for c in BOX_CRITERIA if f"box_{c.name}_error" in quantities]
+    if box_keys:
+        out += ["", f"### Terminal errors against the acceptance box's centre ({n_reached} samples that reached the "
+                "terminal interface)", "", "What the requirement table judges: each criterion's value less the box's "
+                "centre (the distance to the target as it is), in the box's units; a value beyond the criterion's "
+                "tolerance is outside the box.", "", table(box_keys)]
     out += ["", "### Peak path quantities, heat load and flight time (every sample that flew)", "",
             table([c for c, *_ in PEAK_QUANTITIES + OTHER_QUANTITIES])]
     if any(c in rows for c, *_ in CONTROL_QUANTITIES):

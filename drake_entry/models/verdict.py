@@ -171,21 +171,28 @@ BOX_CRITERIA = (
     BoxCriterion("flight_path", "terminal flight-path angle", "flight_path_deg", "flight_path_tolerance_deg",
                  math.pi / 180.0, "deg"),
     BoxCriterion("alpha", "terminal angle of attack", "alpha_deg", "alpha_tolerance_deg", math.pi / 180.0, "deg"),
+    BoxCriterion("vertical_speed", "terminal vertical speed", "vertical_speed_m_s", "vertical_speed_tolerance_m_s",
+                 1.0, "m/s"),
+    BoxCriterion("geodetic_altitude", "terminal geodetic altitude", "geodetic_altitude_km",
+                 "geodetic_altitude_tolerance_km", 1e3, "km"),
 )
 _CRITERIA = {c.name: c for c in BOX_CRITERIA}
 
 
 def acceptance_box(terminal, *, altitude_m: float, mach: float, distance_m: float, velocity_m_s: float = math.nan,
-                   flight_path_rad: float = math.nan, alpha_rad: float = math.nan) -> dict:
+                   flight_path_rad: float = math.nan, alpha_rad: float = math.nan, vertical_speed_m_s: float = math.nan,
+                   geodetic_altitude_m: float = math.nan) -> dict:
     """The mission's acceptance box (a scenario's TerminalSpec, paper 000 Table 1) at a final
     point: {criterion: {"error": e, "tolerance": tol, "inside": |e| <= tol}} (SI: m, m/s, rad;
     Mach) for each criterion of ``BOX_CRITERIA`` whose tolerance (and centre) is given:
     'altitude' about terminal.altitude_km (``altitude_m`` in the scenario's datum), 'mach',
-    'distance' to the target, 'velocity', 'flight_path' and 'alpha' about their values. The box
+    'distance' to the target, 'velocity', 'flight_path', 'alpha', 'vertical_speed' (V sin gamma)
+    and 'geodetic_altitude' about their values. The box
     is closed, up to ``ROUNDING`` (the degree-radian conversion's rounding at an edge); a
     criterion whose measured value is not given (nan) is never inside."""
     measured = {"altitude": altitude_m, "mach": mach, "distance": distance_m, "velocity": velocity_m_s,
-                "flight_path": flight_path_rad, "alpha": alpha_rad}
+                "flight_path": flight_path_rad, "alpha": alpha_rad, "vertical_speed": vertical_speed_m_s,
+                "geodetic_altitude": geodetic_altitude_m}
     box = {}
     for c in BOX_CRITERIA:
         tol = getattr(terminal, c.tolerance, None)

@@ -7,8 +7,8 @@ Same models and limits as the SCvx entry problem in its direct formulation (eqs.
 54-55): states [h, lon, lat, V, gamma, psi, alpha, sigma], controls their rates within the
 mission's and vehicle's rate limits, alpha and bank within their bounds, heat flux and total
 load at most the vehicle's limits and gamma within eq. 70's bounds along the path, and at the
-final node the DRS box: geodetic altitude window narrowed by the margin (eq. 64), Mach (eq. 65),
-vertical speed (eq. 66) and the site cone measured as the SCvx planner measures it (eqs. 67-68).
+final node the DRS box: geodetic altitude window narrowed by the margin (eq. 64), Mach (eq. 64),
+vertical speed (eq. 65) and the site cone measured as the SCvx planner measures it (eq. 69).
 """
 from __future__ import annotations
 

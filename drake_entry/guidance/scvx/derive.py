@@ -150,7 +150,7 @@ def derive(scenario) -> Derivation:
                         "(paper 001 eq. 64)")
     if not t.distance_tolerance_km:
         raise CannotFly("the mission's box gives no distance tolerance: SCvx plans into a cone about the site "
-                        "(paper 001 eqs. 67-68)")
+                        "(paper 001 eq. 69)")
     box_window = box_mach_window(scenario, interface)
     if box_window is not None:
         mach_window, mach_how = box_window

@@ -30,9 +30,9 @@ the vehicle's limit where it states one (paper 000 eq. 34; inactive rows otherwi
 the settings' path_margin),
 flight-path bounds (eq. 70); at the DRS point: geodetic altitude window (eq. 64, narrowed by
 the mission's final_altitude_margin_m), M_min a <= V <= M a
-(eq. 65; M_min 0 in paper 001, a TAEM box's lower Mach otherwise), V sin(gamma) >= V_v,min (eq. 66)
+(eq. 64; M_min 0 in paper 001, a TAEM box's lower Mach otherwise), V sin(gamma) >= V_v,min (eq. 65, linearised as eq. 66)
 and, where the mission sets one, V sin(gamma) <= V_v,max (not in paper 001: a glide's final
-descent made definite, so that the flight's altitude stop falls where the plan ends), and a cone ||miss|| <= site radius (eqs. 67-68)
+descent made definite, so that the flight's altitude stop falls where the plan ends), and a cone ||miss|| <= site radius (eq. 69)
 with a buffer. Hard bounds on the other states (eq. 70) and the fixed entry state.
 
 Objectives (paper 001 Table 2, ``OBJECTIVES``; the min-max ones through an epigraph variable
@@ -401,7 +401,7 @@ class EntryProblem(ConvexifiableProblem):
         return self.vehicle.bank_rate_limit * np.diff(self.mesh.s) * tf
 
     def site_miss(self, xf) -> float:
-        """Distance [m] of state xf from the site as the site cone measures it (eqs. 67-68)."""
+        """Distance [m] of state xf from the site as the site cone measures it (eq. 69)."""
         return self.planet.reference_radius * math.hypot(math.cos(self.site_lat) * (xf[1] - self.site_lon),
                                                          xf[2] - self.site_lat)
 
@@ -514,7 +514,7 @@ class EntryProblem(ConvexifiableProblem):
     # ----- convex constraints -------------------------------------------------------------
     def add_convex_constraints(self, prog, z):
         """|u_k| <= 1 at every node (eq. 42, lossless bank), the epigraph cones of the rate and
-        miss objectives, the site cone with its buffer (eqs. 67-68), and the lossless bank's
+        miss objectives, the site cone with its buffer (eq. 69), and the lossless bank's
         rate chords with theirs (module doc)."""
         U = z[self._u].reshape(-1, self.n_u)
         if self.formulation.bank == "lossless":

@@ -40,18 +40,18 @@ class ScvxMission:
       entry_speed_m_s, entry_flight_path_deg, entry_heading_deg: Earth-relative speed [m/s],
         flight-path angle and heading from north, clockwise [deg] at the EIP.
       site_longitude_deg, site_latitude_deg: landing site, geodetic latitude [deg].
-      site_radius_m: largest miss of the DRS point from the site [m] (eq. 68).
+      site_radius_m: largest miss of the DRS point from the site [m] (eq. 69).
       final_altitude_m: geodetic DRS altitude window [m] (eq. 64).
       final_altitude_margin_m: the plan keeps its DRS altitude this far inside final_altitude_m [m],
         a design margin (not the paper's: it plans to the window's edges) so that the flown
         point, within the plan's accuracy, stays inside the window; 0 plans to the edges; None
         (default): DEFAULT_DRS_ALTITUDE_MARGIN_M of the formulation's bank form
         (``drs_altitude_window``).
-      final_mach_max: largest DRS Mach number (eq. 65: subsonic).
+      final_mach_max: largest DRS Mach number (eq. 64: subsonic).
       final_mach_min: smallest DRS Mach number (0 in paper 001; a TAEM box's lower edge).
       flown_mach_margin: a plan's flown DRS point may exceed final_mach_max by this (0 in paper
         001): where the plan aims inside a narrower window than the mission's box checks.
-      final_vertical_speed_min_m_s: lowest V sin(gamma) at the DRS point [m/s] (eq. 66).
+      final_vertical_speed_min_m_s: lowest V sin(gamma) at the DRS point [m/s] (eq. 65).
       final_vertical_speed_max_m_s: highest V sin(gamma) there [m/s], or None (paper 001: none);
         planned, not checked on the flown DRS point (a design aim, not a box criterion).
       flight_path_bounds_deg: path bounds on gamma [deg] (eq. 70), buffered.

@@ -29,8 +29,8 @@ class Scvx(ReplanningSpec):
     # equatorial sphere); terminal_mach is not used to stop
     terminal_altitude_km: float = 10.5
     terminal_mach: float = 0.7
-    # DRS box: miss cone radius [m] (eq. 68), geodetic altitude window [m] (eq. 64) and the
-    # plan's design margin inside it [m], Mach (eq. 65), vertical speed [m/s] (eq. 66)
+    # DRS box: miss cone radius [m] (eq. 69), geodetic altitude window [m] (eq. 64) and the
+    # plan's design margin inside it [m], Mach (eq. 64), vertical speed [m/s] (eq. 65)
     site_radius_m: float = 10e3
     final_altitude_m: list[float] = dc.field(default_factory=lambda: [10e3, 13e3])
     # (None: the formulation's default, 1200 m for the lossless bank, 200 m for a bank state)

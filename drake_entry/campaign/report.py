@@ -27,6 +27,7 @@ import numpy as np
 
 from drake_entry.campaign import report_figures as figures
 from drake_entry.campaign.drivers import failure_drivers
+from drake_entry.campaign.sensitivity import pawn_sensitivity
 from drake_entry.campaign.rows import row_problem
 from drake_entry.campaign.statistics import (
     CONFIDENCE,
@@ -242,13 +243,16 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     quantities = _quantities(rows, reached, scenario)
     stats["distributions"] = {key: describe(values) for key, (_, _, values) in quantities.items()}
     stats["drivers"] = failure_drivers(rows)
+    stats["sensitivity"] = pawn_sensitivity(rows)
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
         json.dump(stats, f, indent=2)
     name = title or _name(meta)
     figs = _figures(rows, reached, traj, out_dir, scenario, limits, name, meta)
+    figs += [f for f in [_sensitivity_figure(rows, stats, out_dir, name)] if f is not None]
     sections = [_header(meta, stats, title, rows), _provenance(meta, stats), _dispersions(scenario),
                 _requirements(rows, reached, stats, scenario, verdict), _outcome(rows, stats, traj),
-                _distributions(rows, quantities, reached, stats, reference, scenario), _drivers(stats), _cost(stats),
+                _distributions(rows, quantities, reached, stats, reference, scenario), _drivers(stats), _sensitivity(stats),
+                _cost(stats),
                 figure_list(figs)]
     return write_markdown_report(sections, out_dir, title=name)
 
@@ -804,12 +808,96 @@ def _drivers(stats_: dict) -> str:
             cells.append(f"**{text}**" if c is not None and c[1] < d["level"] else text)
         lines.append(f"| {label(r['input'])} | " + " | ".join(cells) + " |")
     if d.get("failures"):
-        lines += ["", "Failed against successful samples (the inputs most associated with success; medians and the "
-                      "Mann-Whitney U test's p-value):", ""]
-        lines += [f"- {label(f['input'])}: median {format_number(f['median_failed'])} in the failed samples, "
-                  f"{format_number(f['median_successful'])} in the successful ones (ρ with success {f['rho']:+.2f}, "
-                  f"Mann-Whitney p = {f['mann_whitney_p']:.2g})" for f in d["failures"]]
+        level = d.get("input_level", 0.05)
+        lines += ["", "### Failed against successful samples", "",
+                  "Each input's values in the failed samples against the successful ones: the two-sample "
+                  "Kolmogorov-Smirnov test (any difference of distribution, so a failure mode at both tails of an "
+                  "input shows where a shift does not), the Mann-Whitney U test (a shift), and the failures counted "
+                  f"in the input's {len(d['failures'][0]['failed_by_quintile'])} quantile bins (equal sample counts, "
+                  f"lowest first). The three inputs with the smallest KS p-value; bold below the level {level:.2g} "
+                  "(0.05 over the inputs).", "",
+                  "| input | median failed / successful | KS D | KS p | Mann-Whitney p | failures by quintile |",
+                  "|---|---|---|---|---|---|"]
+        for f in d["failures"]:
+            p = f"{f['ks_p']:.2g}"
+            lines.append(f"| {label(f['input'])} | {format_number(f['median_failed'])} / "
+                         f"{format_number(f['median_successful'])} | {f['ks']:.2f} | "
+                         f"{f'**{p}**' if f['ks_p'] < level else p} | {f['mann_whitney_p']:.2g} | "
+                         f"{' · '.join(str(k) for k in f['failed_by_quintile'])} |")
+    if d.get("modes"):
+        lines += ["", "Failure modes (the failed samples grouped by why they failed; for a group of 3 or more, the "
+                      "input that separates it best from the successful samples):", ""]
+        for m in d["modes"]:
+            text = f"- {m['reason']}: {m['samples']} (samples {', '.join(str(i) for i in m['indices'])}"
+            text += ", …)" if m["samples"] > len(m["indices"]) else ")"
+            sep = m.get("separating")
+            if sep:
+                text += (f"; {label(sep['input'])}: median {format_number(sep['median_failed'])} against "
+                         f"{format_number(sep['median_successful'])} in the successful samples (KS p = "
+                         f"{sep['ks_p']:.2g}; by quintile {' · '.join(str(k) for k in sep['failed_by_quintile'])})")
+            lines.append(text)
     return "\n".join(lines)
+
+
+def _input_words(col: str) -> str:
+    return DISPERSION_LABELS.get(col, col.removeprefix("disp_"))
+
+
+#: the unit of each outcome column the sensitivity figures plot (margins: 1 - peak / limit)
+OUTCOME_UNITS = {col: unit for col, _, unit in ERROR_COLUMNS}
+
+
+def _outcome_words(col: str, words: str) -> str:
+    return f"{words} [{OUTCOME_UNITS.get(col, '1 - peak / limit')}]"
+
+
+def _sensitivity(stats_: dict) -> str:
+    """The PAWN table (campaign.sensitivity): each leading input's index on each outcome, bold
+    above the outcome's noise floor, the floors in the last row."""
+    d = stats_.get("sensitivity") or {}
+    if not d.get("inputs"):
+        return ""
+    outcomes = d["outcomes"]
+    lines = ["### How much each input shapes each outcome (PAWN)", "",
+             f"PAWN index (SALib): the median over {d['slices']} equal-probability slices of the input of the "
+             "Kolmogorov-Smirnov distance between the outcome's distribution and its distribution within the slice "
+             "(0: the outcome ignores the input; 1: the input alone decides it). Computed from this campaign's "
+             f"{d['samples']} samples, no special design; it sees non-monotonic effects that ρ misses. Bold: above "
+             f"the outcome's noise floor, the largest index of {d['dummies']} independent dummy inputs analysed "
+             "alongside (last row).", "",
+             "| input | " + " | ".join(w for _, w in outcomes) + " |", "|---" * (len(outcomes) + 1) + "|"]
+    for r in d["inputs"]:
+        cells = []
+        for col, _ in outcomes:
+            c = r["cells"].get(col)
+            text = "—" if c is None else f"{c[0]:.2f}"
+            cells.append(f"**{text}**" if c is not None and c[1] else text)
+        lines.append(f"| {_input_words(r['input'])} | " + " | ".join(cells) + " |")
+    lines.append("| *noise floor (dummies)* | " + " | ".join(
+        f"*{d['floors'][col]:.2f}*" if col in d["floors"] else "—" for col, _ in outcomes) + " |")
+    return "\n".join(lines)
+
+
+def _sensitivity_figure(rows: dict, stats_: dict, out_dir: str, title: str, panels: int = 3):
+    """report_figures.sensitivity_scatter of the ``panels`` strongest significant (input,
+    outcome) pairs of the PAWN table, one per input and one per outcome (an energy stop's speed
+    error mirrors its altitude error: a second panel of one input would repeat the first)."""
+    d = stats_.get("sensitivity") or {}
+    n = len(rows["index"])
+    words = dict((c, w) for c, w in d.get("outcomes", []))
+    order = {c: k for k, c in enumerate(words)}  # a tie goes to the outcome listed first
+    candidates = sorted(((index, r["input"], col) for r in d.get("inputs", [])
+                         for col, (index, significant) in r["cells"].items() if significant),
+                        key=lambda c: (-c[0], order[c[2]]))
+    chosen, used = [], set()
+    for index, inp, col in candidates:
+        if inp not in used and col not in used and len(chosen) < panels:
+            chosen.append((index, inp, col))
+            used |= {inp, col}
+    failed = np.array([not bool(v) for v in rows["success"]])
+    pairs = [(_input_words(inp), finite_column(rows, inp, n), _outcome_words(col, words[col]),
+              finite_column(rows, col, n), index, d["floors"][col], failed) for index, inp, col in chosen]
+    return figures.sensitivity_scatter(pairs, out_dir, title)
 
 
 def _cost(stats_: dict) -> str:

@@ -418,6 +418,31 @@ def convergence(est: dict, out_dir: str, title: str, *, miss: str | None = None,
                     "as 1/N.")
 
 
+def sensitivity_scatter(pairs: list, out_dir: str, title: str) -> tuple[str, str] | None:
+    """Each of ``pairs`` [(input words, input values, outcome words, outcome values, PAWN index,
+    noise floor, failed mask)] as a panel: the outcome against the input, failed samples red on
+    top; None without a pair."""
+    if not pairs:
+        return None
+    fig, axes = plt.subplots(1, len(pairs), figsize=(4.2 * len(pairs), 3.8), squeeze=False)
+    for ax, (x_words, x, y_words, y, index, floor, failed) in zip(axes[0], pairs):
+        x, y, failed = np.asarray(x, float), np.asarray(y, float), np.asarray(failed, bool)
+        ax.plot(x[~failed], y[~failed], "o", color="C0", ms=3, alpha=0.6, label=f"successful ({int((~failed).sum())})")
+        if failed.any():
+            ax.plot(x[failed], y[failed], "o", color="r", ms=4, label=f"failed ({int(failed.sum())})")
+        ax.set_xlabel(x_words)
+        ax.set_ylabel(y_words)
+        ax.set_title(f"PAWN {index:.2f} (noise floor {floor:.2f})", fontsize=9)
+        plain_axis(ax, "x")
+        plain_axis(ax, "y")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, loc="best")
+    path = _save(fig, out_dir, "sensitivity.png", title)
+    return path, ("The outcomes most shaped by one dispersed input, each against that input (PAWN index above the "
+                  "largest of the dummy inputs' indices, the noise floor), failed samples in red on top. Look at: "
+                  "where the failed samples sit along the input (a tail of it, or spread through it).")
+
+
 def energy_range(traj: dict) -> tuple[float, float]:
     """(E0, Ef) of ENERGY_DEFINITION: the highest and lowest energy stored [J/kg]."""
     E = np.asarray(traj["energy_J_kg"], float)

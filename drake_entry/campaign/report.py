@@ -27,8 +27,8 @@ import numpy as np
 
 from drake_entry.campaign import report_figures as figures
 from drake_entry.campaign.drivers import failure_drivers
-from drake_entry.campaign.sensitivity import pawn_sensitivity
 from drake_entry.campaign.rows import row_problem
+from drake_entry.campaign.sensitivity import pawn_sensitivity
 from drake_entry.campaign.statistics import (
     CONFIDENCE,
     COVERAGE,

@@ -105,6 +105,8 @@ def test_report_is_self_contained_with_provenance_requirements_and_bounds(tmp_pa
     assert "| bank reversals | - | 2 |" in text
     assert "Why the figures differ from paper 000 Table 3: This guidance re-plans the drag profile every 20 s" in text
     assert os.path.exists(f"{out}/nominal.json")  # the undispersed flight, overlaid on the envelopes
+    assert os.path.getsize(f"{out}/interactive.html") > 1e6  # plotly.js inline: it opens without a network
+    assert '<a href="interactive.html">Interactive view</a>' in open(f"{out}/report.html").read()
     assert "the dashed line the nominal flight (the scenario without dispersions)" in text
     figures = [line for line in text.splitlines() if line.startswith("*Figure ")]
     assert len(figures) == 9 and all(len(f) > 120 for f in figures)  # each with its caption

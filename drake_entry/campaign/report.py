@@ -27,6 +27,7 @@ import numpy as np
 
 from drake_entry.campaign import report_figures as figures
 from drake_entry.campaign.drivers import failure_drivers
+from drake_entry.campaign.interactive import INTERACTIVE, write_interactive
 from drake_entry.campaign.rows import row_problem
 from drake_entry.campaign.sensitivity import pawn_sensitivity
 from drake_entry.campaign.statistics import (
@@ -249,22 +250,25 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
     name = title or _name(meta)
     figs = _figures(rows, reached, traj, out_dir, scenario, limits, name, meta)
     figs += [f for f in [_sensitivity_figure(rows, stats, out_dir, name)] if f is not None]
+    write_interactive(out_dir, rows, traj, scenario, name, labels=DISPERSION_LABELS)
+    note = (f'<p><a href="{INTERACTIVE}">Interactive view</a>: the footprint and the margins linked; selecting '
+            "samples shows their trajectories and inputs (self-contained, beside this file).</p>")
     sections = [_header(meta, stats, title, rows), _provenance(meta, stats), _dispersions(scenario),
                 _requirements(rows, reached, stats, scenario, verdict), _outcome(rows, stats, traj),
                 _distributions(rows, quantities, reached, stats, reference, scenario), _drivers(stats), _sensitivity(stats),
                 _cost(stats),
                 figure_list(figs)]
-    return write_markdown_report(sections, out_dir, title=name)
+    return write_markdown_report(sections, out_dir, title=name, html_note=note)
 
 
-def write_markdown_report(sections: list, out_dir: str, *, title: str) -> str:
-    """report.md (the non-empty ``sections``, blank-line separated) and report.html in ``out_dir``;
-    returns the path of report.md."""
+def write_markdown_report(sections: list, out_dir: str, *, title: str, html_note: str = "") -> str:
+    """report.md (the non-empty ``sections``, blank-line separated) and report.html in ``out_dir``
+    (``html_note``: HTML put under its title only); returns the path of report.md."""
     md = "\n\n".join(section for section in sections if section) + "\n"
     path = os.path.join(out_dir, "report.md")
     with open(path, "w") as f:
         f.write(md)
-    write_html(md, out_dir, title=title)
+    write_html(md, out_dir, title=title, note=html_note)
     return path
 
 
@@ -977,11 +981,14 @@ def figure_list(figs: list) -> str:
     return "\n".join(out)
 
 
-def write_html(markdown_text: str, out_dir: str, *, title: str) -> str:
-    """report.html: the Markdown rendered (tables), every figure inline as a data URI."""
+def write_html(markdown_text: str, out_dir: str, *, title: str, note: str = "") -> str:
+    """report.html: the Markdown rendered (tables), every figure inline as a data URI; ``note``
+    (HTML) under the first heading."""
     import markdown
 
     body = markdown.markdown(markdown_text, extensions=["tables"])
+    if note:
+        body = body.replace("</h1>", "</h1>\n" + note, 1)
 
     def inline(match):
         src = match.group(1)

@@ -75,6 +75,21 @@ def test_a_worker_past_its_memory_budget_retires_and_a_new_one_takes_the_rest():
     assert len(rows) == 6 and len({r["pid"] for r in rows}) <= 2
 
 
+def test_a_serial_campaign_past_its_memory_budget_hands_the_rest_to_a_worker_process():
+    """This process runs the cases until it holds more than its budget after one, then one worker
+    process (retiring as the pool's do) takes every case left, none lost or repeated."""
+    from drake_entry.campaign.backends import run_serial
+
+    rows = []
+    cases = iter([{"index": i, "x": float(i)} for i in range(4)])  # a lazy iterable, as a campaign's
+    run_serial(PID_TOY, cases, lambda r, t: rows.append(r), memory_budget=0)
+    assert [r["index"] for r in rows] == [0, 1, 2, 3] and [r["y"] for r in rows] == [3.0 * i ** 2 for i in range(4)]
+    assert rows[0]["pid"] == os.getpid() and all(r["pid"] != os.getpid() for r in rows[1:])
+    rows.clear()  # within the budget every case stays here
+    run_serial(PID_TOY, [{"index": i, "x": float(i)} for i in range(3)], lambda r, t: rows.append(r))
+    assert {r["pid"] for r in rows} == {os.getpid()}
+
+
 def test_a_worker_that_dies_leaves_its_case_a_failed_row_and_the_campaign_goes_on(tmp_path):
     cases = [{"index": i, "x": x} for i, x in enumerate([1.0, 13.0, 2.0, 3.0])]
     run_cases(PID_TOY, cases, str(tmp_path), task_manifest(PID_TOY, cases), backend="processes", workers=2,

@@ -33,7 +33,7 @@ __all__ = ["main", "commands", "FAMILIES"]
 
 #: the command families, in the order of ``drake-entry --help`` (each a module with ``COMMANDS``)
 FAMILIES = ("drake_entry.cli.flights", "drake_entry.cli.campaigns", "drake_entry.cli.comparisons",
-            "drake_entry.cli.optimize")
+            "drake_entry.cli.publish", "drake_entry.cli.optimize")
 
 
 def commands() -> list[Command]:

@@ -28,7 +28,6 @@ STALE = {
     "paper002_guidance/report.md": "commit not recorded",
     "campaigns/horus2b/report.md": "made from 3661bc4 with uncommitted changes",
     "campaigns/shefex3_ampi/report.md": "made from 3661bc4 with uncommitted changes",
-    "campaigns/sphynx_paper001/report.md": "made from 28b5ace with uncommitted changes",
 }
 
 COMMIT = re.compile(r"commit ([0-9a-f]{7,40})(\+changes)?")

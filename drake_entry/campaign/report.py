@@ -795,22 +795,14 @@ def _drivers(stats_: dict) -> str:
     d = stats_.get("drivers") or {}
     if not d.get("inputs"):
         return ""
-    outcomes = d["outcomes"]
-    label = lambda col: DISPERSION_LABELS.get(col, col.removeprefix("disp_"))  # noqa: E731
+    label = _input_words
     lines = ["## What drives the misses and the failures", "",
              "Every dispersed input against every outcome by Spearman rank correlation ρ over the samples where both "
              "are finite (success counts 1, failure 0; a margin is 1 - peak / limit, so a negative ρ means the input "
              "eats the margin). The inputs with the largest |ρ| in any column are listed. A monotonic association, "
              "not a causal share: with many inputs some ρ are large by chance, so only the bold cells pass the "
-             f"Bonferroni level p < {d['level']:.2g} (0.05 over the number of cells).", "",
-             "| input | " + " | ".join(w for _, w in outcomes) + " |", "|---" * (len(outcomes) + 1) + "|"]
-    for r in d["inputs"]:
-        cells = []
-        for col, _ in outcomes:
-            c = r["cells"].get(col)
-            text = "—" if c is None else f"{c[0]:+.2f}"
-            cells.append(f"**{text}**" if c is not None and c[1] < d["level"] else text)
-        lines.append(f"| {label(r['input'])} | " + " | ".join(cells) + " |")
+             f"Bonferroni level p < {d['level']:.2g} (0.05 over the number of cells).", ""]
+    lines += _input_table(d, "+.2f", lambda c: c[1] < d["level"])
     if d.get("failures"):
         level = d.get("input_level", 0.05)
         lines += ["", "### Failed against successful samples", "",
@@ -847,6 +839,21 @@ def _input_words(col: str) -> str:
     return DISPERSION_LABELS.get(col, col.removeprefix("disp_"))
 
 
+def _input_table(d: dict, number: str, bold) -> list[str]:
+    """The header and one row per input of a drivers or sensitivity table ``d`` (its outcomes,
+    inputs and cells): each cell's first number in the format ``number``, bold where ``bold(cell)``."""
+    outcomes = d["outcomes"]
+    lines = ["| input | " + " | ".join(w for _, w in outcomes) + " |", "|---" * (len(outcomes) + 1) + "|"]
+    for r in d["inputs"]:
+        cells = []
+        for col, _ in outcomes:
+            c = r["cells"].get(col)
+            text = "—" if c is None else format(c[0], number)
+            cells.append(f"**{text}**" if c is not None and bold(c) else text)
+        lines.append(f"| {_input_words(r['input'])} | " + " | ".join(cells) + " |")
+    return lines
+
+
 #: the unit of each outcome column the sensitivity figures plot (margins: 1 - peak / limit)
 OUTCOME_UNITS = {col: unit for col, _, unit in ERROR_COLUMNS}
 
@@ -868,15 +875,8 @@ def _sensitivity(stats_: dict) -> str:
              "(0: the outcome ignores the input; 1: the input alone decides it). Computed from this campaign's "
              f"{d['samples']} samples, no special design; it sees non-monotonic effects that ρ misses. Bold: above "
              f"the outcome's noise floor, the largest index of {d['dummies']} independent dummy inputs analysed "
-             "alongside (last row).", "",
-             "| input | " + " | ".join(w for _, w in outcomes) + " |", "|---" * (len(outcomes) + 1) + "|"]
-    for r in d["inputs"]:
-        cells = []
-        for col, _ in outcomes:
-            c = r["cells"].get(col)
-            text = "—" if c is None else f"{c[0]:.2f}"
-            cells.append(f"**{text}**" if c is not None and c[1] else text)
-        lines.append(f"| {_input_words(r['input'])} | " + " | ".join(cells) + " |")
+             "alongside (last row).", ""]
+    lines += _input_table(d, ".2f", lambda c: c[1])
     lines.append("| *noise floor (dummies)* | " + " | ".join(
         f"*{d['floors'][col]:.2f}*" if col in d["floors"] else "—" for col, _ in outcomes) + " |")
     return "\n".join(lines)

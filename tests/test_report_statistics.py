@@ -167,7 +167,10 @@ def test_a_cloud_in_separate_arms_has_several_modes_and_no_normal_ellipse(tmp_pa
     _, caption = footprint(arms[0], arms[1], str(tmp_path), "arms", radius_km=5.0)
     assert "No normal ellipse: the cloud is not one cluster (3 modes" in caption
     _, caption = footprint(*rng.normal(size=(2, 300)), str(tmp_path), "normal", radius_km=5.0)
-    assert "The ellipse holds 99 % of a normal distribution" in caption
+    assert "The ellipse holds 99 % of a normal distribution" in caption and "red crosses" not in caption
+    failed = np.arange(300) % 50 == 0
+    _, caption = footprint(*rng.normal(size=(2, 300)), str(tmp_path), "normal", radius_km=5.0, failed=failed)
+    assert "the 6 not successful drawn as red crosses on top" in caption
 
 
 def test_path_figure_draws_failed_samples_on_top_and_the_total_load_where_limited(tmp_path):

@@ -924,8 +924,10 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
         distance = tuple(f"{label} [{unit}]" for col, label, unit in ERROR_COLUMNS if col == "err_distance_m")
         figs.append(figures.error_histograms(errors, out_dir, title, nonnegative=distance))
         radius = getattr(getattr(scenario, "terminal", None), "distance_tolerance_km", None)
+        not_successful = np.array([not bool(v) for v in rows["success"]])[reached]
         figs.append(figures.footprint(finite_column(rows, "err_crossrange_m", n)[reached] / 1e3,
-                                      finite_column(rows, "err_range_m", n)[reached] / 1e3, out_dir, title, radius_km=radius))
+                                      finite_column(rows, "err_range_m", n)[reached] / 1e3, out_dir, title,
+                                      radius_km=radius, failed=not_successful))
     peaks = {f"{label} [{unit}]": (finite_column(rows, col, n) * scale,
                                    getattr(limits, lim) * scale if limits is not None else None)
              for col, label, unit, scale, lim in PEAK_QUANTITIES if col in rows}

@@ -95,13 +95,19 @@ def error_histograms(errors: dict, out_dir: str, title: str, *, nonnegative: tup
                      if nonnegative else "") + ". Look for skew and outliers beyond the dashed lines.")
 
 
-def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float | None) -> tuple[str, str]:
-    """Cross-range against range to go [km] of the reached samples, centred on the target."""
+def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float | None,
+              failed=None) -> tuple[str, str]:
+    """Cross-range against range to go [km] of the reached samples, centred on the target; the
+    samples ``failed`` marks (not successful: outside the box or past a limit) in red on top."""
     x, y = np.asarray(cross_km, float), np.asarray(range_km, float)
+    bad = np.zeros(x.size, bool) if failed is None else np.asarray(failed, bool)
     ok = np.isfinite(x) & np.isfinite(y)
-    x, y = x[ok], y[ok]
+    x, y, bad = x[ok], y[ok], bad[ok]
     fig, ax = plt.subplots(figsize=(6.4, 6.0))
-    ax.plot(x, y, ".", ms=4, color="C0", label=f"samples (N = {x.size})")
+    ax.plot(x[~bad], y[~bad], ".", ms=4, color="C0", label=f"successful ({int((~bad).sum())})")
+    if bad.any():
+        ax.plot(x[bad], y[bad], "x", ms=7, mew=1.5, color="r", zorder=5,
+                label=f"not successful ({int(bad.sum())}: outside the box or past a limit)")
     ax.plot(0.0, 0.0, "r*", ms=14, label="target")
     t = np.linspace(0.0, 2.0 * np.pi, 300)
     circle = np.vstack([np.cos(t), np.sin(t)])
@@ -130,11 +136,13 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
     ax.set_aspect("equal")
     ax.set_xlabel("cross-range [km] (+ right of the final heading)")
     ax.set_ylabel("range to go [km] (+ short of the target)")
-    ax.legend(fontsize=8, loc="upper right")
+    ax.legend(fontsize=8, loc="best", framealpha=0.8)  # where it hides the fewest samples
     ax.grid(True, alpha=0.4)
     path = _save(fig, out_dir, "footprint.png", title)
     caption = (f"Terminal footprint of the {x.size} samples that reached the terminal interface, centred on the "
-               "target, equal axes. "
+               "target, equal axes" + (f"; the {int(bad.sum())} not successful drawn as red crosses on top (a cross "
+                                       "inside the acceptance region breached a path limit)" if bad.any() else "")
+               + ". "
                + ("The ellipse holds 99 % of a normal distribution with the sample's mean and covariance (k = 3.035σ "
                   "in 2-D)" if modes == 1 else
                   f"No normal ellipse: the cloud is not one cluster ({modes} modes of its kernel density along a "

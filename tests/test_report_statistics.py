@@ -180,6 +180,7 @@ def test_path_figure_draws_failed_samples_on_top_and_the_total_load_where_limite
 
     from drake_entry.campaign.report_figures import path_quantities
     from drake_entry.figures import plt
+    from drake_entry.models.verdict import PathLimit
 
     t = np.linspace(0.0, 1.0, 20)
     traj = {"sample": [0] * 20 + [1] * 20, "energy_J_kg": list(-t) * 2,
@@ -187,12 +188,13 @@ def test_path_figure_draws_failed_samples_on_top_and_the_total_load_where_limite
             "normal_load_g": list(t) * 2, "total_load_g": list(1.1 * t) * 2}
     limits = types.SimpleNamespace(dynamic_pressure_max=2e4, heat_flux_max=5e5, normal_load_max=2.5,
                                    total_load_max=2.0)
-    figures = []
+    figures, made = [], []
     real_subplots = plt.subplots
 
     def counting(*a, **k):
         fig, axes = real_subplots(*a, **k)
         figures.append(len(np.atleast_1d(axes)))
+        made.append(np.atleast_1d(axes))
         return fig, axes
 
     plt.subplots = counting
@@ -200,7 +202,16 @@ def test_path_figure_draws_failed_samples_on_top_and_the_total_load_where_limite
         _, caption = path_quantities(traj, str(tmp_path), "t", limits, failed=[1, 7])
         limits.total_load_max = math.inf
         path_quantities(traj, str(tmp_path), "t", limits)
+        # a mission's bound on a state (paper 001's flight-path bounds) gets a panel of its own
+        traj["flight_path_deg"] = list(-31.0 * t) * 2
+        gamma = PathLimit("flight_path", "gamma", upper=math.radians(0.5), lower=math.radians(-30.0), unit="deg",
+                          scale=180.0 / math.pi)
+        path_quantities(traj, str(tmp_path), "t", limits, mission_limits=[gamma], failed=[1])
+        axes = made[-1]
     finally:
         plt.subplots = real_subplots
     assert "not successful in red, on top: 1" in caption and "of the 2 stored trajectories" in caption
-    assert figures == [4, 3]
+    assert figures == [4, 3, 4]
+    bounds = sorted(line.get_ydata()[0] for line in axes[-1].get_lines() if line.get_linestyle() == ":")
+    assert bounds == pytest.approx([-30.0, 0.5]) and axes[-1].get_ylabel() == "flight path [deg]"
+    assert min(axes[-1].get_lines()[1].get_ydata()) == pytest.approx(-31.0)  # the failed dive, past -30

@@ -103,7 +103,7 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
     bad = np.zeros(x.size, bool) if failed is None else np.asarray(failed, bool)
     ok = np.isfinite(x) & np.isfinite(y)
     x, y, bad = x[ok], y[ok], bad[ok]
-    fig, ax = plt.subplots(figsize=(6.4, 6.0))
+    fig, ax = plt.subplots(figsize=(6.4, 7.2))
     ax.plot(x[~bad], y[~bad], ".", ms=4, color="C0", label=f"successful ({int((~bad).sum())})")
     if bad.any():
         ax.plot(x[bad], y[bad], "x", ms=7, mew=1.5, color="r", zorder=5,
@@ -136,7 +136,7 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
     ax.set_aspect("equal")
     ax.set_xlabel("cross-range [km] (+ right of the final heading)")
     ax.set_ylabel("range to go [km] (+ short of the target)")
-    ax.legend(fontsize=8, loc="best", framealpha=0.8)  # where it hides the fewest samples
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=2)  # below: it hides no sample
     ax.grid(True, alpha=0.4)
     path = _save(fig, out_dir, "footprint.png", title)
     caption = (f"Terminal footprint of the {x.size} samples that reached the terminal interface, centred on the "
@@ -236,12 +236,18 @@ def envelopes(traj: dict, out_dir: str, title: str, *, nominal: dict | None = No
 OFF_SCALE = 3.0
 
 
+#: a mission path limit's state column -> (the stored trajectory's column, its factor to the
+#: limit's display unit): such a limit gets a panel of its own in path_quantities
+STATE_COLUMNS = {"gamma": ("flight_path_deg", 1.0)}
+
+
 def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits=(),
                     failed=()) -> tuple[str, str]:
     """Dynamic pressure, heat flux and normal load (and the total load where the vehicle limits
     it) against normalised energy, every sample, the ``failed`` samples (indices) drawn on top in
     red; the vehicle's limits (``limits``) dashed and the mission's (``mission_limits``:
-    PathLimits on the same quantities, e.g. a lower bound on q) dotted, each labelled."""
+    PathLimits on the same quantities, e.g. a lower bound on q, or on a state of STATE_COLUMNS,
+    e.g. paper 001's flight-path bounds, in a panel of its own) dotted, each labelled."""
     sample = np.asarray(traj["sample"])
     e = normalised_energy(traj)
     ids = np.unique(sample)
@@ -253,6 +259,10 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits
               ("normal_load_g", "normal_load", 1.0, "normal load [g]", "normal_load_max", "g")]
     if limits is not None and np.isfinite(getattr(limits, "total_load_max", np.inf)) and "total_load_g" in traj:
         panels.append(("total_load_g", "total_load", 1.0, "total load [g]", "total_load_max", "g"))
+    for m in mission_limits:  # a mission's limit on a state (paper 001's flight-path bounds): its own panel
+        col = STATE_COLUMNS.get(m.column)
+        if col is not None and col[0] in traj and all(p[1] != m.column for p in panels):
+            panels.append((col[0], m.column, col[1], f"{m.name.replace('_', ' ')} [{m.unit}]", None, m.unit))
     fig, axes = plt.subplots(1, len(panels), figsize=(4.7 * len(panels), 4.0))
     for ax, (col, quantity, scale, label, lim, unit) in zip(axes, panels):
         v = np.asarray(traj[col], float) * scale
@@ -261,19 +271,22 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits
         for k, g in enumerate(bad):
             ax.plot(e[g], v[g], lw=0.9, alpha=0.9, color="C3", label=f"not successful ({len(bad)})" if k == 0 else None)
         top = float(np.nanmax(v)) if v.size else 0.0
-        value = getattr(limits, lim, None) if limits is not None else None
+        value = getattr(limits, lim, None) if limits is not None and lim is not None else None
         lines = [] if value is None or not np.isfinite(value) else [(value * scale, f"vehicle limit {value * scale:g} {unit}",
                                                                        "--")]
         for m in mission_limits:
             if m.column == quantity:
-                for bound in (m.lower, m.upper):  # SI, as the columns before ``scale``
+                for bound in (m.lower, m.upper):  # SI; a state's panel shows the display unit (m.scale)
                     if np.isfinite(bound):
-                        lines.append((bound * scale, f"{m.name} {m.bound_text()}", ":"))
+                        y = bound * (m.scale if quantity in STATE_COLUMNS else scale)
+                        lines.append((y, f"{m.name} {m.bound_text()}", ":"))
+        named = set()
         for y, text, style in lines:
-            if top > 0 and y > OFF_SCALE * top:
+            if quantity not in STATE_COLUMNS and top > 0 and y > OFF_SCALE * top:
                 ax.plot([], [], " ", label=f"{text} (off scale)")
             else:
-                ax.axhline(y, color="r", ls=style, lw=1.2, label=text)
+                ax.axhline(y, color="r", ls=style, lw=1.2, label=None if text in named else text)
+            named.add(text)
         if lines or bad:
             ax.legend(fontsize=8)
         ax.set_xlabel(ENERGY_AXIS)
@@ -283,7 +296,8 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits
     return path, (f"Path quantities of the {len(groups) + len(bad)} stored trajectories against normalised energy (one "
                   "line per sample, at the storage step: the peaks between stored points are in the peak histograms"
                   + (f"; not successful in red, on top: {len(bad)}" if bad else "") + "), the "
-                  "vehicle's limits dashed and the mission's dotted (a limit more than "
+                  "vehicle's limits dashed and the mission's dotted (a mission's limit on a state, such as the "
+                  "flight-path bounds, in a panel of its own; a limit more than "
                   f"{OFF_SCALE:g} times the largest flown value is named in the legend, not drawn). {ENERGY_DEFINITION}.")
 
 

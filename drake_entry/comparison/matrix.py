@@ -15,27 +15,18 @@ import json
 import os
 import shutil
 
-from scipy import stats as scipy_stats
-
+from drake_entry.campaign.statistics import success_lower_bound
 from drake_entry.campaign.store import write_atomic
 from drake_entry.comparison.report import derivation_tables, read_comparison_manifest
 from drake_entry.errors import CampaignError
 
-__all__ = ["LEVEL", "DERIVATIONS", "success_lower_bound", "read_comparison", "matrix_markdown", "write_derivations",
+__all__ = ["LEVEL", "DERIVATIONS", "read_comparison", "matrix_markdown", "write_derivations",
            "write_matrix"]
 
 #: the one-sided confidence of the success bound
 LEVEL = 0.90
 #: the folder, beside the matrix, of each mission's derivation page and flown scenarios
 DERIVATIONS = "derivations"
-
-
-def success_lower_bound(successes: int, runs: int, level: float = LEVEL) -> float:
-    """The one-sided ``level`` lower Clopper-Pearson bound on a success probability."""
-    if runs <= 0:
-        return 0.0
-    test = scipy_stats.binomtest(int(successes), int(runs), alternative="greater")
-    return float(test.proportion_ci(confidence_level=level, method="exact").low)
 
 
 def read_comparison(folder: str) -> dict:
@@ -69,7 +60,7 @@ def _cell(m: dict) -> str:
         first = short.split(";")[0].split(" (")[0]
         return "not flown: " + (first if len(first) <= 90 else first[:90].rsplit(" ", 1)[0] + " ...")
     k, n = s["successful"], s["samples"]
-    text = f"**{k}/{n}** (>= {100 * success_lower_bound(k, n):.0f} %)"
+    text = f"**{k}/{n}** (>= {100 * (success_lower_bound(k, n, LEVEL) if n else 0.0):.0f} %)"
     miss = s.get("miss_km")
     if miss:
         text += f", miss {miss['median']:.3g} / {miss['p95']:.3g} km"

@@ -15,18 +15,24 @@ import json
 import os
 import shutil
 
-from drake_entry.campaign.statistics import success_lower_bound
+from drake_entry.campaign import statistics
 from drake_entry.campaign.store import write_atomic
 from drake_entry.comparison.report import derivation_tables, read_comparison_manifest
 from drake_entry.errors import CampaignError
 
-__all__ = ["LEVEL", "DERIVATIONS", "read_comparison", "matrix_markdown", "write_derivations",
+__all__ = ["LEVEL", "DERIVATIONS", "success_lower_bound", "read_comparison", "matrix_markdown", "write_derivations",
            "write_matrix"]
 
 #: the one-sided confidence of the success bound
 LEVEL = 0.90
 #: the folder, beside the matrix, of each mission's derivation page and flown scenarios
 DERIVATIONS = "derivations"
+
+
+def success_lower_bound(successes: int, runs: int, level: float = LEVEL) -> float:
+    """The matrix's bound: the one-sided ``level`` lower Clopper-Pearson bound on a success
+    probability (campaign.statistics.success_lower_bound), 0 for a cell of no runs."""
+    return statistics.success_lower_bound(successes, runs, level) if runs > 0 else 0.0
 
 
 def read_comparison(folder: str) -> dict:
@@ -60,7 +66,7 @@ def _cell(m: dict) -> str:
         first = short.split(";")[0].split(" (")[0]
         return "not flown: " + (first if len(first) <= 90 else first[:90].rsplit(" ", 1)[0] + " ...")
     k, n = s["successful"], s["samples"]
-    text = f"**{k}/{n}** (>= {100 * (success_lower_bound(k, n, LEVEL) if n else 0.0):.0f} %)"
+    text = f"**{k}/{n}** (>= {100 * success_lower_bound(k, n):.0f} %)"
     miss = s.get("miss_km")
     if miss:
         text += f", miss {miss['median']:.3g} / {miss['p95']:.3g} km"

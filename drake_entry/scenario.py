@@ -71,7 +71,7 @@ class TerminalSpec:
     flight_path_tolerance_deg: Optional[float] = None
     alpha_deg: Optional[float] = None
     alpha_tolerance_deg: Optional[float] = None
-    # terminal vertical speed V sin(gamma) [m/s] and its window (+- m/s), e.g. paper 001 eq. 66
+    # terminal vertical speed V sin(gamma) [m/s] and its window (+- m/s), e.g. paper 001 eq. 65
     vertical_speed_m_s: Optional[float] = None
     vertical_speed_tolerance_m_s: Optional[float] = None
     # terminal geodetic altitude [km] and its window (+- km), whatever the scenario's altitude
@@ -348,9 +348,7 @@ class Scenario:
             planet = self.make_planet().with_(j2=0.0)
             check_range("terminal.energy_MJ_kg", t.energy_MJ_kg, planet.specific_energy(0.0, 0.0) / 1e6,
                         self.entry_energy() / 1e6)
-        for name in ("altitude_tolerance_km", "mach_tolerance", "distance_tolerance_km", "velocity_tolerance_m_s",
-                     "flight_path_tolerance_deg", "alpha_tolerance_deg", "vertical_speed_tolerance_m_s",
-                     "geodetic_altitude_tolerance_km"):
+        for name in (c.tolerance for c in BOX_CRITERIA):  # every criterion's window, >= 0
             if getattr(t, name) is not None:
                 check_range(f"terminal.{name}", getattr(t, name), 0.0, 1e5)
         if t.flight_path_deg is not None:

@@ -124,10 +124,9 @@ def _failure_modes(rows: dict, n: int, inputs: list, success) -> list:
     report.failure_categories' form: the message's first clause), each group of at least
     MIN_MODE samples with the input that separates it best from the successful samples
     (smallest Kolmogorov-Smirnov p-value)."""
-    reasons = [_reason(rows, i) for i in range(n)]
     groups: dict = {}
     for i in np.flatnonzero(~success):
-        groups.setdefault(reasons[i], []).append(i)
+        groups.setdefault(_reason(rows, i), []).append(i)
     modes = []
     for reason, members in sorted(groups.items(), key=lambda kv: -len(kv[1])):
         mask = np.zeros(n, bool)

@@ -795,7 +795,6 @@ def _drivers(stats_: dict) -> str:
     d = stats_.get("drivers") or {}
     if not d.get("inputs"):
         return ""
-    label = _input_words
     lines = ["## What drives the misses and the failures", "",
              "Every dispersed input against every outcome by Spearman rank correlation ρ over the samples where both "
              "are finite (success counts 1, failure 0; a margin is 1 - peak / limit, so a negative ρ means the input "
@@ -816,7 +815,7 @@ def _drivers(stats_: dict) -> str:
                   "|---|---|---|---|---|---|"]
         for f in d["failures"]:
             p = f"{f['ks_p']:.2g}"
-            lines.append(f"| {label(f['input'])} | {format_number(f['median_failed'])} / "
+            lines.append(f"| {_input_words(f['input'])} | {format_number(f['median_failed'])} / "
                          f"{format_number(f['median_successful'])} | {f['ks']:.2f} | "
                          f"{f'**{p}**' if f['ks_p'] < level else p} | {f['mann_whitney_p']:.2g} | "
                          f"{' · '.join(str(k) for k in f['failed_by_quintile'])} |")
@@ -828,7 +827,7 @@ def _drivers(stats_: dict) -> str:
             text += ", …)" if m["samples"] > len(m["indices"]) else ")"
             sep = m.get("separating")
             if sep:
-                text += (f"; {label(sep['input'])}: median {format_number(sep['median_failed'])} against "
+                text += (f"; {_input_words(sep['input'])}: median {format_number(sep['median_failed'])} against "
                          f"{format_number(sep['median_successful'])} in the successful samples (KS p = "
                          f"{sep['ks_p']:.2g}; by quintile {' · '.join(str(k) for k in sep['failed_by_quintile'])})")
             lines.append(text)

@@ -48,8 +48,9 @@ def pawn_sensitivity(rows: dict, top: int = 8) -> dict:
     dummies = np.random.default_rng(DUMMY_SEED).uniform(size=(n, DUMMIES))
     cells: dict = {col: {} for col, _ in inputs}
     floors, analysed = {}, []
+    inputs_finite = np.all([np.isfinite(x) for _, x in inputs], axis=0)
     for out_col, words, y in outcomes:
-        ok = np.isfinite(y) & np.all([np.isfinite(x) for _, x in inputs], axis=0)
+        ok = np.isfinite(y) & inputs_finite
         if ok.sum() < MIN_SENSITIVITY_SAMPLES:
             continue
         ranks = np.column_stack([sps.rankdata(x[ok]) / ok.sum() for _, x in inputs] + [dummies[ok]])

@@ -98,6 +98,7 @@ class SuccessRequirementSpec:
 
     probability: Optional[float] = None  # e.g. 0.9973 (3 sigma); in (0, 1)
     confidence: float = 0.9  # of the one-sided Clopper-Pearson lower bound; in (0.5, 1)
+    source: Optional[str] = None  # where the required probability comes from (the report's source column)
 
     def validate(self) -> None:
         """Each field in its range (ScenarioError naming it); an unstated probability passes."""
@@ -105,6 +106,8 @@ class SuccessRequirementSpec:
             raise ScenarioError(f"success_requirement.probability = {self.probability}: allowed in (0, 1), e.g. 0.9973")
         if not 0.5 < self.confidence < 1.0:
             raise ScenarioError(f"success_requirement.confidence = {self.confidence}: allowed in (0.5, 1), e.g. 0.9")
+        if self.source is not None and not str(self.source).strip():
+            raise ScenarioError("success_requirement.source is empty: say where the required probability comes from")
 
 
 @dc.dataclass

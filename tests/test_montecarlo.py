@@ -8,7 +8,7 @@ import pytest
 
 from drake_entry.campaign.montecarlo import TIMING_COLUMNS, done_indices, run_campaign, run_sample, sample_seed
 from drake_entry.campaign.report import summary_statistics, write_report
-from drake_entry.campaign.sample import DETAILED_SAMPLES, DETAILED_STEP_S
+from drake_entry.campaign.sample import DETAILED_SAMPLES, DETAILED_STEP_S, EXTREME_COLUMNS, PEAK_COLUMNS
 from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 from drake_entry.errors import CampaignError
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
@@ -30,7 +30,10 @@ def test_a_sample_rerun_alone_reproduces_its_row_bit_for_bit(horus):
     assert sample_seed(11, 5) != sample_seed(11, 6) != sample_seed(12, 5)
     _, traj = run_sample(horus, 11, DETAILED_SAMPLES, trajectory_step_s=10.0)
     t = np.asarray(traj["time_s"])
-    assert np.allclose(np.diff(t)[:-1], 10.0) and t[-1] > 1000.0  # every 10 s, then the final instant
+    grid = np.arange(0.0, t[-1], 10.0)  # every 10 s, the final instant, and each flight's peaks (log samples)
+    assert np.isin(grid, t).all() and t[-1] > 1000.0 and np.all(np.diff(t) > 0)
+    extra = t[~np.isin(t, grid)][:-1]
+    assert extra.size <= len(PEAK_COLUMNS) + 2 * len(EXTREME_COLUMNS)
 
 
 def test_a_failing_sample_is_recorded_with_its_reason(horus):

@@ -78,7 +78,21 @@ def test_until_confident_runs_in_batches_until_the_requirement_is_shown(tmp_path
 
 
 def test_until_confident_needs_a_stated_requirement(tmp_path, capsys):
-    assert main(["campaign", "horus2b", "--runs", "2", "--until-confident", "--out", str(tmp_path / "c")]) != 0
+    assert main(["campaign", "horus2b", "--runs", "2", "--until-confident", "--set", "success_requirement.probability=null",
+                 "--out", str(tmp_path / "c")]) != 0
     assert ("horus2b: running until confident needs the scenario's success_requirement.probability (e.g. 0.9973"
             in capsys.readouterr().err)
     assert not os.path.exists(tmp_path / "c")  # refused before any sample
+
+
+def test_a_packaged_campaign_too_small_to_judge_its_3_sigma_requirement_says_so_and_exits_zero(tmp_path, capsys):
+    """horus2b requires 99.73 % at 90 % (the project's 3-sigma requirement, its source named): 2
+    successful runs leave it OPEN (850 more successful runs would show it: 852 in all), which is
+    not a failure (exit 0); the report's requirement row names the source."""
+    out = str(tmp_path / "c")
+    assert main(["campaign", "horus2b", "--runs", "2", "--workers", "1", "--trajectory-step", "0", "--out", out]) == 0
+    err = capsys.readouterr().err
+    assert "the success requirement is not shown: OPEN: 2 of 2 successful" in err and "850 more runs" in err
+    required = json.load(open(os.path.join(out, "summary.json")))["success_requirement"]
+    assert required["status"] == "OPEN" and required["more_runs"] == 850
+    assert "Hanson & Beard, NASA/TP-2010-216447" in open(os.path.join(out, "report.md")).read()

@@ -317,3 +317,21 @@ def test_the_requirement_table_names_each_source_and_lists_the_departures_not_ju
     assert "| distance to the target | ≤ 25 km | largest value of 2 | 2 km | 23 km | PASS (2 of 2 inside) | departure: " in text
     assert ("| terminal speed in [570, 620] m/s (paper 003 Table 1) | not judged | — | — | — | NOT JUDGED | departure: "
             "the packaged database's references end at the window's 620 m/s corner") in text
+
+
+def test_the_stored_trajectory_keeps_each_flights_peaks_between_its_storage_points():
+    """A campaign stores a flight every 10 s (campaign.sample.downsample); a heat-flux pulse
+    peaking at t = 13 s and a flight-path dip to -31 deg at t = 27 s, both between storage points,
+    are kept at their log samples, so the path figure's line reaches them; without them the
+    stored maxima would be 0.5 q_max and -5 deg."""
+    from drake_entry.campaign.sample import downsample
+
+    t = np.arange(0.0, 41.0, 1.0)
+    heat = 1e5 * (1.0 + 0.5 * (t == 13.0)) * np.where(t == 13.0, 2.0, 0.5)
+    gamma = np.radians(np.where(t == 27.0, -31.0, -5.0))
+    stored = downsample(_trajectory(t, heat, gamma=gamma), 7, 10.0)
+    assert stored["time_s"] == [0.0, 10.0, 13.0, 20.0, 27.0, 30.0, 40.0]
+    assert max(stored["heat_flux_W_m2"]) == pytest.approx(3e5) and min(stored["flight_path_deg"]) == pytest.approx(-31.0)
+    assert set(stored["sample"]) == {7}
+    plain = downsample(_trajectory(t, np.full(t.size, 1e5), gamma=np.full(t.size, -0.1)), 0, 10.0)
+    assert plain["time_s"][:2] == [0.0, 10.0] and plain["time_s"][-1] == 40.0  # nothing added when flat: ties at 0

@@ -617,10 +617,11 @@ def _requirements(rows: dict, reached, stats: dict, scenario, verdict=None) -> s
     lines = []
     sources = dict(getattr(scenario.terminal, "requirement_sources", {}) or {}) if scenario is not None else {}
     if verdict is not None:
+        source = scenario.success_requirement.source or "the scenario's `success_requirement`"
         lines.append(f"| success probability | {verdict.required} | one-sided Clopper-Pearson lower bound of "
                      f"{verdict.successes} of {verdict.runs} | {100 * verdict.lower:.3f} % | "
-                     f"{100 * (verdict.lower - verdict.probability):+.3f} % | {verdict.text()} | the scenario's "
-                     "`success_requirement` |")
+                     f"{100 * (verdict.lower - verdict.probability):+.3f} % | {verdict.text()} | "
+                     f"{source} |")
     term = scenario.terminal if scenario is not None else None
     lines.append(f"| reach the terminal interface | every sample | count | {nr} of {n} | — | "
                  f"{'PASS' if nr == n else 'FAIL'} | the verdict's |")

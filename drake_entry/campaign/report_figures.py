@@ -294,7 +294,9 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits
         ax.grid(True, alpha=0.4)
     path = _save(fig, out_dir, "path_quantities.png", title)
     return path, (f"Path quantities of the {len(groups) + len(bad)} stored trajectories against normalised energy (one "
-                  "line per sample, at the storage step: the peaks between stored points are in the peak histograms"
+                  "line per sample, at the storage step and at each flight's peaks of these quantities and extremes of "
+                  "the flight-path angle, taken at the log period: a line's top is its flight's peak; the peaks "
+                  "between log samples, at the integrator's steps, are in the peak histograms"
                   + (f"; not successful in red, on top: {len(bad)}" if bad else "") + "), the "
                   "vehicle's limits dashed and the mission's dotted (a mission's limit on a state, such as the "
                   "flight-path bounds, in a panel of its own; a limit more than "

@@ -24,7 +24,8 @@ from drake_entry.scenario import scenario_from_dump
 from drake_entry.systems.native_plant import as_flight_error
 
 __all__ = ["TRAJECTORY_STEP_S", "DETAILED_SAMPLES", "DETAILED_STEP_S", "TIMING_COLUMNS", "sample_seed",
-           "setup_worker", "run_case", "run_sample", "campaign_row", "downsample"]
+           "setup_worker", "run_case", "run_sample", "campaign_row", "downsample", "PEAK_COLUMNS",
+           "EXTREME_COLUMNS"]
 
 TRAJECTORY_STEP_S = 10.0  # default spacing of the down-sampled trajectory table [s]
 #: the first samples are stored at this finer step [s] (the report's bank histories), when the
@@ -127,9 +128,23 @@ def campaign_row(res: ClosedLoopResult, setup: ClosedLoopSetup) -> dict:
     }
 
 
+#: trajectory columns whose per-flight largest value ``downsample`` keeps (the path limits' quantities)
+PEAK_COLUMNS = ("dynamic_pressure_Pa", "heat_flux_W_m2", "normal_load_g", "total_load_g")
+#: trajectory columns whose per-flight smallest and largest values it keeps (a mission's state bounds)
+EXTREME_COLUMNS = ("flight_path_deg",)
+
+
 def downsample(tr, index: int, step_s: float) -> dict:
-    """Trajectory columns of ``tr`` every ``step_s`` [s] and at its final instant, tagged ``sample`` = index."""
-    t = tr.time
-    keep = np.unique(np.append(np.searchsorted(t, np.arange(0.0, t[-1], step_s)), len(t) - 1))
-    out = {"sample": np.full(keep.size, index), **{k: np.asarray(v)[keep] for k, v in tr.table().items()}}
+    """Trajectory columns of ``tr`` every ``step_s`` [s], at its final instant and at the log
+    samples where each PEAK_COLUMNS column is largest and each EXTREME_COLUMNS column smallest
+    and largest (so a stored line reaches its flight's peaks at the log period, not only the
+    peaks that fall on the ``step_s`` grid), tagged ``sample`` = index."""
+    t, table = tr.time, tr.table()
+    picks = [np.searchsorted(t, np.arange(0.0, t[-1], step_s)), [len(t) - 1]]
+    for name in PEAK_COLUMNS + EXTREME_COLUMNS:
+        v = np.asarray(table.get(name, ()), float)
+        if v.size and np.isfinite(v).any():
+            picks.append([np.nanargmax(v)] + ([np.nanargmin(v)] if name in EXTREME_COLUMNS else []))
+    keep = np.unique(np.concatenate([np.asarray(p, int) for p in picks]))
+    out = {"sample": np.full(keep.size, index), **{k: np.asarray(v)[keep] for k, v in table.items()}}
     return {k: np.asarray(v).tolist() for k, v in out.items()}

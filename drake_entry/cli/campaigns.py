@@ -25,15 +25,20 @@ def campaign(args) -> int:
         out = run_campaign(args.scenario, **settings)
     stats = write_and_print_report(out)
     required = stats.get("success_requirement")
-    if required is not None:  # a stated success requirement decides
-        if required["status"] != "PASS":
-            print(f"drake-entry: the success requirement is not shown: {required['text']} (see "
-                  f"{os.path.join(out, 'report.md')})", file=sys.stderr)
+    where = os.path.join(out, "report.md")
+    failures = stats["samples"] - stats["successful"]
+    if required is not None and required["status"] != "PASS":
+        print(f"drake-entry: the success requirement is not shown: {required['text']} (see {where})", file=sys.stderr)
+        # shown not met, a failure flown, or --until-confident stopped short: exit non-zero; OPEN
+        # without a failure is a campaign too small to judge, not a failure
+        if required["status"] == "FAIL" or failures or args.until_confident:
             return 1
+        print("drake-entry: no sample failed; `--until-confident` runs until the requirement is decided",
+              file=sys.stderr)
         return 0
-    if stats["successful"] < stats["samples"]:  # a campaign that shows a failure exits non-zero
-        print(f"drake-entry: {stats['samples'] - stats['successful']} of {stats['samples']} samples are not "
-              f"successful (see {os.path.join(out, 'report.md')})", file=sys.stderr)
+    if failures:  # a campaign that shows a failure exits non-zero
+        print(f"drake-entry: {failures} of {stats['samples']} samples are not successful (see {where})",
+              file=sys.stderr)
         return 1
     return 0
 
@@ -108,26 +113,59 @@ def _add_results_arguments(parser) -> None:
                         "(default: out/results); index.md lists them")
 
 
-def write_results_index(out_dir: str, *, runs: int, seed: int) -> str:
+def _provenance(campaign_dir: str) -> tuple[str, str]:
+    """(seed, the commits of its sessions, short, '+changes' kept) of a campaign directory."""
+    try:
+        with open(os.path.join(campaign_dir, "campaign.json")) as f:
+            record = json.load(f)
+    except (OSError, ValueError):
+        return "—", "not recorded"
+    commits = list(dict.fromkeys((s.get("git_commit") or "not recorded") for s in record.get("sessions", [])))
+    short = [c if c == "not recorded" else c[:7] + ("+changes" if c.endswith("+changes") else "") for c in commits]
+    return str(record.get("seed", "—")), ", ".join(short) or "not recorded"
+
+
+def write_results_index(out_dir: str) -> str:
     """index.md of every packaged closed-loop scenario's campaign directory below ``out_dir`` (those
-    of earlier runs with --only too): successes and the 90 % bound, a link to each report;
-    returns its path."""
+    of earlier runs with --only too): runs, successes, the 90 % lower bound, the scenario's
+    required success probability with its verdict (PASS, OPEN with the further runs that would
+    show it, or FAIL), seed and commit, a link to each report; returns its path."""
     from drake_entry.scenario import closed_loop_scenarios
 
     lines = ["# Campaign results", "",
-             f"Packaged closed-loop scenarios flown as Monte-Carlo campaigns by `drake-entry results --runs {runs} "
-             f"--seed {seed}` (every campaign directory below this one is listed, also those of an earlier run "
-             "with `--only`; each report states its runs, seed and commit); each directory holds report.md (and "
-             "report.html, self-contained), its figures, summary.json and campaign.json.", "",
-             "| scenario | successful | success probability, 90 % lower bound | report |", "|---|---|---|---|"]
+             "Packaged closed-loop scenarios flown as Monte-Carlo campaigns (`drake-entry publish` regenerates "
+             "every one from a committed tree; `drake-entry results` flies them into any directory). Each "
+             "directory holds report.md (and report.html, self-contained), its figures, summary.json and "
+             "campaign.json; each report states its command, runs, seed and commit. The required success "
+             "probability is the scenario's `success_requirement`: PASS when the one-sided Clopper-Pearson lower "
+             "bound reaches it, FAIL when the upper bound is below it, OPEN otherwise (with the further runs, "
+             "every one successful, that would show it).", "",
+             "| scenario | runs | successful | success probability, 90 % lower bound | required | verdict | seed "
+             "| commit | report |", "|---|---|---|---|---|---|---|---|---|"]
+    absent = []
     for name in closed_loop_scenarios():
-        summary = os.path.join(out_dir, name, "summary.json")
+        directory = os.path.join(out_dir, name)
+        summary = os.path.join(directory, "summary.json")
         if not os.path.isfile(summary):
+            absent.append(f"`{name}`")
             continue
         with open(summary) as f:
             stats = json.load(f)
-        lines.append(f"| `{name}` | {stats['successful']} of {stats['samples']} | "
-                     f"{100 * stats['success_lower_bound']['0.9']:.2f} % | [report]({name}/report.md) |")
+        seed, commits = _provenance(directory)
+        req = stats.get("success_requirement")
+        if req is None:
+            required, verdict = "none stated", "—"
+        else:
+            required = f"{100 * req['probability']:g} % at {100 * req['confidence']:g} %"
+            verdict = {"PASS": "**PASS**", "FAIL": "**FAIL**"}.get(req["status"], "OPEN")
+            if req["status"] == "OPEN":
+                verdict += (f": {req['more_runs']} more successful runs would show it" if req.get("more_runs")
+                            else ": not within 1e8 runs")
+        lines.append(f"| `{name}` | {stats['samples']} | {stats['successful']} | "
+                     f"{100 * stats['success_lower_bound']['0.9']:.2f} % | {required} | {verdict} | {seed} | "
+                     f"{commits} | [report]({name}/report.md) |")
+    if absent:
+        lines += ["", f"Not flown in this directory: {', '.join(absent)}."]
     path = os.path.join(out_dir, "index.md")
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
@@ -157,7 +195,7 @@ def results(args) -> int:
             stats = json.load(f)
         failed += stats["successful"] < stats["samples"]
         print(f"   {stats['successful']} of {stats['samples']} successful; report: {path}", flush=True)
-    print(f"wrote {write_results_index(args.out, runs=args.runs, seed=args.seed)}")
+    print(f"wrote {write_results_index(args.out)}")
     if failed:
         print(f"drake-entry: {failed} scenario(s) with samples that are not successful (see their reports)",
               file=sys.stderr)

@@ -88,7 +88,7 @@ def publish_results(out: str, *, runs: int, comparison_runs: int, campaigns=None
                                      "wall_s": round(time.perf_counter() - t, 1)}
         print(f"   {stats['successful']} of {stats['samples']} successful", flush=True)
     if campaigns:
-        write_results_index(folder, runs=runs, seed=CAMPAIGN_SEED)
+        write_results_index(folder)
     folders = []
     for name in missions:
         t = time.perf_counter()

@@ -114,3 +114,29 @@ def test_publish_writes_each_campaign_its_index_and_the_record_of_the_run(tmp_pa
         in (tmp_path / "campaigns" / "index.md").read_text()
     report = (tmp_path / "campaigns" / "horus2b" / "report.md").read_text()
     assert f"--runs 2 --seed {CAMPAIGN_SEED}" in report
+
+
+def test_publish_flies_its_samples_on_a_dask_cluster_given_its_scheduler(tmp_path):
+    """`drake-entry publish --scheduler ADDRESS` (a dask-jobqueue cluster's, here a LocalCluster's):
+    the samples fly on the cluster's workers, with the rows a local run gives (they depend on
+    (seed, index) only), and published.json says where they flew."""
+    import json
+
+    import pyarrow.parquet as pq
+    from dask.distributed import LocalCluster
+
+    from drake_entry.campaign.montecarlo import run_campaign
+    from drake_entry.cli.publish import CAMPAIGN_SEED, publish_results
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=None) as cluster:
+        record = publish_results(str(tmp_path / "pub"), runs=2, comparison_runs=1, campaigns=["horus2b"], missions=[],
+                                 allow_changes=True, scheduler=cluster.scheduler_address, trajectory_step_s=0.0)
+    assert record["samples_flown_on"] == f"Dask cluster {cluster.scheduler_address}"
+    assert json.loads((tmp_path / "pub" / "published.json").read_text())["samples_flown_on"].startswith("Dask cluster")
+    flown = pq.read_table(tmp_path / "pub" / "campaigns" / "horus2b" / "samples.parquet").to_pydict()
+    here = run_campaign("horus2b", runs=2, out_dir=str(tmp_path / "local"), seed=CAMPAIGN_SEED, workers=1,
+                        progress=False, backend="serial", trajectory_step_s=0.0)
+    local = pq.read_table(f"{here}/samples.parquet").to_pydict()
+    assert flown["index"] == [0, 1]
+    for col in ("err_range_m", "err_altitude_m", "peak_heat_flux_W_m2"):
+        assert flown[col] == local[col], col

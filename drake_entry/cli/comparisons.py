@@ -24,6 +24,9 @@ def _add_compare_arguments(parser) -> None:
     parser.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
     parser.add_argument("--trajectory-step", type=float, default=10.0, metavar="SECONDS",
                         help="trajectory storage step of the campaigns (default: 10)")
+    parser.add_argument("--scheduler", default=None,
+                        help="address of a running Dask scheduler that flies the samples (searches and plans stay "
+                             "here; default: local processes)")
     parser.add_argument("--out", default=None, help="comparison directory (default: out/compare/<name>)")
 
 
@@ -34,7 +37,7 @@ def compare(args) -> int:
     comparison = load_comparison_or_mission(args.comparison)
     out = args.out or os.path.join("out", "compare", comparison.name)
     path = run_comparison(comparison, runs=args.runs, out_dir=out, seed=args.seed, workers=args.workers,
-                          only=args.only, trajectory_step_s=args.trajectory_step)
+                          only=args.only, trajectory_step_s=args.trajectory_step, scheduler=args.scheduler)
     failed, flown = print_comparison_summary(out)
     print(f"report: {path}")
     if not flown:

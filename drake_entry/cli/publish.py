@@ -53,9 +53,11 @@ def _checked(names, allowed, flag: str) -> list[str]:
 
 
 def publish_results(out: str, *, runs: int, comparison_runs: int, campaigns=None, missions=None,
-                    workers: int | None = None, allow_changes: bool = False, trajectory_step_s: float = 10.0) -> dict:
+                    workers: int | None = None, allow_changes: bool = False, trajectory_step_s: float = 10.0,
+                    scheduler: str | None = None) -> dict:
     """Regenerate the results below ``out`` (module doc): ``campaigns`` and ``missions`` name
-    subsets (None: all; []: none). Returns the published.json record."""
+    subsets (None: all; []: none); ``scheduler``: the address of a Dask cluster that flies the
+    samples (None: ``workers`` local processes). Returns the published.json record."""
     from drake_entry.campaign.montecarlo import run_campaign
     from drake_entry.campaign.report import write_report
     from drake_entry.cli.campaigns import write_results_index
@@ -70,9 +72,11 @@ def publish_results(out: str, *, runs: int, comparison_runs: int, campaigns=None
     missions = list(MATRIX_MISSIONS) if missions is None else _checked(missions, MATRIX_MISSIONS, "--missions")
     if runs < 1 or comparison_runs < 1:
         raise DrakeEntryError(f"publish: --runs {runs} and --comparison-runs {comparison_runs}: allowed >= 1")
+    where = {"backend": "dask", "scheduler": scheduler} if scheduler else {}
     started, t0 = datetime.datetime.now(datetime.timezone.utc), time.perf_counter()
     record = {"commit": commit, "started_utc": started.isoformat(timespec="seconds"), "campaign_runs": runs,
               "campaign_seed": CAMPAIGN_SEED, "comparison_runs": comparison_runs, "comparison_seed": COMPARISON_SEED,
+              "samples_flown_on": f"Dask cluster {scheduler}" if scheduler else "local processes",
               "campaigns": {}, "comparisons": {}}
     folder = os.path.join(out, "campaigns")
     os.makedirs(folder, exist_ok=True)
@@ -80,7 +84,7 @@ def publish_results(out: str, *, runs: int, comparison_runs: int, campaigns=None
         t = time.perf_counter()
         print(f"== campaign {name}: {runs} runs", flush=True)
         path = run_campaign(name, runs=runs, out_dir=os.path.join(folder, name), seed=CAMPAIGN_SEED, workers=workers,
-                            trajectory_step_s=trajectory_step_s)
+                            trajectory_step_s=trajectory_step_s, **where)
         write_report(path)
         with open(os.path.join(path, "summary.json")) as f:
             stats = json.load(f)
@@ -95,7 +99,7 @@ def publish_results(out: str, *, runs: int, comparison_runs: int, campaigns=None
         print(f"== every method on {name}: {comparison_runs} runs each", flush=True)
         directory = os.path.join(out, "compare", name)
         run_comparison(mission_comparison(name), runs=comparison_runs, out_dir=directory,
-                       seed=COMPARISON_SEED, workers=workers, trajectory_step_s=trajectory_step_s)
+                       seed=COMPARISON_SEED, workers=workers, trajectory_step_s=trajectory_step_s, **where)
         with open(os.path.join(directory, "comparison_summary.json")) as f:
             summary = json.load(f)
         record["comparisons"][name] = {
@@ -119,6 +123,9 @@ def _add_publish_arguments(parser) -> None:
     parser.add_argument("--missions", nargs="*", default=None, metavar="MISSION",
                         help=f"these matrix missions only ({', '.join(MATRIX_MISSIONS)}; given with no name: none)")
     parser.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    parser.add_argument("--scheduler", default=None,
+                        help="address of a running Dask scheduler (e.g. tcp://host:8786, a dask-jobqueue cluster's) "
+                             "that flies the samples; searches and plans stay here (default: local processes)")
     parser.add_argument("--allow-changes", action="store_true",
                         help="publish from a tree with uncommitted changes (the reports say '+changes')")
     parser.add_argument("--out", default=os.path.join("docs", "results"), help="the results directory")
@@ -126,7 +133,8 @@ def _add_publish_arguments(parser) -> None:
 
 def publish(args) -> int:
     record = publish_results(args.out, runs=args.runs, comparison_runs=args.comparison_runs, campaigns=args.campaigns,
-                             missions=args.missions, workers=args.workers, allow_changes=args.allow_changes)
+                             missions=args.missions, workers=args.workers, allow_changes=args.allow_changes,
+                             scheduler=args.scheduler)
     print(f"published at commit {record['commit']} in {record['wall_s']:.0f} s: "
           f"{len(record['campaigns'])} campaigns, {len(record['comparisons'])} comparisons; "
           f"{os.path.join(args.out, 'published.json')}")

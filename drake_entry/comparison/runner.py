@@ -47,16 +47,21 @@ INTERRUPTED = "its campaign did not finish in this directory: run the same comma
 
 def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, workers: int | None = None,
                    only: list[str] | None = None, progress: bool = True,
-                   trajectory_step_s: float = TRAJECTORY_STEP_S) -> str:
+                   trajectory_step_s: float = TRAJECTORY_STEP_S, backend: str = "processes",
+                   scheduler: str | None = None) -> str:
     """Fly every method of ``comparison`` (a Comparison, a packaged name or a file) that can fly
     its mission as a campaign of ``runs`` samples (seed ``seed``) into ``out_dir/<label>``, then
     write ``out_dir/report.md``; returns the report's path. ``only``: these labels only (the
     others keep what an earlier run left). A method whose planner cannot be built for the mission
-    is recorded with its reason and the others still fly. The campaigns resume like any other."""
+    is recorded with its reason and the others still fly. The campaigns resume like any other.
+    ``backend``, ``scheduler``: where the samples fly (montecarlo.run_campaign: local processes,
+    serial, or a Dask cluster); the settings' searches and pre-flight plans run here."""
     from drake_entry.campaign.report import write_report
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 
-    check_run_arguments(runs=runs, seed=seed, trajectory_step_s=trajectory_step_s, workers=workers)
+    if scheduler:
+        backend = "dask"
+    check_run_arguments(runs=runs, seed=seed, trajectory_step_s=trajectory_step_s, workers=workers, backend=backend)
     out_dir = check_output_dir(out_dir, "out_dir")
     comp = comparison if isinstance(comparison, Comparison) else load_comparison(comparison)
     comp.validate()
@@ -142,7 +147,8 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
             print(f"   {record['preflight_planning_s']:.1f} s; {runs} samples", flush=True)
         campaign_dir = os.path.join(out_dir, entry.label)
         run_campaign(path, runs=runs, out_dir=campaign_dir, seed=seed, workers=workers, progress=progress,
-                     trajectory_step_s=trajectory_step_s, nominal_setup=setup)  # its nominal: no third plan
+                     trajectory_step_s=trajectory_step_s, nominal_setup=setup,  # its nominal: no third plan
+                     backend=backend, scheduler=scheduler)
         del setup
         write_report(campaign_dir, title=f"{comp.name}: {entry.label}")
         methods[entry.label] = {**record, "campaign": entry.label}

@@ -215,3 +215,31 @@ def test_path_figure_draws_failed_samples_on_top_and_the_total_load_where_limite
     bounds = sorted(line.get_ydata()[0] for line in axes[-1].get_lines() if line.get_linestyle() == ":")
     assert bounds == pytest.approx([-30.0, 0.5]) and axes[-1].get_ylabel() == "flight path [deg]"
     assert min(axes[-1].get_lines()[1].get_ydata()) == pytest.approx(-31.0)  # the failed dive, past -30
+
+
+def test_drag_figure_shows_the_tracking_error_with_the_failed_samples_on_top(tmp_path):
+    """Sample 0 flies 10 % above its reference, sample 1 (not successful) 5 % below: the right
+    panel plots +10 % and -5 % where the reference is engaged (> 0), the failed one last and red."""
+    from drake_entry.campaign.report_figures import drag_profiles
+    from drake_entry.figures import plt
+
+    t = np.linspace(0.0, 1.0, 20)
+    ref = np.where(t > 0.2, 5.0 + 10.0 * t, 0.0)
+    traj = {"sample": [0] * 20 + [1] * 20, "energy_J_kg": list(-t) * 2, "reference_drag_m_s2": list(ref) * 2,
+            "drag_m_s2": list(np.where(ref > 0, 1.1 * ref, 2.0)) + list(np.where(ref > 0, 0.95 * ref, 2.0))}
+    made, real_subplots = [], plt.subplots
+
+    def keeping(*a, **k):
+        fig, axes = real_subplots(*a, **k)
+        made.append(axes)
+        return fig, axes
+
+    plt.subplots = keeping
+    try:
+        _, caption = drag_profiles(traj, str(tmp_path), "t", failed=[1])
+    finally:
+        plt.subplots = real_subplots
+    lines = [line for line in made[-1][1].get_lines() if len(line.get_ydata()) > 2]
+    assert [len(line.get_ydata()) for line in lines] == [int((ref > 0).sum())] * 2
+    assert np.allclose(lines[0].get_ydata(), 10.0) and np.allclose(lines[1].get_ydata(), -5.0)
+    assert lines[1].get_color() == "C3" and "the 1 not successful in red on top" in caption

@@ -27,6 +27,7 @@ import numpy as np
 
 from drake_entry.campaign import report_figures as figures
 from drake_entry.campaign.drivers import failure_drivers
+from drake_entry.campaign.engine import source_commit
 from drake_entry.campaign.interactive import INTERACTIVE, write_interactive
 from drake_entry.campaign.rows import row_problem
 from drake_entry.campaign.sensitivity import pawn_sensitivity
@@ -443,7 +444,8 @@ def _provenance(meta: dict, stats: dict) -> str:
             ("campaign fingerprint", f"{str(meta.get('fingerprint', '?'))[:16]}…"),
             ("reproduce", f"`{command}`"),
             ("report written", f"{datetime.datetime.now(datetime.timezone.utc).isoformat(timespec='seconds')} by "
-                               f"drake_entry {drake_entry_version()}")]
+                               f"drake_entry {drake_entry_version()}"
+                               + (f", commit {writer}" if (writer := source_commit()) else ""))]
     return "## Provenance\n\n| item | value |\n|---|---|\n" + "\n".join(f"| {a} | {b} |" for a, b in rows)
 
 
@@ -937,7 +939,7 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
         failed = [i for i, ok in zip(rows["index"], rows["success"]) if not ok]
         figs.append(figures.path_quantities(traj, out_dir, title, limits, mission_limits=_mission_limits(scenario),
                                             failed=failed))
-        figs.append(figures.drag_profiles(traj, out_dir, title))
+        figs.append(figures.drag_profiles(traj, out_dir, title, failed=failed))
         target = ((scenario.target.longitude_deg, scenario.target.latitude_deg) if scenario is not None else None)
         figs.append(figures.ground_tracks(traj, out_dir, title, target=target))
         step = float((meta or {}).get("trajectory_step_s") or 10.0)

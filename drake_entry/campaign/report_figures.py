@@ -303,29 +303,47 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits
                   f"{OFF_SCALE:g} times the largest flown value is named in the legend, not drawn). {ENERGY_DEFINITION}.")
 
 
-def drag_profiles(traj: dict, out_dir: str, title: str) -> tuple[str, str] | None:
-    """Flown drag (light) under the guidance's references (dark) against normalised energy."""
+def drag_profiles(traj: dict, out_dir: str, title: str, failed=()) -> tuple[str, str] | None:
+    """Flown drag (light) under the guidance's references (dark) against normalised energy (left)
+    and the tracking error, flown minus reference drag relative to the reference [%] (right),
+    the ``failed`` samples (indices) in red on top."""
     if "reference_drag_m_s2" not in traj:
         return None
     sample = np.asarray(traj["sample"])
     e = normalised_energy(traj)
-    groups = [np.flatnonzero(sample == s) for s in np.unique(sample)]
+    ids = np.unique(sample)
+    failed = {int(i) for i in failed} & {int(i) for i in ids}
+    groups = [(int(s), np.flatnonzero(sample == s)) for s in ids]
     ref = np.asarray(traj["reference_drag_m_s2"], float)
     D = np.asarray(traj["drag_m_s2"], float)
-    fig, ax = plt.subplots(figsize=(7.5, 4.8))
-    for i, g in enumerate(groups):
+    fig, (ax, ax_err) = plt.subplots(1, 2, figsize=(13.0, 4.8))
+    for i, (_, g) in enumerate(groups):
         ax.plot(e[g], D[g], lw=2.0, alpha=0.25, color="C1", label="flown drag" if i == 0 else None)
-    for i, g in enumerate(groups):
+    for i, (_, g) in enumerate(groups):
         m = ref[g] > 0
         ax.plot(e[g][m], ref[g][m], lw=0.6, color="k", alpha=0.6, label="reference (re-planned)" if i == 0 else None)
-    ax.set_xlabel(ENERGY_AXIS)
-    ax.set_ylabel("drag acceleration [m/s^2]")
+    first_bad = True
+    for s, g in sorted(groups, key=lambda sg: sg[0] in failed):  # the failed ones last: on top
+        m = ref[g] > 0
+        bad = s in failed
+        ax_err.plot(e[g][m], 100.0 * (D[g][m] / ref[g][m] - 1.0), lw=0.9 if bad else 0.4, alpha=0.9 if bad else 0.4,
+                    color="C3" if bad else "C0", label=f"not successful ({len(failed)})" if bad and first_bad else None)
+        first_bad = first_bad and not bad
+    ax_err.axhline(0.0, color="k", lw=0.8)
+    for a, label in ((ax, "drag acceleration [m/s^2]"), (ax_err, "tracking error: flown / reference - 1 [%]")):
+        a.set_xlabel(ENERGY_AXIS)
+        a.set_ylabel(label)
+        a.grid(True, alpha=0.4)
     ax.legend(fontsize=8)
-    ax.grid(True, alpha=0.4)
+    if failed:
+        ax_err.legend(fontsize=8)
     path = _save(fig, out_dir, "drag_profiles.png", title)
-    return path, (f"Drag tracking of the {len(groups)} stored trajectories: the flown drag (wide light lines) under "
-                  "the drag reference the guidance was tracking at each stored point (thin dark lines; it changes "
-                  f"at every re-plan). {ENERGY_DEFINITION}.")
+    return path, (f"Drag tracking of the {len(groups)} stored trajectories: left, the flown drag (wide light lines) "
+                  "under the drag reference the guidance was tracking at each stored point (thin dark lines; it "
+                  "changes at every re-plan); right, the tracking error, flown drag relative to that reference, "
+                  "where the guidance engages (reference > 0)" + (f", the {len(failed)} not successful in red on top"
+                                                                  if failed else "")
+                  + f". {ENERGY_DEFINITION}.")
 
 
 def ground_tracks(traj: dict, out_dir: str, title: str, *, target=None) -> tuple[str, str]:

@@ -81,6 +81,7 @@ def error_histograms(errors: dict, out_dir: str, title: str, *, nonnegative: tup
         plain_axis(ax)
         ax.set_xlabel(label)
         ax.locator_params(axis="x", nbins=5)
+        ax.tick_params(axis="x", labelrotation=30)  # long labels (-0.0025 deg) do not run into each other
         ax.grid(True, alpha=0.4)
     for ax in axes.ravel()[n_panels:]:
         ax.set_visible(False)

@@ -139,7 +139,8 @@ def write_results_index(out_dir: str) -> str:
              "campaign.json; each report states its command, runs, seed and commit. The required success "
              "probability is the scenario's `success_requirement`: PASS when the one-sided Clopper-Pearson lower "
              "bound reaches it, FAIL when the upper bound is below it, OPEN otherwise (with the further runs, "
-             "every one successful, that would show it).", "",
+             "every one successful, that would show it). Each `NAME_flight` is the flight-like twin of `NAME`: the "
+             "same mission and method in a flight-like environment (docs/campaigns.md, flight-like twins).", "",
              "| scenario | runs | successful | success probability, 90 % lower bound | required | verdict | seed "
              "| commit | report |", "|---|---|---|---|---|---|---|---|---|"]
     absent = []

@@ -25,7 +25,6 @@ STALE = {
     "paper004_mc100_fixed/report.md": "an early report: no commit recorded",
     "paper004_mc100_onboard/report.md": "an early report: no commit recorded",
     "paper002_guidance/report.md": "commit not recorded",
-    "campaigns/shefex3_ampi/report.md": "made from 3661bc4 with uncommitted changes",
 }
 
 COMMIT = re.compile(r"commit ([0-9a-f]{7,40})(\+changes)?")

@@ -243,3 +243,29 @@ def test_drag_figure_shows_the_tracking_error_with_the_failed_samples_on_top(tmp
     assert [len(line.get_ydata()) for line in lines] == [int((ref > 0).sum())] * 2
     assert np.allclose(lines[0].get_ydata(), 10.0) and np.allclose(lines[1].get_ydata(), -5.0)
     assert lines[1].get_color() == "C3" and "the 1 not successful in red on top" in caption
+
+
+def test_a_star_of_arms_from_one_centre_or_far_outliers_get_no_normal_ellipse(tmp_path):
+    """A normal cloud fills its contours as a normal does (about 50 % and 99 % inside the 50 % and
+    99 % ones); three arms from one centre (one mode: the plan-once swarm footprint's shape), a
+    ring, and a normal core with 1 % far outliers do not, and the footprint draws no ellipse and
+    says why; fewer than 20 points are not judged."""
+    from drake_entry.campaign.report_figures import footprint
+    from drake_entry.campaign.statistics import normal_ellipse_fill, principal_axis_modes
+
+    rng = np.random.default_rng(3)
+    f50, f99, fits = normal_ellipse_fill(*rng.normal(size=(2, 1000)))
+    assert fits and abs(f50 - 0.5) < 0.05 and abs(f99 - 0.99) < 0.01
+    r = rng.exponential(1.0, 900)
+    angle = np.repeat(np.radians([90.0, 210.0, 330.0]), 300) + 0.02 * rng.normal(size=900)
+    star = np.vstack([r * np.cos(angle), r * np.sin(angle)])
+    assert principal_axis_modes(*star) == 1 and not normal_ellipse_fill(*star)[2]
+    theta = rng.uniform(0.0, 2.0 * np.pi, 1000)
+    assert not normal_ellipse_fill(np.cos(theta), np.sin(theta))[2]  # a ring: 0 % inside the 50 % contour
+    core = np.hstack([rng.normal(size=(2, 990)), 40.0 * np.ones((2, 10))])
+    assert not normal_ellipse_fill(*core)[2]
+    assert normal_ellipse_fill(*star[:, :19])[2]  # too few to judge
+    _, caption = footprint(star[0], star[1], str(tmp_path), "star", radius_km=5.0)
+    assert "No normal ellipse: the samples do not fill a normal's contours" in caption
+    _, caption = footprint(*rng.normal(size=(2, 1000)), str(tmp_path), "normal", radius_km=5.0)
+    assert "as a normal sample would" in caption

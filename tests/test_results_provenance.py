@@ -22,8 +22,6 @@ STALE = {
        for m in ("", "drag_energy/", "fnpeg/", "swarm_bank/", "swarm_bank_onboard/")},
     **{f"fnpeg_capsule_lu2008_mc500/{m}/report.md": "made from e6cfe2b with uncommitted changes"
        for m in ("constant", "linear", "nominal_models")},
-    "paper004_mc100_fixed/report.md": "an early report: no commit recorded",
-    "paper004_mc100_onboard/report.md": "an early report: no commit recorded",
     "paper002_guidance/report.md": "commit not recorded",
 }
 

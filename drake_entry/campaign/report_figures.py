@@ -12,7 +12,7 @@ import math
 import numpy as np
 from scipy import stats
 
-from drake_entry.campaign.statistics import principal_axis_modes
+from drake_entry.campaign.statistics import normal_ellipse_fill, principal_axis_modes
 from drake_entry.figures import plt, save_figure  # sets the Agg backend before pyplot is imported
 
 __all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "plain_axis",
@@ -115,8 +115,9 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
     extent = [np.abs(x).max(initial=0.0), np.abs(y).max(initial=0.0)]
     miss = np.hypot(x, y)
     modes = principal_axis_modes(x, y)
+    f50, f99, fits = normal_ellipse_fill(x, y)
     if x.size > 2:
-        if modes == 1:
+        if modes == 1 and fits:
             vals, vecs = np.linalg.eigh(np.cov(np.vstack([x, y])))
             ell = vecs @ (ELLIPSE_99_K * np.sqrt(np.maximum(vals, 0.0))[:, None] * circle)
             ax.plot(x.mean() + ell[0], y.mean() + ell[1], "C1-", lw=1.5,
@@ -145,9 +146,15 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
                                        "inside the acceptance region breached a path limit)" if bad.any() else "")
                + ". "
                + ("The ellipse holds 99 % of a normal distribution with the sample's mean and covariance (k = 3.035σ "
-                  "in 2-D)" if modes == 1 else
+                  "in 2-D)" + (f"; {100 * f50:.0f} % and {100 * f99:.1f} % of the samples lie inside its 50 % and 99 % "
+                               "contours, as a normal sample would" if np.isfinite(f50) else "")
+                  if modes == 1 and fits else
                   f"No normal ellipse: the cloud is not one cluster ({modes} modes of its kernel density along a "
-                  "principal axis), and an ellipse would cover ground no sample reached")
+                  "principal axis), and an ellipse would cover ground no sample reached" if modes > 1 else
+                  f"No normal ellipse: the samples do not fill a normal's contours ({100 * f50:.0f} % inside its 50 % "
+                  f"contour, {100 * f99:.1f} % inside its 99 %, where a normal sample of {x.size} gives 50 ± "
+                  f"{300 * math.sqrt(0.25 / x.size):.0f} % and 99 ± {300 * math.sqrt(0.0099 / x.size):.1f} %): arms "
+                  "from one centre, a ring or outliers far from the core, which an ellipse would misstate")
                + "; the dotted circle is the 99th percentile of the miss distance")
     caption += (f"; the dashed circle is the acceptance region ({radius_km:g} km)" if radius_km is not None else "")
     if radius_km is not None and not in_view:

@@ -27,7 +27,7 @@ from drake_entry.errors import ScenarioError
 __all__ = ["PERCENTILES", "COVERAGE", "CONFIDENCE", "SUCCESS_LEVELS", "success_lower_bound",
            "success_upper_bound", "runs_for_bound",
            "order_statistic_rank", "order_statistic_bound", "finite_column", "describe", "percentile_key", "convergence_counts", "running_estimates",
-           "MODE_PROMINENCE", "principal_axis_modes"]
+           "MODE_PROMINENCE", "principal_axis_modes", "FILL_MIN_SAMPLES", "normal_ellipse_fill"]
 
 #: the percentiles of the report [%] (P0.13 and P99.87: the normal distribution's 3-sigma levels)
 PERCENTILES = (0.13, 1.0, 50.0, 99.0, 99.87)
@@ -147,6 +147,35 @@ def principal_axis_modes(x, y, grid: int = 512) -> int:
         peaks, _ = find_peaks(np.concatenate([[0.0], density, [0.0]]), prominence=MODE_PROMINENCE * density.max())
         most = max(most, len(peaks))
     return most
+
+
+#: fewer samples than this: normal_ellipse_fill does not judge (too few to tell a normal from another)
+FILL_MIN_SAMPLES = 20
+
+
+def normal_ellipse_fill(x, y) -> tuple[float, float, bool]:
+    """(f50, f99, fits): the fractions of the cloud (x, y) inside the 50 % and 99 % contours of
+    the normal with its own mean and covariance, and whether both are what a normal sample of this
+    size gives, each within 3 binomial standard deviations of 0.50 and 0.99. A star of arms from
+    one centre (one mode, so principal_axis_modes passes it), a ring, or a core with far outliers
+    that inflate the covariance fails, and its ellipse would misstate where the samples land.
+    Fewer than FILL_MIN_SAMPLES finite points, or a degenerate cloud: (nan, nan, True)."""
+    pts = np.vstack([np.asarray(x, float), np.asarray(y, float)])
+    pts = pts[:, np.isfinite(pts).all(axis=0)]
+    n = pts.shape[1]
+    if n < FILL_MIN_SAMPLES:
+        return math.nan, math.nan, True
+    cov = np.cov(pts)
+    if np.linalg.matrix_rank(cov) < 2:
+        return math.nan, math.nan, True
+    centred = pts - pts.mean(axis=1, keepdims=True)
+    d2 = np.einsum("in,ij,jn->n", centred, np.linalg.inv(cov), centred)
+    fits, fractions = True, []
+    for p in (0.5, 0.99):
+        f = float(np.mean(d2 <= stats.chi2.ppf(p, 2)))
+        fractions.append(f)
+        fits &= abs(f - p) <= 3.0 * math.sqrt(p * (1.0 - p) / n)
+    return fractions[0], fractions[1], bool(fits)
 
 
 def convergence_counts(runs: int, points: int = 60) -> np.ndarray:

@@ -20,8 +20,6 @@ STALE = {
        for m in ("", "drag_energy/", "fnpeg/", "swarm_bank/", "bank_profile/")},
     **{f"compare_cav_h_lu2014/{m}report.md": "made from 272aef9 / 502f252 / 61daa16 with uncommitted changes"
        for m in ("", "drag_energy/", "fnpeg/", "swarm_bank/", "swarm_bank_onboard/")},
-    **{f"fnpeg_capsule_lu2008_mc500/{m}/report.md": "made from e6cfe2b with uncommitted changes"
-       for m in ("constant", "linear", "nominal_models")},
     "paper002_guidance/report.md": "commit not recorded",
 }
 

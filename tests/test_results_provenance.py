@@ -16,8 +16,6 @@ RESULTS = REPO / "docs" / "results"
 STALE = {
     **{f"compare_cav_h_paper004/{m}report.md": "made from 6da754d with uncommitted changes"
        for m in ("", "drag_energy/", "fnpeg/", "swarm_bank/", "swarm_bank_onboard/")},
-    **{f"compare_cav_h_lu2014/{m}report.md": "made from 272aef9 / 502f252 / 61daa16 with uncommitted changes"
-       for m in ("", "drag_energy/", "fnpeg/", "swarm_bank/", "swarm_bank_onboard/")},
     "paper002_guidance/report.md": "commit not recorded",
 }
 

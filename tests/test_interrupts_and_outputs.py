@@ -55,8 +55,11 @@ def test_ctrl_c_ends_a_campaign_with_one_line_exit_130_and_no_worker_left(tmp_pa
             "--trajectory-step", "0", "--out", out, "--backend", backend]
     # cwd outside the repository: `python -m` puts the cwd first on the path, and the working tree
     # is not the installed package (its diagrams/ and systems/ are mapped in by the install)
+    # SIGINT at its default in the child, as in a terminal's foreground job: a test run started in
+    # the background of a shell without job control inherits SIGINT ignored, and Python then
+    # leaves it ignored, so the interrupt would never land
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
-                            cwd=str(tmp_path))
+                            cwd=str(tmp_path), preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 300
     while _rows(out) < 1 and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)

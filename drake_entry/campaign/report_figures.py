@@ -12,7 +12,7 @@ import math
 import numpy as np
 from scipy import stats
 
-from drake_entry.campaign.statistics import normal_ellipse_fill, principal_axis_modes
+from drake_entry.campaign.statistics import fill_tolerance, normal_ellipse_fill, principal_axis_modes
 from drake_entry.figures import plt, save_figure  # sets the Agg backend before pyplot is imported
 
 __all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "plain_axis",
@@ -153,7 +153,7 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
                   "principal axis), and an ellipse would cover ground no sample reached" if modes > 1 else
                   f"No normal ellipse: the samples do not fill a normal's contours ({100 * f50:.0f} % inside its 50 % "
                   f"contour, {100 * f99:.1f} % inside its 99 %, where a normal sample of {x.size} gives 50 ± "
-                  f"{300 * math.sqrt(0.25 / x.size):.0f} % and 99 ± {300 * math.sqrt(0.0099 / x.size):.1f} %): arms "
+                  f"{100 * fill_tolerance(0.5, x.size):.0f} % and 99 ± {100 * fill_tolerance(0.99, x.size):.1f} %): arms "
                   "from one centre, a ring or outliers far from the core, which an ellipse would misstate")
                + "; the dotted circle is the 99th percentile of the miss distance")
     caption += (f"; the dashed circle is the acceptance region ({radius_km:g} km)" if radius_km is not None else "")
@@ -249,6 +249,16 @@ OFF_SCALE = 3.0
 STATE_COLUMNS = {"gamma": ("flight_path_deg", 1.0)}
 
 
+def _split_by_success(traj: dict, failed) -> tuple[list, list]:
+    """The stored trajectory's row indices per sample: (those of the successful samples, those
+    of the ``failed`` ones (sample indices; only those stored count), in sample order)."""
+    sample = np.asarray(traj["sample"])
+    ids = np.unique(sample)
+    failed = {int(i) for i in failed} & {int(i) for i in ids}
+    return ([np.flatnonzero(sample == s) for s in ids if int(s) not in failed],
+            [np.flatnonzero(sample == s) for s in sorted(failed)])
+
+
 def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits=(),
                     failed=()) -> tuple[str, str]:
     """Dynamic pressure, heat flux and normal load (and the total load where the vehicle limits
@@ -256,12 +266,8 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits
     red; the vehicle's limits (``limits``) dashed and the mission's (``mission_limits``:
     PathLimits on the same quantities, e.g. a lower bound on q, or on a state of STATE_COLUMNS,
     e.g. paper 001's flight-path bounds, in a panel of its own) dotted, each labelled."""
-    sample = np.asarray(traj["sample"])
     e = normalised_energy(traj)
-    ids = np.unique(sample)
-    failed = {int(i) for i in failed} & {int(i) for i in ids}
-    groups = [np.flatnonzero(sample == s) for s in ids if int(s) not in failed]
-    bad = [np.flatnonzero(sample == s) for s in sorted(failed)]
+    groups, bad = _split_by_success(traj, failed)
     panels = [("dynamic_pressure_Pa", "dynamic_pressure", 1e-3, "dynamic pressure [kPa]", "dynamic_pressure_max", "kPa"),
               ("heat_flux_W_m2", "heat_flux", 1e-3, "heat flux [kW/m^2]", "heat_flux_max", "kW/m^2"),
               ("normal_load_g", "normal_load", 1.0, "normal load [g]", "normal_load_max", "g")]
@@ -317,40 +323,39 @@ def drag_profiles(traj: dict, out_dir: str, title: str, failed=()) -> tuple[str,
     the ``failed`` samples (indices) in red on top."""
     if "reference_drag_m_s2" not in traj:
         return None
-    sample = np.asarray(traj["sample"])
     e = normalised_energy(traj)
-    ids = np.unique(sample)
-    failed = {int(i) for i in failed} & {int(i) for i in ids}
-    groups = [(int(s), np.flatnonzero(sample == s)) for s in ids]
+    good, bad = _split_by_success(traj, failed)
     ref = np.asarray(traj["reference_drag_m_s2"], float)
     D = np.asarray(traj["drag_m_s2"], float)
     fig, (ax, ax_err) = plt.subplots(1, 2, figsize=(13.0, 4.8))
-    for i, (_, g) in enumerate(groups):
+    for i, g in enumerate(good + bad):
         ax.plot(e[g], D[g], lw=2.0, alpha=0.25, color="C1", label="flown drag" if i == 0 else None)
-    for i, (_, g) in enumerate(groups):
+    for i, g in enumerate(good + bad):
         m = ref[g] > 0
         ax.plot(e[g][m], ref[g][m], lw=0.6, color="k", alpha=0.6, label="reference (re-planned)" if i == 0 else None)
-    first_bad = True
-    for s, g in sorted(groups, key=lambda sg: sg[0] in failed):  # the failed ones last: on top
-        m = ref[g] > 0
-        bad = s in failed
-        ax_err.plot(e[g][m], 100.0 * (D[g][m] / ref[g][m] - 1.0), lw=0.9 if bad else 0.4, alpha=0.9 if bad else 0.4,
-                    color="C3" if bad else "C0", label=f"not successful ({len(failed)})" if bad and first_bad else None)
-        first_bad = first_bad and not bad
+    engaged = np.flatnonzero(ref > 0)
+    error = np.full(D.shape, np.nan)
+    error[engaged] = 100.0 * (D[engaged] / ref[engaged] - 1.0)
+    for g in good:
+        g = g[ref[g] > 0]
+        ax_err.plot(e[g], error[g], lw=0.4, alpha=0.4, color="C0")
+    for k, g in enumerate(bad):  # the failed ones last: on top
+        g = g[ref[g] > 0]
+        ax_err.plot(e[g], error[g], lw=0.9, alpha=0.9, color="C3", label=f"not successful ({len(bad)})" if k == 0 else None)
     ax_err.axhline(0.0, color="k", lw=0.8)
     for a, label in ((ax, "drag acceleration [m/s^2]"), (ax_err, "tracking error: flown / reference - 1 [%]")):
         a.set_xlabel(ENERGY_AXIS)
         a.set_ylabel(label)
         a.grid(True, alpha=0.4)
     ax.legend(fontsize=8)
-    if failed:
+    if bad:
         ax_err.legend(fontsize=8)
     path = _save(fig, out_dir, "drag_profiles.png", title)
-    return path, (f"Drag tracking of the {len(groups)} stored trajectories: left, the flown drag (wide light lines) "
-                  "under the drag reference the guidance was tracking at each stored point (thin dark lines; it "
+    return path, (f"Drag tracking of the {len(good) + len(bad)} stored trajectories: left, the flown drag (wide "
+                  "light lines) under the drag reference the guidance was tracking at each stored point (thin dark lines; it "
                   "changes at every re-plan); right, the tracking error, flown drag relative to that reference, "
-                  "where the guidance engages (reference > 0)" + (f", the {len(failed)} not successful in red on top"
-                                                                  if failed else "")
+                  "where the guidance engages (reference > 0)" + (f", the {len(bad)} not successful in red on top"
+                                                                  if bad else "")
                   + f". {ENERGY_DEFINITION}.")
 
 

@@ -27,7 +27,8 @@ from drake_entry.errors import ScenarioError
 __all__ = ["PERCENTILES", "COVERAGE", "CONFIDENCE", "SUCCESS_LEVELS", "success_lower_bound",
            "success_upper_bound", "runs_for_bound",
            "order_statistic_rank", "order_statistic_bound", "finite_column", "describe", "percentile_key", "convergence_counts", "running_estimates",
-           "MODE_PROMINENCE", "principal_axis_modes", "FILL_MIN_SAMPLES", "normal_ellipse_fill"]
+           "MODE_PROMINENCE", "principal_axis_modes", "FILL_MIN_SAMPLES", "FILL_SIGMAS", "fill_tolerance",
+           "normal_ellipse_fill"]
 
 #: the percentiles of the report [%] (P0.13 and P99.87: the normal distribution's 3-sigma levels)
 PERCENTILES = (0.13, 1.0, 50.0, 99.0, 99.87)
@@ -151,6 +152,14 @@ def principal_axis_modes(x, y, grid: int = 512) -> int:
 
 #: fewer samples than this: normal_ellipse_fill does not judge (too few to tell a normal from another)
 FILL_MIN_SAMPLES = 20
+#: normal_ellipse_fill's band about each contour's probability, in binomial standard deviations
+FILL_SIGMAS = 3.0
+
+
+def fill_tolerance(p: float, n: int) -> float:
+    """The half-width of normal_ellipse_fill's band about the fraction ``p`` of ``n`` samples:
+    FILL_SIGMAS binomial standard deviations."""
+    return FILL_SIGMAS * math.sqrt(p * (1.0 - p) / n)
 
 
 def normal_ellipse_fill(x, y) -> tuple[float, float, bool]:
@@ -174,7 +183,7 @@ def normal_ellipse_fill(x, y) -> tuple[float, float, bool]:
     for p in (0.5, 0.99):
         f = float(np.mean(d2 <= stats.chi2.ppf(p, 2)))
         fractions.append(f)
-        fits &= abs(f - p) <= 3.0 * math.sqrt(p * (1.0 - p) / n)
+        fits &= abs(f - p) <= fill_tolerance(p, n)
     return fractions[0], fractions[1], bool(fits)
 
 

@@ -130,6 +130,7 @@ def write_results_index(out_dir: str) -> str:
     of earlier runs with --only too): runs, successes, the 90 % lower bound, the scenario's
     required success probability with its verdict (PASS, OPEN with the further runs that would
     show it, or FAIL), seed and commit, a link to each report; returns its path."""
+    from drake_entry.campaign.success_requirement import MAX_RUNS
     from drake_entry.scenario import closed_loop_scenarios
 
     lines = ["# Campaign results", "",
@@ -161,7 +162,7 @@ def write_results_index(out_dir: str) -> str:
             verdict = {"PASS": "**PASS**", "FAIL": "**FAIL**"}.get(req["status"], "OPEN")
             if req["status"] == "OPEN":
                 verdict += (f": {req['more_runs']} more successful runs would show it" if req.get("more_runs")
-                            else ": not within 1e8 runs")
+                            else f": not within {MAX_RUNS:.0e} runs")
         lines.append(f"| `{name}` | {stats['samples']} | {stats['successful']} | "
                      f"{100 * stats['success_lower_bound']['0.9']:.2f} % | {required} | {verdict} | {seed} | "
                      f"{commits} | [report]({name}/report.md) |")

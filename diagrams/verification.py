@@ -20,7 +20,12 @@ always goes through the AlphaActuator system.
 Without ``actuation`` the C2 splines feed the vehicle directly. Optimal-control controls (NLP
 solutions):
 
-    TrajectorySource(u(t)) --u--> OptimalControlPlant (SI)
+    TrajectorySource(u(t)) --u--> the problem's dynamics (SI); PlantGuard(h, lon, lat, V, gamma, psi)
+
+the dynamics as a SymbolicVectorSystem evaluated in C++ (planning.ocp_system.native_ocp_plant;
+the guard stops the flight where the Python plant's models would raise) when every model of the
+problem has a symbolic form, else OptimalControlPlant (Python, the reference; tests hold the
+two to each other).
 
 Integration. Through the sampled actuators (whose path has a kink at every 0.02-s sub-step)
 the flight takes fixed RK5 steps of ``period / ENTRY_STEPS_PER_PERIOD``; on the nominal
@@ -35,13 +40,14 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput, TrajectorySource, ZeroOrderHold
+from pydrake.systems.primitives import Demultiplexer, LogVectorOutput, TrajectorySource, ZeroOrderHold
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.diagrams.common import add_step_loggers, collect_trajectory
 from drake_entry.errors import ModelRangeError, NonFiniteStateError, ScenarioError
-from drake_entry.planning.ocp_system import OptimalControlPlant
+from drake_entry.planning.ocp_system import OptimalControlPlant, native_ocp_plant
 from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, OcpControls
+from drake_entry.scenario import PLANTS
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.monitors import PlantGuard
 from drake_entry.systems.native_plant import add_plant, flight_stop
@@ -72,7 +78,8 @@ def fly_controls(controls: EntryControls | OcpControls, *, accuracy: float | Non
         docstring (a reference flight to hold the default to, or a looser study).
       log_points: samples logged over the flight.
       plant: the entry plant: "auto", "native" (systems/native_plant.py, with a PlantGuard) or
-        "python" (systems/native_plant.add_plant).
+        "python" (systems/native_plant.add_plant); for OcpControls the problem's dynamics:
+        "auto" (native when every model has a symbolic form), "native" or "python" (_ocp_plant).
       actuator_systems: fly a command known in advance through the sampled actuator systems
         (a Python call per integrator stage) instead of their precomputed response (the same
         law and segments; the reference the tests hold the default to).
@@ -80,7 +87,7 @@ def fly_controls(controls: EntryControls | OcpControls, *, accuracy: float | Non
     if isinstance(controls, EntryControls):
         return _fly_entry(controls, accuracy, log_points, plant, actuator_systems)
     if isinstance(controls, OcpControls):
-        return _fly_ocp(controls, accuracy or OCP_ACCURACY, log_points)
+        return _fly_ocp(controls, accuracy or OCP_ACCURACY, log_points, plant)
     raise ScenarioError(f"fly_controls flies EntryControls or OcpControls, got {type(controls).__name__}")
 
 
@@ -188,15 +195,50 @@ def _actuated(builder, name: str, command, actuator, t_end: float, as_system: bo
     return actuator.GetOutputPort(name)
 
 
-def _fly_ocp(c: OcpControls, accuracy: float, log_points: int) -> FlownControls:
+#: an entry problem's first states (the vehicle's, in PlantGuard's order)
+ENTRY_STATES = ("h", "lon", "lat", "V", "gamma", "psi")
+
+
+def _ocp_plant(problem, plant: str):
+    """The problem's dynamics as a system (module docstring): ``plant`` "python" the Python
+    OptimalControlPlant, "native" the SymbolicVectorSystem (ScenarioError when a model has no
+    symbolic form), "auto" native where it can be built."""
+    if plant not in PLANTS:
+        raise ScenarioError(f"plant = '{plant}'; allowed: {', '.join(PLANTS)}")
+    native = native_ocp_plant(problem) if plant != "python" else None
+    if native is None and plant == "native":
+        raise ScenarioError("plant = 'native' needs the problem's models in a symbolic form (an aerodynamic table or "
+                            "a user function written with math has none): use 'auto' or 'python'")
+    return OptimalControlPlant(problem) if native is None else native
+
+
+def _guard_entry_states(builder, problem, plant) -> None:
+    """A PlantGuard on a native plant's vehicle states when the problem flies an atmosphere
+    (the range and finiteness checks the Python plant makes inside its derivatives)."""
+    atmosphere = getattr(problem, "atmosphere", None)
+    if isinstance(plant, OptimalControlPlant) or atmosphere is None \
+            or tuple(problem.state_names[:6]) != ENTRY_STATES:
+        return
+    guard = builder.AddNamedSystem("guard", PlantGuard(h_min=atmosphere.h_min, h_max=atmosphere.h_max,
+                                                       model=atmosphere.name, planet=problem.planet))
+    state = plant.get_output_port()
+    if problem.n_states > 6:
+        split = builder.AddSystem(Demultiplexer([6, problem.n_states - 6]))
+        builder.Connect(state, split.get_input_port())
+        state = split.get_output_port(0)
+    builder.Connect(state, guard.get_input_port())
+
+
+def _fly_ocp(c: OcpControls, accuracy: float, log_points: int, plant_kind: str = "auto") -> FlownControls:
     tf = float(c.final_time)
     u = np.asarray(c.controls, float).T
     traj = (_spline(c.time, u) if c.interpolation == "cubic"
             else PiecewisePolynomial.FirstOrderHold(np.asarray(c.time, float), u))
     builder = DiagramBuilder()
     source = builder.AddSystem(TrajectorySource(traj))
-    plant = builder.AddNamedSystem("plant", OptimalControlPlant(c.problem))
+    plant = builder.AddNamedSystem("plant", _ocp_plant(c.problem, plant_kind))
     builder.Connect(source.get_output_port(), plant.get_input_port())
+    _guard_entry_states(builder, c.problem, plant)
     logger = LogVectorOutput(plant.get_output_port(), builder, tf / log_points)
     diagram = builder.Build()
     simulator = Simulator(diagram)

@@ -199,6 +199,59 @@ def test_a_verified_flight_that_leaves_the_atmosphere_model_stops_with_the_reaso
     assert flown.time[-1] < 100.0
 
 
+def test_ocp_controls_fly_the_same_on_the_native_dynamics_and_stop_where_the_python_plant_raises():
+    """An NLP's controls (Betts' shuttle, its propagated guess) flown by the verifier on the
+    problem's dynamics as a SymbolicVectorSystem and as the Python OptimalControlPlant: the same
+    final state (1e-6 relative; the same RK5 steps up to rounding); a bank of 80 deg at zero
+    alpha dives below the exponential model's -5 km, and both flights stop there with the same
+    reason (the native one by its PlantGuard, within one integrator step of the other)."""
+    from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.planning.nlp import catalogue
+    from drake_entry.planning.nlp.guess import initial_guess
+    from drake_entry.planning.ocp_system import native_ocp_plant
+    from drake_entry.planning.verification import OcpControls
+
+    problem, _ = catalogue.shuttle_crossrange()
+    assert native_ocp_plant(problem) is not None  # "auto" flies it natively
+    t, X, U = initial_guess(problem)
+    flown = {k: fly_controls(OcpControls(problem, X[0], float(t[-1]), t, U, "linear"), plant=k)
+             for k in ("python", "native")}
+    assert not flown["python"].failure and not flown["native"].failure
+    end_py, end_native = flown["python"].states[-1], flown["native"].states[-1]
+    assert end_py[0] > 20e3  # a real flight to the guess's end, not a stop
+    np.testing.assert_allclose(end_native, end_py, rtol=1e-6, atol=1e-6)
+    dive = U.copy()
+    dive[:, 0], dive[:, 1] = 0.0, math.radians(80.0)
+    stopped = {k: fly_controls(OcpControls(problem, X[0], 3 * float(t[-1]), 3 * t, dive, "linear"), plant=k)
+               for k in ("python", "native")}
+    for f in stopped.values():
+        assert "outside the exponential range [-5000, 1e+07] m" in f.failure, f.failure
+    assert abs(stopped["native"].time[-1] - stopped["python"].time[-1]) < 0.1
+    assert stopped["native"].time[-1] < float(t[-1])
+
+
+def test_a_native_ocp_flight_is_refused_for_a_model_without_a_symbolic_form():
+    """plant='native' on a problem whose vehicle's aerodynamics are a table look-up: a
+    ScenarioError saying so; 'auto' flies it on the Python plant."""
+    from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.planning.nlp import catalogue
+    from drake_entry.planning.nlp.guess import initial_guess
+    from drake_entry.planning.ocp_system import native_ocp_plant
+    from drake_entry.planning.verification import OcpControls
+
+    problem, _ = catalogue.shuttle_crossrange()
+    alpha_deg, mach = np.array([0.0, 20.0, 40.0, 60.0]), np.array([1.0, 5.0, 10.0, 30.0])
+    cl = np.outer(np.sin(np.radians(alpha_deg)), np.ones(4))
+    problem = dc.replace(problem, vehicle=dc.replace(problem.vehicle, aero=TableAero(alpha_deg=alpha_deg, mach=mach,
+                                                                                      CL=cl, CD=0.1 + cl**2)))
+    assert native_ocp_plant(problem) is None
+    t, X, U = initial_guess(problem)
+    controls = OcpControls(problem, X[0], 100.0, t, U, "linear")
+    with pytest.raises(ScenarioError, match="needs the problem's models in a symbolic form"):
+        fly_controls(controls, plant="native")
+    assert fly_controls(controls, plant="auto").time[-1] == pytest.approx(100.0)
+
+
 # -- helpers ----------------------------------------------------------------------------
 def _dispersed(vehicle):
     return dc.replace(vehicle, mass=vehicle.mass * 1.04, aero=ScaledAero(vehicle.aero, 0.93, 1.07))

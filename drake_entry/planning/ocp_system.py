@@ -1,6 +1,7 @@
-"""OptimalControlPlant: the dynamics of an optimal-control problem as a Drake system, for
-Drake's DirectCollocation (which needs a System converting to AutoDiffXd) and for
-propagating NLP controls with the Simulator.
+"""The dynamics of an optimal-control problem as a Drake system: OptimalControlPlant (Python,
+for Drake's DirectCollocation, which needs a System converting to AutoDiffXd, and the
+reference) and ``native_ocp_plant`` (the same dynamics as a SymbolicVectorSystem evaluated in
+C++, for propagating NLP controls with the Simulator: the verification).
 
 The plant runs in scaled units: state x_s = x / state_scale, input u_s = u / control_scale
 and time t_s = t / time_scale, so dx_s/dt_s = time_scale / state_scale * f(x, u). With all
@@ -13,12 +14,14 @@ Ports:
 from __future__ import annotations
 
 import numpy as np
+from pydrake.symbolic import Expression, Variable
 from pydrake.systems.framework import BasicVector_, ContinuousStateIndex, LeafSystem_
+from pydrake.systems.primitives import SymbolicVectorSystem
 from pydrake.systems.scalar_conversion import TemplateSystem
 
-from drake_entry.errors import DrakeEntryError
+from drake_entry.errors import DrakeEntryError, UnsupportedScalarError
 
-__all__ = ["OptimalControlPlant_", "OptimalControlPlant"]
+__all__ = ["OptimalControlPlant_", "OptimalControlPlant", "native_ocp_plant"]
 
 
 @TemplateSystem.define("OptimalControlPlant_")
@@ -67,3 +70,24 @@ def OptimalControlPlant_(T):
 
 
 OptimalControlPlant = OptimalControlPlant_[None]
+
+
+def native_ocp_plant(problem) -> SymbolicVectorSystem | None:
+    """``problem.dynamics`` (SI) built once with symbolic scalars into a SymbolicVectorSystem:
+    input port 0 the controls u [n_controls], state and output port 0 the state x [n_states],
+    every derivative evaluated in C++ (no Python call per integrator stage). None when a model
+    of the problem has no symbolic form (an aerodynamic table, a user function written
+    with ``math``): the caller then propagates with OptimalControlPlant.
+
+    Unlike OptimalControlPlant it checks no model range (the symbolic atmosphere extends its end
+    pieces, drake_entry.models.atmosphere.Atmosphere.symbolic_profile): a caller that needs the
+    check tests the flown states against the ranges (diagrams.verification does)."""
+    x = [Variable(name) for name in problem.state_names]
+    u = [Variable(f"u{j}") for j in range(problem.n_controls)]
+    try:
+        with np.errstate(all="ignore"):  # numpy's object loops report stray FP flags as warnings
+            f = problem.dynamics(np.array([Expression(v) for v in x]), np.array([Expression(v) for v in u]))
+    except (UnsupportedScalarError, TypeError):
+        return None
+    f = [v if isinstance(v, Expression) else Expression(float(v)) for v in np.ravel(f)]
+    return SymbolicVectorSystem(state=x, input=u, dynamics=f, output=x)

@@ -81,6 +81,30 @@ def test_publish_refuses_a_tree_with_uncommitted_changes_and_names_the_way_out(m
     assert committed_source(False) == "0123456789abcdef0123456789abcdef01234567"
 
 
+def test_systems_and_diagrams_from_another_checkout_are_not_this_commit(tmp_path, monkeypatch):
+    """drake_entry imported from one checkout while another checkout's editable install supplies
+    systems/ and diagrams/ (a worktree on PYTHONPATH): foreign_sources names both, the commit
+    is marked '+changes' and publish refuses, naming the directories and the way out. This
+    checkout's own install has none foreign."""
+    import os
+
+    import drake_entry
+    from drake_entry.campaign import engine
+    from drake_entry.cli.publish import committed_source
+    from drake_entry.errors import DrakeEntryError
+
+    top = os.path.dirname(os.path.dirname(os.path.abspath(drake_entry.__file__)))
+    assert engine.foreign_sources(top) == []
+    assert engine.foreign_sources(str(tmp_path)) == [f"drake_entry.systems from {os.path.join(top, 'systems')}",
+                                                     f"drake_entry.diagrams from {os.path.join(top, 'diagrams')}"]
+    monkeypatch.setattr(engine, "foreign_sources", lambda _: ["drake_entry.systems from /elsewhere/systems"])
+    commit = engine.source_commit()
+    assert commit is not None and commit.endswith("+changes")
+    with pytest.raises(DrakeEntryError, match=r"drake_entry is imported from .* but drake_entry.systems from "
+                                              r"/elsewhere/systems \(another checkout's install\).*pip install -e"):
+        committed_source(False)
+
+
 def test_publish_writes_each_campaign_its_index_and_the_record_of_the_run(tmp_path):
     """A reduced publish (one scenario, two runs, no mission): the campaign with its report, the
     index and published.json with the commit, sizes, seeds and wall times; a bad name is refused

@@ -24,7 +24,7 @@ from drake_entry.campaign.backends import BACKENDS, Task, run_backend
 from drake_entry.campaign.store import CampaignStore
 from drake_entry.errors import Interrupted, ScenarioError
 
-__all__ = ["versions", "session", "source_commit", "task_manifest", "check_backend", "run_cases", "SampleCases"]
+__all__ = ["versions", "session", "source_commit", "foreign_sources", "MAPPED_PACKAGES", "task_manifest", "check_backend", "run_cases", "SampleCases"]
 
 
 def versions() -> dict:
@@ -50,9 +50,31 @@ def session() -> dict:
             "platform": platform.platform(terse=True), "git_commit": source_commit(), **versions()}
 
 
+#: the packages pyproject's package-dir installs inside drake_entry from the checkout's top level
+MAPPED_PACKAGES = (("drake_entry.systems", "systems"), ("drake_entry.diagrams", "diagrams"))
+
+
+def foreign_sources(top: str) -> list[str]:
+    """The mapped packages (MAPPED_PACKAGES) imported from outside the checkout ``top``, as
+    'name from directory': with drake_entry taken from one checkout (e.g. PYTHONPATH) and
+    another checkout's editable install on the path, systems/ and diagrams/ come from that other
+    checkout, so the commit of drake_entry alone does not name the code that ran."""
+    import importlib.util
+
+    foreign = []
+    for name, folder in MAPPED_PACKAGES:
+        spec = importlib.util.find_spec(name)
+        where = os.path.dirname(spec.origin) if spec is not None and spec.origin else None
+        mine = os.path.join(top, folder)
+        if where is None or not os.path.isdir(mine) or not os.path.samefile(where, mine):
+            foreign.append(f"{name} from {where}")
+    return foreign
+
+
 def source_commit() -> str | None:
     """The git commit of the drake_entry source tree (with '+changes' when it has uncommitted
-    ones), or None when the package is not a git checkout."""
+    ones, or when systems/ or diagrams/ are imported from another checkout: ``foreign_sources``),
+    or None when the package is not a git checkout."""
     here = os.path.dirname(os.path.abspath(drake_entry.__file__))
     try:
         top = subprocess.run(["git", "-C", here, "rev-parse", "--show-toplevel"], capture_output=True, text=True,
@@ -64,7 +86,8 @@ def source_commit() -> str | None:
                                capture_output=True, text=True, timeout=10)
     except (OSError, subprocess.SubprocessError):
         return None
-    return head.stdout.strip() + ("+changes" if dirty.stdout.strip() else "") if head.returncode == 0 else None
+    changed = bool(dirty.stdout.strip()) or bool(foreign_sources(top.stdout.strip()))
+    return head.stdout.strip() + ("+changes" if changed else "") if head.returncode == 0 else None
 
 
 def task_manifest(task: Task, cases: list, **extra) -> dict:

@@ -33,16 +33,25 @@ CAMPAIGN_SEED, COMPARISON_SEED = 2018, 2026
 
 def committed_source(allow_changes: bool) -> str:
     """The commit of the drake_entry source tree; DrakeEntryError when it has uncommitted
-    changes or is not a git checkout, unless ``allow_changes``."""
-    from drake_entry.campaign.engine import source_commit
+    changes, runs with another checkout's systems/ or diagrams/ (engine.foreign_sources) or is
+    not a git checkout, unless ``allow_changes``."""
+    import drake_entry
+    from drake_entry.campaign.engine import foreign_sources, source_commit
 
     commit = source_commit()
-    if not allow_changes and (commit is None or commit.endswith("+changes")):
-        where = ("is not a git checkout (an installed wheel: publish from a clone, `pip install -e .`)"
-                 if commit is None else f"has uncommitted changes ({commit})")
-        raise DrakeEntryError(f"publish: the drake_entry source tree {where}; commit first, so that every published "
-                              "report names the commit that made it, or pass --allow-changes")
-    return commit or "not a git checkout"
+    if allow_changes or (commit is not None and not commit.endswith("+changes")):
+        return commit or "not a git checkout"
+    if commit is None:
+        raise DrakeEntryError("publish: the drake_entry source tree is not a git checkout (an installed wheel: publish "
+                              "from a clone, `pip install -e .`), or pass --allow-changes")
+    top = os.path.dirname(os.path.dirname(os.path.abspath(drake_entry.__file__)))
+    foreign = foreign_sources(top)
+    if foreign:
+        raise DrakeEntryError(f"publish: drake_entry is imported from {top} but {' and '.join(foreign)} (another "
+                              f"checkout's install), so no one commit names the code: install this checkout in its "
+                              f"own environment (`pip install -e {top}`), or pass --allow-changes")
+    raise DrakeEntryError(f"publish: the drake_entry source tree has uncommitted changes ({commit}); commit first, so "
+                          "that every published report names the commit that made it, or pass --allow-changes")
 
 
 def _checked(names, allowed, flag: str) -> list[str]:

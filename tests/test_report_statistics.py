@@ -215,6 +215,8 @@ def test_path_figure_draws_failed_samples_on_top_and_the_total_load_where_limite
     bounds = sorted(line.get_ydata()[0] for line in axes[-1].get_lines() if line.get_linestyle() == ":")
     assert bounds == pytest.approx([-30.0, 0.5]) and axes[-1].get_ylabel() == "flight path [deg]"
     assert min(axes[-1].get_lines()[1].get_ydata()) == pytest.approx(-31.0)  # the failed dive, past -30
+    legend = [t.get_text() for t in axes[0].get_legend().get_texts()]
+    assert legend[:2] == ["successful (1)", "not successful (1)"], legend  # both groups named with their counts
 
 
 def test_drag_figure_shows_the_tracking_error_with_the_failed_samples_on_top(tmp_path):

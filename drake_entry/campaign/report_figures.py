@@ -280,8 +280,8 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits
     fig, axes = plt.subplots(1, len(panels), figsize=(4.7 * len(panels), 4.0))
     for ax, (col, quantity, scale, label, lim, unit) in zip(axes, panels):
         v = np.asarray(traj[col], float) * scale
-        for g in groups:
-            ax.plot(e[g], v[g], lw=0.4, alpha=0.4, color="C0")
+        for k, g in enumerate(groups):
+            ax.plot(e[g], v[g], lw=0.4, alpha=0.4, color="C0", label=f"successful ({len(groups)})" if k == 0 else None)
         for k, g in enumerate(bad):
             ax.plot(e[g], v[g], lw=0.9, alpha=0.9, color="C3", label=f"not successful ({len(bad)})" if k == 0 else None)
         top = float(np.nanmax(v)) if v.size else 0.0
@@ -336,9 +336,9 @@ def drag_profiles(traj: dict, out_dir: str, title: str, failed=()) -> tuple[str,
     engaged = np.flatnonzero(ref > 0)
     error = np.full(D.shape, np.nan)
     error[engaged] = 100.0 * (D[engaged] / ref[engaged] - 1.0)
-    for g in good:
+    for k, g in enumerate(good):
         g = g[ref[g] > 0]
-        ax_err.plot(e[g], error[g], lw=0.4, alpha=0.4, color="C0")
+        ax_err.plot(e[g], error[g], lw=0.4, alpha=0.4, color="C0", label=f"successful ({len(good)})" if k == 0 else None)
     for k, g in enumerate(bad):  # the failed ones last: on top
         g = g[ref[g] > 0]
         ax_err.plot(e[g], error[g], lw=0.9, alpha=0.9, color="C3", label=f"not successful ({len(bad)})" if k == 0 else None)

@@ -89,14 +89,17 @@ def test_systems_and_diagrams_from_another_checkout_are_not_this_commit(tmp_path
     import os
 
     import drake_entry
+    import drake_entry.diagrams
+    import drake_entry.systems
     from drake_entry.campaign import engine
     from drake_entry.cli.publish import committed_source
     from drake_entry.errors import DrakeEntryError
 
     top = os.path.dirname(os.path.dirname(os.path.abspath(drake_entry.__file__)))
-    assert engine.foreign_sources(top) == []
-    assert engine.foreign_sources(str(tmp_path)) == [f"drake_entry.systems from {os.path.join(top, 'systems')}",
-                                                     f"drake_entry.diagrams from {os.path.join(top, 'diagrams')}"]
+    assert engine.foreign_sources(top) == []  # a checkout (top/systems) or an installed wheel (inside drake_entry/)
+    systems, diagrams = (os.path.dirname(os.path.abspath(m.__file__)) for m in (drake_entry.systems, drake_entry.diagrams))
+    assert engine.foreign_sources(str(tmp_path)) == [f"drake_entry.systems from {systems}",
+                                                     f"drake_entry.diagrams from {diagrams}"]
     monkeypatch.setattr(engine, "foreign_sources", lambda _: ["drake_entry.systems from /elsewhere/systems"])
     commit = engine.source_commit()
     assert commit is not None and commit.endswith("+changes")

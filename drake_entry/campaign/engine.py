@@ -55,18 +55,20 @@ MAPPED_PACKAGES = (("drake_entry.systems", "systems"), ("drake_entry.diagrams", 
 
 
 def foreign_sources(top: str) -> list[str]:
-    """The mapped packages (MAPPED_PACKAGES) imported from outside the checkout ``top``, as
-    'name from directory': with drake_entry taken from one checkout (e.g. PYTHONPATH) and
-    another checkout's editable install on the path, systems/ and diagrams/ come from that other
-    checkout, so the commit of drake_entry alone does not name the code that ran."""
+    """The mapped packages (MAPPED_PACKAGES) imported from outside ``top`` (the directory that
+    holds drake_entry/), as 'name from directory': with drake_entry taken from one checkout (e.g.
+    PYTHONPATH) and another checkout's editable install on the path, systems/ and diagrams/ come
+    from that other checkout, so the commit of drake_entry alone does not name the code that ran.
+    Their own places: ``top/systems`` in a checkout, ``top/drake_entry/systems`` in an installed
+    wheel."""
     import importlib.util
 
     foreign = []
     for name, folder in MAPPED_PACKAGES:
         spec = importlib.util.find_spec(name)
         where = os.path.dirname(spec.origin) if spec is not None and spec.origin else None
-        mine = os.path.join(top, folder)
-        if where is None or not os.path.isdir(mine) or not os.path.samefile(where, mine):
+        homes = [os.path.join(top, folder), os.path.join(top, "drake_entry", folder)]
+        if where is None or not any(os.path.isdir(h) and os.path.samefile(where, h) for h in homes):
             foreign.append(f"{name} from {where}")
     return foreign
 

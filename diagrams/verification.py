@@ -45,6 +45,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.diagrams.common import add_step_loggers, collect_trajectory
 from drake_entry.errors import ModelRangeError, NonFiniteStateError, ScenarioError
+from drake_entry.models.dynamics import STATE_NAMES
 from drake_entry.planning.ocp_system import OptimalControlPlant, native_ocp_plant
 from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, OcpControls
 from drake_entry.scenario import PLANTS
@@ -195,10 +196,6 @@ def _actuated(builder, name: str, command, actuator, t_end: float, as_system: bo
     return actuator.GetOutputPort(name)
 
 
-#: an entry problem's first states (the vehicle's, in PlantGuard's order)
-ENTRY_STATES = ("h", "lon", "lat", "V", "gamma", "psi")
-
-
 def _ocp_plant(problem, plant: str):
     """The problem's dynamics as a system (module docstring): ``plant`` "python" the Python
     OptimalControlPlant, "native" the SymbolicVectorSystem (ScenarioError when a model has no
@@ -217,7 +214,7 @@ def _guard_entry_states(builder, problem, plant) -> None:
     (the range and finiteness checks the Python plant makes inside its derivatives)."""
     atmosphere = getattr(problem, "atmosphere", None)
     if isinstance(plant, OptimalControlPlant) or atmosphere is None \
-            or tuple(problem.state_names[:6]) != ENTRY_STATES:
+            or tuple(problem.state_names[:6]) != STATE_NAMES:
         return
     guard = builder.AddNamedSystem("guard", PlantGuard(h_min=atmosphere.h_min, h_max=atmosphere.h_max,
                                                        model=atmosphere.name, planet=problem.planet))

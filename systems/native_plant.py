@@ -32,7 +32,7 @@ from drake_entry.errors import ModelRangeError, NonFiniteStateError, ScenarioErr
 from drake_entry.models import dynamics
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
-from drake_entry.models.symbolic_system import stateless
+from drake_entry.models.symbolic_system import expression, stateless
 from drake_entry.models.vehicles import Vehicle
 from drake_entry.scenario import PLANTS
 from drake_entry.systems.atmosphere import AtmosphereSystem
@@ -105,7 +105,7 @@ class NativeEntryVehicle(Diagram):
         motion = builder.AddNamedSystem("equations_of_motion", SymbolicVectorSystem(
             state=DEVIATION, input=[BANK, ALPHA, *air], dynamics=list(xdot), output=x))
         cond = builder.AddNamedSystem("flight_conditions", stateless([*STATE, ALPHA, *air],
-                                                                     [_expression(c) for c in conditions]))
+                                                                     [expression(c) for c in conditions]))
         inputs = [("alpha", 1), ("air_data", 2)] + ([("wind", 2)] if winds else [])
         sizes = [n for _, n in inputs] + ([len(AIR_VELOCITY)] if winds else [])
         controls = builder.AddNamedSystem("controls", Multiplexer([1] + sizes))
@@ -161,10 +161,6 @@ def flight_stop(error: BaseException) -> BaseException | None:
     if isinstance(e, ValueError) and not isinstance(e, ModelRangeError):
         return None
     return e
-
-
-def _expression(v):
-    return v if isinstance(v, Expression) else Expression(float(v))
 
 
 def add_plant(builder, vehicle: Vehicle, planet: Earth, atmosphere: Atmosphere, *, initial_state,

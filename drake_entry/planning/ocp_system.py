@@ -20,6 +20,7 @@ from pydrake.systems.primitives import SymbolicVectorSystem
 from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drake_entry.errors import DrakeEntryError, UnsupportedScalarError
+from drake_entry.models.symbolic_system import expression
 
 __all__ = ["OptimalControlPlant_", "OptimalControlPlant", "native_ocp_plant"]
 
@@ -89,5 +90,4 @@ def native_ocp_plant(problem) -> SymbolicVectorSystem | None:
             f = problem.dynamics(np.array([Expression(v) for v in x]), np.array([Expression(v) for v in u]))
     except (UnsupportedScalarError, TypeError):
         return None
-    f = [v if isinstance(v, Expression) else Expression(float(v)) for v in np.ravel(f)]
-    return SymbolicVectorSystem(state=x, input=u, dynamics=f, output=x)
+    return SymbolicVectorSystem(state=x, input=u, dynamics=[expression(v) for v in np.ravel(f)], output=x)

@@ -119,6 +119,13 @@ def test_report_is_self_contained_with_provenance_requirements_and_bounds(tmp_pa
     summary = json.load(open(f"{out}/summary.json"))
     assert summary["success_lower_bound"]["0.9"] == pytest.approx(0.1 ** 0.5)
     assert summary["distributions"]["err_distance_m"]["n"] == 2
+    # resumed at another commit: the report names both, and each run's
+    manifest["sessions"][0]["git_commit"] = "0" * 40
+    with open(f"{out}/campaign.json", "w") as f:
+        json.dump(manifest, f)
+    provenance = open(write_report(out)).read().split("## Dispersions")[0]
+    assert f"| 0.1.0, commits {'0' * 40}, " in provenance and "resumed at another commit" in provenance
+    assert "` at commit 0000000;" in provenance  # the first run's
 
 
 def test_campaign_without_trajectories_keeps_rows_only(tmp_path):

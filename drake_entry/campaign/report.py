@@ -429,12 +429,17 @@ def _provenance(meta: dict, stats: dict) -> str:
                f"--seed {meta.get('seed', '?')} --trajectory-step {meta.get('trajectory_step_s', '?')}"
                + "".join(" --set " + shlex.quote(f"{k}={val if isinstance(val, str) else json.dumps(val)}")
                          for k, val in overrides.items()) + " --out DIR")
-    commit = last.get("git_commit") or "not recorded (an installed package, not a git checkout)"
-    rows = [("drake_entry", f"{v.get('drake_entry', '?')}, commit {commit}"),
+    commits = list(dict.fromkeys(s.get("git_commit") or "not recorded (an installed package, not a git checkout)"
+                                 for s in sessions)) or ["not recorded (an installed package, not a git checkout)"]
+    flown = (f"commit {commits[0]}" if len(commits) == 1 else
+             f"commits {', '.join(commits)} (the campaign was resumed at another commit: each run's is below)")
+    rows = [("drake_entry", f"{v.get('drake_entry', '?')}, {flown}"),
             ("Drake", f"{v.get('drake', '?')} (its build carries the solvers: Clarabel, SCS, Ipopt, SNOPT)"),
             ("Python, NumPy, SciPy", ", ".join(str(last.get(k, "not recorded")) for k in ("python", "numpy", "scipy"))),
             ("platform", str(last.get("platform", "not recorded"))),
-            ("runs of the campaign", "; ".join(f"{s.get('date_utc', '?')}: `{s.get('command', '')}`" for s in sessions)
+            ("runs of the campaign", "; ".join(f"{s.get('date_utc', '?')}: `{s.get('command', '')}`"
+                                               + (f" at commit {str(s.get('git_commit'))[:7]}" if len(commits) > 1 else "")
+                                               for s in sessions)
              or "not recorded (a campaign written before the provenance record)"),
             ("scenario", f"`{meta.get('scenario', '?')}`, as flown (overrides applied) sha256 {digest[:16]}…"),
             ("overrides", ", ".join(f"{k} = {val}" for k, val in overrides.items()) or "none"),

@@ -13,9 +13,7 @@ REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "docs" / "results"
 
 #: reports made before results were published from a committed tree: path below docs/results -> why
-STALE = {
-    "paper002_guidance/report.md": "commit not recorded",
-}
+STALE: dict = {}
 
 COMMIT = re.compile(r"commit ([0-9a-f]{7,40})(\+changes)?")
 

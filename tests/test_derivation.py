@@ -74,6 +74,23 @@ def test_drag_energy_re_plans_in_the_sensed_air_where_the_mission_disperses_the_
     assert not derivation_for(load_scenario("horus2b"), DragEnergy).spec.replan_model_scales
 
 
+def test_drag_energy_re_plans_from_its_reference_kept_off_the_corridor_bounds_with_a_wider_reversal_corridor():
+    """The derived drag-energy guidance re-plans from the reference (not paper 000's flown drag),
+    keeps its profile off the corridor's bounds (weight 1000, then 0 searched) and tries its
+    reversal corridor widened at the upper speed first, then the mission's own (Lu 2014's CAV-H:
+    FNPEG's 3-15 deg tried as 3-25 first)."""
+    from drake_entry.guidance.drag_energy.derive import CENTRING_CANDIDATES
+    from drake_entry.guidance.drag_energy.spec import DragEnergy
+
+    d = derivation_for(load_scenario("cav_h_fnpeg"), DragEnergy)
+    assert d.spec.replan_start == "reference" and d.spec.corridor_centring == 1000.0
+    steps = {s.name: s for s in d.search}
+    assert [c["guidance.corridor_centring"] for c in steps["guidance.corridor_centring"].candidates] == list(
+        CENTRING_CANDIDATES) == [1000.0, 0.0]
+    corridors = [c["guidance.reversal_heading_deg"] for c in steps["guidance.reversal_heading_deg"].candidates]
+    assert corridors == [[3.0, 25.0], [3.0, 15.0]] and d.spec.reversal_heading_deg == [3.0, 25.0]
+
+
 def test_derivation_is_deterministic():
     scenario = load_scenario("horus2b")
     for spec in REGISTRY:

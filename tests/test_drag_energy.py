@@ -220,6 +220,74 @@ def test_drag_inversion_from_a_neighbour_guess_equals_the_bracketed_root(planner
         assert drag_acceleration(h_s, V_s, c.alpha[i], planner.vehicle, planner.atmosphere) == pytest.approx(D, rel=1e-8)
 
 
+def _corridor_shares(ref):
+    """(lambda, ramp) at the nodes: I's distance from the I of D_max as a share of the corridor's
+    width in I, and the centring ramp (0 at the ends, 1 from a tenth of the span in)."""
+    p, op = ref.problem, ref.lgl
+    lo, hi = p.corridor.bounds(op.x)
+    lam = (ref.I - 1.0 / hi) / (1.0 / lo - 1.0 / hi)
+    e = (op.x - op.x[0]) / (op.x[-1] - op.x[0])
+    return lam, np.clip(np.minimum(e, 1.0 - e) / 0.1, 0.0, 1.0)
+
+
+def test_corridor_centring_keeps_every_node_its_share_from_both_bounds(planner, engagement_state):
+    """With the centring weight the profile keeps the share m of the corridor's width (in 1/D)
+    from both bounds at every node (ramped at the fixed ends), m grows with the weight and lies
+    above the paper's smoothest profile's least share, the range and the end conditions
+    (eqs. 83-85) still hold, and eq. 92's smoothness is paid for it (never below the paper's)."""
+    paper = planner.plan_from_state(engagement_state)
+    shares = {}
+    for weight in (100.0, 1000.0):
+        ref = planner.plan_from_state(engagement_state, centring=weight)
+        assert ref.success, ref.message
+        lam, ramp = _corridor_shares(ref)
+        m = shares[weight] = ref.corridor_share
+        assert np.all(lam >= m * ramp - 1e-7) and np.all(1.0 - lam >= m * ramp - 1e-7)
+        assert ref.range_flown() == pytest.approx(ref.problem.range_to_go, rel=1e-6)
+        assert 1.0 / ref.I[0] == pytest.approx(paper.problem.D0, rel=1e-7) and ref.D[-1] == pytest.approx(
+            paper.problem.Df, rel=1e-6)
+        assert ref.objective >= paper.objective * (1 - 1e-6)
+    lam0, ramp0 = _corridor_shares(paper)
+    least_paper = float(np.min(np.minimum(lam0, 1.0 - lam0)[ramp0 == 1.0]))
+    assert least_paper < shares[100.0] < shares[1000.0] < 0.5
+    assert math.isnan(paper.corridor_share)
+
+
+def test_a_re_plan_from_the_reference_starts_at_its_drag_and_slope_not_the_flown_one(planner, engagement_state):
+    """replan_start: a re-plan from a state 1 km lower than planned starts (eq. 84) at the
+    previous reference's drag and slope at that energy with "reference", at the flown drag with
+    "flown" (paper 000's, as the first plan)."""
+    import copy
+
+    first = planner.plan_from_state(engagement_state)
+    later = engagement_state.copy()
+    later[0] -= 1000.0
+    E = planner.energy(later)
+    D_ref, Dp_ref, _ = first.profile(E)
+    flown = planner.plan_from_state(later, previous=first)
+    assert flown.success and 1.0 / flown.I[0] == pytest.approx(planner.drag_state(later).D, rel=1e-7)
+    assert abs(planner.drag_state(later).D / D_ref[0] - 1.0) > 0.01  # the two starts differ
+    from_reference = copy.copy(planner)
+    from_reference.replan_start = "reference"
+    ref = from_reference.plan_from_state(later, previous=first)
+    assert ref.success, ref.message
+    D, Dp, _ = ref.profile(E)
+    assert D[0] == pytest.approx(D_ref[0], rel=1e-7) and Dp[0] == pytest.approx(Dp_ref[0], rel=1e-4)
+    assert from_reference.plan_from_state(later).I[0] == pytest.approx(flown.I[0])  # no previous: the flown drag
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("guidance.replan_start", "'now'", r"guidance.replan_start 'now' is unknown; allowed: flown, reference"),
+    ("guidance.corridor_centring", "-1", r"guidance.corridor_centring"),
+])
+def test_drag_energy_refuses_an_unknown_re_plan_start_and_a_negative_centring(field, value, message):
+    from drake_entry.errors import ScenarioError
+    from drake_entry.scenario import apply_overrides
+
+    with pytest.raises(ScenarioError, match=message):
+        apply_overrides(load_scenario("horus2b"), {field: value})
+
+
 def test_replan_where_clarabel_stalls_without_refinement_still_succeeds(planner):
     """A re-plan from a dispersed flight (tests/data) on which Clarabel with iterative
     refinement off (the planner's fast setting) stops with InsufficientProgress: the planner

@@ -98,6 +98,10 @@ class DragEnergyProblem:
     initial_tolerance: float = 0.03
     # first guess of the ground-range weight kappa(E) (e.g. from the previous plan), or None
     kappa_guess: object = None
+    # corridor centring (not paper 000's; 0: the paper's smoothness alone): the weight of the least
+    # share m of the corridor's width in I = 1/D that the profile keeps from both bounds, in the
+    # cost s' + s'' - centring * m (eq. 92 is dimensionless in the scaled I: see _add_centring)
+    centring: float = 0.0
 
     def validate(self):
         if not self.E0 > self.Ef:
@@ -140,6 +144,7 @@ class DragEnergyReference(PlanResult):
     kappa: np.ndarray | None = None
     solver: str = ""
     binding: list = field(default_factory=list)  # which bounds bind, where (diagnosis)
+    corridor_share: float = math.nan  # centring: the share of the corridor's width kept from each bound
     _nodal: np.ndarray | None = field(default=None, repr=False)
     _extraction: Extraction | None = field(default=None, repr=False)
 
@@ -301,29 +306,10 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
         A[1:, 1:] = Dk / norms[k]
         prog.AddLorentzConeConstraint(A, np.zeros(n + 1), np.concatenate([[s[k]], I]))
     prog.AddLinearCost(norms / norms[1], 0.0, s)  # eq. 92 (divided by |D2| if conditioned)
+    m = (_add_centring(prog, op, I, scale / D_hi, scale / D_lo, p.centring / norms[1])  # as eq. 92's cost
+         if p.centring > 0.0 else None)
     t1 = time.perf_counter()
-    solver = SOLVERS[p.solver]()
-    options = SolverOptions()
-    if p.solver == "scs":
-        for k, v in SCS_OPTIONS.items():
-            options.SetOption(solver.solver_id(), k, v)
-    else:  # Clarabel's iterative refinement of each KKT solve took about 30 % of the solve time here
-        # and moved the 40-node solution by 5e-9 (relative); _check_solution verifies the result.
-        # Without it Clarabel stalled (InsufficientProgress) in about 1 of 170 re-plans: then
-        # the problem is solved again with Clarabel's defaults.
-        options.SetOption(solver.solver_id(), "iterative_refinement_enable", False)
-    if p.solver == "clarabel":
-        drake_log = logging.getLogger("drake")
-        level = drake_log.level
-        drake_log.setLevel(logging.WARNING)  # the fast attempt's rare stall is expected: no INFO line
-        try:
-            result = solver.Solve(prog, None, options)
-        finally:
-            drake_log.setLevel(level)
-        if not result.is_success():
-            result = solver.Solve(prog, None, SolverOptions())
-    else:
-        result = solver.Solve(prog, None, options)
+    result = _solve(prog, p.solver)
     t2 = time.perf_counter()
     ok = result.is_success()
     details = result.get_solver_details()
@@ -336,7 +322,56 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
             ok, msg = False, f"{p.solver} returned an inaccurate solution: {problem_msg}"
     return DragEnergyReference(success=ok, message=msg, problem=p, lgl=op, I=I_sol if ok else None, solver=p.solver,
                                build_time=t1 - t0, solve_time=t2 - t1, iterations=iters,
-                               objective=_smoothness(op, I_sol) if ok else math.nan)
+                               objective=_smoothness(op, I_sol) if ok else math.nan,
+                               corridor_share=float(result.GetSolution(m)[0]) if ok and m is not None else math.nan)
+
+
+def _solve(prog: MathematicalProgram, solver_name: str):
+    """Solve with Clarabel (fast options, then its defaults on a stall) or SCS (``SCS_OPTIONS``)."""
+    solver = SOLVERS[solver_name]()
+    options = SolverOptions()
+    if solver_name == "scs":
+        for k, v in SCS_OPTIONS.items():
+            options.SetOption(solver.solver_id(), k, v)
+        return solver.Solve(prog, None, options)
+    # Clarabel's iterative refinement of each KKT solve took about 30 % of the solve time here
+    # and moved the 40-node solution by 5e-9 (relative); _check_solution verifies the result.
+    # Without it Clarabel stalled (InsufficientProgress) in about 1 of 170 re-plans: then
+    # the problem is solved again with Clarabel's defaults.
+    options.SetOption(solver.solver_id(), "iterative_refinement_enable", False)
+    drake_log = logging.getLogger("drake")
+    level = drake_log.level
+    drake_log.setLevel(logging.WARNING)  # the fast attempt's rare stall is expected: no INFO line
+    try:
+        result = solver.Solve(prog, None, options)
+    finally:
+        drake_log.setLevel(level)
+    return result if result.is_success() else solver.Solve(prog, None, SolverOptions())
+
+
+def _add_centring(prog, op: LGL, I_top, I_hi, I_lo, weight: float):
+    """The corridor-centring term (not paper 000's): a margin m in [0, 1/2], every node's scaled
+    I at least m r_k of the corridor's width in I inside both bounds, and the cost -weight * m
+    beside eq. 92. The ramp r_k grows from 0 at the first and last nodes (fixed by eqs. 84-85)
+    to 1 a tenth of the energy span in. Eq. 92's s' + s'' is taken on I scaled by D0 and in the
+    normalised tau, so both terms are dimensionless; at 40 nodes a weight of 1000 keeps about
+    four fifths of the largest margin the range allows (Lu 2014's CAV-H at engagement: m = 0.24
+    of a largest 0.30), 100 about three fifths. Returns m."""
+    m = prog.NewContinuousVariables(1, "m")
+    prog.AddBoundingBoxConstraint(0.0, 0.5, m)
+    e = (op.x - op.x[0]) / (op.x[-1] - op.x[0])
+    ramp = np.clip(np.minimum(e, 1.0 - e) / 0.1, 0.0, 1.0)
+    width = I_lo - I_hi
+    n = len(op.x)
+    k = np.flatnonzero(ramp > 0.0)
+    A = np.zeros((len(k), n + 1))
+    A[np.arange(len(k)), k] = 1.0
+    A[:, n] = -ramp[k] * width[k]  # I_k - m r_k w_k >= I_hi
+    prog.AddLinearConstraint(A, I_hi[k], np.full(len(k), np.inf), np.concatenate([I_top, m]))
+    A[:, n] = ramp[k] * width[k]  # I_k + m r_k w_k <= I_lo
+    prog.AddLinearConstraint(A, np.full(len(k), -np.inf), I_lo[k], np.concatenate([I_top, m]))
+    prog.AddLinearCost([-weight], 0.0, m)
+    return m
 
 
 def _smoothness(op: LGL, I) -> float:
@@ -525,7 +560,7 @@ class DragEnergyPlanner:
                  target_lon: float, target_lat: float, E_entry: float, E_final: float, n_nodes: int = 40,
                  solver: str = "clarabel", margin: float = 0.03, corridor_points: int = 300,
                  sigma_max: float | None = None, terminal_drag: float | None = None,
-                 terminal_state: tuple | None = None):
+                 terminal_state: tuple | None = None, replan_start: str = "flown", centring: float = 0.0):
         if alpha.variable != "energy":
             raise ScenarioError(f"the drag-energy planner needs alpha scheduled in energy, got '{alpha.variable}'")
         self.vehicle, self.atmosphere, self.alpha = vehicle, atmosphere, alpha
@@ -535,6 +570,8 @@ class DragEnergyPlanner:
         self.terminal_drag = terminal_drag  # D_f of eq. 85, or None (free)
         self.terminal_state = terminal_state  # (h_f [m], V_f [m/s]): where D_f is taken (sensed re-plans)
         self.n_nodes, self.solver = n_nodes, solver
+        self.replan_start = replan_start  # DragEnergy.replan_start: "flown" or "reference"
+        self.centring = centring  # DragEnergy.corridor_centring
         self.sigma_max = vehicle.bank_limit if sigma_max is None else sigma_max
         E = np.linspace(E_final, E_entry + 0.02 * (E_entry - E_final), corridor_points)
         self.margin = margin
@@ -579,7 +616,8 @@ class DragEnergyPlanner:
             alpha=scenario.schedule("alpha"), target_lon=math.radians(scenario.target.longitude_deg),
             target_lat=math.radians(scenario.target.latitude_deg), E_entry=scenario.entry_energy(), E_final=Ef,
             n_nodes=g.n_nodes, solver=g.solver, margin=g.corridor_margin, corridor_points=g.corridor_points,
-            terminal_drag=D_f, terminal_state=(h_f, V_f))
+            terminal_drag=D_f, terminal_state=(h_f, V_f), replan_start=g.replan_start,
+            centring=g.corridor_centring)
 
     def energy(self, x) -> float:
         return float(self.planet.specific_energy(x[0], x[3]))
@@ -610,13 +648,20 @@ class DragEnergyPlanner:
                   corridor=self.corridor, E0=self.energy(x), Ef=self.E_final, D0=d.D, D0_prime=d.D_prime,
                   range_to_go=self.range_to_go(x), lat0=float(x[2]), latf=self.target[1],
                   heading0=float(x[5]), headingf=bearing(x[1], x[2], *self.target), Df=self.terminal_drag,
-                  n_nodes=self.n_nodes, solver=self.solver, sigma_max=self.sigma_max)
+                  n_nodes=self.n_nodes, solver=self.solver, sigma_max=self.sigma_max, centring=self.centring)
         kw.update(overrides)
         return DragEnergyProblem(**kw)
 
     def plan_from_state(self, x, previous: DragEnergyReference | None = None, sensed_drag: float | None = None,
                         **overrides) -> DragEnergyReference:
-        """Plan from state x; a successful ``previous`` plan seeds kappa(E), so one SOCP suffices."""
+        """Plan from state x; a successful ``previous`` plan seeds kappa(E), so one SOCP suffices.
+        With ``replan_start`` "reference" a re-plan (``previous`` given) starts at the previous
+        reference's drag and slope at the flight's energy (eq. 84 at the reference), so the
+        tracking law keeps correcting its error: started at the flown drag, every re-plan adopts
+        the error and a drift of the drag (a phugoid on a long glide) is planned around."""
         if previous is not None and previous.success and previous.kappa is not None:
             overrides = {"kappa_guess": previous.kappa_at, "range_iterations": 1, **overrides}
+        if previous is not None and previous.success and self.replan_start == "reference":
+            D, D_prime, _ = previous.profile(self.energy(x))
+            overrides = {"D0": float(D[0]), "D0_prime": float(D_prime[0]), **overrides}
         return plan(self.problem(x, sensed_drag, **overrides))

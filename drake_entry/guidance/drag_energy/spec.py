@@ -6,7 +6,10 @@ import dataclasses as dc
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
 
-__all__ = ["DragEnergy"]
+__all__ = ["DragEnergy", "REPLAN_STARTS"]
+
+#: where a re-plan's initial drag and slope come from (DragEnergy.replan_start)
+REPLAN_STARTS = ("flown", "reference")
 
 
 @dc.dataclass
@@ -30,6 +33,13 @@ class DragEnergy(ReversingBankSpec, ReplansOnBoard):
     # the lift and drag ratios the flight has sensed (its q and heat-rate limits divided by the
     # sensed density ratio, as SCvx's re-plans hold them)
     replan_model_scales: bool = False
+    # where each re-plan starts (eq. 84's initial drag and slope): "flown", the drag and slope
+    # the vehicle has (as the first plan); "reference", the current reference's at the flight's
+    # energy, so a tracking error is left to the tracking law and is not built into the new plan
+    replan_start: str = "flown"
+    # corridor centring (not paper 000's; 0: the paper's smoothest profile): the weight of the
+    # profile's least distance from both bounds beside eq. 92 (DragEnergyProblem.centring)
+    corridor_centring: float = 0.0
     # drag tracking (eq. 101), energy domain: zeta < 0 because E decreases (paper 000 Sec. VI.D)
     zeta: float = -0.7
     # pseudo-frequency omega_D [1/(J/kg)] = 2 pi / (energy per oscillation) (paper 000: constant)
@@ -50,8 +60,12 @@ class DragEnergy(ReversingBankSpec, ReplansOnBoard):
         check_range("guidance.bandwidth_rad_s", self.bandwidth_rad_s, 0.0, 10.0)
         check_range("guidance.replan_until_e", self.replan_until_e, 0.0, 1.0)
         check_range("guidance.corridor_margin", self.corridor_margin, 0.0, 0.49)
+        check_range("guidance.corridor_centring", self.corridor_centring, 0.0, 1e5)
         check_range("guidance.corridor_points", self.corridor_points, 20, 100000)
         check_range("guidance.pre_guidance_min_s", self.pre_guidance_min_s, 0.0, 1e5)
         check_range("guidance.pre_guidance_bank_deg", self.pre_guidance_bank_deg, -180.0, 180.0)
+        if self.replan_start not in REPLAN_STARTS:
+            raise ScenarioError(f"guidance.replan_start '{self.replan_start}' is unknown; allowed: "
+                                f"{', '.join(REPLAN_STARTS)}")
         if self.solver not in ("clarabel", "scs"):
             raise ScenarioError(f"guidance.solver '{self.solver}' is unknown; allowed: clarabel, scs")

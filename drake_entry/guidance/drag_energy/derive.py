@@ -4,6 +4,7 @@ reversal corridor, re-plans from the reference; the interface's altitude, the co
 the corridor centring and the reversal corridor's width searched (paper 000's corridor closes
 where the vehicle's limits meet: the altitude that keeps it open is the mission's)."""
 
+import dataclasses as dc
 import math
 
 import numpy as np
@@ -82,6 +83,8 @@ def derive(scenario) -> Derivation:
     mach = interface.mach
     heading, velocity, corridor = reversal_corridor(scenario)
     widened = [heading[0], round(heading[1] * REVERSAL_WIDENING, 3)]
+    corridor = dc.replace(corridor, how=f"{corridor.how}; its half-width at the upper speed is searched, "
+                                        f"{widened[1]:g} deg first")
     breakpoints, values, alpha_how = alpha_rewritten(scenario, interface, "normalized_energy")
     own = scenario.alpha
     alpha = (None if own.variable in ("energy", "normalized_energy")

@@ -45,10 +45,19 @@ def test_a_method_the_comparison_does_not_list_is_reported_not_configured():
 
 @pytest.mark.parametrize("name", PACKAGED_COMPARISONS)
 def test_every_flown_method_shares_the_mission_and_flies_its_own_method(name):
+    """Each flown entry's scenario (written settings, the mission's own, or those derived from the
+    mission: the derivation's first candidates here) is the mission but for the method's settings."""
+    from drake_entry.comparison.derive import apply_derivation
+    from drake_entry.comparison.spec import needs_derivation
+    from drake_entry.guidance.derivation import derivation_for
+
     comp = load_comparison(name)
     mission = load_scenario(comp.mission)
+    specs = {spec.__name__: spec for spec in REGISTRY}
     for m in comp.flown():
-        s = method_scenario(comp, m)
+        derived = (apply_derivation(mission, derivation_for(mission, specs[m.method]))
+                   if needs_derivation(comp, m, mission) else None)
+        s = method_scenario(comp, m, derived)
         assert type(s.guidance).__name__ == m.method
         assert s.name == f"{mission.name}-{m.label}"
         # everything but the method's own settings (guidance, alpha) is the mission, to the byte

@@ -63,11 +63,10 @@ def fly_form(form: str, draws: int) -> dict:
             "target": (setup.scenario.target.longitude_deg, setup.scenario.target.latitude_deg)}
 
 
-def range_to_go_km(table: dict, target) -> np.ndarray:
+def range_to_go_km(table: dict, target, planet) -> np.ndarray:
+    """The great-circle distance [km] from each logged point to the target, on ``planet``'s sphere."""
     lon, lat = np.radians(table["longitude_deg"]), np.radians(table["latitude_deg"])
-    tl, tp = np.radians(target[0]), np.radians(target[1])
-    c = np.sin(lat) * np.sin(tp) + np.cos(lat) * np.cos(tp) * np.cos(tl - lon)
-    return 6378.137 * np.arccos(np.clip(c, -1.0, 1.0))
+    return planet.great_circle_distance(lon, lat, *np.radians(target)) / 1e3
 
 
 def main(quick: bool = False, out_dir: str = "out/examples/26") -> dict:
@@ -93,7 +92,7 @@ def main(quick: bool = False, out_dir: str = "out/examples/26") -> dict:
         a.plot(e, t["drag_m_s2"], color=f"C{k}", lw=1.0, label=f"{form}: flown drag")
         a.plot(e[engaged], np.asarray(t["reference_drag_m_s2"])[engaged], color=f"C{k}", ls=":", lw=1.4,
                label=f"{form}: reference (re-planned)")
-        b.plot(t["time_s"], range_to_go_km(t, f["target"]), color=f"C{k}", lw=1.2,
+        b.plot(t["time_s"], range_to_go_km(t, f["target"], f["planner"].planet), color=f"C{k}", lw=1.2,
                label=f"{form}: nominal miss {f['rows'][0]['err_distance_m'] / 1e3:.1f} km")
     a.set(xlabel="normalised energy e = (E0 - E) / (E0 - Ef) [-]", ylabel="drag acceleration [m/s^2]",
           xlim=(0, 1), ylim=(0, 8))

@@ -429,8 +429,8 @@ def _provenance(meta: dict, stats: dict) -> str:
                f"--seed {meta.get('seed', '?')} --trajectory-step {meta.get('trajectory_step_s', '?')}"
                + "".join(" --set " + shlex.quote(f"{k}={val if isinstance(val, str) else json.dumps(val)}")
                          for k, val in overrides.items()) + " --out DIR")
-    commits = list(dict.fromkeys(s.get("git_commit") or "not recorded (an installed package, not a git checkout)"
-                                 for s in sessions)) or ["not recorded (an installed package, not a git checkout)"]
+    unrecorded = "not recorded (an installed package, not a git checkout)"
+    commits = list(dict.fromkeys(s.get("git_commit") or unrecorded for s in sessions)) or [unrecorded]
     flown = (f"commit {commits[0]}" if len(commits) == 1 else
              f"commits {', '.join(commits)} (the campaign was resumed at another commit: each run's is below)")
     rows = [("drake_entry", f"{v.get('drake_entry', '?')}, {flown}"),

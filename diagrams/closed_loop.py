@@ -37,7 +37,7 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
 from drake_entry.models.trajectory import Trajectory
 from drake_entry.models.vehicles import Vehicle
-from drake_entry.models.verdict import Verdict, box_text, judge
+from drake_entry.models.verdict import Verdict, box_text, failure_message, judge
 from drake_entry.scenario import Scenario, load_scenario
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.inertial_navigation import InertialNavigation
@@ -286,9 +286,6 @@ def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoo
     elif not finite:
         msg = f"reached {name} with non-finite terminal errors {errors}"
     else:
-        parts = [f"outside the acceptance box: {'; '.join(missed)}"] if missed else []
-        if not verdict.within_limits:
-            parts.append(f"path limits breached: {verdict.violations_text()}")
         where = f"reached {name} at t = {tr.time[-1]:.1f} s, {errors['distance_m'] / 1e3:.3f} km from the target"
-        msg = f"{' | '.join(parts)} ({where})" if parts else where
+        msg = failure_message(missed, verdict.violations_text(), where)
     return ClosedLoopResult(tr, errors, verdict.success, msg, setup.method.name, guidance, box, reached, verdict)

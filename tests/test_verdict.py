@@ -9,9 +9,17 @@ import pytest
 from drake_entry.models.constraints import PathLimits
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.models.trajectory import Trajectory, control_activity, metrics
-from drake_entry.models.verdict import PathLimit, check_limits, judge, vehicle_path_limits
+from drake_entry.models.verdict import (
+    PathLimit,
+    check_limits,
+    failure_clauses,
+    failure_message,
+    judge,
+    vehicle_path_limits,
+)
 
 Q = FLIGHT_CONDITION_NAMES.index("heat_flux")
+HEAT_BREACH = "heat_flux 540 kW/m^2 at t = 700.0 s (limit <= 530 kW/m^2, margin -1.89 %)"
 
 
 def _trajectory(time, heat_flux, gamma=None, bank=None) -> Trajectory:
@@ -104,9 +112,9 @@ def test_the_report_counts_success_box_and_limits_separately():
     rows = {"index": [0, 1, 2, 3, 4], "success": [True, True, False, False, False],
             "reached_terminal": [True, True, True, True, False], "inside_box": [True, True, True, False, False],
             "within_limits": [True, True, False, True, True], "err_distance_m": [1.0, 2.0, 3.0, 9e4, math.nan],
-            "violations": ["", "", "heat_flux 540 kW/m^2 at t = 700.0 s (limit <= 530 kW/m^2, margin -1.89 %)",
-                           "", ""],
-            "message": ["ok", "ok", "path limits breached: ...", "outside the acceptance box: ...",
+            "violations": ["", "", HEAT_BREACH, "", ""],
+            "message": ["ok", "ok", failure_message([], HEAT_BREACH, "reached E_f at t = 900.0 s"),
+                        failure_message(["distance error +90.000 km outside +-2.5 km"], "", "reached E_f"),
                         "stopped before E_f: altitude floor"]}
     st = summary_statistics(rows)
     assert (st["successful"], st["reached"], st["inside_acceptance_box"], st["within_limits"], st["failed"]) == \
@@ -114,6 +122,21 @@ def test_the_report_counts_success_box_and_limits_separately():
     assert st["failure_reasons"] == {"heat_flux limit breached": 1, "outside the acceptance box": 1,
                                      "stopped before E_f": 1}
     assert st["inside_box"] == {}  # per criterion (inside_<criterion>_box): none given here
+
+
+def test_a_verdict_message_reads_back_its_missed_criteria_and_breached_limits():
+    """failure_clauses inverts failure_message: the box criteria and limits by name, in order;
+    a message of a flight that did not reach (or a success) has neither, only its first clause."""
+    missed = ["altitude error -3.721 km outside +-3 km", "distance error +4.000 km outside +-2.5 km"]
+    breaches = HEAT_BREACH + "; dynamic_pressure 31.2 kPa at t = 470.0 s (limit <= 30 kPa, margin -4.00 %)"
+    where = "reached E_f at t = 520.0 s, 4.000 km from the target"
+    message = failure_message(missed, breaches, where)
+    assert failure_clauses(message) == (["altitude", "distance"], ["heat_flux", "dynamic_pressure"],
+                                        "outside the acceptance box")
+    assert failure_clauses(failure_message([], breaches, where))[:2] == ([], ["heat_flux", "dynamic_pressure"])
+    assert failure_message([], "", where) == where
+    assert failure_clauses(where) == ([], [], where.split(":")[0])
+    assert failure_clauses("stopped before E_f: altitude floor") == ([], [], "stopped before E_f")
 
 
 def test_control_activity_counts_reversals_travel_rate_and_time_at_the_limits():

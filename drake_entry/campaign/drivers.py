@@ -14,6 +14,7 @@ import numpy as np
 import scipy.stats as sps
 
 from drake_entry.campaign.statistics import finite_column
+from drake_entry.models.verdict import failure_clauses
 
 __all__ = ["OUTCOMES", "MIN_SAMPLES", "QUANTILE_BINS", "MIN_MODE", "failure_drivers", "dispersed_inputs",
            "outcome_columns"]
@@ -145,15 +146,10 @@ MIN_MODE = 3
 
 
 def _reason(rows: dict, i: int) -> str:
-    """A failed sample's reason as a short key: the breached limits or missed box criteria of its
-    message ('outside the acceptance box: distance ...' -> 'outside the box: distance'), else its
-    first clause."""
-    message = str((rows.get("message") or [""] * (i + 1))[i] or "")
-    parts = []
-    for clause in message.split(" | "):
-        clause = clause.split(" (reached")[0]
-        if clause.startswith("outside the acceptance box: "):
-            parts.append("outside the box: " + ", ".join(c.split()[0] for c in clause.split(": ", 1)[1].split("; ")))
-        elif clause.startswith("path limits breached: "):
-            parts.append("breached: " + ", ".join(c.split()[0] for c in clause.split(": ", 1)[1].split("; ")))
-    return "; ".join(parts) if parts else message.split(":")[0][:80]
+    """A failed sample's reason as a short key: the missed box criteria and breached limits its
+    message names ('outside the acceptance box: distance ...' -> 'outside the box: distance';
+    models.verdict.failure_clauses), else its first clause."""
+    missed, breached, first = failure_clauses(str((rows.get("message") or [""] * (i + 1))[i] or ""))
+    parts = ([f"outside the box: {', '.join(missed)}"] if missed else []) + (
+        [f"breached: {', '.join(breached)}"] if breached else [])
+    return "; ".join(parts) if parts else first

@@ -47,7 +47,7 @@ from drake_entry.campaign.success_requirement import success_verdict
 from drake_entry.errors import CampaignError, DrakeEntryError
 from drake_entry.models.aerodynamics import AERO_REGIMES
 from drake_entry.models.dispersions import PERTURBATION_COLUMNS_KM
-from drake_entry.models.verdict import BOX_CRITERIA
+from drake_entry.models.verdict import BOX_CRITERIA, BOX_MISSED, failure_clauses
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario, upgrade_scenario_yaml
 from drake_entry.typed_yaml import load_yaml_typed
@@ -74,16 +74,12 @@ def _flags(rows: dict, col: str, n: int, default) -> np.ndarray:
 
 def failure_categories(row: dict) -> list[str]:
     """Why a row is not a success: 'outside the acceptance box' and '<limit> limit breached'
-    for each breached path limit (the row's ``violations``) when that is why; otherwise the
-    first clause of its message (it did not reach, its guidance never engaged, it raised)."""
-    message = str(row.get("message") or "")
-    inside, within = row.get("inside_box"), row.get("within_limits")
-    if inside is None or within is None or not message.startswith(("outside the acceptance box",
-                                                                    "path limits breached")):
-        return [message.split(":")[0][:80]]  # it did not reach, or its guidance never engaged, ...
-    out = [] if inside else ["outside the acceptance box"]
-    out += [f"{part.split()[0]} limit breached" for part in str(row.get("violations") or "").split("; ") if part]
-    return out or [message.split(":")[0][:80]]
+    for each breached path limit its message names (models.verdict.failure_clauses); otherwise
+    the first clause of its message (it did not reach, its guidance never engaged, it raised)."""
+    missed, breached, first = failure_clauses(str(row.get("message") or ""))
+    out = [BOX_MISSED] if missed else []
+    out += [f"{name} limit breached" for name in breached]
+    return out or [first]
 
 
 def reached_terminal(rows: dict) -> np.ndarray:

@@ -23,7 +23,8 @@ import numpy as np
 
 from drake_entry.models.constraints import PathLimits
 
-__all__ = ["PathLimit", "vehicle_path_limits", "LimitCheck", "check_limits", "breaches_text", "ROUNDING",
+__all__ = ["PathLimit", "vehicle_path_limits", "LimitCheck", "check_limits", "breaches_text", "BOX_MISSED",
+           "LIMITS_BREACHED", "failure_message", "failure_clauses", "ROUNDING",
            "BoxCriterion", "BOX_CRITERIA", "acceptance_box", "box_text", "Verdict", "judge"]
 
 
@@ -130,6 +131,34 @@ def breaches_text(checks) -> str:
     """Each breached limit of ``checks`` (LimitChecks) with its peak, time and margin, '; '
     apart ('' when every limit held)."""
     return "; ".join(c.text() for c in checks if not c.held)
+
+
+#: how a flight's verdict message opens its two failure clauses (failure_message)
+BOX_MISSED, LIMITS_BREACHED = "outside the acceptance box", "path limits breached"
+
+
+def failure_message(missed: list[str], breaches: str, where: str) -> str:
+    """The verdict message of a flight that reached its interface: the acceptance-box criteria
+    ``missed`` (each 'name ...', box_text's), the ``breaches`` (breaches_text's; '' when none)
+    and ``where`` it ended; ``where`` alone when nothing failed. failure_clauses reads it back."""
+    parts = [f"{BOX_MISSED}: {'; '.join(missed)}"] if missed else []
+    if breaches:
+        parts.append(f"{LIMITS_BREACHED}: {breaches}")
+    return f"{' | '.join(parts)} ({where})" if parts else where
+
+
+def failure_clauses(message: str) -> tuple[list[str], list[str], str]:
+    """(the box criteria missed, the path limits breached, by name, and the message's first
+    clause, up to 80 characters) of a verdict ``message``: failure_message's inverse; any other
+    message (a flight stopped before its interface, a guidance that never engaged, an exception)
+    has no criteria and no limits, only its first clause."""
+    missed, breached = [], []
+    for clause in message.split(" | "):
+        clause = clause.split(" (reached")[0]
+        for prefix, names in ((BOX_MISSED, missed), (LIMITS_BREACHED, breached)):
+            if clause.startswith(prefix + ": "):
+                names += [part.split()[0] for part in clause[len(prefix) + 2:].split("; ") if part]
+    return missed, breached, message.split(":")[0][:80]
 
 
 #: relative slack for floating-point rounding at a bound a clamp holds exactly (the bank limit)

@@ -155,6 +155,24 @@ def test_an_unreachable_dask_scheduler_is_one_line(tmp_path, monkeypatch):
                      scheduler="tcp://127.0.0.1:9")
 
 
+def test_a_scheduler_address_implies_the_dask_backend_in_the_engine_itself(tmp_path, monkeypatch):
+    """An address with the default backend flies on Dask (the engine's rule, so a campaign, a
+    comparison and publish all follow it); with backend 'serial' it is a contradiction, refused."""
+    from drake_entry.campaign.engine import resolve_backend
+
+    assert resolve_backend("processes", "tcp://host:8786") == "dask"
+    assert resolve_backend("dask", "tcp://host:8786") == "dask"
+    assert resolve_backend("processes", None) == "processes" and resolve_backend("serial", "") == "serial"
+    with pytest.raises(ScenarioError, match=r"backend 'serial' with the Dask scheduler tcp://host:8786"):
+        resolve_backend("serial", "tcp://host:8786")
+    pytest.importorskip("dask.distributed")
+    import drake_entry.campaign.backends as backends
+
+    monkeypatch.setattr(backends, "SCHEDULER_TIMEOUT_S", 1)  # the default backend reaches the Dask client
+    with pytest.raises(ScenarioError, match=r"--scheduler tcp://127\.0\.0\.1:9: no Dask scheduler answered"):
+        run_campaign("horus2b", runs=1, out_dir=str(tmp_path / "c"), progress=False, scheduler="tcp://127.0.0.1:9")
+
+
 @settings(max_examples=60, deadline=None, derandomize=True, database=None)
 @given(parts=st.lists(st.text(st.characters(blacklist_characters="/\0", blacklist_categories=("Cs",)), max_size=40)
                       .filter(lambda p: p not in (".", "..")), min_size=1, max_size=4),

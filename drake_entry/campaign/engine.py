@@ -24,7 +24,7 @@ from drake_entry.campaign.backends import BACKENDS, Task, run_backend
 from drake_entry.campaign.store import CampaignStore
 from drake_entry.errors import Interrupted, ScenarioError
 
-__all__ = ["versions", "session", "source_commit", "foreign_sources", "MAPPED_PACKAGES", "task_manifest", "check_backend", "run_cases", "SampleCases"]
+__all__ = ["versions", "session", "source_commit", "foreign_sources", "MAPPED_PACKAGES", "task_manifest", "check_backend", "resolve_backend", "run_cases", "SampleCases"]
 
 
 def versions() -> dict:
@@ -108,14 +108,28 @@ def check_backend(backend: str, workers) -> None:
         raise ScenarioError(f"workers = {workers} is out of range; allowed: an integer in [1, 4096] (default: all cores)")
 
 
+def resolve_backend(backend: str, scheduler: str | None) -> str:
+    """The backend that flies the cases: a Dask ``scheduler`` address implies 'dask' (the
+    cluster at it), so 'processes' (the default) becomes 'dask'; 'serial' with an address is a
+    ScenarioError (one process here cannot fly on a cluster); without an address, ``backend``."""
+    if not scheduler:
+        return backend
+    if backend == "serial":
+        raise ScenarioError(f"backend 'serial' with the Dask scheduler {scheduler}: the samples fly either in this "
+                            f"one process or on the cluster; omit one of them")
+    return "dask"
+
+
 def run_cases(task: Task, cases: list, out_dir: str, manifest: dict, *, backend: str = "processes",
               workers: int | None = None, scheduler: str | None = None, progress: bool = True,
               desc: str = "campaign") -> str:
     """Run the cases of ``cases`` (dicts, each with a unique integer 'index') not yet done in
     ``out_dir``; returns out_dir. ``manifest`` identifies the campaign (``task_manifest``, or
     the Monte-Carlo manifest); a directory holding another campaign is refused (CampaignError).
-    workers: local processes (default all cores, at most one per case)."""
+    workers: local processes (default all cores, at most one per case); ``scheduler``: the
+    address of a Dask cluster, which implies backend 'dask' (resolve_backend)."""
     check_backend(backend, workers)
+    backend = resolve_backend(backend, scheduler)
     if not isinstance(cases, SampleCases):
         indices = [c.get("index") for c in cases]
         if any(isinstance(i, bool) or not isinstance(i, int) for i in indices) or len(set(indices)) != len(indices):

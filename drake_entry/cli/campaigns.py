@@ -15,9 +15,8 @@ __all__ = ["write_results_index", "COMMANDS", "write_and_print_report"]
 def campaign(args) -> int:
     from drake_entry.campaign.montecarlo import run_campaign, run_until_confident
 
-    backend = "dask" if args.scheduler else args.backend
     settings = dict(runs=args.runs, out_dir=args.out, seed=args.seed, workers=args.workers,
-                    overrides=parse_overrides(args.overrides), backend=backend, scheduler=args.scheduler,
+                    overrides=parse_overrides(args.overrides), backend=args.backend, scheduler=args.scheduler,
                     trajectory_step_s=args.trajectory_step)
     if args.until_confident:
         out, _ = run_until_confident(args.scenario, max_runs=args.max_runs, **settings)

@@ -81,7 +81,7 @@ def publish_results(out: str, *, runs: int, comparison_runs: int, campaigns=None
     missions = list(MATRIX_MISSIONS) if missions is None else _checked(missions, MATRIX_MISSIONS, "--missions")
     if runs < 1 or comparison_runs < 1:
         raise DrakeEntryError(f"publish: --runs {runs} and --comparison-runs {comparison_runs}: allowed >= 1")
-    where = {"backend": "dask", "scheduler": scheduler} if scheduler else {}
+    where = {"scheduler": scheduler} if scheduler else {}  # an address implies the Dask backend
     started, t0 = datetime.datetime.now(datetime.timezone.utc), time.perf_counter()
     record = {"commit": commit, "started_utc": started.isoformat(timespec="seconds"), "campaign_runs": runs,
               "campaign_seed": CAMPAIGN_SEED, "comparison_runs": comparison_runs, "comparison_seed": COMPARISON_SEED,

@@ -111,7 +111,7 @@ def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_
                          plant=plant_kind)
     if used == "native":  # the native plant cannot raise: the guard stops the flight as it would
         guard = builder.AddNamedSystem("plant_guard", PlantGuard(
-            h_min=c.atmosphere.h_min, h_max=c.atmosphere.h_max, model=type(c.atmosphere).__name__, planet=c.planet))
+            h_min=c.atmosphere.h_min, h_max=c.atmosphere.h_max, model=c.atmosphere.name, planet=c.planet))
         builder.Connect(plant.GetOutputPort("state"), guard.get_input_port())
     tf = float(c.final_time)
     bank_plan = _spline(t, np.reshape(c.bank, (1, -1)))
@@ -216,8 +216,8 @@ def _guard_entry_states(builder, problem, plant) -> None:
     if isinstance(plant, OptimalControlPlant) or atmosphere is None \
             or tuple(problem.state_names[:6]) != STATE_NAMES:
         return
-    guard = builder.AddNamedSystem("guard", PlantGuard(h_min=atmosphere.h_min, h_max=atmosphere.h_max,
-                                                       model=atmosphere.name, planet=problem.planet))
+    guard = builder.AddNamedSystem("plant_guard", PlantGuard(h_min=atmosphere.h_min, h_max=atmosphere.h_max,
+                                                             model=atmosphere.name, planet=problem.planet))
     state = plant.get_output_port()
     if problem.n_states > 6:
         split = builder.AddSystem(Demultiplexer([6, problem.n_states - 6]))

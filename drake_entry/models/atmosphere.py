@@ -148,7 +148,7 @@ class Atmosphere:
         return False
 
     def check(self, h):
-        _check_range(type(self).__name__, h, self.h_min, self.h_max)
+        _check_range(self.name, h, self.h_min, self.h_max)
 
     def density(self, h):
         """Density rho(h) [kg/m^3]."""

@@ -165,6 +165,13 @@ def test_a_scheduler_address_implies_the_dask_backend_in_the_engine_itself(tmp_p
     assert resolve_backend("processes", None) == "processes" and resolve_backend("serial", "") == "serial"
     with pytest.raises(ScenarioError, match=r"backend 'serial' with the Dask scheduler tcp://host:8786"):
         resolve_backend("serial", "tcp://host:8786")
+    from drake_entry.comparison.runner import run_comparison
+
+    for run in (run_campaign, run_comparison):  # refused before any search, plan or directory
+        with pytest.raises(ScenarioError, match=r"backend 'serial' with the Dask scheduler"):
+            run("horus2b", runs=1, out_dir=str(tmp_path / "s"), progress=False, backend="serial",
+                scheduler="tcp://host:8786")
+    assert not (tmp_path / "s").exists()
     pytest.importorskip("dask.distributed")
     import drake_entry.campaign.backends as backends
 

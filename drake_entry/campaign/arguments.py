@@ -11,7 +11,7 @@ import os
 
 import numpy as np
 
-from drake_entry.campaign.engine import check_backend
+from drake_entry.campaign.engine import check_backend, resolve_backend
 from drake_entry.errors import ScenarioError
 
 __all__ = ["MAX_RUNS", "RUNS_NOTE", "check_output_dir", "check_run_arguments"]
@@ -46,10 +46,13 @@ def check_output_dir(out, name: str = "--out") -> str:
     return out
 
 
-def check_run_arguments(*, runs, seed, trajectory_step_s, workers=None, backend: str = "processes") -> None:
+def check_run_arguments(*, runs, seed, trajectory_step_s, workers=None, backend: str = "processes",
+                        scheduler: str | None = None) -> None:
     """One-line ScenarioErrors for a sample count, seed, trajectory step, backend or worker count
-    out of range (the same for a campaign and a comparison)."""
+    out of range, or a backend that contradicts a Dask ``scheduler`` address (the same for a
+    campaign and a comparison, before any search or plan)."""
     check_backend(backend, workers)
+    resolve_backend(backend, scheduler)
     for name, value, lo, hi in (("runs", runs, 1, MAX_RUNS), ("seed", seed, 0, 2**63 - 1)):
         integer = isinstance(value, (int, np.integer)) and not isinstance(value, bool)
         if not integer or not lo <= value <= hi:

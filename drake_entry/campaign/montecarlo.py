@@ -91,7 +91,8 @@ def run_campaign(scenario_path: str, *, runs: int, out_dir: str, seed: int = 0, 
     ``runs`` with the same settings extends it. Rows stream to out_dir/samples.jsonl,
     trajectories to trajectories.jsonl; at the end both are converted to Parquet.
     """
-    check_run_arguments(runs=runs, seed=seed, trajectory_step_s=trajectory_step_s, workers=workers, backend=backend)
+    check_run_arguments(runs=runs, seed=seed, trajectory_step_s=trajectory_step_s, workers=workers, backend=backend,
+                        scheduler=scheduler)
     if not isinstance(scenario_path, (str, os.PathLike)):
         raise ScenarioError(f"scenario_path must be a path (text); got {type(scenario_path).__name__}")
     scenario_path, out_dir = os.fspath(scenario_path), check_output_dir(out_dir, "out_dir")

@@ -59,7 +59,8 @@ def run_comparison(comparison, *, runs: int, out_dir: str, seed: int = 0, worker
     from drake_entry.campaign.report import write_report
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup
 
-    check_run_arguments(runs=runs, seed=seed, trajectory_step_s=trajectory_step_s, workers=workers, backend=backend)
+    check_run_arguments(runs=runs, seed=seed, trajectory_step_s=trajectory_step_s, workers=workers, backend=backend,
+                        scheduler=scheduler)
     out_dir = check_output_dir(out_dir, "out_dir")
     comp = comparison if isinstance(comparison, Comparison) else load_comparison(comparison)
     comp.validate()

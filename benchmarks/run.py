@@ -1,6 +1,6 @@
 """Benchmarks, each printing its figures and ratios measured side by side in one run.
 
-    python benchmarks/run.py [open-loop|socp|nlp|nlp-cost|dymos|campaign|interface-cost|method-cost|paper001|aborts|paper003|paper004|examples|all] [options]
+    python benchmarks/run.py [open-loop|socp|nlp|nlp-cost|dymos|campaign|interface-cost|method-cost|memory|paper001|aborts|paper003|paper004|examples|all] [options]
 
 open-loop       Drake open loop vs scipy solve_ivp at equal accuracy (ratio)
 socp            both SOCP planners with Clarabel vs SCS: drag-energy SOCP by node count, SCvx
@@ -16,6 +16,9 @@ interface-cost  paper-000 campaign cost per sample: this checkout vs a baseline 
 method-cost     every packaged guidance scenario: core seconds per sample split into the plant
                 (the scenario's own, native or Python), on-board planning and the rest, vs a
                 baseline commit (--baseline, default the previous commit; --scenarios names)
+memory          a campaign worker's resident memory and live Python systems after its set-up
+                and each sample, growth per sample, vs a baseline commit (--baseline, default
+                the previous commit; --scenarios names)
 paper001        paper 001: SCvx nominal plan time and iterations by mesh vs the paper, flown by Drake
 aborts          paper 001: the 9 x 9 orbital-abort map through the campaign engine vs the 15-min goal
 paper003        paper 003: AMPI database storage, LD-HD reconstruction, synthesis vs OCP CPU time,
@@ -35,7 +38,7 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("which", nargs="?", default="all",
                         choices=("all", "open-loop", "socp", "nlp", "nlp-cost", "dymos", "campaign", "interface-cost",
-                                 "method-cost",
+                                 "method-cost", "memory",
                                  "paper001", "aborts", "paper003", "paper004", "examples"))
     parser.add_argument("--samples", type=int, default=100, help="campaign: samples per backend")
     parser.add_argument("--rounds", type=int, default=2, help="campaign / interface-cost: interleaved rounds")
@@ -54,8 +57,8 @@ if __name__ == "__main__":
     parser.add_argument("--only", nargs="*", default=None, help="examples: numbers or names to run")
     parser.add_argument("--write", action="store_true", help="examples: write the measured times into the docs")
     parser.add_argument("--scenarios", nargs="*", default=None,
-                        help="method-cost: packaged scenarios to cost, or variants NAME:field=value[,field=value] "
-                        "(e.g. cav_h_paper004:guidance.replan_period_s=100)")
+                        help="method-cost, memory: packaged scenarios to measure; method-cost also variants "
+                        "NAME:field=value[,field=value] (e.g. cav_h_paper004:guidance.replan_period_s=100)")
     args = parser.parse_args()
     if args.which == "examples":  # minutes of wall time: on request only
         from example_times import examples_benchmark
@@ -96,6 +99,10 @@ if __name__ == "__main__":
         from method_cost import method_cost_benchmark
 
         method_cost_benchmark(baseline=args.baseline or "HEAD~1", rounds=args.rounds, only=args.scenarios)
+    if args.which in ("all", "memory"):
+        from memory import memory_benchmark
+
+        memory_benchmark(baseline=args.baseline or "HEAD~1", only=args.scenarios)
     if args.which in ("all", "paper001"):
         from paper001 import paper001_benchmark
 

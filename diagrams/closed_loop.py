@@ -41,6 +41,7 @@ from drake_entry.models.verdict import Verdict, box_text, failure_message, judge
 from drake_entry.scenario import Scenario, load_scenario
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.inertial_navigation import InertialNavigation
+from drake_entry.systems.lifetime import release_system
 from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.native_plant import add_plant
 from drake_entry.systems.navigation import Navigation
@@ -262,9 +263,12 @@ def fly(scenario: Scenario | ClosedLoopSetup, planner=None, *, initial_state=Non
     setup = scenario if isinstance(scenario, ClosedLoopSetup) else ClosedLoopSetup.from_scenario(scenario, planner)
     built = build_closed_loop(setup, nav_seed=nav_seed, nav_bias=nav_bias, nav_noise=nav_noise,
                               initial_state=initial_state, draw=draw)
-    tr, simulator = run(built.diagram, built.loggers, setup.scenario, sources=built.sources, closed_loop=True,
-                        columns=built.columns, step_loggers=built.step_loggers)
-    return summarise(setup, built.diagram, simulator.get_context(), tr)
+    try:
+        tr, simulator = run(built.diagram, built.loggers, setup.scenario, sources=built.sources, closed_loop=True,
+                            columns=built.columns, step_loggers=built.step_loggers)
+        return summarise(setup, built.diagram, simulator.get_context(), tr)
+    finally:
+        release_system(built.diagram)
 
 
 def summarise(setup: ClosedLoopSetup, diagram, ctx, tr: Trajectory) -> ClosedLoopResult:

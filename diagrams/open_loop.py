@@ -17,6 +17,7 @@ from drake_entry.diagrams.common import run
 from drake_entry.models.trajectory import Trajectory
 from drake_entry.scenario import Scenario
 from drake_entry.systems.actuators import BankActuator
+from drake_entry.systems.lifetime import release_system
 from drake_entry.systems.monitors import TerminationMonitor
 from drake_entry.systems.native_plant import add_plant
 from drake_entry.systems.schedule import make_schedule_source
@@ -72,4 +73,7 @@ def simulate(scenario: Scenario, *, initial_state=None) -> Trajectory:
     diagram, loggers = build_open_loop(scenario)
     sources = {"state": ("vehicle", "state"), "conditions": ("vehicle", "flight_conditions"),
                "bank": ("bank_actuator", "bank"), "alpha": ("alpha_schedule", 0)}
-    return run(diagram, loggers, scenario, sources=sources, initial_state=initial_state)[0]
+    try:
+        return run(diagram, loggers, scenario, sources=sources, initial_state=initial_state)[0]
+    finally:
+        release_system(diagram)

@@ -50,6 +50,7 @@ from drake_entry.planning.ocp_system import OptimalControlPlant, native_ocp_plan
 from drake_entry.planning.verification import Actuation, EntryControls, FlownControls, OcpControls
 from drake_entry.scenario import PLANTS
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
+from drake_entry.systems.lifetime import release_system
 from drake_entry.systems.monitors import PlantGuard
 from drake_entry.systems.native_plant import add_plant, flight_stop
 from drake_entry.systems.replanning_guidance import ReplanningGuidance
@@ -151,10 +152,15 @@ def _fly_entry(c: EntryControls, accuracy: float | None, log_points: int, plant_
         integrator = ResetIntegratorFromFlags(simulator, "runge_kutta5", 10.0)
         integrator.set_target_accuracy(accuracy or ENTRY_ACCURACY)
     simulator.get_mutable_context().SetAccuracy(accuracy or ENTRY_ACCURACY)
-    failure = _advance(simulator, tf)
-    tr = collect_trajectory(diagram, loggers, simulator.get_context(), sources=sources,
-                            reason=failure or "t_f", wall_time=0.0, step_loggers=step_loggers,
-                            final_instant=not failure)
+    try:
+        failure = _advance(simulator, tf)
+        tr = collect_trajectory(diagram, loggers, simulator.get_context(), sources=sources,
+                                reason=failure or "t_f", wall_time=0.0, step_loggers=step_loggers,
+                                final_instant=not failure)
+    finally:  # the actuators too: one whose response was flown instead is in no diagram
+        for system in (diagram, bank_act, alpha_act):
+            if system is not None:
+                release_system(system)
     return FlownControls(tr.time, tr.state, tr, failure)
 
 
@@ -243,13 +249,16 @@ def _fly_ocp(c: OcpControls, accuracy: float, log_points: int, plant_kind: str =
     plant.GetMyMutableContextFromRoot(ctx).SetContinuousState(np.asarray(c.initial_state, float))
     integrator = ResetIntegratorFromFlags(simulator, "runge_kutta5", tf / 200)
     integrator.set_target_accuracy(accuracy)
-    failure = _advance(simulator, tf)
-    log = logger.FindLog(ctx)
-    t_end = ctx.get_time()
-    x_end = plant.GetMyContextFromRoot(ctx).get_continuous_state_vector().CopyToVector()
-    keep = log.sample_times() < t_end - 1e-9
-    return FlownControls(np.append(log.sample_times()[keep], t_end), np.vstack([log.data()[:, keep].T, x_end]),
-                         None, failure)
+    try:
+        failure = _advance(simulator, tf)
+        log = logger.FindLog(ctx)
+        t_end = ctx.get_time()
+        x_end = plant.GetMyContextFromRoot(ctx).get_continuous_state_vector().CopyToVector()
+        keep = log.sample_times() < t_end - 1e-9
+        times, states = np.append(log.sample_times()[keep], t_end), np.vstack([log.data()[:, keep].T, x_end])
+    finally:
+        release_system(diagram)
+    return FlownControls(times, states, None, failure)
 
 
 def _advance(simulator: Simulator, tf: float) -> str:

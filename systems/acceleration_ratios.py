@@ -15,6 +15,7 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.models.acceleration_ratios import filtered_ratios
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.systems.lifetime import weak_method
 
 __all__ = ["AccelerationRatioFilter"]
 
@@ -30,7 +31,7 @@ class AccelerationRatioFilter(LeafSystem):
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self.alpha_port = self.DeclareVectorInputPort("alpha_command", 1)
         self._ratios = self.DeclareDiscreteState(BasicVector([1.0, 1.0]))
-        self.DeclarePeriodicDiscreteUpdateEvent(self.period, 0.0, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(self.period, 0.0, weak_method(self._update))
         self.DeclareStateOutputPort("ratios", self._ratios)
 
     def _update(self, context, discrete_state):

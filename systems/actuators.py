@@ -27,6 +27,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_entry.errors import ScenarioError
 from drake_entry.models.actuator import BANDWIDTH_RAD_S, SUBSTEP_S, actuator_rates, integrate_actuator
+from drake_entry.systems.lifetime import weak_element, weak_method
 
 __all__ = ["LimitedActuator", "BankActuator", "AlphaActuator"]
 
@@ -63,11 +64,11 @@ class LimitedActuator(LeafSystem):
             raise ScenarioError(f"{type(self).__name__}.substep must be in (0, period], got {substep}")
         self.n_sub = max(1, int(round(period / substep)))
         self._segment = self.DeclareAbstractState(AbstractValue.Make(_constant_segment(initial)))
-        self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._plan_segment)
+        self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, weak_method(self._plan_segment))
         deps = {self.abstract_state_ticket(self._segment), self.time_ticket()}
-        self.DeclareVectorOutputPort(name, 1, lambda c, o: o.SetAtIndex(0, self._sample(c)[0]),
+        self.DeclareVectorOutputPort(name, 1, weak_element(self._sample, 0),
                                      prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort(f"{name}_rate", 1, lambda c, o: o.SetAtIndex(0, self._sample(c)[1]),
+        self.DeclareVectorOutputPort(f"{name}_rate", 1, weak_element(self._sample, 1),
                                      prerequisites_of_calc=deps)
 
     def DoCalcTimeDerivatives(self, context, derivatives):

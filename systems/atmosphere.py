@@ -16,6 +16,7 @@ from pydrake.systems.scalar_conversion import TemplateSystem
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.dynamics import air_data, wind_at
 from drake_entry.models.planet import Earth
+from drake_entry.systems.lifetime import weak_method
 
 __all__ = ["AtmosphereSystem_", "AtmosphereSystem"]
 
@@ -28,10 +29,10 @@ def AtmosphereSystem_(T):
             self.atmosphere = atmosphere
             self.planet = planet
             self.state_port = self.DeclareVectorInputPort("state", 6)
-            self.DeclareVectorOutputPort("air_data", 2, self._calc,
+            self.DeclareVectorOutputPort("air_data", 2, weak_method(self._calc),
                                          prerequisites_of_calc={self.state_port.ticket()})
             if atmosphere.has_wind:
-                self.DeclareVectorOutputPort("wind", 2, self._calc_wind,
+                self.DeclareVectorOutputPort("wind", 2, weak_method(self._calc_wind),
                                              prerequisites_of_calc={self.state_port.ticket()})
 
         def _construct_copy(self, other, converter=None):

@@ -20,6 +20,7 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 from drake_entry.errors import ScenarioError
 from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle
 from drake_entry.models.geodesy import bearing
+from drake_entry.systems.lifetime import weak_element, weak_method
 
 __all__ = ["BankReversalLogic"]
 
@@ -37,14 +38,19 @@ class BankReversalLogic(LeafSystem):
         self.est_port = self.DeclareVectorInputPort("estimated_state", 6)
         self.mag_port = self.DeclareVectorInputPort("bank_magnitude", 1)
         self._state = self.DeclareDiscreteState(BasicVector([1.0 if initial_sign >= 0 else -1.0, 0.0]))
-        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
-        self.DeclareVectorOutputPort(
-            "bank_command", 1,
-            lambda c, o: o.SetAtIndex(0, c.get_discrete_state(self._state).get_value()[0] * self.mag_port.Eval(c)[0]),
-            prerequisites_of_calc={self.xd_ticket(), self.mag_port.ticket()})
-        self.DeclareVectorOutputPort(
-            "reversals", 1, lambda c, o: o.SetAtIndex(0, c.get_discrete_state(self._state).get_value()[1]),
-            prerequisites_of_calc={self.xd_ticket()})
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, weak_method(self._update))
+        self.DeclareVectorOutputPort("bank_command", 1, weak_element(self._signed_bank, 0),
+                                     prerequisites_of_calc={self.xd_ticket(), self.mag_port.ticket()})
+        self.DeclareVectorOutputPort("reversals", 1, weak_element(self._sign_and_count, 1),
+                                     prerequisites_of_calc={self.xd_ticket()})
+
+    def _sign_and_count(self, context) -> np.ndarray:
+        """[bank sign (+1 or -1), reversals so far]."""
+        return context.get_discrete_state(self._state).get_value()
+
+    def _signed_bank(self, context) -> list:
+        """[the bank command: the sign times the commanded magnitude, rad]."""
+        return [self._sign_and_count(context)[0] * self.mag_port.Eval(context)[0]]
 
     def heading_error(self, x) -> float:
         return wrap_angle(x[5] - bearing(x[1], x[2], *self.target))

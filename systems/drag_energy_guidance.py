@@ -31,6 +31,7 @@ from pydrake.common.value import AbstractValue
 
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner, DragEnergyReference
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.systems.lifetime import weak_method
 from drake_entry.systems.replan_scheduler import ReplanScheduler
 
 __all__ = ["sensed_drag", "GuidanceMemory", "DragEnergyGuidance"]
@@ -76,8 +77,8 @@ class DragEnergyGuidance(ReplanScheduler):
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self.scales_port = self.DeclareVectorInputPort("model_scales", 2) if model_scales else None
         self._memory = self.DeclareAbstractState(AbstractValue.Make(GuidanceMemory()))
-        self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._update)
-        self.DeclareVectorOutputPort("reference", 4, self._calc,
+        self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, weak_method(self._update))
+        self.DeclareVectorOutputPort("reference", 4, weak_method(self._calc),
                                      prerequisites_of_calc={self.est_port.ticket(), self.all_state_ticket()})
 
     def memory(self, context) -> GuidanceMemory:

@@ -28,6 +28,7 @@ from drake_entry.errors import ScenarioError
 from drake_entry.guidance.drag_energy.planner import DragEnergyPlanner
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.systems.drag_energy_guidance import sensed_drag
+from drake_entry.systems.lifetime import weak_element, weak_method
 
 __all__ = ["DragTrackingController"]
 
@@ -56,13 +57,15 @@ class DragTrackingController(LeafSystem):
         self.fc_port = self.DeclareVectorInputPort("flight_conditions", len(FLIGHT_CONDITION_NAMES))
         # [|sigma|, u, integral of dD dE, E at last update (nan before engagement)]
         self._state = self.DeclareDiscreteState(BasicVector([pre_guidance_bank, 0.0, 0.0, np.nan]))
-        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
-        self.DeclareVectorOutputPort("bank_magnitude", 1,
-                                     lambda c, o: o.SetAtIndex(0, c.get_discrete_state(self._state).get_value()[0]),
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, weak_method(self._update))
+        self.DeclareVectorOutputPort("bank_magnitude", 1, weak_element(self._held, 0),
                                      prerequisites_of_calc={self.xd_ticket()})
-        self.DeclareVectorOutputPort("vertical_control", 1,
-                                     lambda c, o: o.SetAtIndex(0, c.get_discrete_state(self._state).get_value()[1]),
+        self.DeclareVectorOutputPort("vertical_control", 1, weak_element(self._held, 1),
                                      prerequisites_of_calc={self.xd_ticket()})
+
+    def _held(self, context) -> np.ndarray:
+        """The held state [|sigma| rad, u, integral of dD dE, E at the last update]."""
+        return context.get_discrete_state(self._state).get_value()
 
     def control(self, x, ref, integral: float, sensed: float | None = None):
         """(|sigma|, u) for estimate x and reference [D, D', D''] (eq. 101)."""

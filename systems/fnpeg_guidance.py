@@ -34,6 +34,7 @@ from drake_entry.errors import ScenarioError
 from drake_entry.guidance.fnpeg.onboard import FnpegSetup
 from drake_entry.models.acceleration_ratios import filtered_ratios
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.systems.lifetime import weak_element, weak_method
 from drake_entry.systems.replan_scheduler import ReplanScheduler
 
 __all__ = ["FnpegGuidance"]
@@ -70,13 +71,13 @@ class FnpegGuidance(ReplanScheduler):
         self._state = self.DeclareDiscreteState(BasicVector(start))
         self.DeclareReplanSchedule(replan_period_s=replan_period, latency_s=latency_s,  # the first: at engagement
                                    latency_factor=latency_factor, pending_size=3)
-        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, weak_method(self._update))
         deps = {self.xd_ticket()}
         for name, index in (("bank_magnitude", _MAGNITUDE), ("alpha_command", _ALPHA), ("sigma0", _SIGMA0),
                             ("range_error", _Z)):
-            self.DeclareVectorOutputPort(name, 1, lambda c, o, i=index: o.SetAtIndex(0, self._memory(c)[i]),
+            self.DeclareVectorOutputPort(name, 1, weak_element(self._memory, index),
                                          prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort("stats", 6, self._stats, prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort("stats", 6, weak_method(self._stats), prerequisites_of_calc=deps)
 
     def _stats(self, context, output):
         m, s = self._memory(context), self.replan_stats(context)

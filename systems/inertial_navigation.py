@@ -23,6 +23,7 @@ from drake_entry.errors import ScenarioError
 from drake_entry.models import inertial_navigation as ins
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
 from drake_entry.models.planet import Earth
+from drake_entry.systems.lifetime import weak_method
 
 __all__ = ["InertialNavigation"]
 
@@ -43,12 +44,12 @@ class InertialNavigation(LeafSystem):
         start[:6] = errors.initial if errors.enabled else 0.0
         self._error = self.DeclareDiscreteState(BasicVector(start))
         if errors.enabled:
-            self.DeclarePeriodicDiscreteUpdateEvent(self.period, 0.0, self._update)
+            self.DeclarePeriodicDiscreteUpdateEvent(self.period, 0.0, weak_method(self._update))
         deps = {self.true_port.ticket(), self.discrete_state_ticket(self._error)}
-        self.DeclareVectorOutputPort("estimated_state", 6, self._calc_state, prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort("sensed_conditions", len(FLIGHT_CONDITION_NAMES), self._calc_sensed,
+        self.DeclareVectorOutputPort("estimated_state", 6, weak_method(self._calc_state), prerequisites_of_calc=deps)
+        self.DeclareVectorOutputPort("sensed_conditions", len(FLIGHT_CONDITION_NAMES), weak_method(self._calc_sensed),
                                      prerequisites_of_calc={self.conditions_port.ticket()})
-        self.DeclareVectorOutputPort("navigation_error", 2, self._calc_error,
+        self.DeclareVectorOutputPort("navigation_error", 2, weak_method(self._calc_error),
                                      prerequisites_of_calc={self.discrete_state_ticket(self._error)})
 
     def _update(self, context, discrete_state):

@@ -23,6 +23,7 @@ from drake_entry.errors import ModelRangeError, NonFiniteStateError, ScenarioErr
 from drake_entry.models.atmosphere import US76_H_MAX
 from drake_entry.models.dynamics import specific_energy
 from drake_entry.models.planet import Earth
+from drake_entry.systems.lifetime import weak_method
 
 __all__ = ["CEILING_M", "require_finite", "TerminationMonitor", "PlantGuard"]
 
@@ -63,9 +64,10 @@ class TerminationMonitor(LeafSystem):
         for name in ("altitude", "mach", "energy", "velocity"):
             if name != "altitude" and name not in self.targets:
                 continue
-            event = PublishEvent(self._make_handler(name))
+            event = PublishEvent(weak_method(self._reached, name))
             self._witnesses.append(self.MakeWitnessFunction(
-                f"reached {name}", WitnessFunctionDirection.kPositiveThenNonPositive, self._make_calc(name), event))
+                f"reached {name}", WitnessFunctionDirection.kPositiveThenNonPositive,
+                weak_method(self._distance, name), event))
 
     def _altitude(self, context) -> float:
         """The altitude the band bounds [m]: the state altitude, or the geodetic one. A
@@ -74,33 +76,31 @@ class TerminationMonitor(LeafSystem):
         x = require_finite(self.state_port.Eval(context), context)
         return self.planet.atmospheric_altitude(x[0], x[2]) if self.geodetic else x[0]
 
-    def _make_calc(self, name):
-        if name == "altitude":  # the band [floor, ceiling]
-            floor, ceiling = self.floor, self.ceiling
-
-            def band(c):
-                h = self._altitude(c)
-                return min(h - floor, ceiling - h)
-            return band
-        target = self.targets[name]
+    def _distance(self, context, name: str) -> float:
+        """The witness value of target ``name``, positive before it is reached: the altitude's
+        distance to the band [floor, ceiling] [m], or the velocity [m/s], Mach or energy [J/kg]
+        above its target."""
+        if name == "altitude":
+            h = self._altitude(context)
+            return min(h - self.floor, self.ceiling - h)
+        x = self.state_port.Eval(context)
         if name == "velocity":
-            return lambda c: self.state_port.Eval(c)[3] - target
+            return x[3] - self.targets[name]
         if name == "mach":
-            return lambda c: self.state_port.Eval(c)[3] / self.air_port.Eval(c)[1] - target
-        return lambda c: specific_energy(self.state_port.Eval(c), self.planet) - target
+            return x[3] / self.air_port.Eval(context)[1] - self.targets[name]
+        return specific_energy(x, self.planet) - self.targets[name]
 
-    def _make_handler(self, name):
-        def handler(context, event):
-            if name != "altitude":
-                self.reason, detail = f"reached {name}", f" = {self.targets[name]:g}"
-            elif self._altitude(context) > 0.5 * (self.floor + self.ceiling):
-                self.reason, detail = "skipped out above the atmosphere", f" (h = {self.ceiling / 1e3:g} km)"
-            elif "altitude" in self.targets:
-                self.reason, detail = "reached altitude", f" = {self.floor:g}"
-            else:
-                self.reason, detail = "reached the surface", " (h = 0 m)"
-            return EventStatus.ReachedTermination(self, self.reason + detail)
-        return handler
+    def _reached(self, context, event, name: str):
+        """Ends the flight at target ``name`` with its reason (``self.reason``)."""
+        if name != "altitude":
+            self.reason, detail = f"reached {name}", f" = {self.targets[name]:g}"
+        elif self._altitude(context) > 0.5 * (self.floor + self.ceiling):
+            self.reason, detail = "skipped out above the atmosphere", f" (h = {self.ceiling / 1e3:g} km)"
+        elif "altitude" in self.targets:
+            self.reason, detail = "reached altitude", f" = {self.floor:g}"
+        else:
+            self.reason, detail = "reached the surface", " (h = 0 m)"
+        return EventStatus.ReachedTermination(self, self.reason + detail)
 
     def DoGetWitnessFunctions(self, context):
         return self._witnesses
@@ -125,7 +125,8 @@ class PlantGuard(LeafSystem):
         self.h_min, self.h_max, self.model = float(h_min), float(h_max), model
         self.planet = planet or Earth()
         self.state_port = self.DeclareVectorInputPort("state", 6)
-        self._witness = [self.MakeWitnessFunction("plant guard", WitnessFunctionDirection.kNone, self._check)]
+        self._witness = [self.MakeWitnessFunction("plant guard", WitnessFunctionDirection.kNone,
+                                                  weak_method(self._check))]
 
     def _check(self, context) -> float:
         x = require_finite(self.state_port.Eval(context), context)

@@ -14,6 +14,7 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from drake_entry.errors import ScenarioError
+from drake_entry.systems.lifetime import weak_method
 
 __all__ = ["Navigation"]
 
@@ -35,8 +36,8 @@ class Navigation(LeafSystem):
         self.true_port = self.DeclareVectorInputPort("true_state", 6)
         self._noise = self.DeclareDiscreteState(BasicVector(np.zeros(7)))  # [noise(6), k]
         if np.any(self.sigma > 0):
-            self.DeclarePeriodicDiscreteUpdateEvent(self.period, 0.0, self._update)
-        self.DeclareVectorOutputPort("estimated_state", 6, self._calc,
+            self.DeclarePeriodicDiscreteUpdateEvent(self.period, 0.0, weak_method(self._update))
+        self.DeclareVectorOutputPort("estimated_state", 6, weak_method(self._calc),
                                      prerequisites_of_calc={self.true_port.ticket(), self.all_state_ticket()})
 
     def noise_sample(self, k: int) -> np.ndarray:

@@ -59,6 +59,7 @@ from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.guidance.ampi.spec import TRACKING_INDICES
 from drake_entry.guidance.path_feedback import PathLimits, corrected_cos_bank, path_limit_correction
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, specific_energy
+from drake_entry.systems.lifetime import weak_method
 
 __all__ = ["LAW_STATES", "SCALE_HEIGHT_STEP_M", "TrackerMemory", "ReferenceTracker", "sensed_reference",
            "sensed_bank", "limited_bank"]
@@ -156,10 +157,10 @@ class ReferenceTracker(LeafSystem):
             "flight_conditions", len(FLIGHT_CONDITION_NAMES))
         self._memory = self.DeclareAbstractState(AbstractValue.Make(TrackerMemory()))
         self._bank = self.DeclareDiscreteState(BasicVector([float(initial_bank)]))
-        self.DeclareInitializationUnrestrictedUpdateEvent(self._start)
-        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+        self.DeclareInitializationUnrestrictedUpdateEvent(weak_method(self._start))
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, weak_method(self._update))
         self.DeclareStateOutputPort("bank_command", self._bank)
-        self.DeclareVectorOutputPort("reference_state", 7, self._reference_state,
+        self.DeclareVectorOutputPort("reference_state", 7, weak_method(self._reference_state),
                                      prerequisites_of_calc={self.all_state_ticket(), self.time_ticket(),
                                                             self.all_input_ports_ticket()})
 

@@ -48,6 +48,8 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, DiscreteValues, LeafSystem
 
+from drake_entry.systems.lifetime import weak_method
+
 __all__ = ["DUE_TOLERANCE_S", "ReplanOutcome", "Solve", "ReplanStats", "ReplanScheduler"]
 
 #: the schedule's discrete state: next due time [s], attempts, applied, clean, wall time [s], and
@@ -125,12 +127,14 @@ class ReplanScheduler(LeafSystem):
                 self._held = self.DeclareAbstractState(AbstractValue.Make(_Held(None)))
             else:
                 self._held_numbers = self.DeclareDiscreteState(int(pending_size))
-        self.DeclareVectorOutputPort("replan_stats", 4,
-                                     lambda c, o: o.SetFromVector(self._schedule_of(c)[_ATTEMPTS:_HELD_UNTIL]),
+        self.DeclareVectorOutputPort("replan_stats", 4, weak_method(self._replan_stats),
                                      prerequisites_of_calc={self.xd_ticket()})
 
     def _schedule_of(self, context):
         return context.get_discrete_state(self._schedule).get_value()
+
+    def _replan_stats(self, context, output):
+        output.SetFromVector(self._schedule_of(context)[_ATTEMPTS:_HELD_UNTIL])
 
     def _mutable(self, values, index=None):
         """A discrete group's vector in an update's output (a DiscreteValues or a State)."""

@@ -44,6 +44,7 @@ from typing import Callable
 import numpy as np
 from pydrake.common.value import AbstractValue
 
+from drake_entry.systems.lifetime import weak_element, weak_method
 from drake_entry.systems.replan_scheduler import ReplanScheduler
 
 __all__ = ["FlownPlan", "ReplanMemory", "Replan", "ReplanningGuidance"]
@@ -131,13 +132,14 @@ class ReplanningGuidance(ReplanScheduler):
         self._memory = self.DeclareAbstractState(AbstractValue.Make(first))
         self._offsets = self.DeclareDiscreteState(2)
         if replan_period > 0 or feedback is not None:
-            self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._update)
+            self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, weak_method(self._update))
         deps = {self.est_port.ticket(), self.all_state_ticket(), self.time_ticket()}
-        self.DeclareVectorOutputPort("bank_command", 1, lambda c, o: o.SetAtIndex(0, self._commands(c)[0]),
+        self.DeclareVectorOutputPort("bank_command", 1, weak_element(self._commands, 0),
                                      prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort("alpha_command", 1, lambda c, o: o.SetAtIndex(0, self._commands(c)[1]),
+        self.DeclareVectorOutputPort("alpha_command", 1, weak_element(self._commands, 1),
                                      prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort("plan_stats", 3, self._stats, prerequisites_of_calc={self.all_state_ticket()})
+        self.DeclareVectorOutputPort("plan_stats", 3, weak_method(self._stats),
+                                     prerequisites_of_calc={self.all_state_ticket()})
         self.DeclareStateOutputPort("command_offsets", self._offsets)
 
     def memory(self, context) -> ReplanMemory:

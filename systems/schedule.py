@@ -21,6 +21,7 @@ from drake_entry.errors import ScenarioError
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES, specific_energy
 from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
+from drake_entry.systems.lifetime import weak_method
 
 __all__ = ["make_schedule_source", "ScheduleSource"]
 
@@ -61,12 +62,12 @@ class ScheduleSource(LeafSystem):
             if not period > 0:
                 raise ScenarioError(f"ScheduleSource.period must be > 0 s, got {period}")
             self._held = self.DeclareDiscreteState([initial_value])
-            self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._sample)
-            self.DeclareForcedDiscreteUpdateEvent(self._sample)
+            self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, weak_method(self._sample))
+            self.DeclareForcedDiscreteUpdateEvent(weak_method(self._sample))
             self.DeclareStateOutputPort("command", self._held)
             return
         prereq = {self.time_ticket()} if var == "time" else {self.all_input_ports_ticket()}
-        self.DeclareVectorOutputPort("command", 1, self._calc, prerequisites_of_calc=prereq)
+        self.DeclareVectorOutputPort("command", 1, weak_method(self._calc), prerequisites_of_calc=prereq)
 
     def _sample(self, context, discrete_state):
         discrete_state.get_mutable_vector(self._held).SetAtIndex(0, self.value(context))

@@ -47,6 +47,7 @@ from drake_entry.guidance.swarm_bank.guidance_law import LawMemory, law_commands
 from drake_entry.guidance.swarm_bank.search import resolve_bank_end, resolve_sigma0
 from drake_entry.models.acceleration_ratios import filtered_ratios, sensed_vehicle
 from drake_entry.models.dynamics import FLIGHT_CONDITION_NAMES
+from drake_entry.systems.lifetime import weak_element, weak_method
 from drake_entry.systems.replan_scheduler import ReplanScheduler
 
 __all__ = ["SwarmBankGuidance"]
@@ -86,17 +87,18 @@ class SwarmBankGuidance(ReplanScheduler):
         self.DeclareReplanSchedule(replan_period_s=replan_period,
                                    first_due_s=replan_period if replan_period > 0 else math.inf,
                                    latency_s=latency_s, latency_factor=latency_factor, pending_size=2)
-        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, weak_method(self._update))
         deps = {self.xd_ticket(), self.est_port.ticket(), self.fc_port.ticket()}
-        self.DeclareVectorOutputPort("bank_magnitude", 1, lambda c, o: o.SetAtIndex(0, self.commands(c)[0]),
+        self.DeclareVectorOutputPort("bank_magnitude", 1, weak_element(self.commands, 0),
                                      prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort("alpha_command", 1, lambda c, o: o.SetAtIndex(0, self.commands(c)[1]),
+        self.DeclareVectorOutputPort("alpha_command", 1, weak_element(self.commands, 1),
                                      prerequisites_of_calc=deps)
-        self.DeclareVectorOutputPort("sigma0", 1, lambda c, o: o.SetAtIndex(0, self._memory(c)[_SIGMA0]),
+        self.DeclareVectorOutputPort("sigma0", 1, weak_element(self._memory, _SIGMA0),
                                      prerequisites_of_calc={self.xd_ticket()})
-        self.DeclareVectorOutputPort("sigma_f", 1, lambda c, o: o.SetAtIndex(0, self._memory(c)[_SIGMAF]),
+        self.DeclareVectorOutputPort("sigma_f", 1, weak_element(self._memory, _SIGMAF),
                                      prerequisites_of_calc={self.xd_ticket()})
-        self.DeclareVectorOutputPort("plan_stats", 3, self._plan_stats, prerequisites_of_calc={self.xd_ticket()})
+        self.DeclareVectorOutputPort("plan_stats", 3, weak_method(self._plan_stats),
+                                     prerequisites_of_calc={self.xd_ticket()})
 
     def _plan_stats(self, context, output):
         s = self.replan_stats(context)

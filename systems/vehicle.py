@@ -22,6 +22,7 @@ from drake_entry.models import dynamics
 from drake_entry.models.atmosphere import Atmosphere
 from drake_entry.models.planet import Earth
 from drake_entry.models.vehicles import Vehicle
+from drake_entry.systems.lifetime import weak_method
 
 __all__ = ["N_STATE", "N_CONDITIONS", "EntryVehicle_", "EntryVehicle"]
 
@@ -53,7 +54,7 @@ def EntryVehicle_(T):
             for port in (self.air_port, self.wind_port):
                 if port is not None:
                     deps.add(port.ticket())
-            self.DeclareVectorOutputPort("flight_conditions", N_CONDITIONS, self._calc_conditions,
+            self.DeclareVectorOutputPort("flight_conditions", N_CONDITIONS, weak_method(self._calc_conditions),
                                          prerequisites_of_calc=deps)
 
         def _construct_copy(self, other, converter=None):

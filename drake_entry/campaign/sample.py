@@ -21,6 +21,7 @@ from drake_entry.diagrams.common import collect_trajectory, make_simulator
 from drake_entry.models.dispersions import draw
 from drake_entry.models.trajectory import control_activity, metrics, navigation_errors
 from drake_entry.scenario import scenario_from_dump
+from drake_entry.systems.lifetime import release_system
 from drake_entry.systems.native_plant import as_flight_error
 
 __all__ = ["TRAJECTORY_STEP_S", "DETAILED_SAMPLES", "DETAILED_STEP_S", "TIMING_COLUMNS", "sample_seed",
@@ -97,6 +98,9 @@ def run_sample(setup: ClosedLoopSetup, campaign_seed: int, index: int, *,
         row.update({"success": False, "message": f"{type(e).__name__}: {e}".splitlines()[0][:500],
                     "traceback": traceback.format_exc(limit=3)[-2000:]})
         traj = None
+    finally:
+        if "built" in box:  # everything wanted from the flight is read: let its diagram be freed
+            release_system(box["built"].diagram)
     row["wall_time_s"] = time.perf_counter() - t_wall
     return row, traj
 

@@ -113,8 +113,8 @@ def run_serial(task: Task, cases, record, memory_budget: int | None = None):
     """The cases in this process, one after the other, until this process holds more than
     ``memory_budget`` bytes (default SERIAL_MEMORY_FRACTION of the machine's memory) after a case:
     then the rest go to one worker process that retires as run_processes' do (this process cannot
-    retire, and a Diagram with a Python LeafSystem is never freed: an SCvx campaign of one worker
-    held 21 GB after 97 samples)."""
+    retire; before flown diagrams were released, systems/lifetime.py, an SCvx campaign of one
+    worker held 21 GB after 97 samples)."""
     import psutil
 
     budget = int(SERIAL_MEMORY_FRACTION * psutil.virtual_memory().total) if memory_budget is None else memory_budget
@@ -130,8 +130,8 @@ def run_serial(task: Task, cases, record, memory_budget: int | None = None):
 
 
 #: a local worker retires after a case that leaves it holding more than this fraction of the
-#: machine's memory shared among the workers (its replacement builds the task's state afresh):
-#: pydrake 1.51.1 never frees a Diagram holding a Python LeafSystem (docs/performance.md, "Memory")
+#: machine's memory shared among the workers (its replacement builds the task's state afresh): a
+#: guard against what a method or model keeps; flown diagrams are freed (docs/performance.md, "Memory")
 WORKER_MEMORY_FRACTION = 0.6
 #: a serial campaign hands its remaining cases to a worker process past this fraction (the
 #: worker then has the rest of WORKER_MEMORY_FRACTION)

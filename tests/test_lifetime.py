@@ -116,3 +116,28 @@ def test_campaign_samples_leave_no_system_alive():
     rows = [run_sample(setup, 7, i, trajectory_step_s=0.0)[0] for i in range(2)]
     assert all(row["success"] for row in rows), [row["message"] for row in rows]
     assert live_python_systems() == before
+
+
+@pytest.mark.parametrize("actuator_systems", [False, True])
+def test_a_plan_verification_flight_leaves_no_system_alive(actuator_systems):
+    """The verifier's flight of a plan through the closed loop's actuators (their response
+    flown, or the actuator systems themselves): no Python system outlives it, the actuators
+    built for the response included. A re-planning method flies one per plan."""
+    from drake_entry.diagrams.verification import fly_controls
+    from drake_entry.models.atmosphere import US76Atmosphere
+    from drake_entry.models.planet import Earth
+    from drake_entry.models.vehicles import load_vehicle
+    from drake_entry.planning.verification import Actuation, EntryControls
+
+    horus = load_vehicle("horus2b")
+    actuation = Actuation(period_s=1.0, lead_s=0.0, bank_limit=1.4, bank_rate_limit=0.35, bank_accel_limit=0.35,
+                          alpha_bounds=(0.0, 0.7), alpha_rate_limit=0.1, alpha_accel_limit=0.1, initial_bank=0.5,
+                          initial_alpha=0.4)
+    controls = EntryControls(horus, Earth.spherical(), US76Atmosphere(),
+                             np.array([80e3, 0.1, 0.2, 7000.0, -0.01, 1.0]), 60.0, np.array([0.0, 60.0]),
+                             np.array([0.5, 0.8]), np.array([0.4, 0.4]), actuation=actuation)
+    before = live_python_systems()
+    flown = fly_controls(controls, actuator_systems=actuator_systems)
+    assert not flown.failure and flown.time[-1] == pytest.approx(60.0)
+    assert flown.trajectory.bank[-1] == pytest.approx(0.8, abs=0.01)  # the actuator followed the plan's ramp
+    assert live_python_systems() == before

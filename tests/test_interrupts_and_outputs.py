@@ -205,3 +205,37 @@ def test_fuzzed_output_locations_are_accepted_or_refused_in_one_line(tmp_path_fa
         os.makedirs(out, exist_ok=True)
     except OSError as e:  # what the CLI turns into one line (os_error_line)
         assert "cannot use" in os_error_line(e, out)
+
+
+def slow_setup(config):
+    """A toy campaign worker's state (killed-parent test)."""
+    return {"pause_s": float(config["pause_s"])}
+
+
+def slow_run(state, case):
+    time.sleep(state["pause_s"])
+    return {"index": case["index"], "success": True}, None
+
+
+_KILLED_PARENT = """
+import sys
+sys.path.insert(0, sys.argv[1])
+from drake_entry.campaign.backends import Task, run_processes
+task = Task("test_interrupts_and_outputs:slow_setup", "test_interrupts_and_outputs:slow_run", {"pause_s": 0.5})
+run_processes(task, [{"index": i} for i in range(1000)], lambda row, trajectory: print(row["index"], flush=True),
+              workers=2)
+"""
+
+
+def test_the_workers_of_a_killed_campaign_end_on_their_own():
+    """A campaign's main process killed outright (SIGKILL: no Ctrl-C handling, no clean-up) once
+    its two local workers are flying cases: both workers end within a few seconds instead of
+    waiting for ever for their next case (they check that their parent still runs)."""
+    proc = subprocess.Popen([sys.executable, "-c", _KILLED_PARENT, os.path.dirname(os.path.abspath(__file__))],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    first = proc.stdout.readline()  # a case answered: the workers are up and flying
+    assert first.strip().isdigit(), proc.stderr.read()[-2000:]
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=10)
+    left = subprocess.run(["ps", "-o", "pid,stat,args", "-g", str(proc.pid)], capture_output=True, text=True).stdout
+    assert _group_ended(proc.pid, within_s=15.0), left

@@ -145,15 +145,34 @@ def worker_memory_budget(workers: int, fraction: float = WORKER_MEMORY_FRACTION)
     return int(fraction * psutil.virtual_memory().total / max(workers, 1))
 
 
-def _process_worker(task: Task, inbox, outbox, slot: int, budget: int):
-    """A local worker: builds the task's state, then runs the cases it is sent (None ends it),
-    answering (slot, row, trajectory, retiring) for each; it retires (ends after answering)
-    when its resident memory has grown past ``budget`` bytes."""
+#: how often [s] a local worker waiting for its next case checks that its parent still runs
+ORPHAN_CHECK_S = 1.0
+
+
+def _next_case(inbox, parent: int):
+    """The next case sent to this worker, or None to end: when sent None, and when the process
+    that started it has gone (killed, so never sends None: its workers would otherwise wait for
+    ever, or a case in hand would be the last they fly)."""
+    import queue as queue_module
+
+    while True:
+        try:
+            return inbox.get(timeout=ORPHAN_CHECK_S)
+        except queue_module.Empty:
+            if os.getppid() != parent:
+                return None
+
+
+def _process_worker(task: Task, inbox, outbox, slot: int, budget: int, parent: int):
+    """A local worker: builds the task's state, then runs the cases it is sent (None ends it, and
+    its parent ``parent`` ending: ``_next_case``), answering (slot, row, trajectory, retiring) for
+    each; it retires (ends after answering) when its resident memory has grown past ``budget``
+    bytes."""
     import psutil
 
     init_pool_worker(task)
     me = psutil.Process()
-    while (case := inbox.get()) is not None:
+    while (case := _next_case(inbox, parent)) is not None:
         row, traj = work(case)
         retiring = me.memory_info().rss > budget
         outbox.put((slot, row, traj, retiring))
@@ -167,7 +186,8 @@ def run_processes(task: Task, cases, record, workers: int, memory_budget: int | 
     ``memory_budget`` bytes (default ``worker_memory_budget``) after a case retires and a new one
     takes its place; a worker that dies during a case (killed, out of memory, a crash in native
     code) leaves that case a failed row with its exit code, and a new worker goes on with the
-    rest. On Ctrl-C the workers are terminated and KeyboardInterrupt propagates."""
+    rest. On Ctrl-C the workers are terminated and KeyboardInterrupt propagates; when this process
+    is killed outright, each worker ends once its case in hand is done (``_next_case``)."""
     import queue as queue_module
 
     ctx = mp.get_context("spawn")
@@ -177,8 +197,9 @@ def run_processes(task: Task, cases, record, workers: int, memory_budget: int | 
     slots: dict[int, dict] = {}  # slot -> {"process", "inbox", "case" (None: idle)}
 
     def start(slot: int) -> None:
-        inbox = ctx.SimpleQueue()
-        process = ctx.Process(target=_process_worker, args=(task, inbox, outbox, slot, budget), daemon=True)
+        inbox = ctx.Queue()
+        process = ctx.Process(target=_process_worker, args=(task, inbox, outbox, slot, budget, os.getpid()),
+                              daemon=True)
         process.start()
         slots[slot] = {"process": process, "inbox": inbox, "case": None}
 

@@ -8,8 +8,10 @@ drag-energy guidance with the settings it derives from the mission
 - **paper**: each re-plan starts at the flown drag and slope (eq. 84 as at engagement), the
   smoothest profile (eq. 92), the mission's reversal corridor (3-15 deg);
 - **long glide**: re-plans start at the reference's drag and slope (``replan_start: reference``),
-  the profile is kept off the corridor's bounds (``corridor_centring: 1000``), and the reversal
-  corridor is 3-25 deg: what the derivation chooses.
+  the profile is kept off the corridor's bounds (``corridor_centring: 1000``), the reversal
+  corridor is 3-25 deg, and the plans fly 2.37 km less than the range to go
+  (``range_offset_m: -2370``, the range the nominal flight's end game adds): what the derivation
+  chooses.
 
 Each form flies the nominal entry and dispersed draws of the mission (seed 2026, the draws of the
 packaged comparison). The figure shows the flown and reference drag against normalised energy
@@ -41,7 +43,7 @@ FORMS = {
     "paper": {"guidance.replan_start": "flown", "guidance.corridor_centring": 0.0,
               "guidance.reversal_heading_deg": [3.0, 15.0]},
     "long glide": {"guidance.replan_start": "reference", "guidance.corridor_centring": 1000.0,
-                   "guidance.reversal_heading_deg": [3.0, 25.0]},
+                   "guidance.reversal_heading_deg": [3.0, 25.0], "guidance.range_offset_m": -2370.0},
 }
 
 

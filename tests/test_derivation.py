@@ -194,7 +194,7 @@ def test_an_exhaustive_step_flies_every_candidate_and_keeps_the_best(monkeypatch
 
     ratio = {45.0: 0.7, 50.0: 0.2, 40.0: 0.5}
     monkeypatch.setattr(derive, "_fly_candidate", lambda scenario, draws: (
-        [Flight("nominal", True, ratio[scenario.guidance.bank_end_deg])], ""))
+        [Flight("nominal", True, ratio[scenario.guidance.bank_end_deg])], "", None))
     mission = load_scenario("horus2b")
     spec = Fnpeg(terminal_altitude_km=25.0, terminal_velocity_m_s=750.0, bank_end_deg=45.0)
     for exhaustive, flown, kept in ((False, [45.0], 45.0), (True, [45.0, 50.0, 40.0], 50.0)):
@@ -202,6 +202,33 @@ def test_an_exhaustive_step_flies_every_candidate_and_keeps_the_best(monkeypatch
         chosen = derive_settings(mission, Derivation(spec, [], [step]))
         assert [t.values["guidance.bank_end_deg"] for t in chosen.trials] == flown
         assert chosen.chosen == {"guidance.bank_end_deg": kept}
+
+
+@pytest.mark.parametrize("first", [False, True])
+def test_a_calibrated_step_tries_the_value_measured_on_the_nominal_flight_first(monkeypatch, first):
+    """A fake flight whose final range to go is -2 km minus the range offset: the calibrated step
+    reads -2000 m on the nominal flight of the settings chosen before (the previous step's kept
+    trial, no extra flight; a nominal flown for it when it is the first step), tries it first,
+    lands (box ratio 0) and keeps it; the fixed fallback 0 is not flown."""
+    import drake_entry.comparison.derive as derive
+    from drake_entry.guidance.drag_energy.spec import DragEnergy
+
+    flown = []
+
+    def fake(scenario, draws):
+        miss = -2000.0 - scenario.guidance.range_offset_m
+        flown.append((scenario.guidance.range_offset_m, draws))
+        return [Flight("nominal", True, abs(miss) / 5000.0)], "", {"err_range_m": miss}
+
+    monkeypatch.setattr(derive, "_fly_candidate", fake)
+    spec = DragEnergy(terminal_altitude_km=26.5, terminal_mach=2.5)
+    steps = [SearchStep.calibrated("guidance.range_offset_m", lambda row: row["err_range_m"], (0.0,), "test")]
+    if not first:
+        steps.insert(0, SearchStep.over("guidance.corridor_margin", (0.05,), "test"))
+    chosen = derive_settings(load_scenario("horus2b"), Derivation(spec, [], steps))
+    assert chosen.chosen["guidance.range_offset_m"] == -2000.0
+    assert chosen.trials[-1].values == {"guidance.range_offset_m": -2000.0} and chosen.trials[-1].mean_ratio == 0.0
+    assert flown == ([(0.0, 0)] if first else [(0.0, 2)]) + [(-2000.0, 2)]
 
 
 def test_the_search_flies_its_candidates_and_keeps_the_best():

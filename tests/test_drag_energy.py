@@ -276,9 +276,29 @@ def test_a_re_plan_from_the_reference_starts_at_its_drag_and_slope_not_the_flown
     assert from_reference.plan_from_state(later).I[0] == pytest.approx(flown.I[0])  # no previous: the flown drag
 
 
+def test_a_range_offset_moves_the_planned_range_and_the_plan_flies_it(planner, engagement_state):
+    """range_offset_m: the plan from the engagement state flies the great-circle range to go plus
+    the offset (its own integral of the range, eq. 83, equals it), never below a
+    tenth of the distance left."""
+    import copy
+
+    distance = float(planner.planet.great_circle_distance(engagement_state[1], engagement_state[2], *planner.target))
+    short = copy.copy(planner)
+    short.range_offset = -20e3
+    assert short.range_to_go(engagement_state) == pytest.approx(distance - 20e3, abs=1e-6)
+    base, shortened = planner.plan_from_state(engagement_state), short.plan_from_state(engagement_state)
+    assert base.success and shortened.success, shortened.message
+    flown = [p.range_flown() for p in (base, shortened)]  # the range, eq. 83, over the plan's nodes
+    assert flown[0] == pytest.approx(distance, rel=1e-4) and flown[1] == pytest.approx(distance - 20e3, rel=1e-4)
+    assert base.problem.range_to_go - shortened.problem.range_to_go == pytest.approx(20e3, rel=1e-9)
+    short.range_offset = -10.0 * distance
+    assert short.range_to_go(engagement_state) == pytest.approx(0.1 * distance)
+
+
 @pytest.mark.parametrize("field, value, message", [
     ("guidance.replan_start", "'now'", r"guidance.replan_start 'now' is unknown; allowed: flown, reference"),
     ("guidance.corridor_centring", "-1", r"guidance.corridor_centring"),
+    ("guidance.range_offset_m", "-2e6", r"guidance.range_offset_m"),
 ])
 def test_drag_energy_refuses_an_unknown_re_plan_start_and_a_negative_centring(field, value, message):
     from drake_entry.errors import ScenarioError

@@ -58,6 +58,7 @@ class Trial:
     flights: list[Flight]
     wall_s: float
     setup_failure: str = ""
+    nominal_row: dict | None = None  # the nominal flight's campaign row (a later calibrated step reads it)
 
     @property
     def successes(self) -> int:
@@ -125,9 +126,9 @@ def _flight(sample: str, row: dict, tolerances: dict) -> Flight:
     return Flight(sample, success, ratio, "" if success or not message else message.splitlines()[0][:200])
 
 
-def _fly_candidate(scenario, draws: int) -> tuple[list[Flight], str]:
-    """The nominal flight and ``draws`` dispersed samples of ``scenario``; ('', flights) or the
-    pre-flight failure."""
+def _fly_candidate(scenario, draws: int) -> tuple[list[Flight], str, dict | None]:
+    """The nominal flight and ``draws`` dispersed samples of ``scenario``: (flights, '' or the
+    pre-flight failure, the nominal flight's campaign row or None)."""
     from drake_entry.campaign.preparation import prepare
     from drake_entry.campaign.sample import campaign_row, run_sample
     from drake_entry.diagrams.closed_loop import ClosedLoopSetup, fly
@@ -136,24 +137,45 @@ def _fly_candidate(scenario, draws: int) -> tuple[list[Flight], str]:
         prepare(scenario)  # nothing, or built once and cached (e.g. AMPI's database for the mission)
         setup = ClosedLoopSetup.from_scenario(scenario)
     except DrakeEntryError as e:
-        return [], f"pre-flight planning failed: {str(e).splitlines()[0][:300]}"
+        return [], f"pre-flight planning failed: {str(e).splitlines()[0][:300]}", None
     tolerances = {k: b["tolerance"] for k, b in
                   acceptance_box(scenario.terminal, altitude_m=math.nan, mach=math.nan, distance_m=math.nan).items()}
+    nominal = None
     try:
-        flights = [_flight("nominal", campaign_row(fly(setup), setup), tolerances)]
+        nominal = campaign_row(fly(setup), setup)
+        flights = [_flight("nominal", nominal, tolerances)]
     except (DrakeEntryError, RuntimeError) as e:
         flights = [Flight("nominal", False, math.inf, str(e).splitlines()[0][:200])]
     return flights + [_flight(str(i), run_sample(setup, SEARCH_SEED, i, trajectory_step_s=0)[0], tolerances)
-                      for i in range(draws)], ""
+                      for i in range(draws)], "", nominal
+
+
+def _calibrated(step, mission, derivation: Derivation, chosen: dict, before: Trial | None) -> tuple:
+    """``step``'s candidates, its measured one first when it is calibrated: measured on the
+    nominal row of ``before`` (the trial that chose the settings so far), or of a nominal flight
+    flown now when there is none; the fixed candidates alone when the nominal flight fails to
+    give the measure."""
+    if step.calibrate is None:
+        return step.candidates
+    row = before.nominal_row if before is not None else None
+    if row is None:
+        _, _, row = _fly_candidate(apply_derivation(mission, derivation, chosen), 0)
+    try:
+        measured = step.calibrate(row) if row is not None else None
+    except (KeyError, TypeError, ValueError):
+        measured = None
+    if measured is None or not all(isinstance(v, (int, float)) and math.isfinite(v) for v in measured.values()):
+        return step.candidates
+    return (measured, *(c for c in step.candidates if c != measured))
 
 
 def derive_settings(mission, derivation: Derivation, *, draws: int = SEARCH_DRAWS, progress=None) -> DerivedSettings:
     """Choose ``derivation``'s free settings on ``mission`` (module doc); ``progress(text)``
     is told each trial."""
-    chosen, trials = {}, []
+    chosen, trials, best = {}, [], None
     for step in derivation.search:
         step_trials = []
-        for values in step.candidates:
+        for values in _calibrated(step, mission, derivation, chosen, best):
             t0 = time.perf_counter()
             try:
                 scenario = apply_derivation(mission, derivation, {**chosen, **values})
@@ -161,8 +183,8 @@ def derive_settings(mission, derivation: Derivation, *, draws: int = SEARCH_DRAW
                 step_trials.append(Trial(step.name, values, [], time.perf_counter() - t0,
                                          f"refused: {str(e).splitlines()[0][:300]}"))
                 continue
-            flights, failure = _fly_candidate(scenario, draws)
-            trial = Trial(step.name, values, flights, time.perf_counter() - t0, failure)
+            flights, failure, nominal = _fly_candidate(scenario, draws)
+            trial = Trial(step.name, values, flights, time.perf_counter() - t0, failure, nominal)
             step_trials.append(trial)
             if progress:
                 shown = ", ".join(f"{k.split('.')[-1]} {value_text(v)}" for k, v in values.items())

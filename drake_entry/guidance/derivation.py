@@ -16,6 +16,7 @@ reversal corridor.
 import dataclasses as dc
 import importlib
 import math
+from typing import Callable
 
 import numpy as np
 import scipy.optimize
@@ -80,16 +81,25 @@ class SearchStep:
     dotted fields it sets ({'guidance.bank_end_deg': 45.0}; the first is the derivation's own
     value), and why it is free. ``exhaustive``: every candidate is flown and the best kept (a
     setting whose effect is graded, such as one that moves the terminal altitude), instead of
-    the first good enough. ``over`` builds the step of one field."""
+    the first good enough. ``calibrate``: a candidate measured, tried before ``candidates``: the
+    fields it returns from the campaign row (drake_entry.campaign.sample.campaign_row) of the
+    nominal flight with the settings chosen before this step. ``over`` builds the step of one
+    field, ``calibrated`` one whose value is measured."""
 
     name: str
     candidates: tuple
     why: str
     exhaustive: bool = False
+    calibrate: Callable[[dict], dict] | None = None
 
     @classmethod
     def over(cls, field: str, values, why: str, *, exhaustive: bool = False) -> "SearchStep":
         return cls(field, tuple({field: v} for v in values), why, exhaustive)
+
+    @classmethod
+    def calibrated(cls, field: str, measure: Callable[[dict], float], fallbacks, why: str) -> "SearchStep":
+        """``field`` at ``measure(row)`` of the nominal flight first, then at each of ``fallbacks``."""
+        return cls(field, tuple({field: v} for v in fallbacks), why, calibrate=lambda row: {field: measure(row)})
 
 
 @dc.dataclass

@@ -560,7 +560,8 @@ class DragEnergyPlanner:
                  target_lon: float, target_lat: float, E_entry: float, E_final: float, n_nodes: int = 40,
                  solver: str = "clarabel", margin: float = 0.03, corridor_points: int = 300,
                  sigma_max: float | None = None, terminal_drag: float | None = None,
-                 terminal_state: tuple | None = None, replan_start: str = "flown", centring: float = 0.0):
+                 terminal_state: tuple | None = None, replan_start: str = "flown", centring: float = 0.0,
+                 range_offset: float = 0.0):
         if alpha.variable != "energy":
             raise ScenarioError(f"the drag-energy planner needs alpha scheduled in energy, got '{alpha.variable}'")
         self.vehicle, self.atmosphere, self.alpha = vehicle, atmosphere, alpha
@@ -572,6 +573,7 @@ class DragEnergyPlanner:
         self.n_nodes, self.solver = n_nodes, solver
         self.replan_start = replan_start  # DragEnergy.replan_start: "flown" or "reference"
         self.centring = centring  # DragEnergy.corridor_centring
+        self.range_offset = float(range_offset)  # DragEnergy.range_offset_m
         self.sigma_max = vehicle.bank_limit if sigma_max is None else sigma_max
         E = np.linspace(E_final, E_entry + 0.02 * (E_entry - E_final), corridor_points)
         self.margin = margin
@@ -617,7 +619,7 @@ class DragEnergyPlanner:
             target_lat=math.radians(scenario.target.latitude_deg), E_entry=scenario.entry_energy(), E_final=Ef,
             n_nodes=g.n_nodes, solver=g.solver, margin=g.corridor_margin, corridor_points=g.corridor_points,
             terminal_drag=D_f, terminal_state=(h_f, V_f), replan_start=g.replan_start,
-            centring=g.corridor_centring)
+            centring=g.corridor_centring, range_offset=g.range_offset_m)
 
     def energy(self, x) -> float:
         return float(self.planet.specific_energy(x[0], x[3]))
@@ -639,7 +641,10 @@ class DragEnergyPlanner:
                           a_Dgamma=k * d.a_Dgamma, b_Dgamma=k * d.b_Dgamma)
 
     def range_to_go(self, x) -> float:
-        return float(self.planet.great_circle_distance(x[1], x[2], *self.target))
+        """The range [m] a plan from state x flies: the great-circle distance to the target plus
+        ``range_offset`` (DragEnergy.range_offset_m), never below a tenth of that distance."""
+        distance = float(self.planet.great_circle_distance(x[1], x[2], *self.target))
+        return max(distance + self.range_offset, 0.1 * distance)
 
     def problem(self, x, sensed_drag: float | None = None, **overrides) -> DragEnergyProblem:
         """The planning request from state x [h, lon, lat, V, gamma, psi] (and sensed drag)."""

@@ -40,6 +40,10 @@ class DragEnergy(ReversingBankSpec, ReplansOnBoard):
     # corridor centring (not paper 000's; 0: the paper's smoothest profile): the weight of the
     # profile's least distance from both bounds beside eq. 92 (DragEnergyProblem.centring)
     corridor_centring: float = 0.0
+    # the plans fly the great-circle range to go plus this [m] (not paper 000's; 0: the range to
+    # the target): the range a flight's end game adds beyond its plan, negative when it ends past
+    # the target; never below a tenth of the range left (DragEnergyPlanner.range_to_go)
+    range_offset_m: float = 0.0
     # drag tracking (eq. 101), energy domain: zeta < 0 because E decreases (paper 000 Sec. VI.D)
     zeta: float = -0.7
     # pseudo-frequency omega_D [1/(J/kg)] = 2 pi / (energy per oscillation) (paper 000: constant)
@@ -61,6 +65,7 @@ class DragEnergy(ReversingBankSpec, ReplansOnBoard):
         check_range("guidance.replan_until_e", self.replan_until_e, 0.0, 1.0)
         check_range("guidance.corridor_margin", self.corridor_margin, 0.0, 0.49)
         check_range("guidance.corridor_centring", self.corridor_centring, 0.0, 1e5)
+        check_range("guidance.range_offset_m", self.range_offset_m, -1e6, 1e6)
         check_range("guidance.corridor_points", self.corridor_points, 20, 100000)
         check_range("guidance.pre_guidance_min_s", self.pre_guidance_min_s, 0.0, 1e5)
         check_range("guidance.pre_guidance_bank_deg", self.pre_guidance_bank_deg, -180.0, 180.0)

@@ -39,7 +39,7 @@ class BankReversalLogic(LeafSystem):
         self.mag_port = self.DeclareVectorInputPort("bank_magnitude", 1)
         self._state = self.DeclareDiscreteState(BasicVector([1.0 if initial_sign >= 0 else -1.0, 0.0]))
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, weak_method(self._update))
-        self.DeclareVectorOutputPort("bank_command", 1, weak_element(self._signed_bank, 0),
+        self.DeclareVectorOutputPort("bank_command", 1, weak_method(self._bank_command),
                                      prerequisites_of_calc={self.xd_ticket(), self.mag_port.ticket()})
         self.DeclareVectorOutputPort("reversals", 1, weak_element(self._sign_and_count, 1),
                                      prerequisites_of_calc={self.xd_ticket()})
@@ -48,9 +48,9 @@ class BankReversalLogic(LeafSystem):
         """[bank sign (+1 or -1), reversals so far]."""
         return context.get_discrete_state(self._state).get_value()
 
-    def _signed_bank(self, context) -> list:
-        """[the bank command: the sign times the commanded magnitude, rad]."""
-        return [self._sign_and_count(context)[0] * self.mag_port.Eval(context)[0]]
+    def _bank_command(self, context, output):
+        """The bank command [rad]: the sign times the commanded magnitude."""
+        output.SetAtIndex(0, self._sign_and_count(context)[0] * self.mag_port.Eval(context)[0])
 
     def heading_error(self, x) -> float:
         return wrap_angle(x[5] - bearing(x[1], x[2], *self.target))

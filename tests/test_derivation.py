@@ -1,6 +1,7 @@
 """Settings a method derives from a mission (drake_entry.guidance.derivation) and the search that
 chooses its free ones by flying (drake_entry.comparison.derive)."""
 import dataclasses as dc
+import math
 
 import numpy as np
 import pytest
@@ -155,14 +156,35 @@ def test_a_constant_alpha_and_one_in_time():
     assert values == [14.0, 10.5, 11.0] and "own method's (!Fnpeg)" in how and speeds[-1] == pytest.approx(1.0, abs=1e-9)
 
 
+def test_a_geodetic_box_is_an_interface_at_the_targets_latitude():
+    """Paper 001's DRS box gives its altitude geodetically (10-13 km, eq. 64): a method aims at its
+    centre as the state altitude whose geodetic altitude at the target is 11.5 km, with the
+    box's 1.5-km tolerance; on the ellipsoid datum the geodetic altitude is stated as it is."""
+    sphynx = load_scenario("sphynx_paper001")
+    interface = terminal_interface(sphynx)
+    planet, lat = sphynx.make_planet(), math.radians(sphynx.target.latitude_deg)
+    assert float(planet.atmospheric_altitude(interface.altitude_km * 1e3, lat)) == pytest.approx(11.5e3, abs=1e-6)
+    assert 3.5 < interface.altitude_km < 4.0  # the Azores site: the local radius 7.7 km under the reference sphere's
+    assert interface.altitude_tolerance_km == 1.5 and interface.mach == 0.5 and interface.mach_given
+    a = float(sphynx.make_atmosphere().speed_of_sound(11.5e3))
+    assert interface.speed_m_s == pytest.approx(0.5 * a)
+    assert interface_altitudes(sphynx, interface)[0] == pytest.approx(interface.altitude_km)
+    ellipsoid = dc.replace(sphynx, altitude_datum="ellipsoid")
+    assert terminal_interface(ellipsoid).altitude_km == 11.5
+    assert terminal_interface(load_scenario("horus2b")).altitude_tolerance_km == \
+        load_scenario("horus2b").terminal.altitude_tolerance_km
+
+
 def test_a_method_without_a_derivation_and_a_mission_without_an_interface_are_refused_in_one_line(monkeypatch):
     import importlib
 
     from drake_entry.guidance.fnpeg.spec import Fnpeg
 
-    sphynx = load_scenario("sphynx_paper001")  # its box is the guidance's DRS window: no terminal altitude
-    with pytest.raises(CannotFly, match="gives no altitude_km"):
-        derivation_for(sphynx, Fnpeg)
+    sphynx = load_scenario("sphynx_paper001")
+    no_altitude = dc.replace(sphynx, terminal=dc.replace(sphynx.terminal, geodetic_altitude_km=None,
+                                                         geodetic_altitude_tolerance_km=None))
+    with pytest.raises(CannotFly, match="gives neither altitude_km nor geodetic_altitude_km"):
+        derivation_for(no_altitude, Fnpeg)
     real = importlib.import_module
 
     def missing(name, *a, **k):

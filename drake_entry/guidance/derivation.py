@@ -27,7 +27,7 @@ from drake_entry.models.planet import G0
 from drake_entry.scenario import stated_guidance
 
 __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "derivation_for",
-           "terminal_interface", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
+           "terminal_interface", "box_altitude_tolerance_km", "geodetic_interface_km", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
            "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed",
            "box_mach_window", "load_limit_speed", "FORCE_SIGMAS", "FINAL_DESCENT_DEG", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds", "PATH_GAIN",
            "PATH_LIMIT_FRACTION", "path_gain"]
@@ -122,15 +122,17 @@ class CannotFly(ScenarioError):
 
 @dc.dataclass(frozen=True)
 class Interface:
-    """The mission's terminal interface, the centre of its acceptance box: geodetic altitude
-    [km], speed [m/s], its Mach number there, the speed of sound there [m/s], and whether the
-    mission gives the Mach number (else the speed)."""
+    """The mission's terminal interface, the centre of its acceptance box: altitude [km] as a
+    guidance block states it (the scenario's altitude datum), speed [m/s], its Mach number there,
+    the speed of sound there [m/s], whether the mission gives the Mach number (else the speed),
+    and the box's altitude tolerance about it [km] (None: the box checks no altitude)."""
 
     altitude_km: float
     speed_m_s: float
     mach: float
     speed_of_sound: float
     mach_given: bool
+    altitude_tolerance_km: float | None = None
 
 
 def derivation_for(scenario, spec_type) -> Derivation:
@@ -175,17 +177,43 @@ def require_alpha_window(scenario, widen_deg: float = 0.0) -> None:
 
 
 def terminal_interface(scenario) -> Interface:
-    """The centre of the mission's acceptance box (terminal.altitude_km and its mach or
-    velocity_m_s); CannotFly when the mission gives no altitude or no speed."""
+    """The centre of the mission's acceptance box (terminal.altitude_km, or its
+    geodetic_altitude_km at the target's latitude, and its mach or velocity_m_s); CannotFly when
+    the mission gives no altitude or no speed."""
     t = scenario.terminal
-    if t.altitude_km is None:
-        raise CannotFly("the mission's terminal block gives no altitude_km: no terminal interface to aim at")
-    a = float(scenario.make_atmosphere().speed_of_sound(t.altitude_km * 1e3))
+    altitude_km, geodetic_m = t.altitude_km, None
+    if altitude_km is None and t.geodetic_altitude_km is not None:
+        altitude_km, geodetic_m = geodetic_interface_km(scenario), t.geodetic_altitude_km * 1e3
+    tolerance_km = box_altitude_tolerance_km(t)
+    if altitude_km is None:
+        raise CannotFly("the mission's terminal block gives neither altitude_km nor geodetic_altitude_km: no "
+                        "terminal interface to aim at")
+    a = float(scenario.make_atmosphere().speed_of_sound(altitude_km * 1e3 if geodetic_m is None else geodetic_m))
     if t.mach is not None:
-        return Interface(t.altitude_km, float(t.mach) * a, float(t.mach), a, True)
+        return Interface(altitude_km, float(t.mach) * a, float(t.mach), a, True, tolerance_km)
     if t.velocity_m_s is not None:
-        return Interface(t.altitude_km, float(t.velocity_m_s), float(t.velocity_m_s) / a, a, False)
+        return Interface(altitude_km, float(t.velocity_m_s), float(t.velocity_m_s) / a, a, False, tolerance_km)
     raise CannotFly("the mission's terminal block gives neither mach nor velocity_m_s: no terminal speed to aim at")
+
+
+def box_altitude_tolerance_km(terminal) -> float | None:
+    """The box's tolerance [km] about the altitude a method aims at: altitude_tolerance_km, or
+    geodetic_altitude_tolerance_km when the box gives its altitude geodetically only."""
+    if terminal.altitude_km is None and terminal.geodetic_altitude_km is not None:
+        return terminal.geodetic_altitude_tolerance_km
+    return terminal.altitude_tolerance_km
+
+
+def geodetic_interface_km(scenario) -> float:
+    """The box's geodetic altitude (terminal.geodetic_altitude_km) as the terminal altitude a
+    guidance block states [km]: the geodetic altitude itself with altitude_datum 'ellipsoid', else
+    the state altitude at the target's latitude (paper 001's DRS box is geodetic: 11.5 km there
+    is a 3.8-km state altitude at the Azores site)."""
+    geodetic = scenario.terminal.geodetic_altitude_km * 1e3
+    if scenario.altitude_datum == "ellipsoid":
+        return geodetic / 1e3
+    lat = math.radians(scenario.target.latitude_deg)
+    return float(scenario.make_planet().state_altitude(geodetic, lat)) / 1e3
 
 
 def _altitude_at_energy(E: float, E0: float, h0: float, Ef: float, hf: float) -> float:
@@ -274,7 +302,7 @@ ALTITUDE_WHY = "the interface inside the box where the path limits hold to the e
 def interface_altitudes(scenario, interface: Interface) -> tuple[float, ...]:
     """The terminal altitudes [km] to try inside the mission's box (ALTITUDE_STEPS; the centre
     alone when the box has no altitude tolerance), never below the ground."""
-    tol = scenario.terminal.altitude_tolerance_km
+    tol = interface.altitude_tolerance_km
     if not tol:
         return (interface.altitude_km,)
     return tuple(h for h in (round(interface.altitude_km + k * tol, 4) for k in ALTITUDE_STEPS) if h >= 0.0)

@@ -27,6 +27,7 @@ from pydrake.common.yaml import yaml_dump_typed
 
 from drake_entry.errors import ScenarioError
 from drake_entry.guidance.ampi.spec import MISSION_DATABASE
+from drake_entry.guidance.derivation import box_altitude_tolerance_km
 from drake_entry.models.vehicles import PACKAGED_VEHICLES
 from drake_entry.planning.ocp_yaml import (
     AlphaScheduleSpec,
@@ -102,7 +103,7 @@ def mission_problem_spec(spec, scenario) -> ProblemSpec:
             if math.isfinite(bound)]
     h_f = spec.terminal_altitude_km * 1e3
     E_f = dc.replace(scenario, guidance=spec).guidance_terminal_state()[2]  # where the closed loop stops
-    tol = scenario.terminal.altitude_tolerance_km
+    tol = box_altitude_tolerance_km(scenario.terminal)
     window = ALTITUDE_WINDOW_FRACTION * tol * 1e3 if tol else ALTITUDE_WINDOW_M
     bank = BANK_FRACTION * math.degrees(vehicle.bank_limit)
     rate = BANK_RATE_FRACTION * math.degrees(vehicle.bank_rate_limit)

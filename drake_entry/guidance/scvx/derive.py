@@ -118,8 +118,8 @@ def aim_window(scenario, altitude_km: float, mach_window: tuple, mach: float, al
     found every re-plan infeasible at its last node), not below ``mach_floor`` (the box's
     lower edge where it checks the speed); the interface's ``mach`` held inside the window as
     the spec's terminal_mach."""
-    t = scenario.terminal
-    centre_km, tolerance_km = t.altitude_km, t.altitude_tolerance_km
+    interface = terminal_interface(scenario)
+    centre_km, tolerance_km = interface.altitude_km, interface.altitude_tolerance_km
     half = min(AIM_WINDOW_KM, 0.25 * tolerance_km, tolerance_km - abs(altitude_km - centre_km))
     a = float(scenario.make_atmosphere().speed_of_sound(altitude_km * 1e3))
     glides = glides_at(scenario, altitude_km, mach * a, alpha_deg(mach * a))
@@ -145,7 +145,7 @@ def derive(scenario) -> Derivation:
     """Scvx settings for ``scenario``'s mission stating no !Scvx block (module doc)."""
     t = scenario.terminal
     interface = terminal_interface(scenario)
-    if not t.altitude_tolerance_km:
+    if not interface.altitude_tolerance_km:
         raise CannotFly("the mission's box gives no altitude tolerance: SCvx plans to an altitude window "
                         "(paper 001 eq. 64)")
     if not t.distance_tolerance_km:
@@ -164,7 +164,7 @@ def derive(scenario) -> Derivation:
                 f"its planned load bound at the interface altitude (room for the flown error), reaching down to "
                 f"where forces {force_high:.3g} x the nominal ({FORCE_SIGMAS:g} sigma of the mission's force "
                 f"dispersions) meet that load bound")
-    h, tol = interface.altitude_km, t.altitude_tolerance_km
+    h, tol = interface.altitude_km, interface.altitude_tolerance_km
     if h - tol < 0.0:
         raise CannotFly(f"the mission's altitude window reaches below the ground ({h - tol:g} km)")
     altitudes = interface_altitudes(scenario, interface)

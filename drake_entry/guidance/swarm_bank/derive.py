@@ -68,7 +68,7 @@ def derive(scenario) -> Derivation:
         speeds, scheduled, how, laws = [], [], f"no schedule in speed ({e})", ("load",)
     term = scenario.terminal
     distance_km = term.distance_tolerance_km or SwarmBank.objective_range_unit_km  # the paper's where none
-    altitude_km = term.altitude_tolerance_km or SwarmBank.objective_altitude_unit_km
+    altitude_km = interface.altitude_tolerance_km or SwarmBank.objective_altitude_unit_km
     vehicle = scenario.make_vehicle()
     bank_limit = min(89.0, vehicle.bank_limit_deg)
     gain = path_gain(vehicle)

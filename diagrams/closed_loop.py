@@ -47,12 +47,20 @@ from drake_entry.systems.native_plant import add_plant
 from drake_entry.systems.navigation import Navigation
 from drake_entry.systems.schedule import ScheduleSource
 
-__all__ = ["ALTITUDE_FLOOR_M", "NAVIGATION_ERROR_COLUMNS", "ClosedLoopSetup", "ClosedLoopResult", "ClosedLoopDiagram", "build_closed_loop",
+__all__ = ["ALTITUDE_FLOOR_M", "altitude_floor", "NAVIGATION_ERROR_COLUMNS", "ClosedLoopSetup", "ClosedLoopResult", "ClosedLoopDiagram", "build_closed_loop",
            "terminal_errors", "acceptance_box", "fly", "summarise"]
 
+#: the crash guard of a flight that stops at the terminal energy [m]: this altitude, or half the
+#: terminal altitude when the interface lies below twice it (paper 001's DRS box at 3.8 km)
 ALTITUDE_FLOOR_M = 5000.0
 #: the logged columns of an INS flight's navigation error (InertialNavigation "navigation_error")
 NAVIGATION_ERROR_COLUMNS = ("nav_position_error_m", "nav_velocity_error_m_s")
+
+
+def altitude_floor(terminal_altitude_m: float) -> float:
+    """The crash guard [m] of a flight stopping at the terminal energy: ALTITUDE_FLOOR_M, never
+    above half the terminal altitude (a floor above the interface stops every flight short of it)."""
+    return min(ALTITUDE_FLOOR_M, 0.5 * max(terminal_altitude_m, 0.0))
 
 
 @dc.dataclass
@@ -216,7 +224,7 @@ def build_closed_loop(setup: ClosedLoopSetup, *, nav_seed: int = 0, nav_bias=Non
         builder.Connect(alpha_out, sink)
     # altitudes of the stop and the floor are geodetic with altitude_datum 'ellipsoid'
     stop = ({"altitude": g.terminal_altitude_km * 1e3} if g.stops_at_altitude
-            else {"energy": setup.terminal[2], "altitude": ALTITUDE_FLOOR_M})
+            else {"energy": setup.terminal[2], "altitude": altitude_floor(g.terminal_altitude_km * 1e3)})
     monitor = builder.AddNamedSystem("termination", TerminationMonitor(
         **stop, planet=setup.energy_planet, geodetic=scenario.altitude_datum == "ellipsoid"))
     builder.Connect(state, monitor.GetInputPort("state"))

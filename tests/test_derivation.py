@@ -175,6 +175,30 @@ def test_a_geodetic_box_is_an_interface_at_the_targets_latitude():
         load_scenario("horus2b").terminal.altitude_tolerance_km
 
 
+def test_fnpeg_on_a_skipping_entry_engages_at_a_lower_acceleration_and_reaches_a_low_interface():
+    """SPHYNX's shallow entry skips: wings level its first pull-out senses at most 1.09 m/s^2, so
+    at Lu 2014's 1.52 FNPEG engages only past the site and ends thousands of km from it; at half
+    of Lu's value (the derivation's next candidate) it engages in the first dip and ends inside the
+    DRS box at E_f, which lies at 3.83 km, below the 5-km crash floor (now half of it)."""
+    from drake_entry.diagrams.closed_loop import ALTITUDE_FLOOR_M, altitude_floor, fly
+    from drake_entry.guidance.fnpeg.derive import ENGAGE_ACCELERATIONS_M_S2
+    from drake_entry.guidance.fnpeg.spec import Fnpeg
+
+    assert altitude_floor(26.5e3) == ALTITUDE_FLOOR_M and altitude_floor(3830.0) == 1915.0 and altitude_floor(0.0) == 0.0
+    sphynx = load_scenario("sphynx_paper001")
+    d = derivation_for(sphynx, Fnpeg)
+    assert [s.candidates for s in d.search if s.name == "guidance.engage_acceleration_m_s2"] == \
+        [tuple({"guidance.engage_acceleration_m_s2": a} for a in ENGAGE_ACCELERATIONS_M_S2)]
+    flights = {a: fly(apply_derivation(sphynx, d, {"guidance.bank_end_deg": 20.0,
+                                                   "guidance.engage_acceleration_m_s2": a}))
+               for a in ENGAGE_ACCELERATIONS_M_S2[:2]}
+    late, engaged = flights[1.52], flights[0.76]
+    assert late.guidance.fields["engage_time_s"] > 1000.0 and late.errors["distance_m"] > 1e6 and not late.success
+    assert engaged.guidance.fields["engage_time_s"] < 400.0
+    assert engaged.reached and engaged.success, engaged.message
+    assert engaged.errors["distance_m"] < 10e3
+
+
 def test_a_method_without_a_derivation_and_a_mission_without_an_interface_are_refused_in_one_line(monkeypatch):
     import importlib
 

@@ -16,7 +16,7 @@ from drake_entry.guidance.derivation import (
 )
 from drake_entry.guidance.fnpeg.spec import Fnpeg
 
-__all__ = ["derive", "BANK_END_CANDIDATES_DEG", "LIMIT_MARGINS"]
+__all__ = ["derive", "BANK_END_CANDIDATES_DEG", "LIMIT_MARGINS", "ENGAGE_ACCELERATIONS_M_S2"]
 
 #: sigma_f flown on the nominal flight and the search's draws, every one (it sets the altitude
 #: at e_f, graded: on Lu's CAV-H case 50, 40 and 30 deg end 2.0 km low, centred and 1.3 km high)
@@ -25,6 +25,12 @@ BANK_END_CANDIDATES_DEG = (45.0, 50.0, 40.0, 55.0, 35.0, 60.0, 30.0, 65.0, 25.0,
 #: fractions of the vehicle's limits the path feedback enforces, tried in order (the hand-tuned
 #: HORUS-2B values were 0.90-0.94)
 LIMIT_MARGINS = (0.93, 0.9, 0.85, 0.8)
+#: the sensed aerodynamic acceleration at which FNPEG engages [m/s^2], tried in order: Lu 2014's
+#: 1.52, then a half and a quarter of it. SPHYNX's entry (-1.29 deg at 115 km, L/D 0.9 at 40 deg)
+#: skips: wings level its first pull-out senses at most 1.09 m/s^2 (74 km, 354 s), and at 1.52 the
+#: guidance engaged only at 1340 s, past the site, ending 3500-4100 km from it; at 1.0 and 0.5 it
+#: engaged at 319 and 247 s and ended 3.5 and 3.6 km from it
+ENGAGE_ACCELERATIONS_M_S2 = (1.52, 0.76, 0.38)
 
 
 def derive(scenario) -> Derivation:
@@ -74,5 +80,10 @@ def derive(scenario) -> Derivation:
                         "sigma_f sets the lift left at the end, so the altitude at e_f (Lu: chosen per vehicle); "
                         "every candidate flown, the best kept", exhaustive=True),
         dc.replace(margin, name="limit margin at that sigma_f"),
+        SearchStep.over("guidance.engage_acceleration_m_s2", ENGAGE_ACCELERATIONS_M_S2,
+                        "Lu 2014's engagement at 1.52 m/s^2 of sensed acceleration first; a vehicle that skips "
+                        "on a shallow entry senses less in its first pull-out and would glide on wings level "
+                        "until past the target: half, then a quarter (last, so a mission that engages at Lu's "
+                        "keeps it)"),
     ]
     return Derivation(spec, choices, search)

@@ -79,6 +79,31 @@ def test_ctrl_c_ends_a_campaign_with_one_line_exit_130_and_no_worker_left(tmp_pa
     assert done_indices(out) == set(range(12))
 
 
+@pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_campaign_started_in_the_background_stops_on_sigint_or_sigterm_keeping_its_samples(tmp_path, signum):
+    """A campaign started as a shell's background job (SIGINT ignored, which Python leaves
+    ignored) and signalled alone, as `kill -INT PID` or `kill PID` does: exit 130 with the one
+    line naming the finished count, its workers ended, the lock released, the samples kept."""
+    out = str(tmp_path / "c")
+    argv = [sys.executable, "-m", "drake_entry.cli", "campaign", "horus2b", "--runs", "12", "--workers", "2",
+            "--trajectory-step", "0", "--out", out]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            cwd=str(tmp_path), preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
+    deadline = time.monotonic() + 300
+    while _rows(out) < 1 and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is None, ("the campaign ended before the signal could land", proc.communicate()[1][-2000:])
+    os.kill(proc.pid, signum)
+    _, err = proc.communicate(timeout=120)
+    lines = [line for line in err.replace("\r", "\n").splitlines() if line.strip() and "campaign:" not in line]
+    assert proc.returncode == 130, err
+    finished = _rows(out)
+    assert "Traceback" not in err and len(lines) == 1 and f"interrupted after {finished} of 12" in lines[0], lines
+    assert _group_ended(proc.pid, within_s=30.0)
+    assert not os.path.exists(os.path.join(out, "campaign.lock")) and 1 <= finished < 12
+
+
 def test_a_full_disk_keeps_finished_rows_and_names_the_file(tmp_path, monkeypatch, capsys):
     """The third row's write comes back short (what a full disk does): exit 2 with one line
     naming samples.jsonl and the cause; the two finished rows are intact and resume works."""

@@ -22,8 +22,11 @@ Benchmarks are scripts, not commands: python benchmarks/run.py (see README).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import signal
 import sys
+import threading
 
 from drake_entry.campaign.arguments import check_output_dir
 from drake_entry.cli.common import Command, HelpWithDefaults, os_error_line
@@ -61,6 +64,28 @@ def _version() -> str:
     return f"drake-entry {drake_entry.__version__} (Drake {drake}, Python {sys.version.split()[0]})"
 
 
+def _terminated(signum, frame):
+    raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def stoppable():
+    """SIGINT and SIGTERM stop the command as Ctrl-C does (a campaign keeps its finished samples
+    and says how to resume), also when it was started in the background, where the shell leaves
+    SIGINT ignored and Python would leave it so; the handlers before are restored after."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, _terminated)
+    try:
+        yield
+    finally:
+        for s, handler in before.items():
+            signal.signal(s, handler)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="drake-entry", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -76,12 +101,13 @@ def main(argv=None) -> int:
         out = getattr(args, "out", None)
         if out is not None:
             check_output_dir(out)
-        return args.func(args)
+        with stoppable():
+            return args.func(args)
     except Interrupted as e:  # Ctrl-C in a campaign: finished samples kept
         print(f"\ndrake-entry: {' '.join(str(e).split())}", file=sys.stderr)
         return 130
     except KeyboardInterrupt:
-        print(f"\ndrake-entry: interrupted (Ctrl-C); '{args.command}' stopped", file=sys.stderr)
+        print(f"\ndrake-entry: interrupted (Ctrl-C or SIGTERM); '{args.command}' stopped", file=sys.stderr)
         return 130
     except DrakeEntryError as e:  # bad input, a refused campaign directory, an unusable solver: one line
         print(f"drake-entry: error: {' '.join(str(e).split())}", file=sys.stderr)

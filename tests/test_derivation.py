@@ -176,6 +176,27 @@ def test_a_geodetic_box_is_an_interface_at_the_targets_latitude():
         load_scenario("horus2b").terminal.altitude_tolerance_km
 
 
+def test_a_box_without_a_speed_is_aimed_at_the_speed_where_the_missions_own_method_stops():
+    """SHEFEX-3's box checks altitude and distance only (paper 003's speed window is a listed
+    departure): the others aim at the 620 m/s where its AMPI guidance stops, and say so; a mission
+    with no speed and no method of its own that stops at one is refused with why."""
+    from drake_entry.guidance.fnpeg.spec import Fnpeg
+    from drake_entry.guidance.lgl_terminal.spec import LglTerminal
+
+    shefex = load_scenario("shefex3_ampi")
+    interface = terminal_interface(shefex)
+    assert interface.altitude_km == 23.5 and interface.speed_m_s == 620.0 and interface.speed_from_own_method
+    assert "own method stops" in interface.speed_words and not interface.mach_given
+    choices = {c.field: c.how for c in derivation_for(shefex, LglTerminal).choices}
+    assert "own method stops" in choices["guidance.terminal_altitude_km, terminal_velocity_m_s"]
+    with pytest.raises(CannotFly, match="alpha schedule is in time"):  # Table 2's alpha law, in time
+        derivation_for(shefex, Fnpeg)
+    assert not terminal_interface(load_scenario("horus2b")).speed_from_own_method
+    alone = dc.replace(shefex, guidance=None)
+    with pytest.raises(CannotFly, match="its own method stops at no speed"):
+        terminal_interface(alone)
+
+
 def test_fnpeg_on_a_skipping_entry_engages_at_a_lower_acceleration_and_reaches_a_low_interface():
     """SPHYNX's shallow entry skips: wings level its first pull-out senses at most 1.09 m/s^2, so
     at Lu 2014's 1.52 FNPEG engages only past the site and ends thousands of km from it; at half

@@ -125,7 +125,8 @@ class Interface:
     """The mission's terminal interface, the centre of its acceptance box: altitude [km] as a
     guidance block states it (the scenario's altitude datum), speed [m/s], its Mach number there,
     the speed of sound there [m/s], whether the mission gives the Mach number (else the speed),
-    and the box's altitude tolerance about it [km] (None: the box checks no altitude)."""
+    the box's altitude tolerance about it [km] (None: the box checks no altitude), and whether
+    the speed is where the mission's own method stops (the box checks none)."""
 
     altitude_km: float
     speed_m_s: float
@@ -133,6 +134,14 @@ class Interface:
     speed_of_sound: float
     mach_given: bool
     altitude_tolerance_km: float | None = None
+    speed_from_own_method: bool = False
+
+    @property
+    def speed_words(self) -> str:
+        """Where the interface's speed comes from, in words."""
+        if self.speed_from_own_method:
+            return "the speed where the mission's own method stops (its box checks no speed)"
+        return "the box's centre speed"
 
 
 def derivation_for(scenario, spec_type) -> Derivation:
@@ -178,8 +187,9 @@ def require_alpha_window(scenario, widen_deg: float = 0.0) -> None:
 
 def terminal_interface(scenario) -> Interface:
     """The centre of the mission's acceptance box (terminal.altitude_km, or its
-    geodetic_altitude_km at the target's latitude, and its mach or velocity_m_s); CannotFly when
-    the mission gives no altitude or no speed."""
+    geodetic_altitude_km at the target's latitude, and its mach or velocity_m_s; where the box
+    checks no speed, the speed at which the mission's own method stops); CannotFly when the
+    mission gives no altitude, or no speed and no method of its own that stops at one."""
     t = scenario.terminal
     altitude_km, geodetic_m = t.altitude_km, None
     if altitude_km is None and t.geodetic_altitude_km is not None:
@@ -193,7 +203,15 @@ def terminal_interface(scenario) -> Interface:
         return Interface(altitude_km, float(t.mach) * a, float(t.mach), a, True, tolerance_km)
     if t.velocity_m_s is not None:
         return Interface(altitude_km, float(t.velocity_m_s), float(t.velocity_m_s) / a, a, False, tolerance_km)
-    raise CannotFly("the mission's terminal block gives neither mach nor velocity_m_s: no terminal speed to aim at")
+    own = stated_guidance(scenario)
+    if own is not None and not own.stops_at_altitude:
+        # the box checks no speed: aim at the speed where the mission's own method stops (SHEFEX-3's
+        # AMPI: 620 m/s, the corner of paper 003's window its database ends at)
+        own_a = float(scenario.make_atmosphere().speed_of_sound(own.terminal_altitude_km * 1e3))
+        speed = float(own.terminal_speed(own_a))
+        return Interface(altitude_km, speed, speed / a, a, False, tolerance_km, speed_from_own_method=True)
+    raise CannotFly("the mission's terminal block gives neither mach nor velocity_m_s, and its own method stops at "
+                    "no speed: no terminal speed to aim at")
 
 
 def box_altitude_tolerance_km(terminal) -> float | None:

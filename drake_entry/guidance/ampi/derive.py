@@ -125,7 +125,7 @@ def derive(scenario) -> Derivation:
                "problem form (bank rate, alpha scheduled, bank effort with a flight-path term) from the mission's entry, target, interface "
                "and vehicle limits"),
         Choice("guidance.terminal_altitude_km, terminal_velocity_m_s", f"{altitude:g} km, {speed:.1f} m/s",
-               f"the box's centre speed ({interface.speed_m_s:.1f} m/s), or {Q_SPEED_FRACTION:g} of the speed where "
+               f"{interface.speed_words} ({interface.speed_m_s:.1f} m/s), or {Q_SPEED_FRACTION:g} of the speed where "
                f"the planned dynamic-pressure bound is met at the altitude when lower"),
         Choice("guidance.grid", ", ".join(f"{n} {steps[n]:g} {units.get(n, 'deg')}" for n in names),
                "the entry deviations that move the end most, each at its 3-sigma reach (end moved by "

@@ -106,8 +106,8 @@ def derive(scenario) -> Derivation:
                       replan_model_scales=bool(forces), replan_start="reference",
                       corridor_centring=CENTRING_CANDIDATES[0])
     choices = [
-        Choice("guidance.terminal_mach", round(mach, 4), "the centre of the mission's acceptance box"
-               + ("" if interface.mach_given else f" ({interface.speed_m_s:g} m/s as a Mach number)")),
+        Choice("guidance.terminal_mach", round(mach, 4), f"the Mach number of {interface.speed_words}"
+               + ("" if interface.mach_given else f" ({interface.speed_m_s:g} m/s)")),
         Choice("alpha", "as the mission's" if alpha is None else
                ", ".join(f"{v:g} deg at e = {b:.3f}" for b, v in zip(breakpoints, values)),
                alpha_how if alpha is not None else "the planner flies alpha(E): the mission's schedule is in energy"),

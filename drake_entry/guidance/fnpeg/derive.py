@@ -60,8 +60,8 @@ def derive(scenario) -> Derivation:
                "Lu's e_f at the altitude of the mission's acceptance box (not searched: the altitude at e_f is "
                "sigma_f's)"),
         Choice("guidance.terminal_velocity_m_s", round(interface.speed_m_s, 3),
-               "Lu's e_f at the speed of the mission's acceptance box"
-               + (f" (Mach {interface.mach:g} at its centre, as a speed)" if interface.mach_given else "")),
+               f"Lu's e_f at {interface.speed_words}"
+               + (f" (Mach {interface.mach:g}, as a speed)" if interface.mach_given else "")),
         Choice("guidance.final_range_km", 0.0, "the target is the box's distance centre"),
         Choice("guidance.alpha_deg, alpha_velocity_m_s",
                ", ".join(f"{a:g} deg at {s:.0f} m/s" for a, s in zip(alphas, speeds)), alpha_how),

@@ -60,7 +60,7 @@ def derive(scenario) -> Derivation:
                       "vehicle limits (paper 002's eq. 11 objective)"),
                Choice("guidance.terminal_altitude_km, terminal_velocity_m_s",
                       f"{spec.terminal_altitude_km:g} km, {spec.terminal_velocity_m_s:.1f} m/s",
-                      f"the box's centre speed ({interface.speed_m_s:.1f} m/s), or {Q_SPEED_FRACTION:g} of the "
+                      f"{interface.speed_words} ({interface.speed_m_s:.1f} m/s), or {Q_SPEED_FRACTION:g} of the "
                       f"speed where the planned dynamic-pressure bound is met at the altitude when lower, or the "
                       f"speed where forces {force_high:.3g} x the nominal ({FORCE_SIGMAS:g} sigma of the mission's "
                       f"force dispersions) meet the planned load bound at alpha {lo:g} deg when lower still (a "

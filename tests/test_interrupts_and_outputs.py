@@ -40,6 +40,30 @@ def _group_ended(pgid: int, within_s: float) -> bool:
     return False
 
 
+def _running_campaign(tmp_path, out: str, extra: list, sigint) -> subprocess.Popen:
+    """A 12-sample horus2b campaign in its own process group with SIGINT at ``sigint``, once its
+    first sample has landed. Its cwd is outside the repository: `python -m` puts the cwd first on
+    the path, and the working tree is not the installed package."""
+    argv = [sys.executable, "-m", "drake_entry.cli", "campaign", "horus2b", "--runs", "12", "--workers", "2",
+            "--trajectory-step", "0", "--out", out, *extra]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            cwd=str(tmp_path), preexec_fn=lambda: signal.signal(signal.SIGINT, sigint))
+    deadline = time.monotonic() + 300
+    while _rows(out) < 1 and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is None, ("the campaign ended before the signal could land", proc.communicate()[1][-2000:])
+    return proc
+
+
+def _stopped(proc: subprocess.Popen, send) -> tuple[str, list[str]]:
+    """``send(pid)``, then the campaign's stderr and its lines other than the progress bar, once it
+    exited 130."""
+    send(proc.pid)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    return err, [line for line in err.replace("\r", "\n").splitlines() if line.strip() and "campaign:" not in line]
+
+
 @pytest.mark.slow  # a campaign: out of the default run, in CI's -m "slow and not long" set
 @pytest.mark.parametrize("backend", ["processes", "dask"])
 def test_ctrl_c_ends_a_campaign_with_one_line_exit_130_and_no_worker_left(tmp_path, backend):
@@ -51,23 +75,10 @@ def test_ctrl_c_ends_a_campaign_with_one_line_exit_130_and_no_worker_left(tmp_pa
     if backend == "dask":
         pytest.importorskip("dask.distributed")
     out = str(tmp_path / "c")
-    argv = [sys.executable, "-m", "drake_entry.cli", "campaign", "horus2b", "--runs", "12", "--workers", "2",
-            "--trajectory-step", "0", "--out", out, "--backend", backend]
-    # cwd outside the repository: `python -m` puts the cwd first on the path, and the working tree
-    # is not the installed package (its diagrams/ and systems/ are mapped in by the install)
     # SIGINT at its default in the child, as in a terminal's foreground job: a test run started in
-    # the background of a shell without job control inherits SIGINT ignored, and Python then
-    # leaves it ignored, so the interrupt would never land
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
-                            cwd=str(tmp_path), preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    deadline = time.monotonic() + 300
-    while _rows(out) < 1 and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.05)
-    assert proc.poll() is None, ("the campaign ended before the interrupt could land", proc.communicate()[1][-2000:])
-    os.killpg(proc.pid, signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
-    lines = [line for line in err.replace("\r", "\n").splitlines() if line.strip() and "campaign:" not in line]
-    assert proc.returncode == 130, err
+    # the background of a shell without job control inherits SIGINT ignored
+    proc = _running_campaign(tmp_path, out, ["--backend", backend], signal.SIG_DFL)
+    err, lines = _stopped(proc, lambda pid: os.killpg(pid, signal.SIGINT))
     assert "Traceback" not in err and len(lines) == 1, lines
     finished = _rows(out)
     assert 1 <= finished < 12, finished  # the interrupt landed mid-campaign
@@ -86,18 +97,8 @@ def test_a_campaign_started_in_the_background_stops_on_sigint_or_sigterm_keeping
     ignored) and signalled alone, as `kill -INT PID` or `kill PID` does: exit 130 with the one
     line naming the finished count, its workers ended, the lock released, the samples kept."""
     out = str(tmp_path / "c")
-    argv = [sys.executable, "-m", "drake_entry.cli", "campaign", "horus2b", "--runs", "12", "--workers", "2",
-            "--trajectory-step", "0", "--out", out]
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
-                            cwd=str(tmp_path), preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
-    deadline = time.monotonic() + 300
-    while _rows(out) < 1 and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.05)
-    assert proc.poll() is None, ("the campaign ended before the signal could land", proc.communicate()[1][-2000:])
-    os.kill(proc.pid, signum)
-    _, err = proc.communicate(timeout=120)
-    lines = [line for line in err.replace("\r", "\n").splitlines() if line.strip() and "campaign:" not in line]
-    assert proc.returncode == 130, err
+    proc = _running_campaign(tmp_path, out, [], signal.SIG_IGN)
+    err, lines = _stopped(proc, lambda pid: os.kill(pid, signum))
     finished = _rows(out)
     assert "Traceback" not in err and len(lines) == 1 and f"interrupted after {finished} of 12" in lines[0], lines
     assert _group_ended(proc.pid, within_s=30.0)

@@ -35,7 +35,7 @@ from drake_entry.comparison.spec import (
 )
 from drake_entry.errors import DrakeEntryError, ScenarioError
 from drake_entry.guidance.derivation import CannotFly
-from drake_entry.scenario import load_scenario
+from drake_entry.scenario import load_scenario, stated_guidance
 
 __all__ = ["SCENARIOS", "INTERRUPTED", "run_comparison", "comparison_identity", "check_comparison_dir"]
 
@@ -212,12 +212,32 @@ def _spec_type(entry):
     return next(spec for spec in REGISTRY if spec.__name__ == entry.method)
 
 
-def _cannot_fly(mission, entry) -> str:
-    """Why ``entry``'s method cannot fly the mission, when its derivation says so without flying ('' else)."""
+def _mission_for(mission, entry):
+    """The mission as ``entry``'s method derives its settings from it: as it is for the mission's
+    own method; for another, an alpha schedule in time rewritten in speed by the mission's
+    open-loop flight (comparison.mission_alpha), with the Choice that says so (None when not)."""
+    from drake_entry.comparison.mission_alpha import alpha_in_speed
+
+    if type(stated_guidance(mission)) is _spec_type(entry):
+        return mission, None
+    return alpha_in_speed(mission)
+
+
+def _derivation(mission, entry):
+    """(the mission as the method sees it, its Derivation) (CannotFly when it cannot fly it)."""
     from drake_entry.guidance.derivation import derivation_for
 
+    seen, alpha = _mission_for(mission, entry)
+    derivation = derivation_for(seen, _spec_type(entry))
+    if alpha is not None:
+        derivation.choices.insert(0, alpha)
+    return seen, derivation
+
+
+def _cannot_fly(mission, entry) -> str:
+    """Why ``entry``'s method cannot fly the mission, when its derivation says so without flying ('' else)."""
     try:
-        derivation_for(mission, _spec_type(entry))
+        _derivation(mission, entry)
     except CannotFly as e:
         return f"cannot fly this mission: {e}"
     return ""
@@ -229,11 +249,10 @@ def _derived_scenario(comp: Comparison, entry, mission, path: str, earlier: dict
     derivation is deterministic), else derived and searched now (CannotFly when the method cannot
     fly the mission)."""
     from drake_entry.comparison.derive import derive_settings
-    from drake_entry.guidance.derivation import derivation_for
 
     if earlier and earlier.get("derivation") and os.path.exists(path):
         return method_scenario(comp, entry, load_scenario(path)), earlier["derivation"]
-    derivation = derivation_for(mission, _spec_type(entry))
+    mission, derivation = _derivation(mission, entry)
     if progress:
         print(f"== {entry.label} (!{entry.method}): settings derived from the mission"
               + (", searched on the nominal flight and dispersed draws" if derivation.search else ""), flush=True)

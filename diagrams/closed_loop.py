@@ -37,7 +37,7 @@ from drake_entry.models.planet import Earth
 from drake_entry.models.schedules import Schedule
 from drake_entry.models.trajectory import Trajectory
 from drake_entry.models.vehicles import Vehicle
-from drake_entry.models.verdict import Verdict, box_text, failure_message, judge
+from drake_entry.models.verdict import ALTITUDE_FLOOR_M, Verdict, altitude_floor, box_text, failure_message, judge
 from drake_entry.scenario import Scenario, load_scenario
 from drake_entry.systems.actuators import AlphaActuator, BankActuator
 from drake_entry.systems.inertial_navigation import InertialNavigation
@@ -50,17 +50,8 @@ from drake_entry.systems.schedule import ScheduleSource
 __all__ = ["ALTITUDE_FLOOR_M", "altitude_floor", "NAVIGATION_ERROR_COLUMNS", "ClosedLoopSetup", "ClosedLoopResult", "ClosedLoopDiagram", "build_closed_loop",
            "terminal_errors", "acceptance_box", "fly", "summarise"]
 
-#: the crash guard of a flight that stops at the terminal energy [m]: this altitude, or half the
-#: terminal altitude when the interface lies below twice it (paper 001's DRS box at 3.8 km)
-ALTITUDE_FLOOR_M = 5000.0
 #: the logged columns of an INS flight's navigation error (InertialNavigation "navigation_error")
 NAVIGATION_ERROR_COLUMNS = ("nav_position_error_m", "nav_velocity_error_m_s")
-
-
-def altitude_floor(terminal_altitude_m: float) -> float:
-    """The crash guard [m] of a flight stopping at the terminal energy: ALTITUDE_FLOOR_M, never
-    above half the terminal altitude (a floor above the interface stops every flight short of it)."""
-    return min(ALTITUDE_FLOOR_M, 0.5 * max(terminal_altitude_m, 0.0))
 
 
 @dc.dataclass

@@ -121,6 +121,23 @@ def test_a_sign_change_across_a_jump_is_not_taken_for_a_root():
     assert bracketed and sigma == pytest.approx(41.3, abs=1e-9) and abs(miss) < 1e-6
 
 
+def test_the_replica_stops_at_the_closed_loops_crash_floor():
+    """The population's flights stop below the closed loop's crash floor: 5 km at paper 004's
+    30-km TAEM altitude; half the interface's altitude where it lies below 10 km (SPHYNX's DRS box
+    at 3.83 km: a 5-km floor ended every predicted flight short of the TAEM energy)."""
+    import dataclasses as dc
+
+    from drake_entry.guidance.swarm_bank.evaluator import SwarmProblem
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario
+    from drake_entry.models.verdict import ALTITUDE_FLOOR_M
+
+    problem = problem_from_scenario(_scenario())
+    assert problem.h_f == 30e3 and problem.altitude_floor_m == ALTITUDE_FLOOR_M == 5000.0
+    fields = {f.name: getattr(problem, f.name) for f in dc.fields(SwarmProblem)}
+    low = SwarmProblem(**{**fields, "h_f": 3830.0, "altitude_floor_m": None})
+    assert low.altitude_floor_m == 1915.0
+
+
 def test_on_board_bank_end_resolution_zeroes_the_range_with_sigma0_held():
     """With sigma_0 held at the planned root the sigma_f re-solution finds the planned 60 deg; held
     3 deg off (a range error of kilometres), it finds the sigma_f whose predicted flight ends at

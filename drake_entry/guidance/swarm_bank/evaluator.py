@@ -44,6 +44,7 @@ from drake_entry.models.constraints import dynamic_pressure
 from drake_entry.models.dynamics import aero_accelerations, air_data, equations_of_motion, state_derivatives
 from drake_entry.models.geodesy import bearings, downtrack_crosstrack
 from drake_entry.models.kernels import Kernel, compile_kernels
+from drake_entry.models.verdict import altitude_floor
 
 __all__ = ["RANGE_UNIT_M", "ALTITUDE_UNIT_M", "SPEED_UNIT_M_S", "SwarmProblem", "Evaluation", "HISTORY_COLUMNS",
            "CONTROL_COLUMNS", "ENGINES", "evaluate", "range_error", "LIMIT_WEIGHT", "limit_excess"]
@@ -118,7 +119,7 @@ class SwarmProblem:
     reversal_velocity: tuple = (1000.0, 6000.0)
     guidance_step_s: float = 1.0
     actuator_substep_s: float = 0.02
-    altitude_floor_m: float = 5000.0
+    altitude_floor_m: float | None = None  # None: models.verdict.altitude_floor(h_f), the closed loop's
     max_time_s: float = 5000.0
     initial_alpha: float | None = None
     initial_bank: float = 0.0
@@ -133,6 +134,8 @@ class SwarmProblem:
     path_fraction: float = 0.9
 
     def __post_init__(self):
+        if self.altitude_floor_m is None:
+            self.altitude_floor_m = altitude_floor(self.h_f)
         if self.case not in ALPHA_LAWS:
             raise ScenarioError(f"paper-004 alpha law case = {self.case!r}; allowed: {', '.join(ALPHA_LAWS)}")
         speeds, values = self.alpha_schedule

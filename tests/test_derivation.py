@@ -115,8 +115,14 @@ def test_fnpeg_on_horus2b_takes_the_box_centre_the_limits_and_the_alpha_ramp():
     assert d.spec.alpha_deg == [15.0, 40.0] and d.spec.reversal_heading_deg == [5.0, 15.0]
     # sigma_f (which sets the altitude at e_f) is flown over its whole grid, then the margin re-checked at it
     assert [s.name for s in d.search] == ["limit margin", "guidance.bank_end_deg", "limit margin at that sigma_f",
-                                         "guidance.engage_acceleration_m_s2"]
-    assert [s.exhaustive for s in d.search] == [False, True, False, False] and d.search[2].candidates == d.search[0].candidates
+                                         "guidance.engage_acceleration_m_s2", "guidance.final_range_km"]
+    assert [s.exhaustive for s in d.search] == [False, True, False, False, False]
+    assert d.search[2].candidates == d.search[0].candidates
+    # s_f* measured from the nominal flight's overshoot (28.5 km past: aim 28.5 km short), then 0
+    final = d.search[4]
+    assert final.calibrate({"err_range_m": -28_460.0}) == {"guidance.final_range_km": 28.5}
+    assert final.calibrate({"err_range_m": 3_000.0}) == {"guidance.final_range_km": 0.0}
+    assert final.candidates == ({"guidance.final_range_km": 0.0},)
     sigma_f = [c["guidance.bank_end_deg"] for c in d.search[1].candidates]
     assert sigma_f[0] == d.spec.bank_end_deg == 45.0 and sorted(sigma_f) == [20.0 + 5.0 * i for i in range(11)]
     assert interface_altitudes(scenario, terminal_interface(scenario)) == (25.0, 25.5, 26.0, 26.5, 24.5, 24.0)

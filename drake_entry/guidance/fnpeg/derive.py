@@ -16,7 +16,7 @@ from drake_entry.guidance.derivation import (
 )
 from drake_entry.guidance.fnpeg.spec import Fnpeg
 
-__all__ = ["derive", "BANK_END_CANDIDATES_DEG", "LIMIT_MARGINS", "ENGAGE_ACCELERATIONS_M_S2"]
+__all__ = ["derive", "BANK_END_CANDIDATES_DEG", "LIMIT_MARGINS", "ENGAGE_ACCELERATIONS_M_S2", "final_range_from"]
 
 #: sigma_f flown on the nominal flight and the search's draws, every one (it sets the altitude
 #: at e_f, graded: on Lu's CAV-H case 50, 40 and 30 deg end 2.0 km low, centred and 1.3 km high)
@@ -85,5 +85,15 @@ def derive(scenario) -> Derivation:
                         "on a shallow entry senses less in its first pull-out and would glide on wings level "
                         "until past the target: half, then a quarter (last, so a mission that engages at Lu's "
                         "keeps it)"),
+        SearchStep.calibrated("guidance.final_range_km", final_range_from, (0.0,),
+                              "Lu's s_f* at the distance the nominal flight with the settings chosen before ends "
+                              "past the target (the flight flies range its predictions do not see), then 0"),
     ]
     return Derivation(spec, choices, search)
+
+
+def final_range_from(nominal: dict) -> float:
+    """Lu's s_f* [km] that cancels the nominal flight's overshoot: the distance past the target
+    its campaign row's ``err_range_m`` gives (negative past it), to 0.1 km; 0 for a flight that
+    ends short (s_f* >= 0)."""
+    return max(round(-float(nominal["err_range_m"]) / 100.0) / 10.0, 0.0)

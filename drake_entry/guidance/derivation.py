@@ -99,7 +99,19 @@ class SearchStep:
     @classmethod
     def calibrated(cls, field: str, measure: Callable[[dict], float], fallbacks, why: str) -> "SearchStep":
         """``field`` at ``measure(row)`` of the nominal flight first, then at each of ``fallbacks``."""
-        return cls(field, tuple({field: v} for v in fallbacks), why, calibrate=lambda row: {field: measure(row)})
+        return cls(field, tuple({field: v} for v in fallbacks), why, calibrate=_Measured(field, measure))
+
+
+@dc.dataclass(frozen=True)
+class _Measured:
+    """A calibrated step's measure: {field: measure(row)} (comparable, so that the same mission
+    derives equal steps)."""
+
+    field: str
+    measure: Callable[[dict], float]
+
+    def __call__(self, row: dict) -> dict:
+        return {self.field: self.measure(row)}
 
 
 @dc.dataclass

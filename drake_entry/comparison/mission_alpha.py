@@ -51,9 +51,10 @@ def alpha_in_speed(mission):
     in_time = np.interp(t, s.breakpoints, values)
     in_speed = np.interp(V, rewritten.breakpoints, rewritten.values_deg)
     worst = int(np.argmax(np.abs(in_speed - in_time)))
-    if abs(in_speed[worst] - in_time[worst]) > ALPHA_TOLERANCE_DEG:
+    gap = abs(in_speed[worst] - in_time[worst])
+    if gap > ALPHA_TOLERANCE_DEG:
         raise CannotFly(f"the mission's alpha schedule is in time, and in speed it departs from itself along the "
-                        f"mission's open-loop flight by {abs(in_speed[worst] - in_time[worst]):.2g} deg at "
+                        f"mission's open-loop flight by {gap:.2g} deg at "
                         f"{t[worst]:.0f} s ({V[worst]:.0f} m/s; allowed {ALPHA_TOLERANCE_DEG:g}): its speed does "
                         f"not fall through the breakpoints")
     ends = [(rewritten.breakpoints[i], rewritten.values_deg[i]) for i in (0, -1)]
@@ -62,6 +63,5 @@ def alpha_in_speed(mission):
     how = (f"the mission's alpha schedule in time ({', '.join(f'{a:g} deg at {b:g} s' for b, a in zip(s.breakpoints, values))}) "
            f"rewritten in speed at the speeds of the mission's open-loop flight (its own alpha and bank schedules, "
            f"the Drake Simulator) at those times and at each logged instant between them; flown along that flight "
-           f"the two agree within "
-           f"{abs(in_speed[worst] - in_time[worst]):.2g} deg")
+           f"the two agree within {gap:.2g} deg")
     return dc.replace(mission, alpha=rewritten), Choice("alpha", text, how)

@@ -23,6 +23,10 @@ import numpy as np
 
 from drake_entry.models.constraints import PathLimits
 
+__all__ = ["ALTITUDE_FLOOR_M", "altitude_floor", "PathLimit", "vehicle_path_limits", "LimitCheck", "check_limits", "breaches_text", "BOX_MISSED",
+           "LIMITS_BREACHED", "failure_message", "failure_clauses", "ROUNDING",
+           "BoxCriterion", "BOX_CRITERIA", "acceptance_box", "box_text", "Verdict", "judge"]
+
 #: the crash guard of a flight that stops at the terminal energy [m]: below it the flight is
 #: stopped and has not reached its interface; at most half the terminal altitude (altitude_floor)
 ALTITUDE_FLOOR_M = 5000.0
@@ -33,10 +37,6 @@ def altitude_floor(terminal_altitude_m: float) -> float:
     above half the terminal altitude (a floor above the interface stops every flight short of it:
     paper 001's DRS box lies at a 3.83-km state altitude at the Azores site)."""
     return min(ALTITUDE_FLOOR_M, 0.5 * max(terminal_altitude_m, 0.0))
-
-__all__ = ["ALTITUDE_FLOOR_M", "altitude_floor", "PathLimit", "vehicle_path_limits", "LimitCheck", "check_limits", "breaches_text", "BOX_MISSED",
-           "LIMITS_BREACHED", "failure_message", "failure_clauses", "ROUNDING",
-           "BoxCriterion", "BOX_CRITERIA", "acceptance_box", "box_text", "Verdict", "judge"]
 
 
 @dc.dataclass(frozen=True)

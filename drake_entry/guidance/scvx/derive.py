@@ -102,7 +102,7 @@ def glides_at(scenario, altitude_km: float, speed_m_s: float, alpha_deg: float) 
     return lift >= equilibrium_glide_lift(speed_m_s, r, planet.mu / r ** 2)
 
 
-def aim_window(scenario, altitude_km: float, mach_window: tuple, mach: float, alpha_deg, *,
+def aim_window(scenario, interface, altitude_km: float, mach_window: tuple, alpha_deg, *,
                force_high: float = 1.0, mach_floor: float = 0.0) -> dict:
     """The fields that make a plan end at ``altitude_km`` where the flight stops: the DRS
     window the flown plan is checked in [m] (AIM_WINDOW_KM about it, at most a quarter of the
@@ -116,9 +116,9 @@ def aim_window(scenario, altitude_km: float, mach_window: tuple, mach: float, al
     flight whose aerodynamic forces are ``force_high`` times the nominal meets the planned load
     bound (a re-plan predicts with the forces sensed: paper 004's CAV-H with 6-9 % more drag
     found every re-plan infeasible at its last node), not below ``mach_floor`` (the box's
-    lower edge where it checks the speed); the interface's ``mach`` held inside the window as
-    the spec's terminal_mach."""
-    interface = terminal_interface(scenario)
+    lower edge where it checks the speed); the ``interface``'s (terminal_interface) Mach number
+    held inside the window as the spec's terminal_mach, its altitude and tolerance the box's."""
+    mach = interface.mach
     centre_km, tolerance_km = interface.altitude_km, interface.altitude_tolerance_km
     half = min(AIM_WINDOW_KM, 0.25 * tolerance_km, tolerance_km - abs(altitude_km - centre_km))
     a = float(scenario.make_atmosphere().speed_of_sound(altitude_km * 1e3))
@@ -176,7 +176,7 @@ def derive(scenario) -> Derivation:
     bounds = [min(alphas), max(alphas)] if max(alphas) > min(alphas) else [max(0.0, alphas[0] - 2.0), alphas[0] + 2.0]
     psi = scenario.entry.heading_deg
     law = alpha_law(alpha_deg, alpha_speeds)  # the plans' own alpha(V) [rad]
-    aims = [aim_window(scenario, altitude, mach_window, interface.mach,
+    aims = [aim_window(scenario, interface, altitude, mach_window,
                        lambda V: math.degrees(law(V)), force_high=force_high,
                        mach_floor=mach_window[0] if box_window is not None else 0.0) for altitude in altitudes]
     aims = [aim for aim in aims if aim["guidance.final_mach_min"] < aim["guidance.final_mach_max"]]

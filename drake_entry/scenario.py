@@ -201,7 +201,8 @@ class Scenario:
     aero: str = ""
     # the mission's path and bank limits where they differ from the vehicle file's (keys:
     # heat_flux_max_kW_m2, dynamic_pressure_max_kPa, normal_load_max_g, total_load_max_g,
-    # bank_limit_deg, bank_rate_limit_deg_s, bank_accel_limit_deg_s2)
+    # bank_limit_deg, bank_rate_limit_deg_s, bank_accel_limit_deg_s2, alpha_rate_limit_deg_s,
+    # alpha_accel_limit_deg_s2)
     vehicle_limits: dict[str, float] = dc.field(default_factory=dict)
     planet: PlanetSpec = dc.field(default_factory=PlanetSpec)  # the Earth model
     # what entry.altitude_km and terminal.altitude_km are measured from: 'sphere' (the state

@@ -1,3 +1,5 @@
+import math
+
 import numpy as np
 import pytest
 
@@ -53,6 +55,19 @@ def test_negative_mass_names_the_field_and_range(tmp_path):
     f = tmp_path / "v.yaml"
     f.write_text("name: bad\nmass_kg: -5\nreference_area_m2: 1\nnose_radius_m: 1\naero: {a: {model: cav_h}}\n")
     with pytest.raises(ScenarioError, match=r"mass_kg = -5.0 is out of range; allowed: \(0, 1e\+06\] kg"):
+        load_vehicle(str(f))
+
+
+def test_an_alpha_actuator_limit_is_optional_and_a_bad_one_names_its_field(tmp_path):
+    """SHEFEX-3's file states paper 003 Table 2's alpha actuator (5 deg/s, 4 deg/s^2); a vehicle
+    stating none has None; zero is refused naming the field."""
+    v = load_vehicle("shefex3")
+    assert (math.degrees(v.alpha_rate_limit), math.degrees(v.alpha_accel_limit)) == pytest.approx((5.0, 4.0))
+    assert load_vehicle("horus2b").alpha_rate_limit is None
+    f = tmp_path / "v.yaml"
+    f.write_text("name: bad\nmass_kg: 5\nreference_area_m2: 1\nnose_radius_m: 1\naero: {a: {model: cav_h}}\n"
+                 "alpha_rate_limit_deg_s: 0\n")
+    with pytest.raises(ScenarioError, match=r"alpha_rate_limit_deg_s = 0(\.0)? is out of range: must be > 0"):
         load_vehicle(str(f))
 
 

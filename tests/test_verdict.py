@@ -358,3 +358,26 @@ def test_the_stored_trajectory_keeps_each_flights_peaks_between_its_storage_poin
     assert set(stored["sample"]) == {7}
     plain = downsample(_trajectory(t, np.full(t.size, 1e5), gamma=np.full(t.size, -0.1)), 0, 10.0)
     assert plain["time_s"][:2] == [0.0, 10.0] and plain["time_s"][-1] == 40.0  # nothing added when flat: ties at 0
+
+
+def test_a_bank_clamped_at_its_limit_holds_in_the_verdict_and_in_every_report_count():
+    """A margin of -1e-16 (a clamp at the bound, rounded) holds; -1e-9 breaches; the campaign's
+    and the comparison's breach counts use the verdict's test, with the scenario's tolerance."""
+    from drake_entry.campaign.report import summary_statistics
+    from drake_entry.comparison.report import method_summary
+    from drake_entry.models.verdict import margin_breached
+
+    bank = PathLimit("bank", "bank", upper=math.radians(60.0), absolute=True)
+    clamped = math.radians(60.0) * (1.0 + 1e-16)
+    (c,) = check_limits([0.0, 1.0], lambda _: np.array([0.1, clamped]), [bank])
+    assert c.held and c.margin <= 0.0
+    (c,) = check_limits([0.0, 1.0], lambda _: np.array([0.1, math.radians(60.0) * (1.0 + 1e-9)]), [bank])
+    assert not c.held
+    assert list(margin_breached([-1e-16, -1e-9, 0.0, 0.01])) == [False, True, False, False]
+    assert list(margin_breached([-1e-9, -0.02], tolerance=0.01)) == [False, True]
+    rows = {"index": [0, 1, 2], "success": [True, True, False], "reached_terminal": [True] * 3,
+            "inside_box": [True] * 3, "within_limits": [True, True, False], "err_distance_m": [1.0, 2.0, 3.0],
+            "message": ["ok", "ok", "path limits breached: bank"], "margin_bank": [-1e-16, 0.2, -1e-9]}
+    assert summary_statistics(rows)["margins"]["margin_bank"]["violations"] == 1
+    assert summary_statistics(rows, tolerance=0.01)["margins"]["margin_bank"]["violations"] == 0
+    assert method_summary(rows)["margins"]["margin_bank"]["breached"] == 1

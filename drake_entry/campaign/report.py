@@ -47,12 +47,12 @@ from drake_entry.campaign.success_requirement import success_verdict
 from drake_entry.errors import CampaignError, DrakeEntryError
 from drake_entry.models.aerodynamics import AERO_REGIMES
 from drake_entry.models.dispersions import PERTURBATION_COLUMNS_KM
-from drake_entry.models.verdict import BOX_CRITERIA, BOX_MISSED, failure_clauses
+from drake_entry.models.verdict import BOX_CRITERIA, BOX_MISSED, failure_clauses, margin_breached
 from drake_entry.scenario import ERROR_COLUMNS as ERROR_COLUMN_NAMES
 from drake_entry.scenario import Scenario, upgrade_scenario_yaml
 from drake_entry.typed_yaml import load_yaml_typed
 
-__all__ = ["ERROR_COLUMNS", "MARGIN_COLUMNS", "failure_categories", "reached_terminal", "requirement_verdict",
+__all__ = ["path_limit_tolerance", "ERROR_COLUMNS", "MARGIN_COLUMNS", "failure_categories", "reached_terminal", "requirement_verdict",
            "summary_statistics", "counts_sentence", "errors_markdown", "flown_scenario", "rows_as_columns",
            "write_report", "write_markdown_report", "PEAK_QUANTITIES", "OTHER_QUANTITIES", "CONTROL_QUANTITIES",
            "DISPERSION_FIELDS", "NAV_UNITS", "DISPERSION_LABELS", "NAV_NAMES", "table_cell", "format_number",
@@ -82,6 +82,11 @@ def failure_categories(row: dict) -> list[str]:
     return out or [first]
 
 
+def path_limit_tolerance(scenario) -> float:
+    """The scenario's relative path-limit tolerance (terminal.path_limit_tolerance; 0 without one)."""
+    return float(getattr(getattr(scenario, "terminal", None), "path_limit_tolerance", 0.0) or 0.0)
+
+
 def reached_terminal(rows: dict) -> np.ndarray:
     """Samples whose flight reached the terminal interface (E_f, or the terminal altitude of a
     method that stops there: the row's ``reached_terminal``; campaigns written before that
@@ -95,7 +100,7 @@ def reached_terminal(rows: dict) -> np.ndarray:
     return np.array(reached, bool) & np.isfinite(finite_column(rows, "err_distance_m", n))
 
 
-def summary_statistics(rows: dict) -> dict:
+def summary_statistics(rows: dict, tolerance: float = 0.0) -> dict:
     """Statistics of a campaign's rows (a column dict, e.g. from Parquet).
 
     Counts, each separately: samples, successful (the verdict: reached, inside the box and
@@ -104,7 +109,8 @@ def summary_statistics(rows: dict) -> dict:
     breached no limit is within them), failed (not successful) with their reasons
     (``failure_categories``), and the samples inside each box criterion. Terminal-error
     statistics over the reached samples; path-limit margins (every ``margin_*`` column) over
-    every sample that flew (a finite margin).
+    every sample that flew (a finite margin), a breach counted as the verdict counts it
+    (models.verdict.margin_breached with the scenario's path-limit ``tolerance``).
     """
     n = len(rows["index"])
     ok = np.array([bool(v) for v in rows["success"]])
@@ -138,7 +144,8 @@ def summary_statistics(rows: dict) -> dict:
         m = finite_column(rows, col, n)
         flew = np.isfinite(m)
         if flew.any():
-            out["margins"][col] = {"worst": float(m[flew].min()), "violations": int((m[flew] < 0).sum()),
+            out["margins"][col] = {"worst": float(m[flew].min()),
+                                   "violations": int(margin_breached(m[flew], tolerance).sum()),
                                    "worst_sample": int(np.asarray(rows["index"])[flew][m[flew].argmin()])}
     if "wall_time_s" in rows:
         w = finite_column(rows, "wall_time_s", n)
@@ -224,8 +231,8 @@ def write_report(out_dir: str, *, title: str | None = None, limits=None, referen
         for s in sorted(trajs):
             for k, v in trajs[s].items():
                 traj.setdefault(k, []).extend(v)
-    stats = summary_statistics(rows)
     scenario = flown_scenario(meta)
+    stats = summary_statistics(rows, path_limit_tolerance(scenario))
     if limits is None and scenario is not None:
         limits = _vehicle_limits(scenario)
     if reference is None:

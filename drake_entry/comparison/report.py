@@ -24,6 +24,7 @@ from drake_entry.campaign.report import (
     figure_list,
     flown_scenario,
     format_number,
+    path_limit_tolerance,
     reached_terminal,
     rows_as_columns,
     summary_statistics,
@@ -36,6 +37,7 @@ from drake_entry.campaign.store import coverage, read_manifest
 from drake_entry.comparison.derive import value_text
 from drake_entry.errors import CampaignError
 from drake_entry.figures import plt, save_figure
+from drake_entry.models.verdict import margin_breached
 
 __all__ = ["MANIFEST", "LEVEL", "MARGIN_NAMES", "read_comparison_manifest", "clopper_pearson", "method_summary",
            "summary_text", "dispersion_check", "write_comparison_report", "derivation_tables", "footprints",
@@ -78,10 +80,11 @@ def _method_rows(out_dir: str, label: str) -> dict | None:
     return rows_as_columns(records) if records else None
 
 
-def method_summary(rows: dict) -> dict:
-    """The comparison's figures of one method's campaign rows."""
+def method_summary(rows: dict, tolerance: float = 0.0) -> dict:
+    """The comparison's figures of one method's campaign rows (``tolerance``: its scenario's
+    relative path-limit tolerance, which the breaches are counted with)."""
     n = len(rows["index"])
-    s = summary_statistics(rows)
+    s = summary_statistics(rows, tolerance)
     reached = reached_terminal(rows)
     out = {"samples": n, "successful": s["successful"], "reached": s["reached"],
            "inside_box": s["inside_acceptance_box"], "within_limits": s["within_limits"],
@@ -100,7 +103,7 @@ def method_summary(rows: dict) -> dict:
         m = finite_column(rows, col, n)
         m = m[np.isfinite(m)]
         if m.size:
-            out["margins"][col] = {"worst": float(m.min()), "breached": int((m < 0).sum())}
+            out["margins"][col] = {"worst": float(m.min()), "breached": int(margin_breached(m, tolerance).sum())}
     for col in ("bank_reversals", "bank_travel_deg", "time_at_bank_limit_s", "time_at_bank_rate_limit_s",
                 "plans", "planning_wall_s", "wall_time_s"):
         v = finite_column(rows, col, n)
@@ -154,7 +157,8 @@ def write_comparison_report(out_dir: str) -> str:
         if info.get("flown") and os.path.isdir(os.path.join(out_dir, label)):
             rows = _method_rows(out_dir, label)
             if rows is not None:
-                all_rows[label], summaries[label] = rows, method_summary(rows)
+                flown = flown_scenario(read_manifest(os.path.join(out_dir, label)))
+                all_rows[label], summaries[label] = rows, method_summary(rows, path_limit_tolerance(flown))
     same, compared, worst = dispersion_check(all_rows)
     first = next(iter(all_rows), None)  # every method flies the same mission: its terminal box
     scenario = flown_scenario(read_manifest(os.path.join(out_dir, first))) if first else None
@@ -268,7 +272,7 @@ def _margin_table(summaries) -> str:
         cells = []
         for c in cols:
             m = s["margins"].get(c)
-            cells.append("—" if m is None else f"{100 * m['worst']:.1f} % ({m['breached']})")
+            cells.append("—" if m is None else f"{round(100 * m['worst'], 1) + 0.0:.1f} % ({m['breached']})")  # no -0.0
         out.append(f"| {label} | " + " | ".join(cells) + " |")
     return "\n".join(out)
 

@@ -30,7 +30,7 @@ __all__ = ["Choice", "SearchStep", "Derivation", "CannotFly", "Interface", "deri
            "terminal_interface", "box_altitude_tolerance_km", "geodetic_interface_km", "mission_alpha", "alpha_rewritten", "ALTITUDE_STEPS", "ALTITUDE_WHY",
            "interface_altitudes", "reversal_corridor", "LIMIT_MARGIN", "require_alpha_window", "q_limit_speed",
            "box_mach_window", "load_limit_speed", "FORCE_SIGMAS", "FINAL_DESCENT_DEG", "Q_SPEED_FRACTION", "terminal_speed", "interface_speeds", "PATH_GAIN",
-           "PATH_LIMIT_FRACTION", "path_gain"]
+           "PATH_LIMIT_FRACTION", "path_gain", "alpha_actuator"]
 
 #: the fraction of a vehicle limit a method's own limit feedback enforces (the rest is the margin
 #: for dispersions; FNPEG's hand-set HORUS-2B values were 0.90-0.94 of the limits)
@@ -64,6 +64,24 @@ def path_gain(vehicle) -> float:
     lim = vehicle.limits
     limited = any(math.isfinite(x) for x in (lim.heat_flux_max, lim.dynamic_pressure_max, lim.load_bound_max))
     return PATH_GAIN if limited else 0.0
+
+
+def alpha_actuator(scenario, fields: tuple[str, str], own: tuple[float, float], whose: str):
+    """The alpha actuator a method commanding alpha flies on the mission: the vehicle's rate
+    [deg/s] and acceleration [deg/s^2] limits where its file states them, else the method's own
+    paper's (``own``, named by ``whose``). Returns (rate, acceleration, the Choice for
+    ``fields``): a plan flown at its own paper's 1 deg/s where the vehicle's actuator gives 5
+    lags the mission's alpha (SHEFEX-3's SCvx plan flown 20.8 km from itself, 2.1 km at 5)."""
+    v = scenario.make_vehicle()
+    stated = (v.alpha_rate_limit, v.alpha_accel_limit)
+    rate, accel = (own[i] if x is None else round(math.degrees(x), 9) for i, x in enumerate(stated))
+    if all(x is not None for x in stated):
+        how = "the vehicle's alpha actuator (its file's limits)"
+    elif any(x is not None for x in stated):
+        how = f"the vehicle's alpha actuator where its file states a limit, else {whose}"
+    else:
+        how = f"{whose}: the vehicle states no alpha actuator limits"
+    return rate, accel, Choice(", ".join(fields), f"{rate:g} deg/s, {accel:g} deg/s^2", how)
 
 
 @dc.dataclass

@@ -10,6 +10,7 @@ import dataclasses as dc
 import math
 import numbers
 import os
+from typing import Optional
 
 import numpy as np
 
@@ -104,6 +105,10 @@ class VehicleSpec:
     bank_limit_deg: float = 90.0  # largest |bank| the actuator commands
     bank_rate_limit_deg_s: float = 20.0  # bank actuator rate limit
     bank_accel_limit_deg_s2: float = 10.0  # bank actuator acceleration limit
+    # angle-of-attack actuator rate and acceleration limits (none: a method commanding alpha
+    # uses its own paper's)
+    alpha_rate_limit_deg_s: Optional[float] = None
+    alpha_accel_limit_deg_s2: Optional[float] = None
 
 
 @dc.dataclass
@@ -117,6 +122,8 @@ class Vehicle:
       heat_flux: the HeatFlux form of this vehicle.
       limits: PathLimits.
       bank_limit, bank_rate_limit, bank_accel_limit: [rad], [rad/s], [rad/s^2].
+      alpha_rate_limit, alpha_accel_limit: the alpha actuator's limits [rad/s], [rad/s^2], or
+        None where the vehicle states none.
       representative: True when the data are a labelled substitute.
       source: where the data come from.
     """
@@ -131,6 +138,8 @@ class Vehicle:
     bank_limit: float = np.pi / 2
     bank_rate_limit: float = np.radians(20.0)
     bank_accel_limit: float = np.radians(10.0)
+    alpha_rate_limit: float | None = None
+    alpha_accel_limit: float | None = None
     representative: bool = False
     source: str = ""
 
@@ -141,6 +150,10 @@ class Vehicle:
             if isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 < v < math.inf):
                 raise ScenarioError(f"Vehicle.{field} = {v!r} must be a finite number > 0 {unit}")
             setattr(self, field, float(v))
+        for field, unit in (("alpha_rate_limit", "rad/s"), ("alpha_accel_limit", "rad/s^2")):
+            v = getattr(self, field)
+            if v is not None and (isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 < v < math.inf)):
+                raise ScenarioError(f"Vehicle.{field} = {v!r} must be None or a finite number > 0 {unit}")
         if not 0 < self.bank_limit <= np.pi:
             raise ScenarioError(f"Vehicle.bank_limit must be in (0, 180] deg, got {np.degrees(self.bank_limit):.4g} deg")
         if self.heat_flux is None:
@@ -223,6 +236,10 @@ def vehicle_from_spec(spec: VehicleSpec, aero: str | None = None, where: str = "
     for field in ("bank_rate_limit_deg_s", "bank_accel_limit_deg_s2"):
         if not 0 < getattr(spec, field) < math.inf:
             raise ScenarioError(f"{where}.{field} = {getattr(spec, field)} is out of range: must be > 0 and finite")
+    for field in ("alpha_rate_limit_deg_s", "alpha_accel_limit_deg_s2"):
+        v = getattr(spec, field)
+        if v is not None and not 0 < v < math.inf:
+            raise ScenarioError(f"{where}.{field} = {v} is out of range: must be > 0 and finite (or left out: none stated)")
     try:
         hf = make_heat_flux(spec.heat_flux.form, nose_radius=spec.nose_radius_m,
                             coefficient=spec.heat_flux.coefficient,
@@ -244,6 +261,8 @@ def vehicle_from_spec(spec: VehicleSpec, aero: str | None = None, where: str = "
         bank_limit=np.radians(spec.bank_limit_deg),
         bank_rate_limit=np.radians(spec.bank_rate_limit_deg_s),
         bank_accel_limit=np.radians(spec.bank_accel_limit_deg_s2),
+        alpha_rate_limit=None if spec.alpha_rate_limit_deg_s is None else math.radians(spec.alpha_rate_limit_deg_s),
+        alpha_accel_limit=None if spec.alpha_accel_limit_deg_s2 is None else math.radians(spec.alpha_accel_limit_deg_s2),
         representative=spec.representative,
         source=spec.source,
     )
@@ -259,7 +278,8 @@ def vehicle_spec(name_or_path: str) -> VehicleSpec:
 
 #: the vehicle-file fields a scenario may replace for its mission (Scenario.vehicle_limits)
 LIMIT_FIELDS = ("heat_flux_max_kW_m2", "dynamic_pressure_max_kPa", "normal_load_max_g", "total_load_max_g",
-                "bank_limit_deg", "bank_rate_limit_deg_s", "bank_accel_limit_deg_s2")
+                "bank_limit_deg", "bank_rate_limit_deg_s", "bank_accel_limit_deg_s2", "alpha_rate_limit_deg_s",
+                "alpha_accel_limit_deg_s2")
 
 
 def load_vehicle(name: str, *, aero: str | None = None, limits: dict | None = None) -> Vehicle:

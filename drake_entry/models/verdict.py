@@ -24,7 +24,7 @@ import numpy as np
 from drake_entry.models.constraints import PathLimits
 
 __all__ = ["ALTITUDE_FLOOR_M", "altitude_floor", "PathLimit", "vehicle_path_limits", "LimitCheck", "check_limits", "breaches_text", "BOX_MISSED",
-           "LIMITS_BREACHED", "failure_message", "failure_clauses", "ROUNDING",
+           "LIMITS_BREACHED", "failure_message", "failure_clauses", "ROUNDING", "margin_breached",
            "BoxCriterion", "BOX_CRITERIA", "acceptance_box", "box_text", "Verdict", "judge"]
 
 #: the crash guard of a flight that stops at the terminal energy [m]: below it the flight is
@@ -126,15 +126,13 @@ def check_limits(time, column, limits, tolerance: float = 0.0) -> list[LimitChec
         candidates = []
         if math.isfinite(lim.upper):
             i = int(np.argmax(vv))
-            candidates.append(((lim.upper - vv[i]) / _scale(lim.upper), vv[i], tv[i],
-                               vv[i] <= lim.upper + (tolerance + ROUNDING) * abs(lim.upper)))
+            candidates.append(((lim.upper - vv[i]) / _scale(lim.upper), vv[i], tv[i]))
         if math.isfinite(lim.lower):
             i = int(np.argmin(vv))
-            candidates.append(((vv[i] - lim.lower) / _scale(lim.lower), vv[i], tv[i],
-                               vv[i] >= lim.lower - (tolerance + ROUNDING) * abs(lim.lower)))
-        margin, peak, when, held = min(candidates, key=lambda c: c[0])
+            candidates.append(((vv[i] - lim.lower) / _scale(lim.lower), vv[i], tv[i]))
+        margin, peak, when = min(candidates, key=lambda c: c[0])
         out.append(LimitCheck(lim, float(peak), float(when), float(margin),
-                              bool(all(c[3] for c in candidates))))
+                              not bool(margin_breached(margin, tolerance))))
     return out
 
 
@@ -174,6 +172,13 @@ def failure_clauses(message: str) -> tuple[list[str], list[str], str]:
 
 #: relative slack for floating-point rounding at a bound a clamp holds exactly (the bank limit)
 ROUNDING = 1e-12
+
+
+def margin_breached(margin, tolerance: float = 0.0):
+    """True where a relative margin (LimitCheck.margin: negative past the bound) breaches its
+    limit widened by ``tolerance`` and ROUNDING: the one test the verdict and every report count
+    breaches with (a bank clamped at its limit reads a margin of -1e-16 and holds)."""
+    return np.asarray(margin, float) < -(tolerance + ROUNDING)
 
 
 def _scale(bound: float) -> float:

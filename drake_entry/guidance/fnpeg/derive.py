@@ -8,6 +8,7 @@ from drake_entry.guidance.derivation import (
     Choice,
     Derivation,
     SearchStep,
+    alpha_actuator,
     alpha_rewritten,
     path_gain,
     require_alpha_window,
@@ -51,10 +52,14 @@ def derive(scenario) -> Derivation:
     gain = path_gain(v)  # Lu 2014's path-limit feedback where the vehicle has a limit (HORUS-2B's hand-tuned 40)
     candidates = tuple(b for b in BANK_END_CANDIDATES_DEG if b <= v.bank_limit_deg)
     first = {k.split(".", 1)[1]: x for k, x in enforced(LIMIT_MARGINS[0]).items()}
+    alpha_rate, alpha_accel, actuator = alpha_actuator(
+        scenario, ("guidance.alpha_rate_deg_s", "alpha_accel_deg_s2"), (Fnpeg.alpha_rate_deg_s, Fnpeg.alpha_accel_deg_s2),
+        "the spec's defaults")
     spec = Fnpeg(terminal_altitude_km=interface.altitude_km, terminal_velocity_m_s=round(interface.speed_m_s, 3),
                  final_range_km=0.0, bank_end_deg=candidates[0], alpha_deg=alphas,
                  alpha_velocity_m_s=[round(x, 3) for x in speeds], reversal_heading_deg=heading,
-                 reversal_velocity_m_s=velocity, path_gain=gain, **first)
+                 reversal_velocity_m_s=velocity, path_gain=gain, alpha_rate_deg_s=alpha_rate,
+                 alpha_accel_deg_s2=alpha_accel, **first)
     choices = [
         Choice("guidance.terminal_altitude_km", interface.altitude_km,
                "Lu's e_f at the altitude of the mission's acceptance box (not searched: the altitude at e_f is "
@@ -65,6 +70,7 @@ def derive(scenario) -> Derivation:
         Choice("guidance.final_range_km", 0.0, "the target is the box's distance centre"),
         Choice("guidance.alpha_deg, alpha_velocity_m_s",
                ", ".join(f"{a:g} deg at {s:.0f} m/s" for a, s in zip(alphas, speeds)), alpha_how),
+        actuator,
         corridor,
         Choice("guidance.path_gain", gain, "Lu 2014's path-limit feedback, on where the vehicle has a limit (the "
                "load enforced is the lower of its normal and total load limits: the total bounds the normal)"),

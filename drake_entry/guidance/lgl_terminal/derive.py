@@ -15,6 +15,7 @@ from drake_entry.guidance.derivation import (
     Choice,
     Derivation,
     SearchStep,
+    alpha_actuator,
     interface_speeds,
     mission_alpha,
     terminal_interface,
@@ -51,11 +52,15 @@ def derive(scenario) -> Derivation:
                   for h, V in interface_speeds(scenario, interface, LglTerminal.path_margin, load_alpha_deg=lo,
                                                force_high=force_high)]
     first = candidates[0]
+    rate_limit, alpha_accel, actuator = alpha_actuator(
+        scenario, ("the alpha actuator's rate", "guidance.alpha_accel_limit_deg_s2"),
+        (ALPHA_RATE_DEG_S, LglTerminal.alpha_accel_limit_deg_s2), "the derivation's rate bound and the spec's acceleration")
+    alpha_rate = min(ALPHA_RATE_DEG_S, rate_limit)
     spec = LglTerminal(problem=MISSION, terminal_altitude_km=first["guidance.terminal_altitude_km"],
                        terminal_velocity_m_s=first["guidance.terminal_velocity_m_s"], final_flight_path_deg=gamma,
                        final_descent_deg=FINAL_DESCENT_DEG if gamma is None else None,
-                       alpha_bounds_deg=[lo, hi], alpha_rate_deg_s=ALPHA_RATE_DEG_S, nodes=NODES,
-                       segments=SEGMENTS)
+                       alpha_bounds_deg=[lo, hi], alpha_rate_deg_s=alpha_rate, nodes=NODES,
+                       segments=SEGMENTS, alpha_accel_limit_deg_s2=alpha_accel)
     choices = [Choice("guidance.problem", MISSION, "the problem the mission poses: its entry state, target, box and "
                       "vehicle limits (paper 002's eq. 11 objective)"),
                Choice("guidance.terminal_altitude_km, terminal_velocity_m_s",
@@ -73,7 +78,9 @@ def derive(scenario) -> Derivation:
                       "the box's angle is planned" if gamma is not None else
                       "the plan ends descending at least this steeply: the flight stops where it first crosses the "
                       "terminal altitude (paper 004's CAV-H levelling off there was crossed up to 75 km short)"),
-               Choice("guidance.nodes, segments, alpha_rate_deg_s", f"{NODES}, {SEGMENTS}, {ALPHA_RATE_DEG_S:g}",
-                      "the derivation's (4 LGL segments: each solve about twice as fast, verified closer)")]
+               actuator,
+               Choice("guidance.nodes, segments, alpha_rate_deg_s", f"{NODES}, {SEGMENTS}, {alpha_rate:g}",
+                      "the derivation's (4 LGL segments: each solve about twice as fast, verified closer; the planned "
+                      f"alpha rate {ALPHA_RATE_DEG_S:g} deg/s, or the actuator's when slower)")]
     search = [SearchStep("guidance.terminal_altitude_km", tuple(candidates), ALTITUDE_WHY)]
     return Derivation(spec, choices, search)

@@ -18,6 +18,7 @@ from drake_entry.guidance.derivation import (
     Choice,
     Derivation,
     SearchStep,
+    alpha_actuator,
     alpha_rewritten,
     box_mach_window,
     interface_altitudes,
@@ -32,7 +33,8 @@ from drake_entry.models.dispersions import force_dispersions, force_ratio_high
 
 __all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW_KM", "AIM_TOLERANCE_KM",
            "FEEDBACK", "REPLAN_PERIOD_S", "REPLAN_TIME_TO_GO_FRACTION", "REPLAN_MIN_TIME_TO_GO_S", "FLOWN_MACH_SLACK",
-           "GLIDE_AIM_TOLERANCE_KM", "glides_at", "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "OBJECTIVE", "FORMULATION", "aim_window"]
+           "GLIDE_AIM_TOLERANCE_KM", "glides_at", "INTERFACE_SPEED_WINDOW", "FLIGHT_PATH_BOUNDS_DEG", "OBJECTIVE", "FORMULATION", "aim_window",
+           "MAX_ITERATIONS"]
 
 #: the plan's objective and formulation on another method's mission: the control effort (the
 #: integral of |sigma_dot|), with the bank a state and alpha the mission's law. Measured on
@@ -42,6 +44,11 @@ __all__ = ["derive", "SITE_RADIUS_FRACTION", "MACH_WINDOW_FRACTION", "AIM_WINDOW
 #: is as good); max load 76 km, max heat flux 132 km, heat load 183 km, time 176 km (bang-bang
 #: bank swings the actuators lag); max control rate: the sub-problem failed
 OBJECTIVE, FORMULATION = "control_effort", "direct_bank"
+
+#: the SCvx iteration cap of the derived plans (paper 001's scenario: 100): SHEFEX-3's pre-flight
+#: control-effort plan is feasible (defects 4e-9) by iteration 30, then its trust region sits at
+#: 0.002 and the effort falls about 0.25 % an iteration; it converged in 161 iterations (9.8 s)
+MAX_ITERATIONS = 250
 
 #: the plan's site cone as a fraction of the box's distance tolerance (room for the flown error)
 SITE_RADIUS_FRACTION = 0.5
@@ -175,6 +182,9 @@ def derive(scenario) -> Derivation:
         alpha_deg, alpha_speeds = [alphas[-1], alphas[0]], [max(speeds[0], 1.0), speeds[-1]]
     bounds = [min(alphas), max(alphas)] if max(alphas) > min(alphas) else [max(0.0, alphas[0] - 2.0), alphas[0] + 2.0]
     psi = scenario.entry.heading_deg
+    alpha_rate, alpha_accel, actuator = alpha_actuator(
+        scenario, ("guidance.alpha_rate_limit_deg_s", "alpha_accel_limit_deg_s2"),
+        (Scvx.alpha_rate_limit_deg_s, Scvx.alpha_accel_limit_deg_s2), "paper 001's rate and the spec's acceleration")
     law = alpha_law(alpha_deg, alpha_speeds)  # the plans' own alpha(V) [rad]
     aims = [aim_window(scenario, interface, altitude, mach_window,
                        lambda V: math.degrees(law(V)), force_high=force_high,
@@ -198,7 +208,8 @@ def derive(scenario) -> Derivation:
                 alpha_deg=alpha_deg, alpha_speeds_m_s=alpha_speeds, alpha_bounds_deg=bounds,
                 replan_period_s=REPLAN_PERIOD_S, replan_min_time_to_go_s=REPLAN_MIN_TIME_TO_GO_S,
                 replan_time_to_go_fraction=REPLAN_TIME_TO_GO_FRACTION,
-                path_margin=round(1.0 - LIMIT_MARGIN, 4), feedback=FEEDBACK, replan_model_scales=bool(forces))
+                path_margin=round(1.0 - LIMIT_MARGIN, 4), feedback=FEEDBACK, replan_model_scales=bool(forces),
+                alpha_rate_limit_deg_s=alpha_rate, alpha_accel_limit_deg_s2=alpha_accel, max_iterations=MAX_ITERATIONS)
     load, _ = scenario.make_vehicle().limits.planned_load()
     choices = [
         Choice("guidance.final_mach_min, final_mach_max",
@@ -211,6 +222,10 @@ def derive(scenario) -> Derivation:
                f"{SITE_RADIUS_FRACTION:g} x the box's distance tolerance (room for the flown error)"),
         Choice("guidance.alpha_deg, alpha_speeds_m_s, alpha_bounds_deg",
                f"{alpha_deg} deg at {[round(v) for v in alpha_speeds]} m/s, bounds {bounds} deg", alpha_how),
+        actuator,
+        Choice("guidance.max_iterations", MAX_ITERATIONS,
+               "paper 001's 100 stopped SHEFEX-3's feasible pre-flight plan while its effort still fell 0.25 % an "
+               "iteration (converged in 161)"),
         Choice("guidance.heading_bounds_deg", spec.heading_bounds_deg, "half a turn either side of the entry heading"),
         Choice("guidance.final_vertical_speed_max_m_s", spec.final_vertical_speed_max_m_s,
                f"the plans end descending at {FINAL_DESCENT_DEG:g} deg or steeper at the interface speed (the "

@@ -4,7 +4,7 @@ import dataclasses as dc
 import math
 from typing import Optional
 
-from drake_entry.errors import FieldError, ScenarioError
+from drake_entry.errors import FieldError, ScenarioError, check_range
 from drake_entry.guidance.scvx.mission import ScvxMission
 from drake_entry.guidance.scvx.settings import EntryProblemSettings, FlightCheck, ScvxSettings
 from drake_entry.guidance.spec import ReplanningSpec
@@ -55,6 +55,9 @@ class Scvx(ReplanningSpec):
     alpha_speeds_m_s: list[float] = dc.field(default_factory=lambda: [2000.0, 5000.0])
     alpha_bounds_deg: list[float] = dc.field(default_factory=lambda: [15.0, 45.0])
     alpha_rate_limit_deg_s: float = 1.0
+    # the alpha actuator's acceleration limit [deg/s^2] the plans are flown with (not in paper
+    # 001: a labelled choice well above what its 1 deg/s alpha rate needs)
+    alpha_accel_limit_deg_s2: float = 5.0
     # planner: formulation (direct | direct_bank | hybrid | lossless), objective (Table 2),
     # Lobatto mesh, SCvx iteration cap and SOCP solver (clarabel | scs)
     formulation: str = "direct"
@@ -89,6 +92,7 @@ class Scvx(ReplanningSpec):
         """How the plans are verified: flown through the closed loop's actuators at the guidance
         period with the guidance's command lead and its feedback between re-plans."""
         return FlightCheck(period_s=self.period_s, lead_s=self.command_lead_s, feedback=self.feedback,
+                           alpha_acceleration_deg_s2=self.alpha_accel_limit_deg_s2,
                            feedback_state_weight=self.feedback_state_weight,
                            feedback_offset_limits=self.feedback_offset_limits())
 
@@ -105,6 +109,7 @@ class Scvx(ReplanningSpec):
         super().validate(scenario)
         self.mission(scenario)
         self.planner_settings()
+        check_range("guidance.alpha_accel_limit_deg_s2", self.alpha_accel_limit_deg_s2, 1e-3, 1000.0)
         if self.terminal_mach > self.final_mach_max:
             raise ScenarioError(f"guidance.terminal_mach = {self.terminal_mach} exceeds guidance.final_mach_max = "
                                 f"{self.final_mach_max}")

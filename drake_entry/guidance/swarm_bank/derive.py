@@ -13,6 +13,7 @@ from drake_entry.guidance.derivation import (
     Choice,
     Derivation,
     SearchStep,
+    alpha_actuator,
     alpha_rewritten,
     interface_altitudes,
     mission_alpha,
@@ -73,10 +74,14 @@ def derive(scenario) -> Derivation:
     bank_limit = min(89.0, vehicle.bank_limit_deg)
     gain = path_gain(vehicle)
     end_bounds = [BANK_END_BOUNDS_DEG[0], min(BANK_END_BOUNDS_DEG[1], bank_limit)]
+    alpha_rate, alpha_accel, actuator = alpha_actuator(
+        scenario, ("guidance.alpha_rate_deg_s", "alpha_accel_deg_s2"),
+        (SwarmBank.alpha_rate_deg_s, SwarmBank.alpha_accel_deg_s2), "paper 004's")
     spec = SwarmBank(terminal_altitude_km=interface.altitude_km, terminal_velocity_m_s=round(interface.speed_m_s, 3),
                      bank_start_bounds_deg=[0.0, bank_limit], bank_end_bounds_deg=end_bounds, alpha_law=laws[0],
                      alpha_deg=scheduled, alpha_velocity_m_s=[round(v, 3) for v in speeds],
-                     alpha_min_deg=lo, alpha_max_deg=hi, replan_period_s=REPLAN_PERIOD_S,
+                     alpha_min_deg=lo, alpha_max_deg=hi, alpha_rate_deg_s=alpha_rate, alpha_accel_deg_s2=alpha_accel,
+                     replan_period_s=REPLAN_PERIOD_S,
                      objective_range_unit_km=distance_km, objective_altitude_unit_km=altitude_km,
                      optimizer=OPTIMIZER, limit_fraction=LIMIT_FRACTION, replan_until_e=REPLAN_UNTIL_E,
                      resolve_bank_end=RESOLVE_BANK_END, path_gain=gain,
@@ -90,6 +95,7 @@ def derive(scenario) -> Derivation:
                f"the extremes of {source} alpha schedule (widened to 2 deg when constant)"),
         Choice("guidance.alpha_deg, alpha_velocity_m_s",
                ", ".join(f"{a:g} deg at {v:.0f} m/s" for a, v in zip(scheduled, speeds)) or "none", how),
+        actuator,
         Choice("guidance.bank_start_bounds_deg", f"0-{bank_limit:g} deg", "the vehicle's bank limit"),
         Choice("guidance.objective_range_unit_km, objective_altitude_unit_km", f"{distance_km:g} km, {altitude_km:g} km",
                "eq. 32's units at the mission's box tolerances (paper 004: 100 nmi and 1 km), so the search weighs "

@@ -75,7 +75,27 @@ def test_bracketed_root_finding_finds_the_case1_sigma0(method, max_trajectories,
     r = search(problem_from_scenario(_scenario()), method)
     assert r.x[0] == pytest.approx(SIGMA0_CASE1, abs=0.03) and not r.message
     assert r.trajectories <= max_trajectories and r.calls <= max_populations
-    assert r.J < 0.6  # at the root J is the altitude floor's (about 550 m, J 0.55) plus the speed term
+    # at the root J is the altitude floor's (about 550 m, J 0.55) plus the speed term and eq. 32's
+    # range term, the distance to the TAEM point: the crossrange (2.5-6.4 km over 100 nmi)
+    assert r.J < 0.63
+
+
+def test_eq_32s_range_term_is_the_great_circle_distance_to_the_taem_point():
+    """J = s / 100 nmi + |dh| / 1 km + |dV| / 100 m/s with s the great-circle range to go to the
+    TAEM point (Lu 2014's s, paper 004 eq. 32): the along-track error and the crossrange both
+    count (hypot of the two within 0.1 % at these distances)."""
+    from drake_entry.guidance.swarm_bank.evaluator import evaluate
+    from drake_entry.guidance.swarm_bank.search import problem_from_scenario
+    from drake_entry.models.geodesy import central_angle
+
+    p = problem_from_scenario(_scenario())
+    e = evaluate(p, np.radians([SIGMA0_CASE1 - 0.5, SIGMA0_CASE1, SIGMA0_CASE1 + 0.5]))
+    assert e.reached.all()
+    s = p.planet.reference_radius * central_angle(e.final_state[:, 1], e.final_state[:, 2], *p.target)
+    rest = np.abs(e.altitude_error_m) / 1e3 + np.abs(e.velocity_error_m_s) / 100.0
+    np.testing.assert_allclose(e.J, s / 1.852e5 + rest, rtol=1e-12)
+    np.testing.assert_allclose(s, np.hypot(e.range_error_m, e.crossrange_m), rtol=1e-3)
+    assert np.abs(e.crossrange_m).min() > 1e3  # the crossrange is in the objective, not only the range
 
 
 def test_on_board_resolution_from_entry_recovers_the_planned_sigma0():

@@ -42,7 +42,7 @@ from drake_entry.models.aerodynamics import ScaledAero
 from drake_entry.models.bank_reversal import corridor_half_width, reversal_sign, wrap_angle
 from drake_entry.models.constraints import dynamic_pressure
 from drake_entry.models.dynamics import aero_accelerations, air_data, equations_of_motion, state_derivatives
-from drake_entry.models.geodesy import bearings, downtrack_crosstrack
+from drake_entry.models.geodesy import bearings, central_angle, downtrack_crosstrack
 from drake_entry.models.kernels import Kernel, compile_kernels
 from drake_entry.models.verdict import altitude_floor
 
@@ -189,8 +189,8 @@ class Evaluation:
     """Per member (arrays): objective J (eq. 32), its parts, the final state and peaks.
 
     Attributes:
-      J: objective of eq. 32 (inf where the TAEM energy was not reached); under the 'schedule'
-        alpha law plus LIMIT_WEIGHT times the path limits' relative excess (limit_excess).
+      J: objective of eq. 32, its range term the great-circle distance to the TAEM point (inf
+        where the TAEM energy was not reached); under the 'schedule' alpha law plus LIMIT_WEIGHT times the path limits' relative excess (limit_excess).
       range_error_m: signed along-track distance at TAEM [m], + beyond the target.
       crossrange_m: cross-track distance from the entry-to-target great circle [m].
       altitude_error_m: h - h_f at the TAEM energy [m].
@@ -257,7 +257,10 @@ def _evaluation(p: SwarmProblem, final, t_end, reached, peaks, reversals, n, his
     ds, c = range_error(p, final[1], final[2])
     dh, dV = final[0] - p.h_f, final[3] - p.V_f
     range_unit, altitude_unit, speed_unit = p.objective_units
-    J = np.abs(ds) / range_unit + np.abs(dh) / altitude_unit + np.abs(dV) / speed_unit  # eq. 32
+    # eq. 32's s(e_f): the great-circle range to go to the TAEM point (s* = 0), crossrange included:
+    # along-track alone planned SPHYNX's long glide 151 km beside the site, the bank's magnitude set for range only
+    s = p.planet.reference_radius * central_angle(final[1], final[2], *p.target)
+    J = s / range_unit + np.abs(dh) / altitude_unit + np.abs(dV) / speed_unit  # eq. 32
     if p.case == "schedule":  # an alpha law that holds no path limit: its breaches are penalised
         J = J + LIMIT_WEIGHT * limit_excess(p.vehicle.limits, peaks, p.limit_fraction)
     J = np.where(reached, J, np.inf)

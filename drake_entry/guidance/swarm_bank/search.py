@@ -86,6 +86,17 @@ class Objective:
         i = int(np.argmin(J))
         return X[i], float(J[i])
 
+    def nearest_root(self) -> tuple[np.ndarray, float]:
+        """The reached position evaluated so far with the smallest |signed range error| (what
+        the bracketed root solves look for: eq. 32's J also weighs the crossrange, which the
+        reversal timing moves by km between neighbouring sigma_0) and its J."""
+        X = np.concatenate([x for x, _ in self.log])
+        d = np.concatenate([e.range_error_m for _, e in self.log])
+        J = np.concatenate([e.J for _, e in self.log])
+        ok = np.concatenate([e.reached for _, e in self.log])
+        i = int(np.argmin(np.where(ok, np.abs(d), np.inf)))
+        return X[i], float(J[i])
+
 
 @dc.dataclass
 class SearchResult:
@@ -146,7 +157,7 @@ def search(problem: SwarmProblem, method: str, bounds_deg=((0.0, 89.0),), *, see
         message = _bracketed_secant(f, *bounds[0])
     else:
         raise ScenarioError(f"search method {method!r}; allowed: {', '.join(SWARMS + BASELINES)}")
-    x, J = f.best()
+    x, J = f.nearest_root() if method in ("brentq", "secant") else f.best()
     if swarm is not None:
         x, J = swarm.x, swarm.J
     return SearchResult(method, np.asarray(x, float), float(J), f.trajectories, f.calls, time.perf_counter() - t0,

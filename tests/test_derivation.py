@@ -469,6 +469,8 @@ def test_the_schedule_law_s_search_pays_for_each_limit_it_breaches():
     peaks = np.array([[530e3, 583e3], [9e3, 11e3], [2.0, 3.0]])
     np.testing.assert_allclose(limit_excess(limits, peaks), [0.0, 0.1 + 0.1 + 0.2], rtol=1e-12)
     np.testing.assert_allclose(limit_excess(limits, peaks, 0.9)[0], 530 / 477 - 1.0, rtol=1e-12)
+    # under the load law (eq. 31's alpha holds the load) only the heat rate and q are paid for
+    np.testing.assert_allclose(limit_excess(limits, peaks, held=("load",)), [0.0, 0.1 + 0.1], rtol=1e-12)
 
 
 def test_a_box_alpha_window_the_mission_s_alpha_misses_is_beyond_a_bank_only_method():

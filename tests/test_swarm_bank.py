@@ -436,7 +436,7 @@ def test_a_plan_that_reaches_taem_far_from_the_target_is_not_a_success(case1_pla
 
 
 @pytest.mark.parametrize("variant", ["load", "heat", "schedule", "scaled aerodynamics", "two parameters",
-                                     "floor and time", "path feedback", "mid-reversal"])
+                                     "floor and time", "path feedback", "load-law feedback", "mid-reversal"])
 def test_compiled_population_flies_as_the_numpy_evaluator(variant):
     """The population flown in one compiled call (population_flight with kernels generated from
     the models) against the vectorised numpy evaluator it replicates: every member's J within
@@ -463,9 +463,12 @@ def test_compiled_population_flies_as_the_numpy_evaluator(variant):
     elif variant == "path feedback":  # Lu 2014's feedback on a re-solution's sensed vehicle (limits divided)
         from drake_entry.models.acceleration_ratios import sensed_vehicle
         p = dc.replace(p, vehicle=sensed_vehicle(p.vehicle, (1.06, 1.1)), path_gain=40.0, path_fraction=0.8)
-        assert p.law().path is None  # under the load law eq. 31's alpha holds the limits: no feedback
+        law = p.law().path  # under the load law eq. 31's alpha holds the load: the feedback the heat rate and q
+        assert law.active and math.isinf(law.load_max) and law.heat_max == pytest.approx(0.8 * p.vehicle.limits.heat_flux_max)
         p = dc.replace(p, case="schedule", alpha_schedule=((2000.0, 5500.0, 7000.0), tuple(np.radians([11.0, 10.5, 14.0]))))
         assert p.law().path.active
+    elif variant == "load-law feedback":  # the feedback on the heat rate and q beside eq. 31, tight enough to act
+        p = dc.replace(p, path_gain=40.0, path_fraction=0.5)
     elif variant == "mid-reversal":  # an on-board re-solution while the actuator sweeps to the other side
         p = dc.replace(p, initial_bank=math.radians(-65.0), initial_bank_rate=math.radians(-4.0), initial_sign=1.0)
     a = evaluate(p, sigma0, sigma_f=sigma_f)

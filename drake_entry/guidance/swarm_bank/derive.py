@@ -110,13 +110,15 @@ def derive(scenario) -> Derivation:
                "on it has shrunk), sigma_f is re-solved within its bounds (Lu 2014's CAV-H: 8 -> 9 of 10)"),
         Choice("guidance.optimizer", OPTIMIZER, "sigma_0 and sigma_f searched together: paper 004's PIO budget "
                "does not converge in two dimensions (HORUS-2B: J 14.5 against 0.40)"),
-        Choice("guidance.limit_fraction", LIMIT_FRACTION, "under the mission's alpha schedule the search keeps the "
-               "replica's peaks under this fraction of the vehicle's limits (the Drake flight samples finer)"),
+        Choice("guidance.limit_fraction", LIMIT_FRACTION, "the search keeps the "
+               "replica's peaks under this fraction of the vehicle's limits its alpha law does not hold (the Drake "
+               "flight samples finer)"),
         Choice("guidance.path_gain, path_limit_fraction", f"{gain:g}, {PATH_LIMIT_FRACTION:g}",
                "Lu 2014's path-limit feedback on the bank (FNPEG's), holding that fraction of the vehicle's limits "
-               "under the mission's alpha schedule, which does not hold them as paper 004's alpha laws do (HORUS-2B, "
-               "100 runs: 57 without it, the heat rate 0.3-2.8 % over; 100 with it); off under the load law, whose "
-               "alpha holds the limits" if gain > 0 else "the vehicle states no limit to hold"),
+               "that the alpha law does not hold: every limit under the mission's alpha schedule (HORUS-2B, 100 runs: "
+               "57 without it, the heat rate 0.3-2.8 % over; 100 with it), the heat rate and q under the load law, "
+               "whose alpha holds the load (SPHYNX's heat rate, which eq. 31 does not hold, 725 kW/m^2 against 670)"
+               if gain > 0 else "the vehicle states no limit to hold"),
         corridor,
     ]
     search = [SearchStep.over("guidance.alpha_law", laws,

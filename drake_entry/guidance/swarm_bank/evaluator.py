@@ -47,22 +47,29 @@ from drake_entry.models.kernels import Kernel, compile_kernels
 from drake_entry.models.verdict import altitude_floor
 
 __all__ = ["RANGE_UNIT_M", "ALTITUDE_UNIT_M", "SPEED_UNIT_M_S", "SwarmProblem", "Evaluation", "HISTORY_COLUMNS",
-           "CONTROL_COLUMNS", "ENGINES", "evaluate", "range_error", "LIMIT_WEIGHT", "limit_excess"]
+           "CONTROL_COLUMNS", "ENGINES", "evaluate", "range_error", "LIMIT_WEIGHT", "limit_excess",
+           "HELD_BY_ALPHA"]
 
 #: J of eq. 32: range error over 100 nmi, altitude error over 1 km, speed error over 100 m/s
 RANGE_UNIT_M, ALTITUDE_UNIT_M, SPEED_UNIT_M_S = 1.852e5, 1e3, 100.0
-#: J added per unit of relative path-limit excess under the 'schedule' alpha law, which holds no
-#: limit as Cases 1 and 2 do (a 10 % breach weighs as 10 km of altitude error)
+#: J added per unit of relative excess of a path limit the alpha law does not hold (the 'schedule'
+#: law holds none, eq. 31 the load alone; a 10 % breach weighs as 10 km of altitude error)
 LIMIT_WEIGHT = 100.0
 
 
-def limit_excess(limits, peaks, fraction: float = 1.0):
-    """Sum over heat flux, dynamic pressure and load of max(0, peak / (fraction limit) - 1) per
-    member; ``peaks`` (3, n): [heat flux W/m^2, q Pa, total load g] (the total load against the
-    lower of the vehicle's total and normal load limits: the total bounds the normal)."""
-    bounds = (limits.heat_flux_max, limits.dynamic_pressure_max, limits.load_bound_max)
+#: the path limits each alpha law holds by its alpha (eq. 31 flies the load on its limit; Case 2
+#: the heat rate, then the load): the bank's path feedback and J's penalty see only the others
+HELD_BY_ALPHA = {"load": ("load",), "heat": ("heat", "load"), "schedule": ()}
+
+
+def limit_excess(limits, peaks, fraction: float = 1.0, held=()):
+    """Sum over heat flux ('heat'), dynamic pressure ('q') and load ('load') of
+    max(0, peak / (fraction limit) - 1) per member, except the limits in ``held``; ``peaks``
+    (3, n): [heat flux W/m^2, q Pa, total load g] (the total load against the lower of the
+    vehicle's total and normal load limits: the total bounds the normal)."""
+    bounds = (("heat", limits.heat_flux_max), ("q", limits.dynamic_pressure_max), ("load", limits.load_bound_max))
     return sum(np.maximum(np.asarray(peak, float) / (fraction * bound) - 1.0, 0.0)
-               for peak, bound in zip(peaks, bounds) if math.isfinite(bound))
+               for peak, (name, bound) in zip(peaks, bounds) if math.isfinite(bound) and name not in held)
 
 
 @dc.dataclass
@@ -83,7 +90,7 @@ class SwarmProblem:
       alpha_schedule: ((speeds [m/s], increasing), (alpha [rad])) of the 'schedule' case.
       objective_units: eq. 32's range [m], altitude [m] and speed [m/s] units (paper 004: 100 nmi,
         1 km, 100 m/s).
-      limit_fraction: under the 'schedule' law, J is penalised past this fraction of each limit.
+      limit_fraction: J is penalised past this fraction of each limit the alpha law does not hold.
       path_gain, path_horizon_s, path_fraction: Lu 2014's path-limit feedback on the bank (gain,
         horizon [s]) holding this fraction of the vehicle's limits under the 'schedule' case
         (guidance.path_feedback; gain 0: paper 004's law).
@@ -169,12 +176,16 @@ class SwarmProblem:
     def path_limits(self) -> PathLimits | None:
         """The path-limit feedback's settings: path_fraction of the vehicle's limits (those of a
         re-solution's sensed vehicle, models.acceleration_ratios.sensed_vehicle, in its nominal
-        air), or None without a gain or under paper 004's alpha laws (their alpha holds the
-        limits: eq. 31 flies the load on its limit, which the feedback would fight)."""
-        if self.path_gain <= 0.0 or self.case != "schedule":
+        air) that the alpha law does not hold (HELD_BY_ALPHA: eq. 31 flies the load on its
+        limit, which the feedback would fight; it does not hold the heat rate or q), or None
+        without a gain or a limit left to hold."""
+        held = HELD_BY_ALPHA[self.case]
+        if self.path_gain <= 0.0 or "heat" in held:  # Case 2's alpha holds the heat rate, then the load
             return None
-        return PathLimits.of_vehicle(self.vehicle.limits, self.planet, gain=self.path_gain,
+        path = PathLimits.of_vehicle(self.vehicle.limits, self.planet, gain=self.path_gain,
                                      horizon=self.path_horizon_s, fraction=self.path_fraction, beta=self.beta)
+        path = dc.replace(path, load_max=math.inf) if "load" in held else path
+        return path if path.active else None
 
     def law(self) -> LawSettings:
         pl = self.planet
@@ -190,7 +201,8 @@ class Evaluation:
 
     Attributes:
       J: objective of eq. 32, its range term the great-circle distance to the TAEM point (inf
-        where the TAEM energy was not reached); under the 'schedule' alpha law plus LIMIT_WEIGHT times the path limits' relative excess (limit_excess).
+        where the TAEM energy was not reached), plus LIMIT_WEIGHT times the relative excess of the
+        path limits the alpha law does not hold (limit_excess, HELD_BY_ALPHA).
       range_error_m: signed along-track distance at TAEM [m], + beyond the target.
       crossrange_m: cross-track distance from the entry-to-target great circle [m].
       altitude_error_m: h - h_f at the TAEM energy [m].
@@ -261,8 +273,8 @@ def _evaluation(p: SwarmProblem, final, t_end, reached, peaks, reversals, n, his
     # along-track alone planned SPHYNX's long glide 151 km beside the site, the bank's magnitude set for range only
     s = p.planet.reference_radius * central_angle(final[1], final[2], *p.target)
     J = s / range_unit + np.abs(dh) / altitude_unit + np.abs(dV) / speed_unit  # eq. 32
-    if p.case == "schedule":  # an alpha law that holds no path limit: its breaches are penalised
-        J = J + LIMIT_WEIGHT * limit_excess(p.vehicle.limits, peaks, p.limit_fraction)
+    # the breaches of the limits the alpha law does not hold are penalised
+    J = J + LIMIT_WEIGHT * limit_excess(p.vehicle.limits, peaks, p.limit_fraction, HELD_BY_ALPHA[p.case])
     J = np.where(reached, J, np.inf)
     return Evaluation(J, ds, c, dh, dV, final.T.copy(), t_end, reached, peaks[0], peaks[1], peaks[2], reversals, n,
                       history, controls)

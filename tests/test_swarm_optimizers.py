@@ -48,7 +48,8 @@ def test_bad_swarm_settings_are_one_line():
 def test_pio_on_cav_h_case1_finds_the_prototype_study_optimum():
     """Paper 004 settings (N 10, k_max 20, k_c 14, R 0.2), Case 1 on the substitute mission:
     sigma0* within 0.03 deg of the root of the signed range error (58.79 deg; paper 004: 58.89),
-    J within 5e-3 of the grid refinement's 0.5727."""
+    J within 5e-3 of the grid refinement's 0.5910 (eq. 32's range term the distance to the TAEM
+    point: the 5-km cross-range at the root counts; 0.5727 when it counted the along-track error)."""
     import sys
     from pathlib import Path
 
@@ -59,7 +60,7 @@ def test_pio_on_cav_h_case1_finds_the_prototype_study_optimum():
 
     problem = _case1_problem()
     r = pio(lambda X: evaluate(problem, np.radians(X[:, 0])).J, [(0.0, 89.0)], seed=0)
-    assert r.x[0] == pytest.approx(58.79, abs=0.03) and r.J < 0.5727 + 5e-3 and r.evaluations == 163
+    assert r.x[0] == pytest.approx(58.79, abs=0.03) and r.J < 0.5910 + 5e-3 and r.evaluations == 163
 
 
 def test_searches_in_lockstep_equal_the_same_searches_run_alone():

@@ -660,7 +660,7 @@ def _requirements(rows: dict, reached, stats: dict, scenario, verdict=None) -> s
             limits = []
     peaks = {"heat_flux": "peak_heat_flux_W_m2", "dynamic_pressure": "peak_dynamic_pressure_Pa",
              "normal_load": "peak_normal_load_g", "total_load": "peak_total_load_g"}
-    tolerance = scenario.terminal.path_limit_tolerance if scenario is not None else 0.0
+    tolerance = path_limit_tolerance(scenario)
     for lim in limits:
         m = stats["margins"].get(f"margin_{lim.name}")
         if m is None:

@@ -152,16 +152,15 @@ def write_comparison_report(out_dir: str) -> str:
     meta = read_comparison_manifest(out_dir)
     if meta is None:
         raise CampaignError(f"{out_dir} holds no comparison ({MANIFEST}): run `drake-entry compare` first")
-    all_rows, summaries = {}, {}
+    all_rows, summaries, flown = {}, {}, {}
     for label, info in meta["methods"].items():
         if info.get("flown") and os.path.isdir(os.path.join(out_dir, label)):
             rows = _method_rows(out_dir, label)
             if rows is not None:
-                flown = flown_scenario(read_manifest(os.path.join(out_dir, label)))
-                all_rows[label], summaries[label] = rows, method_summary(rows, path_limit_tolerance(flown))
+                flown[label] = flown_scenario(read_manifest(os.path.join(out_dir, label)))
+                all_rows[label], summaries[label] = rows, method_summary(rows, path_limit_tolerance(flown[label]))
     same, compared, worst = dispersion_check(all_rows)
-    first = next(iter(all_rows), None)  # every method flies the same mission: its terminal box
-    scenario = flown_scenario(read_manifest(os.path.join(out_dir, first))) if first else None
+    scenario = next(iter(flown.values()), None)  # every method flies the same mission: its terminal box
     radius = getattr(getattr(scenario, "terminal", None), "distance_tolerance_km", None)
     with open(os.path.join(out_dir, "comparison_summary.json"), "w") as f:
         json.dump({"comparison": meta["comparison"], "mission": meta["mission"], "seed": meta["seed"],

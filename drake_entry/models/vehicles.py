@@ -111,6 +111,10 @@ class VehicleSpec:
     alpha_accel_limit_deg_s2: Optional[float] = None
 
 
+#: the Vehicle limits it may leave as None (the alpha actuator: not every vehicle file states one)
+_OPTIONAL_LIMITS = ("alpha_rate_limit", "alpha_accel_limit")
+
+
 @dc.dataclass
 class Vehicle:
     """A point-mass entry vehicle.
@@ -145,15 +149,16 @@ class Vehicle:
 
     def __post_init__(self):
         for field, unit in (("mass", "kg"), ("reference_area", "m^2"), ("nose_radius", "m"), ("bank_rate_limit", "rad/s"),
-                            ("bank_accel_limit", "rad/s^2")):  # a file's vehicle is inside SIZE_RANGES; a dispersed one scaled
+                            ("bank_accel_limit", "rad/s^2"), ("alpha_rate_limit", "rad/s"),
+                            ("alpha_accel_limit", "rad/s^2")):  # a file's vehicle is inside SIZE_RANGES; a dispersed one scaled
             v = getattr(self, field)
+            optional = field in _OPTIONAL_LIMITS
+            if v is None and optional:
+                continue
             if isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 < v < math.inf):
-                raise ScenarioError(f"Vehicle.{field} = {v!r} must be a finite number > 0 {unit}")
+                raise ScenarioError(f"Vehicle.{field} = {v!r} must be {'None or ' if optional else ''}a finite number > 0 "
+                                    f"{unit}")
             setattr(self, field, float(v))
-        for field, unit in (("alpha_rate_limit", "rad/s"), ("alpha_accel_limit", "rad/s^2")):
-            v = getattr(self, field)
-            if v is not None and (isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 < v < math.inf)):
-                raise ScenarioError(f"Vehicle.{field} = {v!r} must be None or a finite number > 0 {unit}")
         if not 0 < self.bank_limit <= np.pi:
             raise ScenarioError(f"Vehicle.bank_limit must be in (0, 180] deg, got {np.degrees(self.bank_limit):.4g} deg")
         if self.heat_flux is None:
@@ -233,13 +238,11 @@ def vehicle_from_spec(spec: VehicleSpec, aero: str | None = None, where: str = "
     for field in ("bank_limit_deg",):
         if not 0 < getattr(spec, field) <= 180:
             raise ScenarioError(f"{where}.{field} = {getattr(spec, field)} is out of range (0, 180] deg")
-    for field in ("bank_rate_limit_deg_s", "bank_accel_limit_deg_s2"):
-        if not 0 < getattr(spec, field) < math.inf:
-            raise ScenarioError(f"{where}.{field} = {getattr(spec, field)} is out of range: must be > 0 and finite")
-    for field in ("alpha_rate_limit_deg_s", "alpha_accel_limit_deg_s2"):
-        v = getattr(spec, field)
-        if v is not None and not 0 < v < math.inf:
-            raise ScenarioError(f"{where}.{field} = {v} is out of range: must be > 0 and finite (or left out: none stated)")
+    for field in ("bank_rate_limit_deg_s", "bank_accel_limit_deg_s2", "alpha_rate_limit_deg_s", "alpha_accel_limit_deg_s2"):
+        v, optional = getattr(spec, field), field.startswith("alpha_")
+        if not (v is None and optional) and not 0 < v < math.inf:
+            raise ScenarioError(f"{where}.{field} = {v} is out of range: must be > 0 and finite"
+                                + (" (or left out: none stated)" if optional else ""))
     try:
         hf = make_heat_flux(spec.heat_flux.form, nose_radius=spec.nose_radius_m,
                             coefficient=spec.heat_flux.coefficient,

@@ -86,17 +86,6 @@ class Objective:
         i = int(np.argmin(J))
         return X[i], float(J[i])
 
-    def nearest_root(self) -> tuple[np.ndarray, float]:
-        """The reached position evaluated so far with the smallest |signed range error| (what
-        the bracketed root solves look for: eq. 32's J also weighs the crossrange, which the
-        reversal timing moves by km between neighbouring sigma_0) and its J."""
-        X = np.concatenate([x for x, _ in self.log])
-        d = np.concatenate([e.range_error_m for _, e in self.log])
-        J = np.concatenate([e.J for _, e in self.log])
-        ok = np.concatenate([e.reached for _, e in self.log])
-        i = int(np.argmin(np.where(ok, np.abs(d), np.inf)))
-        return X[i], float(J[i])
-
 
 @dc.dataclass
 class SearchResult:
@@ -157,7 +146,11 @@ def search(problem: SwarmProblem, method: str, bounds_deg=((0.0, 89.0),), *, see
         message = _bracketed_secant(f, *bounds[0])
     else:
         raise ScenarioError(f"search method {method!r}; allowed: {', '.join(SWARMS + BASELINES)}")
-    x, J = f.nearest_root() if method in ("brentq", "secant") else f.best()
+    if method in ("brentq", "secant"):  # the root they solve for: eq. 32's J also weighs the crossrange,
+        x, _, J = _nearest_root(f)    # which the reversal timing moves by km between neighbouring sigma_0
+        x = [x]
+    else:
+        x, J = f.best()
     if swarm is not None:
         x, J = swarm.x, swarm.J
     return SearchResult(method, np.asarray(x, float), float(J), f.trajectories, f.calls, time.perf_counter() - t0,
@@ -174,6 +167,14 @@ def _samples(f: Objective, lo: float = -np.inf, hi: float = np.inf):
     keep = (X >= lo) & (X <= hi)
     order = np.argsort(X[keep], kind="stable")
     return X[keep][order], d[keep][order], J[keep][order], ok[keep][order]
+
+
+def _nearest_root(f: Objective) -> tuple[float, float, float]:
+    """(sigma_0 [deg], signed range error [m], J) of the reached member evaluated so far with the
+    smallest |signed range error| (one-parameter searches)."""
+    X, d, J, ok = _samples(f)
+    i = int(np.argmin(np.where(ok, np.abs(d), np.inf)))
+    return float(X[i]), float(d[i]), float(J[i])
 
 
 def _brackets(f: Objective, lo: float = -np.inf, hi: float = np.inf) -> list[tuple[float, float, float, float]]:
@@ -262,9 +263,8 @@ def _root(f: Objective, previous: float, bounds_deg, width_deg: float, points: i
         e = f.evaluate([[x]])
         if e.reached[0] and abs(e.range_error_m[0]) <= min(abs(found[2]), abs(found[3])):
             return x, True, float(e.range_error_m[0])
-    X, d, _, ok = _samples(f)
-    i = int(np.argmin(np.where(ok, np.abs(d), np.inf)))
-    return float(X[i]), False, float(d[i])
+    x, d, _ = _nearest_root(f)
+    return x, False, d
 
 
 def resolve_sigma0(problem: SwarmProblem, previous_deg: float, bounds_deg=(0.0, 89.0), *, width_deg: float = 6.0,

@@ -93,6 +93,9 @@ def test_a_plan_flight_is_judged_where_it_first_meets_the_terminal_altitude():
     assert alpha == pytest.approx(0.2)
     x_end, _, _, t_end = interface_crossing(tr, 26e3)  # never that low: judged at its end
     assert t_end == 100.0 and x_end[0] == h[-1]
+    # the altitude the stop reads (geodetic): 2 km above the state altitude, it crosses 30 km where h does 28 km
+    x_geo, _, _, t_geo = interface_crossing(tr, 30e3, h + 2e3)
+    assert t_geo == pytest.approx(t_stop, rel=1e-12) and x_geo[0] == pytest.approx(x[0], rel=1e-12)
 
 
 @pytest.mark.parametrize("field, value, words", [
@@ -227,6 +230,34 @@ def test_a_mission_poses_its_own_terminal_problem(horus_derived):
     assert [t.kind for t in p.objective] == ["control_margin"] and p.objective[0].k == (1.0, 18.0, 20.0)
     assert s.guidance.path_limits(s) == []  # its constraints are the vehicle's limits, checked anyway
     assert s.guidance.terminal_speed(300.0) == g.terminal_velocity_m_s
+
+
+def test_a_mission_with_geodetic_altitudes_plans_and_floors_the_geodetic_terminal_altitude():
+    """SHEFEX-3's altitudes are geodetic (altitude_datum 'ellipsoid'), as the closed loop's stop
+    reads them: the plan ends at the state altitude whose geodetic altitude at the target is the
+    terminal altitude (23.5 km geodetic is a 5.1-km state altitude at 68.1 N; the state altitude
+    23.5 km is 41.9 km geodetic there), and the interface floor reads the geodetic altitude."""
+    from drake_entry.guidance.derivation import derivation_for
+    from drake_entry.guidance.lgl_terminal.spec import LglTerminal
+
+    mission = load_scenario("shefex3_ampi")
+    s = dc.replace(mission, guidance=derivation_for(mission, LglTerminal).spec).validate()
+    planet, h_f = s.make_planet(), s.guidance.terminal_altitude_km * 1e3
+    p = s.guidance.problem_for(s)
+    lat_f = math.radians(s.target.latitude_deg)
+    assert h_f == 23.5e3 and p.final["lat"] == lat_f
+    assert float(planet.atmospheric_altitude(p.final["h"], lat_f)) == pytest.approx(h_f, abs=1e-6)
+    assert 4.5e3 < p.final["h"] < 5.5e3
+    # the state bound: the geodetic floor's lowest state altitude between the entry's and the target's latitude
+    lat0 = p.initial["lat"]
+    assert abs(lat0) > abs(lat_f)  # flying from 71.9 N to 68.1 N: the entry's latitude gives the lower bound
+    assert p.state_bounds["h"][0] == pytest.approx(float(planet.state_altitude(h_f, lat0)), abs=1e-6)
+    assert p.state_bounds["h"][0] < p.final["h"]
+    floor = next(c for c in p.path if c.label == "interface_floor")
+    for lat in (lat0, lat_f):
+        x = np.array([float(planet.state_altitude(h_f, lat)), 0.0, lat, s.guidance.terminal_velocity_m_s, 0.0, 0.0,
+                      0.3, 0.0])
+        assert floor.quantity(x, None, None) == pytest.approx(0.0, abs=1e-6)
 
 
 def test_the_derived_final_speed_stays_below_the_planned_dynamic_pressure(horus_derived):

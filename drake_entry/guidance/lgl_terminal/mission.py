@@ -35,16 +35,20 @@ class InterfaceFloor:
     (V - V_f) / ``speed_scale`` (smooth; the full ``margin`` m [m] far from the final speed V_f
     [m/s], none at it). Without it an optimum that bleeds speed low rides the terminal altitude
     at its nodes and dips under it between them (Lu 2014's CAV-H in thin air: the flight stopped
-    at 28 km 87 s before the plan's end, 190-240 km short)."""
+    at 28 km 87 s before the plan's end, 190-240 km short). h is the geodetic altitude on
+    ``planet`` where the mission's altitudes are geodetic (altitude_datum 'ellipsoid', as the
+    closed loop's stop reads it), else (``planet`` None) the state altitude."""
 
     h_f: float
     v_f: float
     margin: float = FLOOR_MARGIN_M
     speed_scale: float = FLOOR_SPEED_SCALE_M_S
+    planet: object | None = None
 
     def __call__(self, x, u, env):
         s = (x[3] - self.v_f) / self.speed_scale
-        return x[0] - self.h_f - self.margin * (s * s) / (1.0 + s * s)
+        h = x[0] if self.planet is None else self.planet.atmospheric_altitude(x[0], x[2])
+        return h - self.h_f - self.margin * (s * s) / (1.0 + s * s)
 
 
 #: the flight-path bounds of a mission's problem [deg] (paper 002 bounds none; a glide stays
@@ -102,14 +106,17 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
     and an ``InterfaceFloor`` above it (the closed loop stops at its first descent through it),
     the path constraints ``spec.path_margin`` inside their bounds (``margin=False``: as
     the file gives them, the bounds the verdict checks); the rest (final speed and alpha, bounds,
-    objective) from the problem file."""
+    objective) from the problem file. The terminal altitude is geodetic with altitude_datum
+    'ellipsoid' (the final state altitude is its value at the target's latitude)."""
     p = mission_problem(spec, scenario) if spec.problem == MISSION else load_guidance_problem(spec)
     x0 = scenario.initial_state()
     initial = dict(p.initial)
     initial.update({n: float(v) for n, v in zip(("h", "lon", "lat", "V", "gamma", "psi"), x0)})
     final = dict(p.final)
-    final.update(h=scenario.guidance.terminal_altitude_km * 1e3, lon=math.radians(scenario.target.longitude_deg),
-                 lat=math.radians(scenario.target.latitude_deg))
+    lat_f = math.radians(scenario.target.latitude_deg)
+    # the state altitude at the target of the guidance's terminal altitude (geodetic with
+    # altitude_datum 'ellipsoid': SHEFEX-3's 23.5 km is a 5.1-km state altitude at 68.1 N)
+    final.update(h=scenario.guidance_terminal_state()[0], lon=math.radians(scenario.target.longitude_deg), lat=lat_f)
     if spec.final_flight_path_deg is not None:
         final["gamma"] = math.radians(spec.final_flight_path_deg)
     elif spec.final_descent_deg is not None:
@@ -119,9 +126,14 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
     if spec.problem == MISSION:  # the closed loop stops where it first meets the terminal altitude
         # the floor implies the bound at the nodes; the bound is a simple bound the solver keeps
         # every iterate inside (the plans of the measured campaigns were solved with both)
-        bounds["h"] = (final["h"], math.inf)
-        path.append(PathConstraint(InterfaceFloor(final["h"], spec.terminal_velocity_m_s), min=0.0,
-                                   scale=FLOOR_MARGIN_M, name=FLOOR_LABEL))
+        geodetic, planet = scenario.altitude_datum == "ellipsoid", scenario.make_planet()
+        h_stop = scenario.guidance.terminal_altitude_km * 1e3
+        # a geodetic floor as a state bound: its lowest state altitude between the entry's and
+        # the target's latitudes (the geodetic altitude of a state altitude grows with |lat|)
+        bounds["h"] = (min(float(planet.state_altitude(h_stop, lat)) for lat in (initial["lat"], lat_f))
+                       if geodetic else final["h"], math.inf)
+        path.append(PathConstraint(InterfaceFloor(h_stop, spec.terminal_velocity_m_s, planet=planet if geodetic else None),
+                                   min=0.0, scale=FLOOR_MARGIN_M, name=FLOOR_LABEL))
     return dc.replace(p, vehicle=scenario.make_vehicle(), planet=scenario.make_planet(),
                       atmosphere=scenario.make_atmosphere(), initial=initial, final=final, path=path,
                       state_bounds=bounds, name=f"{scenario.name}_{p.name}")

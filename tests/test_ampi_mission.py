@@ -144,13 +144,13 @@ def test_mission_problem_is_the_mission_with_its_limits_planned_inside(tmp_path)
     assert [problem.initial[n] for n in ("h", "lon", "lat", "V", "gamma", "psi")] == pytest.approx(list(x0))
     assert "V" not in problem.final
     assert problem.final["lat"] == pytest.approx(math.radians(scenario.target.latitude_deg))
-    energy, altitude = problem.terminal  # the stop's energy, inside half the box's altitude tolerance
+    energy, = problem.terminal  # the stop's energy, inside half the box's altitude tolerance
     E_f = scenario.guidance_terminal_state()[2]
     assert energy.quantity == "central_energy" and energy.min == energy.max == pytest.approx(E_f)
     x_end = np.array([28e3, 0.0, 0.0, d.spec.terminal_velocity_m_s, 0.0, 0.0])
     assert energy.value(x_end, None, None, problem.planet) == pytest.approx(E_f, rel=1e-12)
     half = ALTITUDE_WINDOW_FRACTION * scenario.terminal.altitude_tolerance_km * 1e3
-    assert (altitude.min, altitude.max) == (pytest.approx(28e3 - half), pytest.approx(28e3 + half))
+    assert problem.final["h"] == (pytest.approx(28e3 - half), pytest.approx(28e3 + half))  # the state altitude
     bounds = {c.quantity: c.max for c in problem.path}
     limits = vehicle.limits
     assert bounds["dynamic_pressure"] == pytest.approx(0.93 * limits.dynamic_pressure_max)
@@ -163,6 +163,26 @@ def test_mission_problem_is_the_mission_with_its_limits_planned_inside(tmp_path)
     assert fingerprint(dc.replace(d.spec, grid={"V": 10.0}), scenario)[1] != key
     assert fingerprint(d.spec, scenario)[1] == key
     assert problem_from_spec(mission_problem_spec(d.spec, scenario)).final == problem.final
+
+
+def test_the_mission_problem_ends_at_the_terminal_altitude_in_the_mission_s_datum():
+    """SPHYNX (altitude_datum 'sphere', an oblate Earth): the guidance's terminal altitude is a
+    state altitude (3.83 km at the site, 11.5 km geodetic) and bounds the final state altitude;
+    SHEFEX-3 (altitude_datum 'ellipsoid'): it is geodetic and a terminal constraint."""
+
+    sphynx, d = _derived("sphynx_paper001")
+    p = problem_from_spec(mission_problem_spec(d.spec, sphynx))
+    h_f, half = d.spec.terminal_altitude_km * 1e3, 0.5 * sphynx.terminal.geodetic_altitude_tolerance_km * 1e3
+    assert 3.5e3 < h_f < 4e3 and p.final["h"] == (pytest.approx(h_f - half), pytest.approx(h_f + half))
+    assert [c.quantity for c in p.terminal] == ["central_energy"]
+    lat = math.radians(sphynx.target.latitude_deg)
+    assert float(p.planet.atmospheric_altitude(h_f, lat)) == pytest.approx(11.5e3, abs=1.0)  # the box's geodetic centre
+    shefex = load_scenario("shefex3_ampi")
+    spec = dc.replace(_derived("cav_h_fnpeg")[1].spec, terminal_altitude_km=23.5)
+    q = problem_from_spec(mission_problem_spec(spec, shefex))
+    energy, altitude = q.terminal
+    assert altitude.quantity == "geodetic_altitude" and (altitude.min + altitude.max) / 2 == pytest.approx(23.5e3)
+    assert "h" not in q.final
 
 
 @pytest.mark.parametrize("change, message", [

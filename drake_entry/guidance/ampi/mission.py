@@ -3,7 +3,8 @@
 Paper 003 builds its database for SHEFEX-3's own problem (Sec. III). With ``database:
 mission`` the guidance poses that problem's form from the scenario instead
 (``mission_problem_spec``): from the entry state to the target, ending at the energy where the
-closed loop stops (the guidance's terminal altitude and speed) within an altitude window, alpha the mission's schedule, the bank a state driven by its rate within the vehicle's
+closed loop stops (the guidance's terminal altitude and speed) within an altitude window (in the
+mission's altitude datum), alpha the mission's schedule, the bank a state driven by its rate within the vehicle's
 limits, the vehicle's heat-flux, dynamic-pressure and load limits planned ``path_margin`` inside,
 the bank-effort objective. The problem is written as a problem file; the database study
 (guidance.ampi.database_study) solves it on the spec's grid of entry offsets; a few entries
@@ -105,6 +106,13 @@ def mission_problem_spec(spec, scenario) -> ProblemSpec:
     E_f = dc.replace(scenario, guidance=spec).guidance_terminal_state()[2]  # where the closed loop stops
     tol = box_altitude_tolerance_km(scenario.terminal)
     window = ALTITUDE_WINDOW_FRACTION * tol * 1e3 if tol else ALTITUDE_WINDOW_M
+    # the terminal altitude in the mission's datum: geodetic (a terminal constraint) with
+    # altitude_datum 'ellipsoid', else the state altitude (a final bound; SPHYNX's 3.83-km state
+    # altitude at the site is 11.5 km geodetic, and a geodetic window about 3.83 km was infeasible)
+    altitude_window = {"min": h_f - window, "max": h_f + window}
+    geodetic = scenario.altitude_datum == "ellipsoid"
+    final_altitude = {} if geodetic else {"altitude_km": BoundSpec(**{k: v / 1e3 for k, v in altitude_window.items()})}
+    terminal_altitude = [PathSpec(quantity="geodetic_altitude", **altitude_window, scale=1.0e4)] if geodetic else []
     bank = BANK_FRACTION * math.degrees(vehicle.bank_limit)
     rate = BANK_RATE_FRACTION * math.degrees(vehicle.bank_rate_limit)
     return ProblemSpec(
@@ -115,14 +123,13 @@ def mission_problem_spec(spec, scenario) -> ProblemSpec:
         atmosphere=dc.replace(scenario.atmosphere), controls="bank_rate", alpha_schedule=schedule,
         initial={k: BoundSpec(value=float(v)) for k, v in initial.items()},
         final={"longitude_deg": BoundSpec(value=float(target.longitude_deg)),
-               "latitude_deg": BoundSpec(value=float(target.latitude_deg))},
+               "latitude_deg": BoundSpec(value=float(target.latitude_deg)), **final_altitude},
         final_time_s=BoundSpec(min=1.0, max=float(scenario.simulation.max_time_s)),
         state_bounds={"bank_deg": BoundSpec(min=-bank, max=bank),
                       "flight_path_deg": BoundSpec(min=GAMMA_BOUNDS_DEG[0], max=GAMMA_BOUNDS_DEG[1])},
         control_bounds={"bank_rate_deg_s": BoundSpec(min=-rate, max=rate)},
         path=path,
-        terminal=[PathSpec(quantity="central_energy", min=E_f, max=E_f),
-                  PathSpec(quantity="geodetic_altitude", min=h_f - window, max=h_f + window, scale=1.0e4)],
+        terminal=[PathSpec(quantity="central_energy", min=E_f, max=E_f), *terminal_altitude],
         objective=[ObjectiveSpec(kind="bank_effort", bank_max_deg=bank, bank_rate_max_deg_s=rate,
                                  rate_weight=RATE_WEIGHT, bank_centre_deg=BANK_CENTRE_FRACTION * bank),
                    ObjectiveSpec(kind="flight_path_effort", weight=FLIGHT_PATH_WEIGHT,

@@ -169,7 +169,6 @@ def test_the_mission_problem_ends_at_the_terminal_altitude_in_the_mission_s_datu
     """SPHYNX (altitude_datum 'sphere', an oblate Earth): the guidance's terminal altitude is a
     state altitude (3.83 km at the site, 11.5 km geodetic) and bounds the final state altitude;
     SHEFEX-3 (altitude_datum 'ellipsoid'): it is geodetic and a terminal constraint."""
-
     sphynx, d = _derived("sphynx_paper001")
     p = problem_from_spec(mission_problem_spec(d.spec, sphynx))
     h_f, half = d.spec.terminal_altitude_km * 1e3, 0.5 * sphynx.terminal.geodetic_altitude_tolerance_km * 1e3

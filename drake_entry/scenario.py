@@ -298,14 +298,24 @@ class Scenario:
     def guidance_terminal_state(self) -> tuple[float, float, float]:
         """(h_f [m], V_f [m/s], E_f [J/kg]) of the guidance terminal interface: h_f the state
         altitude (with altitude_datum 'ellipsoid' the guidance's geodetic terminal altitude
-        converted at the target's latitude), the speed of sound at the geodetic altitude."""
+        converted at the target's latitude), the speed of sound where the atmosphere is read
+        there (``air_altitude``)."""
         g = self.guidance
-        geodetic = g.terminal_altitude_km * 1e3
-        V = g.terminal_speed(float(self.make_atmosphere().speed_of_sound(geodetic)))
+        altitude = g.terminal_altitude_km * 1e3
+        V = g.terminal_speed(float(self.make_atmosphere().speed_of_sound(self.air_altitude(altitude))))
         planet = self.make_planet()
-        h = (float(planet.state_altitude(geodetic, np.radians(self.target.latitude_deg)))
-             if self.altitude_datum == "ellipsoid" else geodetic)
+        h = (float(planet.state_altitude(altitude, np.radians(self.target.latitude_deg)))
+             if self.altitude_datum == "ellipsoid" else altitude)
         return h, V, float(planet.with_(j2=0.0).specific_energy(h, V))
+
+    def air_altitude(self, altitude_m: float) -> float:
+        """The altitude [m] the atmosphere is read at, over the target, for ``altitude_m`` in this
+        scenario's datum: itself with altitude_datum 'ellipsoid' (geodetic), else the planet's
+        atmospheric altitude of that state altitude (itself on a spherical planet; on SPHYNX's
+        oblate Earth its 3.83-km state altitude is read at 11.5 km, geodetic, as the plant reads it)."""
+        if self.altitude_datum == "ellipsoid":
+            return float(altitude_m)
+        return float(self.make_planet().atmospheric_altitude(altitude_m, np.radians(self.target.latitude_deg)))
 
     def schedule(self, which: str) -> Schedule:
         """The alpha or bank schedule in SI; 'normalized_energy' breakpoints

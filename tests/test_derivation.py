@@ -182,6 +182,30 @@ def test_a_geodetic_box_is_an_interface_at_the_targets_latitude():
         load_scenario("horus2b").terminal.altitude_tolerance_km
 
 
+def test_a_state_altitude_on_an_oblate_earth_reads_the_atmosphere_at_its_geodetic_altitude(monkeypatch):
+    """SPHYNX states its altitudes above the reference sphere (altitude_datum 'sphere') on an
+    oblate Earth, whose plant reads the atmosphere at the geodetic altitude: the guidance's
+    terminal Mach 0.72 at 2.5 km (state) is a speed at the speed of sound 10.17 km up (not the
+    2.5 km one, 10 % faster), and the dynamic-pressure speed is the one of the air there. On a
+    spherical planet, or with geodetic altitudes, the altitude is read as it is."""
+    from drake_entry.guidance.derivation import q_limit_speed
+
+    sphynx = load_scenario("sphynx_paper001")
+    planet, lat, atmosphere = sphynx.make_planet(), math.radians(sphynx.target.latitude_deg), sphynx.make_atmosphere()
+    air = float(planet.atmospheric_altitude(2.5e3, lat))
+    assert sphynx.air_altitude(2.5e3) == pytest.approx(air, rel=1e-12) and 10.0e3 < air < 10.3e3
+    h_f, V_f, _ = sphynx.guidance_terminal_state()
+    assert h_f == 2.5e3 and V_f == pytest.approx(0.72 * float(atmosphere.speed_of_sound(air)), rel=1e-12)
+    assert V_f < 0.95 * 0.72 * float(atmosphere.speed_of_sound(2.5e3))
+    limited = dc.replace(sphynx.make_vehicle(), limits=dc.replace(sphynx.make_vehicle().limits,
+                                                                  dynamic_pressure_max=20e3))
+    monkeypatch.setattr(type(sphynx), "make_vehicle", lambda self: limited)
+    assert q_limit_speed(sphynx, 2.5) == pytest.approx((2 * 20e3 / float(atmosphere.density(air))) ** 0.5, rel=1e-12)
+    monkeypatch.undo()
+    for name in ("horus2b", "shefex3_ampi"):  # a spherical planet; geodetic altitudes
+        assert load_scenario(name).air_altitude(25e3) == 25e3
+
+
 def test_a_box_without_a_speed_is_aimed_at_the_speed_where_the_missions_own_method_stops():
     """SHEFEX-3's box checks altitude and distance only (paper 003's speed window is a listed
     departure): the others aim at the 620 m/s where its AMPI guidance stops, and say so; a mission

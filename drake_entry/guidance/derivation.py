@@ -221,14 +221,14 @@ def terminal_interface(scenario) -> Interface:
     checks no speed, the speed at which the mission's own method stops); CannotFly when the
     mission gives no altitude, or no speed and no method of its own that stops at one."""
     t = scenario.terminal
-    altitude_km, geodetic_m = t.altitude_km, None
+    altitude_km = t.altitude_km
     if altitude_km is None and t.geodetic_altitude_km is not None:
-        altitude_km, geodetic_m = geodetic_interface_km(scenario), t.geodetic_altitude_km * 1e3
+        altitude_km = geodetic_interface_km(scenario)
     tolerance_km = box_altitude_tolerance_km(t)
     if altitude_km is None:
         raise CannotFly("the mission's terminal block gives neither altitude_km nor geodetic_altitude_km: no "
                         "terminal interface to aim at")
-    a = float(scenario.make_atmosphere().speed_of_sound(altitude_km * 1e3 if geodetic_m is None else geodetic_m))
+    a = float(scenario.make_atmosphere().speed_of_sound(scenario.air_altitude(altitude_km * 1e3)))
     if t.mach is not None:
         return Interface(altitude_km, float(t.mach) * a, float(t.mach), a, True, tolerance_km)
     if t.velocity_m_s is not None:
@@ -237,7 +237,7 @@ def terminal_interface(scenario) -> Interface:
     if own is not None and not own.stops_at_altitude:
         # the box checks no speed: aim at the speed where the mission's own method stops (SHEFEX-3's
         # AMPI: 620 m/s, the corner of paper 003's window its database ends at)
-        own_a = float(scenario.make_atmosphere().speed_of_sound(own.terminal_altitude_km * 1e3))
+        own_a = float(scenario.make_atmosphere().speed_of_sound(scenario.air_altitude(own.terminal_altitude_km * 1e3)))
         speed = float(own.terminal_speed(own_a))
         return Interface(altitude_km, speed, speed / a, a, False, tolerance_km, speed_from_own_method=True)
     raise CannotFly("the mission's terminal block gives neither mach nor velocity_m_s, and its own method stops at "
@@ -372,12 +372,12 @@ def box_mach_window(scenario, interface: Interface) -> tuple[tuple[float, float]
 
 def q_limit_speed(scenario, altitude_km: float, fraction: float = 1.0) -> float:
     """The speed [m/s] at which the vehicle meets ``fraction`` of its dynamic-pressure limit at
-    ``altitude_km`` (the mission's atmosphere; inf when the vehicle limits none): a plan ending
-    there faster breaches it."""
+    ``altitude_km`` (in the mission's datum; the mission's atmosphere read there over the target,
+    Scenario.air_altitude; inf when the vehicle limits none): a plan ending there faster breaches it."""
     q_max = scenario.make_vehicle().limits.dynamic_pressure_max
     if not math.isfinite(q_max):
         return math.inf
-    rho = float(scenario.make_atmosphere().density(altitude_km * 1e3))
+    rho = float(scenario.make_atmosphere().density(scenario.air_altitude(altitude_km * 1e3)))
     return math.sqrt(2.0 * fraction * q_max / rho)
 
 
@@ -391,7 +391,8 @@ def load_limit_speed(scenario, altitude_km: float, alpha_deg, fraction: float = 
     if not math.isfinite(limit):
         return math.inf
     atmosphere = scenario.make_atmosphere()
-    rho, a = float(atmosphere.density(altitude_km * 1e3)), float(atmosphere.speed_of_sound(altitude_km * 1e3))
+    air = scenario.air_altitude(altitude_km * 1e3)
+    rho, a = float(atmosphere.density(air)), float(atmosphere.speed_of_sound(air))
 
     def excess(V: float) -> float:
         alpha = math.radians(float(alpha_deg(V)))

@@ -103,8 +103,9 @@ def glides_at(scenario, altitude_km: float, speed_m_s: float, alpha_deg: float) 
     hold level flight at ``altitude_km`` and ``speed_m_s`` (nominal air): L/m >= g - V^2/r."""
     vehicle, atmosphere, planet = scenario.make_vehicle(), scenario.make_atmosphere(), scenario.make_planet()
     h = altitude_km * 1e3
-    CL, _ = vehicle.aero.coefficients(math.radians(alpha_deg), speed_m_s / float(atmosphere.speed_of_sound(h)))
-    lift = 0.5 * float(atmosphere.density(h)) * speed_m_s ** 2 * vehicle.area_over_mass * float(CL)
+    air = scenario.air_altitude(h)
+    CL, _ = vehicle.aero.coefficients(math.radians(alpha_deg), speed_m_s / float(atmosphere.speed_of_sound(air)))
+    lift = 0.5 * float(atmosphere.density(air)) * speed_m_s ** 2 * vehicle.area_over_mass * float(CL)
     r = float(planet.radius(h))
     return lift >= equilibrium_glide_lift(speed_m_s, r, planet.mu / r ** 2)
 
@@ -128,7 +129,7 @@ def aim_window(scenario, interface, altitude_km: float, mach_window: tuple, alph
     mach = interface.mach
     centre_km, tolerance_km = interface.altitude_km, interface.altitude_tolerance_km
     half = min(AIM_WINDOW_KM, 0.25 * tolerance_km, tolerance_km - abs(altitude_km - centre_km))
-    a = float(scenario.make_atmosphere().speed_of_sound(altitude_km * 1e3))
+    a = float(scenario.make_atmosphere().speed_of_sound(scenario.air_altitude(altitude_km * 1e3)))
     glides = glides_at(scenario, altitude_km, mach * a, alpha_deg(mach * a))
     margin = min(max(half - (GLIDE_AIM_TOLERANCE_KM if glides else AIM_TOLERANCE_KM), 0.0), 0.49 * 2.0 * half)
     fields = {"guidance.final_altitude_m": [round((altitude_km - half) * 1e3, 3), round((altitude_km + half) * 1e3, 3)],

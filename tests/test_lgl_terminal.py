@@ -406,7 +406,7 @@ def test_a_pre_flight_plan_whose_segments_do_not_converge_is_solved_on_one_polyn
     calls = []
 
     def solve(problem, **kw):
-        calls.append((kw["segments"], kw["nodes"], [c.label for c in problem.path]))
+        calls.append((kw["segments"], kw["nodes"], [c.label for c in problem.path], kw["refine"]))
         return types.SimpleNamespace(success=False, converged=converged and kw["segments"] == 4,
                                      message="not solved: SNOPT: major iteration limit reached (info 32)")
 
@@ -414,6 +414,11 @@ def test_a_pre_flight_plan_whose_segments_do_not_converge_is_solved_on_one_polyn
     plan = planner.plan_terminal(s, lambda *a, **k: None, progress=False)
     assert [c[0] for c in calls] == solved_on and all(c[1] == 81 for c in calls)
     assert all("interface_floor" not in c[2] for c in calls) and not plan.success
+    assert all(c[3] is True for c in calls)  # the mesh refined from the spec's nodes (refine_mesh)
+    calls.clear()
+    planner.plan_terminal(dc.replace(s, guidance=dc.replace(s.guidance, refine_mesh=False)), lambda *a, **k: None,
+                          progress=False)
+    assert calls and all(c[3] is False for c in calls)
 
 
 def test_a_resolve_in_denser_air_holds_q_and_the_heat_rate_there():

@@ -56,13 +56,14 @@ def test_ampi_plan_report_flies_the_reference_inside_paper003_limits(tmp_path, c
 
 @pytest.mark.slow
 def test_lgl_terminal_plan_report_refuses_an_under_resolved_plan_with_its_figures(tmp_path, capsys):
-    """paper 002's pre-flight plan on 40 LGL nodes (marv_guidance has 80): SNOPT converges but the
+    """paper 002's pre-flight plan on 40 LGL nodes (marv_guidance has 80) without mesh refinement
+    (refine_mesh false): SNOPT converges but the
     dynamics between the nodes miss by more than the 1e-3 tolerance, so the plan is not a success,
     is not flown through the actuators, and the report says so by its exit code, its words and
     plan.json (the figures still show the solution against its Drake propagation)."""
     s = load_scenario("marv_guidance")
     path = tmp_path / "marv40.yaml"
-    path.write_text(yaml_dump_typed(dc.replace(s, guidance=dc.replace(s.guidance, nodes=40)), schema=Scenario))
+    path.write_text(yaml_dump_typed(dc.replace(s, guidance=dc.replace(s.guidance, nodes=40, refine_mesh=False)), schema=Scenario))
     out = tmp_path / "plan"
     code = main(["plan", str(path), "--out", str(out)])
     summary = json.loads((out / "plan.json").read_text())

@@ -57,6 +57,9 @@ class LglTerminal(ReplanningSpec):
     solver: str = "snopt"
     tolerance: float = 1.0e-7
     max_iterations: int = 3000
+    # refine the pre-flight mesh (more nodes in the same segments, from ``nodes`` up to 150) while
+    # the dynamics between the nodes miss their tolerance; False: refuse such a plan as it is
+    refine_mesh: bool = True
     # re-solves from replan_start_s [s] every replan_period_s [s] (0: fly the pre-flight solution)
     # while more than replan_min_time_to_go_s [s] remain, on one node per replan_node_spacing_s
     # [s] of the remaining horizon, within replan_nodes [min, max], to replan_tolerance

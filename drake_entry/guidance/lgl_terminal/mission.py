@@ -122,11 +122,11 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
     elif spec.final_descent_deg is not None:
         final["gamma"] = (math.radians(GAMMA_BOUNDS_DEG[0]), -math.radians(spec.final_descent_deg))
     path = [inside_bounds(c, spec.path_margin) for c in p.path] if margin else list(p.path)
-    bounds = dict(p.state_bounds)
+    bounds, planet = dict(p.state_bounds), scenario.make_planet()
     if spec.problem == MISSION:  # the closed loop stops where it first meets the terminal altitude
         # the floor implies the bound at the nodes; the bound is a simple bound the solver keeps
         # every iterate inside (the plans of the measured campaigns were solved with both)
-        geodetic, planet = scenario.altitude_datum == "ellipsoid", scenario.make_planet()
+        geodetic = scenario.altitude_datum == "ellipsoid"
         h_stop = scenario.guidance.terminal_altitude_km * 1e3
         # a geodetic floor as a state bound: its lowest state altitude between the entry's and
         # the target's latitudes (the geodetic altitude of a state altitude grows with |lat|)
@@ -134,7 +134,7 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
                        if geodetic else final["h"], math.inf)
         path.append(PathConstraint(InterfaceFloor(h_stop, spec.terminal_velocity_m_s, planet=planet if geodetic else None),
                                    min=0.0, scale=FLOOR_MARGIN_M, name=FLOOR_LABEL))
-    return dc.replace(p, vehicle=scenario.make_vehicle(), planet=scenario.make_planet(),
+    return dc.replace(p, vehicle=scenario.make_vehicle(), planet=planet,
                       atmosphere=scenario.make_atmosphere(), initial=initial, final=final, path=path,
                       state_bounds=bounds, name=f"{scenario.name}_{p.name}")
 

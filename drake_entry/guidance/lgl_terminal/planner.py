@@ -239,9 +239,10 @@ def plan_terminal(scenario, verifier, *, progress="auto") -> LglPlan:
     converged and verified, and draws 0-2 of seed 2026 ended 1.2, 133 and 10 m from the target.
 
     With the spec's ``refine_mesh`` the mesh is refined (nlp.solve's ``refine``: more nodes in the
-    same segments, each solve from the last) while the dynamics between the nodes miss their tolerance: SHEFEX-3's steep dive
-    (-10 deg at 81 km, 4.7 km/s) on 81 nodes in 4 segments converged with 0.0023 between the
-    nodes against 0.001 in the pull-out; on 121 nodes it is verified."""
+    same segments, each solve from the last) while the dynamics between the nodes miss their
+    tolerance: SHEFEX-3's steep dive (-10 deg at 81 km, 4.7 km/s) on 81 nodes in 4 segments
+    converged with 0.0023 between the nodes against 0.001 in the pull-out; refined to 125 nodes,
+    0.00021, it is verified."""
     spec = scenario.guidance
     verifier = require_verifier(verifier, "the terminal guidance's plan")
     problem = spec.problem_for(scenario)

@@ -424,6 +424,47 @@ def test_the_matrix_reads_comparison_directories(tmp_path):
         in matrix_markdown([str(folder)])
 
 
+def test_a_matrix_rewritten_from_some_missions_keeps_the_other_rows_marked_carried(tmp_path):
+    """A matrix too long to fly at once is regenerated mission by mission: rewriting the file from
+    one mission's directory replaces that row in place, keeps the others (marked carried, their
+    commits read from their derivation pages into the header) and adds a new mission last."""
+    import json
+
+    from drake_entry.comparison.matrix import CARRIED, read_matrix_rows, write_matrix
+    from drake_entry.errors import CampaignError
+
+    def comparison(name, commit, successes):
+        folder = tmp_path / name
+        folder.mkdir()
+        (folder / "comparison.json").write_text(json.dumps({
+            "comparison": name, "mission": f"x/{name}.yaml", "runs": 10, "seed": 3,
+            "sessions": [{"git_commit": commit}], "methods": {"fnpeg": {"method": "Fnpeg", "flown": True}}}))
+        (folder / "comparison_summary.json").write_text(json.dumps({"methods": {"fnpeg": {
+            "successful": successes, "samples": 10, "miss_km": {"median": 1.0, "p95": 2.0}}}}))
+        return str(folder)
+
+    out = tmp_path / "out" / "matrix.md"
+    first = [comparison("a", "aaa1111", 10), comparison("b", "bbb2222", 9)]
+    write_matrix(first, str(out))
+    rows = read_matrix_rows(str(out))
+    assert list(rows) == ["a", "b"] and rows["b"]["commits"] == ["bbb2222"]
+    assert rows["b"]["cells"] == {"fnpeg": "**9/10** (>= 66 %), miss 1 / 2 km"}
+    (tmp_path / "a").rename(tmp_path / "a_old")
+    again = [comparison("a", "ccc3333", 7), comparison("c", "ddd4444", 10)]
+    text = open(write_matrix(again, str(out))).read()
+    lines = [line for line in text.splitlines() if line.startswith("| [")]
+    assert [line.split("]")[0] for line in lines] == ["| [a", "| [b", "| [c"]
+    assert lines[0].startswith("| [a](derivations/a.md) (10 runs, seed 3) | **7/10**")
+    assert lines[1] == f"| [b](derivations/b.md) {CARRIED} (10 runs, seed 3) | **9/10** (>= 66 %), miss 1 / 2 km |"
+    assert "commit bbb2222, ccc3333, ddd4444." in text and "aaa1111" not in text and "1 row carried" in text
+    assert list(read_matrix_rows(str(out))) == ["a", "b", "c"]  # a carried row is read back as such
+    assert "carried" not in open(write_matrix(again + [first[1]], str(out))).read().split("Each cell")[0]
+    out.write_text(open(out).read().replace(" | **9/10**", " | **9/10** | x"))
+    with pytest.raises(CampaignError, match="the row of b has 2 cells against 1 methods"):
+        read_matrix_rows(str(out))
+    assert read_matrix_rows(str(tmp_path / "none.md")) == {}
+
+
 def test_a_resumed_comparison_reuses_the_derived_scenario(tmp_path, monkeypatch):
     """Derivation is deterministic, so a comparison run again into its directory flies the
     scenario the first run derived (its file and record) without searching again."""

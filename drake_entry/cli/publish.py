@@ -4,7 +4,9 @@ committed tree (docs/results):
 - ``OUT/campaigns/<scenario>``: every packaged closed-loop scenario (the papers' and their
   flight-like twins) as a Monte-Carlo campaign with its report, and ``OUT/campaigns/index.md``;
 - ``OUT/compare/<mission>``: every method on each matrix mission (``drake-entry compare MISSION``,
-  settings derived from the mission), and ``OUT/matrix.md`` with ``OUT/derivations/``;
+  settings derived from the mission), and ``OUT/matrix.md`` with ``OUT/derivations/`` (with
+  ``--missions`` naming some, the other missions' rows are carried from the matrix already there,
+  marked so: the matrix is regenerated mission by mission);
 - ``OUT/published.json``: the commit, the sizes, seeds and wall time of every part.
 
 It refuses a source tree with uncommitted changes (or not a git checkout): a published figure

@@ -8,11 +8,17 @@ the method was not flown (its first clause). Read from each directory's ``compar
 the directories, never typed. Beside it, each mission's page ``derivations/<mission>.md`` (every
 derived method's search: the candidates flown and which were kept) and the scenario each method
 flew (``derivations/<mission>/<label>.yaml``: fly a cell again with ``drake-entry campaign``).
+
+Rewriting a matrix file from directories of some of its missions keeps the other missions' rows
+as the file had them, marked as carried (a row is only ever replaced by its mission's directory),
+so a matrix too long to fly in one sitting is regenerated mission by mission, each row naming the
+commits its derivation page gives.
 """
 from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 
 from drake_entry.campaign import statistics
@@ -20,13 +26,17 @@ from drake_entry.campaign.store import write_atomic
 from drake_entry.comparison.report import derivation_tables, read_comparison_manifest
 from drake_entry.errors import CampaignError
 
-__all__ = ["LEVEL", "DERIVATIONS", "success_lower_bound", "read_comparison", "matrix_markdown", "write_derivations",
-           "write_matrix"]
+__all__ = ["LEVEL", "DERIVATIONS", "CARRIED", "success_lower_bound", "read_comparison", "read_matrix_rows",
+           "matrix_markdown", "write_derivations", "write_matrix"]
 
 #: the one-sided confidence of the success bound
 LEVEL = 0.90
 #: the folder, beside the matrix, of each mission's derivation page and flown scenarios
 DERIVATIONS = "derivations"
+#: the mark after a row's mission when the row is carried from the matrix file being rewritten
+CARRIED = "(carried)"
+_ROW = re.compile(r"^\| \[([^\]]+)\]\(" + DERIVATIONS + r"/[^)]+\.md\)(?: \(carried\))? (\([^)]*\)) \| (.*) \|$")
+_ROW_COMMITS = re.compile(r"in the matrix's row, commit ([0-9a-f, +changes]+) \(fly")
 
 
 def success_lower_bound(successes: int, runs: int, level: float = LEVEL) -> float:
@@ -83,22 +93,66 @@ def _runs_text(comparison: dict) -> str:
     return f"{counts.pop()} runs" if len(counts) == 1 else "runs per cell" if counts else "none flown"
 
 
-def matrix_markdown(folders: list[str], *, links: bool = False) -> str:
+def read_matrix_rows(path: str) -> dict:
+    """The rows of a matrix file ``write_matrix`` wrote: {mission: {'runs': '(100 runs, seed 2026)',
+    'cells': {label: cell text}, 'commits': [the commits its derivation page names]}} in the
+    file's order; {} when there is no file."""
+    if not os.path.isfile(path):
+        return {}
+    labels, rows = [], {}
+    for line in open(path).read().splitlines():
+        if line.startswith("| mission | "):
+            labels = [c.strip() for c in line.strip("|").split("|")[1:]]
+            continue
+        match = _ROW.match(line)
+        if not match or not labels:
+            continue
+        mission, runs, cells = match.groups()
+        texts = [c.strip() for c in cells.split(" | ")]
+        if len(texts) != len(labels):
+            raise CampaignError(f"{path}: the row of {mission} has {len(texts)} cells against {len(labels)} methods "
+                                f"in the header: not a matrix file drake-entry wrote; remove it or fix the row")
+        page = os.path.join(os.path.dirname(os.path.abspath(path)), DERIVATIONS, f"{mission}.md")
+        found = _ROW_COMMITS.search(open(page).read()) if os.path.isfile(page) else None
+        rows[mission] = {"runs": runs, "cells": dict(zip(labels, texts)),
+                         "commits": [c.strip() for c in found.group(1).split(",")] if found else []}
+    return rows
+
+
+def matrix_markdown(folders: list[str], *, links: bool = False, carried: dict | None = None) -> str:
     """The matrix of these comparison directories (rows: missions; columns: methods); with
-    ``links`` each row names its mission's derivation page (``write_matrix`` writes them)."""
-    comparisons = [read_comparison(f) for f in folders]
+    ``links`` each row names its mission's derivation page (``write_matrix`` writes them);
+    ``carried``: the rows of an earlier matrix (``read_matrix_rows``): those of missions with no
+    directory here are kept, marked CARRIED, in the earlier order, the directories' missions in
+    place of their old rows (new missions last)."""
+    comparisons = {c["name"]: c for c in (read_comparison(f) for f in folders)}
+    earlier = carried or {}
+    carried = {m: row for m, row in earlier.items() if m not in comparisons}
+    order = list(earlier) + [name for name in comparisons if name not in earlier]
     labels = []
-    for c in comparisons:
+    for c in comparisons.values():
         labels += [label for label in c["methods"] if label not in labels]
+    for row in carried.values():
+        labels += [label for label in row["cells"] if label not in labels]
     out = ["| mission | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]
-    for c in comparisons:
-        cells = [_cell(c["methods"][label]) if label in c["methods"] else "—" for label in labels]
-        name = f"[{c['name']}]({DERIVATIONS}/{c['name']}.md)" if links else c["name"]
-        out.append(f"| {name} ({_runs_text(c)}, seed {c['seed']}) | " + " | ".join(cells) + " |")
+    for name in order:
+        link = f"[{name}]({DERIVATIONS}/{name}.md)" if links else name
+        if name in comparisons:
+            c = comparisons[name]
+            cells = [_cell(c["methods"][label]) if label in c["methods"] else "—" for label in labels]
+            out.append(f"| {link} ({_runs_text(c)}, seed {c['seed']}) | " + " | ".join(cells) + " |")
+        else:
+            row = carried[name]
+            cells = [row["cells"].get(label, "—") for label in labels]
+            out.append(f"| {link} {CARRIED} {row['runs']} | " + " | ".join(cells) + " |")
     out += ["", f"Each cell: successful/samples (the one-sided {100 * LEVEL:.0f} % lower Clopper-Pearson bound on the "
             f"success probability), the miss distance's median / 95th percentile over the samples that reached the "
             f"interface, core seconds per sample; * settings derived from the mission (the mission's own method "
             f"flies the mission's settings). Not flown: the method's own reason (its comparison report has it whole)."]
+    if carried:
+        out += ["", f"{CARRIED}: the row as the matrix had it before its mission was flown again into a kept "
+                f"comparison directory (`drake-entry publish --missions MISSION`); its derivation page names the "
+                f"commits it was flown at."]
     return "\n".join(out)
 
 
@@ -127,14 +181,24 @@ def write_derivations(folder: str, out_dir: str) -> str:
     return path
 
 
-def write_matrix(folders: list[str], path: str, *, title: str = "Every method on every mission") -> str:
+def write_matrix(folders: list[str], path: str, *, title: str = "Every method on every mission",
+                 carry: bool = True) -> str:
     """Write the matrix of ``folders`` to the Markdown file ``path`` and each mission's derivation
-    page beside it (``write_derivations`` into DERIVATIONS); returns ``path``."""
-    commits = sorted({c for f in folders for c in read_comparison(f)["commits"]})  # every session's: --only mixes
+    page beside it (``write_derivations`` into DERIVATIONS); with ``carry`` the rows of missions
+    with no directory among ``folders`` are kept from the file already at ``path`` (module doc).
+    Returns ``path``."""
+    earlier = read_matrix_rows(path) if carry else {}
+    names = {read_comparison(f)["name"] for f in folders}
+    carried = {m: row for m, row in earlier.items() if m not in names}
+    commits = sorted({c for f in folders for c in read_comparison(f)["commits"]}  # every session's: --only mixes
+                     | {c for row in carried.values() for c in row["commits"]})
     for folder in folders:
         write_derivations(folder, os.path.join(os.path.dirname(os.path.abspath(path)), DERIVATIONS))
-    text = (f"# {title}\n\nFrom {len(folders)} comparison directories (`drake-entry compare MISSION`), commit "
-            f"{', '.join(commits)}. Each mission links to the settings every method flew there and the search "
-            f"that chose them.\n\n" + matrix_markdown(folders, links=True) + "\n")
+    source = f"{len(folders)} comparison directories (`drake-entry compare MISSION`)"
+    if carried:
+        source += f" and {len(carried)} row{'s' if len(carried) > 1 else ''} carried from the earlier matrix"
+    text = (f"# {title}\n\nFrom {source}, commit {', '.join(commits)}. Each mission links to the settings every "
+            f"method flew there and the search that chose them.\n\n"
+            + matrix_markdown(folders, links=True, carried=earlier) + "\n")
     write_atomic(path, text.encode())
     return path

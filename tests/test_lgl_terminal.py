@@ -19,8 +19,8 @@ def scenario():
 
 def test_the_problem_flown_is_the_scenarios_mission_with_the_files_conditions(scenario):
     """Entry state, target, vehicle, planet and atmosphere come from the scenario; the final speed
-    and alpha, the bounds and the objective from problems/marv.yaml (eqs. 16-19); the final
-    flight-path angle from the spec."""
+    and alpha, the bounds and the objective from problems/marv.yaml (eqs. 16-19), the bank within
+    the vehicle's limit; the final flight-path angle from the spec."""
     from drake_entry.planning.ocp_yaml import load_problem
 
     p = scenario.guidance.problem_for(scenario)
@@ -30,7 +30,11 @@ def test_the_problem_flown_is_the_scenarios_mission_with_the_files_conditions(sc
     assert p.final["gamma"] == pytest.approx(math.radians(-80.0)) and file.final["gamma"] == pytest.approx(math.radians(-89.0))
     assert p.final["V"] == file.final["V"] == 1219.0 and p.final["alpha"] == 0.0
     assert p.planet.reference_radius == 6378145.0 and p.vehicle.mass / p.vehicle.reference_area == 1000.0
-    assert p.state_bounds == file.state_bounds and p.control_bounds == file.control_bounds
+    assert p.state_bounds["alpha"] == file.state_bounds["alpha"] and p.control_bounds == file.control_bounds
+    # the bank within the actuator's limit (180 deg), not the file's +-360 deg: a plan that banks
+    # 268.9 deg means -91.1 deg, and the actuator would fly 180
+    assert file.state_bounds["sigma"] == pytest.approx((-2 * math.pi, 2 * math.pi))
+    assert p.state_bounds["sigma"] == pytest.approx((-math.pi, math.pi)) == (-p.vehicle.bank_limit, p.vehicle.bank_limit)
     assert scenario.guidance.terminal_speed(300.0) == 1219.0  # the impact speed, not a Mach number
 
 

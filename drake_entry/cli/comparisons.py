@@ -66,7 +66,8 @@ def print_comparison_summary(out: str) -> tuple[int, int]:
 def _add_matrix_arguments(parser) -> None:
     parser.add_argument("folders", nargs="+", metavar="DIR", help="comparison directories (drake-entry compare --out)")
     parser.add_argument("--out", default=os.path.join("out", "compare"),
-                        help="directory of the Markdown file written, matrix.md (default: out/compare)")
+                        help="directory of the Markdown file written, matrix.md (default: out/compare); the rows of "
+                             "missions not among DIR are kept from a matrix.md already there, marked carried")
 
 
 def matrix(args) -> int:

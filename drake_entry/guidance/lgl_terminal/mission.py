@@ -106,8 +106,9 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
     and an ``InterfaceFloor`` above it (the closed loop stops at its first descent through it),
     the path constraints ``spec.path_margin`` inside their bounds (``margin=False``: as
     the file gives them, the bounds the verdict checks); the rest (final speed and alpha, bounds,
-    objective) from the problem file. The terminal altitude is geodetic with altitude_datum
-    'ellipsoid' (the final state altitude is its value at the target's latitude)."""
+    objective) from the problem file, the bank bounded by the vehicle's bank limit (the
+    actuator's). The terminal altitude is geodetic with altitude_datum 'ellipsoid' (the final
+    state altitude is its value at the target's latitude)."""
     p = mission_problem(spec, scenario) if spec.problem == MISSION else load_guidance_problem(spec)
     x0 = scenario.initial_state()
     initial = dict(p.initial)
@@ -122,7 +123,13 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
     elif spec.final_descent_deg is not None:
         final["gamma"] = (math.radians(GAMMA_BOUNDS_DEG[0]), -math.radians(spec.final_descent_deg))
     path = [inside_bounds(c, spec.path_margin) for c in p.path] if margin else list(p.path)
-    bounds, planet = dict(p.state_bounds), scenario.make_planet()
+    bounds, planet, vehicle = dict(p.state_bounds), scenario.make_planet(), scenario.make_vehicle()
+    # the bank actuator flies |sigma| <= the vehicle's bank limit (systems.actuators.BankActuator):
+    # a plan past it is one the closed loop cannot fly (paper 002's problem file allows +-360 deg;
+    # in 4 segments SNOPT's MaRV plan banked 268.9 deg, the -91.1 deg it meant, which the actuator
+    # clipped to 180 deg: into the ground 36 s later, and the plan was refused)
+    lo, hi = bounds.get("sigma", (-math.inf, math.inf))
+    bounds["sigma"] = (max(lo, -vehicle.bank_limit), min(hi, vehicle.bank_limit))
     if spec.problem == MISSION:  # the closed loop stops where it first meets the terminal altitude
         # the floor implies the bound at the nodes; the bound is a simple bound the solver keeps
         # every iterate inside (the plans of the measured campaigns were solved with both)
@@ -134,7 +141,7 @@ def problem_for_scenario(spec, scenario, *, margin: bool = True):
                        if geodetic else final["h"], math.inf)
         path.append(PathConstraint(InterfaceFloor(h_stop, spec.terminal_velocity_m_s, planet=planet if geodetic else None),
                                    min=0.0, scale=FLOOR_MARGIN_M, name=FLOOR_LABEL))
-    return dc.replace(p, vehicle=scenario.make_vehicle(), planet=planet,
+    return dc.replace(p, vehicle=vehicle, planet=planet,
                       atmosphere=scenario.make_atmosphere(), initial=initial, final=final, path=path,
                       state_bounds=bounds, name=f"{scenario.name}_{p.name}")
 

@@ -252,3 +252,18 @@ def test_an_interrupted_comparison_resumes_with_the_same_command_keeping_its_sam
     assert record["flown"] and "reason" not in record
     resumed = (out / "bank_profile" / "samples.jsonl").read_text().splitlines()
     assert len(resumed) == 2 and resumed[0] == rows[0]
+
+
+def test_the_footprint_zoom_shows_the_acceptance_region_or_the_successful_cluster():
+    """The zoom panel repeats nothing: three times the distance criterion when the spread is wider
+    than twice that; else 1.2 x the successful samples' 90th-percentile offset; without a
+    criterion a tenth of the spread."""
+    from drake_entry.comparison.report import footprint_zoom
+
+    assert footprint_zoom(500.0, 10.0, [1.0, 2.0]) == (30.0, "zoom on the acceptance region")
+    offsets = list(np.linspace(0.1, 10.0, 100))  # SHEFEX-like: every sample within 70 km of a 25-km ring
+    half, name = footprint_zoom(70.0, 25.0, offsets)
+    assert half == pytest.approx(1.2 * np.percentile(offsets, 90)) and name == "zoom on 90 % of the successful samples"
+    assert footprint_zoom(70.0, 25.0, [])[0] == 75.0  # nothing successful: the acceptance region
+    assert footprint_zoom(70.0, 25.0, [0.0] * 5)[0] == pytest.approx(0.025)  # never a zero-width panel
+    assert footprint_zoom(200.0, None, [1.0]) == (20.0, "zoom on the centre (a tenth of the spread)")

@@ -41,7 +41,7 @@ from drake_entry.models.verdict import margin_breached
 
 __all__ = ["MANIFEST", "LEVEL", "MARGIN_NAMES", "read_comparison_manifest", "clopper_pearson", "method_summary",
            "summary_text", "dispersion_check", "write_comparison_report", "derivation_tables", "footprints",
-           "success_intervals", "miss_distributions"]
+           "success_intervals", "miss_distributions", "footprint_zoom"]
 
 #: the file a comparison directory is identified by
 MANIFEST = "comparison.json"
@@ -350,11 +350,24 @@ def _figures(all_rows, summaries, out_dir, title, radius_km) -> list:
             miss_distributions(all_rows, out_dir, title, radius_km)]
 
 
+def footprint_zoom(half: float, radius_km, successful) -> tuple[float, str]:
+    """The zoom panel's half-width [km] and title: three times the distance criterion when the
+    whole spread (``half`` [km]) is wider than twice that; else (the zoom would repeat the whole)
+    1.2 times the 90th percentile of the successful samples' larger offset (``successful`` [km]),
+    so the accurate methods' clusters are seen; a tenth of the spread without a criterion."""
+    if radius_km is None:
+        return 0.1 * half, "zoom on the centre (a tenth of the spread)"
+    if half > 6.0 * radius_km or len(successful) == 0:
+        return 3.0 * radius_km, "zoom on the acceptance region"
+    p90 = float(np.percentile(successful, 90))
+    return max(1.2 * p90, 1e-3 * radius_km), "zoom on 90 % of the successful samples"
+
+
 def footprints(all_rows: dict, out_dir: str, title: str, radius_km) -> tuple[str, str]:
     """Overlaid terminal footprints (cross-range against range to go [km]) of every method: the
     whole spread, and a zoom on the acceptance region."""
     fig, axes = plt.subplots(1, 2, figsize=(12.0, 6.2))
-    extent = []
+    extent, inner = [], []  # |x|, |y| of every sample reached; of the successful ones
     t = np.linspace(0.0, 2.0 * np.pi, 300)
     for k, (label, rows) in enumerate(all_rows.items()):
         n = len(rows["index"])
@@ -369,10 +382,10 @@ def footprints(all_rows: dict, out_dir: str, title: str, radius_km) -> tuple[str
             if (~ok).any():
                 ax.plot(x[~ok], y[~ok], "x", ms=6, color=color, label=f"{label}: not successful ({(~ok).sum()})")
         extent += list(np.abs(x)) + list(np.abs(y))
+        inner += list(np.maximum(np.abs(x[ok]), np.abs(y[ok])))
     half = 1.1 * max(extent, default=1.0)
-    zoom = 3.0 * radius_km if radius_km is not None else 0.1 * half
-    for ax, h, name in ((axes[0], max(half, zoom), "every sample that reached"),
-                        (axes[1], zoom, "zoom on the acceptance region")):
+    zoom, zoom_name = footprint_zoom(half, radius_km, inner)
+    for ax, h, name in ((axes[0], max(half, zoom), "every sample that reached"), (axes[1], zoom, zoom_name)):
         if radius_km is not None:
             ax.plot(radius_km * np.cos(t), radius_km * np.sin(t), "r--", lw=1.2,
                     label=f"distance criterion ({radius_km:g} km)")
@@ -385,15 +398,18 @@ def footprints(all_rows: dict, out_dir: str, title: str, radius_km) -> tuple[str
         ax.set_ylabel("range to go [km] (+ short of the target)")
         ax.grid(True, alpha=0.4)
     handles, labels = axes[1].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8)
+    rows = -(-len(labels) // 4)  # the legend's rows below the axes, their labels clear of it
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8)
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout(rect=(0, 0.12, 1, 0.96))
+    fig.tight_layout(rect=(0, 0.03 + 0.033 * rows, 1, 0.96))
     path = os.path.join(out_dir, "comparison_footprints.png")
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path, ("Terminal footprints of every method on the same dispersed samples (those that reached the "
                   "terminal interface), centred on the target, equal axes; left the whole spread, right a zoom to "
-                  "three times the distance criterion (dashed circle). Dots are successful flights, crosses the "
+                  "three times the distance criterion (dashed circle), or, when the whole spread is already that "
+                  "close, to the successful samples' 90th percentile (its title says which). Dots are successful "
+                  "flights, crosses the "
                   "others (outside the box in distance, altitude or speed, or a path limit breached). Look for the "
                   "spread and bias of each method, and for crosses inside the circle: failed on altitude, speed or "
                   "limits.")

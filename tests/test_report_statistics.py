@@ -271,3 +271,34 @@ def test_a_star_of_arms_from_one_centre_or_far_outliers_get_no_normal_ellipse(tm
     assert "No normal ellipse: the samples do not fill a normal's contours" in caption
     _, caption = footprint(*rng.normal(size=(2, 1000)), str(tmp_path), "normal", radius_km=5.0)
     assert "as a normal sample would" in caption
+
+
+def test_a_footprint_whose_successful_samples_would_be_a_dot_gets_an_inset_on_them(tmp_path):
+    """The LGL guidance's SHEFEX-3 footprint: 99 samples within 40 m and one failure 26 km out on a
+    25-km ring. The axes span the ring, so the successful core (1.3 x its P99 offset) gets an inset
+    in the corner with the fewest samples (not the failure's); a cloud already visible gets none."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from drake_entry.campaign.report_figures import footprint, footprint_core_inset
+
+    rng = np.random.default_rng(5)
+    x = np.append(0.003 * rng.normal(size=99), -17.6)
+    y = np.append(-0.025 + 0.004 * rng.normal(size=99), 19.9)
+    failed = np.arange(100) == 99
+    fig, ax = plt.subplots()
+    core = footprint_core_inset(ax, x, y, failed, half=27.5)
+    good = np.maximum(np.abs(x[:99]), np.abs(y[:99]))
+    assert core == pytest.approx(1.3 * np.percentile(good, 99))
+    (inset,) = ax.child_axes
+    assert inset.get_xlim() == pytest.approx((-core, core)) and inset.get_position().x0 > 0.5  # not the failure's corner
+    plt.close(fig)
+    fig, ax = plt.subplots()  # a cloud the axes already show: no inset
+    assert footprint_core_inset(ax, *rng.normal(size=(2, 100)), np.zeros(100, bool), half=4.0) is None
+    assert footprint_core_inset(ax, x[:2], y[:2], np.zeros(2, bool), half=27.5) is None  # too few to zoom on
+    assert not ax.child_axes
+    plt.close(fig)
+    _, caption = footprint(x, y, str(tmp_path), "inset", radius_km=25.0, failed=failed)
+    assert f"the inset zooms on the successful samples (+-{core:.3g} km" in caption

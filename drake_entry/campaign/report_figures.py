@@ -17,7 +17,7 @@ from drake_entry.figures import plt, save_figure  # sets the Agg backend before 
 
 __all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "plain_axis",
            "error_histograms",
-           "footprint", "peak_histograms", "envelopes", "OFF_SCALE", "path_quantities", "drag_profiles",
+           "footprint", "footprint_core_inset", "INSET_SIZE", "INSET_RATIO", "peak_histograms", "envelopes", "OFF_SCALE", "path_quantities", "drag_profiles",
            "ground_tracks", "bank_histories", "energy_range", "normalised_energy", "convergence"]
 
 #: k of the 99 % probability ellipse of a 2-D normal: sqrt(chi2.ppf(0.99, 2)) = 3.035
@@ -140,6 +140,7 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
     ax.set_ylabel("range to go [km] (+ short of the target)")
     ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=2)  # below: it hides no sample
     ax.grid(True, alpha=0.4)
+    core = footprint_core_inset(ax, x, y, bad, half)
     path = _save(fig, out_dir, "footprint.png", title)
     caption = (f"Terminal footprint of the {x.size} samples that reached the terminal interface, centred on the "
                "target, equal axes" + (f"; the {int(bad.sum())} not successful drawn as red crosses on top (a cross "
@@ -159,7 +160,46 @@ def footprint(cross_km, range_km, out_dir: str, title: str, *, radius_km: float 
     caption += (f"; the dashed circle is the acceptance region ({radius_km:g} km)" if radius_km is not None else "")
     if radius_km is not None and not in_view:
         caption += " (drawn only when near the samples: here far outside the axes)"
+    if core is not None:
+        caption += (f"; the inset zooms on the successful samples (+-{core:.3g} km: 1.3 x their 99th-percentile "
+                    f"offset), which the axes' scale would show as one dot")
     return path, caption + "."
+
+
+#: the inset's side [axes fraction], and how much smaller than the axes the successful core must
+#: be for one (a core 1/15 of the half-width is a few points across: a dot)
+INSET_SIZE, INSET_RATIO = 0.36, 15.0
+
+
+def footprint_core_inset(ax, x, y, failed, half: float) -> float | None:
+    """An inset of ``ax`` zoomed on the successful samples (not ``failed``) when their core (1.3 x
+    the 99th percentile of max(|x|, |y|) [km]) is under 1/INSET_RATIO of the axes' half-width
+    ``half`` [km], in the corner with the fewest samples; returns the core's half-width [km], or
+    None when no inset is drawn (fewer than 3 successful samples, or the core already visible)."""
+    good = ~np.asarray(failed, bool)
+    if good.sum() < 3:
+        return None
+    core = 1.3 * float(np.percentile(np.maximum(np.abs(x[good]), np.abs(y[good])), 99))
+    if not 0.0 < core < half / INSET_RATIO:
+        return None
+    corners = [(0.62, 0.62, 1, 1), (0.02, 0.62, -1, 1), (0.62, 0.02, 1, -1), (0.02, 0.02, -1, -1)]
+    edge = 0.25 * half  # samples beyond a quarter of the half-width in a corner's direction would be hidden
+
+    def hidden(corner):
+        return int(np.sum((corner[2] * x > edge) & (corner[3] * y > edge)))
+
+    cx, cy, _, _ = min(corners, key=hidden)
+    inset = ax.inset_axes([cx, cy, INSET_SIZE, INSET_SIZE])
+    inset.plot(x[good], y[good], ".", ms=3, color="C0")
+    inset.plot(0.0, 0.0, "r*", ms=9)
+    inset.set_xlim(-core, core)
+    inset.set_ylim(-core, core)
+    inset.set_aspect("equal")
+    inset.set_title("successful samples [km]", fontsize=7)
+    inset.tick_params(labelsize=6)
+    inset.grid(True, alpha=0.3)
+    ax.indicate_inset_zoom(inset, edgecolor="0.4")
+    return core
 
 
 def peak_histograms(peaks: dict, out_dir: str, title: str) -> tuple[str, str] | None:

@@ -35,8 +35,10 @@ LEVEL = 0.90
 DERIVATIONS = "derivations"
 #: the mark after a row's mission when the row is carried from the matrix file being rewritten
 CARRIED = "(carried)"
-_ROW = re.compile(r"^\| \[([^\]]+)\]\(" + DERIVATIONS + r"/[^)]+\.md\)(?: \(carried\))? (\([^)]*\)) \| (.*) \|$")
-_ROW_COMMITS = re.compile(r"in the matrix's row, commit ([0-9a-f, +changes]+) \(fly")
+_ROW = re.compile(r"^\| \[([^\]]+)\]\(" + DERIVATIONS + r"/[^)]+\.md\)(?: " + re.escape(CARRIED)
+                  + r")? (\([^)]*\)) \| (.*) \|$")
+_COMMIT = r"[0-9a-f]+(?:\+changes)?"
+_ROW_COMMITS = re.compile(rf"in the matrix's row, commit ({_COMMIT}(?:, {_COMMIT})*) \(fly")
 
 
 def success_lower_bound(successes: int, runs: int, level: float = LEVEL) -> float:
@@ -188,10 +190,10 @@ def write_matrix(folders: list[str], path: str, *, title: str = "Every method on
     with no directory among ``folders`` are kept from the file already at ``path`` (module doc).
     Returns ``path``."""
     earlier = read_matrix_rows(path) if carry else {}
-    names = {read_comparison(f)["name"] for f in folders}
-    carried = {m: row for m, row in earlier.items() if m not in names}
-    commits = sorted({c for f in folders for c in read_comparison(f)["commits"]}  # every session's: --only mixes
-                     | {c for row in carried.values() for c in row["commits"]})
+    comparisons = [read_comparison(f) for f in folders]
+    carried = {m: row for m, row in earlier.items() if m not in {c["name"] for c in comparisons}}
+    commits = sorted({commit for c in comparisons for commit in c["commits"]}  # every session's: --only mixes
+                     | {commit for row in carried.values() for commit in row["commits"]})
     for folder in folders:
         write_derivations(folder, os.path.join(os.path.dirname(os.path.abspath(path)), DERIVATIONS))
     source = f"{len(folders)} comparison directories (`drake-entry compare MISSION`)"

@@ -75,14 +75,17 @@ def _speed(E: float, r: float, mu: float) -> float:
 
 def compute_corridor(energies, alpha_of_E: Callable[[float], float], vehicle: Vehicle, planet: Earth,
                      atmosphere: Atmosphere, limits: PathLimits | None = None, *, margin: float = 0.0,
-                     h_floor: float = 0.0) -> Corridor:
+                     h_floor: float = 0.0, lat_of_E: Callable[[float], float] | None = None) -> Corridor:
     """Corridor on the given energies [J/kg] (any order; stored increasing).
 
     Args:
       alpha_of_E: scheduled angle of attack [rad] at energy E.
       limits: path limits (default: the vehicle's).
       margin: relative safety margin on both bounds (e.g. 0.05).
-      h_floor: lowest altitude searched [m].
+      h_floor: lowest altitude searched [m] (of the air, where ``lat_of_E`` places it).
+      lat_of_E: the latitude [rad] where the vehicle is expected at energy E: the air is read
+        there, at ``planet.atmospheric_altitude`` (the geodetic altitude on an oblate planet, as
+        the plant reads it); None reads it at the state altitude.
     """
     limits = limits or vehicle.limits
     if not 0.0 <= margin < 0.5:
@@ -97,13 +100,15 @@ def compute_corridor(energies, alpha_of_E: Callable[[float], float], vehicle: Ve
         h_top = mu / (-E) - planet.reference_radius  # V = 0 on this energy level
         if not h_top > h_floor:
             raise ScenarioError(f"energy {E:.6g} J/kg is below the surface energy; corridor undefined there")
-        h_hi = min(h_top - 1.0, atmosphere.h_max)
+        lat = None if lat_of_E is None else float(lat_of_E(E))
+        h_lo = h_floor if lat is None else float(planet.state_altitude(h_floor, lat))  # state altitudes
+        h_hi = min(h_top - 1.0, atmosphere.h_max if lat is None else float(planet.state_altitude(atmosphere.h_max, lat)))
         sa, ca = math.sin(alpha), math.cos(alpha)
 
         def state(h):
             r = planet.radius(h)
             V = _speed(E, r, mu)
-            rho, _, a = atmosphere.properties(h)
+            rho, _, a = atmosphere.properties(h if lat is None else float(planet.atmospheric_altitude(h, lat)))
             cl, cd = vehicle.aero.coefficients(alpha, V / a if a > 0 else 0.0)
             q = 0.5 * rho * V * V
             return r, V, rho, q, q * S_m * cl, q * S_m * cd
@@ -129,9 +134,9 @@ def compute_corridor(energies, alpha_of_E: Callable[[float], float], vehicle: Ve
                                                   "total_load": "total_load_max"}[name])):
                 continue
             f = excess(name)
-            if f(h_floor) < 0.0:  # never reached on this energy level
+            if f(h_lo) < 0.0:  # never reached on this energy level
                 continue
-            upper[name][i] = drag_at(brentq(f, h_floor, h_hi, xtol=1e-3))
+            upper[name][i] = drag_at(brentq(f, h_lo, h_hi, xtol=1e-3))
 
         def glide(h):
             r, V, rho, q, L, D = state(h)
@@ -139,8 +144,8 @@ def compute_corridor(energies, alpha_of_E: Callable[[float], float], vehicle: Ve
 
         if glide(h_hi) >= 0.0:  # super-circular or lift to spare up to the top: no lower bound
             D_eq[i] = 0.0
-        elif glide(h_floor) < 0.0:
+        elif glide(h_lo) < 0.0:
             D_eq[i] = np.inf
         else:
-            D_eq[i] = drag_at(brentq(glide, h_floor, h_hi, xtol=1e-3))
+            D_eq[i] = drag_at(brentq(glide, h_lo, h_hi, xtol=1e-3))
     return Corridor(E_grid, alphas, upper, D_eq, margin)

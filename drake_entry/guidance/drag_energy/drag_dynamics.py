@@ -84,15 +84,23 @@ class DragTerms:
     and speed V [m/s] for the scheduled alpha(E): air data, Mach and aerodynamic partials,
     D and the D' split a_Dgamma, b_Dgamma (eqs. 73-74). ``at(gamma)`` completes them to a
     DragDynamics; the planner's state extraction solves eq. 94 for gamma in between, with
-    one model evaluation per node."""
+    one model evaluation per node.
+
+    The air is read where the plant reads it: at ``planet.atmospheric_altitude(h, lat)``, the
+    geodetic altitude on an oblate planet (SPHYNX's state altitude lies 5-12 km under it), with
+    d h_air / dh = 1 at a fixed latitude (the latitude's own drift of the offset, about 0.1 deg of
+    flight-path angle on a long glide, is left to the feedback). With ``drag`` [m/s^2] (the
+    accelerometer's) D is that drag: a constant density or drag-coefficient factor enters eqs.
+    40-63 through D alone (the ratios rho_h / rho, C_D' / C_D are unchanged; b_D does not scale
+    with it), so the terms are exact for such a factor."""
 
     def __init__(self, h: float, V: float, alpha: AlphaProfile, vehicle: Vehicle, planet: Earth,
-                 atmosphere: Atmosphere):
+                 atmosphere: Atmosphere, *, lat: float = 0.0, drag: float | None = None):
         self.V, self.alpha, self.planet = V, alpha, planet
         self.r = r = planet.radius(h)
         self.g = planet.mu / (r * r)
         self.g_h = -2.0 * self.g / r
-        dens, temp = atmosphere.derivatives(h)
+        dens, temp = atmosphere.derivatives(float(planet.atmospheric_altitude(h, lat)))
         self.rho, self.rho_h, self.rho_hh = dens
         T, T_h, T_hh = temp
         a = math.sqrt(atmosphere.gamma * atmosphere.gas_constant * T)
@@ -104,7 +112,7 @@ class DragTerms:
         self.cd, CL = vehicle.aero.drag_derivatives(alpha.alpha, M)
         self.CD = self.cd.value
         self.lift_to_drag = CL / self.CD
-        self.D = 0.5 * self.rho * V * V * vehicle.area_over_mass * self.CD
+        self.D = 0.5 * self.rho * V * V * vehicle.area_over_mass * self.CD if drag is None else float(drag)
         self.a_Dgamma = self.first(0.0)[-1]
         self.b_Dgamma = self.first(1.0)[-1] - self.a_Dgamma
 
@@ -155,9 +163,10 @@ class DragTerms:
 
 def drag_dynamics(h: float, V: float, gamma: float, alpha: AlphaProfile, vehicle: Vehicle, planet: Earth,
                   atmosphere: Atmosphere, *, lat: float = 0.0, heading: float = 0.0,
-                  earth_rate: bool = True) -> DragDynamics:
-    """D, D', a_D, b_D, a_Dgamma, b_Dgamma at altitude h [m], speed V [m/s], flight-path
-    angle gamma [rad], for the scheduled alpha(E). ``lat``, ``heading`` [rad] feed the
-    Earth-rate correction (eq. 50) when ``earth_rate`` and the planet rotates."""
-    return DragTerms(h, V, alpha, vehicle, planet, atmosphere).at(gamma, lat=lat, heading=heading,
-                                                                  earth_rate=earth_rate)
+                  earth_rate: bool = True, drag: float | None = None) -> DragDynamics:
+    """D, D', a_D, b_D, a_Dgamma, b_Dgamma at state altitude h [m], speed V [m/s], flight-path
+    angle gamma [rad], for the scheduled alpha(E). ``lat`` [rad] places the air (DragTerms);
+    ``lat``, ``heading`` [rad] feed the Earth-rate correction (eq. 50) when ``earth_rate`` and the
+    planet rotates; ``drag`` [m/s^2]: the sensed drag (DragTerms)."""
+    return DragTerms(h, V, alpha, vehicle, planet, atmosphere, lat=lat, drag=drag).at(
+        gamma, lat=lat, heading=heading, earth_rate=earth_rate)

@@ -478,11 +478,11 @@ def extract(p: DragEnergyProblem, op: LGL, I: np.ndarray) -> Extraction:
     h = slope = None
     for i, E in enumerate(op.x):
         alpha = _alpha_profile(p.alpha, E)
-        h, V, slope = _altitude_speed(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere, h_guess=h,
-                                      slope_guess=slope)
         lat = p.lat0 + frac[i] * (p.latf - p.lat0)
         heading = p.heading0 + frac[i] * (p.headingf - p.heading0)
-        terms = DragTerms(h, V, alpha, p.vehicle, p.planet, p.atmosphere)
+        h, V, slope = _altitude_speed(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere, h_guess=h,
+                                      slope_guess=slope, lat=lat)
+        terms = DragTerms(h, V, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat)
         gamma = math.asin(min(max((Dp[i] - terms.a_Dgamma) / terms.b_Dgamma, -1.0), 1.0))  # eq. 94
         dd = terms.at(gamma, lat=lat, heading=heading)
         u = dd.feedforward(Dpp[i])  # eq. 95
@@ -496,26 +496,31 @@ def extract(p: DragEnergyProblem, op: LGL, I: np.ndarray) -> Extraction:
 
 
 def altitude_speed_from_drag(E: float, D: float, alpha: float, vehicle: Vehicle, planet: Earth,
-                             atmosphere: Atmosphere, h_floor: float = 0.0, h_guess: float | None = None):
-    """(h, V) on energy level E where the drag equals D (eq. 93), to 1e-4 m.
+                             atmosphere: Atmosphere, h_floor: float = 0.0, h_guess: float | None = None,
+                             lat: float = 0.0):
+    """(state altitude h, V) on energy level E where the drag equals D (eq. 93), to 1e-4 m, the
+    air read at ``planet.atmospheric_altitude(h, lat)`` (lat [rad]).
 
     With ``h_guess`` (the neighbouring node's altitude) a secant iteration on ln D, nearly
     linear in h, converges in a few model evaluations; Brent's bracketed method is the
     fallback and the default."""
-    return _altitude_speed(E, D, alpha, vehicle, planet, atmosphere, h_floor, h_guess)[:2]
+    return _altitude_speed(E, D, alpha, vehicle, planet, atmosphere, h_floor, h_guess, lat=lat)[:2]
 
 
-def _altitude_speed(E, D, alpha, vehicle, planet, atmosphere, h_floor=0.0, h_guess=None, slope_guess=None):
+def _altitude_speed(E, D, alpha, vehicle, planet, atmosphere, h_floor=0.0, h_guess=None, slope_guess=None,
+                    lat: float = 0.0):
     """altitude_speed_from_drag and the last secant slope d ln D / dh [1/m] (None after
     Brent), which starts the next node's secant one model evaluation closer."""
-    h_top = min(planet.mu / (-E) - planet.reference_radius - 1.0, atmosphere.h_max)
+    h_top = min(planet.mu / (-E) - planet.reference_radius - 1.0,
+                float(planet.state_altitude(atmosphere.h_max, lat)))
 
     def f(h):
         V = math.sqrt(max(2.0 * (E + planet.mu / planet.radius(h)), 0.0))
-        return drag_acceleration(h, V, alpha, vehicle, atmosphere) - D
+        return drag_acceleration(float(planet.atmospheric_altitude(h, lat)), V, alpha, vehicle, atmosphere) - D
 
-    found = _secant_log_drag(f, D, h_guess, h_floor, h_top, slope_guess) if h_guess is not None else None
-    h, slope = found if found is not None else (brentq(f, h_floor, h_top, xtol=1e-4), None)
+    h_lo = float(planet.state_altitude(h_floor, lat))  # the air's floor as a state altitude
+    found = _secant_log_drag(f, D, h_guess, h_lo, h_top, slope_guess) if h_guess is not None else None
+    h, slope = found if found is not None else (brentq(f, h_lo, h_top, xtol=1e-4), None)
     return h, math.sqrt(2.0 * (E + planet.mu / planet.radius(h))), slope
 
 
@@ -561,7 +566,11 @@ class DragEnergyPlanner:
                  solver: str = "clarabel", margin: float = 0.03, corridor_points: int = 300,
                  sigma_max: float | None = None, terminal_drag: float | None = None,
                  terminal_state: tuple | None = None, replan_start: str = "flown", centring: float = 0.0,
-                 range_offset: float = 0.0):
+                 range_offset: float = 0.0, entry_lat: float | None = None):
+        """``entry_lat`` [rad]: where the corridor reads the air (``lat_of_E``); None reads it at
+        the state altitude (the same on a spherical planet). ``terminal_drag`` (D_f of eq. 85)
+        is taken within the corridor at E_final (SPHYNX's DRS point, Mach 0.5 at 11.5 km
+        geodetic, lies under the equilibrium glide: the plan ends on the corridor's floor)."""
         if alpha.variable != "energy":
             raise ScenarioError(f"the drag-energy planner needs alpha scheduled in energy, got '{alpha.variable}'")
         self.vehicle, self.atmosphere, self.alpha = vehicle, atmosphere, alpha
@@ -577,8 +586,21 @@ class DragEnergyPlanner:
         self.sigma_max = vehicle.bank_limit if sigma_max is None else sigma_max
         E = np.linspace(E_final, E_entry + 0.02 * (E_entry - E_final), corridor_points)
         self.margin = margin
-        self.corridor = compute_corridor(E, alpha, vehicle, self.planet, atmosphere, margin=margin)
+        self.entry_lat = entry_lat
+        self.corridor = compute_corridor(E, alpha, vehicle, self.planet, atmosphere, margin=margin,
+                                         lat_of_E=None if entry_lat is None else self.lat_of_E)
+        if terminal_drag is not None:  # D_f within the corridor, as a re-plan in the sensed air takes it
+            D_lo, D_hi = self.corridor.bounds(np.array([E_final]))
+            self.terminal_drag = float(min(max(terminal_drag, D_lo[0]), D_hi[0]))
         self._sensed: tuple = (None, None)  # (rounded scales, their overrides): the last one asked
+
+    def lat_of_E(self, E: float) -> float:
+        """The latitude [rad] the corridor reads the air at, at energy E [J/kg]: linear in energy
+        from the entry's to the target's (as eq. 50's Earth-rate term takes it); the target's
+        below E_final, the entry's above E_entry. On an oblate planet the geodetic offset of the
+        air changes with it (SPHYNX: 5.3 km at the entry's 29.8 deg, 7.7 km at the site's 36.8)."""
+        share = min(max((self.E_entry - E) / (self.E_entry - self.E_final), 0.0), 1.0)
+        return self.entry_lat + share * (self.target[1] - self.entry_lat)
 
     def sensed(self, scales) -> dict:
         """The ``problem`` overrides of a re-plan in the flight's sensed air: the vehicle with
@@ -596,12 +618,14 @@ class DragEnergyPlanner:
         if self._sensed[0] != key:
             vehicle = sensed_vehicle(self.vehicle, key)
             corridor = compute_corridor(self.corridor.energy, self.alpha, vehicle, self.planet, self.atmosphere,
-                                        margin=self.margin)
+                                        margin=self.margin,
+                                        lat_of_E=None if self.entry_lat is None else self.lat_of_E)
             found = {"vehicle": vehicle, "corridor": corridor}
             if self.terminal_drag is not None and self.terminal_state is not None:
                 h_f, V_f = self.terminal_state
                 D_lo, D_hi = corridor.bounds(np.array([self.E_final]))
-                D_f = drag_acceleration(h_f, V_f, self.alpha(self.E_final), vehicle, self.atmosphere)
+                D_f = drag_acceleration(float(self.planet.atmospheric_altitude(h_f, self.target[1])), V_f,
+                                        self.alpha(self.E_final), vehicle, self.atmosphere)
                 found["Df"] = float(min(max(D_f, D_lo[0]), D_hi[0]))
             self._sensed = (key, found)
         return dict(self._sensed[1])
@@ -612,33 +636,35 @@ class DragEnergyPlanner:
         vehicle = scenario.make_vehicle()
         h_f, V_f, Ef = scenario.guidance_terminal_state()
         alpha = scenario.schedule("alpha")
-        D_f = drag_acceleration(h_f, V_f, alpha(Ef), vehicle, scenario.make_atmosphere()) if g.terminal_drag else None
+        planet, lat_f = scenario.make_planet(), math.radians(scenario.target.latitude_deg)
+        D_f = (drag_acceleration(float(planet.atmospheric_altitude(h_f, lat_f)), V_f, alpha(Ef), vehicle,
+                                 scenario.make_atmosphere()) if g.terminal_drag else None)
         return DragEnergyPlanner(
-            vehicle=vehicle, planet=scenario.make_planet(), atmosphere=scenario.make_atmosphere(),
-            alpha=scenario.schedule("alpha"), target_lon=math.radians(scenario.target.longitude_deg),
-            target_lat=math.radians(scenario.target.latitude_deg), E_entry=scenario.entry_energy(), E_final=Ef,
+            vehicle=vehicle, planet=planet, atmosphere=scenario.make_atmosphere(),
+            alpha=alpha, target_lon=math.radians(scenario.target.longitude_deg),
+            target_lat=lat_f, E_entry=scenario.entry_energy(), E_final=Ef,
             n_nodes=g.n_nodes, solver=g.solver, margin=g.corridor_margin, corridor_points=g.corridor_points,
             terminal_drag=D_f, terminal_state=(h_f, V_f), replan_start=g.replan_start,
-            centring=g.corridor_centring, range_offset=g.range_offset_m)
+            centring=g.corridor_centring, range_offset=g.range_offset_m,
+            entry_lat=float(scenario.initial_state()[2]))
 
     def energy(self, x) -> float:
         return float(self.planet.specific_energy(x[0], x[3]))
 
     def drag_state(self, x, sensed_drag: float | None = None) -> DragDynamics:
-        """D, D', a_D, b_D at state x for the scheduled alpha(E) (eqs. 40-63).
+        """D, D', a_D, b_D at state x for the scheduled alpha(E) (eqs. 40-63), the air read where
+        the plant reads it (DragTerms).
 
-        With ``sensed_drag`` (the accelerometer's drag acceleration [m/s^2]) the model's
-        drag dynamics are scaled by sensed/model: a density or drag-coefficient error scales
-        D, D' and D'' alike to first order, and the feedback then acts on the true drag.
+        With ``sensed_drag`` (the accelerometer's drag acceleration [m/s^2]) the terms are
+        evaluated at that drag (DragTerms: exact for a constant density or drag-coefficient
+        factor), and the feedback acts on the true drag. (Scaling the model's D', a_D and b_D by
+        sensed / model instead, as this did before, multiplied the feedback's gain by model /
+        sensed: b_D does not depend on the density level.)
         """
         E = self.energy(x)
-        d = drag_dynamics(x[0], x[3], x[4], _alpha_profile(self.alpha, E), self.vehicle, self.planet,
-                          self.atmosphere, lat=x[2], heading=x[5])
-        if sensed_drag is None or not sensed_drag > 0:
-            return d
-        k = sensed_drag / d.D
-        return dc.replace(d, D=sensed_drag, D_prime=k * d.D_prime, a_D=k * d.a_D, b_D=k * d.b_D,
-                          a_Dgamma=k * d.a_Dgamma, b_Dgamma=k * d.b_Dgamma)
+        drag = sensed_drag if sensed_drag is not None and sensed_drag > 0 else None
+        return drag_dynamics(x[0], x[3], x[4], _alpha_profile(self.alpha, E), self.vehicle, self.planet,
+                             self.atmosphere, lat=x[2], heading=x[5], drag=drag)
 
     def range_to_go(self, x) -> float:
         """The range [m] a plan from state x flies: the great-circle distance to the target plus

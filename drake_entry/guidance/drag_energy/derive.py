@@ -53,34 +53,60 @@ RANGE_OFFSET_WHY = (
     "offset, range error -1.7 +- 2.2 km; 93 with it, +0.6 +- 2.2 km)")
 
 
+#: the bank [deg] held before the guidance engages: paper 000's lift up first
+PRE_GUIDANCE_BANK_CANDIDATES = (0.0, 30.0, 45.0, 60.0)
+
+#: why the pre-guidance bank is searched
+PRE_GUIDANCE_WHY = ("the bank held until the guidance engages (paper 000 flies the lift up): a lifting vehicle "
+                    "entering shallow near circular speed pulls out high with the lift up (SPHYNX: at 74 km, drag "
+                    "0.8 m/s^2), where the first plan asks for a descent that its 90-deg bank limit cannot fly "
+                    "(the drag 60 % under the plan for 300 s, the flight 780 km long); banked, it engages lower "
+                    "(45 deg: at 400 s, 1 km from the target on the nominal flight)")
+
+
 def require_glide_floor(scenario, interface, altitudes_km, alpha_deg: float) -> None:
     """CannotFly when at every candidate interface altitude the vehicle's drag at the box's speed
     (and the mission's alpha there) lies below the corridor's floor, the equilibrium glide with
-    the lift vertical (paper 000 eq. 70): the guidance flies inside the corridor and never engages
-    (a capsule of L/D 0.3 at 19 km, 305 m/s: 13 m/s^2 against 30)."""
+    the lift vertical (paper 000 eq. 70), so far that the plan, which ends on the floor, ends
+    outside the box's altitude window: on the interface's energy level the floor's drag lies
+    that much lower (a capsule of L/D 0.3 at 19 km, 305 m/s: 13 m/s^2 against 30, the floor's
+    drag 6 km under the box). SPHYNX's DRS point lies under the floor too (Mach 0.5 at 11.5 km
+    geodetic), but the floor's drag is within its box."""
     from drake_entry.guidance.drag_energy.corridor import compute_corridor
     from drake_entry.guidance.drag_energy.drag_dynamics import drag_acceleration
+    from drake_entry.guidance.drag_energy.planner import altitude_speed_from_drag
 
     vehicle, atmosphere = scenario.make_vehicle(), scenario.make_atmosphere()
     planet = scenario.make_planet().with_(j2=0.0)
-    alpha = math.radians(alpha_deg)
+    alpha, lat_f = math.radians(alpha_deg), math.radians(scenario.target.latitude_deg)
+    geodetic = scenario.altitude_datum == "ellipsoid"
+    centre, tol = interface.altitude_km, interface.altitude_tolerance_km
     below = []
     for h_km in altitudes_km:
-        h = h_km * 1e3
-        E = float(planet.specific_energy(h, interface.speed_m_s))
-        floor = float(compute_corridor([E], lambda _: alpha, vehicle, planet, atmosphere).D_min[0])
-        drag = float(drag_acceleration(h, interface.speed_m_s, alpha, vehicle, atmosphere))
+        h = h_km * 1e3  # in the mission's datum
+        state_h = float(planet.state_altitude(h, lat_f)) if geodetic else h
+        E = float(planet.specific_energy(state_h, interface.speed_m_s))
+        floor = float(compute_corridor([E], lambda _: alpha, vehicle, planet, atmosphere,
+                                       lat_of_E=lambda _: lat_f).D_min[0])
+        drag = float(drag_acceleration(scenario.air_altitude(h), interface.speed_m_s, alpha, vehicle, atmosphere))
         if drag >= floor:
             return
-        below.append((h_km, drag, floor))
+        h_floor = altitude_speed_from_drag(E, floor, alpha, vehicle, planet, atmosphere, h_guess=state_h,
+                                           lat=lat_f)[0]
+        h_floor_km = (float(planet.atmospheric_altitude(h_floor, lat_f)) if geodetic else h_floor) / 1e3
+        if tol is None or abs(h_floor_km - centre) <= tol:
+            return
+        below.append((h_km, drag, floor, h_floor_km))
+
     def span(values, fmt: str) -> str:
         lo, hi = format(min(values), fmt), format(max(values), fmt)
         return lo if lo == hi else f"{lo}-{hi}"
-    heights, drags, floors = zip(*below)
+    heights, drags, floors, floor_heights = zip(*below)
     raise CannotFly(f"drag below the glide floor at the interface: {span(drags, '.3g')} m/s^2 against "
                     f"{span(floors, '.3g')} ({span(heights, 'g')} km, {interface.speed_m_s:.0f} m/s, alpha "
                     f"{alpha_deg:g} deg; the floor of paper 000's drag corridor, eq. 70, is the equilibrium glide "
-                    f"with the lift vertical): the guidance flies inside the corridor and would never engage")
+                    f"with the lift vertical): a plan ends on the floor, whose drag on the interface's energy "
+                    f"level lies at {span(floor_heights, '.3g')} km, outside the box's {centre:g} +- {tol:g} km")
 
 
 def derive(scenario) -> Derivation:
@@ -124,7 +150,8 @@ def derive(scenario) -> Derivation:
                f"the nominal corridor, 11 over the 2-g load on the planned drag; 99 with the sensed one)" if forces else
                "the mission disperses nothing that changes the lift or drag: the nominal corridor is the flight's"),
     ]
-    search = [SearchStep.over("guidance.terminal_altitude_km", altitudes, ALTITUDE_WHY),
+    search = [SearchStep.over("guidance.pre_guidance_bank_deg", PRE_GUIDANCE_BANK_CANDIDATES, PRE_GUIDANCE_WHY),
+              SearchStep.over("guidance.terminal_altitude_km", altitudes, ALTITUDE_WHY),
               SearchStep.over("guidance.corridor_margin", MARGIN_CANDIDATES,
                          "room between the profile and the limits for the dispersions"),
               SearchStep.over("guidance.corridor_centring", CENTRING_CANDIDATES,

@@ -87,17 +87,23 @@ class DragTerms:
     one model evaluation per node.
 
     The air is read where the plant reads it: at ``planet.atmospheric_altitude(h, lat)``, the
-    geodetic altitude on an oblate planet (SPHYNX's state altitude lies 5-12 km under it), with
-    d h_air / dh = 1 at a fixed latitude (the latitude's own drift of the offset, about 0.1 deg of
-    flight-path angle on a long glide, is left to the feedback). With ``drag`` [m/s^2] (the
+    geodetic altitude on an oblate planet (SPHYNX's state altitude lies 5-12 km under it). The
+    offset R_eq (1 - f sin^2 lat) drifts as the vehicle changes latitude: with ``heading`` the air's
+    altitude rate carries it, dh_air/dE = -(sin(gamma) + c) / D with c = R_eq f sin(2 lat)
+    cos(psi) / r (cos(gamma) taken as 1, so D' stays linear in sin(gamma), eq. 94; the drift's own
+    rate is left out of D''). On a -0.12 deg glide at 47 deg, c is 0.028 deg and moves D' by 50 %.
+    With ``drag`` [m/s^2] (the
     accelerometer's) D is that drag: a constant density or drag-coefficient factor enters eqs.
     40-63 through D alone (the ratios rho_h / rho, C_D' / C_D are unchanged; b_D does not scale
     with it), so the terms are exact for such a factor."""
 
     def __init__(self, h: float, V: float, alpha: AlphaProfile, vehicle: Vehicle, planet: Earth,
-                 atmosphere: Atmosphere, *, lat: float = 0.0, drag: float | None = None):
+                 atmosphere: Atmosphere, *, lat: float = 0.0, heading: float | None = None,
+                 drag: float | None = None):
         self.V, self.alpha, self.planet = V, alpha, planet
         self.r = r = planet.radius(h)
+        self.drift = (0.0 if heading is None or planet.is_spherical else
+                      planet.equatorial_radius * planet.flattening * math.sin(2.0 * lat) * math.cos(heading) / r)
         self.g = planet.mu / (r * r)
         self.g_h = -2.0 * self.g / r
         dens, temp = atmosphere.derivatives(float(planet.atmospheric_altitude(h, lat)))
@@ -117,14 +123,16 @@ class DragTerms:
         self.b_Dgamma = self.first(1.0)[-1] - self.a_Dgamma
 
     def first(self, s: float):
-        """h', V', M', C_D', rho', D' for sin(gamma) = s (eqs. 37, 40, 42, 44, 45)."""
+        """h', the air's altitude rate h_air', V', M', C_D', rho', D' for sin(gamma) = s (eqs. 37,
+        40, 42, 44, 45)."""
         D, V, g = self.D, self.V, self.g
         hp = -s / D
+        hp_air = -(s + self.drift) / D
         Vp = 1.0 / V + g * s / (D * V)
-        Mp = self.M_h * hp + self.M_V * Vp
+        Mp = self.M_h * hp_air + self.M_V * Vp
         CDp = self.cd.d_alpha * self.alpha.d_alpha + self.cd.d_mach * Mp
-        rhop = self.rho_h * hp
-        return hp, Vp, Mp, CDp, rhop, D * (rhop / self.rho + 2.0 * Vp / V + CDp / self.CD)
+        rhop = self.rho_h * hp_air
+        return hp, hp_air, Vp, Mp, CDp, rhop, D * (rhop / self.rho + 2.0 * Vp / V + CDp / self.CD)
 
     def at(self, gamma: float, *, lat: float = 0.0, heading: float = 0.0, earth_rate: bool = True) -> DragDynamics:
         """D, D', a_D, b_D, a_Dgamma, b_Dgamma at flight-path angle gamma [rad]."""
@@ -135,17 +143,17 @@ class DragTerms:
         C_gamma = gamma_correction(D, V, r, gamma, lat, heading, w) if w else 0.0
         a_gamma = cg / D * (g / (V * V) - 1.0 / r) + C_gamma  # eq. 49
         b_gamma = -1.0 / (V * V)
-        hp, Vp, Mp, CDp, rhop, Dp = self.first(sg)
+        hp, ha, Vp, Mp, CDp, rhop, Dp = self.first(sg)  # ha: the air's altitude rate
         gp = self.g_h * hp
 
         def second(u):
             """D'' for vertical control u (eqs. 41-47, 53-61)."""
             gam_p = a_gamma + b_gamma * u  # eq. 48
-            hpp = sg * Dp / (D * D) - cg * gam_p / D  # eq. 47
+            hpp = (sg + self.drift) * Dp / (D * D) - cg * gam_p / D  # eq. 47, of the air's altitude
             Vpp = (-Vp / (V * V) + gp * sg / (D * V) + g * cg * gam_p / (D * V)
                    - g * sg / (D * D * V * V) * (Dp * V + D * Vp))  # eq. 47
-            rhopp = self.rho_hh * hp * hp + self.rho_h * hpp  # eq. 42
-            Mpp = self.M_hh * hp * hp + 2.0 * self.M_hV * hp * Vp + M_h * hpp + M_V * Vpp  # eq. 45 (M_VV = 0)
+            rhopp = self.rho_hh * ha * ha + self.rho_h * hpp  # eq. 42
+            Mpp = self.M_hh * ha * ha + 2.0 * self.M_hV * ha * Vp + M_h * hpp + M_V * Vpp  # eq. 45 (M_VV = 0)
             CDpp = (cd.d_alpha_alpha * al.d_alpha**2 + 2.0 * cd.d_alpha_mach * al.d_alpha * Mp
                     + cd.d_alpha * al.dd_alpha + cd.d_mach_mach * Mp * Mp + cd.d_mach * Mpp)  # eq. 44/61
             return Dp * Dp / D + D * (rhopp / rho - (rhop / rho) ** 2 + 2.0 * Vpp / V - 2.0 * (Vp / V) ** 2
@@ -168,5 +176,5 @@ def drag_dynamics(h: float, V: float, gamma: float, alpha: AlphaProfile, vehicle
     angle gamma [rad], for the scheduled alpha(E). ``lat`` [rad] places the air (DragTerms);
     ``lat``, ``heading`` [rad] feed the Earth-rate correction (eq. 50) when ``earth_rate`` and the
     planet rotates; ``drag`` [m/s^2]: the sensed drag (DragTerms)."""
-    return DragTerms(h, V, alpha, vehicle, planet, atmosphere, lat=lat, drag=drag).at(
+    return DragTerms(h, V, alpha, vehicle, planet, atmosphere, lat=lat, heading=heading, drag=drag).at(
         gamma, lat=lat, heading=heading, earth_rate=earth_rate)

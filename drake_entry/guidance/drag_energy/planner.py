@@ -482,7 +482,7 @@ def extract(p: DragEnergyProblem, op: LGL, I: np.ndarray) -> Extraction:
         heading = p.heading0 + frac[i] * (p.headingf - p.heading0)
         h, V, slope = _altitude_speed(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere, h_guess=h,
                                       slope_guess=slope, lat=lat)
-        terms = DragTerms(h, V, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat)
+        terms = DragTerms(h, V, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat, heading=heading)
         gamma = math.asin(min(max((Dp[i] - terms.a_Dgamma) / terms.b_Dgamma, -1.0), 1.0))  # eq. 94
         dd = terms.at(gamma, lat=lat, heading=heading)
         u = dd.feedforward(Dpp[i])  # eq. 95

@@ -466,8 +466,10 @@ def test_a_matrix_rewritten_from_some_missions_keeps_the_other_rows_marked_carri
 
 
 def test_a_resumed_comparison_reuses_the_derived_scenario(tmp_path, monkeypatch):
-    """Derivation is deterministic, so a comparison run again into its directory flies the
-    scenario the first run derived (its file and record) without searching again."""
+    """Derivation is deterministic for one code, so a comparison run again into its directory at
+    the commit of its derivation flies the scenario the first run derived (its file and record)
+    without searching again; derived at another commit (or with no commit recorded), it derives
+    again."""
     from pydrake.common.yaml import yaml_dump_typed
 
     import drake_entry.comparison.derive as derive_module
@@ -482,7 +484,10 @@ def test_a_resumed_comparison_reuses_the_derived_scenario(tmp_path, monkeypatch)
                                                bank_end_deg=30.0))
     path = tmp_path / "fnpeg.yaml"
     path.write_text(yaml_dump_typed(flown))
-    record = {"choices": [], "chosen": {"guidance.bank_end_deg": 30.0}, "trials": []}
+    import drake_entry.campaign.engine as engine_module
+
+    monkeypatch.setattr(engine_module, "source_commit", lambda: "c0ffee")
+    record = {"choices": [], "chosen": {"guidance.bank_end_deg": 30.0}, "trials": [], "commit": "c0ffee"}
 
     def refuse(*a, **k):
         raise AssertionError("searched again")
@@ -492,6 +497,9 @@ def test_a_resumed_comparison_reuses_the_derived_scenario(tmp_path, monkeypatch)
     assert again == record and scenario.guidance.bank_end_deg == 30.0 and scenario.name == "horus2b-fnpeg"
     with pytest.raises(AssertionError, match="searched again"):  # no record: it derives
         _derived_scenario(comp, entry, mission, str(path), None, progress=False)
+    for other in ({**record, "commit": "decade"}, {k: v for k, v in record.items() if k != "commit"}):
+        with pytest.raises(AssertionError, match="searched again"):  # derived by other code: it derives
+            _derived_scenario(comp, entry, mission, str(path), {"derivation": other}, progress=False)
 
 
 def test_swarm_bank_on_horus2b_flies_the_mission_alpha_and_weighs_the_box():

@@ -245,12 +245,17 @@ def _cannot_fly(mission, entry) -> str:
 
 def _derived_scenario(comp: Comparison, entry, mission, path: str, earlier: dict | None, progress: bool):
     """The scenario ``entry`` flies with its settings derived from the mission, and the
-    derivation's record: an earlier run's (its scenario file and record, when both are there:
-    derivation is deterministic), else derived and searched now (CannotFly when the method cannot
-    fly the mission)."""
+    derivation's record: an earlier run's (its scenario file and record, when both are there and
+    the record was derived at this source commit: derivation is deterministic for one code), else
+    derived and searched now (CannotFly when the method cannot fly the mission). A method flown
+    again after its code changed is derived again: reusing the old settings flew SPHYNX's
+    drag-energy cell with the pre-guidance bank its earlier code had no search for."""
+    from drake_entry.campaign.engine import source_commit
     from drake_entry.comparison.derive import derive_settings
 
-    if earlier and earlier.get("derivation") and os.path.exists(path):
+    commit = source_commit()
+    if (earlier and earlier.get("derivation") and os.path.exists(path)
+            and earlier["derivation"].get("commit") == commit):
         return method_scenario(comp, entry, load_scenario(path)), earlier["derivation"]
     mission, derivation = _derivation(mission, entry)
     if progress:
@@ -258,7 +263,7 @@ def _derived_scenario(comp: Comparison, entry, mission, path: str, earlier: dict
               + (", searched on the nominal flight and dispersed draws" if derivation.search else ""), flush=True)
     chosen = derive_settings(mission, derivation, progress=(lambda text: print(f"   {text}", flush=True))
                              if progress else None)
-    return method_scenario(comp, entry, chosen.scenario), chosen.record()
+    return method_scenario(comp, entry, chosen.scenario), {**chosen.record(), "commit": commit}
 
 
 def _derivation_text(record: dict) -> str:

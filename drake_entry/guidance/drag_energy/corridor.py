@@ -98,10 +98,10 @@ def compute_corridor(energies, alpha_of_E: Callable[[float], float], vehicle: Ve
 
     for i, (E, alpha) in enumerate(zip(E_grid, alphas)):
         h_top = mu / (-E) - planet.reference_radius  # V = 0 on this energy level
-        if not h_top > h_floor:
-            raise ScenarioError(f"energy {E:.6g} J/kg is below the surface energy; corridor undefined there")
         lat = None if lat_of_E is None else float(lat_of_E(E))
         h_lo = h_floor if lat is None else float(planet.state_altitude(h_floor, lat))  # state altitudes
+        if not h_top > h_lo:
+            raise ScenarioError(f"energy {E:.6g} J/kg is below the surface energy; corridor undefined there")
         h_hi = min(h_top - 1.0, atmosphere.h_max if lat is None else float(planet.state_altitude(atmosphere.h_max, lat)))
         sa, ca = math.sin(alpha), math.cos(alpha)
 

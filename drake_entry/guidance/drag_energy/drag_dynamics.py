@@ -92,10 +92,9 @@ class DragTerms:
     altitude rate carries it, dh_air/dE = -(sin(gamma) + c) / D with c = R_eq f sin(2 lat)
     cos(psi) / r (cos(gamma) taken as 1, so D' stays linear in sin(gamma), eq. 94; the drift's own
     rate is left out of D''). On a -0.12 deg glide at 47 deg, c is 0.028 deg and moves D' by 50 %.
-    With ``drag`` [m/s^2] (the
-    accelerometer's) D is that drag: a constant density or drag-coefficient factor enters eqs.
-    40-63 through D alone (the ratios rho_h / rho, C_D' / C_D are unchanged; b_D does not scale
-    with it), so the terms are exact for such a factor."""
+    With ``drag`` [m/s^2] (the accelerometer's) D is that drag: a constant density or
+    drag-coefficient factor enters eqs. 40-63 through D alone (the ratios rho_h / rho, C_D' / C_D
+    are unchanged; b_D does not scale with it), so the terms are exact for such a factor."""
 
     def __init__(self, h: float, V: float, alpha: AlphaProfile, vehicle: Vehicle, planet: Earth,
                  atmosphere: Atmosphere, *, lat: float = 0.0, heading: float | None = None,

@@ -587,8 +587,7 @@ class DragEnergyPlanner:
         E = np.linspace(E_final, E_entry + 0.02 * (E_entry - E_final), corridor_points)
         self.margin = margin
         self.entry_lat = entry_lat
-        self.corridor = compute_corridor(E, alpha, vehicle, self.planet, atmosphere, margin=margin,
-                                         lat_of_E=None if entry_lat is None else self.lat_of_E)
+        self.corridor = self._corridor(E, vehicle)
         if terminal_drag is not None:  # D_f within the corridor, as a re-plan in the sensed air takes it
             D_lo, D_hi = self.corridor.bounds(np.array([E_final]))
             self.terminal_drag = float(min(max(terminal_drag, D_lo[0]), D_hi[0]))
@@ -601,6 +600,12 @@ class DragEnergyPlanner:
         air changes with it (SPHYNX: 5.3 km at the entry's 29.8 deg, 7.7 km at the site's 36.8)."""
         share = min(max((self.E_entry - E) / (self.E_entry - self.E_final), 0.0), 1.0)
         return self.entry_lat + share * (self.target[1] - self.entry_lat)
+
+    def _corridor(self, energies, vehicle: Vehicle) -> Corridor:
+        """The corridor of ``vehicle`` on ``energies`` [J/kg] with this planner's alpha, margin and
+        air (``lat_of_E`` when the entry latitude is known)."""
+        return compute_corridor(energies, self.alpha, vehicle, self.planet, self.atmosphere, margin=self.margin,
+                                lat_of_E=None if self.entry_lat is None else self.lat_of_E)
 
     def sensed(self, scales) -> dict:
         """The ``problem`` overrides of a re-plan in the flight's sensed air: the vehicle with
@@ -617,9 +622,7 @@ class DragEnergyPlanner:
             return {}
         if self._sensed[0] != key:
             vehicle = sensed_vehicle(self.vehicle, key)
-            corridor = compute_corridor(self.corridor.energy, self.alpha, vehicle, self.planet, self.atmosphere,
-                                        margin=self.margin,
-                                        lat_of_E=None if self.entry_lat is None else self.lat_of_E)
+            corridor = self._corridor(self.corridor.energy, vehicle)
             found = {"vehicle": vehicle, "corridor": corridor}
             if self.terminal_drag is not None and self.terminal_state is not None:
                 h_f, V_f = self.terminal_state

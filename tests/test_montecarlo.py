@@ -112,10 +112,10 @@ def test_report_is_self_contained_with_provenance_requirements_and_bounds(tmp_pa
     assert '<a href="interactive.html">Interactive view</a>' in open(f"{out}/report.html").read()
     assert "the dashed line the nominal flight (the scenario without dispersions)" in text
     figures = [line for line in text.splitlines() if line.startswith("*Figure ")]
-    assert len(figures) == 9 and all(len(f) > 120 for f in figures)  # each with its caption
+    assert len(figures) == 10 and all(len(f) > 120 for f in figures)  # each with its caption (the margin histograms too)
     assert "How the estimates settle as the 2 samples accumulate" in text and os.path.exists(f"{out}/convergence.png")
     html_text = open(f"{out}/report.html").read()
-    assert html_text.count("data:image/png;base64,") == 9 and "<table>" in html_text
+    assert html_text.count("data:image/png;base64,") == 10 and "<table>" in html_text
     summary = json.load(open(f"{out}/summary.json"))
     assert summary["success_lower_bound"]["0.9"] == pytest.approx(0.1 ** 0.5)
     assert summary["distributions"]["err_distance_m"]["n"] == 2

@@ -219,6 +219,42 @@ def test_path_figure_draws_failed_samples_on_top_and_the_total_load_where_limite
     assert legend[:2] == ["successful (1)", "not successful (1)"], legend  # both groups named with their counts
 
 
+def test_margin_figure_shows_a_lower_bound_breach_the_path_panels_cannot(tmp_path):
+    """Three flights' margins to a 12-kPa floor (+8 %, +3 %, -1.2 %: the last one not successful)
+    and to a vehicle 'no limit': the floor gets a panel whose bins meet at the limit, the breach
+    sits left of 0 in red, the worst sample is named by its index; the far limit is named in the
+    caption, not drawn."""
+    from drake_entry.campaign.report_figures import margin_histograms
+    from drake_entry.figures import plt
+
+    made, real_subplots = [], plt.subplots
+
+    def keeping(*a, **k):
+        fig, axes = real_subplots(*a, **k)
+        made.append(axes)
+        return fig, axes
+
+    plt.subplots = keeping
+    try:
+        _, caption = margin_histograms(
+            {"path_dynamic_pressure": ([0.08, 0.03, -0.012], [False, False, True], ">= 12 kPa"),
+             "dynamic_pressure": ([0.999, 0.999, 0.999], [False, False, True], "<= 1e+06 kPa")},
+            str(tmp_path), "t", samples=[4, 9, 17])
+    finally:
+        plt.subplots = real_subplots
+    axes = made[-1]
+    assert [ax.get_visible() for ax in axes.flat] == [True]
+    ax = axes.flat[0]
+    red = [p for p in ax.patches if p.get_facecolor()[0] > 0.7 and p.get_height() > 0]
+    assert len(red) == 1 and red[0].get_x() < -1.2 and red[0].get_x() + red[0].get_width() <= 1e-12
+    w = red[0].get_width()  # every edge a whole number of widths from 0: 0 is an edge
+    assert all(p.get_x() / w == pytest.approx(round(p.get_x() / w), abs=1e-9) for p in ax.patches)
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "limit >= 12 kPa" in legend and "worst -1.20 % (sample 17)" in legend, legend
+    assert "Not drawn" in caption and "dynamic pressure <= 1e+06 kPa" in caption
+    assert margin_histograms({"x": ([np.nan], [True], "")}, str(tmp_path), "t") is None
+
+
 def test_drag_figure_shows_the_tracking_error_with_the_failed_samples_on_top(tmp_path):
     """Sample 0 flies 10 % above its reference, sample 1 (not successful) 5 % below: the right
     panel plots +10 % and -5 % where the reference is engaged (> 0), the failed one last and red."""

@@ -942,6 +942,7 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
                                    getattr(limits, lim) * scale if limits is not None else None)
              for col, label, unit, scale, lim in PEAK_QUANTITIES if col in rows}
     figs.append(figures.peak_histograms(peaks, out_dir, title))
+    figs.append(_margin_figure(rows, out_dir, scenario, title))
     if traj is not None:
         figs.append(figures.envelopes(traj, out_dir, title, nominal=read_nominal(out_dir)))
         failed = [i for i, ok in zip(rows["index"], rows["success"]) if not ok]
@@ -954,6 +955,22 @@ def _figures(rows: dict, reached, traj, out_dir: str, scenario, limits, title: s
         figs.append(figures.bank_histories(traj, out_dir, title, detailed=_detailed_samples(traj, step)))
     figs.append(_convergence_figure(rows, out_dir, scenario, title))
     return [f for f in figs if f is not None]
+
+
+def _margin_figure(rows: dict, out_dir: str, scenario, title: str):
+    """figures.margin_histograms of every margin_* column of the rows, each named with its
+    limit's bound (the scenario's path limits; the column's name alone without a scenario)."""
+    n = len(rows["index"])
+    texts = {}
+    try:
+        texts = {lim.name: lim.bound_text() for lim in scenario.path_limits()} if scenario is not None else {}
+    except DrakeEntryError:
+        pass
+    bad = np.array([not bool(v) for v in rows["success"]])
+    margins = {c.removeprefix("margin_"): (finite_column(rows, c, n), bad, texts.get(c.removeprefix("margin_"), ""))
+               for c in sorted(c for c in rows if c.startswith("margin_"))}
+    tolerance = getattr(getattr(scenario, "terminal", None), "path_limit_tolerance", 0.0) or 0.0
+    return figures.margin_histograms(margins, out_dir, title, samples=rows["index"], tolerance=tolerance)
 
 
 def _convergence_figure(rows: dict, out_dir: str, scenario, title: str):

@@ -17,7 +17,7 @@ from drake_entry.figures import plt, save_figure  # sets the Agg backend before 
 
 __all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "plain_axis",
            "error_histograms",
-           "footprint", "footprint_core_inset", "INSET_SIZE", "INSET_RATIO", "peak_histograms", "envelopes", "OFF_SCALE", "path_quantities", "drag_profiles",
+           "footprint", "footprint_core_inset", "INSET_SIZE", "INSET_RATIO", "peak_histograms", "margin_histograms", "envelopes", "OFF_SCALE", "path_quantities", "drag_profiles",
            "ground_tracks", "bank_histories", "energy_range", "normalised_energy", "convergence"]
 
 #: k of the 99 % probability ellipse of a 2-D normal: sqrt(chi2.ppf(0.99, 2)) = 3.035
@@ -227,6 +227,69 @@ def peak_histograms(peaks: dict, out_dir: str, title: str) -> tuple[str, str] | 
                   "between the rightmost bar and the limit line is the campaign's worst margin.")
 
 
+def margin_histograms(margins: dict, out_dir: str, title: str, *, samples=None,
+                      tolerance: float = 0.0) -> tuple[str, str] | None:
+    """``margins``: {limit name: (worst relative margin of each sample, nan where it did not
+    fly; not-successful mask; the limit's bound text)}: each flight's worst distance to each path
+    limit, upper and lower bounds alike (models.verdict.check_limits: negative past the bound),
+    in % of the limit, the successful and not-successful samples stacked, the limit at 0 and the
+    breach threshold (``tolerance``, relative) drawn, the worst sample named by its index in
+    ``samples`` (the rows' sample indices; the position without). A limit no flight came within
+    1 - 1/OFF_SCALE of is named in the caption, not drawn (a vehicle file's 'no limit')."""
+    panels, far = [], []
+    for name, (v, bad, text) in margins.items():
+        ids = np.arange(len(v)) if samples is None else np.asarray(samples)
+        v, bad = np.asarray(v, float), np.asarray(bad, bool)
+        ok = np.isfinite(v)
+        if not ok.any():
+            continue
+        if v[ok].min() > 1.0 - 1.0 / OFF_SCALE:
+            far.append(f"{name.replace('_', ' ')} {text}".rstrip())
+        else:
+            panels.append((name, 100 * v[ok], bad[ok], text, ids[ok]))
+    if not panels:
+        return None
+    cols = min(len(panels), 3)
+    rows = -(-len(panels) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.7 * rows), squeeze=False)
+    for ax in axes.flat[len(panels):]:
+        ax.set_visible(False)
+    n = 0
+    for ax, (name, v, bad, text, index) in zip(axes.flat, panels):
+        n = max(n, v.size)
+        edges = fd_bins(v)  # their width, moved to put an edge at the limit (0)
+        w = (float(edges[1] - edges[0]) if not isinstance(edges, int)
+             else max(float(np.ptp(v)), 1e-9 + abs(float(v[0]))) / edges)
+        edges = w * np.arange(math.floor(v.min() / w), math.floor(v.max() / w) + 2)
+        ax.hist([v[~bad], v[bad]], bins=edges, stacked=True, color=["C0", "C3"],
+                label=[f"successful ({int((~bad).sum())})", f"not successful ({int(bad.sum())})"])
+        ax.axvline(0.0, color="r", ls="-", lw=1.4, label=f"limit {text}".rstrip())
+        if tolerance > 0:
+            ax.axvline(-100 * tolerance, color="r", ls=":", lw=1.2, label=f"breach past {100 * tolerance:g} %")
+        k = int(np.argmin(v))
+        ax.plot([], [], " ", label=f"worst {v[k]:+.2f} % (sample {int(index[k])})")
+        lo, hi = ax.get_xlim()
+        span = hi - lo
+        ax.set_xlim(min(lo, -100 * tolerance - 0.05 * span), max(hi, 0.05 * span))
+        plain_axis(ax)
+        ax.set_title(name.replace("_", " "), fontsize=10)
+        ax.set_xlabel("worst margin to the limit [% of the limit]")
+        ax.legend(fontsize=7)
+        ax.grid(True, alpha=0.4)
+    for r in range(rows):
+        axes[r, 0].set_ylabel("samples")
+    path = _save(fig, out_dir, "margin_histograms.png", title)
+    return path, (f"Each flight's worst margin to each path limit, the vehicle's and the mission's, upper and lower "
+                  f"bounds alike, over every log sample and integrator step of the {n} samples that flew, in % of the "
+                  "limit (negative: past the bound), not-successful samples stacked in red, Freedman-Diaconis bins with an edge at the limit. "
+                  "The limit is the solid line at 0" + (f", a breach is counted past the dotted line "
+                                                       f"({100 * tolerance:g} % of the limit)" if tolerance > 0 else "")
+                  + "; the legend names the worst sample. A lower bound (a dynamic-pressure floor) shows here where "
+                  "the path-quantity panels' scale hides it"
+                  + (f". Not drawn, every flight more than {100 * (1 - 1 / OFF_SCALE):.0f} % from it: "
+                     + ", ".join(far) if far else "") + ".")
+
+
 def _on_energy_grid(e, v, groups, grid):
     """Each sample's values interpolated on ``grid`` of normalised energy (nan outside its range)."""
     out = np.full((len(groups), grid.size), np.nan)
@@ -350,7 +413,8 @@ def path_quantities(traj: dict, out_dir: str, title: str, limits, mission_limits
     return path, (f"Path quantities of the {len(groups) + len(bad)} stored trajectories against normalised energy (one "
                   "line per sample, at the storage step and at each flight's peaks of these quantities and extremes of "
                   "the flight-path angle, taken at the log period: a line's top is its flight's peak; the peaks "
-                  "between log samples, at the integrator's steps, are in the peak histograms"
+                  "between log samples, at the integrator's steps, are in the peak histograms, and each flight's worst "
+                  "margin to every limit, a lower bound's too, in the margin histograms"
                   + (f"; not successful in red, on top: {len(bad)}" if bad else "") + "), the "
                   "vehicle's limits dashed and the mission's dotted (a mission's limit on a state, such as the "
                   "flight-path bounds, in a panel of its own; a limit more than "

@@ -160,6 +160,10 @@ def inside_bounds(c, margin: float):
     return dc.replace(c, min=lo, max=hi, name=c.label)
 
 
+#: SI unit -> (the unit reports print a path limit in, its factor from SI): the vehicle's limits' units
+DISPLAY_UNITS = {"Pa": ("kPa", 1e-3), "W/m^2": ("kW/m^2", 1e-3)}
+
+
 def mission_path_limits(problem) -> list[PathLimit]:
     """The problem's path constraints on flight conditions as flown limits (named 'path_<label>')."""
     out = []
@@ -167,5 +171,6 @@ def mission_path_limits(problem) -> list[PathLimit]:
         if callable(c.quantity) or PATH_QUANTITIES[c.quantity][0] is None:
             continue
         column, unit = PATH_QUANTITIES[c.quantity]
-        out.append(PathLimit(f"path_{c.label}", column, upper=c.max, lower=c.min, unit=unit))
+        unit, scale = DISPLAY_UNITS.get(unit, (unit, 1.0))
+        out.append(PathLimit(f"path_{c.label}", column, upper=c.max, lower=c.min, unit=unit, scale=scale))
     return out

@@ -358,3 +358,64 @@ def test_a_re_plan_in_the_sensed_air_moves_each_limit_s_drag_bound_as_its_physic
     ref = planner.plan_from_state(engagement_state, **over)
     assert ref.success, ref.message
     assert np.all(ref.D <= np.interp(ref.energy, sensed.energy, sensed.D_max) * (1 + 1e-6))
+
+
+CAPSULE_DRAG_ENERGY = """based_on: capsule_lu2008
+name: capsule_drag_energy
+alpha: {variable: normalized_energy, breakpoints: [0.0], values_deg: [20.0]}
+guidance: !DragEnergy
+  terminal_altitude_km: 20.5
+  terminal_mach: 1.0337
+  reversal_heading_deg: [2.0, 8.333]
+  reversal_velocity_m_s: [1000.0, 7000.0]
+  corridor_margin: 0.02
+  replan_period_s: 20.0
+  replan_until_e: 0.99
+  replan_model_scales: true
+  replan_start: reference
+  corridor_centring: 1000.0
+  bandwidth_rad_s: 0.1
+"""
+
+
+def test_a_plan_within_reach_asks_only_for_drag_the_bank_can_give(tmp_path):
+    """A low-L/D capsule at its drag-energy engagement (the nominal flight's loft, t = 337 s,
+    66.3 km, 6794 m/s): paper 000's smoothest profile asks, from e = 0.1 on, for D'' that full
+    lift down cannot give (u_FF -6.6 L/D) and at the end for D' steeper than a vertical
+    descent. Within reach (margin 0.3 of L/D), every node up to e = 0.95 asks for u_FF in
+    [-0.7, 0.7] L/D (to the linearisation's 1e-3) with the range, the initial drag and the
+    terminal drag (eqs. 83-85) still met; the end game, pinned to the terminal drag, stays out
+    of reach at two nodes (measured: e = 0.98 and 1, -1.7 and -1.8 L/D, the last at -62 deg),
+    and the plan's message names them."""
+    from drake_entry.guidance.drag_energy.planner import reach_excess
+
+    path = tmp_path / "capsule.yaml"
+    path.write_text(CAPSULE_DRAG_ENERGY)
+    planner = DragEnergyPlanner.from_scenario(load_scenario(str(path)))
+    x = np.array([66284.47, math.radians(-109.70405), math.radians(20.09349), 6793.794, math.radians(-0.157948),
+                  math.radians(66.14031)])
+    paper = planner.plan_from_state(x)
+    assert paper.success, paper.message
+    within = dc.replace(paper.problem, reach_margin=0.3)
+    assert reach_excess(within, paper.extraction) == math.inf  # a node past vertical
+    e = (within.E0 - paper.energy) / (within.E0 - within.Ef)
+    ratio = paper.extraction.u_ff / paper.extraction.lift_to_drag
+    assert ratio[e < 0.95].min() < -5.0  # five times more than full lift down
+    ref = plan(within)
+    assert ref.success, ref.message
+    ratio = ref.extraction.u_ff / ref.extraction.lift_to_drag
+    assert np.all(np.abs(ratio[e < 0.95]) <= 0.7 + 1e-3), ratio
+    out = np.flatnonzero(np.abs(ratio) > 0.7 + 1e-3)
+    assert len(out) == 2 and e[out].min() > 0.95, (e[out], ratio[out])
+    assert ref.message.count("u_FF") == 2 and "the drag's reach not met at e = 0.9" in ref.message
+    assert ref.range_flown() == pytest.approx(within.range_to_go, rel=1e-5)
+    assert ref.D[0] == pytest.approx(within.D0, rel=1e-6) and ref.D[-1] == pytest.approx(within.Df, rel=1e-6)
+    assert ref.objective > paper.objective  # reach is paid for in eq. 92's smoothness
+
+
+@pytest.mark.parametrize("margin", [-0.1, 0.5])
+def test_a_reach_margin_outside_its_range_is_refused(margin, planner, engagement_state):
+    from drake_entry.errors import ScenarioError
+
+    with pytest.raises(ScenarioError, match=r"reach_margin must be in \[0, 0.45\]"):
+        plan(planner.problem(engagement_state, reach_margin=margin))

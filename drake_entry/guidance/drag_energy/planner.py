@@ -102,6 +102,12 @@ class DragEnergyProblem:
     # share m of the corridor's width in I = 1/D that the profile keeps from both bounds, in the
     # cost s' + s'' - centring * m (eq. 92 is dimensionless in the scaled I: see _add_centring)
     centring: float = 0.0
+    # the drag's reach (not paper 000's; None: the paper's SOCP, whose profile may ask for a D''
+    # no bank gives): every node's feedforward u_FF (eq. 95) held in the bank's range of u less
+    # this share of L/D on each side, by linearising u_FF about the previous solve inside a
+    # trust region (successive convexification, at most ``reach_iterations`` more solves)
+    reach_margin: float | None = None
+    reach_iterations: int = 8
 
     def validate(self):
         if not self.E0 > self.Ef:
@@ -113,6 +119,8 @@ class DragEnergyProblem:
             raise ScenarioError(f"solver '{self.solver}' is unknown; allowed: {', '.join(SOLVERS)}")
         if not 5 <= self.n_nodes <= 400:
             raise ScenarioError(f"n_nodes must be in [5, 400], got {self.n_nodes}")
+        if self.reach_margin is not None and not 0.0 <= self.reach_margin <= 0.45:
+            raise ScenarioError(f"reach_margin must be in [0, 0.45] (a share of L/D), got {self.reach_margin}")
         if not self.D0 > 0 or not self.range_to_go > 0:
             raise ScenarioError(f"D0 and range_to_go must be > 0 (got {self.D0}, {self.range_to_go})")
 
@@ -145,6 +153,7 @@ class DragEnergyReference(PlanResult):
     solver: str = ""
     binding: list = field(default_factory=list)  # which bounds bind, where (diagnosis)
     corridor_share: float = math.nan  # centring: the share of the corridor's width kept from each bound
+    reach_excess: float = math.nan  # the drag's reach: the largest u_FF past its range, a share of L/D (0: met)
     _nodal: np.ndarray | None = field(default=None, repr=False)
     _extraction: Extraction | None = field(default=None, repr=False)
 
@@ -251,6 +260,10 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
         if k + 1 < iterations:  # the next solve's weights from this one's states
             x = ref.extraction
             kappa = p.planet.reference_radius * np.cos(x.gamma) / p.planet.radius(x.h)
+    if ref.success and p.reach_margin is not None:
+        ref, spent = _within_reach(p, op, D_lo, D_hi, ref)
+        total_build, total_solve, total_iterations = (total_build + spent[0], total_solve + spent[1],
+                                                      total_iterations + spent[2])
     ref.build_time, ref.solve_time, ref.iterations = total_build, total_solve, total_iterations
     ref.message += note
     if ref.success:
@@ -264,7 +277,7 @@ def plan(problem: DragEnergyProblem) -> DragEnergyReference:
 SCS_OPTIONS = {"eps_abs": 1e-5, "eps_rel": 1e-5, "max_iters": 100000}
 
 
-def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyReference:
+def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa, reach: tuple | None = None) -> DragEnergyReference:
     """One SOCP of eqs. 82-92 on the LGL operator ``op`` with corridor bounds D_lo, D_hi [m/s^2]
     at its nodes and fixed range weights kappa (``plan`` iterates it and extracts the states).
 
@@ -274,7 +287,10 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
     is 3e5 at 40 nodes), the cost weighted to stay eq. 92 divided by |D2|; unconditioned, SCS
     needed 28 000 iterations at 40 nodes and did not converge at 80. Clarabel (interior point)
     solves the plain form: conditioned, its optimum moved by up to 3e-4 (relative, within its
-    tolerance on this flat optimum) and the closed-loop campaign rows by up to 327 m."""
+    tolerance on this flat optimum) and the closed-loop campaign rows by up to 327 m.
+
+    ``reach``: (A, lo, hi, I_lo, I_hi) adds lo <= A I <= hi and the trust region I_lo <= I <= I_hi
+    (I in s^2/m: ``_within_reach``'s linearised drag reach)."""
     conditioned = p.solver == "scs"
     t0 = time.perf_counter()
     n = p.n_nodes
@@ -283,6 +299,17 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
     I = prog.NewContinuousVariables(n, "I")
     s = prog.NewContinuousVariables(2, "s")
     prog.AddBoundingBoxConstraint(scale / D_hi, scale / D_lo, I)  # eq. 86
+    if reach is not None:  # the linearised reach of the drag and its trust region (_within_reach)
+        A_u, u_lo, u_hi, I_lo, I_hi = reach
+        slack = prog.NewContinuousVariables(len(u_lo), "reach_slack")  # exact penalty: always feasible
+        prog.AddBoundingBoxConstraint(0.0, np.inf, slack)
+        eye = np.eye(len(u_lo))
+        prog.AddLinearConstraint(np.hstack([A_u / scale, eye]), u_lo, np.full(len(u_lo), np.inf),
+                                 np.concatenate([I, slack]))
+        prog.AddLinearConstraint(np.hstack([A_u / scale, -eye]), np.full(len(u_lo), -np.inf), u_hi,
+                                 np.concatenate([I, slack]))
+        prog.AddLinearCost(np.full(len(u_lo), REACH_PENALTY), 0.0, slack)
+        prog.AddBoundingBoxConstraint(scale * I_lo, scale * I_hi, I)
     # eq. 83 with the ground-range weights kappa: R = -sum w_i kappa_i I_i (divided by R if conditioned)
     R = p.range_to_go if conditioned else 1.0
     prog.AddLinearEqualityConstraint((-op.weights * kappa / (scale * R))[None, :], [p.range_to_go / R], I)
@@ -324,6 +351,109 @@ def solve_socp(p: DragEnergyProblem, op: LGL, D_lo, D_hi, kappa) -> DragEnergyRe
                                build_time=t1 - t0, solve_time=t2 - t1, iterations=iters,
                                objective=_smoothness(op, I_sol) if ok else math.nan,
                                corridor_share=float(result.GetSolution(m)[0]) if ok and m is not None else math.nan)
+
+
+#: the trust region of the reach iterations: each node's I within this share of the last solve's
+REACH_TRUST = 0.25
+#: the weight of the reach rows' slack (u and sin(gamma) units) beside eq. 92's cost: large, so
+#: a solve within reach has no slack, and one out of it moves as far toward it as the trust allows
+REACH_PENALTY = 1.0e4
+#: the steepest flight-path angle [deg] a plan within reach may ask for (eq. 94)
+REACH_GAMMA_DEG = 60.0
+
+
+def _u_range(p: DragEnergyProblem, ld: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The range of u = (L/D) cos(sigma) a plan may ask for at nodes of lift-to-drag ``ld``: the
+    bank's [0, sigma_max], less ``reach_margin`` L/D on each side (left to the tracking law)."""
+    m = p.reach_margin or 0.0
+    return ld * (math.cos(p.sigma_max) + m), ld * (1.0 - m)
+
+
+def reach_excess(p: DragEnergyProblem, x: Extraction) -> float:
+    """The largest share of L/D by which the profile's u_FF (eq. 95) leaves ``_u_range`` (0 when
+    every node is within it; inf where the profile asks for a descent steeper than
+    REACH_GAMMA_DEG)."""
+    lo, hi = _u_range(p, x.lift_to_drag)
+    with np.errstate(invalid="ignore"):
+        past = np.maximum((x.u_ff - hi) / x.lift_to_drag, (lo - x.u_ff) / x.lift_to_drag)
+    steep = np.abs(x.gamma) > math.radians(REACH_GAMMA_DEG) + 1e-9
+    return float(max(0.0, np.nanmax(np.where(steep, np.inf, past))))
+
+
+def _reach_rows(p: DragEnergyProblem, op: LGL, I: np.ndarray, x: Extraction) -> tuple:
+    """u_FF and sin(gamma) at every node linearised in I about the profile I [s^2/m] (extraction
+    ``x``): both depend on I through I_k, I'_k, I''_k alone (eqs. 87-88, 93-95); their partials
+    by forward differences, each row then e_k, D1[k], D2[k] combined. sin(gamma) is held within
+    sin(REACH_GAMMA_DEG) (eq. 94's D' of a steeper descent leaves no vertical control: b_D is
+    cos(gamma)'s), u_FF within ``_u_range`` where gamma is (elsewhere u_FF is not defined).
+    Returns (A, lo, hi, I_lo, I_hi): the rows of lo <= A I <= hi, and the trust region
+    (REACH_TRUST)."""
+    n = op.n_nodes
+    I1, I2 = op.D1 @ I, op.D2 @ I
+    span = p.E0 - p.Ef
+    u_lo, u_hi = _u_range(p, x.lift_to_drag)
+    s_max = math.sin(math.radians(REACH_GAMMA_DEG))
+    rows, lo, hi = [], [], []
+    for k in range(n):
+        base = (I[k], I1[k], I2[k])
+        ref = _node_state(p, op, k, *_from_inverse(*base), x.h[k])
+        steps = (1e-6 * I[k], 1e-6 * (abs(I1[k]) + I[k] / span), 1e-6 * (abs(I2[k]) + I[k] / span**2))
+        grads = []
+        for j, step in enumerate(steps):
+            v = list(base)
+            v[j] += step
+            out = _node_state(p, op, k, *_from_inverse(*v), x.h[k])
+            grads.append(((out[3] - ref[3]) / step, (out[6] - ref[6]) / step))
+        for q, (value, low, high) in enumerate(((ref[3], u_lo[k], u_hi[k]), (ref[6], -s_max, s_max))):
+            if q == 0 and abs(ref[6]) >= s_max:
+                continue
+            row = grads[0][q] * np.eye(n)[k] + grads[1][q] * op.D1[k] + grads[2][q] * op.D2[k]
+            offset = value - row @ I  # value(I) ~ value_ref + row (I - I_ref)
+            rows.append(row)
+            lo.append(low - offset)
+            hi.append(high - offset)
+    return np.array(rows), np.array(lo), np.array(hi), I * (1.0 - REACH_TRUST), I * (1.0 + REACH_TRUST)
+
+
+def _from_inverse(I, I1, I2) -> tuple:
+    """(D, D', D'') from I = 1/D and its energy derivatives I', I'' (eqs. 87-88; scalars or arrays)."""
+    return 1.0 / I, -I1 / I**2, 2.0 * I1**2 / I**3 - I2 / I**2
+
+
+def _within_reach(p: DragEnergyProblem, op: LGL, D_lo, D_hi, ref: DragEnergyReference) -> tuple:
+    """The profile re-solved until its u_FF is within ``_u_range`` at every node (1e-3 of L/D),
+    at most ``reach_iterations`` more SOCPs, each linearised about the last (``_reach_rows``).
+    Returns (the last successful reference, with ``reach_excess`` set and the message saying
+    whether the reach was met; (build, solve, iterations) spent)."""
+    spent = [0.0, 0.0, 0]
+    excess = reach_excess(p, ref.extraction)
+    for _ in range(p.reach_iterations):
+        if excess <= 1e-3:
+            break
+        new = solve_socp(p, op, D_lo, D_hi, ref.kappa, reach=_reach_rows(p, op, ref.I, ref.extraction))
+        spent = [spent[0] + new.build_time, spent[1] + new.solve_time, spent[2] + new.iterations]
+        if not new.success:
+            ref.message += f"; the drag's reach not met ({new.message})"
+            break
+        new.kappa = ref.kappa
+        ref, excess = new, reach_excess(p, new.extraction)
+    ref.reach_excess = excess
+    if excess > 1e-3:
+        ref.message += f"; {_out_of_reach(p, op, ref.extraction)}"
+    return ref, spent
+
+
+def _out_of_reach(p: DragEnergyProblem, op: LGL, x: Extraction) -> str:
+    """Where a profile leaves the drag's reach: each such node's normalised energy, u_FF in L/D
+    and flight-path angle."""
+    lo, hi = _u_range(p, x.lift_to_drag)
+    with np.errstate(invalid="ignore"):
+        out = (x.u_ff < lo - 1e-3 * x.lift_to_drag) | (x.u_ff > hi + 1e-3 * x.lift_to_drag)
+    out |= np.abs(x.gamma) > math.radians(REACH_GAMMA_DEG) + 1e-3
+    e = (p.E0 - op.x) / (p.E0 - p.Ef)
+    nodes = ", ".join(f"e = {e[k]:.3f} (u_FF {x.u_ff[k] / x.lift_to_drag[k]:+.3g} L/D, gamma "
+                      f"{math.degrees(x.gamma[k]):.1f} deg)" for k in np.flatnonzero(out))
+    return f"the drag's reach not met at {nodes}"
 
 
 def _solve(prog: MathematicalProgram, solver_name: str):
@@ -467,32 +597,44 @@ def _binding(ref: DragEnergyReference, D_lo, D_hi, tol: float = 1e-4) -> list:
 def extract(p: DragEnergyProblem, op: LGL, I: np.ndarray) -> Extraction:
     """States and bank at the nodes (eqs. 93-96)."""
     n = op.n_nodes
-    D = 1.0 / I
-    I1 = op.D1 @ I
-    I2 = op.D2 @ I
-    Dp = -I1 / I**2
-    Dpp = 2.0 * I1**2 / I**3 - I2 / I**2
+    D, Dp, Dpp = _drag_derivatives(op, I)
     out = {k: np.zeros(n) for k in ("h", "V", "gamma", "u_ff", "sigma", "ld")}
     sat = np.zeros(n, bool)
-    frac = (p.E0 - op.x) / (p.E0 - p.Ef)
+    lo = math.cos(p.sigma_max)
     h = slope = None
     for i, E in enumerate(op.x):
-        alpha = _alpha_profile(p.alpha, E)
-        lat = p.lat0 + frac[i] * (p.latf - p.lat0)
-        heading = p.heading0 + frac[i] * (p.headingf - p.heading0)
-        h, V, slope = _altitude_speed(E, D[i], alpha.alpha, p.vehicle, p.planet, p.atmosphere, h_guess=h,
-                                      slope_guess=slope, lat=lat)
-        terms = DragTerms(h, V, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat, heading=heading)
-        gamma = math.asin(min(max((Dp[i] - terms.a_Dgamma) / terms.b_Dgamma, -1.0), 1.0))  # eq. 94
-        dd = terms.at(gamma, lat=lat, heading=heading)
-        u = dd.feedforward(Dpp[i])  # eq. 95
-        ratio = u / dd.lift_to_drag
-        lo = math.cos(p.sigma_max)
+        h, V, gamma, u, ld, slope, _ = _node_state(p, op, i, D[i], Dp[i], Dpp[i], h, slope)
+        ratio = u / ld
         sat[i] = ratio > 1.0 or ratio < lo
         sigma = math.acos(min(max(ratio, lo), 1.0))  # eq. 96, saturated
-        for k, v in (("h", h), ("V", V), ("gamma", gamma), ("u_ff", u), ("sigma", sigma), ("ld", dd.lift_to_drag)):
+        for k, v in (("h", h), ("V", V), ("gamma", gamma), ("u_ff", u), ("sigma", sigma), ("ld", ld)):
             out[k][i] = v
     return Extraction(out["h"], out["V"], out["gamma"], out["u_ff"], out["sigma"], sat, out["ld"])
+
+
+def _drag_derivatives(op: LGL, I: np.ndarray) -> tuple:
+    """(D, D', D'') at the nodes from I = 1/D [s^2/m] (eqs. 87-88)."""
+    return _from_inverse(I, op.D1 @ I, op.D2 @ I)
+
+
+def _node_state(p: DragEnergyProblem, op: LGL, i: int, D: float, Dp: float, Dpp: float, h_guess=None,
+                slope_guess=None) -> tuple:
+    """(h [m], V [m/s], gamma [rad], u_FF, L/D, the secant slope, sin(gamma) as eq. 94 gives it
+    (past +-1 where D' asks for a descent steeper than vertical)) at node i of a profile with
+    drag D, D', D'' there: altitude and speed from (E, D) (eq. 93), gamma from D' (eq. 94),
+    u_FF (eq. 95), the latitude and heading linear in energy (eq. 50)."""
+    E = float(op.x[i])
+    frac = (p.E0 - E) / (p.E0 - p.Ef)
+    alpha = _alpha_profile(p.alpha, E)
+    lat = p.lat0 + frac * (p.latf - p.lat0)
+    heading = p.heading0 + frac * (p.headingf - p.heading0)
+    h, V, slope = _altitude_speed(E, D, alpha.alpha, p.vehicle, p.planet, p.atmosphere, h_guess=h_guess,
+                                  slope_guess=slope_guess, lat=lat)
+    terms = DragTerms(h, V, alpha, p.vehicle, p.planet, p.atmosphere, lat=lat, heading=heading)
+    sin_gamma = (Dp - terms.a_Dgamma) / terms.b_Dgamma  # eq. 94, past +-1 where D' asks for it
+    gamma = math.asin(min(max(sin_gamma, -1.0), 1.0))
+    dd = terms.at(gamma, lat=lat, heading=heading)
+    return h, V, gamma, dd.feedforward(Dpp), dd.lift_to_drag, slope, sin_gamma  # eq. 95
 
 
 def altitude_speed_from_drag(E: float, D: float, alpha: float, vehicle: Vehicle, planet: Earth,
@@ -566,7 +708,7 @@ class DragEnergyPlanner:
                  solver: str = "clarabel", margin: float = 0.03, corridor_points: int = 300,
                  sigma_max: float | None = None, terminal_drag: float | None = None,
                  terminal_state: tuple | None = None, replan_start: str = "flown", centring: float = 0.0,
-                 range_offset: float = 0.0, entry_lat: float | None = None):
+                 range_offset: float = 0.0, entry_lat: float | None = None, reach_margin: float | None = None):
         """``entry_lat`` [rad]: where the corridor reads the air (``lat_of_E``); None reads it at
         the state altitude (the same on a spherical planet). ``terminal_drag`` (D_f of eq. 85)
         is taken within the corridor at E_final (SPHYNX's DRS point, Mach 0.5 at 11.5 km
@@ -583,6 +725,7 @@ class DragEnergyPlanner:
         self.replan_start = replan_start  # DragEnergy.replan_start: "flown" or "reference"
         self.centring = centring  # DragEnergy.corridor_centring
         self.range_offset = float(range_offset)  # DragEnergy.range_offset_m
+        self.reach_margin = reach_margin  # DragEnergy.reach_margin
         self.sigma_max = vehicle.bank_limit if sigma_max is None else sigma_max
         E = np.linspace(E_final, E_entry + 0.02 * (E_entry - E_final), corridor_points)
         self.margin = margin
@@ -649,7 +792,7 @@ class DragEnergyPlanner:
             n_nodes=g.n_nodes, solver=g.solver, margin=g.corridor_margin, corridor_points=g.corridor_points,
             terminal_drag=D_f, terminal_state=(h_f, V_f), replan_start=g.replan_start,
             centring=g.corridor_centring, range_offset=g.range_offset_m,
-            entry_lat=float(scenario.initial_state()[2]))
+            entry_lat=float(scenario.initial_state()[2]), reach_margin=g.reach_margin)
 
     def energy(self, x) -> float:
         return float(self.planet.specific_energy(x[0], x[3]))
@@ -682,7 +825,8 @@ class DragEnergyPlanner:
                   corridor=self.corridor, E0=self.energy(x), Ef=self.E_final, D0=d.D, D0_prime=d.D_prime,
                   range_to_go=self.range_to_go(x), lat0=float(x[2]), latf=self.target[1],
                   heading0=float(x[5]), headingf=bearing(x[1], x[2], *self.target), Df=self.terminal_drag,
-                  n_nodes=self.n_nodes, solver=self.solver, sigma_max=self.sigma_max, centring=self.centring)
+                  n_nodes=self.n_nodes, solver=self.solver, sigma_max=self.sigma_max, centring=self.centring,
+                  reach_margin=self.reach_margin)
         kw.update(overrides)
         return DragEnergyProblem(**kw)
 

@@ -2,6 +2,7 @@
 ``guidance: !DragEnergy``."""
 
 import dataclasses as dc
+from typing import Optional
 
 from drake_entry.errors import ScenarioError, check_range
 from drake_entry.guidance.spec import ReplansOnBoard, ReversingBankSpec
@@ -44,6 +45,11 @@ class DragEnergy(ReversingBankSpec, ReplansOnBoard):
     # the target): the range a flight's end game adds beyond its plan, negative when it ends past
     # the target; never below a tenth of the range left (DragEnergyPlanner.range_to_go)
     range_offset_m: float = 0.0
+    # the drag's reach (not paper 000's; null: the paper's SOCP): each plan's feedforward u_FF
+    # (eq. 95) kept in the bank's range less this share of L/D on each side, by successive
+    # linearisation (DragEnergyProblem.reach_margin): a low-L/D capsule cannot fly the drag
+    # rises and falls the smoothest profile asks for
+    reach_margin: Optional[float] = None
     # drag tracking (eq. 101), energy domain: zeta < 0 because E decreases (paper 000 Sec. VI.D)
     zeta: float = -0.7
     # pseudo-frequency omega_D [1/(J/kg)] = 2 pi / (energy per oscillation) (paper 000: constant)
@@ -67,6 +73,8 @@ class DragEnergy(ReversingBankSpec, ReplansOnBoard):
         check_range("guidance.corridor_centring", self.corridor_centring, 0.0, 1e5)
         check_range("guidance.range_offset_m", self.range_offset_m, -1e6, 1e6)
         check_range("guidance.corridor_points", self.corridor_points, 20, 100000)
+        if self.reach_margin is not None:
+            check_range("guidance.reach_margin", self.reach_margin, 0.0, 0.45)
         check_range("guidance.pre_guidance_min_s", self.pre_guidance_min_s, 0.0, 1e5)
         check_range("guidance.pre_guidance_bank_deg", self.pre_guidance_bank_deg, -180.0, 180.0)
         if self.replan_start not in REPLAN_STARTS:

@@ -360,25 +360,19 @@ def test_a_re_plan_in_the_sensed_air_moves_each_limit_s_drag_bound_as_its_physic
     assert np.all(ref.D <= np.interp(ref.energy, sensed.energy, sensed.D_max) * (1 + 1e-6))
 
 
-CAPSULE_DRAG_ENERGY = """based_on: capsule_lu2008
-name: capsule_drag_energy
-alpha: {variable: normalized_energy, breakpoints: [0.0], values_deg: [20.0]}
-guidance: !DragEnergy
-  terminal_altitude_km: 20.5
-  terminal_mach: 1.0337
-  reversal_heading_deg: [2.0, 8.333]
-  reversal_velocity_m_s: [1000.0, 7000.0]
-  corridor_margin: 0.02
-  replan_period_s: 20.0
-  replan_until_e: 0.99
-  replan_model_scales: true
-  replan_start: reference
-  corridor_centring: 1000.0
-  bandwidth_rad_s: 0.1
-"""
+def _capsule_drag_energy(reach_margin=None):
+    """The capsule's drag-energy scenario as example 27 flies it (the settings its derivation found)."""
+    import importlib.util
+    import os
+
+    path = os.path.join(os.path.dirname(__file__), os.pardir, "examples", "27_drag_energy_within_reach.py")
+    spec = importlib.util.spec_from_file_location("example_27", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.scenario(reach_margin)
 
 
-def test_a_plan_within_reach_asks_only_for_drag_the_bank_can_give(tmp_path):
+def test_a_plan_within_reach_asks_only_for_drag_the_bank_can_give():
     """A low-L/D capsule at its drag-energy engagement (the nominal flight's loft, t = 337 s,
     66.3 km, 6794 m/s): paper 000's smoothest profile asks, from e = 0.1 on, for D'' that full
     lift down cannot give (u_FF -6.6 L/D) and at the end for D' steeper than a vertical
@@ -389,9 +383,7 @@ def test_a_plan_within_reach_asks_only_for_drag_the_bank_can_give(tmp_path):
     and the plan's message names them."""
     from drake_entry.guidance.drag_energy.planner import reach_excess
 
-    path = tmp_path / "capsule.yaml"
-    path.write_text(CAPSULE_DRAG_ENERGY)
-    planner = DragEnergyPlanner.from_scenario(load_scenario(str(path)))
+    planner = DragEnergyPlanner.from_scenario(_capsule_drag_energy())
     x = np.array([66284.47, math.radians(-109.70405), math.radians(20.09349), 6793.794, math.radians(-0.157948),
                   math.radians(66.14031)])
     paper = planner.plan_from_state(x)

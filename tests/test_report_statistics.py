@@ -219,12 +219,8 @@ def test_path_figure_draws_failed_samples_on_top_and_the_total_load_where_limite
     assert legend[:2] == ["successful (1)", "not successful (1)"], legend  # both groups named with their counts
 
 
-def test_margin_figure_shows_a_lower_bound_breach_the_path_panels_cannot(tmp_path):
-    """Three flights' margins to a 12-kPa floor (+8 %, +3 %, -1.2 %: the last one not successful)
-    and to a vehicle 'no limit': the floor gets a panel whose bins meet at the limit, the breach
-    sits left of 0 in red, the worst sample is named by its index; the far limit is named in the
-    caption, not drawn."""
-    from drake_entry.campaign.report_figures import margin_histograms
+def _recording_subplots(call):
+    """(call()'s result, the axes of every figure pyplot.subplots made during it)."""
     from drake_entry.figures import plt
 
     made, real_subplots = [], plt.subplots
@@ -236,12 +232,22 @@ def test_margin_figure_shows_a_lower_bound_breach_the_path_panels_cannot(tmp_pat
 
     plt.subplots = keeping
     try:
-        _, caption = margin_histograms(
-            {"path_dynamic_pressure": ([0.08, 0.03, -0.012], [False, False, True], ">= 12 kPa"),
-             "dynamic_pressure": ([0.999, 0.999, 0.999], [False, False, True], "<= 1e+06 kPa")},
-            str(tmp_path), "t", samples=[4, 9, 17])
+        return call(), made
     finally:
         plt.subplots = real_subplots
+
+
+def test_margin_figure_shows_a_lower_bound_breach_the_path_panels_cannot(tmp_path):
+    """Three flights' margins to a 12-kPa floor (+8 %, +3 %, -1.2 %: the last one not successful)
+    and to a vehicle 'no limit': the floor gets a panel whose bins meet at the limit, the breach
+    sits left of 0 in red, the worst sample is named by its index; the far limit is named in the
+    caption, not drawn."""
+    from drake_entry.campaign.report_figures import margin_histograms
+
+    (_, caption), made = _recording_subplots(lambda: margin_histograms(
+        {"path_dynamic_pressure": ([0.08, 0.03, -0.012], [False, False, True], ">= 12 kPa"),
+         "dynamic_pressure": ([0.999, 0.999, 0.999], [False, False, True], "<= 1e+06 kPa")},
+        str(tmp_path), "t", samples=[4, 9, 17]))
     axes = made[-1]
     assert [ax.get_visible() for ax in axes.flat] == [True]
     ax = axes.flat[0]
@@ -259,24 +265,12 @@ def test_drag_figure_shows_the_tracking_error_with_the_failed_samples_on_top(tmp
     """Sample 0 flies 10 % above its reference, sample 1 (not successful) 5 % below: the right
     panel plots +10 % and -5 % where the reference is engaged (> 0), the failed one last and red."""
     from drake_entry.campaign.report_figures import drag_profiles
-    from drake_entry.figures import plt
 
     t = np.linspace(0.0, 1.0, 20)
     ref = np.where(t > 0.2, 5.0 + 10.0 * t, 0.0)
     traj = {"sample": [0] * 20 + [1] * 20, "energy_J_kg": list(-t) * 2, "reference_drag_m_s2": list(ref) * 2,
             "drag_m_s2": list(np.where(ref > 0, 1.1 * ref, 2.0)) + list(np.where(ref > 0, 0.95 * ref, 2.0))}
-    made, real_subplots = [], plt.subplots
-
-    def keeping(*a, **k):
-        fig, axes = real_subplots(*a, **k)
-        made.append(axes)
-        return fig, axes
-
-    plt.subplots = keeping
-    try:
-        _, caption = drag_profiles(traj, str(tmp_path), "t", failed=[1])
-    finally:
-        plt.subplots = real_subplots
+    (_, caption), made = _recording_subplots(lambda: drag_profiles(traj, str(tmp_path), "t", failed=[1]))
     lines = [line for line in made[-1][1].get_lines() if len(line.get_ydata()) > 2]
     assert [len(line.get_ydata()) for line in lines] == [int((ref > 0).sum())] * 2
     assert np.allclose(lines[0].get_ydata(), 10.0) and np.allclose(lines[1].get_ydata(), -5.0)

@@ -18,6 +18,12 @@ so the ground range of the extracted trajectory equals the range to go.
 After the solve, states and bank are extracted node by node on first use (eqs. 93-96):
 altitude and speed from (E, D), gamma from D' (eq. 94), u_FF (eq. 95) and sigma (eq. 96),
 with the bank saturated explicitly at [0, sigma_max] (flags returned).
+
+The drag's reach (not paper 000's; ``DragEnergyProblem.reach_margin``): the SOCP bounds D but
+not D'' = a_D + b_D u, which only the bank moves, so on a low-L/D vehicle the smoothest profile
+may ask for more than full lift down. With a reach margin the profile is re-solved with each
+node's u_FF (eq. 95) and sin(gamma) (eq. 94) linearised about the last solve and held in the
+bank's range, inside a trust region (``_within_reach``).
 """
 from __future__ import annotations
 
@@ -49,7 +55,7 @@ from drake_entry.planning.pseudospectral import LGL
 from drake_entry.planning.result import PlanResult
 
 __all__ = ["SOLVERS", "DragEnergyProblem", "Extraction", "DragEnergyReference", "plan", "SCS_OPTIONS", "solve_socp",
-           "extract", "altitude_speed_from_drag", "DragEnergyPlanner"]
+           "extract", "altitude_speed_from_drag", "DragEnergyPlanner", "reach_excess", "REACH_GAMMA_DEG"]
 
 SOLVERS = {"clarabel": ClarabelSolver, "scs": ScsSolver}
 

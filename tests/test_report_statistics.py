@@ -241,7 +241,7 @@ def test_margin_figure_shows_a_lower_bound_breach_the_path_panels_cannot(tmp_pat
     """Three flights' margins to a 12-kPa floor (+8 %, +3 %, -1.2 %: the last one not successful)
     and to a vehicle 'no limit': the floor gets a panel whose bins meet at the limit, the breach
     sits left of 0 in red, the worst sample is named by its index; the far limit is named in the
-    caption, not drawn."""
+    caption, not drawn; a margin within rounding of 0 sits on the limit."""
     from drake_entry.campaign.report_figures import margin_histograms
 
     (_, caption), made = _recording_subplots(lambda: margin_histograms(
@@ -259,6 +259,12 @@ def test_margin_figure_shows_a_lower_bound_breach_the_path_panels_cannot(tmp_pat
     assert "limit >= 12 kPa" in legend and "worst -1.20 % (sample 17)" in legend, legend
     assert "Not drawn" in caption and "dynamic pressure <= 1e+06 kPa" in caption
     assert margin_histograms({"x": ([np.nan], [True], "")}, str(tmp_path), "t") is None
+    # a bank clamped at its limit reads -1e-16: on the limit, not past it (models.verdict.ROUNDING)
+    _, made = _recording_subplots(lambda: margin_histograms({"bank": ([-1e-16, 0.05, 0.1], [False] * 3, "")},
+                                                             str(tmp_path), "t"))
+    ax = made[-1].flat[0]
+    assert min(p.get_x() for p in ax.patches if p.get_height() > 0) == pytest.approx(0.0, abs=1e-12)
+    assert "worst +0.00 % (sample 0)" in [t.get_text() for t in ax.get_legend().get_texts()]
 
 
 def test_drag_figure_shows_the_tracking_error_with_the_failed_samples_on_top(tmp_path):

@@ -14,6 +14,7 @@ from scipy import stats
 
 from drake_entry.campaign.statistics import fill_tolerance, normal_ellipse_fill, principal_axis_modes
 from drake_entry.figures import plt, save_figure  # sets the Agg backend before pyplot is imported
+from drake_entry.models.verdict import ROUNDING
 
 __all__ = ["ELLIPSE_99_K", "ZOOM_DEG", "ENVELOPE", "ENERGY_AXIS", "ENERGY_DEFINITION", "fd_bins", "plain_axis",
            "error_histograms",
@@ -245,8 +246,9 @@ def margin_histograms(margins: dict, out_dir: str, title: str, *, samples=None,
             continue
         if v[ok].min() > 1.0 - 1.0 / OFF_SCALE:
             far.append(f"{name.replace('_', ' ')} {text}".rstrip())
-        else:
-            panels.append((name, 100 * v[ok], bad[ok], text, ids[ok]))
+        else:  # a margin within rounding of 0 (a bank clamped at its limit: -1e-16) is on the limit
+            held = np.where((v[ok] < 0.0) & (v[ok] >= -ROUNDING), 0.0, v[ok])
+            panels.append((name, 100 * held, bad[ok], text, ids[ok]))
     if not panels:
         return None
     cols = min(len(panels), 3)

@@ -276,14 +276,22 @@ def write_markdown_report(sections: list, out_dir: str, *, title: str, html_note
     return path
 
 
+def _path_limits(scenario) -> list:
+    """The flown scenario's path limits (models.verdict.PathLimit; [] when the scenario or its
+    vehicle file cannot be read here)."""
+    if scenario is None:
+        return []
+    try:
+        return scenario.path_limits()
+    except DrakeEntryError:
+        return []
+
+
 def _limits_text(scenario) -> str:
     """The path limits of the flown scenario and their tolerance ('' when the scenario or its
     vehicle file cannot be read here)."""
-    if scenario is None:
-        return ""
-    try:
-        limits = scenario.path_limits()
-    except DrakeEntryError:
+    limits = _path_limits(scenario)
+    if not limits:
         return ""
     return (", ".join(f"{lim.name} {lim.bound_text()}" for lim in limits)
             + f"; tolerance {100 * scenario.terminal.path_limit_tolerance:g} % of each limit")
@@ -652,12 +660,7 @@ def _requirements(rows: dict, reached, stats: dict, scenario, verdict=None) -> s
         lines.append(f"| {c.label} | {threshold} | {statistic} | {format_number(worst)}{unit} | "
                      f"{format_number(tol - worst)}{unit} | {'PASS' if inside == nr == n else 'FAIL'} ({inside} of {n} "
                      f"inside) | {table_cell(sources.get(c.name, '—'))} |")
-    limits = []
-    if scenario is not None:
-        try:
-            limits = scenario.path_limits()
-        except DrakeEntryError:
-            limits = []
+    limits = _path_limits(scenario)
     peaks = {"heat_flux": "peak_heat_flux_W_m2", "dynamic_pressure": "peak_dynamic_pressure_Pa",
              "normal_load": "peak_normal_load_g", "total_load": "peak_total_load_g"}
     tolerance = path_limit_tolerance(scenario)
@@ -961,16 +964,12 @@ def _margin_figure(rows: dict, out_dir: str, scenario, title: str):
     """figures.margin_histograms of every margin_* column of the rows, each named with its
     limit's bound (the scenario's path limits; the column's name alone without a scenario)."""
     n = len(rows["index"])
-    texts = {}
-    try:
-        texts = {lim.name: lim.bound_text() for lim in scenario.path_limits()} if scenario is not None else {}
-    except DrakeEntryError:
-        pass
+    texts = {lim.name: lim.bound_text() for lim in _path_limits(scenario)}
     bad = np.array([not bool(v) for v in rows["success"]])
     margins = {c.removeprefix("margin_"): (finite_column(rows, c, n), bad, texts.get(c.removeprefix("margin_"), ""))
                for c in sorted(c for c in rows if c.startswith("margin_"))}
-    tolerance = getattr(getattr(scenario, "terminal", None), "path_limit_tolerance", 0.0) or 0.0
-    return figures.margin_histograms(margins, out_dir, title, samples=rows["index"], tolerance=tolerance)
+    return figures.margin_histograms(margins, out_dir, title, samples=rows["index"],
+                                     tolerance=path_limit_tolerance(scenario))
 
 
 def _convergence_figure(rows: dict, out_dir: str, scenario, title: str):

@@ -23,7 +23,7 @@ import numpy as np
 
 from drake_entry.models.constraints import PathLimits
 
-__all__ = ["ALTITUDE_FLOOR_M", "altitude_floor", "PathLimit", "vehicle_path_limits", "LimitCheck", "check_limits", "breaches_text", "BOX_MISSED",
+__all__ = ["ALTITUDE_FLOOR_M", "altitude_floor", "PathLimit", "DISPLAY_UNITS", "vehicle_path_limits", "LimitCheck", "check_limits", "breaches_text", "BOX_MISSED",
            "LIMITS_BREACHED", "failure_message", "failure_clauses", "ROUNDING", "margin_breached",
            "BoxCriterion", "BOX_CRITERIA", "acceptance_box", "box_text", "Verdict", "judge"]
 
@@ -69,16 +69,19 @@ class PathLimit:
         return f">= {self.lower * s:.4g} {self.unit}".rstrip()
 
 
+#: SI unit -> (the unit reports print a path limit in, its factor from SI); other units print as they are
+DISPLAY_UNITS = {"Pa": ("kPa", 1e-3), "W/m^2": ("kW/m^2", 1e-3)}
+
+
 def vehicle_path_limits(limits: PathLimits, bank_limit: float | None = None) -> list[PathLimit]:
     """The vehicle's finite path limits (and |bank| <= ``bank_limit`` [rad] when given)."""
     out = []
-    for name, column, unit, scale in (("heat_flux", "heat_flux", "kW/m^2", 1e-3),
-                                      ("dynamic_pressure", "dynamic_pressure", "kPa", 1e-3),
-                                      ("normal_load", "normal_load", "g", 1.0),
-                                      ("total_load", "total_load", "g", 1.0)):
+    for name, si_unit in (("heat_flux", "W/m^2"), ("dynamic_pressure", "Pa"), ("normal_load", "g"),
+                          ("total_load", "g")):
+        unit, scale = DISPLAY_UNITS.get(si_unit, (si_unit, 1.0))
         value = getattr(limits, f"{name}_max")
         if math.isfinite(value):
-            out.append(PathLimit(name, column, upper=float(value), unit=unit, scale=scale))
+            out.append(PathLimit(name, name, upper=float(value), unit=unit, scale=scale))
     if bank_limit is not None:
         out.append(PathLimit("bank", "bank", upper=float(bank_limit), absolute=True, unit="deg",
                              scale=180.0 / math.pi))

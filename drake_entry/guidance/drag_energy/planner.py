@@ -197,8 +197,8 @@ class DragEnergyReference(PlanResult):
         else:
             E = np.clip(np.atleast_1d(np.asarray(E, float)), self.problem.Ef, self.problem.E0)
             I, I1, I2 = (self.lgl.interpolation(E) @ self._nodal).T
-        return (np.atleast_1d(1.0 / I), np.atleast_1d(-I1 / I**2),
-                np.atleast_1d(2.0 * I1**2 / I**3 - I2 / I**2))
+        D, D1, D2 = _from_inverse(I, I1, I2)
+        return np.atleast_1d(D), np.atleast_1d(D1), np.atleast_1d(D2)
 
     def evaluate(self, at) -> dict:
         """{'drag_m_s2', 'drag_slope_1_m' (dD/dE), 'drag_curvature_s2_m3' (d2D/dE2)} at energies [J/kg]."""

@@ -9,7 +9,7 @@ import dataclasses as dc
 import math
 
 from drake_entry.errors import ScenarioError
-from drake_entry.models.verdict import PathLimit
+from drake_entry.models.verdict import DISPLAY_UNITS, PathLimit
 from drake_entry.planning.ocp import PATH_QUANTITIES, ObjectiveTerm, OptimalControlProblem, PathConstraint
 from drake_entry.planning.ocp_yaml import load_problem
 
@@ -158,10 +158,6 @@ def inside_bounds(c, margin: float):
     lo = c.min + margin * abs(c.min) if math.isfinite(c.min) else c.min
     hi = c.max - margin * abs(c.max) if math.isfinite(c.max) else c.max
     return dc.replace(c, min=lo, max=hi, name=c.label)
-
-
-#: SI unit -> (the unit reports print a path limit in, its factor from SI): the vehicle's limits' units
-DISPLAY_UNITS = {"Pa": ("kPa", 1e-3), "W/m^2": ("kW/m^2", 1e-3)}
 
 
 def mission_path_limits(problem) -> list[PathLimit]:

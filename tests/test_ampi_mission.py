@@ -8,7 +8,8 @@ import pytest
 from pydrake.autodiffutils import AutoDiffXd
 
 from drake_entry.errors import ScenarioError
-from drake_entry.guidance.ampi.mission import ALTITUDE_WINDOW_FRACTION, fingerprint, mission_problem_spec
+from drake_entry.guidance.ampi import mission as mission_module
+from drake_entry.guidance.ampi.mission import ALTITUDE_WINDOW_FRACTION, fingerprint, mission_problem_spec, source_digest
 from drake_entry.guidance.ampi.spec import MAX_MISSION_CASES, Ampi
 from drake_entry.guidance.derivation import CannotFly, derivation_for
 from drake_entry.models.dispersions import entry_spread
@@ -166,6 +167,35 @@ def test_mission_problem_is_the_mission_with_its_limits_planned_inside(tmp_path)
     assert fingerprint(dc.replace(d.spec, grid={"V": 10.0}), scenario)[1] != key
     assert fingerprint(d.spec, scenario)[1] == key
     assert problem_from_spec(mission_problem_spec(d.spec, scenario)).final == problem.final
+
+
+def test_a_change_to_the_build_code_is_another_database(tmp_path, monkeypatch):
+    """The fingerprint covers the source of the code that builds the database: a changed rule
+    in any file of those packages (not a byte-compiled cache) is a different digest, and a
+    different digest is a different database folder."""
+    (tmp_path / "a").mkdir()
+    (tmp_path / "a" / "rules.py").write_text("RESOLVE_WITHIN = 0.02\n")
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / "solve.py").write_text("TOL = 1e-6\n")
+    folders = [str(tmp_path / "a"), str(tmp_path / "b")]
+    before = source_digest(folders)
+    (tmp_path / "a" / "__pycache__").mkdir()
+    (tmp_path / "a" / "__pycache__" / "rules.cpython-311.pyc").write_bytes(b"\x00compiled")
+    (tmp_path / "a" / "notes.txt").write_text("not code")
+    assert source_digest(folders) == before
+    (tmp_path / "a" / "rules.py").write_text("RESOLVE_WITHIN = 0.03\n")
+    assert source_digest(folders) != before
+    (tmp_path / "a" / "rules.py").write_text("RESOLVE_WITHIN = 0.02\n")
+    assert source_digest(folders) == before
+    (tmp_path / "b" / "solve.py").rename(tmp_path / "b" / "solve2.py")  # a renamed module is other code
+    assert source_digest(folders) != before
+    # the installed build code is what the fingerprint digests
+    installed = mission_module.build_source_digest()
+    assert len(installed) == 64
+    scenario, d = _derived("capsule_lu2008")
+    key = fingerprint(d.spec, scenario)[1]
+    monkeypatch.setattr(mission_module, "build_source_digest", lambda: "0" * 64)
+    assert fingerprint(d.spec, scenario)[1] != key
 
 
 def test_the_mission_problem_ends_at_the_terminal_altitude_in_the_mission_s_datum():

@@ -13,13 +13,17 @@ drawn like the campaign's are then solved afresh and compared with their AMPI re
 
 The database is built before the first plan (the method's preparation,
 guidance.ampi.mission_study) into the user's cache (drake_entry.user_cache), in a folder named by
-the fingerprint of the problem file, the grid, the solve settings, a user vehicle file's content
-and the drake_entry and Drake versions; the planner loads it from there (``built_database``).
+the fingerprint of the problem file, the grid, the solve settings, a user vehicle file's content,
+the drake_entry and Drake versions and the source of the code that builds it (``BUILD_SOURCES``:
+a change to the build's rules builds afresh rather than reusing an older build); the planner
+loads it from there (``built_database``).
 """
 from __future__ import annotations
 
 import dataclasses as dc
+import functools
 import hashlib
+import importlib.util
 import json
 import math
 import os
@@ -42,7 +46,8 @@ from drake_entry.planning.ocp_yaml import (
 __all__ = ["PROBLEM_FILE", "DATABASE_FILE", "REPORT_FILE", "BANK_FRACTION", "BANK_RATE_FRACTION",
            "GAMMA_BOUNDS_DEG", "FLIGHT_PATH_SCALE_DEG", "FLIGHT_PATH_WEIGHT", "ALTITUDE_WINDOW_FRACTION",
            "ALTITUDE_WINDOW_M", "RATE_WEIGHT", "TOLERANCE", "mission_problem_spec", "database_folder",
-           "read_built", "built_database", "fingerprint", "MissionDatabase"]
+           "read_built", "built_database", "fingerprint", "MissionDatabase", "BUILD_SOURCES",
+           "source_digest", "build_source_digest"]
 
 #: the references end at the energy where the flight stops (the guidance's terminal altitude and
 #: speed: a reference ending at another energy leaves flight unplanned, or is cut short), at an
@@ -149,6 +154,41 @@ def _vehicle_name(scenario) -> str:
     return os.path.abspath(scenario.vehicle)
 
 
+#: the packages whose code builds a database: the database, accuracy and mission studies, the
+#: optimal-control transcription and solver settings, the models and the Drake systems and
+#: diagrams the cases are verified with. Their source is in the fingerprint: drake_entry's
+#: version number changes only at a release, so without it a change to the build's rules
+#: (re-solve criteria, a constraint's form) would silently load a database built by older rules
+BUILD_SOURCES = ("drake_entry.guidance.ampi", "drake_entry.planning", "drake_entry.models",
+                 "drake_entry.systems", "drake_entry.diagrams")
+
+
+def source_digest(folders) -> str:
+    """The sha256 hex digest of every ``.py`` file under ``folders``: each file's path relative
+    to its folder and its bytes, in sorted order (byte-compiled caches and other files ignored)."""
+    h = hashlib.sha256()
+    for folder in folders:
+        files = sorted(os.path.relpath(os.path.join(root, name), folder)
+                       for root, _, names in os.walk(folder) for name in names if name.endswith(".py"))
+        for rel in files:
+            h.update(rel.replace(os.sep, "/").encode())
+            h.update(b"\0")
+            with open(os.path.join(folder, rel), "rb") as f:
+                h.update(f.read())
+            h.update(b"\0")
+    return h.hexdigest()
+
+
+@functools.lru_cache(maxsize=1)
+def build_source_digest() -> str:
+    """source_digest of the installed BUILD_SOURCES packages (computed once per process)."""
+    folders = []
+    for name in BUILD_SOURCES:
+        found = importlib.util.find_spec(name)
+        folders.extend(found.submodule_search_locations)
+    return source_digest(folders)
+
+
 def fingerprint(spec, scenario) -> tuple[str, str]:
     """(the problem file's text, the hex fingerprint of everything the database depends on)."""
     import importlib.metadata
@@ -159,7 +199,7 @@ def fingerprint(spec, scenario) -> tuple[str, str]:
     h = hashlib.sha256()
     for part in (text, json.dumps(dict(spec.grid), sort_keys=True), str(spec.grid_levels), str(spec.ld_nodes),
                  str(spec.accuracy_cases),
-                 drake_entry.__version__, importlib.metadata.version("drake")):
+                 drake_entry.__version__, importlib.metadata.version("drake"), build_source_digest()):
         h.update(part.encode())
         h.update(b"\0")
     if scenario.vehicle not in PACKAGED_VEHICLES:  # a user's vehicle file: its content, not its name

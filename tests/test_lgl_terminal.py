@@ -120,6 +120,8 @@ def test_a_plan_flight_is_judged_where_it_first_meets_the_terminal_altitude():
     ("segments", 40, "guidance.nodes = 80 with guidance.segments = 40: guidance.nodes - 1 must be a multiple of "
                      "guidance.segments with at least 3 nodes per segment; allowed near it: 81"),
     ("segments", 41, "guidance.segments = 41 is out of range"),
+    ("snopt_scale_option", 3, "guidance.snopt_scale_option = 3; allowed 0 (none), 1 (linear constraints and "
+                              "variables), 2 (all)"),
 ])
 def test_bad_spec_fields_are_named(scenario, field, value, words):
     bad = dc.replace(scenario, guidance=dc.replace(scenario.guidance, **{field: value}))

@@ -247,7 +247,8 @@ def plan_terminal(scenario, verifier, *, progress="auto") -> LglPlan:
     verifier = require_verifier(verifier, "the terminal guidance's plan")
     problem = spec.problem_for(scenario)
     settings = dict(nodes=spec.nodes, solver=spec.solver, tolerance=spec.tolerance,
-                    max_iterations=spec.max_iterations, verifier=verifier, progress=progress, refine=spec.refine_mesh)
+                    max_iterations=spec.max_iterations, verifier=verifier, progress=progress, refine=spec.refine_mesh,
+                    solver_options=spec.solver_options())
     plan = _staged(problem, scenario, verifier, dict(settings, segments=spec.segments))
     if spec.segments > 1 and not plan.result.converged:
         plan = _staged(problem, scenario, verifier, dict(settings, segments=1))
@@ -346,5 +347,5 @@ def replan(previous: LglPlan, x, elapsed: float, bank: float, alpha: float, scal
     problem = dc.replace(problem, path=measured_path(planned, limits, values))
     again = resolve_from(r, x_now, elapsed, problem=problem, nodes=replan_nodes(spec, r.final_time - elapsed), solver=spec.solver,
                          tolerance=spec.replan_tolerance, max_iterations=spec.max_iterations,
-                         verifier=previous.verifier, progress=False)
+                         solver_options=spec.solver_options(), verifier=previous.verifier, progress=False)
     return judged(again, scenario, previous.verifier)

@@ -411,3 +411,36 @@ def test_a_reach_margin_outside_its_range_is_refused(margin, planner, engagement
 
     with pytest.raises(ScenarioError, match=r"reach_margin must be in \[0, 0.45\]"):
         plan(planner.problem(engagement_state, reach_margin=margin))
+
+
+def test_the_reach_verdict_and_the_nodes_it_names_agree():
+    """reach_excess (the iterations' stop) and the message naming the nodes out of reach use one
+    tolerance: a node a hair steeper than REACH_GAMMA_DEG, or a hair past its u range, is within
+    reach and named nowhere; one past the tolerance makes the plan out of reach and is named."""
+    from types import SimpleNamespace
+
+    from drake_entry.guidance.drag_energy.planner import (
+        REACH_GAMMA_DEG,
+        REACH_TOLERANCE,
+        _out_of_reach,
+        _u_range,
+        reach_excess,
+    )
+
+    p = SimpleNamespace(reach_margin=0.2, sigma_max=math.radians(80.0), E0=0.0, Ef=-1.0)
+    op = SimpleNamespace(x=np.array([0.0, -0.5, -1.0]))
+    ld = np.full(3, 0.3)
+    lo, hi = _u_range(p, ld)
+    assert hi == pytest.approx(0.3 * 0.8) and lo == pytest.approx(0.3 * (math.cos(math.radians(80.0)) + 0.2))
+    limit = math.radians(REACH_GAMMA_DEG)
+    within = SimpleNamespace(lift_to_drag=ld, u_ff=np.array([0.15, hi[1] + 0.5 * REACH_TOLERANCE * 0.3, lo[2]]),
+                             gamma=np.array([-0.1, -0.2, -limit - 0.5 * REACH_TOLERANCE]))
+    assert 0.0 < reach_excess(p, within) <= REACH_TOLERANCE
+    assert _out_of_reach(p, op, within) == "the drag's reach not met at "  # no node named
+    past_u = SimpleNamespace(lift_to_drag=ld, u_ff=np.array([0.15, hi[1] + 0.1 * 0.3, lo[2]]), gamma=within.gamma)
+    assert reach_excess(p, past_u) == pytest.approx(0.1)
+    assert _out_of_reach(p, op, past_u) == "the drag's reach not met at e = 0.500 (u_FF +0.9 L/D, gamma -11.5 deg)"
+    steep = SimpleNamespace(lift_to_drag=ld, u_ff=np.array([0.15, 0.15, lo[2]]),
+                            gamma=np.array([-0.1, -0.2, -limit - 2.0 * REACH_TOLERANCE]))
+    assert reach_excess(p, steep) == math.inf
+    assert _out_of_reach(p, op, steep) == "the drag's reach not met at e = 1.000 (u_FF +0.374 L/D, gamma -60.1 deg)"

@@ -366,6 +366,9 @@ REACH_TRUST = 0.25
 REACH_PENALTY = 1.0e4
 #: the steepest flight-path angle [deg] a plan within reach may ask for (eq. 94)
 REACH_GAMMA_DEG = 60.0
+#: a plan is within reach when no node's u_FF leaves its range by more than this share of L/D
+#: and none descends more than this [rad] steeper than REACH_GAMMA_DEG
+REACH_TOLERANCE = 1.0e-3
 
 
 def _u_range(p: DragEnergyProblem, ld: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -375,14 +378,21 @@ def _u_range(p: DragEnergyProblem, ld: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return ld * (math.cos(p.sigma_max) + m), ld * (1.0 - m)
 
 
-def reach_excess(p: DragEnergyProblem, x: Extraction) -> float:
-    """The largest share of L/D by which the profile's u_FF (eq. 95) leaves ``_u_range`` (0 when
-    every node is within it; inf where the profile asks for a descent steeper than
-    REACH_GAMMA_DEG)."""
+def _reach_shortfall(p: DragEnergyProblem, x: Extraction) -> tuple[np.ndarray, np.ndarray]:
+    """(each node's share of L/D by which u_FF (eq. 95) leaves ``_u_range`` (<= 0 within it),
+    whether the node's descent is steeper than REACH_GAMMA_DEG by more than REACH_TOLERANCE rad)."""
     lo, hi = _u_range(p, x.lift_to_drag)
     with np.errstate(invalid="ignore"):
         past = np.maximum((x.u_ff - hi) / x.lift_to_drag, (lo - x.u_ff) / x.lift_to_drag)
-    steep = np.abs(x.gamma) > math.radians(REACH_GAMMA_DEG) + 1e-9
+    return past, np.abs(x.gamma) > math.radians(REACH_GAMMA_DEG) + REACH_TOLERANCE
+
+
+def reach_excess(p: DragEnergyProblem, x: Extraction) -> float:
+    """The largest share of L/D by which the profile's u_FF (eq. 95) leaves ``_u_range`` (0 when
+    every node is within it; inf where the profile asks for a descent steeper than
+    REACH_GAMMA_DEG). Within reach: at most REACH_TOLERANCE (``_out_of_reach`` names the nodes
+    past it)."""
+    past, steep = _reach_shortfall(p, x)
     return float(max(0.0, np.nanmax(np.where(steep, np.inf, past))))
 
 
@@ -427,14 +437,14 @@ def _from_inverse(I, I1, I2) -> tuple:
 
 
 def _within_reach(p: DragEnergyProblem, op: LGL, D_lo, D_hi, ref: DragEnergyReference) -> tuple:
-    """The profile re-solved until its u_FF is within ``_u_range`` at every node (1e-3 of L/D),
+    """The profile re-solved until its u_FF is within ``_u_range`` at every node (REACH_TOLERANCE),
     at most ``reach_iterations`` more SOCPs, each linearised about the last (``_reach_rows``).
     Returns (the last successful reference, with ``reach_excess`` set and the message saying
     whether the reach was met; (build, solve, iterations) spent)."""
     spent = [0.0, 0.0, 0]
     excess = reach_excess(p, ref.extraction)
     for _ in range(p.reach_iterations):
-        if excess <= 1e-3:
+        if excess <= REACH_TOLERANCE:
             break
         new = solve_socp(p, op, D_lo, D_hi, ref.kappa, reach=_reach_rows(p, op, ref.I, ref.extraction))
         spent = [spent[0] + new.build_time, spent[1] + new.solve_time, spent[2] + new.iterations]
@@ -444,18 +454,16 @@ def _within_reach(p: DragEnergyProblem, op: LGL, D_lo, D_hi, ref: DragEnergyRefe
         new.kappa = ref.kappa
         ref, excess = new, reach_excess(p, new.extraction)
     ref.reach_excess = excess
-    if excess > 1e-3:
+    if excess > REACH_TOLERANCE:
         ref.message += f"; {_out_of_reach(p, op, ref.extraction)}"
     return ref, spent
 
 
 def _out_of_reach(p: DragEnergyProblem, op: LGL, x: Extraction) -> str:
-    """Where a profile leaves the drag's reach: each such node's normalised energy, u_FF in L/D
-    and flight-path angle."""
-    lo, hi = _u_range(p, x.lift_to_drag)
-    with np.errstate(invalid="ignore"):
-        out = (x.u_ff < lo - 1e-3 * x.lift_to_drag) | (x.u_ff > hi + 1e-3 * x.lift_to_drag)
-    out |= np.abs(x.gamma) > math.radians(REACH_GAMMA_DEG) + 1e-3
+    """Where a profile leaves the drag's reach (``reach_excess`` above REACH_TOLERANCE): each such
+    node's normalised energy, u_FF in L/D and flight-path angle."""
+    past, steep = _reach_shortfall(p, x)
+    out = (past > REACH_TOLERANCE) | steep
     e = (p.E0 - op.x) / (p.E0 - p.Ef)
     nodes = ", ".join(f"e = {e[k]:.3f} (u_FF {x.u_ff[k] / x.lift_to_drag[k]:+.3g} L/D, gamma "
                       f"{math.degrees(x.gamma[k]):.1f} deg)" for k in np.flatnonzero(out))

@@ -56,11 +56,12 @@ class LglTerminal(ReplanningSpec):
     segments: int = 1
     solver: str = "snopt"
     # SNOPT's "Scale option" for every solve, pre-flight and re-solve (0: none, SNOPT's own
-    # default here; 1: the linear constraints and the variables; 2: all constraints and
-    # variables, from the Jacobian at the guess). 2: MaRV's two longest re-solves (60 and 54 nodes,
-    # one polynomial) took 112 and 94 evaluations instead of 404 and 394 (15.2 and 11.4 s to 6.2
-    # and 3.7 s) to the same optimum (objective within 7e-8) (docs/methods/lgl-terminal.md)
-    snopt_scale_option: int = 2
+    # behaviour; 1: the linear constraints and the variables; 2: all constraints and variables,
+    # from the Jacobian at the guess). 2 on MaRV's problem: its two longest re-solves took 112 and
+    # 94 evaluations instead of 404 and 394 to the same optimum, 39 core s per flight instead of
+    # 62. Not the default: with 2, HORUS-2B's derived pre-flight plan (81 nodes) ended SNOPT
+    # info 3 on 4 segments and on one polynomial, solved without it (docs/methods/lgl-terminal.md)
+    snopt_scale_option: int = 0
     tolerance: float = 1.0e-7
     max_iterations: int = 3000
     # refine the pre-flight mesh (more nodes in the same segments, from ``nodes`` up to 150) while
